@@ -1,0 +1,230 @@
+//! The crate's one error type.
+
+use std::path::PathBuf;
+
+use ash::vk;
+
+/// Result alias used throughout the crate.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Hair file formats the crate reads or writes, named in errors.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileFormat {
+    /// Cem Yuksel's binary `.hair`.
+    CyHair,
+    /// AMD TressFX binary `.tfx` (3.x/4.x layout).
+    TressFx,
+    /// Wavefront OBJ mesh.
+    Obj,
+}
+
+impl std::fmt::Display for FileFormat {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            FileFormat::CyHair => ".hair",
+            FileFormat::TressFx => ".tfx",
+            FileFormat::Obj => ".obj",
+        })
+    }
+}
+
+/// Everything that can go wrong in `vkhair`, each case naming the problem.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    // ---- Vulkan and devices -------------------------------------------
+    /// The Vulkan loader library could not be loaded.
+    #[error("the Vulkan loader could not be loaded: {0}")]
+    Loader(String),
+    /// A Vulkan call returned an error code.
+    #[error("{call} failed: {result}")]
+    Vulkan {
+        /// The Vulkan entry point that failed.
+        call: &'static str,
+        /// The code it returned.
+        result: vk::Result,
+    },
+    /// An instance layer that was asked for is not installed.
+    #[error("Vulkan layer {0} is not installed (Debian: vulkan-validationlayers)")]
+    LayerMissing(String),
+    /// No physical device offers what vkhair needs.
+    #[error("no suitable Vulkan device: {0}")]
+    NoSuitableDevice(String),
+    /// The device named by `VKHAIR_DEVICE` (or the options) does not exist or lacks features.
+    #[error("device {name:?} was asked for but {reason}")]
+    DeviceNotUsable {
+        /// The requested name (substring match).
+        name: String,
+        /// Why it cannot be used.
+        reason: String,
+    },
+    /// A host-provided device lacks a feature, extension or version vkhair requires.
+    #[error("the device does not meet vkhair's requirements: missing {0}")]
+    MissingRequirement(String),
+    /// GPU memory allocation failed.
+    #[error("GPU memory allocation for {name:?} failed: {source}")]
+    Allocation {
+        /// Debug name of the resource.
+        name: String,
+        /// The allocator's error.
+        source: gpu_allocator::AllocationError,
+    },
+    /// A SPIR-V module could not be reflected, or its interface does not match the Rust side.
+    #[error("shader {shader}: {reason}")]
+    Shader {
+        /// Shader path under `glsl/`.
+        shader: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// An argument is outside its documented range.
+    #[error("invalid parameter {name}: {reason}")]
+    InvalidParameter {
+        /// The parameter.
+        name: &'static str,
+        /// Why it was rejected.
+        reason: String,
+    },
+    /// A buffer access would run past the end of the buffer.
+    #[error("{what} of {len} bytes at offset {offset} exceeds buffer {name:?} of {size} bytes")]
+    OutOfBounds {
+        /// `upload` or `readback`.
+        what: &'static str,
+        /// Buffer debug name.
+        name: String,
+        /// Byte offset asked for.
+        offset: u64,
+        /// Byte count asked for.
+        len: u64,
+        /// Buffer size.
+        size: u64,
+    },
+
+    // ---- Files ------------------------------------------------------------
+    /// Reading or writing a file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The file does not start with the format's signature.
+    #[error("not a {format} file: {reason}")]
+    BadMagic {
+        /// Expected format.
+        format: FileFormat,
+        /// What was found.
+        reason: String,
+    },
+    /// The file ends before the data its header announces.
+    #[error("truncated {format} file: {what} needs {needed} bytes but only {available} remain")]
+    Truncated {
+        /// Format being read.
+        format: FileFormat,
+        /// Which part was being read.
+        what: &'static str,
+        /// Bytes required.
+        needed: u64,
+        /// Bytes present.
+        available: u64,
+    },
+    /// Header fields contradict each other or the file.
+    #[error("malformed {format} file: {reason}")]
+    Malformed {
+        /// Format being read.
+        format: FileFormat,
+        /// What is inconsistent.
+        reason: String,
+    },
+    /// A file uses a format version or feature that is not supported.
+    #[error("unsupported {format} file: {reason}")]
+    Unsupported {
+        /// Format being read.
+        format: FileFormat,
+        /// What is unsupported.
+        reason: String,
+    },
+
+    // ---- Groom validation --------------------------------------------------
+    /// A groom has no strands.
+    #[error("the groom has no strands")]
+    EmptyGroom,
+    /// More strands than [`crate::groom::MAX_STRANDS`].
+    #[error("{count} strands exceed the limit of {max}")]
+    TooManyStrands {
+        /// Strands asked for.
+        count: u64,
+        /// The limit.
+        max: u64,
+    },
+    /// More points in total than [`crate::groom::MAX_POINTS`].
+    #[error("{count} points exceed the limit of {max}")]
+    TooManyPoints {
+        /// Points asked for.
+        count: u64,
+        /// The limit.
+        max: u64,
+    },
+    /// A strand has fewer than 2 or more than [`crate::groom::MAX_POINTS_PER_STRAND`] points.
+    #[error("strand {strand} has {points} points; a strand needs 2..={max}")]
+    StrandPointCount {
+        /// Strand index.
+        strand: usize,
+        /// Its point count.
+        points: u64,
+        /// The upper limit.
+        max: u64,
+    },
+    /// A position, thickness, transparency or color is NaN or infinite.
+    #[error("strand {strand} point {point}: {what} is not finite")]
+    NonFinite {
+        /// Strand index.
+        strand: usize,
+        /// Point index within the strand.
+        point: usize,
+        /// Which attribute.
+        what: &'static str,
+    },
+    /// Two consecutive points of a strand coincide.
+    #[error("strand {strand} segment {segment} has zero length")]
+    ZeroLengthSegment {
+        /// Strand index.
+        strand: usize,
+        /// Segment index within the strand.
+        segment: usize,
+    },
+    /// A per-point or per-strand attribute array has the wrong length.
+    #[error("{what} has {actual} entries but the groom needs {expected}")]
+    AttributeLength {
+        /// Which attribute array.
+        what: &'static str,
+        /// Entries needed.
+        expected: usize,
+        /// Entries given.
+        actual: usize,
+    },
+    /// A strand index is out of range.
+    #[error("strand index {index} is out of range for {count} strands")]
+    StrandIndex {
+        /// The index.
+        index: usize,
+        /// Strand count.
+        count: usize,
+    },
+    /// A mesh cannot serve as a scalp (no triangles, or none selected).
+    #[error("mesh cannot be used as a scalp: {0}")]
+    BadScalp(String),
+}
+
+impl Error {
+    /// Builds a [`Error::Vulkan`] for `call`; used with `map_err`.
+    pub(crate) fn vk(call: &'static str) -> impl FnOnce(vk::Result) -> Error {
+        move |result| Error::Vulkan { call, result }
+    }
+
+    /// Builds an [`Error::InvalidParameter`].
+    pub(crate) fn param(name: &'static str, reason: impl Into<String>) -> Error {
+        Error::InvalidParameter { name, reason: reason.into() }
+    }
+}

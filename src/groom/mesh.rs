@@ -1,0 +1,83 @@
+//! Triangle meshes (Wavefront OBJ through `tobj`) used as scalps and heads.
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use crate::error::{Error, FileFormat, Result};
+
+/// Most triangles a mesh may have (16,777,216).
+pub const MAX_TRIANGLES: usize = 1 << 24;
+
+/// An indexed triangle mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriMesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Counter-clockwise triangles (outward normals by the right-hand rule).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriMesh {
+    /// A mesh from positions and triangles, validated (finite positions, indices in
+    /// range, at least one triangle).
+    pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self> {
+        let malformed = |reason: String| Error::Malformed { format: FileFormat::Obj, reason };
+        if triangles.is_empty() {
+            return Err(malformed("the mesh has no triangles".into()));
+        }
+        if triangles.len() > MAX_TRIANGLES {
+            return Err(malformed(format!("{} triangles exceed the limit of {MAX_TRIANGLES}", triangles.len())));
+        }
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(malformed(format!("vertex {i} is not finite")));
+        }
+        if let Some(t) = triangles.iter().position(|t| t.iter().any(|&i| i as usize >= positions.len())) {
+            return Err(malformed(format!("triangle {t} indexes past the {} vertices", positions.len())));
+        }
+        Ok(TriMesh { positions, triangles })
+    }
+
+    /// Loads every object of an OBJ file into one mesh (faces are triangulated).
+    pub fn load_obj(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
+        Self::parse_obj(&data)
+    }
+
+    /// Parses OBJ text (materials are ignored).
+    pub fn parse_obj(data: &[u8]) -> Result<Self> {
+        let options =
+            tobj::LoadOptions { single_index: false, triangulate: true, ignore_points: true, ignore_lines: true };
+        let mut reader = std::io::BufReader::new(data);
+        let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::GenericFailure))
+            .map_err(|e| Error::Malformed { format: FileFormat::Obj, reason: e.to_string() })?;
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for model in models {
+            let m = model.mesh;
+            let base = positions.len() as u32;
+            positions.extend(m.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+            triangles.extend(m.indices.chunks_exact(3).map(|c| [base + c[0], base + c[1], base + c[2]]));
+        }
+        Self::new(positions, triangles)
+    }
+
+    /// Axis-aligned bounding box (min, max).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.positions
+            .iter()
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+    }
+
+    /// Corners of triangle `i`.
+    pub fn corners(&self, i: usize) -> [Vec3; 3] {
+        self.triangles[i].map(|v| self.positions[v as usize])
+    }
+
+    /// Area-weighted (unnormalised) normal of triangle `i`: its length is twice the area.
+    pub fn scaled_normal(&self, i: usize) -> Vec3 {
+        let [a, b, c] = self.corners(i);
+        (b - a).cross(c - a)
+    }
+}

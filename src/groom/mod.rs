@@ -1,0 +1,335 @@
+//! Key-hair data: strands as structure-of-arrays, validated on construction.
+//!
+//! A [`Groom`] stores every point of every strand in one array (root to tip,
+//! strand after strand) with a per-strand offset table, plus optional per-point
+//! thickness, transparency and color. Construction checks every invariant the
+//! GPU stages rely on and reports each violation as its own [`Error`] variant:
+//!
+//! | check | error |
+//! | --- | --- |
+//! | at least one strand | [`Error::EmptyGroom`] |
+//! | at most [`MAX_STRANDS`] strands, [`MAX_POINTS`] points | [`Error::TooManyStrands`], [`Error::TooManyPoints`] |
+//! | 2..=[`MAX_POINTS_PER_STRAND`] points per strand | [`Error::StrandPointCount`] |
+//! | finite positions and attributes | [`Error::NonFinite`] |
+//! | no segment shorter than [`MIN_SEGMENT_FRACTION`] × the bounding-box diagonal | [`Error::ZeroLengthSegment`] |
+//! | attribute arrays of the right length | [`Error::AttributeLength`] |
+//!
+//! Sources: [`cyhair`] (`.hair` read/write), [`tfx`] (TressFX `.tfx` read),
+//! [`grow`] (procedural growth on a sphere, ellipsoid or OBJ mesh) and
+//! [`scenes`] (the reference scenes of the design). [`Groom::resampled`] gives
+//! every strand the same point count (the GPU simulation wants it) and
+//! [`Groom::select`] picks key hairs.
+
+mod bytes;
+pub mod cyhair;
+pub mod grow;
+pub mod mesh;
+pub mod scenes;
+pub mod tfx;
+
+mod resample;
+
+use glam::Vec3;
+
+use crate::error::{Error, Result};
+
+/// Most strands a groom may have (4,194,304).
+pub const MAX_STRANDS: usize = 1 << 22;
+/// Most points a groom may have in total (16,777,216).
+pub const MAX_POINTS: usize = 1 << 24;
+/// Most points one strand may have (65,536: a `.hair` file stores segment counts as u16).
+pub const MAX_POINTS_PER_STRAND: usize = 1 << 16;
+/// A segment shorter than this fraction of the groom's bounding-box diagonal counts
+/// as zero-length (scale-free, so it works for meters and for Blender units alike).
+pub const MIN_SEGMENT_FRACTION: f32 = 1e-6;
+
+/// A set of hair strands (see the module docs for the invariants).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Groom {
+    positions: Vec<Vec3>,
+    offsets: Vec<u32>,
+    thickness: Option<Vec<f32>>,
+    transparency: Option<Vec<f32>>,
+    colors: Option<Vec<Vec3>>,
+}
+
+/// Optional per-point attributes of a groom.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Attributes {
+    /// Per-point thickness (diameter, in the groom's length unit).
+    pub thickness: Option<Vec<f32>>,
+    /// Per-point transparency in 0..=1.
+    pub transparency: Option<Vec<f32>>,
+    /// Per-point linear RGB color.
+    pub colors: Option<Vec<Vec3>>,
+}
+
+/// Summary numbers of a groom, as `vkhair inspect` prints them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GroomStats {
+    /// Number of strands.
+    pub strands: usize,
+    /// Number of points.
+    pub points: usize,
+    /// Smallest, mean and largest points per strand.
+    pub points_per_strand: (usize, f64, usize),
+    /// Smallest, mean and largest strand length.
+    pub strand_length: (f32, f64, f32),
+    /// Smallest and largest segment length.
+    pub segment_length: (f32, f32),
+    /// Bounding box minimum and maximum.
+    pub bounds: (Vec3, Vec3),
+    /// Whether thickness, transparency and colors are present.
+    pub has_thickness: bool,
+    /// See `has_thickness`.
+    pub has_transparency: bool,
+    /// See `has_thickness`.
+    pub has_colors: bool,
+}
+
+impl Groom {
+    /// A groom from concatenated positions and per-strand point counts.
+    pub fn new(positions: Vec<Vec3>, points_per_strand: &[u32]) -> Result<Self> {
+        Self::with_attributes(positions, points_per_strand, Attributes::default())
+    }
+
+    /// A groom with optional per-point attributes.
+    pub fn with_attributes(positions: Vec<Vec3>, points_per_strand: &[u32], attributes: Attributes) -> Result<Self> {
+        if points_per_strand.is_empty() {
+            return Err(Error::EmptyGroom);
+        }
+        if points_per_strand.len() > MAX_STRANDS {
+            return Err(Error::TooManyStrands { count: points_per_strand.len() as u64, max: MAX_STRANDS as u64 });
+        }
+        let mut offsets = Vec::with_capacity(points_per_strand.len() + 1);
+        offsets.push(0u32);
+        let mut total: u64 = 0;
+        for (strand, &n) in points_per_strand.iter().enumerate() {
+            if !(2..=MAX_POINTS_PER_STRAND as u64).contains(&u64::from(n)) {
+                return Err(Error::StrandPointCount { strand, points: n.into(), max: MAX_POINTS_PER_STRAND as u64 });
+            }
+            total += u64::from(n);
+            if total > MAX_POINTS as u64 {
+                return Err(Error::TooManyPoints { count: total, max: MAX_POINTS as u64 });
+            }
+            offsets.push(total as u32);
+        }
+        let groom = Groom {
+            positions,
+            offsets,
+            thickness: attributes.thickness,
+            transparency: attributes.transparency,
+            colors: attributes.colors,
+        };
+        groom.validate()?;
+        Ok(groom)
+    }
+
+    /// A groom from one vector of points per strand.
+    pub fn from_strands(strands: &[Vec<Vec3>]) -> Result<Self> {
+        let counts: Vec<u32> = strands.iter().map(|s| s.len().min(u32::MAX as usize) as u32).collect();
+        let total: usize = strands.iter().map(Vec::len).sum();
+        if total > MAX_POINTS {
+            return Err(Error::TooManyPoints { count: total as u64, max: MAX_POINTS as u64 });
+        }
+        Self::new(strands.concat(), &counts)
+    }
+
+    fn validate(&self) -> Result<()> {
+        let points = *self.offsets.last().unwrap_or(&0) as usize;
+        if self.positions.len() != points {
+            return Err(Error::AttributeLength { what: "positions", expected: points, actual: self.positions.len() });
+        }
+        let check_len = |what, len: Option<usize>| match len {
+            Some(actual) if actual != points => Err(Error::AttributeLength { what, expected: points, actual }),
+            _ => Ok(()),
+        };
+        check_len("thickness", self.thickness.as_ref().map(Vec::len))?;
+        check_len("transparency", self.transparency.as_ref().map(Vec::len))?;
+        check_len("colors", self.colors.as_ref().map(Vec::len))?;
+        for strand in 0..self.strand_count() {
+            let range = self.strand_range(strand);
+            let start = range.start;
+            for i in range {
+                let nonfinite = |what| Error::NonFinite { strand, point: i - start, what };
+                if !self.positions[i].is_finite() {
+                    return Err(nonfinite("position"));
+                }
+                if self.thickness.as_ref().is_some_and(|t| !t[i].is_finite()) {
+                    return Err(nonfinite("thickness"));
+                }
+                if self.transparency.as_ref().is_some_and(|t| !t[i].is_finite()) {
+                    return Err(nonfinite("transparency"));
+                }
+                if self.colors.as_ref().is_some_and(|c| !c[i].is_finite()) {
+                    return Err(nonfinite("color"));
+                }
+            }
+        }
+        let (lo, hi) = self.bounds();
+        let min_segment = (hi - lo).length() * MIN_SEGMENT_FRACTION;
+        for strand in 0..self.strand_count() {
+            let points = self.strand(strand);
+            for (segment, pair) in points.windows(2).enumerate() {
+                let length = (pair[1] - pair[0]).length();
+                if length <= min_segment || length == 0.0 {
+                    return Err(Error::ZeroLengthSegment { strand, segment });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of strands.
+    pub fn strand_count(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Number of points of all strands.
+    pub fn point_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Index range of strand `i` in the per-point arrays. Panics if `i` is out of range.
+    pub fn strand_range(&self, i: usize) -> std::ops::Range<usize> {
+        self.offsets[i] as usize..self.offsets[i + 1] as usize
+    }
+
+    /// Points of strand `i`, root first. Panics if `i` is out of range.
+    pub fn strand(&self, i: usize) -> &[Vec3] {
+        &self.positions[self.strand_range(i)]
+    }
+
+    /// Number of points of strand `i`. Panics if `i` is out of range.
+    pub fn strand_len(&self, i: usize) -> usize {
+        self.strand_range(i).len()
+    }
+
+    /// Points per strand when every strand has the same count.
+    pub fn uniform_points_per_strand(&self) -> Option<usize> {
+        let n = self.strand_len(0);
+        (0..self.strand_count()).all(|i| self.strand_len(i) == n).then_some(n)
+    }
+
+    /// All positions, strand after strand.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// Start offsets of every strand plus the total point count at the end.
+    pub fn offsets(&self) -> &[u32] {
+        &self.offsets
+    }
+
+    /// Per-point thickness, when present.
+    pub fn thickness(&self) -> Option<&[f32]> {
+        self.thickness.as_deref()
+    }
+
+    /// Per-point transparency, when present.
+    pub fn transparency(&self) -> Option<&[f32]> {
+        self.transparency.as_deref()
+    }
+
+    /// Per-point colors, when present.
+    pub fn colors(&self) -> Option<&[Vec3]> {
+        self.colors.as_deref()
+    }
+
+    /// The optional attributes (cloned).
+    pub fn attributes(&self) -> Attributes {
+        Attributes {
+            thickness: self.thickness.clone(),
+            transparency: self.transparency.clone(),
+            colors: self.colors.clone(),
+        }
+    }
+
+    /// Axis-aligned bounding box (min, max).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.positions
+            .iter()
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+    }
+
+    /// Length of strand `i` along its segments.
+    pub fn strand_length(&self, i: usize) -> f32 {
+        self.strand(i).windows(2).map(|w| (w[1] - w[0]).length()).sum()
+    }
+
+    /// Counts, lengths and bounds.
+    pub fn stats(&self) -> GroomStats {
+        let n = self.strand_count();
+        let counts = (0..n).map(|i| self.strand_len(i));
+        let lengths: Vec<f32> = (0..n).map(|i| self.strand_length(i)).collect();
+        let segments = (0..n).flat_map(|i| self.strand(i).windows(2).map(|w| (w[1] - w[0]).length()));
+        let (seg_min, seg_max) = segments.fold((f32::INFINITY, 0.0f32), |(a, b), l| (a.min(l), b.max(l)));
+        GroomStats {
+            strands: n,
+            points: self.point_count(),
+            points_per_strand: (
+                counts.clone().min().unwrap_or(0),
+                self.point_count() as f64 / n as f64,
+                counts.max().unwrap_or(0),
+            ),
+            strand_length: (
+                lengths.iter().copied().fold(f32::INFINITY, f32::min),
+                lengths.iter().map(|&l| f64::from(l)).sum::<f64>() / n as f64,
+                lengths.iter().copied().fold(0.0, f32::max),
+            ),
+            segment_length: (seg_min, seg_max),
+            bounds: self.bounds(),
+            has_thickness: self.thickness.is_some(),
+            has_transparency: self.transparency.is_some(),
+            has_colors: self.colors.is_some(),
+        }
+    }
+
+    /// A groom of the strands at `indices` (in that order), with their attributes.
+    pub fn select(&self, indices: &[usize]) -> Result<Groom> {
+        let mut positions = Vec::new();
+        let mut counts = Vec::with_capacity(indices.len());
+        let mut attributes = Attributes {
+            thickness: self.thickness.as_ref().map(|_| Vec::new()),
+            transparency: self.transparency.as_ref().map(|_| Vec::new()),
+            colors: self.colors.as_ref().map(|_| Vec::new()),
+        };
+        for &index in indices {
+            if index >= self.strand_count() {
+                return Err(Error::StrandIndex { index, count: self.strand_count() });
+            }
+            let range = self.strand_range(index);
+            counts.push(range.len() as u32);
+            positions.extend_from_slice(&self.positions[range.clone()]);
+            if let (Some(dst), Some(src)) = (&mut attributes.thickness, &self.thickness) {
+                dst.extend_from_slice(&src[range.clone()]);
+            }
+            if let (Some(dst), Some(src)) = (&mut attributes.transparency, &self.transparency) {
+                dst.extend_from_slice(&src[range.clone()]);
+            }
+            if let (Some(dst), Some(src)) = (&mut attributes.colors, &self.colors) {
+                dst.extend_from_slice(&src[range]);
+            }
+        }
+        Groom::with_attributes(positions, &counts, attributes)
+    }
+
+    /// Every `stride`-th strand starting at strand 0 (key hairs from a dense groom).
+    pub fn every_nth(&self, stride: usize) -> Result<Groom> {
+        if stride == 0 {
+            return Err(Error::param("stride", "must be at least 1"));
+        }
+        let indices: Vec<usize> = (0..self.strand_count()).step_by(stride).collect();
+        self.select(&indices)
+    }
+
+    /// `count` strands spread evenly over the groom's strand order.
+    pub fn select_evenly(&self, count: usize) -> Result<Groom> {
+        let n = self.strand_count();
+        if count == 0 || count > n {
+            return Err(Error::param("key hair count", format!("{count} is outside 1..={n}")));
+        }
+        let indices: Vec<usize> = (0..count).map(|i| i * n / count).collect();
+        self.select(&indices)
+    }
+}

@@ -1,0 +1,101 @@
+//! AMD TressFX binary `.tfx` files (the layout of TressFX 3.x and 4.x).
+//!
+//! A 160-byte header — f32 version, u32 strand count, u32 vertices per
+//! strand, then u32 byte offsets of the vertex positions (float4 per vertex,
+//! w = inverse mass), strand UVs (float2 per strand), vertex UVs (float2 per
+//! vertex), strand thickness (f32 per strand) and vertex colors (float4 per
+//! vertex), an offset of 0 meaning absent, then 32 reserved u32 — followed by
+//! the arrays at their offsets. Every strand has the same vertex count.
+
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+
+use super::bytes::Reader;
+use super::{Attributes, Groom, MAX_POINTS, MAX_POINTS_PER_STRAND, MAX_STRANDS};
+use crate::error::{Error, FileFormat, Result};
+
+const HEADER_SIZE: u64 = 160;
+
+/// A `.tfx` file: the groom plus what TressFX stores beside the strands.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TfxFile {
+    /// Header version (3.x or 4.x).
+    pub version: f32,
+    /// Positions as the groom; strand thickness (when present) as per-point
+    /// thickness, vertex colors (when present) as per-point RGB.
+    pub groom: Groom,
+    /// Per-vertex inverse mass from the positions' w (0 marks pinned vertices).
+    pub inverse_mass: Vec<f32>,
+    /// Per-strand UVs, when present.
+    pub strand_uvs: Option<Vec<Vec2>>,
+}
+
+impl TfxFile {
+    /// Reads a `.tfx` file from disk.
+    pub fn open(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
+        Self::parse(&data)
+    }
+
+    /// Parses `.tfx` bytes.
+    pub fn parse(data: &[u8]) -> Result<Self> {
+        let r = Reader { data, format: FileFormat::TressFx };
+        r.bytes(0, HEADER_SIZE, "header")?;
+        let version = r.f32(0, "version")?;
+        if !(version.is_finite() && (3.0..5.0).contains(&version)) {
+            return Err(Error::BadMagic {
+                format: FileFormat::TressFx,
+                reason: format!("version {version} is not 3.x or 4.x"),
+            });
+        }
+        let strands = u64::from(r.u32(4, "strand count")?);
+        let per_strand = u64::from(r.u32(8, "vertices per strand")?);
+        let offsets: Vec<u64> =
+            (0..5).map(|i| r.u32(12 + 4 * i, "array offset").map(u64::from)).collect::<Result<_>>()?;
+        let [positions_at, strand_uv_at, _vertex_uv_at, thickness_at, colors_at] =
+            [offsets[0], offsets[1], offsets[2], offsets[3], offsets[4]];
+        if strands == 0 {
+            return Err(Error::EmptyGroom);
+        }
+        if strands > MAX_STRANDS as u64 {
+            return Err(Error::TooManyStrands { count: strands, max: MAX_STRANDS as u64 });
+        }
+        if !(2..=MAX_POINTS_PER_STRAND as u64).contains(&per_strand) {
+            return Err(Error::StrandPointCount { strand: 0, points: per_strand, max: MAX_POINTS_PER_STRAND as u64 });
+        }
+        let points = strands * per_strand;
+        if points > MAX_POINTS as u64 {
+            return Err(Error::TooManyPoints { count: points, max: MAX_POINTS as u64 });
+        }
+        if positions_at == 0 {
+            return Err(Error::Malformed {
+                format: FileFormat::TressFx,
+                reason: "the file has no vertex positions".into(),
+            });
+        }
+        let raw = r.f32s(positions_at, 4 * points, "vertex positions")?;
+        let positions: Vec<Vec3> = raw.chunks_exact(4).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
+        let inverse_mass: Vec<f32> = raw.chunks_exact(4).map(|c| c[3]).collect();
+        if let Some(i) = inverse_mass.iter().position(|w| !w.is_finite() || *w < 0.0) {
+            let (strand, point) = ((i as u64 / per_strand) as usize, (i as u64 % per_strand) as usize);
+            return Err(Error::NonFinite { strand, point, what: "inverse mass" });
+        }
+        let strand_uvs = (strand_uv_at != 0)
+            .then(|| r.f32s(strand_uv_at, 2 * strands, "strand UVs"))
+            .transpose()?
+            .map(|v| v.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect());
+        let thickness = (thickness_at != 0)
+            .then(|| r.f32s(thickness_at, strands, "strand thickness"))
+            .transpose()?
+            .map(|t| t.iter().flat_map(|&v| std::iter::repeat_n(v, per_strand as usize)).collect());
+        let colors = (colors_at != 0)
+            .then(|| r.f32s(colors_at, 4 * points, "vertex colors"))
+            .transpose()?
+            .map(|v| v.chunks_exact(4).map(|c| Vec3::new(c[0], c[1], c[2])).collect());
+        let counts = vec![per_strand as u32; strands as usize];
+        let groom = Groom::with_attributes(positions, &counts, Attributes { thickness, transparency: None, colors })?;
+        Ok(TfxFile { version, groom, inverse_mass, strand_uvs })
+    }
+}

@@ -1,0 +1,289 @@
+//! GPU timings of named passes from timestamp queries.
+//!
+//! The profiler keeps one slot of queries per frame in flight. Recording frame
+//! N into slot `N % frames_in_flight` first reads back what that slot measured
+//! for frame `N - frames_in_flight` — which the host has already waited for
+//! before reusing the slot's resources — so reading never stalls. Results are
+//! read without `WAIT` and with availability bits: a slot whose queries are not
+//! available yet yields no report rather than blocking.
+//!
+//! Every scope also opens a debug-utils label, so RenderDoc/Nsight show the same
+//! pass names whether profiling is enabled or not.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use crate::context::GpuContext;
+use crate::error::{Error, Result};
+use crate::vk::debug::LabelColor;
+use crate::vk::device::Device;
+
+/// GPU time of one named pass.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PassTiming {
+    /// Pass name (the same string as its debug label).
+    pub name: String,
+    /// Nesting depth (0 for top-level passes).
+    pub depth: u32,
+    /// GPU time in nanoseconds.
+    pub nanoseconds: f64,
+}
+
+/// Per-pass GPU timings of one frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProfileReport {
+    /// The host's frame index these timings belong to.
+    pub frame: u64,
+    /// Passes in the order they were recorded.
+    pub passes: Vec<PassTiming>,
+}
+
+impl ProfileReport {
+    /// Sum of the top-level passes, nanoseconds.
+    pub fn total_nanoseconds(&self) -> f64 {
+        self.passes.iter().filter(|p| p.depth == 0).map(|p| p.nanoseconds).sum()
+    }
+
+    /// The time of the first pass with this name, nanoseconds.
+    pub fn pass(&self, name: &str) -> Option<f64> {
+        self.passes.iter().find(|p| p.name == name).map(|p| p.nanoseconds)
+    }
+}
+
+impl std::fmt::Display for ProfileReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let width = self.passes.iter().map(|p| p.name.len() + 2 * p.depth as usize).max().unwrap_or(4).max(4);
+        writeln!(f, "{:<width$}  {:>10}", "pass", "GPU ms")?;
+        for p in &self.passes {
+            let name = format!("{}{}", "  ".repeat(p.depth as usize), p.name);
+            writeln!(f, "{name:<width$}  {:>10.3}", p.nanoseconds / 1e6)?;
+        }
+        write!(f, "{:<width$}  {:>10.3}", "total", self.total_nanoseconds() / 1e6)
+    }
+}
+
+/// Handle of an open scope, returned by [`GpuProfiler::begin_scope`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[must_use = "a scope must be closed with end_scope"]
+pub struct ScopeId(Option<u32>);
+
+struct Scope {
+    name: String,
+    depth: u32,
+    begin: u32,
+    end: Option<u32>,
+}
+
+#[derive(Default)]
+struct Slot {
+    frame: Option<u64>,
+    scopes: Vec<Scope>,
+    queries: u32,
+    open: u32,
+}
+
+/// Timestamp-query profiler for passes recorded into the host's command buffers.
+pub struct GpuProfiler {
+    device: Arc<Device>,
+    pool: vk::QueryPool,
+    slots: Vec<Slot>,
+    queries_per_slot: u32,
+    current: Option<usize>,
+    enabled: bool,
+    period_ns: f64,
+    valid_mask: u64,
+    latest: Option<ProfileReport>,
+}
+
+impl GpuProfiler {
+    /// A profiler for `frames_in_flight` frames (1..=16) of at most
+    /// `max_scopes` scopes (1..=1024) each.
+    pub fn new(ctx: &GpuContext, frames_in_flight: u32, max_scopes: u32) -> Result<Self> {
+        if !(1..=16).contains(&frames_in_flight) {
+            return Err(Error::param("frames_in_flight", format!("{frames_in_flight} is outside 1..=16")));
+        }
+        if !(1..=1024).contains(&max_scopes) {
+            return Err(Error::param("max_scopes", format!("{max_scopes} is outside 1..=1024")));
+        }
+        let device = ctx.device.clone();
+        if device.info.timestamp_valid_bits == 0 {
+            return Err(Error::MissingRequirement("timestamps on the graphics queue family".into()));
+        }
+        let queries_per_slot = 2 * max_scopes;
+        let info = vk::QueryPoolCreateInfo::default()
+            .query_type(vk::QueryType::TIMESTAMP)
+            .query_count(queries_per_slot * frames_in_flight);
+        // SAFETY: valid create info; destroyed in Drop.
+        let pool = unsafe { device.raw.create_query_pool(&info, None) }.map_err(Error::vk("vkCreateQueryPool"))?;
+        device.set_name(pool, "vkhair timestamps");
+        let bits = device.info.timestamp_valid_bits;
+        Ok(GpuProfiler {
+            pool,
+            slots: (0..frames_in_flight).map(|_| Slot::default()).collect(),
+            queries_per_slot,
+            current: None,
+            enabled: true,
+            period_ns: f64::from(device.info.timestamp_period),
+            valid_mask: if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 },
+            latest: None,
+            device,
+        })
+    }
+
+    /// Turns timestamp writing on or off from the next frame on (labels stay).
+    pub fn set_enabled(&mut self, enabled: bool) {
+        self.enabled = enabled;
+    }
+
+    /// Whether timestamps are written.
+    pub fn is_enabled(&self) -> bool {
+        self.enabled
+    }
+
+    /// The most recent report read back.
+    pub fn latest(&self) -> Option<&ProfileReport> {
+        self.latest.as_ref()
+    }
+
+    /// Starts recording frame `frame` into `cmd`: returns the report of the frame
+    /// that last used this slot (frame − frames_in_flight) when its results are
+    /// available, then resets the slot's queries in `cmd`.
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of the context's device, outside a render
+    /// pass, submitted to the graphics queue family; the command buffer that recorded
+    /// frame `frame − frames_in_flight` has completed (the usual frames-in-flight wait).
+    pub unsafe fn begin_frame(&mut self, cmd: vk::CommandBuffer, frame: u64) -> Option<ProfileReport> {
+        let index = (frame % self.slots.len() as u64) as usize;
+        let report = self.read_slot(index);
+        if report.is_some() {
+            self.latest.clone_from(&report);
+        }
+        let first = index as u32 * self.queries_per_slot;
+        // SAFETY: guaranteed by the caller; the range lies within the pool.
+        unsafe { self.device.raw.cmd_reset_query_pool(cmd, self.pool, first, self.queries_per_slot) };
+        self.slots[index] = Slot { frame: Some(frame), ..Slot::default() };
+        self.current = Some(index);
+        report
+    }
+
+    /// Opens a named pass: a debug label and, when enabled, a begin timestamp.
+    /// Scopes beyond `max_scopes` in a frame get a label only.
+    ///
+    /// # Safety
+    /// As for [`GpuProfiler::begin_frame`], after it was called for this frame.
+    pub unsafe fn begin_scope(&mut self, cmd: vk::CommandBuffer, name: &str) -> ScopeId {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.device.cmd_begin_label(cmd, name, LabelColor::Compute) };
+        let Some(index) = self.current.filter(|_| self.enabled) else { return ScopeId(None) };
+        let first = index as u32 * self.queries_per_slot;
+        let slot = &mut self.slots[index];
+        if slot.queries + 2 > self.queries_per_slot {
+            slot.open += 1;
+            return ScopeId(None);
+        }
+        let query = slot.queries;
+        slot.queries += 2;
+        slot.scopes.push(Scope { name: name.to_owned(), depth: slot.open, begin: query, end: None });
+        slot.open += 1;
+        // SAFETY: guaranteed by the caller; the query was reset in begin_frame.
+        unsafe {
+            self.device.raw.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, self.pool, first + query)
+        };
+        ScopeId(Some(slot.scopes.len() as u32 - 1))
+    }
+
+    /// Closes the pass opened by `scope`.
+    ///
+    /// # Safety
+    /// As for [`GpuProfiler::begin_scope`], in the same command buffer.
+    pub unsafe fn end_scope(&mut self, cmd: vk::CommandBuffer, scope: ScopeId) {
+        if let Some(index) = self.current {
+            let first = index as u32 * self.queries_per_slot;
+            let slot = &mut self.slots[index];
+            slot.open = slot.open.saturating_sub(1);
+            if let Some(s) = scope.0.and_then(|i| slot.scopes.get_mut(i as usize)) {
+                let query = s.begin + 1;
+                s.end = Some(query);
+                // SAFETY: guaranteed by the caller; the query was reset in begin_frame.
+                unsafe {
+                    self.device.raw.cmd_write_timestamp2(
+                        cmd,
+                        vk::PipelineStageFlags2::ALL_COMMANDS,
+                        self.pool,
+                        first + query,
+                    )
+                };
+            }
+        }
+        // SAFETY: guaranteed by the caller (matching begin_scope).
+        unsafe { self.device.cmd_end_label(cmd) };
+    }
+
+    /// Reads back every slot whose frame is complete, newest last; for a host that
+    /// has waited for all its frames (end of a run).
+    pub fn drain(&mut self) -> Vec<ProfileReport> {
+        let mut order: Vec<usize> = (0..self.slots.len()).filter(|&i| self.slots[i].frame.is_some()).collect();
+        order.sort_by_key(|&i| self.slots[i].frame);
+        let reports: Vec<_> = order.into_iter().filter_map(|i| self.read_slot(i)).collect();
+        for i in 0..self.slots.len() {
+            self.slots[i] = Slot::default();
+        }
+        self.current = None;
+        if let Some(last) = reports.last() {
+            self.latest = Some(last.clone());
+        }
+        reports
+    }
+
+    fn read_slot(&self, index: usize) -> Option<ProfileReport> {
+        let slot = &self.slots[index];
+        let frame = slot.frame?;
+        if slot.queries == 0 {
+            return None;
+        }
+        let first = index as u32 * self.queries_per_slot;
+        // Pairs of (value, availability).
+        let mut data = vec![[0u64; 2]; slot.queries as usize];
+        // SAFETY: the range lies within the pool; no WAIT flag, so this never blocks.
+        let result = unsafe {
+            self.device.raw.get_query_pool_results(
+                self.pool,
+                first,
+                &mut data,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WITH_AVAILABILITY,
+            )
+        };
+        match result {
+            Ok(()) | Err(vk::Result::NOT_READY) => {}
+            Err(e) => {
+                log::warn!("reading timestamps failed: {e}");
+                return None;
+            }
+        }
+        let mut passes = Vec::new();
+        for s in &slot.scopes {
+            let end = s.end?;
+            let (b, e) = (data[s.begin as usize], data[end as usize]);
+            if b[1] == 0 || e[1] == 0 {
+                return None;
+            }
+            let ticks = e[0].wrapping_sub(b[0]) & self.valid_mask;
+            passes.push(PassTiming {
+                name: s.name.clone(),
+                depth: s.depth,
+                nanoseconds: ticks as f64 * self.period_ns,
+            });
+        }
+        Some(ProfileReport { frame, passes })
+    }
+}
+
+impl Drop for GpuProfiler {
+    fn drop(&mut self) {
+        // SAFETY: the pool belongs to this device; the host has finished the frames
+        // that wrote it before dropping the profiler.
+        unsafe { self.device.raw.destroy_query_pool(self.pool, None) };
+    }
+}

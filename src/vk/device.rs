@@ -1,0 +1,212 @@
+//! The device record every GPU object of the crate holds an `Arc` to.
+//!
+//! It is either OWNED (created headless by the crate: instance, messenger and
+//! device are destroyed when the last `Arc` goes) or BORROWED from a host
+//! (nothing but the crate's own allocator is dropped). Resources hold the
+//! `Arc`, so the device can never be destroyed before them.
+
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use ash::vk;
+use gpu_allocator::vulkan::Allocator;
+
+use super::debug::ValidationLog;
+use crate::error::{Error, Result};
+
+/// A queue the crate may submit to, with its family.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Queue {
+    pub family: u32,
+    pub raw: vk::Queue,
+}
+
+/// What the crate needs to know about the physical device.
+#[derive(Debug, Clone)]
+pub struct DeviceInfo {
+    /// Device name as the driver reports it.
+    pub name: String,
+    /// Discrete, integrated, virtual, CPU, ...
+    pub device_type: vk::PhysicalDeviceType,
+    /// Vulkan API version the device supports.
+    pub api_version: u32,
+    /// Driver name and info string (e.g. "llvmpipe", "Mesa 22.3.6").
+    pub driver: String,
+    /// Nanoseconds per timestamp tick.
+    pub timestamp_period: f32,
+    /// Valid bits of timestamps on the graphics queue family (0: no timestamps).
+    pub timestamp_valid_bits: u32,
+    /// Largest compute shared memory per workgroup, bytes.
+    pub max_compute_shared_memory: u32,
+    /// Largest workgroup invocation count.
+    pub max_compute_invocations: u32,
+    /// Largest tessellation level.
+    pub max_tessellation_level: u32,
+    /// Largest storage buffer range, bytes.
+    pub max_storage_buffer_range: u32,
+}
+
+impl DeviceInfo {
+    pub(crate) fn query(instance: &ash::Instance, physical: vk::PhysicalDevice, graphics_family: u32) -> Self {
+        let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+        // SAFETY: `physical` was enumerated from `instance`, which is alive.
+        unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
+        let props = props2.properties;
+        // SAFETY: as above.
+        let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+        let timestamp_valid_bits = families.get(graphics_family as usize).map(|f| f.timestamp_valid_bits).unwrap_or(0);
+        let driver = format!(
+            "{} {}",
+            driver.driver_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+            driver.driver_info_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+        )
+        .trim()
+        .to_owned();
+        DeviceInfo {
+            name: props.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+            device_type: props.device_type,
+            api_version: props.api_version,
+            driver,
+            timestamp_period: props.limits.timestamp_period,
+            timestamp_valid_bits,
+            max_compute_shared_memory: props.limits.max_compute_shared_memory_size,
+            max_compute_invocations: props.limits.max_compute_work_group_invocations,
+            max_tessellation_level: props.limits.max_tessellation_generation_level,
+            max_storage_buffer_range: props.limits.max_storage_buffer_range,
+        }
+    }
+}
+
+/// Objects that exist only when the crate created the device itself.
+pub(crate) struct Owned {
+    pub debug_instance: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    /// Keeps the messenger's user data alive until after `vkDestroyInstance`.
+    pub log: Option<ValidationLog>,
+}
+
+/// The shared device record (see the module docs).
+pub(crate) struct Device {
+    /// Keeps the Vulkan loader library loaded for as long as the device lives.
+    pub entry: ash::Entry,
+    pub instance: ash::Instance,
+    pub physical: vk::PhysicalDevice,
+    pub raw: ash::Device,
+    pub graphics: Queue,
+    pub compute: Option<Queue>,
+    pub info: DeviceInfo,
+    pub debug_utils: Option<ash::ext::debug_utils::Device>,
+    allocator: Option<Arc<Mutex<Allocator>>>,
+    /// Serialises the crate's own submissions to `graphics` (queue access must be
+    /// externally synchronised).
+    pub submit_lock: Mutex<()>,
+    owned: Option<Owned>,
+}
+
+pub(crate) struct DeviceParts {
+    pub entry: ash::Entry,
+    pub instance: ash::Instance,
+    pub physical: vk::PhysicalDevice,
+    pub raw: ash::Device,
+    pub graphics: Queue,
+    pub compute: Option<Queue>,
+    pub debug_utils: bool,
+    pub allocator: Option<Arc<Mutex<Allocator>>>,
+    pub owned: Option<Owned>,
+}
+
+impl Device {
+    /// Assembles the record; creates an allocator when none is given.
+    pub(crate) fn new(parts: DeviceParts) -> Result<Arc<Self>> {
+        let info = DeviceInfo::query(&parts.instance, parts.physical, parts.graphics.family);
+        let debug_utils = parts.debug_utils.then(|| ash::ext::debug_utils::Device::new(&parts.instance, &parts.raw));
+        let allocator = match parts.allocator {
+            Some(a) => a,
+            None => {
+                let desc = gpu_allocator::vulkan::AllocatorCreateDesc {
+                    instance: parts.instance.clone(),
+                    device: parts.raw.clone(),
+                    physical_device: parts.physical,
+                    debug_settings: {
+                        let mut d = gpu_allocator::AllocatorDebugSettings::default();
+                        d.log_leaks_on_shutdown = true;
+                        d
+                    },
+                    buffer_device_address: false,
+                    allocation_sizes: gpu_allocator::AllocationSizes::default(),
+                };
+                match Allocator::new(&desc) {
+                    Ok(a) => Arc::new(Mutex::new(a)),
+                    Err(source) => {
+                        // Tear down what we own before reporting.
+                        let record = Device {
+                            entry: parts.entry,
+                            instance: parts.instance,
+                            physical: parts.physical,
+                            raw: parts.raw,
+                            graphics: parts.graphics,
+                            compute: parts.compute,
+                            info,
+                            debug_utils,
+                            allocator: None,
+                            submit_lock: Mutex::new(()),
+                            owned: parts.owned,
+                        };
+                        drop(record);
+                        return Err(Error::Allocation { name: "allocator".into(), source });
+                    }
+                }
+            }
+        };
+        Ok(Arc::new(Device {
+            entry: parts.entry,
+            instance: parts.instance,
+            physical: parts.physical,
+            raw: parts.raw,
+            graphics: parts.graphics,
+            compute: parts.compute,
+            info,
+            debug_utils,
+            allocator: Some(allocator),
+            submit_lock: Mutex::new(()),
+            owned: parts.owned,
+        }))
+    }
+
+    /// True when the crate created (and will destroy) instance and device.
+    pub(crate) fn is_owned(&self) -> bool {
+        self.owned.is_some()
+    }
+
+    /// Locks the allocator (poisoning is ignored: the allocator holds plain data).
+    pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {
+        let a = self.allocator.as_ref().expect("allocator lives until Device::drop");
+        a.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Locks the crate's own submissions to the graphics queue.
+    pub(crate) fn lock_submit(&self) -> MutexGuard<'_, ()> {
+        self.submit_lock.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+impl Drop for Device {
+    fn drop(&mut self) {
+        // The allocator must go before the device (its memory blocks are freed here).
+        self.allocator = None;
+        let Some(owned) = self.owned.take() else {
+            // Borrowed: the host owns device and instance.
+            return;
+        };
+        // SAFETY: we created these objects; every resource holding this record is
+        // gone (they hold an Arc), and we wait for the device to go idle first.
+        unsafe {
+            let _ = self.raw.device_wait_idle();
+            self.raw.destroy_device(None);
+            if let Some((utils, messenger)) = owned.debug_instance {
+                utils.destroy_debug_utils_messenger(messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+        drop(owned.log);
+    }
+}

@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# The main job: list devices, grow the `thesis` reference scene and inspect it
+# (later stages turn this into the headless renderer).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash tools/setup-debian.sh
+cargo build --release -p vkhair-tools
+vkhair=target/release/vkhair
+out=${VKHAIR_OUT:-out}
+mkdir -p "$out"
+"$vkhair" devices
+"$vkhair" grow --scalp thesis --out "$out/thesis.hair"
+"$vkhair" inspect "$out/thesis.hair"
