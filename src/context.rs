@@ -80,6 +80,9 @@ pub struct HostDevice {
     pub allocator: Option<Arc<Mutex<Allocator>>>,
     /// Whether the host enabled `VK_EXT_debug_utils` on its instance (object names, labels).
     pub debug_utils: bool,
+    /// Whether the host enabled the optional `subgroupSizeControl` and
+    /// `computeFullSubgroups` features (see [`crate::Requirements::optional_features`]).
+    pub compute_full_subgroups: bool,
 }
 
 /// vkhair's handle on a Vulkan device: owned (headless) or borrowed from a host.
@@ -115,6 +118,7 @@ impl GpuContext {
         let chosen = choose_device(guard.instance_ref(), options.device_name.as_deref())?;
         let (physical, support) = chosen;
         let (raw, graphics, compute) = create_device(guard.instance_ref(), physical, &support)?;
+        let full_subgroups = support.full_subgroups;
         let (instance, owned) = guard.release();
         let device = Device::new(DeviceParts {
             entry,
@@ -124,6 +128,7 @@ impl GpuContext {
             graphics,
             compute,
             debug_utils,
+            full_subgroups,
             allocator: None,
             owned: Some(owned),
         })?;
@@ -161,6 +166,7 @@ impl GpuContext {
             graphics: Queue { family: host.graphics_queue.family, raw: host.graphics_queue.queue },
             compute: host.compute_queue.map(|q| Queue { family: q.family, raw: q.queue }),
             debug_utils: host.debug_utils,
+            full_subgroups: host.compute_full_subgroups && support.full_subgroups,
             allocator: host.allocator,
             owned: None,
         })?;

@@ -32,6 +32,38 @@ pub(crate) struct LayoutProbe {
 }
 gpu_struct!(LayoutProbe => "LayoutProbe" { position, radius, transform, ids, weights, color });
 
+/// Per-step parameters of the simulation stages (`SimStepParams` in `glsl/include/sim.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct SimStepParams {
+    /// World-from-head transform at the end of the step, column-major.
+    pub head: [[f32; 4]; 4],
+    /// xyz gravity (m/s²), w time step (s).
+    pub gravity_dt: [f32; 4],
+    /// xyz wind acceleration (m/s²), w turbulence.
+    pub wind: [f32; 4],
+    /// x noise frequency (1/s), y time (s), z spring stiffness (1/s²), w damping per step.
+    pub wind_noise: [f32; 4],
+    /// x bending stiffness per iteration at the root, y at the tip, z DFTL damping.
+    pub bending: [f32; 4],
+    /// x strands, y points per strand, z iterations, w flags.
+    pub counts: [u32; 4],
+    /// x colliders, y hairs per workgroup, z step index, w solver sync group size.
+    pub layout_info: [u32; 4],
+}
+gpu_struct!(SimStepParams => "SimStepParams" { head, gravity_dt, wind, wind_noise, bending, counts, layout_info });
+
+/// A collider in world space (`Collider` in `glsl/include/sim.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct GpuCollider {
+    /// xyz centre or first end, w radius.
+    pub a_radius: [f32; 4],
+    /// xyz second end, w kind (0 sphere, 1 capsule).
+    pub b_kind: [f32; 4],
+}
+gpu_struct!(GpuCollider => "Collider" { a_radius, b_kind });
+
 /// Every Rust GPU struct with the shader-side name, for the layout test.
 #[cfg(test)]
 pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<String> {
@@ -46,5 +78,7 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     let mut problems = Vec::new();
     check::<ScaleAddPush>(reflection, &mut problems);
     check::<LayoutProbe>(reflection, &mut problems);
+    check::<SimStepParams>(reflection, &mut problems);
+    check::<GpuCollider>(reflection, &mut problems);
     problems
 }

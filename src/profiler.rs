@@ -45,6 +45,19 @@ impl ProfileReport {
         self.passes.iter().filter(|p| p.depth == 0).map(|p| p.nanoseconds).sum()
     }
 
+    /// Total time per pass name (passes recorded several times are added up), in
+    /// order of first appearance, nanoseconds.
+    pub fn totals_by_name(&self) -> Vec<(String, f64)> {
+        let mut totals: Vec<(String, f64)> = Vec::new();
+        for p in &self.passes {
+            match totals.iter_mut().find(|(n, _)| *n == p.name) {
+                Some((_, t)) => *t += p.nanoseconds,
+                None => totals.push((p.name.clone(), p.nanoseconds)),
+            }
+        }
+        totals
+    }
+
     /// The time of the first pass with this name, nanoseconds.
     pub fn pass(&self, name: &str) -> Option<f64> {
         self.passes.iter().find(|p| p.name == name).map(|p| p.nanoseconds)

@@ -41,6 +41,13 @@ const CORE_OPTIONAL: &[Feature<vk::PhysicalDeviceFeatures>] = features!(vk::Phys
     pipeline_statistics_query => "pipelineStatisticsQuery",
 );
 
+/// Vulkan 1.3 features used when present: full subgroups in compute let the solver
+/// synchronise hairs with subgroup barriers.
+const V13_OPTIONAL: &[Feature<vk::PhysicalDeviceVulkan13Features<'static>>] = features!(vk::PhysicalDeviceVulkan13Features<'static>:
+    subgroup_size_control => "subgroupSizeControl",
+    compute_full_subgroups => "computeFullSubgroups",
+);
+
 /// Device extensions used when present (later stages choose paths by them).
 const OPTIONAL_EXTENSIONS: &[&CStr] =
     &[ash::ext::transform_feedback::NAME, ash::khr::external_memory_fd::NAME, ash::ext::calibrated_timestamps::NAME];
@@ -88,6 +95,10 @@ pub struct Requirements {
     /// Device extensions vkhair uses when enabled (transform feedback capture,
     /// external memory for the two-device path, calibrated timestamps).
     pub optional_device_extensions: Vec<&'static CStr>,
+    /// Device features vkhair uses when the host enables them: `subgroupSizeControl`
+    /// and `computeFullSubgroups` (subgroup-synchronised constraint solving; say so in
+    /// [`crate::HostDevice::compute_full_subgroups`]) and `pipelineStatisticsQuery`.
+    pub optional_features: Vec<&'static str>,
     /// Instance extensions vkhair uses when enabled: `VK_EXT_debug_utils` for
     /// object names and pass labels.
     pub optional_instance_extensions: Vec<&'static CStr>,
@@ -103,6 +114,7 @@ pub fn requirements() -> Requirements {
         features,
         device_extensions: Vec::new(),
         optional_device_extensions: OPTIONAL_EXTENSIONS.to_vec(),
+        optional_features: V13_OPTIONAL.iter().map(|f| f.name).chain(CORE_OPTIONAL.iter().map(|f| f.name)).collect(),
         optional_instance_extensions: vec![ash::ext::debug_utils::NAME],
     }
 }
@@ -112,6 +124,7 @@ pub fn requirements() -> Requirements {
 pub(crate) struct Support {
     pub optional_extensions: Vec<&'static CStr>,
     pub pipeline_statistics: bool,
+    pub full_subgroups: bool,
 }
 
 impl Requirements {
@@ -159,6 +172,7 @@ impl Requirements {
         Ok(Support {
             optional_extensions: self.optional_device_extensions.iter().copied().filter(|n| has(n)).collect(),
             pipeline_statistics: CORE_OPTIONAL.iter().all(|f| (f.get)(&core) == vk::TRUE),
+            full_subgroups: V13_OPTIONAL.iter().all(|f| (f.get)(&v13) == vk::TRUE),
         })
     }
 }
@@ -189,5 +203,8 @@ pub(crate) fn async_compute_family(families: &[vk::QueueFamilyProperties], graph
 pub(crate) fn enable_optional(features: &mut RequiredFeatures, support: &Support) {
     if support.pipeline_statistics {
         CORE_OPTIONAL.iter().for_each(|f| (f.set)(&mut features.core));
+    }
+    if support.full_subgroups {
+        V13_OPTIONAL.iter().for_each(|f| (f.set)(&mut features.vulkan13));
     }
 }

@@ -131,6 +131,7 @@ impl Host {
             compute_queue: None,
             allocator,
             debug_utils: true,
+            compute_full_subgroups: false,
         }
     }
 

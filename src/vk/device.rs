@@ -43,12 +43,15 @@ pub struct DeviceInfo {
     pub max_tessellation_level: u32,
     /// Largest storage buffer range, bytes.
     pub max_storage_buffer_range: u32,
+    /// Invocations per subgroup (SPIR-V 1.5 modules always see this size).
+    pub subgroup_size: u32,
 }
 
 impl DeviceInfo {
     pub(crate) fn query(instance: &ash::Instance, physical: vk::PhysicalDevice, graphics_family: u32) -> Self {
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
-        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+        let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver).push_next(&mut subgroup);
         // SAFETY: `physical` was enumerated from `instance`, which is alive.
         unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
         let props = props2.properties;
@@ -73,6 +76,7 @@ impl DeviceInfo {
             max_compute_invocations: props.limits.max_compute_work_group_invocations,
             max_tessellation_level: props.limits.max_tessellation_generation_level,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
+            subgroup_size: subgroup.subgroup_size,
         }
     }
 }
@@ -95,6 +99,8 @@ pub(crate) struct Device {
     pub compute: Option<Queue>,
     pub info: DeviceInfo,
     pub debug_utils: Option<ash::ext::debug_utils::Device>,
+    /// Whether `computeFullSubgroups` is enabled (pipelines may require full subgroups).
+    pub full_subgroups: bool,
     allocator: Option<Arc<Mutex<Allocator>>>,
     /// Serialises the crate's own submissions to `graphics` (queue access must be
     /// externally synchronised).
@@ -110,6 +116,7 @@ pub(crate) struct DeviceParts {
     pub graphics: Queue,
     pub compute: Option<Queue>,
     pub debug_utils: bool,
+    pub full_subgroups: bool,
     pub allocator: Option<Arc<Mutex<Allocator>>>,
     pub owned: Option<Owned>,
 }
@@ -147,6 +154,7 @@ impl Device {
                             compute: parts.compute,
                             info,
                             debug_utils,
+                            full_subgroups: parts.full_subgroups,
                             allocator: None,
                             submit_lock: Mutex::new(()),
                             owned: parts.owned,
@@ -166,6 +174,7 @@ impl Device {
             compute: parts.compute,
             info,
             debug_utils,
+            full_subgroups: parts.full_subgroups,
             allocator: Some(allocator),
             submit_lock: Mutex::new(()),
             owned: parts.owned,

@@ -182,13 +182,33 @@ pub(crate) struct ComputePipeline {
 impl ComputePipeline {
     /// Creates the pipeline; `max_sets` descriptor sets (of each set index) can be allocated.
     pub(crate) fn new(device: &Arc<Device>, shader: &ShaderSource, max_sets: u32) -> Result<Self> {
+        Self::with_full_subgroups(device, shader, max_sets, false)
+    }
+
+    /// As [`ComputePipeline::new`]; with `full_subgroups` (only when the device has
+    /// `computeFullSubgroups` enabled) every subgroup of a workgroup is full.
+    pub(crate) fn with_full_subgroups(
+        device: &Arc<Device>,
+        shader: &ShaderSource,
+        max_sets: u32,
+        full_subgroups: bool,
+    ) -> Result<Self> {
+        if full_subgroups && !device.full_subgroups {
+            return Err(Error::MissingRequirement("computeFullSubgroups".into()));
+        }
         let reflection = reflect(shader)?;
         let workgroup_size = reflection
             .workgroup_size
             .ok_or_else(|| Error::Shader { shader: shader.name.to_owned(), reason: "not a compute shader".into() })?;
         let layout = Layout::new(device, shader.name, &[reflection], max_sets)?;
         let module = shader_module(device, shader)?;
+        let flags = if full_subgroups {
+            vk::PipelineShaderStageCreateFlags::REQUIRE_FULL_SUBGROUPS
+        } else {
+            vk::PipelineShaderStageCreateFlags::empty()
+        };
         let stage = vk::PipelineShaderStageCreateInfo::default()
+            .flags(flags)
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)
             .name(c"main");
@@ -206,6 +226,17 @@ impl ComputePipeline {
         self.workgroup_size
     }
 
+    /// Allocates descriptor set `set` and binds those of `buffers` that the shader
+    /// declares (stages sharing one binding table each use a subset of it).
+    pub(crate) fn declared_buffer_set(&self, set: u32, buffers: &[(u32, &Buffer)]) -> Result<vk::DescriptorSet> {
+        let declared: Vec<(u32, &Buffer)> = buffers
+            .iter()
+            .filter(|(binding, _)| self.layout.bindings.iter().any(|(b, _)| b.set == set && b.binding == *binding))
+            .copied()
+            .collect();
+        self.buffer_set(set, &declared)
+    }
+
     /// Allocates descriptor set `set` and points its buffer bindings at `buffers`.
     pub(crate) fn buffer_set(&self, set: u32, buffers: &[(u32, &Buffer)]) -> Result<vk::DescriptorSet> {
         let target = self.layout.allocate_set(set, &format!("{} set {set}", self.name))?;
@@ -213,20 +244,28 @@ impl ComputePipeline {
         Ok(target)
     }
 
-    /// Binds the pipeline, the descriptor sets (from set 0) and the push constants.
+    /// Binds the pipeline and the descriptor sets (from set 0).
     ///
     /// # Safety
     /// `cmd` is a recording command buffer of this device.
-    pub(crate) unsafe fn bind<P: bytemuck::Pod>(&self, cmd: vk::CommandBuffer, sets: &[vk::DescriptorSet], push: &P) {
+    pub(crate) unsafe fn bind(&self, cmd: vk::CommandBuffer, sets: &[vk::DescriptorSet]) {
         let d = &self.layout.device.raw;
-        // SAFETY: guaranteed by the caller; the push size is checked against reflection.
+        // SAFETY: guaranteed by the caller.
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw);
             if !sets.is_empty() {
                 d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout.raw, 0, sets, &[]);
             }
-            self.layout.push(cmd, push);
         }
+    }
+
+    /// Records push constants; their size must equal the shader's block.
+    ///
+    /// # Safety
+    /// `cmd` is recording with this pipeline bound.
+    pub(crate) unsafe fn push<P: bytemuck::Pod>(&self, cmd: vk::CommandBuffer, push: &P) {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.layout.push(cmd, push) };
     }
 
     /// Dispatches enough workgroups to cover `threads` invocations in each dimension.
@@ -384,12 +423,12 @@ impl GraphicsPipeline {
         Ok(target)
     }
 
-    /// Binds the pipeline, descriptor sets (from set 0) and push constants.
+    /// Binds the pipeline and descriptor sets (from set 0).
     ///
     /// # Safety
     /// `cmd` is recording inside a dynamic rendering instance compatible with the
     /// pipeline's formats.
-    pub(crate) unsafe fn bind<P: bytemuck::Pod>(&self, cmd: vk::CommandBuffer, sets: &[vk::DescriptorSet], push: &P) {
+    pub(crate) unsafe fn bind(&self, cmd: vk::CommandBuffer, sets: &[vk::DescriptorSet]) {
         let d = &self.layout.device.raw;
         // SAFETY: guaranteed by the caller.
         unsafe {
@@ -397,8 +436,16 @@ impl GraphicsPipeline {
             if !sets.is_empty() {
                 d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout.raw, 0, sets, &[]);
             }
-            self.layout.push(cmd, push);
         }
+    }
+
+    /// Records push constants; their size must equal the shaders' block.
+    ///
+    /// # Safety
+    /// `cmd` is recording with this pipeline bound.
+    pub(crate) unsafe fn push<P: bytemuck::Pod>(&self, cmd: vk::CommandBuffer, push: &P) {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.layout.push(cmd, push) };
     }
 }
 

@@ -103,7 +103,8 @@ fn scale_add_matches_cpu() {
     d.submit_once("scale_add", |cmd| {
         // SAFETY: recording command buffer of this device.
         unsafe {
-            pipeline.bind(cmd, &[set], &push);
+            pipeline.bind(cmd, &[set]);
+            pipeline.push(cmd, &push);
             pipeline.dispatch_threads(cmd, [n as u32, 1, 1]);
         }
     })
@@ -145,7 +146,8 @@ fn layout_probe_round_trips_every_member() {
     d.submit_once("layout probe", |cmd| {
         // SAFETY: recording command buffer of this device.
         unsafe {
-            pipeline.bind(cmd, &[set], &count);
+            pipeline.bind(cmd, &[set]);
+            pipeline.push(cmd, &count);
             pipeline.dispatch_threads(cmd, [count, 1, 1]);
         }
     })
@@ -165,15 +167,25 @@ fn layout_probe_round_trips_every_member() {
 
 #[test]
 fn every_shader_struct_matches_its_rust_twin() {
-    let mut compared = 0;
+    let names = [
+        ScaleAddPush::GLSL_NAME,
+        LayoutProbe::GLSL_NAME,
+        gpu_types::SimStepParams::GLSL_NAME,
+        gpu_types::GpuCollider::GLSL_NAME,
+    ];
+    let mut found = vec![0usize; names.len()];
     for shader in shaders::ALL {
         let r = reflect(shader).expect("reflect");
         let problems = gpu_types::check_all(&r);
         assert!(problems.is_empty(), "{}: {problems:?}", shader.name);
-        compared += r.structs_named(ScaleAddPush::GLSL_NAME).count() + r.structs_named(LayoutProbe::GLSL_NAME).count();
+        for (count, name) in found.iter_mut().zip(names) {
+            *count += r.structs_named(name).count();
+        }
     }
-    // scale_add uses ScaleAddPush; layout_probe uses LayoutProbe (input block and array).
-    assert!(compared >= 2, "no struct was compared");
+    // Every Rust twin is used by at least one shader, so it was really compared.
+    for (count, name) in found.iter().zip(names) {
+        assert!(*count > 0, "no shader uses {name}");
+    }
 }
 
 /// Deliberately wrong twins: the comparison must reject them.
@@ -307,7 +319,8 @@ fn graphics_pipeline_draws_with_dynamic_rendering() {
                 &[vk::Viewport { x: 0.0, y: 0.0, width: 64.0, height: 48.0, min_depth: 0.0, max_depth: 1.0 }],
             );
             d.raw.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
-            pipeline.bind(cmd, &[], &push);
+            pipeline.bind(cmd, &[]);
+            pipeline.push(cmd, &push);
             d.raw.cmd_draw(cmd, 3, 1, 0, 0);
             d.raw.cmd_end_rendering(cmd);
         }
@@ -339,7 +352,8 @@ fn synchronization_validation_reports_a_missing_barrier() {
             // (transfer write) and the dispatch (storage read) is the point of the test.
             unsafe {
                 d.raw.cmd_fill_buffer(cmd, src.raw(), 0, vk::WHOLE_SIZE, 0);
-                pipeline.bind(cmd, &[set], &push);
+                pipeline.bind(cmd, &[set]);
+                pipeline.push(cmd, &push);
                 pipeline.dispatch_threads(cmd, [64, 1, 1]);
             }
         })
@@ -439,7 +453,8 @@ fn profiler_reports_passes_frames_in_flight_later() {
                 let outer = profiler.begin_scope(cmd, "frame");
                 for pass in ["first", "second"] {
                     let scope = profiler.begin_scope(cmd, pass);
-                    pipeline.bind(cmd, &[set], &push);
+                    pipeline.bind(cmd, &[set]);
+                    pipeline.push(cmd, &push);
                     pipeline.dispatch_threads(cmd, [n as u32, 1, 1]);
                     d.cmd_barrier(cmd, &[barrier::memory(Access::COMPUTE_WRITE, Access::COMPUTE_READ_WRITE)], &[], &[]);
                     profiler.end_scope(cmd, scope);

@@ -1,0 +1,86 @@
+// Declarations shared by the simulation stages (glsl/sim/*.comp).
+// The CPU reference (src/sim/reference.rs) mirrors every function here with
+// the same operation order; `precise` keeps the compiler from fusing or
+// reordering float operations so both sides round the same way.
+#ifndef VKHAIR_SIM_GLSL
+#define VKHAIR_SIM_GLSL
+
+// Per-step parameters (uniform block, binding 0). Twin: gpu_types::SimStepParams.
+struct SimStepParams {
+    mat4 head;            // world-from-head transform at the end of this step
+    vec4 gravity_dt;      // xyz gravity (m/s²), w time step (s)
+    vec4 wind;            // xyz wind acceleration (m/s²), w turbulence (0..1)
+    vec4 wind_noise;      // x noise frequency (1/s), y time (s), z spring stiffness (1/s²), w damping per step (0..1)
+    vec4 bending;         // x stiffness per iteration at the root, y at the tip, z DFTL velocity damping, w unused
+    uvec4 counts;         // x strands, y points per strand, z iterations, w flags (SIM_*)
+    uvec4 layout_info;    // x colliders, y hairs per workgroup, z step index, w sync group size
+};
+
+// One collider in world space. Twin: gpu_types::GpuCollider.
+struct Collider {
+    vec4 a_radius;        // xyz centre (sphere) or first end (capsule), w radius (m)
+    vec4 b_kind;          // xyz second end (capsule), w 0 = sphere, 1 = capsule
+};
+
+const uint SIM_GRAVITY = 1u;
+const uint SIM_WIND = 2u;
+const uint SIM_SPRING = 4u;
+const uint SIM_BENDING = 8u;
+const uint SIM_COLLISIONS = 16u;
+const uint SIM_DFTL = 32u;
+
+// Most colliders (sim::MAX_COLLIDERS).
+const uint SIM_MAX_COLLIDERS = 64u;
+
+// Points of the fixed-size workgroup of the constraint solver.
+const uint SIM_WORKGROUP = 64u;
+
+// head * vec4(p, 1), written out so that the CPU reference can match it.
+vec3 sim_transform_point(mat4 m, vec3 p) {
+    precise vec3 r = ((m[0].xyz * p.x + m[1].xyz * p.y) + m[2].xyz * p.z) + m[3].xyz;
+    return r;
+}
+
+// Integer hash to [-1, 1]; exact on every device.
+float sim_hash(uint x) {
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    // 24 bits times 2^-23 is exact: [0, 2) - 1.
+    return float(x >> 8) * (1.0 / 8388608.0) - 1.0;
+}
+
+// Smooth 1D value noise in [-1, 1] along time, one independent track per strand.
+float sim_noise(float t, uint strand) {
+    precise float cell = floor(t);
+    precise float f = t - cell;
+    precise float s = f * f * (3.0 - 2.0 * f);
+    uint i = uint(int(cell) + 1048576) + strand * 7919u;
+    precise float a = sim_hash(i);
+    precise float b = sim_hash(i + 1u);
+    precise float n = a + (b - a) * s;
+    return n;
+}
+
+// Projects p out of one collider, keeping a gap of `radius` (the particle's pearl).
+vec3 sim_collide(Collider c, vec3 p, float radius) {
+    precise vec3 closest = c.a_radius.xyz;
+    if (c.b_kind.w > 0.5) {
+        precise vec3 ab = c.b_kind.xyz - c.a_radius.xyz;
+        precise float len2 = dot(ab, ab);
+        precise float t = len2 > 0.0 ? clamp(dot(p - c.a_radius.xyz, ab) / len2, 0.0, 1.0) : 0.0;
+        closest = c.a_radius.xyz + ab * t;
+    }
+    precise vec3 d = p - closest;
+    precise float dist = sqrt(dot(d, d));
+    precise float reach = c.a_radius.w + radius;
+    if (dist < reach && dist > 0.0) {
+        precise vec3 out_p = closest + d * (reach / dist);
+        return out_p;
+    }
+    return p;
+}
+
+#endif

@@ -1,0 +1,211 @@
+#version 460
+// Stage 2 — constraint solve, one dispatch for every key hair.
+// Each workgroup holds `hairs per workgroup` whole hairs (one invocation per
+// point) in shared memory and, for N iterations, projects with a barrier
+// between the sets. The barrier's scope is the "sync group": the subgroup when
+// every hair fits into one (hairs are packed so none straddles two), else the
+// whole workgroup (barrier()). The sets are:
+//   1. distance constraints of even segments, 2. of odd segments,
+//   3. bending (distance between points i−1 and i+1, rest from the rest shape,
+//      stiffness from root to tip) centred on i mod 4 ∈ {0,1}, 4. on {2,3},
+//   5. body collisions (spheres, capsules; each particle has its own radius),
+// then writes the hairs back once.
+//
+// Both ends of a constraint compute the same correction from the same two
+// positions, and each keeps its own result: every invocation holds its point
+// in a register and, per set, reads its partner from one half of a
+// double-buffered shared array and writes its own point to the other half, so
+// one barrier per set suffices (collisions, which touch only the own point,
+// share the last set's barrier). The arithmetic is exactly that of projecting
+// the pair in one place, which the CPU reference does.
+//
+// DFTL mode instead places each point at its
+// rest distance from its parent, root to tip, in one sweep (with collisions)
+// and stores the correction vectors for the velocity update.
+#extension GL_KHR_shader_subgroup_basic : require
+#include "sim.glsl"
+
+layout(local_size_x = 64) in;
+
+layout(std140, set = 0, binding = 0) uniform Params { SimStepParams params; };
+layout(std430, set = 0, binding = 3) buffer Predicted { vec4 predicted[]; };
+layout(std430, set = 0, binding = 4) writeonly buffer Correction { vec4 correction[]; };
+layout(std430, set = 0, binding = 5) readonly buffer Rest { vec4 rest[]; };
+layout(std430, set = 0, binding = 6) readonly buffer RestLength { float rest_length[]; };
+// Uniform: every invocation reads the same collider at the same time.
+layout(std140, set = 0, binding = 7) uniform Colliders { Collider colliders[SIM_MAX_COLLIDERS]; };
+
+shared vec4 s_pos[2][SIM_WORKGROUP];
+shared float s_length[SIM_WORKGROUP];
+
+// Ends a constraint set: makes every shared-memory write of the sync group visible.
+// `group` is uniform over the dispatch, so barrier() stays in uniform control flow.
+void sync(uint group) {
+    if (group == SIM_WORKGROUP) {
+        barrier();
+    } else {
+        subgroupBarrier();
+    }
+}
+
+vec3 collide_all(vec3 p, float radius) {
+    for (uint c = 0u; c < params.layout_info.x; c++) {
+        p = sim_collide(colliders[c], p, radius);
+    }
+    return p;
+}
+
+// One end of a constraint between this invocation's point `own` and the point
+// `offset` invocations away, read from half `src`. `first`: own is the lower
+// index (a) of the pair. Returns own's projected position.
+vec4 project_end(vec4 own, uint lid, int offset, bool first, float rest_d, float k, uint src) {
+    if (offset == 0) {
+        return own;
+    }
+    vec4 other = s_pos[src][uint(int(lid) + offset)];
+    vec4 a = first ? own : other;
+    vec4 b = first ? other : own;
+    precise float w = a.w + b.w;
+    precise vec3 d = b.xyz - a.xyz;
+    precise float len = sqrt(dot(d, d));
+    if (w > 0.0 && len > 0.0) {
+        precise float c = ((len - rest_d) / (len * w)) * k;
+        if (first) {
+            precise vec3 pa = a.xyz + d * (a.w * c);
+            own.xyz = pa;
+        } else {
+            precise vec3 pb = b.xyz - d * (b.w * c);
+            own.xyz = pb;
+        }
+    }
+    return own;
+}
+
+// Rest distance and stiffness of the bending constraint centred on point c.
+vec2 bend_at(uint strand_base, uint c, uint points) {
+    precise vec3 r = rest[strand_base + c + 1u].xyz - rest[strand_base + c - 1u].xyz;
+    precise float t = float(c) / float(points - 1u);
+    precise float k = params.bending.x + (params.bending.y - params.bending.x) * t;
+    return vec2(sqrt(dot(r, r)), k);
+}
+
+void main() {
+    uint points = params.counts.y;
+    uint per_group = params.layout_info.y;
+    uint flags = params.counts.w;
+    uint group = params.layout_info.w;
+    uint per_sync = group / points;
+    // With subgroup sync (always full subgroups) hairs are laid out by subgroup.
+    uint lid = group == SIM_WORKGROUP ? gl_LocalInvocationID.x : gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID;
+    uint sync_index = lid / group;
+    uint lane = lid - sync_index * group;
+    uint in_sync = lane / points;
+    uint i = lane - in_sync * points;
+    uint hair = sync_index * per_sync + in_sync;
+    uint strand = gl_WorkGroupID.x * per_group + hair;
+    bool live = in_sync < per_sync && hair < per_group && strand < params.counts.x;
+    uint index = strand * points + i;
+    uint base = strand * points;
+
+    bool collisions = (flags & SIM_COLLISIONS) != 0u;
+    bool bending = (flags & SIM_BENDING) != 0u;
+    vec4 own = vec4(0.0);
+    float radius = 0.0;
+    // Per set: partner offset (0 = none), whether own is the pair's first point,
+    // rest distance and stiffness.
+    int off_even = 0, off_odd = 0, off_bend_a = 0, off_bend_b = 0;
+    bool first_even = false, first_odd = false, first_bend_a = false, first_bend_b = false;
+    float rest_even = 0.0, rest_odd = 0.0;
+    vec2 bend_a = vec2(0.0), bend_b = vec2(0.0);
+    if (live) {
+        own = predicted[index];
+        s_pos[0][lid] = own;
+        s_length[lid] = rest_length[index];
+        radius = rest[index].w;
+        bool has_next = i + 1u < points;
+        float len_next = rest_length[index];
+        float len_prev = i > 0u ? rest_length[index - 1u] : 0.0;
+        // Distance sets: segment (j, j+1) is even when j is even.
+        if ((i & 1u) == 0u) {
+            if (has_next) { off_even = 1; first_even = true; rest_even = len_next; }
+            if (i > 0u) { off_odd = -1; rest_odd = len_prev; }
+        } else {
+            off_even = -1; rest_even = len_prev;
+            if (has_next) { off_odd = 1; first_odd = true; rest_odd = len_next; }
+        }
+        // Bending sets: centre c joins c−1 and c+1; set A has c mod 4 ∈ {0,1}.
+        if (bending) {
+            if (i + 2u < points) {
+                uint c = i + 1u;
+                vec2 bk = bend_at(base, c, points);
+                if (bk.y > 0.0) {
+                    if ((c & 3u) < 2u) { off_bend_a = 2; first_bend_a = true; bend_a = bk; }
+                    else { off_bend_b = 2; first_bend_b = true; bend_b = bk; }
+                }
+            }
+            if (i >= 2u) {
+                uint c = i - 1u;
+                vec2 bk = bend_at(base, c, points);
+                if (bk.y > 0.0) {
+                    if ((c & 3u) < 2u) { off_bend_a = -2; bend_a = bk; }
+                    else { off_bend_b = -2; bend_b = bk; }
+                }
+            }
+        }
+    }
+    sync(group);
+
+    if ((flags & SIM_DFTL) != 0u) {
+        // Follow the leader: sequential down each hair, by its root's invocation.
+        if (live && i == 0u) {
+            for (uint k = 1u; k < points; k++) {
+                vec4 parent = s_pos[0][lid + k - 1u];
+                vec4 q = s_pos[0][lid + k];
+                if (q.w > 0.0) {
+                    precise vec3 d = q.xyz - parent.xyz;
+                    precise float len = sqrt(dot(d, d));
+                    precise vec3 placed = len > 0.0 ? parent.xyz + d * (s_length[lid + k - 1u] / len) : q.xyz;
+                    if (collisions) {
+                        placed = collide_all(placed, rest[index + k].w);
+                    }
+                    s_pos[0][lid + k] = vec4(placed, q.w);
+                }
+            }
+        }
+        sync(group);
+        if (live) {
+            vec4 solved = s_pos[0][lid];
+            precise vec3 d = solved.xyz - own.xyz;
+            correction[index] = vec4(d, 0.0);
+            predicted[index] = solved;
+        }
+        return;
+    }
+
+    // Halves alternate: each set reads `src` and writes the other one.
+    uint src = 0u;
+    for (uint it = 0u; it < params.counts.z; it++) {
+        own = project_end(own, lid, off_even, first_even, rest_even, 1.0, src);
+        if (live) { s_pos[1u - src][lid] = own; }
+        sync(group);
+        src = 1u - src;
+        own = project_end(own, lid, off_odd, first_odd, rest_odd, 1.0, src);
+        if (live) { s_pos[1u - src][lid] = own; }
+        sync(group);
+        src = 1u - src;
+        own = project_end(own, lid, off_bend_a, first_bend_a, bend_a.x, bend_a.y, src);
+        if (live) { s_pos[1u - src][lid] = own; }
+        sync(group);
+        src = 1u - src;
+        own = project_end(own, lid, off_bend_b, first_bend_b, bend_b.x, bend_b.y, src);
+        if (collisions && live && own.w > 0.0) {
+            own.xyz = collide_all(own.xyz, radius);
+        }
+        if (live) { s_pos[1u - src][lid] = own; }
+        sync(group);
+        src = 1u - src;
+    }
+    if (live) {
+        predicted[index] = own;
+    }
+}

@@ -1,0 +1,377 @@
+//! GPU strand simulation: position-based dynamics with a shared-memory
+//! constraint solver, body collisions and head motion.
+//!
+//! [`HairSim`] records one simulation step into the caller's command buffer.
+//! A step is `substeps` sub-steps, each running these stages in order (the
+//! [`SimStage`] enum names their debug labels and timestamp scopes):
+//!
+//! 1. **Predict** ([`predict`], `glsl/sim/predict.comp`): external forces —
+//!    gravity, wind with deterministic gust noise, a spring toward the rest
+//!    shape in the head frame, each switchable — then v* = v + dt·a,
+//!    x* = x + dt·v*. Pinned particles (roots) follow the head transform.
+//! 2. **Solve** ([`solve`], `glsl/sim/solve.comp`): ONE dispatch, one
+//!    workgroup per group of key hairs, positions in shared memory; for N
+//!    iterations the even then odd distance constraints, two sets of bending
+//!    constraints and the body collisions, separated by `barrier()`; one
+//!    global write at the end. DFTL mode replaces this with one
+//!    follow-the-leader sweep and stores correction vectors.
+//! 3. **Integrate** ([`integrate`], `glsl/sim/integrate.comp`): velocity from
+//!    the position change (plus the DFTL correction), damping, and the final
+//!    state into the other half of the double buffer.
+//!
+//! Parameters ([`SimParams`]), colliders ([`Collider`]) and the head transform
+//! ([`RigidTransform`]) are validated before any GPU work. [`CpuHairSim`] runs
+//! the same algorithm on the CPU with the same operation order (the test
+//! oracle and benchmark baseline); [`FixedStepDriver`] turns frame times into
+//! a number of fixed steps.
+
+mod driver;
+pub mod integrate;
+pub mod motion;
+mod params;
+pub mod predict;
+pub(crate) mod reference;
+pub mod solve;
+mod state;
+
+use std::sync::Arc;
+
+use ash::vk;
+
+pub use driver::{FixedStepDriver, StepPlan};
+pub use params::{Collider, RigidTransform, SimParams, SolverMode, MAX_COLLIDERS, MAX_SIM_POINTS};
+pub use state::SimState;
+
+use crate::context::GpuContext;
+use crate::error::{Error, Result};
+use crate::groom::Groom;
+use crate::profiler::GpuProfiler;
+use crate::vk::barrier::{self, Access};
+use crate::vk::device::Device;
+use crate::vk::pipeline::ComputePipeline;
+use params::Schedule;
+use state::GpuState;
+
+/// The stages of a simulation sub-step, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SimStage {
+    /// Stage 1: forces and prediction.
+    Predict,
+    /// Stage 2: constraint solve.
+    Solve,
+    /// Stage 3: velocity update, damping, final state.
+    Integrate,
+}
+
+impl SimStage {
+    /// Every stage in execution order.
+    pub const ALL: [SimStage; 3] = [SimStage::Predict, SimStage::Solve, SimStage::Integrate];
+
+    /// The debug label and timestamp scope name of the stage.
+    pub fn label(self) -> &'static str {
+        match self {
+            SimStage::Predict => "vkhair sim: predict",
+            SimStage::Solve => "vkhair sim: solve",
+            SimStage::Integrate => "vkhair sim: integrate",
+        }
+    }
+
+    /// Position of the stage in a sub-step (its timestamp slot).
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    fn shader(self) -> &'static crate::vk::shaders::ShaderSource {
+        match self {
+            SimStage::Predict => predict::SHADER,
+            SimStage::Solve => solve::SHADER,
+            SimStage::Integrate => integrate::SHADER,
+        }
+    }
+
+    fn threads(self, strands: u32, points: u32, hairs_per_group: u32) -> u32 {
+        match self {
+            SimStage::Predict => predict::threads(strands, points, hairs_per_group),
+            SimStage::Solve => solve::threads(strands, points, hairs_per_group),
+            SimStage::Integrate => integrate::threads(strands, points, hairs_per_group),
+        }
+    }
+}
+
+struct StagePipeline {
+    stage: SimStage,
+    pipeline: ComputePipeline,
+    /// Descriptor sets reading half 0 and half 1 of the double buffer.
+    sets: [vk::DescriptorSet; 2],
+}
+
+/// The GPU hair simulation (see the module docs for the stage list).
+pub struct HairSim {
+    device: Arc<Device>,
+    gpu: GpuState,
+    stages: Vec<StagePipeline>,
+    schedule: Schedule,
+    /// Rest shape and lengths as last uploaded (positions unused).
+    shape: SimState,
+    /// Particle ranges of `shape` to upload with the next step.
+    pending_rest: Vec<std::ops::Range<usize>>,
+    /// The half of the double buffer holding the latest state.
+    current: usize,
+}
+
+impl HairSim {
+    /// Uploads `groom` (key hairs in the head frame, all with the same point count,
+    /// at most [`MAX_SIM_POINTS`]) placed by `head`, at rest. This submits and waits.
+    pub fn new(ctx: &GpuContext, groom: &Groom, params: &SimParams, head: &RigidTransform) -> Result<Self> {
+        let state = SimState::from_groom(groom, params, head)?;
+        Self::from_state(ctx, &state, params, head)
+    }
+
+    /// Starts from an arbitrary state (e.g. one read back or produced by [`CpuHairSim`]).
+    pub fn from_state(ctx: &GpuContext, state: &SimState, params: &SimParams, head: &RigidTransform) -> Result<Self> {
+        let device = ctx.device.clone();
+        // Subgroup-synchronised solving needs full subgroups; without them the solver
+        // synchronises whole workgroups.
+        let subgroup = if device.full_subgroups { device.info.subgroup_size } else { 0 };
+        let schedule = Schedule::new(params, head, state.strands, state.points, subgroup)?;
+        let gpu = GpuState::new(&device, state)?;
+        let mut stages = Vec::new();
+        for stage in SimStage::ALL {
+            let full = stage == SimStage::Solve && device.full_subgroups;
+            let pipeline = ComputePipeline::with_full_subgroups(&device, stage.shader(), 2, full)?;
+            let sets = [
+                pipeline.declared_buffer_set(0, &gpu.bindings(0))?,
+                pipeline.declared_buffer_set(0, &gpu.bindings(1))?,
+            ];
+            stages.push(StagePipeline { stage, pipeline, sets });
+        }
+        Ok(HairSim { device, gpu, stages, schedule, shape: state.clone(), pending_rest: Vec::new(), current: 0 })
+    }
+
+    /// Current parameters.
+    pub fn params(&self) -> &SimParams {
+        &self.schedule.params
+    }
+
+    /// Changes parameters from the next step on (validated first).
+    pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
+        self.schedule.set_params(params)
+    }
+
+    /// Replaces the colliders (in the head frame; at most [`MAX_COLLIDERS`]).
+    pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
+        self.schedule.set_colliders(colliders)
+    }
+
+    /// Changes the rest length of key hair `strand`; only its tip segments change.
+    /// Takes effect with the next recorded step.
+    pub fn set_strand_length(&mut self, strand: usize, length: f32) -> Result<()> {
+        let first = self.shape.set_strand_length(strand, length)?;
+        let end = (strand + 1) * self.shape.points;
+        self.pending_rest.push(first..end);
+        Ok(())
+    }
+
+    /// Key hairs and points per key hair.
+    pub fn size(&self) -> (usize, usize) {
+        (self.shape.strands, self.shape.points)
+    }
+
+    /// The positions buffer holding the latest state (vec4 per particle, w = inverse
+    /// mass). It is written by the compute stage (`SHADER_STORAGE_WRITE`) of the last
+    /// recorded step: a reader needs a barrier from `COMPUTE_SHADER` after it.
+    pub fn positions_buffer(&self) -> vk::Buffer {
+        self.gpu.positions[self.current].raw()
+    }
+
+    /// Records one step that ends with the head at `head` into `cmd`, with a debug
+    /// label and (when a profiler is given) a timestamp scope per stage.
+    ///
+    /// # Safety
+    /// `cmd` is a command buffer of the context's device in the recording state,
+    /// outside a render pass, for a queue of the graphics family. The buffers of this
+    /// simulation must not be in use by other pending work that conflicts with it
+    /// (the recorded barriers order it after everything earlier in submission order).
+    /// With a profiler, its `begin_frame` was called for the frame being recorded.
+    pub unsafe fn record_step(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        head: &RigidTransform,
+        mut profiler: Option<&mut GpuProfiler>,
+    ) -> Result<()> {
+        let inputs = self.schedule.next(head)?;
+        let (strands, points) = (self.schedule.strands, self.schedule.points);
+        let d = &self.device;
+        let entry = barrier::memory(
+            Access::ANY_WRITE,
+            Access {
+                stage: vk::PipelineStageFlags2::COPY | vk::PipelineStageFlags2::COMPUTE_SHADER,
+                access: vk::AccessFlags2::TRANSFER_WRITE
+                    | vk::AccessFlags2::SHADER_STORAGE_READ
+                    | vk::AccessFlags2::SHADER_STORAGE_WRITE
+                    | vk::AccessFlags2::UNIFORM_READ,
+            },
+        );
+        let uploaded = barrier::memory(
+            Access::TRANSFER_WRITE,
+            Access {
+                stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
+                access: vk::AccessFlags2::UNIFORM_READ | vk::AccessFlags2::SHADER_STORAGE_READ,
+            },
+        );
+        let between = barrier::memory(Access::COMPUTE_WRITE, Access::COMPUTE_READ_WRITE);
+        for sub in &inputs {
+            // SAFETY: guaranteed by the caller; all buffers belong to this device, and
+            // update sizes are multiples of 4 below 64 KiB (checked by construction).
+            unsafe {
+                d.cmd_barrier(cmd, &[entry], &[], &[]);
+                d.raw.cmd_update_buffer(cmd, self.gpu.params.raw(), 0, bytemuck::bytes_of(&sub.params));
+                if !sub.colliders.is_empty() {
+                    d.raw.cmd_update_buffer(cmd, self.gpu.colliders.raw(), 0, bytemuck::cast_slice(&sub.colliders));
+                }
+                for range in self.pending_rest.drain(..) {
+                    let rest = bytemuck::cast_slice(&self.shape.rest[range.clone()]);
+                    let lengths = bytemuck::cast_slice(&self.shape.rest_lengths[range.clone()]);
+                    update_chunked(d, cmd, self.gpu.rest.raw(), range.start as u64 * 16, rest);
+                    update_chunked(d, cmd, self.gpu.rest_lengths.raw(), range.start as u64 * 4, lengths);
+                }
+                d.cmd_barrier(cmd, &[uploaded], &[], &[]);
+            }
+            let hairs_per_group = sub.params.layout_info[1];
+            for (k, stage) in self.stages.iter().enumerate() {
+                let threads = stage.stage.threads(strands, points, hairs_per_group);
+                // SAFETY: as above; the profiler contract is the caller's.
+                unsafe {
+                    let scope = profiler.as_deref_mut().map(|p| p.begin_scope(cmd, stage.stage.label()));
+                    if profiler.is_none() {
+                        d.cmd_begin_label(cmd, stage.stage.label(), crate::vk::debug::LabelColor::Compute);
+                    }
+                    stage.pipeline.bind(cmd, &[stage.sets[self.current]]);
+                    stage.pipeline.dispatch_threads(cmd, [threads, 1, 1]);
+                    if k + 1 < self.stages.len() {
+                        d.cmd_barrier(cmd, &[between], &[], &[]);
+                    }
+                    match (profiler.as_deref_mut(), scope) {
+                        (Some(p), Some(scope)) => p.end_scope(cmd, scope),
+                        _ => d.cmd_end_label(cmd),
+                    }
+                }
+            }
+            self.current = 1 - self.current;
+        }
+        Ok(())
+    }
+
+    /// Reads the latest state back (this submits and waits for the queue).
+    pub fn read_state(&self) -> Result<SimState> {
+        let n = self.shape.positions.len();
+        let mut state = self.shape.clone();
+        state.positions = self.device.readback_pod(&self.gpu.positions[self.current], n)?;
+        state.velocities = self.device.readback_pod(&self.gpu.velocities[self.current], n)?;
+        Ok(state)
+    }
+
+    /// Replaces positions and velocities (same size; this submits and waits).
+    pub fn write_state(&mut self, state: &SimState) -> Result<()> {
+        if (state.strands, state.points) != (self.shape.strands, self.shape.points)
+            || state.positions.len() != self.shape.positions.len()
+            || state.velocities.len() != self.shape.positions.len()
+        {
+            return Err(Error::param("state", "size differs from the simulation's"));
+        }
+        self.gpu.upload(&self.device, state, self.current)
+    }
+
+    /// Runs `steps` steps with the head at `head(i)` for step i, in one submission
+    /// (headless use: tests, tools, benchmarks; this submits and waits). With a
+    /// profiler, returns the per-stage GPU timings of the whole run (the profiler
+    /// needs 3 × steps × substeps scopes).
+    pub fn run(
+        &mut self,
+        steps: usize,
+        mut head: impl FnMut(usize) -> RigidTransform,
+        mut profiler: Option<&mut GpuProfiler>,
+    ) -> Result<Option<crate::ProfileReport>> {
+        let device = self.device.clone();
+        let mut result = Ok(());
+        device.submit_once("vkhair sim run", |cmd| {
+            // SAFETY: submit_once hands over a recording command buffer of this device,
+            // and waits for the previous one: every earlier frame has completed.
+            unsafe {
+                if let Some(p) = profiler.as_deref_mut() {
+                    let frame = p.latest().map_or(0, |r| r.frame + 1);
+                    let _ = p.begin_frame(cmd, frame);
+                }
+                for i in 0..steps {
+                    if let Err(e) = self.record_step(cmd, &head(i), profiler.as_deref_mut()) {
+                        result = Err(e);
+                        return;
+                    }
+                }
+            }
+        })?;
+        result?;
+        Ok(profiler.and_then(|p| p.drain().pop()))
+    }
+}
+
+/// `vkCmdUpdateBuffer` in chunks of at most 64 KiB.
+///
+/// # Safety
+/// `cmd` is recording; `buffer` has TRANSFER_DST usage and room for the data;
+/// `offset` and the data length are multiples of 4.
+unsafe fn update_chunked(d: &Device, cmd: vk::CommandBuffer, buffer: vk::Buffer, offset: u64, data: &[u8]) {
+    for (k, chunk) in data.chunks(65536).enumerate() {
+        // SAFETY: guaranteed by the caller.
+        unsafe { d.raw.cmd_update_buffer(cmd, buffer, offset + k as u64 * 65536, chunk) };
+    }
+}
+
+/// The CPU reference simulation: the same algorithm as [`HairSim`], one particle
+/// at a time. Used as the oracle of the GPU tests and as the benchmark baseline.
+pub struct CpuHairSim {
+    schedule: Schedule,
+    state: SimState,
+}
+
+impl CpuHairSim {
+    /// See [`HairSim::new`].
+    pub fn new(groom: &Groom, params: &SimParams, head: &RigidTransform) -> Result<Self> {
+        let state = SimState::from_groom(groom, params, head)?;
+        Self::from_state(state, params, head)
+    }
+
+    /// See [`HairSim::from_state`].
+    pub fn from_state(state: SimState, params: &SimParams, head: &RigidTransform) -> Result<Self> {
+        // The CPU runs the same constraint sets in the same order whatever the packing.
+        let schedule = Schedule::new(params, head, state.strands, state.points, MAX_SIM_POINTS as u32)?;
+        Ok(CpuHairSim { schedule, state })
+    }
+
+    /// See [`HairSim::set_params`].
+    pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
+        self.schedule.set_params(params)
+    }
+
+    /// See [`HairSim::set_colliders`].
+    pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
+        self.schedule.set_colliders(colliders)
+    }
+
+    /// See [`HairSim::set_strand_length`].
+    pub fn set_strand_length(&mut self, strand: usize, length: f32) -> Result<()> {
+        self.state.set_strand_length(strand, length).map(|_| ())
+    }
+
+    /// Advances one step ending with the head at `head`.
+    pub fn step(&mut self, head: &RigidTransform) -> Result<()> {
+        let inputs = self.schedule.next(head)?;
+        reference::step(&mut self.state, &inputs);
+        Ok(())
+    }
+
+    /// The current state.
+    pub fn state(&self) -> &SimState {
+        &self.state
+    }
+}

@@ -1,0 +1,384 @@
+//! Simulation parameters, colliders and the head's rigid transform.
+//!
+//! All lengths are meters (or the groom's unit), times seconds. Everything is
+//! validated before any GPU work; each rejected field is named in the error.
+
+use glam::{Mat4, Quat, Vec3};
+
+use crate::error::{Error, Result};
+use crate::gpu_types::{GpuCollider, SimStepParams};
+
+/// Most colliders a simulation may have.
+pub const MAX_COLLIDERS: usize = 64;
+/// Most points per key hair the GPU solver handles (one 64-invocation workgroup).
+pub const MAX_SIM_POINTS: usize = 64;
+
+/// How the constraints are solved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SolverMode {
+    /// Position-based dynamics: alternating even/odd distance constraints, bending
+    /// and collisions, `iterations` times (the thesis' solver).
+    #[default]
+    Pbd,
+    /// Dynamic follow-the-leader (Müller et al. 2012): one sweep root to tip that
+    /// places each point at its rest distance, with velocity correction.
+    Dftl,
+}
+
+/// Tunable simulation parameters (a technical artist's knobs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimParams {
+    /// Time step of one simulation step, seconds (0 < dt ≤ 0.1). Default: 1/60.
+    pub dt: f32,
+    /// Sub-steps per step (1..=64); the head transform is interpolated between them.
+    /// Default: 1.
+    pub substeps: u32,
+    /// Constraint iterations per sub-step in PBD mode (1..=1000). Default: 20.
+    pub iterations: u32,
+    /// Solver mode. Default: [`SolverMode::Pbd`].
+    pub solver: SolverMode,
+    /// Gravity, m/s². Default: (0, −9.81, 0).
+    pub gravity: Vec3,
+    /// Whether gravity acts. Default: true.
+    pub gravity_enabled: bool,
+    /// Wind acceleration (direction × strength), m/s². Default: (0, 0, 0).
+    pub wind: Vec3,
+    /// Wind turbulence: relative strength of the gust noise (0..=1). Default: 0.3.
+    pub wind_turbulence: f32,
+    /// Gust noise frequency, 1/s (≥ 0). Default: 1.5.
+    pub wind_frequency: f32,
+    /// Whether wind acts. Default: false.
+    pub wind_enabled: bool,
+    /// Stiffness of the spring pulling each particle toward its rest position in the
+    /// head's frame, 1/s² (≥ 0). Default: 2.
+    pub spring_stiffness: f32,
+    /// Whether the rest-shape spring acts. Default: true.
+    pub spring_enabled: bool,
+    /// Bending stiffness at the root (0..=1; fraction of the bending error removed per
+    /// sub-step, independent of iterations). Default: 0.6.
+    pub bending_root: f32,
+    /// Bending stiffness at the tip (0..=1). Default: 0.1.
+    pub bending_tip: f32,
+    /// Whether bending constraints act. Default: true.
+    pub bending_enabled: bool,
+    /// Whether body collisions act. Default: true.
+    pub collisions_enabled: bool,
+    /// Fraction of velocity removed per sub-step (0..1). Default: 0.02.
+    pub damping: f32,
+    /// DFTL velocity correction factor s_damping (0..=1). Default: 0.9.
+    pub dftl_damping: f32,
+    /// Collision radius of each particle ("pearl"), at the root, in groom units (≥ 0).
+    /// Default: 0.002.
+    pub pearl_radius_root: f32,
+    /// Collision radius at the tip (≥ 0). Default: 0.004.
+    pub pearl_radius_tip: f32,
+    /// Key hairs packed into one solver workgroup; 0 packs as many as fit into its 64
+    /// invocations. Default: 0.
+    pub hairs_per_workgroup: u32,
+    /// Let the solver synchronise with subgroup barriers when every hair fits into one
+    /// subgroup (hairs are then packed so that none straddles two); otherwise every
+    /// constraint set ends with a workgroup barrier. Same results either way.
+    /// Default: true.
+    pub subgroup_sync: bool,
+}
+
+impl Default for SimParams {
+    fn default() -> Self {
+        SimParams {
+            dt: 1.0 / 60.0,
+            substeps: 1,
+            iterations: 20,
+            solver: SolverMode::Pbd,
+            gravity: Vec3::new(0.0, -9.81, 0.0),
+            gravity_enabled: true,
+            wind: Vec3::ZERO,
+            wind_turbulence: 0.3,
+            wind_frequency: 1.5,
+            wind_enabled: false,
+            spring_stiffness: 2.0,
+            spring_enabled: true,
+            bending_root: 0.6,
+            bending_tip: 0.1,
+            bending_enabled: true,
+            collisions_enabled: true,
+            damping: 0.02,
+            dftl_damping: 0.9,
+            pearl_radius_root: 0.002,
+            pearl_radius_tip: 0.004,
+            hairs_per_workgroup: 0,
+            subgroup_sync: true,
+        }
+    }
+}
+
+fn finite_vec(name: &'static str, v: Vec3) -> Result<()> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::param(name, format!("{v} is not finite")))
+    }
+}
+
+fn in_range(name: &'static str, v: f32, lo: f32, hi: f32) -> Result<()> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(())
+    } else {
+        Err(Error::param(name, format!("{v} is outside {lo}..={hi}")))
+    }
+}
+
+impl SimParams {
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.dt.is_finite() && self.dt > 0.0 && self.dt <= 0.1) {
+            return Err(Error::param("dt", format!("{} is outside (0, 0.1] seconds", self.dt)));
+        }
+        if !(1..=64).contains(&self.substeps) {
+            return Err(Error::param("substeps", format!("{} is outside 1..=64", self.substeps)));
+        }
+        if !(1..=1000).contains(&self.iterations) {
+            return Err(Error::param("iterations", format!("{} is outside 1..=1000", self.iterations)));
+        }
+        finite_vec("gravity", self.gravity)?;
+        finite_vec("wind", self.wind)?;
+        in_range("wind_turbulence", self.wind_turbulence, 0.0, 1.0)?;
+        in_range("wind_frequency", self.wind_frequency, 0.0, 1000.0)?;
+        in_range("spring_stiffness", self.spring_stiffness, 0.0, 1e6)?;
+        in_range("bending_root", self.bending_root, 0.0, 1.0)?;
+        in_range("bending_tip", self.bending_tip, 0.0, 1.0)?;
+        in_range("damping", self.damping, 0.0, 0.999)?;
+        in_range("dftl_damping", self.dftl_damping, 0.0, 1.0)?;
+        in_range("pearl_radius_root", self.pearl_radius_root, 0.0, 1e6)?;
+        in_range("pearl_radius_tip", self.pearl_radius_tip, 0.0, 1e6)?;
+        if self.hairs_per_workgroup as usize > MAX_SIM_POINTS / 2 {
+            return Err(Error::param("hairs_per_workgroup", format!("{} is above 32", self.hairs_per_workgroup)));
+        }
+        Ok(())
+    }
+
+    /// Sub-step length, seconds.
+    pub fn substep_dt(&self) -> f32 {
+        self.dt / self.substeps as f32
+    }
+
+    /// Stiffness per iteration equivalent to `k` per sub-step (Müller et al.'s
+    /// k' = 1 − (1 − k)^(1/n)), so that bending does not depend on the iteration count.
+    fn per_iteration(&self, k: f32) -> f32 {
+        let n = match self.solver {
+            SolverMode::Pbd => self.iterations,
+            SolverMode::Dftl => 1,
+        };
+        1.0 - (1.0 - k).powf(1.0 / n as f32)
+    }
+}
+
+/// A collision shape in the head's frame; it moves with the head transform.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Collider {
+    /// A sphere.
+    Sphere {
+        /// Centre in the head frame.
+        center: Vec3,
+        /// Radius (> 0).
+        radius: f32,
+    },
+    /// A capsule: the points within `radius` of the segment `a`–`b`.
+    Capsule {
+        /// First end in the head frame.
+        a: Vec3,
+        /// Second end in the head frame.
+        b: Vec3,
+        /// Radius (> 0).
+        radius: f32,
+    },
+}
+
+impl Collider {
+    pub(crate) fn validate(&self) -> Result<()> {
+        let (points, radius) = match *self {
+            Collider::Sphere { center, radius } => ([center, center], radius),
+            Collider::Capsule { a, b, radius } => ([a, b], radius),
+        };
+        finite_vec("collider position", points[0])?;
+        finite_vec("collider position", points[1])?;
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(Error::param("collider radius", format!("{radius} must be finite and > 0")));
+        }
+        Ok(())
+    }
+
+    /// The collider in world space for the GPU (and the CPU reference).
+    pub(crate) fn to_gpu(self, head: &Mat4) -> GpuCollider {
+        match self {
+            Collider::Sphere { center, radius } => {
+                let c = head.transform_point3(center);
+                GpuCollider { a_radius: [c.x, c.y, c.z, radius], b_kind: [c.x, c.y, c.z, 0.0] }
+            }
+            Collider::Capsule { a, b, radius } => {
+                let (a, b) = (head.transform_point3(a), head.transform_point3(b));
+                GpuCollider { a_radius: [a.x, a.y, a.z, radius], b_kind: [b.x, b.y, b.z, 1.0] }
+            }
+        }
+    }
+}
+
+/// The head's rigid motion: rotation then translation (world from head).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigidTransform {
+    /// Rotation (normalised on use).
+    pub rotation: Quat,
+    /// Translation, meters.
+    pub translation: Vec3,
+}
+
+impl Default for RigidTransform {
+    fn default() -> Self {
+        RigidTransform { rotation: Quat::IDENTITY, translation: Vec3::ZERO }
+    }
+}
+
+impl RigidTransform {
+    /// Checks for NaN/Inf and a degenerate rotation.
+    pub fn validate(&self) -> Result<()> {
+        if !self.translation.is_finite() || !self.rotation.is_finite() || self.rotation.length_squared() < 1e-12 {
+            return Err(Error::param("head transform", format!("{self:?} is not a finite rigid transform")));
+        }
+        Ok(())
+    }
+
+    /// The matrix (world from head).
+    pub fn matrix(&self) -> Mat4 {
+        Mat4::from_rotation_translation(self.rotation.normalize(), self.translation)
+    }
+
+    /// Interpolates rotation (slerp) and translation (lerp).
+    pub fn lerp(&self, to: &RigidTransform, t: f32) -> RigidTransform {
+        RigidTransform {
+            rotation: self.rotation.normalize().slerp(to.rotation.normalize(), t),
+            translation: self.translation.lerp(to.translation, t),
+        }
+    }
+}
+
+/// Flags of `SimStepParams::counts.w`, as in `glsl/include/sim.glsl`.
+pub(crate) mod flags {
+    pub const GRAVITY: u32 = 1;
+    pub const WIND: u32 = 2;
+    pub const SPRING: u32 = 4;
+    pub const BENDING: u32 = 8;
+    pub const COLLISIONS: u32 = 16;
+    pub const DFTL: u32 = 32;
+}
+
+/// Everything one sub-step needs, identical for the GPU stages and the CPU reference.
+pub(crate) struct SubstepInputs {
+    pub params: SimStepParams,
+    pub colliders: Vec<GpuCollider>,
+}
+
+/// The host-side bookkeeping shared by [`crate::sim::HairSim`] and
+/// [`crate::sim::CpuHairSim`]: parameters, colliders, the head transform of the
+/// previous step, simulated time and the sub-step counter. Both turn a step into
+/// the same [`SubstepInputs`], so GPU and CPU run on identical numbers.
+#[derive(Debug, Clone)]
+pub(crate) struct Schedule {
+    pub params: SimParams,
+    pub colliders: Vec<Collider>,
+    pub head: RigidTransform,
+    pub time: f64,
+    pub substep: u32,
+    pub strands: u32,
+    pub points: u32,
+    /// Subgroup size of the device the GPU stages run on.
+    pub subgroup_size: u32,
+}
+
+impl Schedule {
+    pub(crate) fn new(
+        params: &SimParams,
+        head: &RigidTransform,
+        strands: usize,
+        points: usize,
+        subgroup_size: u32,
+    ) -> Result<Self> {
+        params.validate()?;
+        head.validate()?;
+        Ok(Schedule {
+            params: params.clone(),
+            colliders: Vec::new(),
+            head: *head,
+            time: 0.0,
+            substep: 0,
+            strands: strands as u32,
+            points: points as u32,
+            subgroup_size,
+        })
+    }
+
+    pub(crate) fn set_params(&mut self, params: &SimParams) -> Result<()> {
+        params.validate()?;
+        self.params = params.clone();
+        Ok(())
+    }
+
+    pub(crate) fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
+        if colliders.len() > MAX_COLLIDERS {
+            return Err(Error::param("colliders", format!("{} exceed the limit of {MAX_COLLIDERS}", colliders.len())));
+        }
+        colliders.iter().try_for_each(Collider::validate)?;
+        self.colliders = colliders.to_vec();
+        Ok(())
+    }
+
+    /// How the solver packs hairs for the current parameters.
+    pub(crate) fn packing(&self) -> super::solve::Packing {
+        super::solve::packing(
+            self.points,
+            self.subgroup_size,
+            self.params.hairs_per_workgroup,
+            self.params.subgroup_sync,
+        )
+    }
+
+    /// The sub-steps of the next step, which ends with the head at `head`.
+    pub(crate) fn next(&mut self, head: &RigidTransform) -> Result<Vec<SubstepInputs>> {
+        head.validate()?;
+        let p = &self.params;
+        let dt = p.substep_dt();
+        let mut flags = 0;
+        flags |= if p.gravity_enabled { flags::GRAVITY } else { 0 };
+        flags |= if p.wind_enabled { flags::WIND } else { 0 };
+        flags |= if p.spring_enabled { flags::SPRING } else { 0 };
+        flags |= if p.bending_enabled { flags::BENDING } else { 0 };
+        flags |= if p.collisions_enabled { flags::COLLISIONS } else { 0 };
+        flags |= if p.solver == SolverMode::Dftl { flags::DFTL } else { 0 };
+        let packing = self.packing();
+        let inputs = (0..p.substeps)
+            .map(|k| {
+                let head = self.head.lerp(head, (k + 1) as f32 / p.substeps as f32).matrix();
+                let t = (self.time + f64::from(dt) * f64::from(k + 1)) as f32;
+                SubstepInputs {
+                    params: SimStepParams {
+                        head: head.to_cols_array_2d(),
+                        gravity_dt: [p.gravity.x, p.gravity.y, p.gravity.z, dt],
+                        wind: [p.wind.x, p.wind.y, p.wind.z, p.wind_turbulence],
+                        wind_noise: [p.wind_frequency, t, p.spring_stiffness, p.damping],
+                        bending: [p.per_iteration(p.bending_root), p.per_iteration(p.bending_tip), p.dftl_damping, 0.0],
+                        counts: [self.strands, self.points, p.iterations, flags],
+                        layout_info: [
+                            self.colliders.len() as u32,
+                            packing.hairs_per_group,
+                            self.substep.wrapping_add(k),
+                            packing.sync_group,
+                        ],
+                    },
+                    colliders: self.colliders.iter().map(|c| c.to_gpu(&head)).collect(),
+                }
+            })
+            .collect();
+        self.head = *head;
+        self.time += f64::from(p.dt);
+        self.substep = self.substep.wrapping_add(p.substeps);
+        Ok(inputs)
+    }
+}

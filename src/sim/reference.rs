@@ -1,0 +1,219 @@
+//! The CPU reference implementation of the simulation step: the oracle of the
+//! GPU tests and the baseline of the benchmarks.
+//!
+//! Every function mirrors `glsl/include/sim.glsl` and `glsl/sim/*.comp` with
+//! the same f32 operations in the same order; sets of independent constraints
+//! are applied in the same sequence as the GPU's barrier-separated phases, so
+//! the result matches the GPU up to how a driver rounds `sqrt` and division.
+
+use glam::{Vec3, Vec4};
+
+use super::params::{flags, SubstepInputs};
+use super::state::SimState;
+use crate::gpu_types::{GpuCollider, SimStepParams};
+
+fn dot(a: Vec3, b: Vec3) -> f32 {
+    (a.x * b.x + a.y * b.y) + a.z * b.z
+}
+
+fn transform_point(m: &[[f32; 4]; 4], p: Vec3) -> Vec3 {
+    let c = |i: usize| Vec3::new(m[i][0], m[i][1], m[i][2]);
+    ((c(0) * p.x + c(1) * p.y) + c(2) * p.z) + c(3)
+}
+
+fn hash(mut x: u32) -> f32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    (x >> 8) as f32 * (1.0 / 8_388_608.0) - 1.0
+}
+
+/// Smooth value noise in [-1, 1], as `sim_noise`.
+pub(crate) fn noise(t: f32, strand: u32) -> f32 {
+    let cell = t.floor();
+    let f = t - cell;
+    let s = f * f * (3.0 - 2.0 * f);
+    let i = ((cell as i32).wrapping_add(1_048_576) as u32).wrapping_add(strand.wrapping_mul(7919));
+    let a = hash(i);
+    let b = hash(i.wrapping_add(1));
+    a + (b - a) * s
+}
+
+fn collide(c: &GpuCollider, p: Vec3, radius: f32) -> Vec3 {
+    let a = Vec3::new(c.a_radius[0], c.a_radius[1], c.a_radius[2]);
+    let mut closest = a;
+    if c.b_kind[3] > 0.5 {
+        let ab = Vec3::new(c.b_kind[0], c.b_kind[1], c.b_kind[2]) - a;
+        let len2 = dot(ab, ab);
+        let t = if len2 > 0.0 { (dot(p - a, ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+        closest = a + ab * t;
+    }
+    let d = p - closest;
+    let dist = dot(d, d).sqrt();
+    let reach = c.a_radius[3] + radius;
+    if dist < reach && dist > 0.0 {
+        closest + d * (reach / dist)
+    } else {
+        p
+    }
+}
+
+fn collide_all(colliders: &[GpuCollider], mut p: Vec3, radius: f32) -> Vec3 {
+    for c in colliders {
+        p = collide(c, p, radius);
+    }
+    p
+}
+
+fn project(s: &mut [Vec4], i: usize, j: usize, rest_d: f32, k: f32) {
+    let (a, b) = (s[i], s[j]);
+    let w = a.w + b.w;
+    let d = b.truncate() - a.truncate();
+    let len = dot(d, d).sqrt();
+    if w > 0.0 && len > 0.0 {
+        let c = ((len - rest_d) / (len * w)) * k;
+        let pa = a.truncate() + d * (a.w * c);
+        let pb = b.truncate() - d * (b.w * c);
+        s[i] = pa.extend(a.w);
+        s[j] = pb.extend(b.w);
+    }
+}
+
+/// Stage 1: forces and prediction.
+fn predict(p: &SimStepParams, state: &SimState, predicted: &mut [Vec4]) {
+    let points = p.counts[1] as usize;
+    let dt = p.gravity_dt[3];
+    let flags = p.counts[3];
+    let gravity = Vec3::new(p.gravity_dt[0], p.gravity_dt[1], p.gravity_dt[2]);
+    let wind = Vec3::new(p.wind[0], p.wind[1], p.wind[2]);
+    for (index, out) in predicted.iter_mut().enumerate() {
+        let strand = (index / points) as u32;
+        let x = state.positions[index];
+        let rest_world = transform_point(&p.head, state.rest[index].truncate());
+        if x.w == 0.0 {
+            *out = rest_world.extend(0.0);
+            continue;
+        }
+        let mut a = Vec3::ZERO;
+        if flags & flags::GRAVITY != 0 {
+            a += gravity;
+        }
+        if flags & flags::WIND != 0 {
+            let gust = 1.0 + p.wind[3] * noise(p.wind_noise[1] * p.wind_noise[0], strand);
+            a += wind * gust;
+        }
+        if flags & flags::SPRING != 0 {
+            a += (rest_world - x.truncate()) * p.wind_noise[2];
+        }
+        let v = state.velocities[index].truncate() + a * dt;
+        *out = (x.truncate() + v * dt).extend(x.w);
+    }
+}
+
+/// Stage 2: constraint solve, hair by hair.
+fn solve(
+    p: &SimStepParams,
+    colliders: &[GpuCollider],
+    state: &SimState,
+    predicted: &mut [Vec4],
+    correction: &mut [Vec4],
+) {
+    let points = p.counts[1] as usize;
+    let flags = p.counts[3];
+    let collisions = flags & flags::COLLISIONS != 0;
+    let mut s = vec![Vec4::ZERO; points];
+    let mut bend = vec![(0.0f32, 0.0f32); points];
+    for strand in 0..p.counts[0] as usize {
+        let base = strand * points;
+        s.copy_from_slice(&predicted[base..base + points]);
+        let lengths = &state.rest_lengths[base..base + points];
+        let radius = |i: usize| state.rest[base + i].w;
+        if flags & flags::DFTL != 0 {
+            for k in 1..points {
+                let parent = s[k - 1];
+                let q = s[k];
+                if q.w > 0.0 {
+                    let d = q.truncate() - parent.truncate();
+                    let len = dot(d, d).sqrt();
+                    let mut placed =
+                        if len > 0.0 { parent.truncate() + d * (lengths[k - 1] / len) } else { q.truncate() };
+                    if collisions {
+                        placed = collide_all(colliders, placed, radius(k));
+                    }
+                    s[k] = placed.extend(q.w);
+                }
+            }
+            for i in 0..points {
+                correction[base + i] = (s[i].truncate() - predicted[base + i].truncate()).extend(0.0);
+                predicted[base + i] = s[i];
+            }
+            continue;
+        }
+        for (i, b) in bend.iter_mut().enumerate() {
+            *b = (0.0, 0.0);
+            if i > 0 && i + 1 < points {
+                let r = state.rest[base + i + 1].truncate() - state.rest[base + i - 1].truncate();
+                let t = i as f32 / (points - 1) as f32;
+                *b = (dot(r, r).sqrt(), p.bending[0] + (p.bending[1] - p.bending[0]) * t);
+            }
+        }
+        let bending = flags & flags::BENDING != 0;
+        for _ in 0..p.counts[2] {
+            for i in (0..points - 1).step_by(2) {
+                project(&mut s, i, i + 1, lengths[i], 1.0);
+            }
+            for i in (1..points - 1).step_by(2) {
+                project(&mut s, i, i + 1, lengths[i], 1.0);
+            }
+            if bending {
+                for phase in [0usize, 2] {
+                    for (i, &(rest_d, k)) in bend.iter().enumerate() {
+                        if k > 0.0 && (i & 3) >= phase && (i & 3) < phase + 2 {
+                            project(&mut s, i - 1, i + 1, rest_d, k);
+                        }
+                    }
+                }
+            }
+            if collisions {
+                for (i, q) in s.iter_mut().enumerate() {
+                    if q.w > 0.0 {
+                        *q = collide_all(colliders, q.truncate(), radius(i)).extend(q.w);
+                    }
+                }
+            }
+        }
+        predicted[base..base + points].copy_from_slice(&s);
+    }
+}
+
+/// Stage 3: velocity update, damping, final state.
+fn integrate(p: &SimStepParams, state: &mut SimState, predicted: &[Vec4], correction: &[Vec4]) {
+    let points = p.counts[1] as usize;
+    let dt = p.gravity_dt[3];
+    let dftl = p.counts[3] & flags::DFTL != 0;
+    for index in 0..predicted.len() {
+        let i = index % points;
+        let solved = predicted[index];
+        let mut v = (solved.truncate() - state.positions[index].truncate()) / dt;
+        if dftl && i + 1 < points {
+            v -= correction[index + 1].truncate() * (p.bending[2] / dt);
+        }
+        v *= 1.0 - p.wind_noise[3];
+        state.positions[index] = solved;
+        state.velocities[index] = v.extend(0.0);
+    }
+}
+
+/// Advances `state` by the given sub-steps.
+pub(crate) fn step(state: &mut SimState, substeps: &[SubstepInputs]) {
+    let n = state.positions.len();
+    let mut predicted = vec![Vec4::ZERO; n];
+    let mut correction = vec![Vec4::ZERO; n];
+    for sub in substeps {
+        predict(&sub.params, state, &mut predicted);
+        solve(&sub.params, &sub.colliders, state, &mut predicted, &mut correction);
+        integrate(&sub.params, state, &predicted, &correction);
+    }
+}

@@ -1,0 +1,256 @@
+//! Simulation state: the CPU form (reference, readback) and the GPU buffers.
+//!
+//! Structure of arrays, one element per particle, strand after strand, root
+//! first, so consecutive invocations touch consecutive memory:
+//!
+//! | buffer | element | meaning |
+//! | --- | --- | --- |
+//! | positions ×2 | vec4 | world position, w inverse mass (0 = pinned to the head) |
+//! | velocities ×2 | vec4 | world velocity (m/s) |
+//! | predicted | vec4 | scratch: predicted, then solved positions |
+//! | correction | vec4 | scratch: DFTL correction vectors |
+//! | rest | vec4 | rest position in the head frame, w collision radius |
+//! | rest lengths | f32 | rest length of the segment to the next point |
+//!
+//! Positions and velocities are double-buffered: a step reads one half and
+//! writes the other, so a renderer can read the result of step N−1 while
+//! step N runs.
+
+use std::sync::Arc;
+
+use ash::vk;
+use glam::{Vec3, Vec4};
+use gpu_allocator::MemoryLocation;
+
+use super::params::{RigidTransform, SimParams, MAX_COLLIDERS, MAX_SIM_POINTS};
+use crate::error::{Error, Result};
+use crate::gpu_types::{GpuCollider, SimStepParams};
+use crate::groom::Groom;
+use crate::vk::buffer::{Buffer, BufferDesc};
+use crate::vk::device::Device;
+
+/// Simulation state on the CPU.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimState {
+    /// Key hairs.
+    pub strands: usize,
+    /// Points per key hair.
+    pub points: usize,
+    /// World positions, w = inverse mass.
+    pub positions: Vec<Vec4>,
+    /// World velocities, w = 0.
+    pub velocities: Vec<Vec4>,
+    /// Rest positions in the head frame, w = collision radius.
+    pub rest: Vec<Vec4>,
+    /// Rest length of the segment from each point to the next (0 for tips).
+    pub rest_lengths: Vec<f32>,
+}
+
+impl SimState {
+    /// The state at rest: the groom (given in the head frame) placed by `head`,
+    /// roots pinned, velocities zero.
+    pub fn from_groom(groom: &Groom, params: &SimParams, head: &RigidTransform) -> Result<Self> {
+        params.validate()?;
+        head.validate()?;
+        let points = groom.uniform_points_per_strand().ok_or_else(|| {
+            Error::param("key hairs", "strands differ in point count; resample them with Groom::resampled")
+        })?;
+        if points > MAX_SIM_POINTS {
+            return Err(Error::param(
+                "key hairs",
+                format!("{points} points per strand exceed {MAX_SIM_POINTS}; resample them with Groom::resampled"),
+            ));
+        }
+        let m = head.matrix();
+        let n = groom.point_count();
+        let mut state = SimState {
+            strands: groom.strand_count(),
+            points,
+            positions: Vec::with_capacity(n),
+            velocities: vec![Vec4::ZERO; n],
+            rest: Vec::with_capacity(n),
+            rest_lengths: Vec::with_capacity(n),
+        };
+        for s in 0..groom.strand_count() {
+            let strand = groom.strand(s);
+            for (i, &p) in strand.iter().enumerate() {
+                let t = i as f32 / (points - 1) as f32;
+                let radius = params.pearl_radius_root + (params.pearl_radius_tip - params.pearl_radius_root) * t;
+                state.rest.push(p.extend(radius));
+                state.positions.push(m.transform_point3(p).extend(if i == 0 { 0.0 } else { 1.0 }));
+                state.rest_lengths.push(strand.get(i + 1).map_or(0.0, |q| (*q - p).length()));
+            }
+        }
+        Ok(state)
+    }
+
+    /// Points of strand `s` (xyz of `positions`).
+    pub fn strand(&self, s: usize) -> impl Iterator<Item = Vec3> + '_ {
+        self.positions[s * self.points..(s + 1) * self.points].iter().map(|p| p.truncate())
+    }
+
+    /// Length of strand `s` along its current segments.
+    pub fn strand_length(&self, s: usize) -> f32 {
+        let pts: Vec<Vec3> = self.strand(s).collect();
+        pts.windows(2).map(|w| (w[1] - w[0]).length()).sum()
+    }
+
+    /// Rest length of strand `s`.
+    pub fn rest_strand_length(&self, s: usize) -> f32 {
+        self.rest_lengths[s * self.points..(s + 1) * self.points].iter().sum()
+    }
+
+    /// Kinetic energy with unit mass per free particle, J/kg.
+    pub fn kinetic_energy(&self) -> f64 {
+        self.positions
+            .iter()
+            .zip(&self.velocities)
+            .filter(|(p, _)| p.w > 0.0)
+            .map(|(_, v)| 0.5 * f64::from(v.truncate().length_squared()))
+            .sum()
+    }
+
+    /// Changes strand `s`'s rest length to `length` by scaling only its tip half
+    /// (segments from (points − 1) / 2 on); root segments keep their length.
+    /// Returns the first particle index whose rest data changed.
+    pub(crate) fn set_strand_length(&mut self, s: usize, length: f32) -> Result<usize> {
+        if s >= self.strands {
+            return Err(Error::StrandIndex { index: s, count: self.strands });
+        }
+        let base = s * self.points;
+        let segments = self.points - 1;
+        let first_tip = segments / 2;
+        let lengths = &self.rest_lengths[base..base + segments];
+        let root_part: f32 = lengths[..first_tip].iter().sum();
+        let tip_part: f32 = lengths[first_tip..].iter().sum();
+        let minimum = root_part + tip_part * 0.05;
+        if !(length.is_finite() && length > minimum && length < 1e6) {
+            return Err(Error::param(
+                "strand length",
+                format!("{length} must be finite and above {minimum} (root segments plus 5 % of the tip segments)"),
+            ));
+        }
+        let scale = (length - root_part) / tip_part;
+        for i in first_tip..segments {
+            let old = self.rest[base + i + 1].truncate() - self.rest[base + i].truncate();
+            self.rest_lengths[base + i] *= scale;
+            let moved = self.rest[base + i].truncate() + old * scale;
+            self.rest[base + i + 1] = moved.extend(self.rest[base + i + 1].w);
+        }
+        Ok(base + first_tip)
+    }
+}
+
+/// The GPU buffers of the simulation.
+pub(crate) struct GpuState {
+    pub positions: [Buffer; 2],
+    pub velocities: [Buffer; 2],
+    pub predicted: Buffer,
+    pub correction: Buffer,
+    pub rest: Buffer,
+    pub rest_lengths: Buffer,
+    pub colliders: Buffer,
+    pub params: Buffer,
+}
+
+/// Binding numbers shared by the stage shaders (see `glsl/sim/*.comp`).
+pub(crate) mod binding {
+    pub const PARAMS: u32 = 0;
+    pub const POS_IN: u32 = 1;
+    pub const VEL_IN: u32 = 2;
+    pub const PREDICTED: u32 = 3;
+    pub const CORRECTION: u32 = 4;
+    pub const REST: u32 = 5;
+    pub const REST_LENGTH: u32 = 6;
+    pub const COLLIDERS: u32 = 7;
+    pub const POS_OUT: u32 = 8;
+    pub const VEL_OUT: u32 = 9;
+}
+
+impl GpuState {
+    /// Creates the buffers and uploads `state` into half 0 (this submits and waits).
+    pub(crate) fn new(device: &Arc<Device>, state: &SimState) -> Result<Self> {
+        let n = state.positions.len() as u64;
+        let vec4_bytes = n * 16;
+        if vec4_bytes > u64::from(device.info.max_storage_buffer_range) {
+            return Err(Error::param(
+                "key hairs",
+                format!(
+                    "{n} particles need {vec4_bytes} bytes per buffer, above the device's {} byte range",
+                    device.info.max_storage_buffer_range
+                ),
+            ));
+        }
+        let storage = |name: &str, size: u64| {
+            Buffer::new(
+                device,
+                &BufferDesc {
+                    name,
+                    size,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                        | vk::BufferUsageFlags::TRANSFER_SRC
+                        | vk::BufferUsageFlags::TRANSFER_DST,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )
+        };
+        let gpu = GpuState {
+            positions: [storage("vkhair sim positions 0", vec4_bytes)?, storage("vkhair sim positions 1", vec4_bytes)?],
+            velocities: [
+                storage("vkhair sim velocities 0", vec4_bytes)?,
+                storage("vkhair sim velocities 1", vec4_bytes)?,
+            ],
+            predicted: storage("vkhair sim predicted", vec4_bytes)?,
+            correction: storage("vkhair sim correction", vec4_bytes)?,
+            rest: storage("vkhair sim rest", vec4_bytes)?,
+            rest_lengths: storage("vkhair sim rest lengths", n * 4)?,
+            colliders: Buffer::new(
+                device,
+                &BufferDesc {
+                    name: "vkhair sim colliders",
+                    size: (MAX_COLLIDERS * std::mem::size_of::<GpuCollider>()) as u64,
+                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )?,
+            params: Buffer::new(
+                device,
+                &BufferDesc {
+                    name: "vkhair sim params",
+                    size: std::mem::size_of::<SimStepParams>() as u64,
+                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )?,
+        };
+        gpu.upload(device, state, 0)?;
+        device.upload_pod(&gpu.rest, &state.rest)?;
+        device.upload_pod(&gpu.rest_lengths, &state.rest_lengths)?;
+        device.upload_pod(&gpu.correction, &vec![Vec4::ZERO; n as usize])?;
+        device.upload_pod(&gpu.predicted, &state.positions)?;
+        Ok(gpu)
+    }
+
+    /// Uploads positions and velocities into half `parity` (submits and waits).
+    pub(crate) fn upload(&self, device: &Arc<Device>, state: &SimState, parity: usize) -> Result<()> {
+        device.upload_pod(&self.positions[parity], &state.positions)?;
+        device.upload_pod(&self.velocities[parity], &state.velocities)
+    }
+
+    /// Buffers by binding number for half `parity` (reads `parity`, writes the other).
+    pub(crate) fn bindings(&self, parity: usize) -> [(u32, &Buffer); 10] {
+        use binding::*;
+        [
+            (PARAMS, &self.params),
+            (POS_IN, &self.positions[parity]),
+            (VEL_IN, &self.velocities[parity]),
+            (PREDICTED, &self.predicted),
+            (CORRECTION, &self.correction),
+            (REST, &self.rest),
+            (REST_LENGTH, &self.rest_lengths),
+            (COLLIDERS, &self.colliders),
+            (POS_OUT, &self.positions[1 - parity]),
+            (VEL_OUT, &self.velocities[1 - parity]),
+        ]
+    }
+}
