@@ -3,8 +3,9 @@
 //!
 //! Scenes: `thesis` (1750 × 6, 20 iterations); a 2,228 × 32 groom with 3
 //! iterations (the size of TressFX's "mohawk" sample); a 10,000 × 32 groom
-//! (20 iterations). Solver variants: subgroup-synchronised packing (default),
+//! (20 iterations). Solver variants: automatic packing (default),
 //! workgroup barriers with as many hairs as fit, and one hair per workgroup.
+//! ("auto" uses subgroup barriers when they keep as many lanes busy.)
 //!
 //! Besides criterion's own report, a summary table (ms per step, particle-steps
 //! per second, per-stage share, ratio to the CPU reference) is printed and
@@ -43,7 +44,7 @@ fn scenes() -> Vec<Scene> {
 
 fn variants(base: &SimParams) -> Vec<(&'static str, SimParams)> {
     vec![
-        ("gpu subgroup sync", base.clone()),
+        ("gpu auto packing (default)", base.clone()),
         ("gpu workgroup sync", SimParams { subgroup_sync: false, ..base.clone() }),
         ("gpu one hair per workgroup", SimParams { subgroup_sync: false, hairs_per_workgroup: 1, ..base.clone() }),
     ]

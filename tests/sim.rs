@@ -97,6 +97,14 @@ fn gpu_matches_cpu_on_the_thesis_scene() {
 }
 
 #[test]
+fn gpu_matches_cpu_with_substeps() {
+    let gpu = Gpu::new();
+    let groom = small_groom(120, 6);
+    let params = SimParams { substeps: 4, iterations: 8, ..SimParams::default() };
+    compare(gpu.ctx(), &groom, &params, &[1, 30]);
+}
+
+#[test]
 fn gpu_matches_cpu_in_dftl_mode() {
     let gpu = Gpu::new();
     let groom = scenes::thesis().expect("thesis");

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The main job: list devices, grow the `thesis` reference scene and inspect it
-# (later stages turn this into the headless renderer).
+# The main job: list devices, grow the `thesis` reference scene, inspect it and
+# simulate it on the GPU with the shaking-head motion (per-stage timing table,
+# checked against the CPU reference). Later stages turn this into the renderer.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup-debian.sh
@@ -11,3 +12,4 @@ mkdir -p "$out"
 "$vkhair" devices
 "$vkhair" grow --scalp thesis --out "$out/thesis.hair"
 "$vkhair" inspect "$out/thesis.hair"
+"$vkhair" simulate --steps 240 --check

@@ -184,6 +184,13 @@ impl HairSim {
         self.gpu.positions[self.current].raw()
     }
 
+    /// The positions buffer holding the state before the latest step (for drawing
+    /// between the last two states with [`StepPlan::alpha`]); same layout and barrier
+    /// rule as [`HairSim::positions_buffer`].
+    pub fn previous_positions_buffer(&self) -> vk::Buffer {
+        self.gpu.positions[1 - self.current].raw()
+    }
+
     /// Records one step that ends with the head at `head` into `cmd`, with a debug
     /// label and (when a profiler is given) a timestamp scope per stage.
     ///

@@ -13,10 +13,15 @@ pub const NECK_PIVOT: Vec3 = Vec3::new(0.0, 1.5, 0.0);
 /// `amplitude` radians at `frequency` Hz plus a nod of a third of it at twice the
 /// frequency, both about the neck pivot.
 pub fn shaking_head(time: f32, amplitude: f32, frequency: f32) -> RigidTransform {
+    shaking_head_about(time, amplitude, frequency, NECK_PIVOT)
+}
+
+/// [`shaking_head`] about another pivot (for grooms placed elsewhere).
+pub fn shaking_head_about(time: f32, amplitude: f32, frequency: f32, pivot: Vec3) -> RigidTransform {
     let phase = std::f32::consts::TAU * frequency * time;
     let rotation =
         Quat::from_rotation_y(amplitude * phase.sin()) * Quat::from_rotation_x(amplitude / 3.0 * (2.0 * phase).sin());
-    RigidTransform { rotation, translation: NECK_PIVOT - rotation * NECK_PIVOT }
+    RigidTransform { rotation, translation: pivot - rotation * pivot }
 }
 
 /// The default reference motion: ±0.6 rad at 1 Hz.

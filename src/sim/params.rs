@@ -76,7 +76,8 @@ pub struct SimParams {
     /// invocations. Default: 0.
     pub hairs_per_workgroup: u32,
     /// Let the solver synchronise with subgroup barriers when every hair fits into one
-    /// subgroup (hairs are then packed so that none straddles two); otherwise every
+    /// subgroup (hairs are then packed so that none straddles two) and that keeps at
+    /// least as many lanes busy as packing the whole workgroup; otherwise every
     /// constraint set ends with a workgroup barrier. Same results either way.
     /// Default: true.
     pub subgroup_sync: bool,

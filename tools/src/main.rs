@@ -11,7 +11,8 @@ use vkhair::groom::grow::{grow, GrowParams, Scalp};
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::{scenes, Groom};
-use vkhair::{list_devices, ContextOptions};
+use vkhair::sim::{motion, CpuHairSim, HairSim, RigidTransform, SimParams, SimStage, SolverMode};
+use vkhair::{list_devices, ContextOptions, GpuContext, GpuProfiler};
 
 #[derive(Parser)]
 #[command(name = "vkhair", version, about = "Real-time strand hair on Vulkan: devices, grooms, growth")]
@@ -31,6 +32,8 @@ enum Command {
     },
     /// Grow strands on a scalp and write them as a .hair file.
     Grow(GrowArgs),
+    /// Simulate a groom on the GPU with the shaking-head motion; print per-stage GPU times.
+    Simulate(SimulateArgs),
     /// Resample and/or pick key hairs from a .hair or .tfx file; write a .hair file.
     Convert {
         /// Input groom (.hair or .tfx).
@@ -45,6 +48,31 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+}
+
+#[derive(clap::Args)]
+struct SimulateArgs {
+    /// Groom file (.hair or .tfx); default: the `thesis` scene with its colliders.
+    #[arg(long)]
+    input: Option<PathBuf>,
+    /// Multiply input positions by this (e.g. 0.01 for Blender units to meters).
+    #[arg(long, default_value_t = 1.0)]
+    scale: f32,
+    /// Resample input strands to this many points (at most 64).
+    #[arg(long, default_value_t = 16)]
+    points: usize,
+    /// Simulation steps (1/60 s each).
+    #[arg(long, default_value_t = 120)]
+    steps: usize,
+    /// Constraint iterations.
+    #[arg(long, default_value_t = 20)]
+    iterations: u32,
+    /// Use the DFTL solver instead of PBD iterations.
+    #[arg(long)]
+    dftl: bool,
+    /// Also run the CPU reference and report the largest position difference.
+    #[arg(long)]
+    check: bool,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -109,6 +137,7 @@ fn main() -> ExitCode {
         Command::Devices => devices(),
         Command::Inspect { file } => inspect(&file),
         Command::Grow(args) => grow_cmd(&args),
+        Command::Simulate(args) => simulate(&args),
         Command::Convert { input, points, key_hairs, out } => convert(&input, points, key_hairs, &out),
     };
     match result {
@@ -287,5 +316,72 @@ fn convert(input: &Path, points: Option<usize>, key_hairs: Option<usize>, out: &
     HairFile::new(groom, &format!("from {}", input.file_name().and_then(|n| n.to_str()).unwrap_or("input")))
         .save(out)?;
     println!("wrote {}: {} strands, {} points", out.display(), s.strands, s.points);
+    Ok(())
+}
+
+fn simulate(a: &SimulateArgs) -> CliResult {
+    let (groom, colliders, label, pivot) = match &a.input {
+        None => (scenes::thesis()?, motion::thesis_colliders(), "thesis scene".to_owned(), motion::NECK_PIVOT),
+        Some(path) => {
+            let (groom, _) = load(path)?;
+            let scaled: Vec<Vec3> = groom.positions().iter().map(|p| *p * a.scale).collect();
+            let counts: Vec<u32> = (0..groom.strand_count()).map(|i| groom.strand_len(i) as u32).collect();
+            let groom = Groom::new(scaled, &counts)?.resampled(a.points)?;
+            // Turn about the centre of the roots' lowest level: roughly the neck.
+            let (lo, hi) = groom.bounds();
+            let pivot = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
+            (groom, Vec::new(), path.display().to_string(), pivot)
+        }
+    };
+    let params = SimParams {
+        iterations: a.iterations,
+        solver: if a.dftl { SolverMode::Dftl } else { SolverMode::Pbd },
+        ..SimParams::default()
+    };
+    let ctx = GpuContext::headless(&ContextOptions::default())?;
+    let head = |i: usize| motion::shaking_head_about((i + 1) as f32 * params.dt, 0.6, 1.0, pivot);
+    let mut sim = HairSim::new(&ctx, &groom, &params, &RigidTransform::default())?;
+    sim.set_colliders(&colliders)?;
+    let mut profiler = GpuProfiler::new(&ctx, 1, 1024)?;
+    let (strands, points) = sim.size();
+    println!(
+        "{label}: {strands} key hairs × {points} points on {}, {} steps of {:.4} s",
+        ctx.info().name,
+        a.steps,
+        params.dt
+    );
+    let mut totals = vec![0.0f64; SimStage::ALL.len()];
+    let chunk = 100;
+    let mut done = 0;
+    while done < a.steps {
+        let n = chunk.min(a.steps - done);
+        let start = done;
+        if let Some(report) = sim.run(n, |i| head(start + i), Some(&mut profiler))? {
+            for (name, ns) in report.totals_by_name() {
+                if let Some(k) = SimStage::ALL.iter().position(|s| s.label() == name) {
+                    totals[k] += ns;
+                }
+            }
+        }
+        done += n;
+    }
+    let sum: f64 = totals.iter().sum();
+    println!("{:<24} {:>12} {:>8}", "stage", "ms/step", "share");
+    for (stage, ns) in SimStage::ALL.iter().zip(&totals) {
+        println!("{:<24} {:>12.3} {:>7.1}%", stage.label(), ns / 1e6 / a.steps as f64, 100.0 * ns / sum.max(1.0));
+    }
+    println!("{:<24} {:>12.3}", "total", sum / 1e6 / a.steps as f64);
+    let state = sim.read_state()?;
+    println!("kinetic energy {:.4} J/kg per particle", state.kinetic_energy() / state.positions.len() as f64);
+    if a.check {
+        let mut cpu = CpuHairSim::new(&groom, &params, &RigidTransform::default())?;
+        cpu.set_colliders(&colliders)?;
+        for i in 0..a.steps {
+            cpu.step(&head(i))?;
+        }
+        let max =
+            state.positions.iter().zip(&cpu.state().positions).map(|(g, c)| (*g - *c).length()).fold(0.0f32, f32::max);
+        println!("largest GPU − CPU reference position difference: {max:e} m");
+    }
     Ok(())
 }
