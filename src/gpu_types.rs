@@ -64,6 +64,21 @@ pub(crate) struct GpuCollider {
 }
 gpu_struct!(GpuCollider => "Collider" { a_radius, b_kind });
 
+/// Push constants of the smoothing pass (`SmoothPush` in `glsl/include/render.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct SmoothPush {
+    /// Key hairs.
+    pub strands: u32,
+    /// Points per key hair.
+    pub points: u32,
+    /// Smoothed segments per key segment.
+    pub level: u32,
+    /// Smoothed vertices per key hair.
+    pub stride: u32,
+}
+gpu_struct!(SmoothPush => "SmoothPush" { strands, points, level, stride });
+
 /// Every Rust GPU struct with the shader-side name, for the layout test.
 #[cfg(test)]
 pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<String> {
@@ -80,5 +95,6 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<LayoutProbe>(reflection, &mut problems);
     check::<SimStepParams>(reflection, &mut problems);
     check::<GpuCollider>(reflection, &mut problems);
+    check::<SmoothPush>(reflection, &mut problems);
     problems
 }

@@ -10,6 +10,7 @@
 //!
 //! - `vk` (crate-private): thin wrappers over ash — device record, buffers,
 //!   images, staging, barriers, reflection, pipelines, debug names and labels.
+//! - [`render`]: drawing hair from the simulated key hairs ([`render::Renderer`]).
 //! - [`sim`]: the GPU simulation ([`sim::HairSim`]) and its CPU reference.
 //! - [`groom`]: key-hair data — the [`Groom`] type, `.hair` and `.tfx` files,
 //!   procedural growth from a scalp, resampling and key-hair selection.
@@ -33,6 +34,7 @@ mod error;
 pub(crate) mod gpu_types;
 pub mod groom;
 mod profiler;
+pub mod render;
 mod requirements;
 pub mod sim;
 pub(crate) mod vk;

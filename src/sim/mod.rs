@@ -184,6 +184,11 @@ impl HairSim {
         self.gpu.positions[self.current].raw()
     }
 
+    /// Both halves of the double-buffered positions and the index of the latest one.
+    pub(crate) fn position_halves(&self) -> ([&crate::vk::buffer::Buffer; 2], usize) {
+        ([&self.gpu.positions[0], &self.gpu.positions[1]], self.current)
+    }
+
     /// The positions buffer holding the state before the latest step (for drawing
     /// between the last two states with [`StepPlan::alpha`]); same layout and barrier
     /// rule as [`HairSim::positions_buffer`].

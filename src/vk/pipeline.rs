@@ -321,6 +321,8 @@ pub(crate) struct GraphicsDesc<'a> {
     /// Additive blending (`ONE`, `ONE`) instead of alpha blending when `Some(true)`;
     /// `None` disables blending.
     pub additive_blend: Option<bool>,
+    /// Discard primitives before rasterization (capture passes that only store).
+    pub rasterizer_discard: bool,
 }
 
 /// A graphics pipeline.
@@ -356,6 +358,7 @@ impl GraphicsPipeline {
             vk::PipelineTessellationStateCreateInfo::default().patch_control_points(desc.patch_control_points);
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .rasterizer_discard_enable(desc.rasterizer_discard)
             .polygon_mode(vk::PolygonMode::FILL)
             .cull_mode(vk::CullModeFlags::NONE)
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)

@@ -172,6 +172,7 @@ fn every_shader_struct_matches_its_rust_twin() {
         LayoutProbe::GLSL_NAME,
         gpu_types::SimStepParams::GLSL_NAME,
         gpu_types::GpuCollider::GLSL_NAME,
+        gpu_types::SmoothPush::GLSL_NAME,
     ];
     let mut found = vec![0usize; names.len()];
     for shader in shaders::ALL {
@@ -281,6 +282,7 @@ fn graphics_pipeline_draws_with_dynamic_rendering() {
             depth_test: false,
             depth_write: false,
             additive_blend: None,
+            rasterizer_discard: false,
         },
         0,
     )

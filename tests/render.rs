@@ -1,0 +1,88 @@
+//! The render passes against CPU references, under validation.
+
+use glam::Vec3;
+use vkhair::groom::grow::{grow, GrowParams};
+use vkhair::groom::scenes;
+use vkhair::render::{reference, RenderParams, Renderer};
+use vkhair::sim::{motion, HairSim, RigidTransform, SimParams};
+use vkhair::{ContextOptions, Error, GpuContext, ValidationLog};
+
+struct Gpu {
+    ctx: Option<GpuContext>,
+    log: ValidationLog,
+}
+
+impl Gpu {
+    fn new() -> Gpu {
+        let log = ValidationLog::new();
+        let ctx = GpuContext::headless(&ContextOptions::validated(&log)).expect("headless context with validation");
+        Gpu { ctx: Some(ctx), log }
+    }
+    fn ctx(&self) -> &GpuContext {
+        self.ctx.as_ref().expect("alive")
+    }
+}
+
+impl Drop for Gpu {
+    fn drop(&mut self) {
+        drop(self.ctx.take());
+        if !std::thread::panicking() {
+            self.log.assert_clean();
+        }
+    }
+}
+
+/// Smoothed vertices equal a CPU evaluation of the same B-spline of the simulated
+/// key hairs: positions within 1e-5 m, tangents unit length within 1e-5 and within
+/// 1e-4 of the CPU's; root and tip at the key hair's root and tip.
+#[test]
+fn smoothing_matches_the_cpu_bspline() {
+    let gpu = Gpu::new();
+    let groom = scenes::thesis().expect("thesis");
+    let params = SimParams::default();
+    let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
+    sim.set_colliders(&motion::thesis_colliders()).expect("colliders");
+    sim.run(30, |i| motion::reference_motion((i + 1) as f32 * params.dt), None).expect("run");
+    let state = sim.read_state().expect("state");
+    for level in [4, 1, 7] {
+        let mut renderer = Renderer::new(gpu.ctx(), &sim, &RenderParams { smoothing_level: level }).expect("renderer");
+        renderer.prepare_now(&sim).expect("prepare");
+        let (positions, tangents) = renderer.read_smoothed().expect("readback");
+        let stride = renderer.smoothed_vertices_per_strand() as usize;
+        assert_eq!(stride, 5 * level as usize + 1);
+        assert_eq!(positions.len(), 1750 * stride);
+        let mut worst = (0.0f32, 0.0f32);
+        for s in 0..state.strands {
+            let keys: Vec<Vec3> = state.strand(s).collect();
+            let cpu = reference::smooth_strand(&keys, level);
+            for (k, (p, t)) in cpu.iter().enumerate() {
+                let (gp, gt) = (positions[s * stride + k].truncate(), tangents[s * stride + k].truncate());
+                worst.0 = worst.0.max((gp - *p).length());
+                worst.1 = worst.1.max((gt - *t).length());
+                assert!((gt.length() - 1.0).abs() < 1e-5, "tangent {s}/{k} has length {}", gt.length());
+            }
+            assert!((positions[s * stride].truncate() - keys[0]).length() < 1e-5, "root of {s}");
+            assert!((positions[s * stride + stride - 1].truncate() - keys[5]).length() < 1e-5, "tip of {s}");
+        }
+        eprintln!("level {level}: largest position difference {:e} m, tangent {:e}", worst.0, worst.1);
+        assert!(worst.0 < 1e-5 && worst.1 < 1e-4, "{worst:?}");
+    }
+}
+
+#[test]
+fn smoothing_level_is_validated() {
+    let gpu = Gpu::new();
+    let groom =
+        grow(&scenes::thesis_scalp(), &GrowParams { strands: 10, points_per_strand: 6, ..GrowParams::default() })
+            .expect("groom");
+    let sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    for bad in [0, 65] {
+        assert!(matches!(
+            Renderer::new(gpu.ctx(), &sim, &RenderParams { smoothing_level: bad }),
+            Err(Error::InvalidParameter { .. })
+        ));
+    }
+    let mut r = Renderer::new(gpu.ctx(), &sim, &RenderParams { smoothing_level: 4 }).expect("renderer");
+    assert!(r.set_params(&RenderParams { smoothing_level: 2 }).is_ok());
+    assert!(matches!(r.set_params(&RenderParams { smoothing_level: 8 }), Err(Error::InvalidParameter { .. })));
+}
