@@ -79,6 +79,33 @@ pub(crate) struct SmoothPush {
 }
 gpu_struct!(SmoothPush => "SmoothPush" { strands, points, level, stride });
 
+/// Push constants of the interpolation pass (`InterpolatePush` in `glsl/include/render.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct InterpolatePush {
+    /// Head rotation quaternion (x, y, z, w).
+    pub head_rotation: [f32; 4],
+    /// Key hairs.
+    pub strands: u32,
+    /// Points per key hair.
+    pub points: u32,
+    /// Smoothed segments per key segment.
+    pub level: u32,
+    /// Smoothed vertices per hair.
+    pub stride: u32,
+    /// Interpolated hairs per key hair.
+    pub hairs: u32,
+    /// Offset radius scale, meters.
+    pub clump_width: f32,
+    /// Fraction of the clump width at the root.
+    pub root_width: f32,
+    /// Fraction of the clump width at the tip.
+    pub tip_width: f32,
+}
+gpu_struct!(InterpolatePush => "InterpolatePush" {
+    head_rotation, strands, points, level, stride, hairs, clump_width, root_width, tip_width
+});
+
 /// Every Rust GPU struct with the shader-side name, for the layout test.
 #[cfg(test)]
 pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<String> {
@@ -96,5 +123,6 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<SimStepParams>(reflection, &mut problems);
     check::<GpuCollider>(reflection, &mut problems);
     check::<SmoothPush>(reflection, &mut problems);
+    check::<InterpolatePush>(reflection, &mut problems);
     problems
 }

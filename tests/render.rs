@@ -45,7 +45,9 @@ fn smoothing_matches_the_cpu_bspline() {
     sim.run(30, |i| motion::reference_motion((i + 1) as f32 * params.dt), None).expect("run");
     let state = sim.read_state().expect("state");
     for level in [4, 1, 7] {
-        let mut renderer = Renderer::new(gpu.ctx(), &sim, &RenderParams { smoothing_level: level }).expect("renderer");
+        let mut renderer =
+            Renderer::new(gpu.ctx(), &sim, &RenderParams { smoothing_level: level, ..RenderParams::default() })
+                .expect("renderer");
         renderer.prepare_now(&sim).expect("prepare");
         let (positions, tangents) = renderer.read_smoothed().expect("readback");
         let stride = renderer.smoothed_vertices_per_strand() as usize;
@@ -78,11 +80,81 @@ fn smoothing_level_is_validated() {
     let sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
     for bad in [0, 65] {
         assert!(matches!(
-            Renderer::new(gpu.ctx(), &sim, &RenderParams { smoothing_level: bad }),
+            Renderer::new(gpu.ctx(), &sim, &RenderParams { smoothing_level: bad, ..RenderParams::default() }),
             Err(Error::InvalidParameter { .. })
         ));
     }
-    let mut r = Renderer::new(gpu.ctx(), &sim, &RenderParams { smoothing_level: 4 }).expect("renderer");
-    assert!(r.set_params(&RenderParams { smoothing_level: 2 }).is_ok());
-    assert!(matches!(r.set_params(&RenderParams { smoothing_level: 8 }), Err(Error::InvalidParameter { .. })));
+    let mut r = Renderer::new(gpu.ctx(), &sim, &RenderParams { smoothing_level: 4, ..RenderParams::default() })
+        .expect("renderer");
+    assert!(r.set_params(&RenderParams { smoothing_level: 2, ..RenderParams::default() }).is_ok());
+    assert!(matches!(
+        r.set_params(&RenderParams { smoothing_level: 8, ..RenderParams::default() }),
+        Err(Error::InvalidParameter { .. })
+    ));
+}
+
+/// Interpolated hairs: counts, offsets inside the clump radius and across the
+/// tangent, positions as the CPU computes them, and one fixed clump coordinate
+/// per hair along its whole length and from frame to frame.
+#[test]
+fn interpolation_grows_stable_clumps() {
+    let gpu = Gpu::new();
+    let groom = scenes::thesis().expect("thesis");
+    let params = SimParams::default();
+    let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
+    sim.set_colliders(&motion::thesis_colliders()).expect("colliders");
+    let render = RenderParams::default();
+    let mut renderer = Renderer::new(gpu.ctx(), &sim, &render).expect("renderer");
+    let (hairs, per_hair) = renderer.hair_counts();
+    assert_eq!((hairs, per_hair), (1750 * 16, 21), "28,000 hairs of 20 segments: 560,000 segments");
+    let references = renderer.reference_vectors().expect("references");
+    let mut coordinates_by_frame = Vec::new();
+    for frame in 0..2 {
+        let start = frame * 25;
+        sim.run(25, |i| motion::reference_motion((start + i + 1) as f32 * params.dt), None).expect("run");
+        renderer.prepare_now(&sim).expect("prepare");
+        let (smoothed, tangents) = renderer.read_smoothed().expect("smoothed");
+        let (positions, hair_tangents) = renderer.read_hairs().expect("hairs");
+        assert_eq!(positions.len(), (hairs * per_hair) as usize);
+        let rotation = sim.head().rotation.normalize();
+        let mut coordinates = Vec::new();
+        let mut worst = 0.0f32;
+        for key in 0..1750usize {
+            let reference = rotation * references[key].truncate();
+            for h in 0..16usize {
+                let expected_c = reference::clump_coordinate(key as u32, h as u32);
+                for k in 0..21usize {
+                    let src = key * 21 + k;
+                    let dst = (key * 16 + h) * 21 + k;
+                    let (p, t) = (smoothed[src].truncate(), tangents[src].truncate());
+                    let s = k as f32 / 20.0;
+                    let w = render.clump_width * (render.root_width + (render.tip_width - render.root_width) * s);
+                    let offset = positions[dst].truncate() - p;
+                    assert!(
+                        offset.length() <= w * 1.0001 + 1e-6,
+                        "hair {key}/{h} vertex {k}: offset {} > {w}",
+                        offset.length()
+                    );
+                    assert!(offset.dot(t).abs() <= 1e-4 * w.max(1e-3), "offset not across the tangent");
+                    assert!((hair_tangents[dst].w - s).abs() < 1e-6);
+                    let (b1, b2) = reference::key_frame(t, reference);
+                    let cpu = p + (expected_c.x * b1 + expected_c.y * b2) * w;
+                    worst = worst.max((positions[dst].truncate() - cpu).length());
+                    if k == 10 {
+                        coordinates.push(Vec3::new(offset.dot(b1) / w, offset.dot(b2) / w, 0.0));
+                    }
+                }
+            }
+        }
+        eprintln!("frame {frame}: largest difference to the CPU interpolation {worst:e} m");
+        assert!(worst < 1e-5, "{worst}");
+        coordinates_by_frame.push(coordinates);
+    }
+    // The same hair keeps its clump coordinate while the head moves.
+    let drift = coordinates_by_frame[0]
+        .iter()
+        .zip(&coordinates_by_frame[1])
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0, f32::max);
+    assert!(drift < 1e-3, "clump coordinates changed between frames by {drift}");
 }

@@ -10,6 +10,59 @@ struct SmoothPush {
     uint stride;          // smoothed vertices per key hair: (points − 1)·level + 1
 };
 
+// Push constants of the interpolation pass. Twin: gpu_types::InterpolatePush.
+struct InterpolatePush {
+    vec4 head_rotation;   // unit quaternion (xyz, w): world from head
+    uint strands;         // key hairs
+    uint points;          // points per key hair
+    uint level;           // smoothed segments per key segment
+    uint stride;          // smoothed vertices per hair
+    uint hairs;           // interpolated hairs per key hair
+    float clump_width;    // offset radius scale (m)
+    float root_width;     // fraction of clump_width at the root
+    float tip_width;      // fraction of clump_width at the tip
+};
+
+vec3 quat_rotate(vec4 q, vec3 v) {
+    vec3 t = 2.0 * cross(q.xyz, v);
+    return v + q.w * t + cross(q.xyz, t);
+}
+
+// Integer hash to [0, 1).
+float hash01(uint x) {
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return float(x >> 8) * (1.0 / 16777216.0);
+}
+
+// The stable random clump coordinate of interpolated hair `hair` of key `key`:
+// uniform in the unit disk, the same every frame.
+vec2 clump_coordinate(uint key, uint hair) {
+    uint seed = key * 64u + hair;
+    float r = sqrt(hash01(seed * 2u + 0x9e3779b9u));
+    float a = 6.28318530718 * hash01(seed * 2u + 0x7f4a7c15u);
+    return r * vec2(cos(a), sin(a));
+}
+
+// Offset frame of a key vertex: B1 = the reference with its tangent part
+// removed, B2 = T × B1. The reference is the key hair's rest-plane normal turned
+// with the head, nearly perpendicular to the strand wherever it bends, so the
+// frame does not flip.
+void key_frame(vec3 t, vec3 reference, out vec3 b1, out vec3 b2) {
+    vec3 r = reference - dot(reference, t) * t;
+    float len = length(r);
+    if (len < 1e-4) {
+        vec3 any_axis = abs(t.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+        r = any_axis - dot(any_axis, t) * t;
+        len = length(r);
+    }
+    b1 = r / len;
+    b2 = cross(t, b1);
+}
+
 // Uniform cubic B-spline basis at u and its derivative (weights of p0..p3).
 void bspline_basis(float u, out vec4 b, out vec4 db) {
     float u2 = u * u;

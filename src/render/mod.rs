@@ -7,10 +7,14 @@
 //!    buffers, as patches of 4 control points, tessellated as isolines into
 //!    uniform cubic B-splines (mirrored phantom points put the curve exactly
 //!    through root and tip); positions and tangents stored for the next passes.
+//! 2. **Interpolate** ([`interpolate`]): a draw with no vertex buffer grows
+//!    `hairs_per_key` hairs around every smoothed key hair, each offset in the
+//!    key hair's frame by a stable random clump coordinate.
 //!
-//! Later passes (strand interpolation, drawing, shading, anti-aliasing, level of
-//! detail) build on the smoothed strands.
+//! Later passes (drawing, shading, anti-aliasing, level of detail) build on the
+//! interpolated strands.
 
+pub mod interpolate;
 pub mod reference;
 pub mod smooth;
 
@@ -22,13 +26,14 @@ use gpu_allocator::MemoryLocation;
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
-use crate::gpu_types::SmoothPush;
+use crate::gpu_types::{InterpolatePush, SmoothPush};
 use crate::profiler::GpuProfiler;
 use crate::sim::HairSim;
 use crate::vk::barrier::{self, Access};
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
+use interpolate::InterpolatePass;
 use smooth::SmoothPass;
 
 /// Most smoothed segments per key segment (the tessellation level limit vkhair uses).
@@ -39,6 +44,8 @@ pub const MAX_SMOOTHING_LEVEL: u32 = 64;
 pub enum RenderPass {
     /// Pass 1: B-spline smoothing of the key hairs.
     Smooth,
+    /// Pass 2: single-strand interpolation.
+    Interpolate,
 }
 
 impl RenderPass {
@@ -46,6 +53,7 @@ impl RenderPass {
     pub fn label(self) -> &'static str {
         match self {
             RenderPass::Smooth => "vkhair render: smooth",
+            RenderPass::Interpolate => "vkhair render: interpolate",
         }
     }
 }
@@ -56,11 +64,20 @@ pub struct RenderParams {
     /// Smoothed segments per key segment (1..=64). Default: 4 (a 6-point key hair
     /// becomes 20 segments, as in the thesis scene).
     pub smoothing_level: u32,
+    /// Hairs grown around each key hair (1..=64). Default: 16 (1750 key hairs give
+    /// 28,000 hairs, as in the thesis scene).
+    pub hairs_per_key: u32,
+    /// Radius of a clump around its key hair, meters (≥ 0). Default: 0.012.
+    pub clump_width: f32,
+    /// Fraction of `clump_width` at the root (≥ 0). Default: 0.3.
+    pub root_width: f32,
+    /// Fraction of `clump_width` at the tip (≥ 0). Default: 1.0.
+    pub tip_width: f32,
 }
 
 impl Default for RenderParams {
     fn default() -> Self {
-        RenderParams { smoothing_level: 4 }
+        RenderParams { smoothing_level: 4, hairs_per_key: 16, clump_width: 0.012, root_width: 0.3, tip_width: 1.0 }
     }
 }
 
@@ -73,6 +90,16 @@ impl RenderParams {
                 format!("{} is outside 1..={MAX_SMOOTHING_LEVEL}", self.smoothing_level),
             ));
         }
+        if !(1..=MAX_SMOOTHING_LEVEL).contains(&self.hairs_per_key) {
+            return Err(Error::param("hairs_per_key", format!("{} is outside 1..=64", self.hairs_per_key)));
+        }
+        for (name, v) in
+            [("clump_width", self.clump_width), ("root_width", self.root_width), ("tip_width", self.tip_width)]
+        {
+            if !(v.is_finite() && (0.0..=1e3).contains(&v)) {
+                return Err(Error::param(name, format!("{v} is outside 0..=1000")));
+            }
+        }
         Ok(())
     }
 }
@@ -83,11 +110,18 @@ pub struct Renderer {
     params: RenderParams,
     strands: u32,
     points: u32,
-    /// Smoothing level the buffers were sized for.
+    /// Smoothing level and hairs per key the buffers were sized for.
     capacity_level: u32,
+    capacity_hairs: u32,
     smoothed_positions: Buffer,
     smoothed_tangents: Buffer,
+    reference: Buffer,
+    hair_positions: Buffer,
+    hair_tangents: Buffer,
     smooth: SmoothPass,
+    interpolate: InterpolatePass,
+    /// Head rotation of the latest prepared frame (for readers of the hair buffers).
+    head_rotation: glam::Quat,
 }
 
 impl Renderer {
@@ -105,13 +139,14 @@ impl Renderer {
         // Sized for the level asked for at creation: level-of-detail only lowers it.
         let stride = (points as u64 - 1) * u64::from(params.smoothing_level) + 1;
         let size = strands as u64 * stride * 16;
-        if size > u64::from(device.info.max_storage_buffer_range) {
+        let hair_size = size * u64::from(params.hairs_per_key);
+        if hair_size > u64::from(device.info.max_storage_buffer_range) {
             return Err(Error::param(
-                "smoothing_level",
-                format!("{size} bytes of smoothed strands exceed the device's storage range; lower the level"),
+                "hairs_per_key",
+                format!("{hair_size} bytes of interpolated strands exceed the device's storage range; lower the level or hair count"),
             ));
         }
-        let storage = |name: &str| {
+        let storage = |name: &str, size: u64| {
             Buffer::new(
                 &device,
                 &BufferDesc {
@@ -122,19 +157,45 @@ impl Renderer {
                 },
             )
         };
-        let smoothed_positions = storage("vkhair smoothed positions")?;
-        let smoothed_tangents = storage("vkhair smoothed tangents")?;
+        let smoothed_positions = storage("vkhair smoothed positions", size)?;
+        let smoothed_tangents = storage("vkhair smoothed tangents", size)?;
+        let hair_positions = storage("vkhair hair positions", hair_size)?;
+        let hair_tangents = storage("vkhair hair tangents", hair_size)?;
+        let reference_data = interpolate::reference_vectors(sim.rest_shape());
+        let reference = Buffer::new(
+            &device,
+            &BufferDesc {
+                name: "vkhair key frames",
+                size: reference_data.len() as u64 * 16,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_DST
+                    | vk::BufferUsageFlags::TRANSFER_SRC,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?;
+        device.upload_pod(&reference, &reference_data)?;
         let (halves, _) = sim.position_halves();
         let smooth = SmoothPass::new(&device, halves, &smoothed_positions, &smoothed_tangents)?;
+        let interpolate = InterpolatePass::new(
+            &device,
+            [&smoothed_positions, &smoothed_tangents, &reference],
+            [&hair_positions, &hair_tangents],
+        )?;
         Ok(Renderer {
             device,
             params: params.clone(),
             strands: strands as u32,
             points: points as u32,
             capacity_level: params.smoothing_level,
+            capacity_hairs: params.hairs_per_key,
             smoothed_positions,
             smoothed_tangents,
+            reference,
+            hair_positions,
+            hair_tangents,
             smooth,
+            interpolate,
+            head_rotation: sim.head().rotation.normalize(),
         })
     }
 
@@ -151,6 +212,12 @@ impl Renderer {
             return Err(Error::param(
                 "smoothing_level",
                 format!("{} exceeds the {} this renderer was created for", params.smoothing_level, self.capacity_level),
+            ));
+        }
+        if params.hairs_per_key > self.capacity_hairs {
+            return Err(Error::param(
+                "hairs_per_key",
+                format!("{} exceeds the {} this renderer was created for", params.hairs_per_key, self.capacity_hairs),
             ));
         }
         self.params = params.clone();
@@ -171,29 +238,40 @@ impl Renderer {
         }
     }
 
-    /// Records the geometry passes (smoothing) for `sim`'s latest state into `cmd`.
+    fn interpolate_push(&self) -> InterpolatePush {
+        InterpolatePush {
+            head_rotation: self.head_rotation.to_array(),
+            strands: self.strands,
+            points: self.points,
+            level: self.params.smoothing_level,
+            stride: self.smoothed_vertices_per_strand(),
+            hairs: self.params.hairs_per_key,
+            clump_width: self.params.clump_width,
+            root_width: self.params.root_width,
+            tip_width: self.params.tip_width,
+        }
+    }
+
+    /// Interpolated hairs and vertices per hair at the current parameters.
+    pub fn hair_counts(&self) -> (u32, u32) {
+        (self.strands * self.params.hairs_per_key, self.smoothed_vertices_per_strand())
+    }
+
+    /// Records one storing pass: label or timestamp scope, an attachment-less
+    /// rendering instance, then a barrier making its pre-rasterization storage
+    /// writes visible to every later shader stage.
     ///
     /// # Safety
-    /// `cmd` is a command buffer of the context's device in the recording state,
-    /// outside a render pass, for a queue of the graphics family; `sim` is the
-    /// simulation this renderer was created for. Work recorded earlier in submission
-    /// order (the simulation step) is ordered before it by the recorded barriers.
-    pub unsafe fn record_prepare(
-        &mut self,
+    /// `cmd` is recording outside a render pass (see [`Renderer::record_prepare`]).
+    unsafe fn capture_pass(
+        &self,
         cmd: vk::CommandBuffer,
-        sim: &HairSim,
-        mut profiler: Option<&mut GpuProfiler>,
-    ) -> Result<()> {
-        let (_, half) = sim.position_halves();
+        pass: RenderPass,
+        profiler: &mut Option<&mut GpuProfiler>,
+        record: impl FnOnce(vk::CommandBuffer),
+    ) {
         let d = &self.device;
-        let entry = barrier::memory(
-            Access::ANY_WRITE,
-            Access {
-                stage: vk::PipelineStageFlags2::VERTEX_SHADER | vk::PipelineStageFlags2::TESSELLATION_EVALUATION_SHADER,
-                access: vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            },
-        );
-        let done = barrier::memory(
+        let written = barrier::memory(
             Access {
                 stage: vk::PipelineStageFlags2::TESSELLATION_EVALUATION_SHADER,
                 access: vk::AccessFlags2::SHADER_STORAGE_WRITE,
@@ -211,14 +289,12 @@ impl Renderer {
         let rendering = vk::RenderingInfo::default()
             .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
             .layer_count(1);
-        let push = self.smooth_push();
         // SAFETY: guaranteed by the caller; every object belongs to this device.
         unsafe {
-            d.cmd_barrier(cmd, &[entry], &[], &[]);
             let scope = match profiler.as_deref_mut() {
-                Some(p) => Some(p.begin_scope(cmd, RenderPass::Smooth.label())),
+                Some(p) => Some(p.begin_scope(cmd, pass.label())),
                 None => {
-                    d.cmd_begin_label(cmd, RenderPass::Smooth.label(), LabelColor::Graphics);
+                    d.cmd_begin_label(cmd, pass.label(), LabelColor::Graphics);
                     None
                 }
             };
@@ -229,13 +305,51 @@ impl Renderer {
                 &[vk::Viewport { x: 0.0, y: 0.0, width: 1.0, height: 1.0, min_depth: 0.0, max_depth: 1.0 }],
             );
             d.raw.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
-            self.smooth.record(d, cmd, half, &push);
+            record(cmd);
             d.raw.cmd_end_rendering(cmd);
-            d.cmd_barrier(cmd, &[done], &[], &[]);
-            match (profiler, scope) {
+            d.cmd_barrier(cmd, &[written], &[], &[]);
+            match (profiler.as_deref_mut(), scope) {
                 (Some(p), Some(scope)) => p.end_scope(cmd, scope),
                 _ => d.cmd_end_label(cmd),
             }
+        }
+    }
+
+    /// Records the geometry passes (smoothing, interpolation) for `sim`'s latest
+    /// state into `cmd`.
+    ///
+    /// # Safety
+    /// `cmd` is a command buffer of the context's device in the recording state,
+    /// outside a render pass, for a queue of the graphics family; `sim` is the
+    /// simulation this renderer was created for. Work recorded earlier in submission
+    /// order (the simulation step) is ordered before it by the recorded barriers.
+    pub unsafe fn record_prepare(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        sim: &HairSim,
+        mut profiler: Option<&mut GpuProfiler>,
+    ) -> Result<()> {
+        let (_, half) = sim.position_halves();
+        self.head_rotation = sim.head().rotation.normalize();
+        let d = &self.device;
+        let entry = barrier::memory(
+            Access::ANY_WRITE,
+            Access {
+                stage: vk::PipelineStageFlags2::VERTEX_SHADER | vk::PipelineStageFlags2::TESSELLATION_EVALUATION_SHADER,
+                access: vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            },
+        );
+        let smooth_push = self.smooth_push();
+        let interpolate_push = self.interpolate_push();
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            d.cmd_barrier(cmd, &[entry], &[], &[]);
+            self.capture_pass(cmd, RenderPass::Smooth, &mut profiler, |cmd| {
+                self.smooth.record(d, cmd, half, &smooth_push)
+            });
+            self.capture_pass(cmd, RenderPass::Interpolate, &mut profiler, |cmd| {
+                self.interpolate.record(d, cmd, &interpolate_push)
+            });
         }
         Ok(())
     }
@@ -259,5 +373,20 @@ impl Renderer {
         let positions = self.device.readback_pod(&self.smoothed_positions, n)?;
         let tangents = self.device.readback_pod(&self.smoothed_tangents, n)?;
         Ok((positions, tangents))
+    }
+}
+
+impl Renderer {
+    /// Reads the interpolated hairs back: positions and (tangent, t along the hair),
+    /// hair after hair ([`Renderer::hair_counts`]; this submits and waits).
+    pub fn read_hairs(&self) -> Result<(Vec<Vec4>, Vec<Vec4>)> {
+        let (hairs, per_hair) = self.hair_counts();
+        let n = hairs as usize * per_hair as usize;
+        Ok((self.device.readback_pod(&self.hair_positions, n)?, self.device.readback_pod(&self.hair_tangents, n)?))
+    }
+
+    /// The key hairs' reference vectors (rest-plane normals, head frame).
+    pub fn reference_vectors(&self) -> Result<Vec<Vec4>> {
+        self.device.readback_pod(&self.reference, self.strands as usize)
     }
 }

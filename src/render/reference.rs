@@ -37,6 +37,36 @@ pub fn smooth_strand(points: &[Vec3], level: u32) -> Vec<(Vec3, Vec3)> {
     out
 }
 
+fn hash01(mut x: u32) -> f32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    (x >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// The stable clump coordinate of interpolated hair `hair` of key hair `key`,
+/// uniform in the unit disk (as `clump_coordinate` in `render.glsl`).
+pub fn clump_coordinate(key: u32, hair: u32) -> glam::Vec2 {
+    let seed = key.wrapping_mul(64).wrapping_add(hair);
+    let r = hash01(seed.wrapping_mul(2).wrapping_add(0x9e37_79b9)).sqrt();
+    let a = std::f32::consts::TAU * hash01(seed.wrapping_mul(2).wrapping_add(0x7f4a_7c15));
+    glam::Vec2::new(r * a.cos(), r * a.sin())
+}
+
+/// The offset frame (B1, B2) of a key vertex with unit tangent `t` and reference
+/// vector `reference` (world), as `key_frame` in `render.glsl`.
+pub fn key_frame(t: Vec3, reference: Vec3) -> (Vec3, Vec3) {
+    let mut r = reference - reference.dot(t) * t;
+    if r.length() < 1e-4 {
+        let any = if t.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
+        r = any - any.dot(t) * t;
+    }
+    let b1 = r.normalize();
+    (b1, t.cross(b1))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -189,6 +189,16 @@ impl HairSim {
         ([&self.gpu.positions[0], &self.gpu.positions[1]], self.current)
     }
 
+    /// The rest shape (head frame) and rest lengths as last uploaded.
+    pub(crate) fn rest_shape(&self) -> &SimState {
+        &self.shape
+    }
+
+    /// The head transform at the end of the latest recorded step.
+    pub fn head(&self) -> RigidTransform {
+        self.schedule.head
+    }
+
     /// The positions buffer holding the state before the latest step (for drawing
     /// between the last two states with [`StepPlan::alpha`]); same layout and barrier
     /// rule as [`HairSim::positions_buffer`].
