@@ -119,8 +119,8 @@ fn interpolation_grows_stable_clumps() {
         let rotation = sim.head().rotation.normalize();
         let mut coordinates = Vec::new();
         let mut worst = 0.0f32;
-        for key in 0..1750usize {
-            let reference = rotation * references[key].truncate();
+        for (key, reference) in references.iter().enumerate() {
+            let reference = rotation * reference.truncate();
             for h in 0..16usize {
                 let expected_c = reference::clump_coordinate(key as u32, h as u32);
                 for k in 0..21usize {
