@@ -193,6 +193,12 @@ impl GpuContext {
         self.device.graphics.family
     }
 
+    /// Records `record` into a fresh command buffer, submits it to the graphics queue
+    /// and waits (headless use: tools, tests, examples; a host submits its own).
+    pub fn run_commands(&self, name: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+        self.device.submit_once(name, record)
+    }
+
     /// Waits until the crate's queue is idle (headless use; hosts sync their own way).
     pub fn wait_idle(&self) -> Result<()> {
         let _lock = self.device.lock_submit();

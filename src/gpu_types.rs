@@ -106,6 +106,48 @@ gpu_struct!(InterpolatePush => "InterpolatePush" {
     head_rotation, strands, points, level, stride, hairs, clump_width, root_width, tip_width
 });
 
+/// One light of the draw pass (`Light` in `glsl/include/render.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct GpuLight {
+    /// xyz position, w kind.
+    pub position_kind: [f32; 4],
+    /// xyz direction of travel, w cos(outer half-angle).
+    pub direction_cone: [f32; 4],
+    /// rgb radiance, w cos(inner half-angle).
+    pub color_range: [f32; 4],
+}
+gpu_struct!(GpuLight => "Light" { position_kind, direction_cone, color_range });
+
+/// Uniform block of the draw pass (`DrawParams` in `glsl/include/render.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct DrawParams {
+    /// World → clip, column-major.
+    pub view_proj: [[f32; 4]; 4],
+    /// xyz camera position, w world size of one pixel at distance 1.
+    pub camera: [f32; 4],
+    /// rgb root albedo, a ambient.
+    pub root_color: [f32; 4],
+    /// rgb tip albedo, a diffuse wrap.
+    pub tip_color: [f32; 4],
+    /// rgb primary highlight, w exponent.
+    pub primary: [f32; 4],
+    /// rgb secondary highlight, w exponent.
+    pub secondary: [f32; 4],
+    /// Primary shift, secondary shift, shift jitter, highlight breakup.
+    pub shifts: [f32; 4],
+    /// Root width, tip width (m), least width (pixels).
+    pub widths: [f32; 4],
+    /// Hairs, vertices per hair, lights.
+    pub counts: [u32; 4],
+    /// The lights.
+    pub lights: [GpuLight; 8],
+}
+gpu_struct!(DrawParams => "DrawParams" {
+    view_proj, camera, root_color, tip_color, primary, secondary, shifts, widths, counts, lights
+});
+
 /// Every Rust GPU struct with the shader-side name, for the layout test.
 #[cfg(test)]
 pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<String> {
@@ -124,5 +166,7 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<GpuCollider>(reflection, &mut problems);
     check::<SmoothPush>(reflection, &mut problems);
     check::<InterpolatePush>(reflection, &mut problems);
+    check::<GpuLight>(reflection, &mut problems);
+    check::<DrawParams>(reflection, &mut problems);
     problems
 }

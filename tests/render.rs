@@ -158,3 +158,174 @@ fn interpolation_grows_stable_clumps() {
         .fold(0.0, f32::max);
     assert!(drift < 1e-3, "clump coordinates changed between frames by {drift}");
 }
+
+// ---- Drawing -----------------------------------------------------------------
+
+use vkhair::groom::mesh::TriMesh;
+use vkhair::render::{Camera, HairMaterial, Light, MeshDrawer, Offscreen};
+
+const W: u32 = 160;
+const H: u32 = 120;
+const BACKGROUND: [u8; 3] = [0, 0, 0];
+
+struct Scene {
+    sim: HairSim,
+    renderer: Renderer,
+    offscreen: Offscreen,
+    camera: Camera,
+}
+
+fn scene(gpu: &Gpu) -> Scene {
+    let groom = scenes::thesis().expect("thesis");
+    let sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    let renderer = Renderer::new(gpu.ctx(), &sim, &RenderParams::default()).expect("renderer");
+    let offscreen = Offscreen::new(gpu.ctx(), W, H).expect("offscreen");
+    let center = scenes::THESIS_HEAD_CENTER;
+    let camera = Camera::look_at(
+        center + Vec3::new(0.0, -0.05, 1.0),
+        center - Vec3::new(0.0, 0.1, 0.0),
+        0.7,
+        W as f32 / H as f32,
+        0.05,
+        10.0,
+    )
+    .expect("camera");
+    Scene { sim, renderer, offscreen, camera }
+}
+
+/// Renders the hair (and `blocker`, drawn first, if given) and returns RGBA8 rows.
+fn draw(gpu: &Gpu, s: &mut Scene, blocker: Option<&MeshDrawer>) -> Vec<u8> {
+    let mut result = Ok(());
+    gpu.ctx()
+        .run_commands("test frame", |cmd| {
+            // SAFETY: a recording command buffer of the context's device.
+            result = unsafe {
+                s.renderer.record_prepare(cmd, &s.sim, None).and_then(|_| {
+                    s.offscreen.record_clear(cmd, Vec3::ZERO);
+                    if let Some(mesh) = blocker {
+                        let vp = s.camera.projection * s.camera.view;
+                        mesh.record(
+                            cmd,
+                            &s.offscreen.target(),
+                            vp,
+                            (glam::Quat::IDENTITY, Vec3::ZERO),
+                            Vec3::new(0.0, 1.0, 0.0),
+                            Vec3::NEG_Z,
+                        );
+                    }
+                    s.renderer.record_draw(cmd, &s.offscreen.target(), &s.camera, None)
+                })
+            };
+        })
+        .expect("submit");
+    result.expect("record");
+    s.offscreen.read_rgba8().expect("readback")
+}
+
+fn hair_pixels(rgba: &[u8]) -> Vec<(u32, u32, f32)> {
+    rgba.chunks_exact(4)
+        .enumerate()
+        .filter(|(_, p)| p[..3] != BACKGROUND)
+        .map(|(i, p)| {
+            ((i as u32) % W, (i as u32) / W, (u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2])) as f32 / 765.0)
+        })
+        .collect()
+}
+
+#[test]
+fn hair_covers_its_projected_region_and_nothing_else() {
+    let gpu = Gpu::new();
+    let mut s = scene(&gpu);
+    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    let rgba = draw(&gpu, &mut s, None);
+    // Project every hair vertex: the drawn pixels must lie within their bounds
+    // (plus the ribbon half-width and a pixel of rasterisation slack).
+    let (positions, _) = s.renderer.read_hairs().expect("hairs");
+    let vp = s.camera.projection * s.camera.view;
+    let (mut lo, mut hi) = (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN));
+    for p in &positions {
+        let c = vp * p.truncate().extend(1.0);
+        let ndc = c.truncate().truncate() / c.w;
+        let px = (ndc * 0.5 + 0.5) * glam::Vec2::new(W as f32, H as f32);
+        lo = lo.min(px);
+        hi = hi.max(px);
+    }
+    let pixels = hair_pixels(&rgba);
+    assert!(!pixels.is_empty(), "nothing drawn");
+    for &(x, y, _) in &pixels {
+        let (fx, fy) = (x as f32 + 0.5, y as f32 + 0.5);
+        assert!(
+            fx >= lo.x - 2.0 && fx <= hi.x + 2.0 && fy >= lo.y - 2.0 && fy <= hi.y + 2.0,
+            "pixel ({x}, {y}) outside the hair's bounds {lo}..{hi}"
+        );
+    }
+    let area = ((hi.x - lo.x) * (hi.y - lo.y)).max(1.0);
+    let coverage = pixels.len() as f32 / area;
+    eprintln!("hair bounds {lo}..{hi}, coverage {coverage:.2}");
+    assert!(coverage > 0.3, "hair covers only {coverage} of its bounds");
+}
+
+#[test]
+fn light_behind_the_head_leaves_the_visible_side_darker() {
+    let gpu = Gpu::new();
+    let mut s = scene(&gpu);
+    let mut mean = |direction: Vec3| {
+        s.renderer.set_lights(&[Light::Directional { direction, color: Vec3::ONE }]).expect("lights");
+        let px = hair_pixels(&draw(&gpu, &mut s, None));
+        px.iter().map(|p| p.2).sum::<f32>() / px.len() as f32
+    };
+    // Light travelling away from the camera lights the visible side.
+    let (front, behind) = (mean(Vec3::NEG_Z), mean(Vec3::Z));
+    eprintln!("mean hair brightness: light in front {front:.4}, behind {behind:.4}");
+    assert!(front > 1.3 * behind, "front {front} vs behind {behind}");
+}
+
+#[test]
+fn primary_highlight_moves_with_its_shift() {
+    let gpu = Gpu::new();
+    let mut s = scene(&gpu);
+    s.renderer
+        .set_lights(&[Light::Directional { direction: Vec3::new(0.0, -0.4, -1.0), color: Vec3::ONE }])
+        .expect("lights");
+    let mut centroid = |shift: f32| {
+        let material = HairMaterial {
+            root_color: Vec3::ZERO,
+            tip_color: Vec3::ZERO,
+            secondary_color: Vec3::ZERO,
+            primary_color: Vec3::ONE,
+            primary_exponent: 60.0,
+            primary_shift: shift,
+            shift_jitter: 0.0,
+            ..HairMaterial::default()
+        };
+        s.renderer.set_material(&material).expect("material");
+        let px = hair_pixels(&draw(&gpu, &mut s, None));
+        let weight: f32 = px.iter().map(|p| p.2).sum();
+        px.iter().map(|p| p.1 as f32 * p.2).sum::<f32>() / weight
+    };
+    let (up, down) = (centroid(-0.4), centroid(0.4));
+    eprintln!("highlight centroid row: shift −0.4 → {up:.2}, +0.4 → {down:.2}");
+    assert!((up - down).abs() > 2.0, "the highlight did not move: {up} vs {down}");
+}
+
+#[test]
+fn hair_is_hidden_behind_what_the_host_drew() {
+    let gpu = Gpu::new();
+    let mut s = scene(&gpu);
+    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    let bare = draw(&gpu, &mut s, None);
+    // A green sphere between the camera and the hair.
+    let center = scenes::THESIS_HEAD_CENTER + Vec3::new(0.0, -0.1, 0.5);
+    let blocker = MeshDrawer::new(gpu.ctx(), &TriMesh::uv_sphere(center, 0.05, 12, 16).expect("sphere")).expect("mesh");
+    let blocked = draw(&gpu, &mut s, Some(&blocker));
+    let vp = s.camera.projection * s.camera.view;
+    let c = vp * center.extend(1.0);
+    let px = ((c.truncate().truncate() / c.w) * 0.5 + 0.5) * glam::Vec2::new(W as f32, H as f32);
+    let at = |img: &[u8]| {
+        let i = ((px.y as u32 * W + px.x as u32) * 4) as usize;
+        [img[i], img[i + 1], img[i + 2]]
+    };
+    assert_ne!(at(&bare), BACKGROUND, "hair is drawn there without the blocker");
+    let seen = at(&blocked);
+    assert!(seen[1] > 40 && seen[0] == 0 && seen[2] == 0, "the blocker is in front: {seen:?}");
+}

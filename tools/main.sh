@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The main job: list devices, grow the `thesis` reference scene, inspect it and
-# simulate it on the GPU with the shaking-head motion (per-stage timing table,
-# checked against the CPU reference). Later stages turn this into the renderer.
+# The main job: list devices, simulate and render the `thesis` scene headless
+# (1750 key hairs → 28,000 hairs, shaking-head motion, three lights): PNG frames,
+# a contact sheet and a per-pass GPU timing table in out/; then the simulation
+# alone against its CPU reference.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup-debian.sh
@@ -10,6 +11,5 @@ vkhair=target/release/vkhair
 out=${VKHAIR_OUT:-out}
 mkdir -p "$out"
 "$vkhair" devices
-"$vkhair" grow --scalp thesis --out "$out/thesis.hair"
-"$vkhair" inspect "$out/thesis.hair"
-"$vkhair" simulate --steps 240 --check
+"$vkhair" render --out "$out"
+"$vkhair" simulate --steps 120 --check

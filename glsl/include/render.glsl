@@ -63,6 +63,33 @@ void key_frame(vec3 t, vec3 reference, out vec3 b1, out vec3 b2) {
     b2 = cross(t, b1);
 }
 
+// Most lights of the draw pass (render::MAX_LIGHTS).
+const uint MAX_LIGHTS = 8u;
+const uint LIGHT_DIRECTIONAL = 0u;
+const uint LIGHT_POINT = 1u;
+const uint LIGHT_SPOT = 2u;
+
+// One light. Twin: gpu_types::GpuLight.
+struct Light {
+    vec4 position_kind;   // xyz position (point, spot), w kind (LIGHT_*)
+    vec4 direction_cone;  // xyz direction the light travels (directional, spot), w cos(outer half-angle)
+    vec4 color_range;     // rgb color × intensity, w cos(inner half-angle) (spot)
+};
+
+// Uniform block of the draw pass. Twin: gpu_types::DrawParams.
+struct DrawParams {
+    mat4 view_proj;       // world → clip
+    vec4 camera;          // xyz camera position, w world size of one pixel at distance 1
+    vec4 root_color;      // rgb albedo at the root, a ambient
+    vec4 tip_color;       // rgb albedo at the tip, a diffuse wrap (0..1)
+    vec4 primary;         // rgb primary highlight color, w exponent
+    vec4 secondary;       // rgb secondary highlight color, w exponent
+    vec4 shifts;          // x primary shift, y secondary shift, z shift jitter, w highlight breakup
+    vec4 widths;          // x root width (m), y tip width (m), z least width (pixels), w unused
+    uvec4 counts;         // x hairs, y vertices per hair, z lights, w unused
+    Light lights[MAX_LIGHTS];
+};
+
 // Uniform cubic B-spline basis at u and its derivative (weights of p0..p3).
 void bspline_basis(float u, out vec4 b, out vec4 db) {
     float u2 = u * u;

@@ -63,6 +63,36 @@ impl TriMesh {
         Self::new(positions, triangles)
     }
 
+    /// A UV sphere of `stacks` × `slices` quads (each ≥ 3), outward-facing.
+    pub fn uv_sphere(center: Vec3, radius: f32, stacks: u32, slices: u32) -> Result<Self> {
+        if !(center.is_finite() && radius.is_finite() && radius > 0.0)
+            || stacks < 3
+            || slices < 3
+            || stacks * slices > 1 << 20
+        {
+            return Err(Error::param("sphere", format!("centre {center}, radius {radius}, {stacks}×{slices}")));
+        }
+        let mut positions = Vec::new();
+        for i in 0..=stacks {
+            let theta = std::f32::consts::PI * i as f32 / stacks as f32;
+            for j in 0..=slices {
+                let phi = std::f32::consts::TAU * j as f32 / slices as f32;
+                positions
+                    .push(center + radius * Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()));
+            }
+        }
+        let row = slices + 1;
+        let mut triangles = Vec::new();
+        for i in 0..stacks {
+            for j in 0..slices {
+                let (a, b, c, d) = (i * row + j, i * row + j + 1, (i + 1) * row + j, (i + 1) * row + j + 1);
+                triangles.push([a, b, c]);
+                triangles.push([b, d, c]);
+            }
+        }
+        Self::new(positions, triangles)
+    }
+
     /// Axis-aligned bounding box (min, max).
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.positions

@@ -11,12 +11,19 @@
 //!    `hairs_per_key` hairs around every smoothed key hair, each offset in the
 //!    key hair's frame by a stable random clump coordinate.
 //!
-//! Later passes (drawing, shading, anti-aliasing, level of detail) build on the
-//! interpolated strands.
+//! 3. **Draw** ([`draw`]): the hairs as camera-facing ribbons, Kajiya-Kay
+//!    diffuse plus two shifted specular highlights ([`HairMaterial`]) for every
+//!    [`Light`], into the host's color and depth images ([`RenderTarget`]).
 
+pub mod draw;
 pub mod interpolate;
+mod offscreen;
 pub mod reference;
+mod shading;
 pub mod smooth;
+
+pub use offscreen::{MeshDrawer, Offscreen, OFFSCREEN_COLOR, OFFSCREEN_DEPTH};
+pub use shading::{Camera, HairMaterial, Light, MAX_LIGHTS};
 
 use std::sync::Arc;
 
@@ -26,13 +33,14 @@ use gpu_allocator::MemoryLocation;
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
-use crate::gpu_types::{InterpolatePush, SmoothPush};
+use crate::gpu_types::{DrawParams, GpuLight, InterpolatePush, SmoothPush};
 use crate::profiler::GpuProfiler;
 use crate::sim::HairSim;
 use crate::vk::barrier::{self, Access};
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
+use draw::{DrawPass, TargetKey};
 use interpolate::InterpolatePass;
 use smooth::SmoothPass;
 
@@ -46,6 +54,8 @@ pub enum RenderPass {
     Smooth,
     /// Pass 2: single-strand interpolation.
     Interpolate,
+    /// Pass 3: drawing and shading.
+    Draw,
 }
 
 impl RenderPass {
@@ -54,6 +64,7 @@ impl RenderPass {
         match self {
             RenderPass::Smooth => "vkhair render: smooth",
             RenderPass::Interpolate => "vkhair render: interpolate",
+            RenderPass::Draw => "vkhair render: draw",
         }
     }
 }
@@ -120,6 +131,10 @@ pub struct Renderer {
     hair_tangents: Buffer,
     smooth: SmoothPass,
     interpolate: InterpolatePass,
+    draw: DrawPass,
+    draw_params: Buffer,
+    material: HairMaterial,
+    lights: Vec<GpuLight>,
     /// Head rotation of the latest prepared frame (for readers of the hair buffers).
     head_rotation: glam::Quat,
 }
@@ -181,6 +196,16 @@ impl Renderer {
             [&smoothed_positions, &smoothed_tangents, &reference],
             [&hair_positions, &hair_tangents],
         )?;
+        let draw = DrawPass::new(&device)?;
+        let draw_params = Buffer::new(
+            &device,
+            &BufferDesc {
+                name: "vkhair draw params",
+                size: std::mem::size_of::<DrawParams>() as u64,
+                usage: vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?;
         Ok(Renderer {
             device,
             params: params.clone(),
@@ -195,6 +220,10 @@ impl Renderer {
             hair_tangents,
             smooth,
             interpolate,
+            draw,
+            draw_params,
+            material: HairMaterial::default(),
+            lights: Vec::new(),
             head_rotation: sim.head().rotation.normalize(),
         })
     }
@@ -388,5 +417,175 @@ impl Renderer {
     /// The key hairs' reference vectors (rest-plane normals, head frame).
     pub fn reference_vectors(&self) -> Result<Vec<Vec4>> {
         self.device.readback_pod(&self.reference, self.strands as usize)
+    }
+}
+
+/// The host's images the hair is drawn into.
+#[derive(Debug, Clone, Copy)]
+pub struct RenderTarget {
+    /// Color attachment view, in `COLOR_ATTACHMENT_OPTIMAL`.
+    pub color: vk::ImageView,
+    /// Its format.
+    pub color_format: vk::Format,
+    /// Depth attachment view (in `DEPTH_ATTACHMENT_OPTIMAL`), or null for none.
+    pub depth: vk::ImageView,
+    /// Its format (`UNDEFINED` for none).
+    pub depth_format: vk::Format,
+    /// Extent of both.
+    pub extent: vk::Extent2D,
+    /// Sample count of both.
+    pub samples: vk::SampleCountFlags,
+}
+
+impl Renderer {
+    /// The hair material.
+    pub fn material(&self) -> &HairMaterial {
+        &self.material
+    }
+
+    /// Changes the material from the next recorded draw on (validated first).
+    pub fn set_material(&mut self, material: &HairMaterial) -> Result<()> {
+        material.validate()?;
+        self.material = material.clone();
+        Ok(())
+    }
+
+    /// Replaces the lights (at most [`MAX_LIGHTS`]).
+    pub fn set_lights(&mut self, lights: &[Light]) -> Result<()> {
+        if lights.len() > MAX_LIGHTS {
+            return Err(Error::param("lights", format!("{} exceed the limit of {MAX_LIGHTS}", lights.len())));
+        }
+        self.lights = lights.iter().map(|l| l.to_gpu()).collect::<Result<_>>()?;
+        Ok(())
+    }
+
+    fn draw_params(&self, camera: &Camera, extent: vk::Extent2D) -> DrawParams {
+        let m = &self.material;
+        let (hairs, per_hair) = self.hair_counts();
+        let mut lights = [GpuLight::default(); MAX_LIGHTS];
+        lights[..self.lights.len()].copy_from_slice(&self.lights);
+        // World size of one pixel at distance 1.
+        let pixel = 2.0 * (0.5 * camera.fov_y).tan() / extent.height.max(1) as f32;
+        DrawParams {
+            view_proj: (camera.projection * camera.view).to_cols_array_2d(),
+            camera: camera.position().extend(pixel).to_array(),
+            root_color: m.root_color.extend(m.ambient).to_array(),
+            tip_color: m.tip_color.extend(m.diffuse_wrap).to_array(),
+            primary: m.primary_color.extend(m.primary_exponent).to_array(),
+            secondary: m.secondary_color.extend(m.secondary_exponent).to_array(),
+            shifts: [m.primary_shift, m.secondary_shift, m.shift_jitter, m.highlight_breakup],
+            widths: [m.root_width, m.tip_width, m.least_pixel_width, 0.0],
+            counts: [hairs, per_hair, self.lights.len() as u32, 0],
+            lights,
+        }
+    }
+
+    /// Records the draw pass: the hairs prepared by [`Renderer::record_prepare`] into
+    /// the host's `target`, seen by `camera`. The color (and depth) image is loaded,
+    /// drawn into with depth test and write against what the host drew, and stored.
+    ///
+    /// # Safety
+    /// As for [`Renderer::record_prepare`], which must have been recorded before in
+    /// submission order. `target`'s views belong to the context's device, are in the
+    /// layouts [`RenderTarget`] names, and are not used by other pending work in a
+    /// conflicting way; writes to them recorded earlier on the same queue are ordered
+    /// before the draw by the recorded barrier.
+    pub unsafe fn record_draw(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        target: &RenderTarget,
+        camera: &Camera,
+        mut profiler: Option<&mut GpuProfiler>,
+    ) -> Result<()> {
+        if target.extent.width == 0 || target.extent.height == 0 {
+            return Err(Error::param("render target", "extent is zero"));
+        }
+        let params = self.draw_params(camera, target.extent);
+        let key = TargetKey { color: target.color_format, depth: target.depth_format, samples: target.samples };
+        let device = self.device.clone();
+        let d = &device;
+        let (hairs, per_hair) = self.hair_counts();
+        let (pipeline, set) = self.draw.pipeline(key, &self.draw_params, &self.hair_positions, &self.hair_tangents)?;
+        let before_update = barrier::memory(Access::ANY_WRITE, Access::TRANSFER_WRITE);
+        let updated = barrier::memory(
+            Access::TRANSFER_WRITE,
+            Access {
+                stage: vk::PipelineStageFlags2::VERTEX_SHADER
+                    | vk::PipelineStageFlags2::GEOMETRY_SHADER
+                    | vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                access: vk::AccessFlags2::UNIFORM_READ,
+            },
+        );
+        // The host's earlier attachment writes (its head, its clear) before ours.
+        let attachments = barrier::memory(
+            Access {
+                stage: vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT
+                    | vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
+                    | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS
+                    | vk::PipelineStageFlags2::ALL_TRANSFER,
+                access: vk::AccessFlags2::COLOR_ATTACHMENT_WRITE
+                    | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE
+                    | vk::AccessFlags2::TRANSFER_WRITE,
+            },
+            Access {
+                stage: vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT
+                    | vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
+                    | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                access: vk::AccessFlags2::COLOR_ATTACHMENT_READ
+                    | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE
+                    | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
+                    | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+            },
+        );
+        let color = [vk::RenderingAttachmentInfo::default()
+            .image_view(target.color)
+            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::LOAD)
+            .store_op(vk::AttachmentStoreOp::STORE)];
+        let depth = vk::RenderingAttachmentInfo::default()
+            .image_view(target.depth)
+            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::LOAD)
+            .store_op(vk::AttachmentStoreOp::STORE);
+        let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: target.extent };
+        let mut rendering = vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&color);
+        if target.depth_format != vk::Format::UNDEFINED {
+            rendering = rendering.depth_attachment(&depth);
+        }
+        // SAFETY: guaranteed by the caller; all objects belong to this device.
+        unsafe {
+            let scope = match profiler.as_deref_mut() {
+                Some(p) => Some(p.begin_scope(cmd, RenderPass::Draw.label())),
+                None => {
+                    d.cmd_begin_label(cmd, RenderPass::Draw.label(), LabelColor::Graphics);
+                    None
+                }
+            };
+            d.cmd_barrier(cmd, &[before_update], &[], &[]);
+            d.raw.cmd_update_buffer(cmd, self.draw_params.raw(), 0, bytemuck::bytes_of(&params));
+            d.cmd_barrier(cmd, &[updated, attachments], &[], &[]);
+            d.raw.cmd_begin_rendering(cmd, &rendering);
+            d.raw.cmd_set_viewport(
+                cmd,
+                0,
+                &[vk::Viewport {
+                    x: 0.0,
+                    y: 0.0,
+                    width: target.extent.width as f32,
+                    height: target.extent.height as f32,
+                    min_depth: 0.0,
+                    max_depth: 1.0,
+                }],
+            );
+            d.raw.cmd_set_scissor(cmd, 0, &[area]);
+            pipeline.bind(cmd, &[*set]);
+            d.raw.cmd_draw(cmd, hairs * (per_hair - 1) * 2, 1, 0, 0);
+            d.raw.cmd_end_rendering(cmd);
+            match (profiler, scope) {
+                (Some(p), Some(scope)) => p.end_scope(cmd, scope),
+                _ => d.cmd_end_label(cmd),
+            }
+        }
+        Ok(())
     }
 }

@@ -123,3 +123,35 @@ impl Drop for Image {
         }
     }
 }
+
+/// A sampler; destroyed on drop.
+pub(crate) struct Sampler {
+    device: Arc<Device>,
+    pub raw: vk::Sampler,
+}
+
+impl Sampler {
+    /// A linear-filtering sampler that repeats (noise textures) or clamps.
+    pub(crate) fn new(device: &Arc<Device>, name: &str, repeat: bool) -> Result<Self> {
+        let mode = if repeat { vk::SamplerAddressMode::REPEAT } else { vk::SamplerAddressMode::CLAMP_TO_EDGE };
+        let info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::LINEAR)
+            .min_filter(vk::Filter::LINEAR)
+            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+            .address_mode_u(mode)
+            .address_mode_v(mode)
+            .address_mode_w(mode)
+            .max_lod(0.0);
+        // SAFETY: valid create info; destroyed in Drop.
+        let raw = unsafe { device.raw.create_sampler(&info, None) }.map_err(Error::vk("vkCreateSampler"))?;
+        device.set_name(raw, name);
+        Ok(Sampler { device: device.clone(), raw })
+    }
+}
+
+impl Drop for Sampler {
+    fn drop(&mut self) {
+        // SAFETY: sampler of this device, no longer used by pending work.
+        unsafe { self.device.raw.destroy_sampler(self.raw, None) };
+    }
+}

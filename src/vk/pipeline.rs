@@ -123,6 +123,48 @@ impl Layout {
         Ok(set)
     }
 
+    /// Points combined image-sampler bindings of `set` at (view, sampler) pairs
+    /// in SHADER_READ_ONLY_OPTIMAL.
+    fn write_images(
+        &self,
+        target: vk::DescriptorSet,
+        set: u32,
+        images: &[(u32, vk::ImageView, vk::Sampler)],
+    ) -> Result<()> {
+        let infos: Vec<_> = images
+            .iter()
+            .map(|(_, view, sampler)| {
+                [vk::DescriptorImageInfo {
+                    sampler: *sampler,
+                    image_view: *view,
+                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                }]
+            })
+            .collect();
+        let mut writes = Vec::new();
+        for ((binding, _, _), info) in images.iter().zip(&infos) {
+            let declared = self.bindings.iter().any(|(b, _)| {
+                b.set == set && b.binding == *binding && b.ty == vk::DescriptorType::COMBINED_IMAGE_SAMPLER
+            });
+            if !declared {
+                return Err(Error::param(
+                    "descriptor binding",
+                    format!("set {set} binding {binding} is not a sampled image"),
+                ));
+            }
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(target)
+                    .dst_binding(*binding)
+                    .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                    .image_info(info),
+            );
+        }
+        // SAFETY: as in write_buffers; views and samplers are alive.
+        unsafe { self.device.raw.update_descriptor_sets(&writes, &[]) };
+        Ok(())
+    }
+
     /// Points storage/uniform buffer bindings of `set` at whole buffers.
     fn write_buffers(&self, target: vk::DescriptorSet, set: u32, buffers: &[(u32, &Buffer)]) -> Result<()> {
         let infos: Vec<_> = buffers.iter().map(|(_, b)| [b.descriptor()]).collect();
@@ -421,8 +463,19 @@ impl GraphicsPipeline {
 
     /// Allocates descriptor set `set` and points its buffer bindings at `buffers`.
     pub(crate) fn buffer_set(&self, set: u32, buffers: &[(u32, &Buffer)]) -> Result<vk::DescriptorSet> {
+        self.resource_set(set, buffers, &[])
+    }
+
+    /// Allocates descriptor set `set` with buffer and combined image-sampler bindings.
+    pub(crate) fn resource_set(
+        &self,
+        set: u32,
+        buffers: &[(u32, &Buffer)],
+        images: &[(u32, vk::ImageView, vk::Sampler)],
+    ) -> Result<vk::DescriptorSet> {
         let target = self.layout.allocate_set(set, &format!("graphics set {set}"))?;
         self.layout.write_buffers(target, set, buffers)?;
+        self.layout.write_images(target, set, images)?;
         Ok(target)
     }
 

@@ -162,6 +162,60 @@ impl Device {
         Ok(bytes.chunks_exact(std::mem::size_of::<T>()).map(bytemuck::pod_read_unaligned).collect())
     }
 
+    /// Uploads tightly packed texels into a whole single-sample color image and leaves
+    /// it in SHADER_READ_ONLY_OPTIMAL (this submits and waits).
+    pub(crate) fn upload_image(self: &Arc<Self>, image: &Image, texels: &[u8]) -> Result<()> {
+        let mut staging = self.staging("image upload staging", texels.len() as u64, MemoryLocation::CpuToGpu)?;
+        staging
+            .mapped_mut()
+            .ok_or_else(|| Error::param("staging memory", "host-visible memory could not be mapped"))?
+            .copy_from_slice(texels);
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(vk::ImageSubresourceLayers {
+                aspect_mask: image.aspect,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            })
+            .image_extent(vk::Extent3D { width: image.extent.width, height: image.extent.height, depth: 1 });
+        self.submit_once("upload image", |cmd| {
+            // SAFETY: resources of this device; layouts are transitioned around the copy.
+            unsafe {
+                self.cmd_barrier(
+                    cmd,
+                    &[],
+                    &[],
+                    &[barrier::image(
+                        image,
+                        Access::NONE,
+                        Access::TRANSFER_WRITE,
+                        vk::ImageLayout::UNDEFINED,
+                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    )],
+                );
+                self.raw.cmd_copy_buffer_to_image(
+                    cmd,
+                    staging.raw(),
+                    image.raw(),
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &[region],
+                );
+                self.cmd_barrier(
+                    cmd,
+                    &[],
+                    &[],
+                    &[barrier::image(
+                        image,
+                        Access::TRANSFER_WRITE,
+                        Access::ANY,
+                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                        vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                    )],
+                );
+            }
+        })
+    }
+
     /// Reads a whole single-sample color image in `layout` back as tightly packed texels
     /// (`texel_size` bytes each); the image is left in `layout`.
     pub(crate) fn readback_image(

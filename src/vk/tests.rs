@@ -174,6 +174,8 @@ fn every_shader_struct_matches_its_rust_twin() {
         gpu_types::GpuCollider::GLSL_NAME,
         gpu_types::SmoothPush::GLSL_NAME,
         gpu_types::InterpolatePush::GLSL_NAME,
+        gpu_types::GpuLight::GLSL_NAME,
+        gpu_types::DrawParams::GLSL_NAME,
     ];
     let mut found = vec![0usize; names.len()];
     for shader in shaders::ALL {

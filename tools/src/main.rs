@@ -1,5 +1,7 @@
 //! `vkhair`: the command-line program of the vkhair crate.
 
+mod render_cmd;
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -34,6 +36,9 @@ enum Command {
     Grow(GrowArgs),
     /// Simulate a groom on the GPU with the shaking-head motion; print per-stage GPU times.
     Simulate(SimulateArgs),
+    /// Simulate and render a head of hair headless: PNG frames, a contact sheet and a
+    /// per-pass GPU timing table.
+    Render(render_cmd::RenderArgs),
     /// Resample and/or pick key hairs from a .hair or .tfx file; write a .hair file.
     Convert {
         /// Input groom (.hair or .tfx).
@@ -138,6 +143,7 @@ fn main() -> ExitCode {
         Command::Inspect { file } => inspect(&file),
         Command::Grow(args) => grow_cmd(&args),
         Command::Simulate(args) => simulate(&args),
+        Command::Render(args) => render_cmd::render(&args),
         Command::Convert { input, points, key_hairs, out } => convert(&input, points, key_hairs, &out),
     };
     match result {

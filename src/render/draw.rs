@@ -1,0 +1,90 @@
+//! Pass 3 — drawing (`glsl/render/draw.*`): the interpolated hairs as
+//! camera-facing ribbons expanded in the geometry stage, shaded with
+//! Kajiya-Kay diffuse and two shifted highlights for every light, into the
+//! host's color and depth images (dynamic rendering, depth-tested against what
+//! the host drew). Pipelines are made on first use for each combination of
+//! color format, depth format and sample count.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::shading::{noise_texels, NOISE_SIZE};
+use crate::error::Result;
+use crate::vk::buffer::Buffer;
+use crate::vk::device::Device;
+use crate::vk::image::{Image, ImageDesc, Sampler};
+use crate::vk::pipeline::{GraphicsDesc, GraphicsPipeline};
+use crate::vk::shaders::{RENDER_DRAW_FRAG, RENDER_DRAW_GEOM, RENDER_DRAW_VERT};
+
+/// Formats and sample count a draw pipeline is made for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(super) struct TargetKey {
+    pub color: vk::Format,
+    pub depth: vk::Format,
+    pub samples: vk::SampleCountFlags,
+}
+
+pub(super) struct DrawPass {
+    device: Arc<Device>,
+    pipelines: HashMap<TargetKey, (GraphicsPipeline, vk::DescriptorSet)>,
+    noise: Image,
+    sampler: Sampler,
+}
+
+impl DrawPass {
+    pub(super) fn new(device: &Arc<Device>) -> Result<Self> {
+        let noise = Image::new(
+            device,
+            &ImageDesc {
+                name: "vkhair hair noise",
+                extent: vk::Extent2D { width: NOISE_SIZE, height: NOISE_SIZE },
+                format: vk::Format::R8G8_UNORM,
+                usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+                samples: vk::SampleCountFlags::TYPE_1,
+                aspect: vk::ImageAspectFlags::COLOR,
+            },
+        )?;
+        device.upload_image(&noise, &noise_texels())?;
+        let sampler = Sampler::new(device, "vkhair noise sampler", true)?;
+        Ok(DrawPass { device: device.clone(), pipelines: HashMap::new(), noise, sampler })
+    }
+
+    /// The pipeline and descriptor set for `key`, made on first use.
+    pub(super) fn pipeline(
+        &mut self,
+        key: TargetKey,
+        params: &Buffer,
+        positions: &Buffer,
+        tangents: &Buffer,
+    ) -> Result<&(GraphicsPipeline, vk::DescriptorSet)> {
+        if !self.pipelines.contains_key(&key) {
+            let color_formats = [key.color];
+            let pipeline = GraphicsPipeline::new(
+                &self.device,
+                &GraphicsDesc {
+                    name: "vkhair hair draw",
+                    stages: &[&RENDER_DRAW_VERT, &RENDER_DRAW_GEOM, &RENDER_DRAW_FRAG],
+                    topology: vk::PrimitiveTopology::LINE_LIST,
+                    patch_control_points: 0,
+                    color_formats: &color_formats,
+                    depth_format: key.depth,
+                    samples: key.samples,
+                    depth_test: key.depth != vk::Format::UNDEFINED,
+                    depth_write: key.depth != vk::Format::UNDEFINED,
+                    additive_blend: None,
+                    rasterizer_discard: false,
+                },
+                1,
+            )?;
+            let set = pipeline.resource_set(
+                0,
+                &[(0, params), (1, positions), (2, tangents)],
+                &[(3, self.noise.view(), self.sampler.raw)],
+            )?;
+            self.pipelines.insert(key, (pipeline, set));
+        }
+        Ok(&self.pipelines[&key])
+    }
+}

@@ -1,0 +1,251 @@
+//! The look of the hair: camera, lights and material, and the noise texture
+//! the shading samples.
+
+use glam::{Mat4, Vec3};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+use crate::error::{Error, Result};
+use crate::gpu_types::GpuLight;
+
+/// Most lights the draw pass shades with.
+pub const MAX_LIGHTS: usize = 8;
+
+/// A perspective camera (Vulkan clip space: y down, depth 0..1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Camera {
+    /// World → view.
+    pub view: Mat4,
+    /// View → clip.
+    pub projection: Mat4,
+    /// Vertical field of view, radians (for pixel-size estimates).
+    pub fov_y: f32,
+}
+
+impl Camera {
+    /// A camera at `eye` looking at `target` with +Y up.
+    pub fn look_at(eye: Vec3, target: Vec3, fov_y: f32, aspect: f32, near: f32, far: f32) -> Result<Camera> {
+        let finite = eye.is_finite() && target.is_finite() && fov_y.is_finite() && aspect.is_finite();
+        if !finite
+            || (eye - target).length() < 1e-6
+            || !(0.01..3.1).contains(&fov_y)
+            || aspect <= 0.0
+            || !(0.0 < near && near < far)
+        {
+            return Err(Error::param(
+                "camera",
+                format!("eye {eye}, target {target}, fov {fov_y}, aspect {aspect}, near {near}, far {far}"),
+            ));
+        }
+        Ok(Camera {
+            view: glam::camera::rh::view::look_at_mat4(eye, target, Vec3::Y),
+            projection: glam::camera::rh::proj::vulkan::perspective(fov_y, aspect, near, far),
+            fov_y,
+        })
+    }
+
+    /// The camera's world position.
+    pub fn position(&self) -> Vec3 {
+        self.view.inverse().w_axis.truncate()
+    }
+}
+
+/// A light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Light {
+    /// Parallel light travelling along `direction`.
+    Directional {
+        /// Direction of travel.
+        direction: Vec3,
+        /// Linear RGB radiance.
+        color: Vec3,
+    },
+    /// A point light; radiance falls off with the squared distance.
+    Point {
+        /// Position, meters.
+        position: Vec3,
+        /// Linear RGB intensity (radiance at 1 m).
+        color: Vec3,
+    },
+    /// A spot light: a point light within a cone.
+    Spot {
+        /// Position, meters.
+        position: Vec3,
+        /// Direction the cone points.
+        direction: Vec3,
+        /// Half-angle where the cone ends, radians.
+        outer_angle: f32,
+        /// Half-angle of full intensity, radians (≤ outer_angle).
+        inner_angle: f32,
+        /// Linear RGB intensity (radiance at 1 m).
+        color: Vec3,
+    },
+}
+
+impl Light {
+    pub(crate) fn to_gpu(self) -> Result<GpuLight> {
+        let bad = || Error::param("light", format!("{self:?} is not finite or has a zero direction"));
+        Ok(match self {
+            Light::Directional { direction, color } => {
+                let d = direction.try_normalize().ok_or_else(bad)?;
+                if !color.is_finite() {
+                    return Err(bad());
+                }
+                GpuLight {
+                    position_kind: [0.0, 0.0, 0.0, 0.0],
+                    direction_cone: [d.x, d.y, d.z, 0.0],
+                    color_range: color.extend(0.0).to_array(),
+                }
+            }
+            Light::Point { position, color } => {
+                if !position.is_finite() || !color.is_finite() {
+                    return Err(bad());
+                }
+                GpuLight {
+                    position_kind: position.extend(1.0).to_array(),
+                    direction_cone: [0.0, -1.0, 0.0, 0.0],
+                    color_range: color.extend(0.0).to_array(),
+                }
+            }
+            Light::Spot { position, direction, outer_angle, inner_angle, color } => {
+                let d = direction.try_normalize().ok_or_else(bad)?;
+                let angles_ok = outer_angle.is_finite()
+                    && inner_angle.is_finite()
+                    && 0.0 <= inner_angle
+                    && inner_angle <= outer_angle
+                    && outer_angle < std::f32::consts::PI;
+                if !position.is_finite() || !color.is_finite() || !angles_ok {
+                    return Err(bad());
+                }
+                GpuLight {
+                    position_kind: position.extend(2.0).to_array(),
+                    direction_cone: [d.x, d.y, d.z, outer_angle.cos()],
+                    color_range: color.extend(inner_angle.cos()).to_array(),
+                }
+            }
+        })
+    }
+}
+
+/// Hair material (Kajiya-Kay diffuse and two shifted specular highlights).
+#[derive(Debug, Clone, PartialEq)]
+pub struct HairMaterial {
+    /// Albedo at the root, linear RGB. Default: dark brown (0.10, 0.05, 0.02).
+    pub root_color: Vec3,
+    /// Albedo at the tip, linear RGB. Default: (0.25, 0.14, 0.06).
+    pub tip_color: Vec3,
+    /// Ambient fraction of the albedo (0..=1). Default: 0.08.
+    pub ambient: f32,
+    /// How far diffuse light wraps around to the side away from the light
+    /// (0 = none, 1 = half way). Default: 0.3.
+    pub diffuse_wrap: f32,
+    /// Primary highlight color, linear RGB. Default: (0.35, 0.33, 0.30).
+    pub primary_color: Vec3,
+    /// Primary highlight exponent (≥ 1). Default: 80.
+    pub primary_exponent: f32,
+    /// Primary tangent shift along the strand normal (−1..=1). Default: −0.1 (toward the tip).
+    pub primary_shift: f32,
+    /// Secondary highlight color (multiplied by the albedo). Default: (1.0, 0.8, 0.6).
+    pub secondary_color: Vec3,
+    /// Secondary highlight exponent (≥ 1). Default: 12.
+    pub secondary_exponent: f32,
+    /// Secondary tangent shift (−1..=1). Default: 0.15.
+    pub secondary_shift: f32,
+    /// Per-hair random shift added to both shifts, amplitude (0..=1). Default: 0.15.
+    pub shift_jitter: f32,
+    /// How much noise breaks up the secondary highlight (0..=1). Default: 0.7.
+    pub highlight_breakup: f32,
+    /// Ribbon width at the root, meters (≥ 0). Default: 0.00012.
+    pub root_width: f32,
+    /// Ribbon width at the tip, meters (≥ 0). Default: 0.00005.
+    pub tip_width: f32,
+    /// Least ribbon width on screen, pixels (0 = none). Default: 1.
+    pub least_pixel_width: f32,
+}
+
+impl Default for HairMaterial {
+    fn default() -> Self {
+        HairMaterial {
+            root_color: Vec3::new(0.10, 0.05, 0.02),
+            tip_color: Vec3::new(0.25, 0.14, 0.06),
+            ambient: 0.08,
+            diffuse_wrap: 0.3,
+            primary_color: Vec3::new(0.35, 0.33, 0.30),
+            primary_exponent: 80.0,
+            primary_shift: -0.1,
+            secondary_color: Vec3::new(1.0, 0.8, 0.6),
+            secondary_exponent: 12.0,
+            secondary_shift: 0.15,
+            shift_jitter: 0.15,
+            highlight_breakup: 0.7,
+            root_width: 0.00012,
+            tip_width: 0.00005,
+            least_pixel_width: 1.0,
+        }
+    }
+}
+
+impl HairMaterial {
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<()> {
+        let colors = [
+            ("root_color", self.root_color),
+            ("tip_color", self.tip_color),
+            ("primary_color", self.primary_color),
+            ("secondary_color", self.secondary_color),
+        ];
+        for (name, c) in colors {
+            if !c.is_finite() || c.min_element() < 0.0 {
+                return Err(Error::param(name, format!("{c} must be finite and ≥ 0")));
+            }
+        }
+        let ranges = [
+            ("ambient", self.ambient, 0.0, 1.0),
+            ("diffuse_wrap", self.diffuse_wrap, 0.0, 1.0),
+            ("primary_exponent", self.primary_exponent, 1.0, 10_000.0),
+            ("secondary_exponent", self.secondary_exponent, 1.0, 10_000.0),
+            ("primary_shift", self.primary_shift, -1.0, 1.0),
+            ("secondary_shift", self.secondary_shift, -1.0, 1.0),
+            ("shift_jitter", self.shift_jitter, 0.0, 1.0),
+            ("highlight_breakup", self.highlight_breakup, 0.0, 1.0),
+            ("root_width", self.root_width, 0.0, 1.0),
+            ("tip_width", self.tip_width, 0.0, 1.0),
+            ("least_pixel_width", self.least_pixel_width, 0.0, 64.0),
+        ];
+        for (name, v, lo, hi) in ranges {
+            if !(v.is_finite() && v >= lo && v <= hi) {
+                return Err(Error::param(name, format!("{v} is outside {lo}..={hi}")));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Side of the square noise texture, texels.
+pub(crate) const NOISE_SIZE: u32 = 128;
+
+/// The RG8 noise texture: R breaks up the secondary highlight, G jitters the
+/// shift. Smoothed white noise (a 3×3 box of random texels), deterministic.
+pub(crate) fn noise_texels() -> Vec<u8> {
+    let n = NOISE_SIZE as usize;
+    let mut rng = Pcg64Mcg::seed_from_u64(0x5eed_4a1e);
+    let raw: Vec<[f32; 2]> = (0..n * n).map(|_| [rng.random::<f32>(), rng.random::<f32>()]).collect();
+    let mut out = Vec::with_capacity(n * n * 2);
+    for y in 0..n {
+        for x in 0..n {
+            let mut sum = [0.0f32; 2];
+            for dy in [n - 1, 0, 1] {
+                for dx in [n - 1, 0, 1] {
+                    let v = raw[((y + dy) % n) * n + (x + dx) % n];
+                    sum[0] += v[0];
+                    sum[1] += v[1];
+                }
+            }
+            // The mean of 9 uniforms has std 0.096: stretch it back to about 0..1.
+            for s in sum {
+                out.push(((s / 9.0 - 0.5) * 3.0 + 0.5).clamp(0.0, 1.0).mul_add(255.0, 0.5) as u8);
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,285 @@
+//! `vkhair render`: headless frames of a simulated, rendered head of hair.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use indicatif::{ProgressBar, ProgressStyle};
+use vkhair::groom::cyhair::HairFile;
+use vkhair::groom::mesh::TriMesh;
+use vkhair::groom::scenes::{self, THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS};
+use vkhair::groom::tfx::TfxFile;
+use vkhair::groom::Groom;
+use vkhair::render::{Camera, Light, MeshDrawer, Offscreen, RenderParams, Renderer};
+use vkhair::sim::{motion, Collider, HairSim, RigidTransform, SimParams};
+use vkhair::{ContextOptions, GpuContext, GpuProfiler};
+
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// Image width, pixels.
+    #[arg(long, default_value_t = 640)]
+    width: u32,
+    /// Image height, pixels.
+    #[arg(long, default_value_t = 480)]
+    height: u32,
+    /// Frames to render (30 per second of motion).
+    #[arg(long, default_value_t = 24)]
+    frames: usize,
+    /// Output folder for frame PNGs and the contact sheet.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// Groom file (.hair or .tfx) instead of the `thesis` scene.
+    #[arg(long)]
+    input: Option<PathBuf>,
+    /// Head mesh (OBJ) to draw and to place the camera by.
+    #[arg(long)]
+    obj: Option<PathBuf>,
+    /// Multiply input positions (groom and mesh) by this (0.01: Blender units → m).
+    #[arg(long, default_value_t = 1.0)]
+    scale: f32,
+    /// Resample input strands to this many points (at most 64).
+    #[arg(long, default_value_t = 16)]
+    points: usize,
+    /// Hairs grown per key hair.
+    #[arg(long, default_value_t = 16)]
+    hairs_per_key: u32,
+    /// Smoothed segments per key segment.
+    #[arg(long, default_value_t = 4)]
+    level: u32,
+    /// Camera distance from the head, meters.
+    #[arg(long, default_value_t = 0.9)]
+    distance: f32,
+}
+
+struct Scene {
+    groom: Groom,
+    colliders: Vec<Collider>,
+    head_mesh: TriMesh,
+    center: Vec3,
+    pivot: Vec3,
+    credit: Option<&'static str>,
+}
+
+fn load_groom(path: &Path, scale: f32, points: usize) -> Result<Groom, vkhair::Error> {
+    let groom = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("tfx")) {
+        TfxFile::open(path)?.groom
+    } else {
+        HairFile::open(path)?.groom
+    };
+    let counts: Vec<u32> = (0..groom.strand_count()).map(|i| groom.strand_len(i) as u32).collect();
+    let scaled = groom.positions().iter().map(|p| *p * scale).collect();
+    Groom::new(scaled, &counts)?.resampled(points)
+}
+
+fn scene(a: &RenderArgs) -> Result<Scene, Box<dyn std::error::Error>> {
+    let sintel =
+        |p: &Option<PathBuf>| p.as_ref().is_some_and(|p| p.to_string_lossy().to_lowercase().contains("sintel"));
+    match &a.input {
+        None => Ok(Scene {
+            groom: scenes::thesis()?,
+            colliders: motion::thesis_colliders(),
+            head_mesh: TriMesh::uv_sphere(THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS * 0.97, 24, 32)?,
+            center: THESIS_HEAD_CENTER,
+            pivot: motion::NECK_PIVOT,
+            credit: None,
+        }),
+        Some(path) => {
+            let groom = load_groom(path, a.scale, a.points)?;
+            let head_mesh = match &a.obj {
+                Some(obj) => {
+                    let m = TriMesh::load_obj(obj)?;
+                    TriMesh::new(m.positions.iter().map(|p| *p * a.scale).collect(), m.triangles)?
+                }
+                None => {
+                    let (lo, hi) = groom.bounds();
+                    TriMesh::uv_sphere(0.5 * (lo + hi), 0.25 * (hi - lo).min_element(), 16, 24)?
+                }
+            };
+            let (lo, hi) = groom.bounds();
+            let center = 0.5 * (lo + hi);
+            Ok(Scene {
+                groom,
+                colliders: Vec::new(),
+                head_mesh,
+                center,
+                pivot: Vec3::new(center.x, lo.y, center.z),
+                credit: (sintel(&a.input) || sintel(&a.obj))
+                    .then_some("Sintel © Blender Foundation | durian.blender.org (CC BY 3.0)"),
+            })
+        }
+    }
+}
+
+/// The thesis scene's three lights: two spots (key and fill) and a rim light.
+fn lights(center: Vec3) -> Vec<Light> {
+    let spot = |offset: Vec3, color: Vec3| Light::Spot {
+        position: center + offset,
+        direction: -offset,
+        outer_angle: 0.6,
+        inner_angle: 0.4,
+        color,
+    };
+    vec![
+        spot(Vec3::new(-0.6, 0.5, 0.8), Vec3::splat(1.1)),
+        spot(Vec3::new(0.9, 0.1, 0.4), Vec3::new(0.25, 0.27, 0.33)),
+        Light::Directional { direction: Vec3::new(0.2, -0.3, 1.0), color: Vec3::new(0.25, 0.22, 0.2) },
+    ]
+}
+
+fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<(), Box<dyn std::error::Error>> {
+    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut encoder = png::Encoder::new(file, width, height);
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    encoder.write_header()?.write_image_data(rgba)?;
+    Ok(())
+}
+
+/// Up to 12 frames, halved, on a 4-column sheet.
+fn contact_sheet(frames: &[Vec<u8>], width: u32, height: u32) -> (u32, u32, Vec<u8>) {
+    let picked: Vec<&Vec<u8>> = if frames.len() <= 12 {
+        frames.iter().collect()
+    } else {
+        (0..12).map(|i| &frames[i * (frames.len() - 1) / 11]).collect()
+    };
+    let (tw, th) = (width / 2, height / 2);
+    let cols = 4u32.min(picked.len() as u32).max(1);
+    let rows = (picked.len() as u32).div_ceil(cols).max(1);
+    let (sw, sh) = (cols * tw, rows * th);
+    let mut sheet = vec![0u8; (sw * sh * 4) as usize];
+    for (k, frame) in picked.iter().enumerate() {
+        let (ox, oy) = ((k as u32 % cols) * tw, (k as u32 / cols) * th);
+        for y in 0..th {
+            for x in 0..tw {
+                for c in 0..4 {
+                    let at =
+                        |dx: u32, dy: u32| u32::from(frame[(((2 * y + dy) * width + 2 * x + dx) * 4 + c) as usize]);
+                    let v = (at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1) + 2) / 4;
+                    sheet[(((oy + y) * sw + ox + x) * 4 + c) as usize] = v as u8;
+                }
+            }
+        }
+    }
+    (sw, sh, sheet)
+}
+
+pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let s = scene(a)?;
+    let ctx = GpuContext::headless(&ContextOptions::default())?;
+    let sim_params = SimParams::default();
+    let mut sim = HairSim::new(&ctx, &s.groom, &sim_params, &RigidTransform::default())?;
+    sim.set_colliders(&s.colliders)?;
+    let params = RenderParams { smoothing_level: a.level, hairs_per_key: a.hairs_per_key, ..RenderParams::default() };
+    let mut renderer = Renderer::new(&ctx, &sim, &params)?;
+    renderer.set_lights(&lights(s.center))?;
+    let offscreen = Offscreen::new(&ctx, a.width, a.height)?;
+    let head = MeshDrawer::new(&ctx, &s.head_mesh)?;
+    let aspect = a.width as f32 / a.height as f32;
+    let camera = Camera::look_at(
+        s.center + Vec3::new(0.0, 0.05, a.distance),
+        s.center - Vec3::new(0.0, 0.08, 0.0),
+        40f32.to_radians(),
+        aspect,
+        0.01,
+        10.0,
+    )?;
+    let mut profiler = GpuProfiler::new(&ctx, 1, 64)?;
+    std::fs::create_dir_all(&a.out)?;
+    let (strands, points) = sim.size();
+    let (hairs, per_hair) = renderer.hair_counts();
+    println!(
+        "{}: {strands} key hairs × {points} points → {hairs} hairs × {} segments ({} segments), {}×{}, {} frames",
+        ctx.info().name,
+        per_hair - 1,
+        hairs as u64 * (per_hair as u64 - 1),
+        a.width,
+        a.height,
+        a.frames
+    );
+    let bar = ProgressBar::new(a.frames as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let steps_per_frame = 2; // 1/60 s steps, 30 frames per second
+    let mut totals: Vec<(String, f64, u32)> = Vec::new();
+    let mut add = |report: vkhair::ProfileReport| {
+        for (name, ns) in report.totals_by_name() {
+            match totals.iter_mut().find(|(n, _, _)| *n == name) {
+                Some(entry) => {
+                    entry.1 += ns;
+                    entry.2 += 1;
+                }
+                None => totals.push((name, ns, 1)),
+            }
+        }
+    };
+    let mut frames = Vec::new();
+    let mut error = None;
+    for frame in 0..a.frames {
+        let first_step = frame * steps_per_frame;
+        ctx.run_commands("vkhair render frame", |cmd| {
+            // SAFETY: run_commands hands over a recording command buffer of the
+            // context's device and waits for the previous one.
+            let result = unsafe {
+                if let Some(report) = profiler.begin_frame(cmd, frame as u64) {
+                    add(report);
+                }
+                let mut result = Ok(());
+                for k in 0..steps_per_frame {
+                    let t = (first_step + k + 1) as f32 * sim_params.dt;
+                    let motion = motion::shaking_head_about(t, 0.6, 1.0, s.pivot);
+                    result = result.and_then(|_| sim.record_step(cmd, &motion, Some(&mut profiler)));
+                }
+                result
+                    .and_then(|_| renderer.record_prepare(cmd, &sim, Some(&mut profiler)))
+                    .map(|_| {
+                        offscreen.record_clear(cmd, Vec3::splat(0.02));
+                        let scope = profiler.begin_scope(cmd, "host: head mesh");
+                        let h = sim.head();
+                        let view_proj = camera.projection * camera.view;
+                        head.record(
+                            cmd,
+                            &offscreen.target(),
+                            view_proj,
+                            (h.rotation, h.translation),
+                            Vec3::new(0.55, 0.4, 0.32),
+                            Vec3::new(0.6, -0.5, -0.8),
+                        );
+                        profiler.end_scope(cmd, scope);
+                    })
+                    .and_then(|_| renderer.record_draw(cmd, &offscreen.target(), &camera, Some(&mut profiler)))
+            };
+            if let Err(e) = result {
+                error = Some(e);
+            }
+        })?;
+        if let Some(e) = error.take() {
+            return Err(e.into());
+        }
+        let rgba = offscreen.read_rgba8()?;
+        write_png(&a.out.join(format!("frame_{frame:04}.png")), a.width, a.height, &rgba)?;
+        frames.push(rgba);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    for report in profiler.drain() {
+        add(report);
+    }
+    let (sw, sh, sheet) = contact_sheet(&frames, a.width, a.height);
+    write_png(&a.out.join("contact_sheet.png"), sw, sh, &sheet)?;
+    println!("{:<28} {:>10}", "pass (GPU, mean per frame)", "ms");
+    let mut sum = 0.0;
+    for (name, ns, count) in &totals {
+        // Each report sums a pass over the frame (the simulation's two steps too).
+        let per_frame = ns / (*count as f64).max(1.0);
+        sum += per_frame;
+        println!("{name:<28} {:>10.3}", per_frame / 1e6);
+    }
+    println!("{:<28} {:>10.3}", "total", sum / 1e6);
+    println!("wrote {} frames and contact_sheet.png to {}", frames.len(), a.out.display());
+    if let Some(credit) = s.credit {
+        println!("{credit}");
+    }
+    Ok(())
+}
