@@ -48,7 +48,7 @@ fn smoothing_matches_the_cpu_bspline() {
         let mut renderer =
             Renderer::new(gpu.ctx(), &sim, &RenderParams { smoothing_level: level, ..RenderParams::default() })
                 .expect("renderer");
-        renderer.prepare_now(&sim).expect("prepare");
+        renderer.prepare_now(&sim, None).expect("prepare");
         let (positions, tangents) = renderer.read_smoothed().expect("readback");
         let stride = renderer.smoothed_vertices_per_strand() as usize;
         assert_eq!(stride, 5 * level as usize + 1);
@@ -112,7 +112,7 @@ fn interpolation_grows_stable_clumps() {
     for frame in 0..2 {
         let start = frame * 25;
         sim.run(25, |i| motion::reference_motion((start + i + 1) as f32 * params.dt), None).expect("run");
-        renderer.prepare_now(&sim).expect("prepare");
+        renderer.prepare_now(&sim, None).expect("prepare");
         let (smoothed, tangents) = renderer.read_smoothed().expect("smoothed");
         let (positions, hair_tangents) = renderer.read_hairs().expect("hairs");
         assert_eq!(positions.len(), (hairs * per_hair) as usize);
@@ -200,7 +200,7 @@ fn draw(gpu: &Gpu, s: &mut Scene, blocker: Option<&MeshDrawer>) -> Vec<u8> {
         .run_commands("test frame", |cmd| {
             // SAFETY: a recording command buffer of the context's device.
             result = unsafe {
-                s.renderer.record_prepare(cmd, &s.sim, None).and_then(|_| {
+                s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
                     s.offscreen.record_clear(cmd, Vec3::ZERO);
                     if let Some(mesh) = blocker {
                         let vp = s.camera.projection * s.camera.view;
@@ -328,4 +328,69 @@ fn hair_is_hidden_behind_what_the_host_drew() {
     assert_ne!(at(&bare), BACKGROUND, "hair is drawn there without the blocker");
     let seen = at(&blocked);
     assert!(seen[1] > 40 && seen[0] == 0 && seen[2] == 0, "the blocker is in front: {seen:?}");
+}
+
+/// Level of detail: at the distances of the thesis' Table 5 the number of segments
+/// actually drawn (geometry-shader invocations, one per segment, counted by a
+/// pipeline-statistics query) falls with distance, while the image keeps covering.
+#[test]
+fn detail_falls_with_distance() {
+    use vkhair::ash::vk;
+    let gpu = Gpu::new();
+    let mut s = scene(&gpu);
+    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    let device = gpu.ctx().raw_device().clone();
+    let info = vk::QueryPoolCreateInfo::default()
+        .query_type(vk::QueryType::PIPELINE_STATISTICS)
+        .query_count(1)
+        .pipeline_statistics(vk::QueryPipelineStatisticFlags::GEOMETRY_SHADER_INVOCATIONS);
+    // SAFETY: valid create info on the context's device; destroyed below.
+    let pool = unsafe { device.create_query_pool(&info, None) }.expect("query pool (pipelineStatisticsQuery)");
+    let center = scenes::THESIS_HEAD_CENTER;
+    let mut drawn = Vec::new();
+    for distance in [0.2f32, 0.4, 0.6, 1.0, 1.5, 3.0] {
+        s.camera =
+            Camera::look_at(center + Vec3::new(0.0, 0.0, distance), center, 0.7, W as f32 / H as f32, 0.01, 20.0)
+                .expect("camera");
+        let mut result = Ok(());
+        gpu.ctx()
+            .run_commands("lod frame", |cmd| {
+                // SAFETY: a recording command buffer of the context's device; the query
+                // spans the draw's rendering instance from outside it.
+                result = unsafe {
+                    device.cmd_reset_query_pool(cmd, pool, 0, 1);
+                    s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
+                        s.offscreen.record_clear(cmd, Vec3::ZERO);
+                        device.cmd_begin_query(cmd, pool, 0, vk::QueryControlFlags::empty());
+                        let r = s.renderer.record_draw(cmd, &s.offscreen.target(), &s.camera, None);
+                        device.cmd_end_query(cmd, pool, 0);
+                        r
+                    })
+                };
+            })
+            .expect("submit");
+        result.expect("record");
+        let mut count = [0u64; 1];
+        // SAFETY: the submission completed (run_commands waits).
+        unsafe {
+            device.get_query_pool_results(
+                pool,
+                0,
+                &mut count,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
+        }
+        .expect("results");
+        let (hairs, per_hair) = s.renderer.hair_counts();
+        assert_eq!(count[0], u64::from(hairs) * u64::from(per_hair - 1), "GS invocations = segments at {distance} m");
+        let covered = hair_pixels(&s.offscreen.read_rgba8().expect("readback")).len();
+        eprintln!("{distance} m: {:?}, {} segments drawn, {covered} pixels", s.renderer.detail(), count[0]);
+        drawn.push((count[0], covered));
+    }
+    // SAFETY: no pending work uses the pool.
+    unsafe { device.destroy_query_pool(pool, None) };
+    assert!(drawn.windows(2).all(|w| w[1].0 <= w[0].0), "cost must not grow with distance: {drawn:?}");
+    assert_eq!(drawn[0].0, drawn[2].0, "full detail up to 0.6 m");
+    assert!(drawn[5].0 * 10 < drawn[2].0, "3 m draws far fewer segments: {drawn:?}");
+    assert!(drawn.iter().all(|d| d.1 > 100), "hair stays visible: {drawn:?}");
 }

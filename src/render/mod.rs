@@ -84,11 +84,75 @@ pub struct RenderParams {
     pub root_width: f32,
     /// Fraction of `clump_width` at the tip (≥ 0). Default: 1.0.
     pub tip_width: f32,
+    /// Level of detail by camera distance.
+    pub lod: LodParams,
 }
 
 impl Default for RenderParams {
     fn default() -> Self {
-        RenderParams { smoothing_level: 4, hairs_per_key: 16, clump_width: 0.012, root_width: 0.3, tip_width: 1.0 }
+        RenderParams {
+            smoothing_level: 4,
+            hairs_per_key: 16,
+            clump_width: 0.012,
+            root_width: 0.3,
+            tip_width: 1.0,
+            lod: LodParams::default(),
+        }
+    }
+}
+
+/// Level of detail by camera distance d (to the centre of the hair), stepped:
+/// with d0 = `full_detail_distance`, hairs per key = round(full · (d0/d)²) (they
+/// cover screen area) and segments per key segment = round(full · d0/d) (they
+/// follow screen length), each clamped between its minimum and the full count of
+/// [`RenderParams`]; ribbon width grows by √(full hairs / hairs) to keep coverage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LodParams {
+    /// Whether detail falls with distance. Default: true.
+    pub enabled: bool,
+    /// Distance up to which full detail is drawn, meters (> 0). Default: 0.6.
+    pub full_detail_distance: f32,
+    /// Fewest hairs per key hair (≥ 1). Default: 2.
+    pub min_hairs_per_key: u32,
+    /// Lowest smoothing level (≥ 1). Default: 1.
+    pub min_smoothing_level: u32,
+}
+
+impl Default for LodParams {
+    fn default() -> Self {
+        LodParams { enabled: true, full_detail_distance: 0.6, min_hairs_per_key: 2, min_smoothing_level: 1 }
+    }
+}
+
+/// The detail actually drawn (see [`LodParams`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Detail {
+    /// Smoothed segments per key segment.
+    pub smoothing_level: u32,
+    /// Hairs per key hair.
+    pub hairs_per_key: u32,
+    /// Ribbon width factor.
+    pub width_scale: f32,
+}
+
+impl RenderParams {
+    /// The detail at camera distance `distance` (full detail when LOD is off).
+    pub fn detail_at(&self, distance: f32) -> Detail {
+        let full =
+            Detail { smoothing_level: self.smoothing_level, hairs_per_key: self.hairs_per_key, width_scale: 1.0 };
+        if !self.lod.enabled || !distance.is_finite() || distance <= self.lod.full_detail_distance {
+            return full;
+        }
+        let ratio = self.lod.full_detail_distance / distance;
+        let hairs = ((self.hairs_per_key as f32 * ratio * ratio).round() as u32)
+            .clamp(self.lod.min_hairs_per_key.min(self.hairs_per_key), self.hairs_per_key);
+        let level = ((self.smoothing_level as f32 * ratio).round() as u32)
+            .clamp(self.lod.min_smoothing_level.min(self.smoothing_level), self.smoothing_level);
+        Detail {
+            smoothing_level: level,
+            hairs_per_key: hairs,
+            width_scale: (self.hairs_per_key as f32 / hairs as f32).sqrt(),
+        }
     }
 }
 
@@ -137,6 +201,10 @@ pub struct Renderer {
     lights: Vec<GpuLight>,
     /// Head rotation of the latest prepared frame (for readers of the hair buffers).
     head_rotation: glam::Quat,
+    /// Centre of the rest shape's bounds, head frame (LOD distance).
+    rest_center: glam::Vec3,
+    /// The detail of the latest prepared frame.
+    detail: Detail,
 }
 
 impl Renderer {
@@ -225,6 +293,15 @@ impl Renderer {
             material: HairMaterial::default(),
             lights: Vec::new(),
             head_rotation: sim.head().rotation.normalize(),
+            rest_center: {
+                let rest = &sim.rest_shape().rest;
+                let (lo, hi) =
+                    rest.iter().fold((glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)), |(lo, hi), p| {
+                        (lo.min(p.truncate()), hi.max(p.truncate()))
+                    });
+                0.5 * (lo + hi)
+            },
+            detail: params.detail_at(0.0),
         })
     }
 
@@ -250,19 +327,25 @@ impl Renderer {
             ));
         }
         self.params = params.clone();
+        self.detail = self.detail.min_with(params);
         Ok(())
     }
 
-    /// Smoothed vertices per key hair at the current level.
+    /// Smoothed vertices per key hair at the detail of the latest prepared frame.
     pub fn smoothed_vertices_per_strand(&self) -> u32 {
-        (self.points - 1) * self.params.smoothing_level + 1
+        (self.points - 1) * self.detail.smoothing_level + 1
+    }
+
+    /// The detail of the latest prepared frame.
+    pub fn detail(&self) -> Detail {
+        self.detail
     }
 
     fn smooth_push(&self) -> SmoothPush {
         SmoothPush {
             strands: self.strands,
             points: self.points,
-            level: self.params.smoothing_level,
+            level: self.detail.smoothing_level,
             stride: self.smoothed_vertices_per_strand(),
         }
     }
@@ -272,18 +355,18 @@ impl Renderer {
             head_rotation: self.head_rotation.to_array(),
             strands: self.strands,
             points: self.points,
-            level: self.params.smoothing_level,
+            level: self.detail.smoothing_level,
             stride: self.smoothed_vertices_per_strand(),
-            hairs: self.params.hairs_per_key,
+            hairs: self.detail.hairs_per_key,
             clump_width: self.params.clump_width,
             root_width: self.params.root_width,
             tip_width: self.params.tip_width,
         }
     }
 
-    /// Interpolated hairs and vertices per hair at the current parameters.
+    /// Interpolated hairs and vertices per hair of the latest prepared frame.
     pub fn hair_counts(&self) -> (u32, u32) {
-        (self.strands * self.params.hairs_per_key, self.smoothed_vertices_per_strand())
+        (self.strands * self.detail.hairs_per_key, self.smoothed_vertices_per_strand())
     }
 
     /// Records one storing pass: label or timestamp scope, an attachment-less
@@ -345,7 +428,8 @@ impl Renderer {
     }
 
     /// Records the geometry passes (smoothing, interpolation) for `sim`'s latest
-    /// state into `cmd`.
+    /// state into `cmd`, at the detail for `camera` ([`LodParams`]; full detail
+    /// without a camera).
     ///
     /// # Safety
     /// `cmd` is a command buffer of the context's device in the recording state,
@@ -356,10 +440,15 @@ impl Renderer {
         &mut self,
         cmd: vk::CommandBuffer,
         sim: &HairSim,
+        camera: Option<&Camera>,
         mut profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
         let (_, half) = sim.position_halves();
-        self.head_rotation = sim.head().rotation.normalize();
+        let head = sim.head();
+        self.head_rotation = head.rotation.normalize();
+        let distance =
+            camera.map_or(0.0, |c| (c.position() - head.matrix().transform_point3(self.rest_center)).length());
+        self.detail = self.params.detail_at(distance);
         let d = &self.device;
         let entry = barrier::memory(
             Access::ANY_WRITE,
@@ -385,12 +474,12 @@ impl Renderer {
 
     /// Records [`Renderer::record_prepare`] in its own submission and waits (headless
     /// use: tests and tools).
-    pub fn prepare_now(&mut self, sim: &HairSim) -> Result<()> {
+    pub fn prepare_now(&mut self, sim: &HairSim, camera: Option<&Camera>) -> Result<()> {
         let device = self.device.clone();
         let mut result = Ok(());
         device.submit_once("vkhair prepare", |cmd| {
             // SAFETY: submit_once hands over a recording command buffer of this device.
-            result = unsafe { self.record_prepare(cmd, sim, None) };
+            result = unsafe { self.record_prepare(cmd, sim, camera, None) };
         })?;
         result
     }
@@ -474,7 +563,12 @@ impl Renderer {
             primary: m.primary_color.extend(m.primary_exponent).to_array(),
             secondary: m.secondary_color.extend(m.secondary_exponent).to_array(),
             shifts: [m.primary_shift, m.secondary_shift, m.shift_jitter, m.highlight_breakup],
-            widths: [m.root_width, m.tip_width, m.least_pixel_width, 0.0],
+            widths: [
+                m.root_width * self.detail.width_scale,
+                m.tip_width * self.detail.width_scale,
+                m.least_pixel_width,
+                0.0,
+            ],
             counts: [hairs, per_hair, self.lights.len() as u32, 0],
             lights,
         }
@@ -587,5 +681,16 @@ impl Renderer {
             }
         }
         Ok(())
+    }
+}
+
+impl Detail {
+    /// This detail, lowered where `params` allows less.
+    fn min_with(self, params: &RenderParams) -> Detail {
+        Detail {
+            smoothing_level: self.smoothing_level.min(params.smoothing_level),
+            hairs_per_key: self.hairs_per_key.min(params.hairs_per_key),
+            width_scale: self.width_scale,
+        }
     }
 }

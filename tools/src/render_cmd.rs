@@ -232,7 +232,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
                     result = result.and_then(|_| sim.record_step(cmd, &motion, Some(&mut profiler)));
                 }
                 result
-                    .and_then(|_| renderer.record_prepare(cmd, &sim, Some(&mut profiler)))
+                    .and_then(|_| renderer.record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler)))
                     .map(|_| {
                         offscreen.record_clear(cmd, Vec3::splat(0.02));
                         let scope = profiler.begin_scope(cmd, "host: head mesh");
