@@ -1,0 +1,104 @@
+//! Render cost over the grid of seed 000's Table 5: GPU time per pass
+//! (smoothing, interpolation, draw) from timestamp queries for the `thesis`
+//! scene at 800×600, 1024×712, 1152×802 and 1280×968 and camera distances
+//! 0.2, 0.4, 0.6, 1.0, 1.5 and 3.0 m (level of detail on). Printed as a table
+//! and written to `target/vkhair-bench/render.csv`.
+//!
+//! `cargo bench --bench render` (add `-- quick` for one resolution).
+
+use std::fmt::Write as _;
+
+use glam::Vec3;
+use vkhair::groom::scenes;
+use vkhair::render::{Camera, Light, Offscreen, RenderParams, RenderPass, Renderer};
+use vkhair::sim::{motion, HairSim, RigidTransform, SimParams};
+use vkhair::{ContextOptions, GpuContext, GpuProfiler};
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "quick");
+    let ctx = GpuContext::headless(&ContextOptions::default()).expect("context");
+    let groom = scenes::thesis().expect("thesis");
+    let mut sim = HairSim::new(&ctx, &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    sim.set_colliders(&motion::thesis_colliders()).expect("colliders");
+    sim.run(30, |i| motion::reference_motion((i + 1) as f32 / 60.0), None).expect("settle");
+    let mut renderer = Renderer::new(&ctx, &sim, &RenderParams::default()).expect("renderer");
+    renderer
+        .set_lights(&[
+            Light::Directional { direction: Vec3::new(0.4, -0.3, -1.0), color: Vec3::splat(0.9) },
+            Light::Directional { direction: Vec3::new(-0.8, -0.2, -0.3), color: Vec3::splat(0.3) },
+            Light::Directional { direction: Vec3::new(0.0, -0.3, 1.0), color: Vec3::splat(0.3) },
+        ])
+        .expect("lights");
+    let mut profiler = GpuProfiler::new(&ctx, 1, 16).expect("profiler");
+    let resolutions: &[(u32, u32)] =
+        if quick { &[(800, 600)] } else { &[(800, 600), (1024, 712), (1152, 802), (1280, 968)] };
+    let distances = [0.2f32, 0.4, 0.6, 1.0, 1.5, 3.0];
+    let passes = [RenderPass::Smooth, RenderPass::Interpolate, RenderPass::Draw];
+    let frames = 3;
+    let mut csv = String::from("width,height,distance_m,hairs,segments,smooth_ms,interpolate_ms,draw_ms,total_ms\n");
+    println!("{} — thesis scene, GPU ms per pass (mean of {frames} frames after one warm-up)", ctx.info().name);
+    println!(
+        "{:>10} {:>6} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9}",
+        "size", "dist", "hairs", "segments", "smooth", "interp", "draw", "total"
+    );
+    let mut frame = 0u64;
+    for &(w, h) in resolutions {
+        let offscreen = Offscreen::new(&ctx, w, h).expect("offscreen");
+        for &distance in &distances {
+            let center = scenes::THESIS_HEAD_CENTER;
+            let camera = Camera::look_at(
+                center + Vec3::new(0.0, 0.0, distance),
+                center - Vec3::new(0.0, 0.1, 0.0),
+                0.7,
+                w as f32 / h as f32,
+                0.01,
+                20.0,
+            )
+            .expect("camera");
+            let mut sums = [0.0f64; 3];
+            for k in 0..=frames {
+                ctx.run_commands("bench frame", |cmd| {
+                    // SAFETY: a recording command buffer of the context's device; the
+                    // previous frame completed (run_commands waits).
+                    unsafe {
+                        profiler.begin_frame(cmd, frame);
+                        renderer.record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler)).expect("prepare");
+                        offscreen.record_clear(cmd, Vec3::ZERO);
+                        renderer.record_draw(cmd, &offscreen.target(), &camera, Some(&mut profiler)).expect("draw");
+                    }
+                })
+                .expect("submit");
+                frame += 1;
+                let report = profiler.drain().pop().expect("timestamps");
+                if k > 0 {
+                    for (sum, pass) in sums.iter_mut().zip(passes) {
+                        *sum += report.pass(pass.label()).unwrap_or(0.0) / 1e6 / frames as f64;
+                    }
+                }
+            }
+            let (hairs, per_hair) = renderer.hair_counts();
+            let segments = u64::from(hairs) * u64::from(per_hair - 1);
+            let total: f64 = sums.iter().sum();
+            println!(
+                "{:>10} {:>6.1} {:>7} {:>9} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
+                format!("{w}x{h}"),
+                distance,
+                hairs,
+                segments,
+                sums[0],
+                sums[1],
+                sums[2],
+                total
+            );
+            let _ = writeln!(
+                csv,
+                "{w},{h},{distance},{hairs},{segments},{:.4},{:.4},{:.4},{total:.4}",
+                sums[0], sums[1], sums[2]
+            );
+        }
+    }
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/vkhair-bench");
+    if std::fs::create_dir_all(&dir).is_ok() && std::fs::write(dir.join("render.csv"), csv).is_ok() {
+        println!("written to {}", dir.join("render.csv").display());
+    }
+}
