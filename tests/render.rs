@@ -394,3 +394,50 @@ fn detail_falls_with_distance() {
     assert!(drawn[5].0 * 10 < drawn[2].0, "3 m draws far fewer segments: {drawn:?}");
     assert!(drawn.iter().all(|d| d.1 > 100), "hair stays visible: {drawn:?}");
 }
+
+/// Edge aliasing, measured as the total variation of luminance between neighbouring
+/// pixels (hard 1-pixel hair edges add the most); supersampling must lower it.
+fn total_variation(rgba: &[u8]) -> f64 {
+    let lum = |x: u32, y: u32| {
+        let i = ((y * W + x) * 4) as usize;
+        (f64::from(rgba[i]) + f64::from(rgba[i + 1]) + f64::from(rgba[i + 2])) / 765.0
+    };
+    let mut tv = 0.0;
+    for y in 0..H - 1 {
+        for x in 0..W - 1 {
+            tv += (lum(x + 1, y) - lum(x, y)).abs() + (lum(x, y + 1) - lum(x, y)).abs();
+        }
+    }
+    tv
+}
+
+#[test]
+fn supersampling_reduces_aliasing_and_keeps_depth_testing() {
+    let gpu = Gpu::new();
+    let mut s = scene(&gpu);
+    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    let plain = draw(&gpu, &mut s, None);
+    let params = RenderParams { supersampling: true, ..s.renderer.params().clone() };
+    s.renderer.set_params(&params).expect("params");
+    let smooth = draw(&gpu, &mut s, None);
+    let (tv_plain, tv_smooth) = (total_variation(&plain), total_variation(&smooth));
+    let (cov_plain, cov_smooth) = (hair_pixels(&plain).len(), hair_pixels(&smooth).len());
+    eprintln!(
+        "total variation: plain {tv_plain:.1}, supersampled {tv_smooth:.1}; hair pixels {cov_plain} vs {cov_smooth}"
+    );
+    assert!(tv_smooth < 0.8 * tv_plain, "supersampling must smooth edges: {tv_smooth} vs {tv_plain}");
+    assert!(cov_smooth as f64 > 0.7 * cov_plain as f64, "the hair must stay where it was");
+    // The host's depth still hides the hair behind its geometry.
+    let center = scenes::THESIS_HEAD_CENTER + Vec3::new(0.0, -0.1, 0.5);
+    let blocker = MeshDrawer::new(gpu.ctx(), &TriMesh::uv_sphere(center, 0.05, 12, 16).expect("sphere")).expect("mesh");
+    let blocked = draw(&gpu, &mut s, Some(&blocker));
+    let vp = s.camera.projection * s.camera.view;
+    let c = vp * center.extend(1.0);
+    let px = ((c.truncate().truncate() / c.w) * 0.5 + 0.5) * glam::Vec2::new(W as f32, H as f32);
+    let i = ((px.y as u32 * W + px.x as u32) * 4) as usize;
+    assert!(
+        blocked[i + 1] > 40 && blocked[i] == 0 && blocked[i + 2] == 0,
+        "the blocker is in front: {:?}",
+        &blocked[i..i + 3]
+    );
+}

@@ -15,7 +15,7 @@ use crate::error::Result;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc, Sampler};
-use crate::vk::pipeline::{GraphicsDesc, GraphicsPipeline};
+use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
 use crate::vk::shaders::{RENDER_DRAW_FRAG, RENDER_DRAW_GEOM, RENDER_DRAW_VERT};
 
 /// Formats and sample count a draw pipeline is made for.
@@ -73,7 +73,7 @@ impl DrawPass {
                     samples: key.samples,
                     depth_test: key.depth != vk::Format::UNDEFINED,
                     depth_write: key.depth != vk::Format::UNDEFINED,
-                    additive_blend: None,
+                    blend: Blend::None,
                     rasterizer_discard: false,
                 },
                 1,

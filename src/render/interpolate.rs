@@ -17,7 +17,7 @@ use crate::gpu_types::InterpolatePush;
 use crate::sim::SimState;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
-use crate::vk::pipeline::{GraphicsDesc, GraphicsPipeline};
+use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
 use crate::vk::shaders::{RENDER_INTERPOLATE_TESC, RENDER_INTERPOLATE_TESE, RENDER_INTERPOLATE_VERT};
 
 /// Per key hair, the normal of the plane its rest shape lies in (head frame):
@@ -55,7 +55,7 @@ impl InterpolatePass {
                 samples: vk::SampleCountFlags::TYPE_1,
                 depth_test: false,
                 depth_write: false,
-                additive_blend: None,
+                blend: Blend::None,
                 rasterizer_discard: true,
             },
             1,

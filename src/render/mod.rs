@@ -14,11 +14,15 @@
 //! 3. **Draw** ([`draw`]): the hairs as camera-facing ribbons, Kajiya-Kay
 //!    diffuse plus two shifted specular highlights ([`HairMaterial`]) for every
 //!    [`Light`], into the host's color and depth images ([`RenderTarget`]).
+//! 4. **Resolve** ([`resolve`], with [`RenderParams::supersampling`]): the draw
+//!    goes to images twice the target's size, then a 5-tap filter blends it into
+//!    the host's target.
 
 pub mod draw;
 pub mod interpolate;
 mod offscreen;
 pub mod reference;
+pub mod resolve;
 mod shading;
 pub mod smooth;
 
@@ -56,6 +60,8 @@ pub enum RenderPass {
     Interpolate,
     /// Pass 3: drawing and shading.
     Draw,
+    /// Pass 4: supersampling resolve.
+    Resolve,
 }
 
 impl RenderPass {
@@ -65,6 +71,7 @@ impl RenderPass {
             RenderPass::Smooth => "vkhair render: smooth",
             RenderPass::Interpolate => "vkhair render: interpolate",
             RenderPass::Draw => "vkhair render: draw",
+            RenderPass::Resolve => "vkhair render: resolve",
         }
     }
 }
@@ -86,6 +93,9 @@ pub struct RenderParams {
     pub tip_width: f32,
     /// Level of detail by camera distance.
     pub lod: LodParams,
+    /// Draw at twice the target's width and height and resolve with a 5-tap filter
+    /// (thesis 3.5). Default: false (a host may use MSAA targets instead).
+    pub supersampling: bool,
 }
 
 impl Default for RenderParams {
@@ -97,6 +107,7 @@ impl Default for RenderParams {
             root_width: 0.3,
             tip_width: 1.0,
             lod: LodParams::default(),
+            supersampling: false,
         }
     }
 }
@@ -205,6 +216,8 @@ pub struct Renderer {
     rest_center: glam::Vec3,
     /// The detail of the latest prepared frame.
     detail: Detail,
+    /// Supersampling images for the current target size, made on first use.
+    supersampling: Option<resolve::Supersampling>,
 }
 
 impl Renderer {
@@ -302,6 +315,7 @@ impl Renderer {
                 0.5 * (lo + hi)
             },
             detail: params.detail_at(0.0),
+            supersampling: None,
         })
     }
 
@@ -403,27 +417,13 @@ impl Renderer {
             .layer_count(1);
         // SAFETY: guaranteed by the caller; every object belongs to this device.
         unsafe {
-            let scope = match profiler.as_deref_mut() {
-                Some(p) => Some(p.begin_scope(cmd, pass.label())),
-                None => {
-                    d.cmd_begin_label(cmd, pass.label(), LabelColor::Graphics);
-                    None
-                }
-            };
+            let scope = begin_pass(d, cmd, profiler, pass);
             d.raw.cmd_begin_rendering(cmd, &rendering);
-            d.raw.cmd_set_viewport(
-                cmd,
-                0,
-                &[vk::Viewport { x: 0.0, y: 0.0, width: 1.0, height: 1.0, min_depth: 0.0, max_depth: 1.0 }],
-            );
-            d.raw.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
+            set_viewport(d, cmd, extent);
             record(cmd);
             d.raw.cmd_end_rendering(cmd);
             d.cmd_barrier(cmd, &[written], &[], &[]);
-            match (profiler.as_deref_mut(), scope) {
-                (Some(p), Some(scope)) => p.end_scope(cmd, scope),
-                _ => d.cmd_end_label(cmd),
-            }
+            end_pass(d, cmd, profiler, scope);
         }
     }
 
@@ -574,9 +574,64 @@ impl Renderer {
         }
     }
 
+    /// Frees the images that depend on the target's size (supersampling), for a
+    /// target of a new size; they are made again on the next draw.
+    ///
+    /// # Safety
+    /// No pending GPU work records of this renderer's draws are still executing (the
+    /// host waited for its frames, as when recreating a swapchain).
+    pub unsafe fn release_size_dependent(&mut self) {
+        self.supersampling = None;
+    }
+
+    /// Records the hair draw into a rendering instance (`rendering`) of images with
+    /// `key`'s formats and `extent`, preceded by the parameter update.
+    ///
+    /// # Safety
+    /// `cmd` is recording outside a render pass; the attachments are in attachment
+    /// layouts and earlier writes to them are ordered before (by the caller).
+    unsafe fn draw_hair(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        key: TargetKey,
+        rendering: &vk::RenderingInfo<'_>,
+        extent: vk::Extent2D,
+        params: &DrawParams,
+    ) -> Result<()> {
+        let device = self.device.clone();
+        let d = &device;
+        let (hairs, per_hair) = self.hair_counts();
+        let (pipeline, set) = self.draw.pipeline(key, &self.draw_params, &self.hair_positions, &self.hair_tangents)?;
+        let before_update = barrier::memory(Access::ANY_WRITE, Access::TRANSFER_WRITE);
+        let updated = barrier::memory(
+            Access::TRANSFER_WRITE,
+            Access {
+                stage: vk::PipelineStageFlags2::VERTEX_SHADER
+                    | vk::PipelineStageFlags2::GEOMETRY_SHADER
+                    | vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                access: vk::AccessFlags2::UNIFORM_READ,
+            },
+        );
+        // SAFETY: guaranteed by the caller; all objects belong to this device.
+        unsafe {
+            d.cmd_barrier(cmd, &[before_update], &[], &[]);
+            d.raw.cmd_update_buffer(cmd, self.draw_params.raw(), 0, bytemuck::bytes_of(params));
+            d.cmd_barrier(cmd, &[updated], &[], &[]);
+            d.raw.cmd_begin_rendering(cmd, rendering);
+            set_viewport(d, cmd, extent);
+            pipeline.bind(cmd, &[*set]);
+            d.raw.cmd_draw(cmd, hairs * (per_hair - 1) * 2, 1, 0, 0);
+            d.raw.cmd_end_rendering(cmd);
+        }
+        Ok(())
+    }
+
     /// Records the draw pass: the hairs prepared by [`Renderer::record_prepare`] into
     /// the host's `target`, seen by `camera`. The color (and depth) image is loaded,
     /// drawn into with depth test and write against what the host drew, and stored.
+    /// With [`RenderParams::supersampling`], the hair is drawn at twice the size into
+    /// the renderer's own images and resolved into `target` (depth tested, not
+    /// written).
     ///
     /// # Safety
     /// As for [`Renderer::record_prepare`], which must have been recorded before in
@@ -594,22 +649,9 @@ impl Renderer {
         if target.extent.width == 0 || target.extent.height == 0 {
             return Err(Error::param("render target", "extent is zero"));
         }
-        let params = self.draw_params(camera, target.extent);
-        let key = TargetKey { color: target.color_format, depth: target.depth_format, samples: target.samples };
         let device = self.device.clone();
         let d = &device;
-        let (hairs, per_hair) = self.hair_counts();
-        let (pipeline, set) = self.draw.pipeline(key, &self.draw_params, &self.hair_positions, &self.hair_tangents)?;
-        let before_update = barrier::memory(Access::ANY_WRITE, Access::TRANSFER_WRITE);
-        let updated = barrier::memory(
-            Access::TRANSFER_WRITE,
-            Access {
-                stage: vk::PipelineStageFlags2::VERTEX_SHADER
-                    | vk::PipelineStageFlags2::GEOMETRY_SHADER
-                    | vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                access: vk::AccessFlags2::UNIFORM_READ,
-            },
-        );
+        let host_key = TargetKey { color: target.color_format, depth: target.depth_format, samples: target.samples };
         // The host's earlier attachment writes (its head, its clear) before ours.
         let attachments = barrier::memory(
             Access {
@@ -631,56 +673,188 @@ impl Renderer {
                     | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
             },
         );
-        let color = [vk::RenderingAttachmentInfo::default()
+        let host_color = [vk::RenderingAttachmentInfo::default()
             .image_view(target.color)
             .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
             .load_op(vk::AttachmentLoadOp::LOAD)
             .store_op(vk::AttachmentStoreOp::STORE)];
-        let depth = vk::RenderingAttachmentInfo::default()
+        let host_depth = vk::RenderingAttachmentInfo::default()
             .image_view(target.depth)
             .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
             .load_op(vk::AttachmentLoadOp::LOAD)
             .store_op(vk::AttachmentStoreOp::STORE);
         let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: target.extent };
-        let mut rendering = vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&color);
+        let mut host_rendering =
+            vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&host_color);
         if target.depth_format != vk::Format::UNDEFINED {
-            rendering = rendering.depth_attachment(&depth);
+            host_rendering = host_rendering.depth_attachment(&host_depth);
         }
-        // SAFETY: guaranteed by the caller; all objects belong to this device.
-        unsafe {
-            let scope = match profiler.as_deref_mut() {
-                Some(p) => Some(p.begin_scope(cmd, RenderPass::Draw.label())),
-                None => {
-                    d.cmd_begin_label(cmd, RenderPass::Draw.label(), LabelColor::Graphics);
-                    None
-                }
-            };
-            d.cmd_barrier(cmd, &[before_update], &[], &[]);
-            d.raw.cmd_update_buffer(cmd, self.draw_params.raw(), 0, bytemuck::bytes_of(&params));
-            d.cmd_barrier(cmd, &[updated, attachments], &[], &[]);
-            d.raw.cmd_begin_rendering(cmd, &rendering);
-            d.raw.cmd_set_viewport(
-                cmd,
-                0,
-                &[vk::Viewport {
-                    x: 0.0,
-                    y: 0.0,
-                    width: target.extent.width as f32,
-                    height: target.extent.height as f32,
-                    min_depth: 0.0,
-                    max_depth: 1.0,
-                }],
-            );
-            d.raw.cmd_set_scissor(cmd, 0, &[area]);
-            pipeline.bind(cmd, &[*set]);
-            d.raw.cmd_draw(cmd, hairs * (per_hair - 1) * 2, 1, 0, 0);
-            d.raw.cmd_end_rendering(cmd);
-            match (profiler, scope) {
-                (Some(p), Some(scope)) => p.end_scope(cmd, scope),
-                _ => d.cmd_end_label(cmd),
+
+        if !self.params.supersampling {
+            let params = self.draw_params(camera, target.extent);
+            // SAFETY: guaranteed by the caller.
+            unsafe {
+                let scope = begin_pass(d, cmd, &mut profiler, RenderPass::Draw);
+                d.cmd_barrier(cmd, &[attachments], &[], &[]);
+                let result = self.draw_hair(cmd, host_key, &host_rendering, target.extent, &params);
+                end_pass(d, cmd, &mut profiler, scope);
+                return result;
             }
         }
-        Ok(())
+
+        if self.supersampling.as_ref().is_some_and(|s| s.target_extent != target.extent) {
+            return Err(Error::param(
+                "render target",
+                "its size changed: call Renderer::release_size_dependent after the frames using the old size completed",
+            ));
+        }
+        if self.supersampling.is_none() {
+            self.supersampling = Some(resolve::Supersampling::new(&self.device, target.extent)?);
+        }
+        let big = vk::Extent2D { width: target.extent.width * 2, height: target.extent.height * 2 };
+        let params = self.draw_params(camera, big);
+        let Some(ss) = self.supersampling.take() else { return Ok(()) };
+        let ss_key = TargetKey {
+            color: resolve::SUPERSAMPLED_COLOR,
+            depth: resolve::SUPERSAMPLED_DEPTH,
+            samples: vk::SampleCountFlags::TYPE_1,
+        };
+        let ss_color = [vk::RenderingAttachmentInfo::default()
+            .image_view(ss.color.view())
+            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } })];
+        let ss_depth = vk::RenderingAttachmentInfo::default()
+            .image_view(ss.depth.view())
+            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+        let ss_rendering = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent: big })
+            .layer_count(1)
+            .color_attachments(&ss_color)
+            .depth_attachment(&ss_depth);
+        let sampled =
+            Access { stage: vk::PipelineStageFlags2::FRAGMENT_SHADER, access: vk::AccessFlags2::SHADER_SAMPLED_READ };
+        let to_attachments = [
+            barrier::image(
+                &ss.color,
+                sampled,
+                Access::COLOR_ATTACHMENT_WRITE,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            ),
+            barrier::image(
+                &ss.depth,
+                sampled,
+                Access::DEPTH_ATTACHMENT,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+            ),
+        ];
+        let to_sampled = [
+            barrier::image(
+                &ss.color,
+                Access::COLOR_ATTACHMENT_WRITE,
+                sampled,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            ),
+            barrier::image(
+                &ss.depth,
+                Access::DEPTH_ATTACHMENT,
+                sampled,
+                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            ),
+        ];
+        let mut ss = ss;
+        // SAFETY: guaranteed by the caller; the supersampling images are this
+        // renderer's and earlier resolves that sampled them are ordered by the barriers.
+        let result = unsafe {
+            let scope = begin_pass(d, cmd, &mut profiler, RenderPass::Draw);
+            d.cmd_barrier(cmd, &[], &[], &to_attachments);
+            let drawn = self.draw_hair(cmd, ss_key, &ss_rendering, big, &params);
+            end_pass(d, cmd, &mut profiler, scope);
+            drawn.and_then(|_| {
+                let scope = begin_pass(d, cmd, &mut profiler, RenderPass::Resolve);
+                let resolved = ss.pipeline(host_key).map(|(pipeline, set)| {
+                    d.cmd_barrier(cmd, &[attachments], &[], &to_sampled);
+                    d.raw.cmd_begin_rendering(cmd, &host_rendering);
+                    set_viewport(d, cmd, target.extent);
+                    pipeline.bind(cmd, &[*set]);
+                    d.raw.cmd_draw(cmd, 3, 1, 0, 0);
+                    d.raw.cmd_end_rendering(cmd);
+                });
+                end_pass(d, cmd, &mut profiler, scope);
+                resolved
+            })
+        };
+        self.supersampling = Some(ss);
+        result
+    }
+}
+
+/// Opens a pass: a timestamp scope (with its label) or just a label.
+///
+/// # Safety
+/// `cmd` is recording; with a profiler, its frame was begun.
+unsafe fn begin_pass(
+    d: &Device,
+    cmd: vk::CommandBuffer,
+    profiler: &mut Option<&mut GpuProfiler>,
+    pass: RenderPass,
+) -> Option<crate::ScopeId> {
+    // SAFETY: guaranteed by the caller.
+    unsafe {
+        match profiler.as_deref_mut() {
+            Some(p) => Some(p.begin_scope(cmd, pass.label())),
+            None => {
+                d.cmd_begin_label(cmd, pass.label(), LabelColor::Graphics);
+                None
+            }
+        }
+    }
+}
+
+/// Closes a pass opened by [`begin_pass`].
+///
+/// # Safety
+/// As for [`begin_pass`], in the same command buffer.
+unsafe fn end_pass(
+    d: &Device,
+    cmd: vk::CommandBuffer,
+    profiler: &mut Option<&mut GpuProfiler>,
+    scope: Option<crate::ScopeId>,
+) {
+    // SAFETY: guaranteed by the caller.
+    unsafe {
+        match (profiler.as_deref_mut(), scope) {
+            (Some(p), Some(scope)) => p.end_scope(cmd, scope),
+            _ => d.cmd_end_label(cmd),
+        }
+    }
+}
+
+/// Full-extent viewport and scissor.
+///
+/// # Safety
+/// `cmd` is recording inside a rendering instance.
+unsafe fn set_viewport(d: &Device, cmd: vk::CommandBuffer, extent: vk::Extent2D) {
+    let viewport = vk::Viewport {
+        x: 0.0,
+        y: 0.0,
+        width: extent.width as f32,
+        height: extent.height as f32,
+        min_depth: 0.0,
+        max_depth: 1.0,
+    };
+    // SAFETY: guaranteed by the caller.
+    unsafe {
+        d.raw.cmd_set_viewport(cmd, 0, &[viewport]);
+        d.raw.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
     }
 }
 

@@ -16,7 +16,7 @@ use crate::vk::barrier::{self, Access};
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc};
-use crate::vk::pipeline::{GraphicsDesc, GraphicsPipeline};
+use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
 use crate::vk::shaders::{RENDER_MESH_FRAG, RENDER_MESH_VERT};
 
 /// Color format of [`Offscreen`] (shading is linear; the target encodes sRGB).
@@ -196,7 +196,7 @@ impl MeshDrawer {
                 samples: vk::SampleCountFlags::TYPE_1,
                 depth_test: true,
                 depth_write: true,
-                additive_blend: None,
+                blend: Blend::None,
                 rasterizer_discard: false,
             },
             1,

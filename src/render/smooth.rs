@@ -17,7 +17,7 @@ use crate::error::Result;
 use crate::gpu_types::SmoothPush;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
-use crate::vk::pipeline::{GraphicsDesc, GraphicsPipeline};
+use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
 use crate::vk::shaders::{RENDER_SMOOTH_TESC, RENDER_SMOOTH_TESE, RENDER_SMOOTH_VERT};
 
 pub(super) struct SmoothPass {
@@ -40,7 +40,7 @@ impl SmoothPass {
                 samples: vk::SampleCountFlags::TYPE_1,
                 depth_test: false,
                 depth_write: false,
-                additive_blend: None,
+                blend: Blend::None,
                 rasterizer_discard: true,
             },
             2,

@@ -149,6 +149,24 @@ impl Sampler {
     }
 }
 
+impl Sampler {
+    /// A nearest-filtering, clamping sampler (depth images, exact texel reads).
+    pub(crate) fn nearest(device: &Arc<Device>, name: &str) -> Result<Self> {
+        let info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::NEAREST)
+            .min_filter(vk::Filter::NEAREST)
+            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .max_lod(0.0);
+        // SAFETY: valid create info; destroyed in Drop.
+        let raw = unsafe { device.raw.create_sampler(&info, None) }.map_err(Error::vk("vkCreateSampler"))?;
+        device.set_name(raw, name);
+        Ok(Sampler { device: device.clone(), raw })
+    }
+}
+
 impl Drop for Sampler {
     fn drop(&mut self) {
         // SAFETY: sampler of this device, no longer used by pending work.

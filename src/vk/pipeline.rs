@@ -360,11 +360,21 @@ pub(crate) struct GraphicsDesc<'a> {
     pub samples: vk::SampleCountFlags,
     pub depth_test: bool,
     pub depth_write: bool,
-    /// Additive blending (`ONE`, `ONE`) instead of alpha blending when `Some(true)`;
-    /// `None` disables blending.
-    pub additive_blend: Option<bool>,
+    /// Color blending.
+    pub blend: Blend,
     /// Discard primitives before rasterization (capture passes that only store).
     pub rasterizer_discard: bool,
+}
+
+/// Color blending of a graphics pipeline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Blend {
+    /// Overwrite.
+    None,
+    /// Add (`ONE`, `ONE`): accumulation.
+    Additive,
+    /// Premultiplied alpha over the destination (`ONE`, `ONE_MINUS_SRC_ALPHA`).
+    Premultiplied,
 }
 
 /// A graphics pipeline.
@@ -410,25 +420,26 @@ impl GraphicsPipeline {
             .depth_test_enable(desc.depth_test)
             .depth_write_enable(desc.depth_write)
             .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL);
-        let attachment = match desc.additive_blend {
-            None => vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA),
-            Some(additive) => vk::PipelineColorBlendAttachmentState::default()
-                .blend_enable(true)
-                .src_color_blend_factor(if additive { vk::BlendFactor::ONE } else { vk::BlendFactor::SRC_ALPHA })
-                .dst_color_blend_factor(if additive {
+        let attachment = match desc.blend {
+            Blend::None => {
+                vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)
+            }
+            Blend::Additive | Blend::Premultiplied => {
+                let dst = if desc.blend == Blend::Additive {
                     vk::BlendFactor::ONE
                 } else {
                     vk::BlendFactor::ONE_MINUS_SRC_ALPHA
-                })
-                .color_blend_op(vk::BlendOp::ADD)
-                .src_alpha_blend_factor(vk::BlendFactor::ONE)
-                .dst_alpha_blend_factor(if additive {
-                    vk::BlendFactor::ONE
-                } else {
-                    vk::BlendFactor::ONE_MINUS_SRC_ALPHA
-                })
-                .alpha_blend_op(vk::BlendOp::ADD)
-                .color_write_mask(vk::ColorComponentFlags::RGBA),
+                };
+                vk::PipelineColorBlendAttachmentState::default()
+                    .blend_enable(true)
+                    .src_color_blend_factor(vk::BlendFactor::ONE)
+                    .dst_color_blend_factor(dst)
+                    .color_blend_op(vk::BlendOp::ADD)
+                    .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .dst_alpha_blend_factor(dst)
+                    .alpha_blend_op(vk::BlendOp::ADD)
+                    .color_write_mask(vk::ColorComponentFlags::RGBA)
+            }
         };
         let attachments = vec![attachment; desc.color_formats.len()];
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);

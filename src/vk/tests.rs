@@ -11,7 +11,7 @@ use super::barrier::{self, Access};
 use super::buffer::{Buffer, BufferDesc};
 use super::device::Device;
 use super::image::{Image, ImageDesc};
-use super::pipeline::{ComputePipeline, GraphicsDesc, GraphicsPipeline};
+use super::pipeline::{Blend, ComputePipeline, GraphicsDesc, GraphicsPipeline};
 use super::reflect::{compare, gpu_struct, reflect, GpuStruct};
 use super::shaders;
 use crate::gpu_types::{self, LayoutProbe, ScaleAddPush};
@@ -284,7 +284,7 @@ fn graphics_pipeline_draws_with_dynamic_rendering() {
             samples: vk::SampleCountFlags::TYPE_1,
             depth_test: false,
             depth_write: false,
-            additive_blend: None,
+            blend: Blend::None,
             rasterizer_discard: false,
         },
         0,

@@ -48,6 +48,12 @@ pub struct RenderArgs {
     /// Camera distance from the head, meters.
     #[arg(long, default_value_t = 0.9)]
     distance: f32,
+    /// Supersample 2× and resolve with the 5-tap filter.
+    #[arg(long)]
+    ssaa: bool,
+    /// Turn level of detail off (always full detail).
+    #[arg(long)]
+    no_lod: bool,
 }
 
 struct Scene {
@@ -169,7 +175,13 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let sim_params = SimParams::default();
     let mut sim = HairSim::new(&ctx, &s.groom, &sim_params, &RigidTransform::default())?;
     sim.set_colliders(&s.colliders)?;
-    let params = RenderParams { smoothing_level: a.level, hairs_per_key: a.hairs_per_key, ..RenderParams::default() };
+    let mut params = RenderParams {
+        smoothing_level: a.level,
+        hairs_per_key: a.hairs_per_key,
+        supersampling: a.ssaa,
+        ..RenderParams::default()
+    };
+    params.lod.enabled = !a.no_lod;
     let mut renderer = Renderer::new(&ctx, &sim, &params)?;
     renderer.set_lights(&lights(s.center))?;
     let offscreen = Offscreen::new(&ctx, a.width, a.height)?;
