@@ -33,6 +33,7 @@ mod context;
 mod error;
 pub(crate) mod gpu_types;
 pub mod groom;
+mod hash;
 mod profiler;
 pub mod render;
 mod requirements;

@@ -5,32 +5,10 @@ use vkhair::groom::grow::{grow, GrowParams};
 use vkhair::groom::scenes;
 use vkhair::render::{reference, RenderParams, Renderer};
 use vkhair::sim::{motion, HairSim, RigidTransform, SimParams};
-use vkhair::{ContextOptions, Error, GpuContext, ValidationLog};
+mod common;
 
-struct Gpu {
-    ctx: Option<GpuContext>,
-    log: ValidationLog,
-}
-
-impl Gpu {
-    fn new() -> Gpu {
-        let log = ValidationLog::new();
-        let ctx = GpuContext::headless(&ContextOptions::validated(&log)).expect("headless context with validation");
-        Gpu { ctx: Some(ctx), log }
-    }
-    fn ctx(&self) -> &GpuContext {
-        self.ctx.as_ref().expect("alive")
-    }
-}
-
-impl Drop for Gpu {
-    fn drop(&mut self) {
-        drop(self.ctx.take());
-        if !std::thread::panicking() {
-            self.log.assert_clean();
-        }
-    }
-}
+use common::Gpu;
+use vkhair::Error;
 
 /// Smoothed vertices equal a CPU evaluation of the same B-spline of the simulated
 /// key hairs: positions within 1e-5 m, tangents unit length within 1e-5 and within

@@ -11,37 +11,14 @@ use glam::{Vec3, Vec4};
 use vkhair::groom::grow::{grow, GrowParams};
 use vkhair::groom::{scenes, Groom};
 use vkhair::sim::{motion, Collider, CpuHairSim, HairSim, RigidTransform, SimParams, SimState, SolverMode};
-use vkhair::{ContextOptions, Error, GpuContext, ValidationLog};
+mod common;
+
+use common::Gpu;
+use vkhair::{Error, GpuContext};
 
 const POSITION_TOLERANCE: f32 = 1e-4;
 /// Worst relative segment-length error with the default 20 iterations.
 const SEGMENT_ERROR_BOUND: f32 = 0.05;
-
-/// A validated context that fails the test on any validation message when dropped.
-struct Gpu {
-    ctx: Option<GpuContext>,
-    log: ValidationLog,
-}
-
-impl Gpu {
-    fn new() -> Gpu {
-        let log = ValidationLog::new();
-        let ctx = GpuContext::headless(&ContextOptions::validated(&log)).expect("headless context with validation");
-        Gpu { ctx: Some(ctx), log }
-    }
-    fn ctx(&self) -> &GpuContext {
-        self.ctx.as_ref().expect("alive")
-    }
-}
-
-impl Drop for Gpu {
-    fn drop(&mut self) {
-        drop(self.ctx.take());
-        if !std::thread::panicking() {
-            self.log.assert_clean();
-        }
-    }
-}
 
 fn head_at(step: usize, params: &SimParams) -> RigidTransform {
     motion::reference_motion((step + 1) as f32 * params.dt)

@@ -2,6 +2,8 @@
 #ifndef VKHAIR_RENDER_GLSL
 #define VKHAIR_RENDER_GLSL
 
+#include "hash.glsl"
+
 // Push constants of the smoothing pass. Twin: gpu_types::SmoothPush.
 struct SmoothPush {
     uint strands;         // key hairs
@@ -28,22 +30,12 @@ vec3 quat_rotate(vec4 q, vec3 v) {
     return v + q.w * t + cross(q.xyz, t);
 }
 
-// Integer hash to [0, 1).
-float hash01(uint x) {
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return float(x >> 8) * (1.0 / 16777216.0);
-}
-
 // The stable random clump coordinate of interpolated hair `hair` of key `key`:
 // uniform in the unit disk, the same every frame.
 vec2 clump_coordinate(uint key, uint hair) {
     uint seed = key * 64u + hair;
-    float r = sqrt(hash01(seed * 2u + 0x9e3779b9u));
-    float a = 6.28318530718 * hash01(seed * 2u + 0x7f4a7c15u);
+    float r = sqrt(hash_unit(seed * 2u + 0x9e3779b9u));
+    float a = 6.28318530718 * hash_unit(seed * 2u + 0x7f4a7c15u);
     return r * vec2(cos(a), sin(a));
 }
 

@@ -5,6 +5,8 @@
 #ifndef VKHAIR_SIM_GLSL
 #define VKHAIR_SIM_GLSL
 
+#include "hash.glsl"
+
 // Per-step parameters (uniform block, binding 0). Twin: gpu_types::SimStepParams.
 struct SimStepParams {
     mat4 head;            // world-from-head transform at the end of this step
@@ -41,15 +43,9 @@ vec3 sim_transform_point(mat4 m, vec3 p) {
     return r;
 }
 
-// Integer hash to [-1, 1]; exact on every device.
+// Integer hash to [-1, 1); exact on every device.
 float sim_hash(uint x) {
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    // 24 bits times 2^-23 is exact: [0, 2) - 1.
-    return float(x >> 8) * (1.0 / 8388608.0) - 1.0;
+    return hash_unit(x) * 2.0 - 1.0;
 }
 
 // Smooth 1D value noise in [-1, 1] along time, one independent track per strand.

@@ -17,7 +17,7 @@ use crate::gpu_types::InterpolatePush;
 use crate::sim::SimState;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
-use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
+use crate::vk::pipeline::GraphicsPipeline;
 use crate::vk::shaders::{RENDER_INTERPOLATE_TESC, RENDER_INTERPOLATE_TESE, RENDER_INTERPOLATE_VERT};
 
 /// Per key hair, the normal of the plane its rest shape lies in (head frame):
@@ -43,21 +43,11 @@ pub(super) struct InterpolatePass {
 
 impl InterpolatePass {
     pub(super) fn new(device: &Arc<Device>, inputs: [&Buffer; 3], outputs: [&Buffer; 2]) -> Result<Self> {
-        let pipeline = GraphicsPipeline::new(
+        let pipeline = super::capture_pipeline(
             device,
-            &GraphicsDesc {
-                name: "vkhair interpolation",
-                stages: &[&RENDER_INTERPOLATE_VERT, &RENDER_INTERPOLATE_TESC, &RENDER_INTERPOLATE_TESE],
-                topology: vk::PrimitiveTopology::PATCH_LIST,
-                patch_control_points: 1,
-                color_formats: &[],
-                depth_format: vk::Format::UNDEFINED,
-                samples: vk::SampleCountFlags::TYPE_1,
-                depth_test: false,
-                depth_write: false,
-                blend: Blend::None,
-                rasterizer_discard: true,
-            },
+            "vkhair interpolation",
+            &[&RENDER_INTERPOLATE_VERT, &RENDER_INTERPOLATE_TESC, &RENDER_INTERPOLATE_TESE],
+            1,
             1,
         )?;
         let set = pipeline

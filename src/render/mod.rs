@@ -797,6 +797,34 @@ impl Renderer {
     }
 }
 
+/// A pipeline of tessellation stages that only store (rasterization off), for the
+/// geometry passes.
+pub(crate) fn capture_pipeline(
+    device: &Arc<Device>,
+    name: &str,
+    stages: &[&crate::vk::shaders::ShaderSource],
+    patch_control_points: u32,
+    max_sets: u32,
+) -> Result<crate::vk::pipeline::GraphicsPipeline> {
+    crate::vk::pipeline::GraphicsPipeline::new(
+        device,
+        &crate::vk::pipeline::GraphicsDesc {
+            name,
+            stages,
+            topology: vk::PrimitiveTopology::PATCH_LIST,
+            patch_control_points,
+            color_formats: &[],
+            depth_format: vk::Format::UNDEFINED,
+            samples: vk::SampleCountFlags::TYPE_1,
+            depth_test: false,
+            depth_write: false,
+            blend: crate::vk::pipeline::Blend::None,
+            rasterizer_discard: true,
+        },
+        max_sets,
+    )
+}
+
 /// Opens a pass: a timestamp scope (with its label) or just a label.
 ///
 /// # Safety

@@ -37,21 +37,12 @@ pub fn smooth_strand(points: &[Vec3], level: u32) -> Vec<(Vec3, Vec3)> {
     out
 }
 
-fn hash01(mut x: u32) -> f32 {
-    x ^= x >> 16;
-    x = x.wrapping_mul(0x7feb_352d);
-    x ^= x >> 15;
-    x = x.wrapping_mul(0x846c_a68b);
-    x ^= x >> 16;
-    (x >> 8) as f32 * (1.0 / 16_777_216.0)
-}
-
 /// The stable clump coordinate of interpolated hair `hair` of key hair `key`,
 /// uniform in the unit disk (as `clump_coordinate` in `render.glsl`).
 pub fn clump_coordinate(key: u32, hair: u32) -> glam::Vec2 {
     let seed = key.wrapping_mul(64).wrapping_add(hair);
-    let r = hash01(seed.wrapping_mul(2).wrapping_add(0x9e37_79b9)).sqrt();
-    let a = std::f32::consts::TAU * hash01(seed.wrapping_mul(2).wrapping_add(0x7f4a_7c15));
+    let r = crate::hash::hash_unit(seed.wrapping_mul(2).wrapping_add(0x9e37_79b9)).sqrt();
+    let a = std::f32::consts::TAU * crate::hash::hash_unit(seed.wrapping_mul(2).wrapping_add(0x7f4a_7c15));
     glam::Vec2::new(r * a.cos(), r * a.sin())
 }
 

@@ -17,7 +17,7 @@ use crate::error::Result;
 use crate::gpu_types::SmoothPush;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
-use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
+use crate::vk::pipeline::GraphicsPipeline;
 use crate::vk::shaders::{RENDER_SMOOTH_TESC, RENDER_SMOOTH_TESE, RENDER_SMOOTH_VERT};
 
 pub(super) struct SmoothPass {
@@ -28,21 +28,11 @@ pub(super) struct SmoothPass {
 
 impl SmoothPass {
     pub(super) fn new(device: &Arc<Device>, keys: [&Buffer; 2], positions: &Buffer, tangents: &Buffer) -> Result<Self> {
-        let pipeline = GraphicsPipeline::new(
+        let pipeline = super::capture_pipeline(
             device,
-            &GraphicsDesc {
-                name: "vkhair smoothing",
-                stages: &[&RENDER_SMOOTH_VERT, &RENDER_SMOOTH_TESC, &RENDER_SMOOTH_TESE],
-                topology: vk::PrimitiveTopology::PATCH_LIST,
-                patch_control_points: 4,
-                color_formats: &[],
-                depth_format: vk::Format::UNDEFINED,
-                samples: vk::SampleCountFlags::TYPE_1,
-                depth_test: false,
-                depth_write: false,
-                blend: Blend::None,
-                rasterizer_discard: true,
-            },
+            "vkhair smoothing",
+            &[&RENDER_SMOOTH_VERT, &RENDER_SMOOTH_TESC, &RENDER_SMOOTH_TESE],
+            4,
             2,
         )?;
         let sets = [

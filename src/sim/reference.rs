@@ -21,13 +21,8 @@ fn transform_point(m: &[[f32; 4]; 4], p: Vec3) -> Vec3 {
     ((c(0) * p.x + c(1) * p.y) + c(2) * p.z) + c(3)
 }
 
-fn hash(mut x: u32) -> f32 {
-    x ^= x >> 16;
-    x = x.wrapping_mul(0x7feb_352d);
-    x ^= x >> 15;
-    x = x.wrapping_mul(0x846c_a68b);
-    x ^= x >> 16;
-    (x >> 8) as f32 * (1.0 / 8_388_608.0) - 1.0
+fn hash(x: u32) -> f32 {
+    crate::hash::hash_unit(x) * 2.0 - 1.0
 }
 
 /// Smooth value noise in [-1, 1], as `sim_noise`.

@@ -170,14 +170,7 @@ impl Device {
             .mapped_mut()
             .ok_or_else(|| Error::param("staging memory", "host-visible memory could not be mapped"))?
             .copy_from_slice(texels);
-        let region = vk::BufferImageCopy::default()
-            .image_subresource(vk::ImageSubresourceLayers {
-                aspect_mask: image.aspect,
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            })
-            .image_extent(vk::Extent3D { width: image.extent.width, height: image.extent.height, depth: 1 });
+        let region = whole_image_region(image);
         self.submit_once("upload image", |cmd| {
             // SAFETY: resources of this device; layouts are transitioned around the copy.
             unsafe {
@@ -226,14 +219,7 @@ impl Device {
     ) -> Result<Vec<u8>> {
         let len = image.extent.width as u64 * image.extent.height as u64 * texel_size;
         let staging = self.staging("image readback staging", len, MemoryLocation::GpuToCpu)?;
-        let region = vk::BufferImageCopy::default()
-            .image_subresource(vk::ImageSubresourceLayers {
-                aspect_mask: image.aspect,
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            })
-            .image_extent(vk::Extent3D { width: image.extent.width, height: image.extent.height, depth: 1 });
+        let region = whole_image_region(image);
         self.submit_once("readback image", |cmd| {
             // SAFETY: resources of this device; layouts are transitioned around the copy.
             unsafe {
@@ -275,4 +261,16 @@ impl Device {
             .map(<[u8]>::to_vec)
             .ok_or_else(|| Error::param("staging memory", "host-visible memory could not be mapped"))
     }
+}
+
+/// A buffer ↔ image copy of a whole single-layer, single-mip image, tightly packed.
+fn whole_image_region(image: &Image) -> vk::BufferImageCopy {
+    vk::BufferImageCopy::default()
+        .image_subresource(vk::ImageSubresourceLayers {
+            aspect_mask: image.aspect,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        })
+        .image_extent(vk::Extent3D { width: image.extent.width, height: image.extent.height, depth: 1 })
 }
