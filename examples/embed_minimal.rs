@@ -1,0 +1,605 @@
+//! A minimal host embedding vkhair.
+//!
+//! The host owns everything Vulkan: it creates its instance (with validation
+//! and a messenger of its own), picks a device and enables what
+//! `vkhair::requirements()` lists, creates its allocator, its color and depth
+//! images and its command buffer, and draws its own head mesh with its own
+//! pipeline and vertex buffer. It lends the device, queue and allocator to
+//! vkhair with `GpuContext::from_host`, then every frame records vkhair's
+//! simulation step and hair passes into its own command buffer between its
+//! own work, and submits. vkhair never destroys the host's objects.
+//!
+//! `cargo run --example embed_minimal` writes `embed_minimal.png`; the test
+//! `tests/embed_example.rs` runs the same code under validation.
+
+use std::ffi::{c_void, CStr};
+use std::sync::{Arc, Mutex};
+
+use ash::vk;
+use glam::Vec3;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme, Allocator, AllocatorCreateDesc};
+use gpu_allocator::MemoryLocation;
+use vkhair::groom::mesh::TriMesh;
+use vkhair::groom::scenes;
+use vkhair::render::{Camera, Light, RenderParams, RenderTarget, Renderer};
+use vkhair::sim::{motion, HairSim, RigidTransform, SimParams};
+use vkhair::{ash, gpu_allocator, requirements, GpuContext, GpuProfiler, HostDevice, HostQueue};
+
+const WIDTH: u32 = 256;
+const HEIGHT: u32 = 192;
+const COLOR: vk::Format = vk::Format::R8G8B8A8_UNORM;
+const DEPTH: vk::Format = vk::Format::D32_SFLOAT;
+const HEAD_RGB: [u8; 3] = [140, 105, 85];
+
+type BoxError = Box<dyn std::error::Error>;
+
+/// What a run produced.
+pub struct Outcome {
+    /// RGBA8 pixels, rows top to bottom.
+    pub pixels: Vec<u8>,
+    /// Validation warnings and errors the host's messenger received.
+    pub validation_messages: Vec<String>,
+    /// The per-pass timings of the last frame.
+    pub timings: String,
+}
+
+unsafe extern "system" fn on_message(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    _: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    if severity
+        .intersects(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR)
+    {
+        // SAFETY: the loader passes valid data; `user` is the host's boxed mutex.
+        let text = unsafe { CStr::from_ptr((*data).p_message) }.to_string_lossy().into_owned();
+        // SAFETY: as above; the box outlives the messenger.
+        let log = unsafe { &*(user as *const Mutex<Vec<String>>) };
+        log.lock().unwrap_or_else(|e| e.into_inner()).push(text);
+    }
+    vk::FALSE
+}
+
+const HEAD_VERT: &str = r#"#version 460
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(push_constant) uniform Push { mat4 mvp; mat4 model; } pc;
+layout(location = 0) out vec3 v_normal;
+void main() {
+    v_normal = mat3(pc.model) * normal;
+    gl_Position = pc.mvp * vec4(position, 1.0);
+}
+"#;
+
+const HEAD_FRAG: &str = r#"#version 460
+layout(location = 0) in vec3 v_normal;
+layout(location = 0) out vec4 color;
+void main() {
+    float l = max(dot(normalize(v_normal), normalize(vec3(0.3, 0.4, 0.9))), 0.0);
+    color = vec4(vec3(0.55, 0.41, 0.33) * (0.35 + 0.65 * l), 1.0);
+}
+"#;
+
+fn compile(source: &str, kind: shaderc::ShaderKind, name: &str) -> Result<Vec<u32>, BoxError> {
+    let compiler = shaderc::Compiler::new()?;
+    let mut options = shaderc::CompileOptions::new()?;
+    options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
+    Ok(compiler.compile_into_spirv(source, kind, name, "main", Some(&options))?.as_binary().to_vec())
+}
+
+/// A host buffer or image with its allocation.
+struct Memory(Option<Allocation>);
+
+impl Memory {
+    fn free(&mut self, allocator: &Mutex<Allocator>) {
+        if let Some(a) = self.0.take() {
+            let _ = allocator.lock().unwrap_or_else(|e| e.into_inner()).free(a);
+        }
+    }
+}
+
+fn allocate(
+    allocator: &Mutex<Allocator>,
+    name: &str,
+    requirements: vk::MemoryRequirements,
+    location: MemoryLocation,
+    linear: bool,
+) -> Result<Allocation, BoxError> {
+    Ok(allocator.lock().unwrap_or_else(|e| e.into_inner()).allocate(&AllocationCreateDesc {
+        name,
+        requirements,
+        location,
+        linear,
+        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+    })?)
+}
+
+/// Runs `frames` frames of the `thesis` scene; `validation` enables the layer.
+pub fn run(frames: usize, validation: bool) -> Result<Outcome, BoxError> {
+    // ---- The host's instance, device, queue and allocator -------------------
+    // SAFETY: loading the system Vulkan loader.
+    let entry = unsafe { ash::Entry::load() }?;
+    let log: Box<Mutex<Vec<String>>> = Box::new(Mutex::new(Vec::new()));
+    let app = vk::ApplicationInfo::default().api_version(vkhair::API_VERSION);
+    let layers = [c"VK_LAYER_KHRONOS_validation".as_ptr()];
+    let extensions = [ash::ext::debug_utils::NAME.as_ptr(), ash::ext::validation_features::NAME.as_ptr()];
+    let sync = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync);
+    let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+        .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR)
+        .message_type(vk::DebugUtilsMessageTypeFlagsEXT::GENERAL | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION)
+        .pfn_user_callback(Some(on_message))
+        .user_data(&*log as *const Mutex<Vec<String>> as *mut c_void);
+    let mut instance_info =
+        vk::InstanceCreateInfo::default().application_info(&app).enabled_extension_names(&extensions[..1]);
+    if validation {
+        // The layer with synchronization validation, its messages into `log`.
+        instance_info = instance_info
+            .enabled_layer_names(&layers)
+            .enabled_extension_names(&extensions)
+            .push_next(&mut features)
+            .push_next(&mut messenger_info);
+    }
+    // SAFETY: valid create info; everything is destroyed at the end of `run`.
+    let instance = unsafe { entry.create_instance(&instance_info, None) }?;
+    let utils = ash::ext::debug_utils::Instance::new(&entry, &instance);
+    // SAFETY: the boxed log outlives the messenger.
+    let messenger = unsafe { utils.create_debug_utils_messenger(&messenger_info, None) }?;
+    // SAFETY: the instance is alive.
+    let physical = unsafe { instance.enumerate_physical_devices() }?.into_iter().next().ok_or("no Vulkan device")?;
+    // SAFETY: as above.
+    let family = unsafe { instance.get_physical_device_queue_family_properties(physical) }
+        .iter()
+        .position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE))
+        .ok_or("no graphics queue")? as u32;
+    let mut req = requirements();
+    let priorities = [1.0];
+    let queue_infos = [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
+    let mut features = req.features.chain();
+    let device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_infos).push_next(&mut features);
+    // SAFETY: the features come from vkhair::requirements(); the driver checks them.
+    let device = unsafe { instance.create_device(physical, &device_info, None) }?;
+    // SAFETY: the queue was requested above.
+    let queue = unsafe { device.get_device_queue(family, 0) };
+    let allocator = Arc::new(Mutex::new(Allocator::new(&AllocatorCreateDesc {
+        instance: instance.clone(),
+        device: device.clone(),
+        physical_device: physical,
+        debug_settings: Default::default(),
+        buffer_device_address: false,
+        allocation_sizes: Default::default(),
+    })?));
+
+    let result = frames_with(&entry, &instance, physical, &device, family, queue, &allocator, frames);
+
+    // ---- Teardown: the host destroys what it created, after vkhair is gone ---
+    drop(allocator);
+    // SAFETY: every object made from these handles is destroyed by now.
+    unsafe {
+        device.destroy_device(None);
+        utils.destroy_debug_utils_messenger(messenger, None);
+        instance.destroy_instance(None);
+    }
+    let (pixels, timings) = result?;
+    let validation_messages = log.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    Ok(Outcome { pixels, validation_messages, timings })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn frames_with(
+    entry: &ash::Entry,
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+    device: &ash::Device,
+    family: u32,
+    queue: vk::Queue,
+    allocator: &Arc<Mutex<Allocator>>,
+    frames: usize,
+) -> Result<(Vec<u8>, String), BoxError> {
+    // ---- vkhair on the host's device -------------------------------------
+    // SAFETY: the handles are valid, belong together, were created with vkhair's
+    // requirements and outlive every vkhair object (dropped before this returns).
+    let ctx = unsafe {
+        GpuContext::from_host(HostDevice {
+            entry: entry.clone(),
+            instance: instance.clone(),
+            physical_device: physical,
+            device: device.clone(),
+            graphics_queue: HostQueue { family, queue },
+            compute_queue: None,
+            allocator: Some(allocator.clone()),
+            debug_utils: true,
+            compute_full_subgroups: false,
+        })
+    }?;
+    let params = SimParams::default();
+    let mut sim = HairSim::new(&ctx, &scenes::thesis()?, &params, &RigidTransform::default())?;
+    sim.set_colliders(&motion::thesis_colliders())?;
+    let mut renderer = Renderer::new(&ctx, &sim, &RenderParams::default())?;
+    renderer.set_lights(&[
+        Light::Directional { direction: Vec3::new(0.3, -0.4, -1.0), color: Vec3::splat(0.9) },
+        Light::Directional { direction: Vec3::new(-0.7, -0.2, -0.4), color: Vec3::splat(0.3) },
+    ])?;
+    let mut profiler = GpuProfiler::new(&ctx, 1, 32)?;
+    let center = scenes::THESIS_HEAD_CENTER;
+    let camera = Camera::look_at(
+        center + Vec3::new(0.0, -0.05, 0.7),
+        center - Vec3::new(0.0, 0.1, 0.0),
+        0.8,
+        WIDTH as f32 / HEIGHT as f32,
+        0.05,
+        10.0,
+    )?;
+
+    // ---- The host's own resources ------------------------------------------
+    let mut owned_memory = Vec::new();
+    let mut make_image = |format: vk::Format,
+                          usage: vk::ImageUsageFlags,
+                          aspect: vk::ImageAspectFlags,
+                          name: &str|
+     -> Result<(vk::Image, vk::ImageView), BoxError> {
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(format)
+            .extent(vk::Extent3D { width: WIDTH, height: HEIGHT, depth: 1 })
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .usage(usage);
+        // SAFETY: valid create info; destroyed below.
+        let image = unsafe { device.create_image(&info, None) }?;
+        // SAFETY: the image is alive.
+        let a = allocate(
+            allocator,
+            name,
+            unsafe { device.get_image_memory_requirements(image) },
+            MemoryLocation::GpuOnly,
+            false,
+        )?;
+        // SAFETY: memory from an allocation for this image.
+        unsafe { device.bind_image_memory(image, a.memory(), a.offset()) }?;
+        owned_memory.push(Memory(Some(a)));
+        let range = vk::ImageSubresourceRange {
+            aspect_mask: aspect,
+            base_mip_level: 0,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(image)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(format)
+            .subresource_range(range);
+        // SAFETY: valid create info; destroyed below.
+        let view = unsafe { device.create_image_view(&view_info, None) }?;
+        Ok((image, view))
+    };
+    let (color, color_view) = make_image(
+        COLOR,
+        vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+        vk::ImageAspectFlags::COLOR,
+        "host color",
+    )?;
+    let (depth, depth_view) =
+        make_image(DEPTH, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT, vk::ImageAspectFlags::DEPTH, "host depth")?;
+    let make_buffer = |size: u64,
+                       usage: vk::BufferUsageFlags,
+                       location: MemoryLocation,
+                       name: &str|
+     -> Result<(vk::Buffer, Allocation), BoxError> {
+        // SAFETY: valid create info; destroyed below.
+        let buffer = unsafe { device.create_buffer(&vk::BufferCreateInfo::default().size(size).usage(usage), None) }?;
+        // SAFETY: the buffer is alive.
+        let a = allocate(allocator, name, unsafe { device.get_buffer_memory_requirements(buffer) }, location, true)?;
+        // SAFETY: memory from an allocation for this buffer.
+        unsafe { device.bind_buffer_memory(buffer, a.memory(), a.offset()) }?;
+        Ok((buffer, a))
+    };
+    // The head: interleaved position + normal, in host-visible memory.
+    let mesh = TriMesh::uv_sphere(center, 0.097, 24, 32)?;
+    let mut vertices: Vec<f32> = Vec::new();
+    for t in 0..mesh.triangles.len() {
+        let n = mesh.scaled_normal(t).normalize_or_zero();
+        for p in mesh.corners(t) {
+            vertices.extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z]);
+        }
+    }
+    let (vertex_buffer, mut vertex_memory) = make_buffer(
+        (vertices.len() * 4) as u64,
+        vk::BufferUsageFlags::VERTEX_BUFFER,
+        MemoryLocation::CpuToGpu,
+        "host head vertices",
+    )?;
+    vertex_memory.mapped_slice_mut().ok_or("vertex memory not mapped")?[..vertices.len() * 4]
+        .copy_from_slice(bytemuck::cast_slice(&vertices));
+    let (readback, readback_memory) = make_buffer(
+        u64::from(WIDTH * HEIGHT * 4),
+        vk::BufferUsageFlags::TRANSFER_DST,
+        MemoryLocation::GpuToCpu,
+        "host readback",
+    )?;
+
+    // The head pipeline (the host's own shaders).
+    let vert = compile(HEAD_VERT, shaderc::ShaderKind::Vertex, "head.vert")?;
+    let frag = compile(HEAD_FRAG, shaderc::ShaderKind::Fragment, "head.frag")?;
+    // SAFETY: SPIR-V from shaderc; modules destroyed below.
+    let modules = unsafe {
+        [
+            device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&vert), None)?,
+            device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&frag), None)?,
+        ]
+    };
+    let push_range = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::VERTEX, offset: 0, size: 128 }];
+    // SAFETY: valid create info; destroyed below.
+    let layout = unsafe {
+        device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&push_range), None)
+    }?;
+    let stages = [
+        vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::VERTEX)
+            .module(modules[0])
+            .name(c"main"),
+        vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::FRAGMENT)
+            .module(modules[1])
+            .name(c"main"),
+    ];
+    let bindings =
+        [vk::VertexInputBindingDescription { binding: 0, stride: 24, input_rate: vk::VertexInputRate::VERTEX }];
+    let attributes = [
+        vk::VertexInputAttributeDescription {
+            location: 0,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: 0,
+        },
+        vk::VertexInputAttributeDescription {
+            location: 1,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: 12,
+        },
+    ];
+    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+        .vertex_binding_descriptions(&bindings)
+        .vertex_attribute_descriptions(&attributes);
+    let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+    let viewport =
+        vk::Viewport { x: 0.0, y: 0.0, width: WIDTH as f32, height: HEIGHT as f32, min_depth: 0.0, max_depth: 1.0 };
+    let scissor = vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: WIDTH, height: HEIGHT } };
+    let viewports = [viewport];
+    let scissors = [scissor];
+    let viewport_state = vk::PipelineViewportStateCreateInfo::default().viewports(&viewports).scissors(&scissors);
+    let raster = vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(vk::PolygonMode::FILL)
+        .cull_mode(vk::CullModeFlags::BACK)
+        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+        .line_width(1.0);
+    let multisample =
+        vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let depth_state = vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(true)
+        .depth_write_enable(true)
+        .depth_compare_op(vk::CompareOp::LESS);
+    let blend_attachments =
+        [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
+    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+    let formats = [COLOR];
+    let mut rendering_info =
+        vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats).depth_attachment_format(DEPTH);
+    let pipeline_info = vk::GraphicsPipelineCreateInfo::default()
+        .stages(&stages)
+        .vertex_input_state(&vertex_input)
+        .input_assembly_state(&assembly)
+        .viewport_state(&viewport_state)
+        .rasterization_state(&raster)
+        .multisample_state(&multisample)
+        .depth_stencil_state(&depth_state)
+        .color_blend_state(&blend)
+        .layout(layout)
+        .push_next(&mut rendering_info);
+    // SAFETY: every pointer refers to locals alive for the call.
+    let pipeline = unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[pipeline_info], None) }
+        .map_err(|(_, e)| e)?[0];
+
+    // SAFETY: valid create infos; destroyed below.
+    let pool = unsafe {
+        device.create_command_pool(
+            &vk::CommandPoolCreateInfo::default()
+                .queue_family_index(family)
+                .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
+            None,
+        )
+    }?;
+    // SAFETY: the pool is alive.
+    let cmd = unsafe {
+        device.allocate_command_buffers(
+            &vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1),
+        )
+    }?[0];
+    // SAFETY: valid create info.
+    let fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }?;
+
+    let color_range = vk::ImageSubresourceRange {
+        aspect_mask: vk::ImageAspectFlags::COLOR,
+        base_mip_level: 0,
+        level_count: 1,
+        base_array_layer: 0,
+        layer_count: 1,
+    };
+    let depth_range = vk::ImageSubresourceRange { aspect_mask: vk::ImageAspectFlags::DEPTH, ..color_range };
+    let mut timings = String::new();
+    for frame in 0..frames {
+        let head = motion::reference_motion((frame + 1) as f32 * 2.0 * params.dt);
+        // SAFETY: the host records its own command buffer; vkhair's calls get it in
+        // the recording state, outside render passes; the previous frame completed.
+        unsafe {
+            device.begin_command_buffer(
+                cmd,
+                &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+            )?;
+            if let Some(report) = profiler.begin_frame(cmd, frame as u64) {
+                timings = report.to_string();
+            }
+            // vkhair: two simulation steps and the geometry passes.
+            sim.record_step(cmd, &motion::reference_motion((frame * 2 + 1) as f32 * params.dt), Some(&mut profiler))?;
+            sim.record_step(cmd, &head, Some(&mut profiler))?;
+            renderer.record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler))?;
+            // Host: clear and draw the head.
+            let to_attachment = [
+                vk::ImageMemoryBarrier2::default()
+                    .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                    .src_access_mask(vk::AccessFlags2::MEMORY_READ)
+                    .dst_stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)
+                    .dst_access_mask(vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
+                    .old_layout(vk::ImageLayout::UNDEFINED)
+                    .new_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                    .image(color)
+                    .subresource_range(color_range),
+                vk::ImageMemoryBarrier2::default()
+                    .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                    .dst_stage_mask(
+                        vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                    )
+                    .dst_access_mask(
+                        vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE
+                            | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ,
+                    )
+                    .old_layout(vk::ImageLayout::UNDEFINED)
+                    .new_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+                    .image(depth)
+                    .subresource_range(depth_range),
+            ];
+            device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&to_attachment));
+            let color_attachment = [vk::RenderingAttachmentInfo::default()
+                .image_view(color_view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.05, 0.06, 0.08, 1.0] } })];
+            let depth_attachment = vk::RenderingAttachmentInfo::default()
+                .image_view(depth_view)
+                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+            let rendering = vk::RenderingInfo::default()
+                .render_area(scissor)
+                .layer_count(1)
+                .color_attachments(&color_attachment)
+                .depth_attachment(&depth_attachment);
+            device.cmd_begin_rendering(cmd, &rendering);
+            device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+            device.cmd_bind_vertex_buffers(cmd, 0, &[vertex_buffer], &[0]);
+            let model = head.matrix();
+            let push: [[[f32; 4]; 4]; 2] =
+                [(camera.projection * camera.view * model).to_cols_array_2d(), model.to_cols_array_2d()];
+            device.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::cast_slice(&push));
+            device.cmd_draw(cmd, (vertices.len() / 6) as u32, 1, 0, 0);
+            device.cmd_end_rendering(cmd);
+            // vkhair: the hair into the host's images, depth-tested against the head.
+            let target = RenderTarget {
+                color: color_view,
+                color_format: COLOR,
+                depth: depth_view,
+                depth_format: DEPTH,
+                extent: scissor.extent,
+                samples: vk::SampleCountFlags::TYPE_1,
+            };
+            renderer.record_draw(cmd, &target, &camera, Some(&mut profiler))?;
+            // Host: copy the image out.
+            let to_copy = [vk::ImageMemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)
+                .src_access_mask(vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::COPY)
+                .dst_access_mask(vk::AccessFlags2::TRANSFER_READ)
+                .old_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .new_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+                .image(color)
+                .subresource_range(color_range)];
+            device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&to_copy));
+            let region = vk::BufferImageCopy::default()
+                .image_subresource(vk::ImageSubresourceLayers {
+                    aspect_mask: vk::ImageAspectFlags::COLOR,
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                })
+                .image_extent(vk::Extent3D { width: WIDTH, height: HEIGHT, depth: 1 });
+            device.cmd_copy_image_to_buffer(cmd, color, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, readback, &[region]);
+            let to_host = [vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+                .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+            device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&to_host));
+            device.end_command_buffer(cmd)?;
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            device.queue_submit2(queue, &[vk::SubmitInfo2::default().command_buffer_infos(&cmds)], fence)?;
+            device.wait_for_fences(&[fence], true, 60_000_000_000)?;
+            device.reset_fences(&[fence])?;
+        }
+    }
+    if let Some(report) = profiler.drain().pop() {
+        timings = report.to_string();
+    }
+    let pixels = readback_memory.mapped_slice().ok_or("readback not mapped")?[..(WIDTH * HEIGHT * 4) as usize].to_vec();
+
+    // vkhair's objects go first; then the host's own.
+    drop((renderer, sim, profiler, ctx));
+    // SAFETY: the last submission completed (its fence was waited on).
+    unsafe {
+        device.destroy_fence(fence, None);
+        device.destroy_command_pool(pool, None);
+        device.destroy_pipeline(pipeline, None);
+        device.destroy_pipeline_layout(layout, None);
+        modules.iter().for_each(|m| device.destroy_shader_module(*m, None));
+        device.destroy_image_view(color_view, None);
+        device.destroy_image_view(depth_view, None);
+        device.destroy_image(color, None);
+        device.destroy_image(depth, None);
+        device.destroy_buffer(vertex_buffer, None);
+        device.destroy_buffer(readback, None);
+    }
+    let mut allocations = vec![Memory(Some(vertex_memory)), Memory(Some(readback_memory))];
+    allocations.extend(owned_memory);
+    allocations.iter_mut().for_each(|m| m.free(allocator));
+    Ok((pixels, timings))
+}
+
+/// Counts (hair, head) pixels: hair is anything neither background nor head-coloured.
+pub fn classify(pixels: &[u8]) -> (usize, usize) {
+    let background = [13u8, 15, 20];
+    let near = |p: &[u8], c: [u8; 3]| p.iter().zip(c).all(|(a, b)| a.abs_diff(b) <= 40);
+    let mut hair = 0;
+    let mut head = 0;
+    for p in pixels.chunks_exact(4) {
+        if near(&p[..3], background) && p[2] >= p[0] {
+            continue;
+        }
+        if near(&p[..3], HEAD_RGB) && p[0] > p[2] + 20 && p[0] > 100 {
+            head += 1;
+        } else {
+            hair += 1;
+        }
+    }
+    (hair, head)
+}
+
+#[allow(dead_code)]
+fn main() -> Result<(), BoxError> {
+    let outcome = run(12, std::env::var("VKHAIR_VALIDATION").is_ok_and(|v| v == "1"))?;
+    let file = std::io::BufWriter::new(std::fs::File::create("embed_minimal.png")?);
+    let mut encoder = png::Encoder::new(file, WIDTH, HEIGHT);
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.write_header()?.write_image_data(&outcome.pixels)?;
+    let (hair, head) = classify(&outcome.pixels);
+    println!("{}\nhair pixels {hair}, head pixels {head}; wrote embed_minimal.png", outcome.timings);
+    for m in &outcome.validation_messages {
+        eprintln!("validation: {m}");
+    }
+    Ok(())
+}
