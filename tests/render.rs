@@ -419,3 +419,45 @@ fn supersampling_reduces_aliasing_and_keeps_depth_testing() {
         &blocked[i..i + 3]
     );
 }
+
+/// Barycentric mode: every hair vertex is the blend of the three key hairs of its
+/// scalp triangle with stable weights (≥ 0, summing to 1), in every frame.
+#[test]
+fn barycentric_interpolation_blends_three_key_hairs() {
+    use vkhair::render::{scalp, InterpolationMode};
+    let gpu = Gpu::new();
+    let groom = scenes::thesis().expect("thesis");
+    let params = SimParams::default();
+    let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
+    let render = RenderParams { interpolation: InterpolationMode::Barycentric, ..RenderParams::default() };
+    let mut renderer = Renderer::new(gpu.ctx(), &sim, &render).expect("renderer");
+    let triangles = scalp::root_triangles(&sim.read_state().expect("state"));
+    assert_eq!(triangles.len() as u32, renderer.scalp_triangle_count());
+    assert!(triangles.len() > 1750 && triangles.len() < 2 * 1750, "{} triangles for 1750 roots", triangles.len());
+    assert!(triangles.iter().flatten().all(|&k| k < 1750));
+    for frame in 0..2 {
+        sim.run(20, |i| motion::reference_motion((frame * 20 + i + 1) as f32 * params.dt), None).expect("run");
+        renderer.prepare_now(&sim, None).expect("prepare");
+        let (hairs, per_hair) = renderer.hair_counts();
+        assert_eq!(hairs as usize, triangles.len() * 16);
+        let (smoothed, _) = renderer.read_smoothed().expect("smoothed");
+        let (positions, tangents) = renderer.read_hairs().expect("hairs");
+        let stride = per_hair as usize;
+        let mut worst = 0.0f32;
+        for (t, tri) in triangles.iter().enumerate().step_by(7) {
+            for h in 0..16 {
+                let w = reference::barycentric_weights(t as u32, h as u32);
+                assert!(w.min_element() >= 0.0 && (w.element_sum() - 1.0).abs() < 1e-6, "weights {w}");
+                for k in 0..stride {
+                    let key = |i: usize| smoothed[tri[i] as usize * stride + k].truncate();
+                    let expected = w.x * key(0) + w.y * key(1) + w.z * key(2);
+                    let got = positions[(t * 16 + h) * stride + k];
+                    worst = worst.max((got.truncate() - expected).length());
+                    assert!((tangents[(t * 16 + h) * stride + k].truncate().length() - 1.0).abs() < 1e-4);
+                }
+            }
+        }
+        eprintln!("frame {frame}: largest difference to the CPU blend {worst:e} m");
+        assert!(worst < 1e-5, "{worst}");
+    }
+}

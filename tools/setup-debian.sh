@@ -25,6 +25,6 @@ if ((${#missing[@]})); then
 fi
 
 if ! command -v cargo >/dev/null 2>&1; then
-    echo "setup: cargo not found; install a Rust toolchain (1.85 or newer) with rustup first" >&2
+    echo "setup: cargo not found; install a Rust toolchain (1.87 or newer) with rustup first" >&2
     exit 1
 fi

@@ -39,6 +39,17 @@ vec2 clump_coordinate(uint key, uint hair) {
     return r * vec2(cos(a), sin(a));
 }
 
+// Stable random barycentric weights of hair `hair` of scalp triangle `tri`:
+// uniform over the triangle (the square-root warp), summing to 1.
+vec3 barycentric_weights(uint tri, uint hair) {
+    uint seed = tri * 64u + hair;
+    float r1 = sqrt(hash_unit(seed * 2u + 0x51ed270bu));
+    float r2 = hash_unit(seed * 2u + 0x2545f491u);
+    float u = 1.0 - r1;
+    float v = r1 * (1.0 - r2);
+    return vec3(u, v, 1.0 - u - v);
+}
+
 // Offset frame of a key vertex: B1 = the reference with its tangent part
 // removed, B2 = T × B1. The reference is the key hair's rest-plane normal turned
 // with the head, nearly perpendicular to the strand wherever it bends, so the

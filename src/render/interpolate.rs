@@ -18,7 +18,7 @@ use crate::sim::SimState;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::pipeline::GraphicsPipeline;
-use crate::vk::shaders::{RENDER_INTERPOLATE_TESC, RENDER_INTERPOLATE_TESE, RENDER_INTERPOLATE_VERT};
+use crate::vk::shaders::{ShaderSource, RENDER_INTERPOLATE_TESC, RENDER_INTERPOLATE_VERT};
 
 /// Per key hair, the normal of the plane its rest shape lies in (head frame):
 /// root tangent × (tip − root), or any perpendicular of the root tangent for a
@@ -42,16 +42,18 @@ pub(super) struct InterpolatePass {
 }
 
 impl InterpolatePass {
-    pub(super) fn new(device: &Arc<Device>, inputs: [&Buffer; 3], outputs: [&Buffer; 2]) -> Result<Self> {
+    /// `evaluation` is the single-strand or the barycentric evaluation stage; the
+    /// buffers are bound by number (0–2 smoothed data and key frames, 3–4 output,
+    /// 5 scalp triangles) where the stage declares them.
+    pub(super) fn new(device: &Arc<Device>, evaluation: &ShaderSource, buffers: &[(u32, &Buffer)]) -> Result<Self> {
         let pipeline = super::capture_pipeline(
             device,
-            "vkhair interpolation",
-            &[&RENDER_INTERPOLATE_VERT, &RENDER_INTERPOLATE_TESC, &RENDER_INTERPOLATE_TESE],
+            evaluation.name,
+            &[&RENDER_INTERPOLATE_VERT, &RENDER_INTERPOLATE_TESC, evaluation],
             1,
             1,
         )?;
-        let set = pipeline
-            .buffer_set(0, &[(0, inputs[0]), (1, inputs[1]), (2, inputs[2]), (3, outputs[0]), (4, outputs[1])])?;
+        let set = pipeline.declared_buffer_set(0, buffers)?;
         Ok(InterpolatePass { pipeline, set })
     }
 
@@ -59,7 +61,8 @@ impl InterpolatePass {
     /// `cmd` is recording inside a dynamic rendering instance with viewport and
     /// scissor set, after the smoothing pass's writes were made visible.
     pub(super) unsafe fn record(&self, device: &Device, cmd: vk::CommandBuffer, push: &InterpolatePush) {
-        // SAFETY: guaranteed by the caller.
+        // SAFETY: guaranteed by the caller. `strands` counts key hairs, or scalp
+        // triangles in barycentric mode: one patch per key segment of each.
         unsafe {
             self.pipeline.bind(cmd, &[self.set]);
             self.pipeline.push(cmd, push);

@@ -23,6 +23,7 @@ pub mod interpolate;
 mod offscreen;
 pub mod reference;
 pub mod resolve;
+pub mod scalp;
 mod shading;
 pub mod smooth;
 
@@ -96,6 +97,19 @@ pub struct RenderParams {
     /// Draw at twice the target's width and height and resolve with a 5-tap filter
     /// (thesis 3.5). Default: false (a host may use MSAA targets instead).
     pub supersampling: bool,
+    /// How hairs are grown from key hairs. Default: [`InterpolationMode::SingleStrand`].
+    pub interpolation: InterpolationMode,
+}
+
+/// How the interpolation pass grows hairs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum InterpolationMode {
+    /// `hairs_per_key` hairs around each key hair, offset in its frame (thesis 3.2).
+    #[default]
+    SingleStrand,
+    /// `hairs_per_key` hairs inside each triangle of key-hair roots, blending the
+    /// three key hairs with stable random barycentric weights (Nalu).
+    Barycentric,
 }
 
 impl Default for RenderParams {
@@ -108,6 +122,7 @@ impl Default for RenderParams {
             tip_width: 1.0,
             lod: LodParams::default(),
             supersampling: false,
+            interpolation: InterpolationMode::SingleStrand,
         }
     }
 }
@@ -218,6 +233,10 @@ pub struct Renderer {
     detail: Detail,
     /// Supersampling images for the current target size, made on first use.
     supersampling: Option<resolve::Supersampling>,
+    /// Scalp triangles between key-hair roots (barycentric mode).
+    triangles: u32,
+    _triangle_buffer: Buffer,
+    interpolate_barycentric: InterpolatePass,
 }
 
 impl Renderer {
@@ -235,7 +254,10 @@ impl Renderer {
         // Sized for the level asked for at creation: level-of-detail only lowers it.
         let stride = (points as u64 - 1) * u64::from(params.smoothing_level) + 1;
         let size = strands as u64 * stride * 16;
-        let hair_size = size * u64::from(params.hairs_per_key);
+        let triangles = scalp::root_triangles(sim.rest_shape());
+        // Room for either mode: key hairs or scalp triangles, each growing hairs.
+        let units = (strands as u64).max(triangles.len() as u64);
+        let hair_size = units * stride * 16 * u64::from(params.hairs_per_key);
         if hair_size > u64::from(device.info.max_storage_buffer_range) {
             return Err(Error::param(
                 "hairs_per_key",
@@ -272,11 +294,34 @@ impl Renderer {
         device.upload_pod(&reference, &reference_data)?;
         let (halves, _) = sim.position_halves();
         let smooth = SmoothPass::new(&device, halves, &smoothed_positions, &smoothed_tangents)?;
-        let interpolate = InterpolatePass::new(
+        let triangle_data: Vec<[u32; 4]> = triangles.iter().map(|t| [t[0], t[1], t[2], 0]).collect();
+        let triangle_buffer = Buffer::new(
             &device,
-            [&smoothed_positions, &smoothed_tangents, &reference],
-            [&hair_positions, &hair_tangents],
+            &BufferDesc {
+                name: "vkhair scalp triangles",
+                size: (triangle_data.len().max(1) * 16) as u64,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
         )?;
+        device.upload_pod(&triangle_buffer, &triangle_data)?;
+        let bindings = [
+            (0, &smoothed_positions),
+            (1, &smoothed_tangents),
+            (2, &reference),
+            (3, &hair_positions),
+            (4, &hair_tangents),
+            (5, &triangle_buffer),
+        ];
+        let interpolate = InterpolatePass::new(&device, &crate::vk::shaders::RENDER_INTERPOLATE_TESE, &bindings)?;
+        let interpolate_barycentric =
+            InterpolatePass::new(&device, &crate::vk::shaders::RENDER_INTERPOLATE_BARY_TESE, &bindings)?;
+        if params.interpolation == InterpolationMode::Barycentric && triangles.is_empty() {
+            return Err(Error::param(
+                "interpolation",
+                "barycentric mode needs at least 3 key hairs forming a triangle",
+            ));
+        }
         let draw = DrawPass::new(&device)?;
         let draw_params = Buffer::new(
             &device,
@@ -316,6 +361,9 @@ impl Renderer {
             },
             detail: params.detail_at(0.0),
             supersampling: None,
+            triangles: triangles.len() as u32,
+            _triangle_buffer: triangle_buffer,
+            interpolate_barycentric,
         })
     }
 
@@ -332,6 +380,12 @@ impl Renderer {
             return Err(Error::param(
                 "smoothing_level",
                 format!("{} exceeds the {} this renderer was created for", params.smoothing_level, self.capacity_level),
+            ));
+        }
+        if params.interpolation == InterpolationMode::Barycentric && self.triangles == 0 {
+            return Err(Error::param(
+                "interpolation",
+                "barycentric mode needs at least 3 key hairs forming a triangle",
             ));
         }
         if params.hairs_per_key > self.capacity_hairs {
@@ -364,10 +418,23 @@ impl Renderer {
         }
     }
 
+    /// Key hairs, or scalp triangles in barycentric mode: what hairs are grown from.
+    fn interpolation_units(&self) -> u32 {
+        match self.params.interpolation {
+            InterpolationMode::SingleStrand => self.strands,
+            InterpolationMode::Barycentric => self.triangles,
+        }
+    }
+
+    /// Scalp triangles between key-hair roots (barycentric mode).
+    pub fn scalp_triangle_count(&self) -> u32 {
+        self.triangles
+    }
+
     fn interpolate_push(&self) -> InterpolatePush {
         InterpolatePush {
             head_rotation: self.head_rotation.to_array(),
-            strands: self.strands,
+            strands: self.interpolation_units(),
             points: self.points,
             level: self.detail.smoothing_level,
             stride: self.smoothed_vertices_per_strand(),
@@ -380,7 +447,7 @@ impl Renderer {
 
     /// Interpolated hairs and vertices per hair of the latest prepared frame.
     pub fn hair_counts(&self) -> (u32, u32) {
-        (self.strands * self.detail.hairs_per_key, self.smoothed_vertices_per_strand())
+        (self.interpolation_units() * self.detail.hairs_per_key, self.smoothed_vertices_per_strand())
     }
 
     /// Records one storing pass: label or timestamp scope, an attachment-less
@@ -465,8 +532,12 @@ impl Renderer {
             self.capture_pass(cmd, RenderPass::Smooth, &mut profiler, |cmd| {
                 self.smooth.record(d, cmd, half, &smooth_push)
             });
+            let pass = match self.params.interpolation {
+                InterpolationMode::SingleStrand => &self.interpolate,
+                InterpolationMode::Barycentric => &self.interpolate_barycentric,
+            };
             self.capture_pass(cmd, RenderPass::Interpolate, &mut profiler, |cmd| {
-                self.interpolate.record(d, cmd, &interpolate_push)
+                pass.record(d, cmd, &interpolate_push)
             });
         }
         Ok(())

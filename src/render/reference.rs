@@ -46,6 +46,17 @@ pub fn clump_coordinate(key: u32, hair: u32) -> glam::Vec2 {
     glam::Vec2::new(r * a.cos(), r * a.sin())
 }
 
+/// Barycentric weights of hair `hair` of scalp triangle `tri`, as
+/// `barycentric_weights` in `render.glsl`.
+pub fn barycentric_weights(tri: u32, hair: u32) -> Vec3 {
+    let seed = tri.wrapping_mul(64).wrapping_add(hair);
+    let r1 = crate::hash::hash_unit(seed.wrapping_mul(2).wrapping_add(0x51ed_270b)).sqrt();
+    let r2 = crate::hash::hash_unit(seed.wrapping_mul(2).wrapping_add(0x2545_f491));
+    let u = 1.0 - r1;
+    let v = r1 * (1.0 - r2);
+    Vec3::new(u, v, 1.0 - u - v)
+}
+
 /// The offset frame (B1, B2) of a key vertex with unit tangent `t` and reference
 /// vector `reference` (world), as `key_frame` in `render.glsl`.
 pub fn key_frame(t: Vec3, reference: Vec3) -> (Vec3, Vec3) {

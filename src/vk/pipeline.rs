@@ -123,6 +123,15 @@ impl Layout {
         Ok(set)
     }
 
+    /// The entries of `buffers` whose binding the pipeline declares in `set`.
+    fn declared<'a>(&self, set: u32, buffers: &[(u32, &'a Buffer)]) -> Vec<(u32, &'a Buffer)> {
+        buffers
+            .iter()
+            .filter(|(binding, _)| self.bindings.iter().any(|(b, _)| b.set == set && b.binding == *binding))
+            .copied()
+            .collect()
+    }
+
     /// Points combined image-sampler bindings of `set` at (view, sampler) pairs
     /// in SHADER_READ_ONLY_OPTIMAL.
     fn write_images(
@@ -271,12 +280,7 @@ impl ComputePipeline {
     /// Allocates descriptor set `set` and binds those of `buffers` that the shader
     /// declares (stages sharing one binding table each use a subset of it).
     pub(crate) fn declared_buffer_set(&self, set: u32, buffers: &[(u32, &Buffer)]) -> Result<vk::DescriptorSet> {
-        let declared: Vec<(u32, &Buffer)> = buffers
-            .iter()
-            .filter(|(binding, _)| self.layout.bindings.iter().any(|(b, _)| b.set == set && b.binding == *binding))
-            .copied()
-            .collect();
-        self.buffer_set(set, &declared)
+        self.buffer_set(set, &self.layout.declared(set, buffers))
     }
 
     /// Allocates descriptor set `set` and points its buffer bindings at `buffers`.
@@ -475,6 +479,11 @@ impl GraphicsPipeline {
     /// Allocates descriptor set `set` and points its buffer bindings at `buffers`.
     pub(crate) fn buffer_set(&self, set: u32, buffers: &[(u32, &Buffer)]) -> Result<vk::DescriptorSet> {
         self.resource_set(set, buffers, &[])
+    }
+
+    /// As [`ComputePipeline::declared_buffer_set`].
+    pub(crate) fn declared_buffer_set(&self, set: u32, buffers: &[(u32, &Buffer)]) -> Result<vk::DescriptorSet> {
+        self.buffer_set(set, &self.layout.declared(set, buffers))
     }
 
     /// Allocates descriptor set `set` with buffer and combined image-sampler bindings.

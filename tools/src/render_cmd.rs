@@ -9,7 +9,7 @@ use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::scenes::{self, THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS};
 use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::Groom;
-use vkhair::render::{Camera, Light, MeshDrawer, Offscreen, RenderParams, Renderer};
+use vkhair::render::{Camera, InterpolationMode, Light, MeshDrawer, Offscreen, RenderParams, Renderer};
 use vkhair::sim::{motion, Collider, HairSim, RigidTransform, SimParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
@@ -54,6 +54,10 @@ pub struct RenderArgs {
     /// Turn level of detail off (always full detail).
     #[arg(long)]
     no_lod: bool,
+    /// Grow hairs inside triangles of key-hair roots (barycentric) instead of
+    /// around each key hair.
+    #[arg(long)]
+    barycentric: bool,
 }
 
 struct Scene {
@@ -179,6 +183,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         smoothing_level: a.level,
         hairs_per_key: a.hairs_per_key,
         supersampling: a.ssaa,
+        interpolation: if a.barycentric { InterpolationMode::Barycentric } else { InterpolationMode::SingleStrand },
         ..RenderParams::default()
     };
     params.lod.enabled = !a.no_lod;
