@@ -148,6 +148,29 @@ gpu_struct!(DrawParams => "DrawParams" {
     view_proj, camera, root_color, tip_color, primary, secondary, shifts, widths, counts, lights
 });
 
+/// Push constants of the Marschner table builder (`MarschnerPush` in `glsl/include/marschner.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct MarschnerPush {
+    /// Index of refraction.
+    pub eta: f32,
+    /// Longitudinal shift of R, radians.
+    pub alpha: f32,
+    /// Longitudinal width of R, radians.
+    pub beta: f32,
+    /// Azimuthal width of TT, radians.
+    pub gamma_tt: f32,
+    /// Azimuthal width of TRT, radians.
+    pub gamma_trt: f32,
+    /// Azimuth of the glints, radians.
+    pub glint: f32,
+    /// Table side, texels.
+    pub size: u32,
+    /// Padding.
+    pub pad0: u32,
+}
+gpu_struct!(MarschnerPush => "MarschnerPush" { eta, alpha, beta, gamma_tt, gamma_trt, glint, size, pad0 });
+
 /// Every Rust GPU struct with the shader-side name, for the layout test.
 #[cfg(test)]
 pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<String> {
@@ -168,5 +191,6 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<InterpolatePush>(reflection, &mut problems);
     check::<GpuLight>(reflection, &mut problems);
     check::<DrawParams>(reflection, &mut problems);
+    check::<MarschnerPush>(reflection, &mut problems);
     problems
 }

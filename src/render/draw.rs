@@ -58,6 +58,7 @@ impl DrawPass {
         params: &Buffer,
         positions: &Buffer,
         tangents: &Buffer,
+        tables: &[(u32, vk::ImageView, vk::Sampler)],
     ) -> Result<&(GraphicsPipeline, vk::DescriptorSet)> {
         if !self.pipelines.contains_key(&key) {
             let color_formats = [key.color];
@@ -78,11 +79,9 @@ impl DrawPass {
                 },
                 1,
             )?;
-            let set = pipeline.resource_set(
-                0,
-                &[(0, params), (1, positions), (2, tangents)],
-                &[(3, self.noise.view(), self.sampler.raw)],
-            )?;
+            let mut images = vec![(3, self.noise.view(), self.sampler.raw)];
+            images.extend_from_slice(tables);
+            let set = pipeline.resource_set(0, &[(0, params), (1, positions), (2, tangents)], &images)?;
             self.pipelines.insert(key, (pipeline, set));
         }
         Ok(&self.pipelines[&key])

@@ -20,6 +20,7 @@
 
 pub mod draw;
 pub mod interpolate;
+pub mod marschner;
 mod offscreen;
 pub mod reference;
 pub mod resolve;
@@ -27,8 +28,9 @@ pub mod scalp;
 mod shading;
 pub mod smooth;
 
+pub use marschner::MarschnerParams;
 pub use offscreen::{MeshDrawer, Offscreen, OFFSCREEN_COLOR, OFFSCREEN_DEPTH};
-pub use shading::{Camera, HairMaterial, Light, MAX_LIGHTS};
+pub use shading::{Camera, HairMaterial, Light, ShadingMode, MAX_LIGHTS};
 
 use std::sync::Arc;
 
@@ -233,6 +235,8 @@ pub struct Renderer {
     detail: Detail,
     /// Supersampling images for the current target size, made on first use.
     supersampling: Option<resolve::Supersampling>,
+    /// Marschner lookup tables, rebuilt when their parameters change.
+    marschner: marschner::MarschnerTables,
     /// Scalp triangles between key-hair roots (barycentric mode).
     triangles: u32,
     _triangle_buffer: Buffer,
@@ -322,6 +326,7 @@ impl Renderer {
                 "barycentric mode needs at least 3 key hairs forming a triangle",
             ));
         }
+        let marschner = marschner::MarschnerTables::new(&device)?;
         let draw = DrawPass::new(&device)?;
         let draw_params = Buffer::new(
             &device,
@@ -361,6 +366,7 @@ impl Renderer {
             },
             detail: params.detail_at(0.0),
             supersampling: None,
+            marschner,
             triangles: triangles.len() as u32,
             _triangle_buffer: triangle_buffer,
             interpolate_barycentric,
@@ -640,7 +646,7 @@ impl Renderer {
                 m.least_pixel_width,
                 0.0,
             ],
-            counts: [hairs, per_hair, self.lights.len() as u32, 0],
+            counts: [hairs, per_hair, self.lights.len() as u32, self.material.shading as u32],
             lights,
         }
     }
@@ -672,7 +678,12 @@ impl Renderer {
         let device = self.device.clone();
         let d = &device;
         let (hairs, per_hair) = self.hair_counts();
-        let (pipeline, set) = self.draw.pipeline(key, &self.draw_params, &self.hair_positions, &self.hair_tangents)?;
+        let tables = [
+            (4, self.marschner.m.view(), self.marschner.sampler.raw),
+            (5, self.marschner.n.view(), self.marschner.sampler.raw),
+        ];
+        let (pipeline, set) =
+            self.draw.pipeline(key, &self.draw_params, &self.hair_positions, &self.hair_tangents, &tables)?;
         let before_update = barrier::memory(Access::ANY_WRITE, Access::TRANSFER_WRITE);
         let updated = barrier::memory(
             Access::TRANSFER_WRITE,
@@ -685,6 +696,8 @@ impl Renderer {
         );
         // SAFETY: guaranteed by the caller; all objects belong to this device.
         unsafe {
+            // The draw pipeline may sample the Marschner tables: build them first.
+            self.marschner.record_update(d, cmd, &self.material.marschner);
             d.cmd_barrier(cmd, &[before_update], &[], &[]);
             d.raw.cmd_update_buffer(cmd, self.draw_params.raw(), 0, bytemuck::bytes_of(params));
             d.cmd_barrier(cmd, &[updated], &[], &[]);
@@ -954,6 +967,21 @@ unsafe fn set_viewport(d: &Device, cmd: vk::CommandBuffer, extent: vk::Extent2D)
     unsafe {
         d.raw.cmd_set_viewport(cmd, 0, &[viewport]);
         d.raw.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
+    }
+}
+
+impl Renderer {
+    /// Builds the Marschner tables for the current material and reads them back
+    /// (M indexed by sin θi, sin θo; N by cos φ, cos θd; rows of
+    /// [`marschner::TABLE_SIZE`] texels) — for tests and tools (submits and waits).
+    pub fn read_marschner_tables(&mut self) -> Result<(Vec<Vec4>, Vec<Vec4>)> {
+        let device = self.device.clone();
+        let params = self.material.marschner;
+        device.submit_once("vkhair marschner tables", |cmd| {
+            // SAFETY: a recording command buffer of this device; earlier work completed.
+            unsafe { self.marschner.record_update(&device, cmd, &params) };
+        })?;
+        Ok((self.marschner.read(&device, false)?, self.marschner.read(&device, true)?))
     }
 }
 

@@ -127,6 +127,17 @@ impl Light {
     }
 }
 
+/// How hair is shaded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ShadingMode {
+    /// Kajiya-Kay diffuse and two shifted highlights (Scheuermann; the thesis).
+    #[default]
+    KajiyaKay = 0,
+    /// Marschner R, TT and TRT through lookup tables (Nalu), with
+    /// [`HairMaterial::marschner`] parameters.
+    Marschner = 1,
+}
+
 /// Hair material (Kajiya-Kay diffuse and two shifted specular highlights).
 #[derive(Debug, Clone, PartialEq)]
 pub struct HairMaterial {
@@ -161,6 +172,11 @@ pub struct HairMaterial {
     pub tip_width: f32,
     /// Least ribbon width on screen, pixels (0 = none). Default: 1.
     pub least_pixel_width: f32,
+    /// Shading model. Default: [`ShadingMode::KajiyaKay`].
+    pub shading: ShadingMode,
+    /// Marschner parameters (used in [`ShadingMode::Marschner`]; the lookup tables
+    /// are rebuilt when they change).
+    pub marschner: super::MarschnerParams,
 }
 
 impl Default for HairMaterial {
@@ -181,6 +197,8 @@ impl Default for HairMaterial {
             root_width: 0.00012,
             tip_width: 0.00005,
             least_pixel_width: 1.0,
+            shading: ShadingMode::KajiyaKay,
+            marschner: super::MarschnerParams::default(),
         }
     }
 }
@@ -217,7 +235,7 @@ impl HairMaterial {
                 return Err(Error::param(name, format!("{v} is outside {lo}..={hi}")));
             }
         }
-        Ok(())
+        self.marschner.validate()
     }
 }
 

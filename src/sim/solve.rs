@@ -28,7 +28,8 @@ pub(crate) fn packing(points: u32, subgroup_size: u32, requested: u32, subgroup_
     let wg = MAX_SIM_POINTS as u32;
     // Lanes doing work: hairs never straddle a sync group, so its tail idles.
     let used = |group: u32| (group / points) * points * (wg / group);
-    let subgroup_fits = subgroup_sync && subgroup_size >= points && subgroup_size > 0 && wg.is_multiple_of(subgroup_size);
+    let subgroup_fits =
+        subgroup_sync && subgroup_size >= points && subgroup_size > 0 && wg.is_multiple_of(subgroup_size);
     // Subgroup barriers are cheaper, but only worth it when they keep as many lanes busy
     // (on lavapipe, 8-wide subgroups fit one 6-point hair: 75 % against 94 %).
     let sync_group = if subgroup_fits && used(subgroup_size) >= used(wg) { subgroup_size } else { wg };

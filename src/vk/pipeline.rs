@@ -132,6 +132,43 @@ impl Layout {
             .collect()
     }
 
+    /// Points storage-image bindings of `set` at views in GENERAL layout.
+    fn write_storage_images(&self, target: vk::DescriptorSet, set: u32, images: &[(u32, vk::ImageView)]) -> Result<()> {
+        let infos: Vec<_> = images
+            .iter()
+            .map(|(_, view)| {
+                [vk::DescriptorImageInfo {
+                    sampler: vk::Sampler::null(),
+                    image_view: *view,
+                    image_layout: vk::ImageLayout::GENERAL,
+                }]
+            })
+            .collect();
+        let mut writes = Vec::new();
+        for ((binding, _), info) in images.iter().zip(&infos) {
+            let declared = self
+                .bindings
+                .iter()
+                .any(|(b, _)| b.set == set && b.binding == *binding && b.ty == vk::DescriptorType::STORAGE_IMAGE);
+            if !declared {
+                return Err(Error::param(
+                    "descriptor binding",
+                    format!("set {set} binding {binding} is not a storage image"),
+                ));
+            }
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(target)
+                    .dst_binding(*binding)
+                    .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                    .image_info(info),
+            );
+        }
+        // SAFETY: as in write_buffers; the views are alive.
+        unsafe { self.device.raw.update_descriptor_sets(&writes, &[]) };
+        Ok(())
+    }
+
     /// Points combined image-sampler bindings of `set` at (view, sampler) pairs
     /// in SHADER_READ_ONLY_OPTIMAL.
     fn write_images(
@@ -287,6 +324,14 @@ impl ComputePipeline {
     pub(crate) fn buffer_set(&self, set: u32, buffers: &[(u32, &Buffer)]) -> Result<vk::DescriptorSet> {
         let target = self.layout.allocate_set(set, &format!("{} set {set}", self.name))?;
         self.layout.write_buffers(target, set, buffers)?;
+        Ok(target)
+    }
+
+    /// Allocates descriptor set `set` and points its storage-image bindings at views
+    /// (in GENERAL layout when dispatched).
+    pub(crate) fn storage_image_set(&self, set: u32, images: &[(u32, vk::ImageView)]) -> Result<vk::DescriptorSet> {
+        let target = self.layout.allocate_set(set, &format!("{} set {set}", self.name))?;
+        self.layout.write_storage_images(target, set, images)?;
         Ok(target)
     }
 

@@ -9,7 +9,9 @@ use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::scenes::{self, THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS};
 use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::Groom;
-use vkhair::render::{Camera, InterpolationMode, Light, MeshDrawer, Offscreen, RenderParams, Renderer};
+use vkhair::render::{
+    Camera, HairMaterial, InterpolationMode, Light, MeshDrawer, Offscreen, RenderParams, Renderer, ShadingMode,
+};
 use vkhair::sim::{motion, Collider, HairSim, RigidTransform, SimParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
@@ -58,6 +60,9 @@ pub struct RenderArgs {
     /// around each key hair.
     #[arg(long)]
     barycentric: bool,
+    /// Shade with Marschner lookup tables instead of Kajiya-Kay.
+    #[arg(long)]
+    marschner: bool,
 }
 
 struct Scene {
@@ -189,6 +194,10 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     params.lod.enabled = !a.no_lod;
     let mut renderer = Renderer::new(&ctx, &sim, &params)?;
     renderer.set_lights(&lights(s.center))?;
+    if a.marschner {
+        let material = HairMaterial { shading: ShadingMode::Marschner, ..HairMaterial::default() };
+        renderer.set_material(&material)?;
+    }
     let offscreen = Offscreen::new(&ctx, a.width, a.height)?;
     let head = MeshDrawer::new(&ctx, &s.head_mesh)?;
     let aspect = a.width as f32 / a.height as f32;
