@@ -1,8 +1,9 @@
 //! Render cost over the grid of seed 000's Table 5: GPU time per pass
-//! (smoothing, interpolation, draw) from timestamp queries for the `thesis`
-//! scene at 800×600, 1024×712, 1152×802 and 1280×968 and camera distances
-//! 0.2, 0.4, 0.6, 1.0, 1.5 and 3.0 m (level of detail on). Printed as a table
-//! and written to `target/vkhair-bench/render.csv`.
+//! (smoothing, interpolation, draw, and the resolve with 2× supersampling)
+//! from timestamp queries for the `thesis` scene at 800×600, 1024×712,
+//! 1152×802 and 1280×968 and camera distances 0.2, 0.4, 0.6, 1.0, 1.5 and
+//! 3.0 m (level of detail on), without and with supersampling. Printed as a
+//! table and written to `target/vkhair-bench/render.csv`; `vkhair plot` charts it.
 //!
 //! `cargo bench --bench render` (add `-- quick` for one resolution).
 
@@ -11,6 +12,8 @@ use std::fmt::Write as _;
 use glam::Vec3;
 use vkhair::groom::scenes;
 use vkhair::render::{Camera, Light, Offscreen, RenderParams, RenderPass, Renderer};
+
+const PASSES: [RenderPass; 4] = [RenderPass::Smooth, RenderPass::Interpolate, RenderPass::Draw, RenderPass::Resolve];
 use vkhair::sim::{motion, HairSim, RigidTransform, SimParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
@@ -33,16 +36,21 @@ fn main() {
     let resolutions: &[(u32, u32)] =
         if quick { &[(800, 600)] } else { &[(800, 600), (1024, 712), (1152, 802), (1280, 968)] };
     let distances = [0.2f32, 0.4, 0.6, 1.0, 1.5, 3.0];
-    let passes = [RenderPass::Smooth, RenderPass::Interpolate, RenderPass::Draw];
     let frames = 3;
-    let mut csv = String::from("width,height,distance_m,hairs,segments,smooth_ms,interpolate_ms,draw_ms,total_ms\n");
+    let mut csv = String::from(
+        "width,height,ssaa,distance_m,hairs,segments,smooth_ms,interpolate_ms,draw_ms,resolve_ms,total_ms\n",
+    );
     println!("{} — thesis scene, GPU ms per pass (mean of {frames} frames after one warm-up)", ctx.info().name);
     println!(
-        "{:>10} {:>6} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9}",
-        "size", "dist", "hairs", "segments", "smooth", "interp", "draw", "total"
+        "{:>10} {:>5} {:>6} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}",
+        "size", "ssaa", "dist", "hairs", "segments", "smooth", "interp", "draw", "resolve", "total"
     );
     let mut frame = 0u64;
-    for &(w, h) in resolutions {
+    for (&(w, h), ssaa) in resolutions.iter().flat_map(|r| [(r, false), (r, true)]) {
+        // SAFETY: every earlier frame completed (run_commands waits).
+        unsafe { renderer.release_size_dependent() };
+        let params = RenderParams { supersampling: ssaa, ..renderer.params().clone() };
+        renderer.set_params(&params).expect("params");
         let offscreen = Offscreen::new(&ctx, w, h).expect("offscreen");
         for &distance in &distances {
             let center = scenes::THESIS_HEAD_CENTER;
@@ -55,7 +63,7 @@ fn main() {
                 20.0,
             )
             .expect("camera");
-            let mut sums = [0.0f64; 3];
+            let mut sums = [0.0f64; 4];
             for k in 0..=frames {
                 ctx.run_commands("bench frame", |cmd| {
                     // SAFETY: a recording command buffer of the context's device; the
@@ -71,7 +79,7 @@ fn main() {
                 frame += 1;
                 let report = profiler.drain().pop().expect("timestamps");
                 if k > 0 {
-                    for (sum, pass) in sums.iter_mut().zip(passes) {
+                    for (sum, pass) in sums.iter_mut().zip(PASSES) {
                         *sum += report.pass(pass.label()).unwrap_or(0.0) / 1e6 / frames as f64;
                     }
                 }
@@ -80,20 +88,26 @@ fn main() {
             let segments = u64::from(hairs) * u64::from(per_hair - 1);
             let total: f64 = sums.iter().sum();
             println!(
-                "{:>10} {:>6.1} {:>7} {:>9} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
+                "{:>10} {:>5} {:>6.1} {:>7} {:>9} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
                 format!("{w}x{h}"),
+                if ssaa { "2x" } else { "off" },
                 distance,
                 hairs,
                 segments,
                 sums[0],
                 sums[1],
                 sums[2],
+                sums[3],
                 total
             );
             let _ = writeln!(
                 csv,
-                "{w},{h},{distance},{hairs},{segments},{:.4},{:.4},{:.4},{total:.4}",
-                sums[0], sums[1], sums[2]
+                "{w},{h},{},{distance},{hairs},{segments},{:.4},{:.4},{:.4},{:.4},{total:.4}",
+                u8::from(ssaa),
+                sums[0],
+                sums[1],
+                sums[2],
+                sums[3]
             );
         }
     }

@@ -2,10 +2,11 @@
 # Installs the Debian packages vkhair needs, only those that are missing:
 # lavapipe (mesa-vulkan-drivers), the Vulkan loader, the validation layers,
 # Debian's static shaderc/glslang/SPIRV-Tools libraries (libshaderc-dev;
-# build.rs links them instead of building shaderc from source) and spirv-val.
+# build.rs links them instead of building shaderc from source), spirv-val, and
+# the DejaVu font `vkhair plot` labels its charts with.
 set -euo pipefail
 
-packages=(mesa-vulkan-drivers libvulkan1 vulkan-validationlayers libshaderc-dev glslc spirv-tools)
+packages=(mesa-vulkan-drivers libvulkan1 vulkan-validationlayers libshaderc-dev glslc spirv-tools fonts-dejavu-core)
 missing=()
 for p in "${packages[@]}"; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

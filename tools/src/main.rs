@@ -1,5 +1,6 @@
 //! `vkhair`: the command-line program of the vkhair crate.
 
+mod plot_cmd;
 mod render_cmd;
 
 use std::path::{Path, PathBuf};
@@ -39,6 +40,8 @@ enum Command {
     /// Simulate and render a head of hair headless: PNG frames, a contact sheet and a
     /// per-pass GPU timing table.
     Render(render_cmd::RenderArgs),
+    /// Chart the render benchmark's CSV (cargo bench --bench render) as a PNG.
+    Plot(plot_cmd::PlotArgs),
     /// Resample and/or pick key hairs from a .hair or .tfx file; write a .hair file.
     Convert {
         /// Input groom (.hair or .tfx).
@@ -144,6 +147,7 @@ fn main() -> ExitCode {
         Command::Grow(args) => grow_cmd(&args),
         Command::Simulate(args) => simulate(&args),
         Command::Render(args) => render_cmd::render(&args),
+        Command::Plot(args) => plot_cmd::plot(&args),
         Command::Convert { input, points, key_hairs, out } => convert(&input, points, key_hairs, &out),
     };
     match result {
