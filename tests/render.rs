@@ -517,3 +517,28 @@ fn marschner_tables_match_the_cpu_and_follow_parameters() {
     eprintln!("Marschner R highlight centroid row: alpha −0.25 → {a:.2}, +0.25 → {b:.2}");
     assert!((a - b).abs() > 2.0, "the R highlight did not move: {a} vs {b}");
 }
+
+#[test]
+fn lines_mode_draws_and_a_bad_camera_is_rejected() {
+    use vkhair::render::Primitive;
+    let gpu = Gpu::new();
+    let mut s = scene(&gpu);
+    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    let ribbons = hair_pixels(&draw(&gpu, &mut s, None)).len();
+    let params = RenderParams { primitive: Primitive::Lines, ..s.renderer.params().clone() };
+    s.renderer.set_params(&params).expect("params");
+    let lines = hair_pixels(&draw(&gpu, &mut s, None)).len();
+    eprintln!("hair pixels: ribbons {ribbons}, lines {lines}");
+    assert!(lines > 1000, "lines mode draws the hair: {lines}");
+    assert!(lines <= ribbons, "one-pixel lines cover no more than ribbons of at least a pixel");
+    let mut bad = s.camera;
+    bad.view.x_axis.x = f32::NAN;
+    let mut result = Ok(());
+    gpu.ctx()
+        .run_commands("bad camera", |cmd| {
+            // SAFETY: a recording command buffer of the context's device.
+            result = unsafe { s.renderer.record_draw(cmd, &s.offscreen.target(), &bad, None) };
+        })
+        .expect("submit");
+    assert!(matches!(result, Err(Error::InvalidParameter { name: "camera", .. })), "{result:?}");
+}

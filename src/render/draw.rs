@@ -18,12 +18,13 @@ use crate::vk::image::{Image, ImageDesc, Sampler};
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
 use crate::vk::shaders::{RENDER_DRAW_FRAG, RENDER_DRAW_GEOM, RENDER_DRAW_VERT};
 
-/// Formats and sample count a draw pipeline is made for.
+/// Formats, sample count and primitive a draw pipeline is made for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub(super) struct TargetKey {
     pub color: vk::Format,
     pub depth: vk::Format,
     pub samples: vk::SampleCountFlags,
+    pub primitive: super::Primitive,
 }
 
 pub(super) struct DrawPass {
@@ -62,11 +63,16 @@ impl DrawPass {
     ) -> Result<&(GraphicsPipeline, vk::DescriptorSet)> {
         if !self.pipelines.contains_key(&key) {
             let color_formats = [key.color];
+            // Lines skip the geometry stage: the fragment stage reads the vertex
+            // stage's outputs at the same locations.
+            let ribbons: &[&crate::vk::shaders::ShaderSource] =
+                &[&RENDER_DRAW_VERT, &RENDER_DRAW_GEOM, &RENDER_DRAW_FRAG];
+            let lines: &[&crate::vk::shaders::ShaderSource] = &[&RENDER_DRAW_VERT, &RENDER_DRAW_FRAG];
             let pipeline = GraphicsPipeline::new(
                 &self.device,
                 &GraphicsDesc {
                     name: "vkhair hair draw",
-                    stages: &[&RENDER_DRAW_VERT, &RENDER_DRAW_GEOM, &RENDER_DRAW_FRAG],
+                    stages: if key.primitive == super::Primitive::Lines { lines } else { ribbons },
                     topology: vk::PrimitiveTopology::LINE_LIST,
                     patch_control_points: 0,
                     color_formats: &color_formats,

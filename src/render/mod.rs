@@ -101,6 +101,18 @@ pub struct RenderParams {
     pub supersampling: bool,
     /// How hairs are grown from key hairs. Default: [`InterpolationMode::SingleStrand`].
     pub interpolation: InterpolationMode,
+    /// What each hair segment is drawn as. Default: [`Primitive::Ribbons`].
+    pub primitive: Primitive,
+}
+
+/// What the draw pass turns each hair segment into.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+pub enum Primitive {
+    /// Camera-facing quads from the geometry stage, [`HairMaterial`] widths.
+    #[default]
+    Ribbons,
+    /// One-pixel lines (no geometry stage; cheapest).
+    Lines,
 }
 
 /// How the interpolation pass grows hairs.
@@ -125,6 +137,7 @@ impl Default for RenderParams {
             lod: LodParams::default(),
             supersampling: false,
             interpolation: InterpolationMode::SingleStrand,
+            primitive: Primitive::Ribbons,
         }
     }
 }
@@ -735,7 +748,16 @@ impl Renderer {
         }
         let device = self.device.clone();
         let d = &device;
-        let host_key = TargetKey { color: target.color_format, depth: target.depth_format, samples: target.samples };
+        let finite = camera.view.is_finite() && camera.projection.is_finite() && camera.fov_y.is_finite();
+        if !finite {
+            return Err(Error::param("camera", "view, projection and field of view must be finite"));
+        }
+        let host_key = TargetKey {
+            color: target.color_format,
+            depth: target.depth_format,
+            samples: target.samples,
+            primitive: self.params.primitive,
+        };
         // The host's earlier attachment writes (its head, its clear) before ours.
         let attachments = barrier::memory(
             Access {
@@ -802,6 +824,7 @@ impl Renderer {
             color: resolve::SUPERSAMPLED_COLOR,
             depth: resolve::SUPERSAMPLED_DEPTH,
             samples: vk::SampleCountFlags::TYPE_1,
+            primitive: self.params.primitive,
         };
         let ss_color = [vk::RenderingAttachmentInfo::default()
             .image_view(ss.color.view())

@@ -10,7 +10,8 @@ use vkhair::groom::scenes::{self, THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS};
 use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::Groom;
 use vkhair::render::{
-    Camera, HairMaterial, InterpolationMode, Light, MeshDrawer, Offscreen, RenderParams, Renderer, ShadingMode,
+    Camera, HairMaterial, InterpolationMode, Light, MeshDrawer, Offscreen, Primitive, RenderParams, Renderer,
+    ShadingMode,
 };
 use vkhair::sim::{motion, Collider, HairSim, RigidTransform, SimParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
@@ -63,6 +64,9 @@ pub struct RenderArgs {
     /// Shade with Marschner lookup tables instead of Kajiya-Kay.
     #[arg(long)]
     marschner: bool,
+    /// Draw one-pixel lines instead of ribbons.
+    #[arg(long)]
+    lines: bool,
 }
 
 struct Scene {
@@ -189,6 +193,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         hairs_per_key: a.hairs_per_key,
         supersampling: a.ssaa,
         interpolation: if a.barycentric { InterpolationMode::Barycentric } else { InterpolationMode::SingleStrand },
+        primitive: if a.lines { Primitive::Lines } else { Primitive::Ribbons },
         ..RenderParams::default()
     };
     params.lod.enabled = !a.no_lod;
