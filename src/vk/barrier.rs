@@ -15,8 +15,6 @@ pub(crate) struct Access {
 
 impl Access {
     pub const NONE: Access = Access { stage: vk::PipelineStageFlags2::NONE, access: vk::AccessFlags2::NONE };
-    pub const COMPUTE_READ: Access =
-        Access { stage: vk::PipelineStageFlags2::COMPUTE_SHADER, access: vk::AccessFlags2::SHADER_STORAGE_READ };
     pub const COMPUTE_WRITE: Access =
         Access { stage: vk::PipelineStageFlags2::COMPUTE_SHADER, access: vk::AccessFlags2::SHADER_STORAGE_WRITE };
     pub const COMPUTE_READ_WRITE: Access = Access {

@@ -160,7 +160,6 @@ pub(crate) fn messenger_info(log: &ValidationLog) -> vk::DebugUtilsMessengerCrea
 pub(crate) enum LabelColor {
     Compute,
     Graphics,
-    Transfer,
 }
 
 impl LabelColor {
@@ -168,7 +167,6 @@ impl LabelColor {
         match self {
             LabelColor::Compute => [0.35, 0.65, 1.0, 1.0],
             LabelColor::Graphics => [1.0, 0.6, 0.2, 1.0],
-            LabelColor::Transfer => [0.6, 0.6, 0.6, 1.0],
         }
     }
 }

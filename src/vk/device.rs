@@ -91,8 +91,13 @@ pub(crate) struct Owned {
 /// The shared device record (see the module docs).
 pub(crate) struct Device {
     /// Keeps the Vulkan loader library loaded for as long as the device lives.
+    #[allow(dead_code, reason = "held for its Drop: unloading the loader would invalidate every handle")]
     pub entry: ash::Entry,
     pub instance: ash::Instance,
+    #[allow(
+        dead_code,
+        reason = "kept for stages that query the physical device (external memory, calibrated timestamps)"
+    )]
     pub physical: vk::PhysicalDevice,
     pub raw: ash::Device,
     pub graphics: Queue,

@@ -27,7 +27,6 @@ pub(crate) struct Image {
     view: vk::ImageView,
     allocation: Option<Allocation>,
     pub extent: vk::Extent2D,
-    pub format: vk::Format,
     pub aspect: vk::ImageAspectFlags,
 }
 
@@ -55,7 +54,6 @@ impl Image {
             view: vk::ImageView::null(),
             allocation: None,
             extent: desc.extent,
-            format: desc.format,
             aspect: desc.aspect,
         };
         // SAFETY: `raw` was just created from this device.

@@ -1,9 +1,5 @@
 //! Thin, crate-private wrappers over ash: the device record, buffers, images,
 //! staging, barriers, reflection, pipelines and debug names/labels.
-//!
-//! Parts of this layer exist for the simulation and render stages built on it;
-//! until every part has a caller, unused items are allowed here.
-#![allow(dead_code)]
 
 pub(crate) mod barrier;
 pub(crate) mod buffer;

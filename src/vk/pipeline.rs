@@ -310,6 +310,7 @@ impl ComputePipeline {
         Ok(ComputePipeline { layout, raw, workgroup_size, name: shader.name.to_owned() })
     }
 
+    #[cfg(test)]
     pub(crate) fn workgroup_size(&self) -> [u32; 3] {
         self.workgroup_size
     }

@@ -54,10 +54,13 @@ pub(crate) struct Reflection {
     pub bindings: Vec<Binding>,
     /// Byte size of the push-constant block (0 when none).
     pub push_constant_size: u32,
+    /// Read by the layout tests, which compare them with the Rust twins.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub structs: Vec<StructLayout>,
 }
 
 impl Reflection {
+    #[cfg(test)]
     /// Every layout of the struct named `name` (a struct used under two layout
     /// rules appears twice).
     pub(crate) fn structs_named<'a>(&'a self, name: &'a str) -> impl Iterator<Item = &'a StructLayout> + 'a {
@@ -329,6 +332,7 @@ pub(crate) fn reflect(shader: &ShaderSource) -> Result<Reflection> {
 
 /// One field of a Rust GPU struct.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(not(test), allow(dead_code, reason = "compared with reflection by the layout tests"))]
 pub(crate) struct FieldLayout {
     pub name: &'static str,
     pub offset: usize,
@@ -336,6 +340,7 @@ pub(crate) struct FieldLayout {
 }
 
 /// A `#[repr(C)]` Pod struct with a GLSL twin of the same name in `glsl/include/`.
+#[cfg_attr(not(test), allow(dead_code, reason = "compared with reflection by the layout tests"))]
 pub(crate) trait GpuStruct: bytemuck::Pod {
     /// The GLSL struct name.
     const GLSL_NAME: &'static str;
@@ -349,6 +354,7 @@ pub(crate) trait GpuStruct: bytemuck::Pod {
 /// every other field must match a GLSL member of the same name, in order, at the
 /// same offset with the same size, and arrays of the struct must have a stride
 /// equal to the Rust size.
+#[cfg(test)]
 pub(crate) fn compare<T: GpuStruct>(layout: &StructLayout) -> std::result::Result<(), String> {
     let rust: Vec<FieldLayout> = T::fields().into_iter().filter(|f| !f.name.starts_with("_pad")).collect();
     let mut problems = Vec::new();

@@ -34,4 +34,10 @@ pub(crate) struct ShaderSource {
     pub words: &'static [u32],
 }
 
-include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+// The table also holds the shaders only the tests use (glsl/core/).
+#[allow(dead_code)]
+mod table {
+    use super::{ShaderSource, ShaderStage};
+    include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+}
+pub(crate) use table::*;
