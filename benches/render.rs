@@ -47,8 +47,6 @@ fn main() {
     );
     let mut frame = 0u64;
     for (&(w, h), ssaa) in resolutions.iter().flat_map(|r| [(r, false), (r, true)]) {
-        // SAFETY: every earlier frame completed (run_commands waits).
-        unsafe { renderer.release_size_dependent() };
         let params = RenderParams { supersampling: ssaa, ..renderer.params().clone() };
         renderer.set_params(&params).expect("params");
         let offscreen = Offscreen::new(&ctx, w, h).expect("offscreen");
@@ -72,7 +70,9 @@ fn main() {
                         profiler.begin_frame(cmd, frame);
                         renderer.record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler)).expect("prepare");
                         offscreen.record_clear(cmd, Vec3::ZERO);
-                        renderer.record_draw(cmd, &offscreen.target(), &camera, Some(&mut profiler)).expect("draw");
+                        renderer
+                            .record_draw(cmd, frame, &offscreen.target(), &camera, Some(&mut profiler))
+                            .expect("draw");
                     }
                 })
                 .expect("submit");

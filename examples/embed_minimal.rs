@@ -508,7 +508,7 @@ fn frames_with(
                 extent: scissor.extent,
                 samples: vk::SampleCountFlags::TYPE_1,
             };
-            renderer.record_draw(cmd, &target, &camera, Some(&mut profiler))?;
+            renderer.record_draw(cmd, frame as u64, &target, &camera, Some(&mut profiler))?;
             // Host: copy the image out.
             let to_copy = [vk::ImageMemoryBarrier2::default()
                 .src_stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)

@@ -142,6 +142,12 @@ fn interpolation_grows_stable_clumps() {
 use vkhair::groom::mesh::TriMesh;
 use vkhair::render::{Camera, HairMaterial, Light, MeshDrawer, Offscreen};
 
+/// Frame indices for record_draw: every test frame is submitted and waited for.
+fn next_frame() -> u64 {
+    static FRAME: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    FRAME.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
 const W: u32 = 160;
 const H: u32 = 120;
 const BACKGROUND: [u8; 3] = [0, 0, 0];
@@ -191,7 +197,7 @@ fn draw(gpu: &Gpu, s: &mut Scene, blocker: Option<&MeshDrawer>) -> Vec<u8> {
                             Vec3::NEG_Z,
                         );
                     }
-                    s.renderer.record_draw(cmd, &s.offscreen.target(), &s.camera, None)
+                    s.renderer.record_draw(cmd, next_frame(), &s.offscreen.target(), &s.camera, None)
                 })
             };
         })
@@ -340,7 +346,7 @@ fn detail_falls_with_distance() {
                     s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
                         s.offscreen.record_clear(cmd, Vec3::ZERO);
                         device.cmd_begin_query(cmd, pool, 0, vk::QueryControlFlags::empty());
-                        let r = s.renderer.record_draw(cmd, &s.offscreen.target(), &s.camera, None);
+                        let r = s.renderer.record_draw(cmd, next_frame(), &s.offscreen.target(), &s.camera, None);
                         device.cmd_end_query(cmd, pool, 0);
                         r
                     })
@@ -537,8 +543,46 @@ fn lines_mode_draws_and_a_bad_camera_is_rejected() {
     gpu.ctx()
         .run_commands("bad camera", |cmd| {
             // SAFETY: a recording command buffer of the context's device.
-            result = unsafe { s.renderer.record_draw(cmd, &s.offscreen.target(), &bad, None) };
+            result = unsafe { s.renderer.record_draw(cmd, next_frame(), &s.offscreen.target(), &bad, None) };
         })
         .expect("submit");
     assert!(matches!(result, Err(Error::InvalidParameter { name: "camera", .. })), "{result:?}");
+}
+
+/// A new target size with supersampling retires the old images and frees them
+/// `frames_in_flight` frames later, with validation clean throughout.
+#[test]
+fn resizing_frees_old_images_frames_in_flight_later() {
+    let gpu = Gpu::new();
+    let mut s = scene(&gpu);
+    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    let params = RenderParams { supersampling: true, frames_in_flight: 2, ..s.renderer.params().clone() };
+    s.renderer.set_params(&params).expect("params");
+    let small = Offscreen::new(gpu.ctx(), 120, 90).expect("offscreen");
+    let frame_with = |s: &mut Scene, target: &Offscreen, frame: u64| {
+        let mut result = Ok(());
+        gpu.ctx()
+            .run_commands("resize frame", |cmd| {
+                // SAFETY: a recording command buffer of the context's device.
+                result = unsafe {
+                    s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
+                        target.record_clear(cmd, Vec3::ZERO);
+                        s.renderer.record_draw(cmd, frame, &target.target(), &s.camera, None)
+                    })
+                };
+            })
+            .expect("submit");
+        result
+    };
+    frame_with(&mut s, &small, 10).expect("frame 10");
+    frame_with(&mut s, &small, 11).expect("frame 11");
+    let large = Offscreen::new(gpu.ctx(), 200, 150).expect("offscreen");
+    // At frame 12 only frames ≤ 10 are known complete: frame 11 may still use them.
+    frame_with(&mut s, &large, 12).expect("frame 12");
+    assert_eq!(s.renderer.retired_image_sets(), 1, "the 120×90 images wait for frame 11 to complete");
+    // At frame 13 frames ≤ 11 are complete: freed.
+    frame_with(&mut s, &large, 13).expect("frame 13");
+    assert_eq!(s.renderer.retired_image_sets(), 0, "freed two frames after their last use");
+    assert!(hair_pixels(&large.read_rgba8().expect("readback")).len() > 1000);
+    assert!(matches!(frame_with(&mut s, &large, 3), Err(Error::InvalidParameter { name: "frame", .. })));
 }

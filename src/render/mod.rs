@@ -103,6 +103,9 @@ pub struct RenderParams {
     pub interpolation: InterpolationMode,
     /// What each hair segment is drawn as. Default: [`Primitive::Ribbons`].
     pub primitive: Primitive,
+    /// Frames the host has in flight (1..=16): images a new target size makes
+    /// obsolete are freed this many frames after their last use. Default: 2.
+    pub frames_in_flight: u32,
 }
 
 /// What the draw pass turns each hair segment into.
@@ -138,6 +141,7 @@ impl Default for RenderParams {
             supersampling: false,
             interpolation: InterpolationMode::SingleStrand,
             primitive: Primitive::Ribbons,
+            frames_in_flight: 2,
         }
     }
 }
@@ -248,6 +252,11 @@ pub struct Renderer {
     detail: Detail,
     /// Supersampling images for the current target size, made on first use.
     supersampling: Option<resolve::Supersampling>,
+    /// Images of earlier target sizes with the last frame that used them, freed
+    /// `frames_in_flight` frames later.
+    retired: Vec<(u64, resolve::Supersampling)>,
+    /// The last frame index `record_draw` was given.
+    last_frame: Option<u64>,
     /// Marschner lookup tables, rebuilt when their parameters change.
     marschner: marschner::MarschnerTables,
     /// Scalp triangles between key-hair roots (barycentric mode).
@@ -379,6 +388,8 @@ impl Renderer {
             },
             detail: params.detail_at(0.0),
             supersampling: None,
+            retired: Vec::new(),
+            last_frame: None,
             marschner,
             triangles: triangles.len() as u32,
             _triangle_buffer: triangle_buffer,
@@ -664,14 +675,15 @@ impl Renderer {
         }
     }
 
-    /// Frees the images that depend on the target's size (supersampling), for a
-    /// target of a new size; they are made again on the next draw.
-    ///
-    /// # Safety
-    /// No pending GPU work records of this renderer's draws are still executing (the
-    /// host waited for its frames, as when recreating a swapchain).
-    pub unsafe fn release_size_dependent(&mut self) {
-        self.supersampling = None;
+    /// Sets of size-dependent images waiting for their frames to complete.
+    pub fn retired_image_sets(&self) -> usize {
+        self.retired.len()
+    }
+
+    /// Frees retired images whose last frame is `frames_in_flight` frames behind.
+    fn collect_retired(&mut self, frame: u64) {
+        let keep = u64::from(self.params.frames_in_flight);
+        self.retired.retain(|(last, _)| last.saturating_add(keep) > frame);
     }
 
     /// Records the hair draw into a rendering instance (`rendering`) of images with
@@ -723,22 +735,26 @@ impl Renderer {
         Ok(())
     }
 
-    /// Records the draw pass: the hairs prepared by [`Renderer::record_prepare`] into
-    /// the host's `target`, seen by `camera`. The color (and depth) image is loaded,
+    /// Records the draw pass for the host's frame `frame`: the hairs prepared by
+    /// [`Renderer::record_prepare`] into the host's `target`, seen by `camera`. The color (and depth) image is loaded,
     /// drawn into with depth test and write against what the host drew, and stored.
     /// With [`RenderParams::supersampling`], the hair is drawn at twice the size into
     /// the renderer's own images and resolved into `target` (depth tested, not
-    /// written).
+    /// written). When the target's size changes, the images of the old size are
+    /// kept until `frame` is [`RenderParams::frames_in_flight`] frames later.
     ///
     /// # Safety
     /// As for [`Renderer::record_prepare`], which must have been recorded before in
     /// submission order. `target`'s views belong to the context's device, are in the
     /// layouts [`RenderTarget`] names, and are not used by other pending work in a
     /// conflicting way; writes to them recorded earlier on the same queue are ordered
-    /// before the draw by the recorded barrier.
+    /// before the draw by the recorded barrier. Frame indices increase by one per host
+    /// frame, and the command buffers of frame `frame − frames_in_flight` and earlier
+    /// have completed (the usual frames-in-flight wait).
     pub unsafe fn record_draw(
         &mut self,
         cmd: vk::CommandBuffer,
+        frame: u64,
         target: &RenderTarget,
         camera: &Camera,
         mut profiler: Option<&mut GpuProfiler>,
@@ -746,6 +762,11 @@ impl Renderer {
         if target.extent.width == 0 || target.extent.height == 0 {
             return Err(Error::param("render target", "extent is zero"));
         }
+        if self.last_frame.is_some_and(|last| frame < last) {
+            return Err(Error::param("frame", format!("{frame} is before the previous frame {:?}", self.last_frame)));
+        }
+        self.last_frame = Some(frame);
+        self.collect_retired(frame);
         let device = self.device.clone();
         let d = &device;
         let finite = camera.view.is_finite() && camera.projection.is_finite() && camera.fov_y.is_finite();
@@ -809,10 +830,10 @@ impl Renderer {
         }
 
         if self.supersampling.as_ref().is_some_and(|s| s.target_extent != target.extent) {
-            return Err(Error::param(
-                "render target",
-                "its size changed: call Renderer::release_size_dependent after the frames using the old size completed",
-            ));
+            if let Some(old) = self.supersampling.take() {
+                // Frames up to the previous one may still be using the old images.
+                self.retired.push((frame.saturating_sub(1), old));
+            }
         }
         if self.supersampling.is_none() {
             self.supersampling = Some(resolve::Supersampling::new(&self.device, target.extent)?);

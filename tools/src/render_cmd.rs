@@ -279,7 +279,9 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
                         );
                         profiler.end_scope(cmd, scope);
                     })
-                    .and_then(|_| renderer.record_draw(cmd, &offscreen.target(), &camera, Some(&mut profiler)))
+                    .and_then(|_| {
+                        renderer.record_draw(cmd, frame as u64, &offscreen.target(), &camera, Some(&mut profiler))
+                    })
             };
             if let Err(e) = result {
                 error = Some(e);
