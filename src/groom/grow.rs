@@ -3,7 +3,8 @@
 //! Roots are spread over the scalp region by area with a seeded generator
 //! (same parameters and seed → the same groom, bit for bit). Each strand leaves
 //! its root along the surface normal (tilted by a small random angle) and bends
-//! toward the gravity direction as it grows, by `droop` radians per unit of
+//! toward the gravity direction as it grows (after an optional comb direction
+//! is added to its root direction), by `droop` radians per unit of
 //! normalised length, never past the gravity direction itself. Segments get
 //! longer toward the tip: the last is `segment_growth` times the first.
 
@@ -72,6 +73,10 @@ pub struct GrowParams {
     pub direction_jitter: f32,
     /// Ratio of the last segment's length to the first (> 0). Default: 2.0.
     pub segment_growth: f32,
+    /// Direction added to every root direction before the strand bends under
+    /// gravity (combing: e.g. backward to keep hair off the face; length ≈ strength).
+    /// Default: zero.
+    pub comb: Vec3,
     /// Seed of the random generator. Default: 1.
     pub seed: u64,
 }
@@ -87,6 +92,7 @@ impl Default for GrowParams {
             gravity: Vec3::NEG_Y,
             direction_jitter: 0.15,
             segment_growth: 2.0,
+            comb: Vec3::ZERO,
             seed: 1,
         }
     }
@@ -127,6 +133,9 @@ impl GrowParams {
         if !(self.direction_jitter.is_finite() && (0.0..=std::f32::consts::FRAC_PI_2).contains(&self.direction_jitter))
         {
             return Err(Error::param("direction_jitter", format!("{} is outside 0..=π/2", self.direction_jitter)));
+        }
+        if !self.comb.is_finite() || self.comb.length() > 100.0 {
+            return Err(Error::param("comb", format!("{} must be finite and at most 100 long", self.comb)));
         }
         if !self.gravity.is_finite() || self.gravity.length_squared() < 1e-12 {
             return Err(Error::param("gravity", format!("{} must be finite and non-zero", self.gravity)));
@@ -243,7 +252,8 @@ pub fn grow(scalp: &Scalp, params: &GrowParams) -> Result<Groom> {
         let spin = std::f32::consts::TAU * rng.random::<f32>();
         let tilt_axis = Quat::from_axis_angle(normal, spin) * normal.any_orthonormal_vector();
         let tilt = params.direction_jitter * rng.random::<f32>();
-        let start = Quat::from_axis_angle(tilt_axis, tilt) * normal;
+        let tilted = Quat::from_axis_angle(tilt_axis, tilt) * normal;
+        let start = (tilted + params.comb).try_normalize().unwrap_or(tilted);
         // Bend in the plane of start and gravity; straight up/down uses the tilt axis.
         let axis = start.cross(gravity).try_normalize().unwrap_or(tilt_axis);
         let max_bend = start.angle_between(gravity);

@@ -17,7 +17,8 @@ pub fn thesis_scalp() -> Scalp {
 }
 
 /// The `thesis` scene's key hairs: 1750 strands × 6 points (10,500 particles) of
-/// long hair (0.35 m) on a head-sized sphere, as in the thesis' shaking-head test.
+/// long hair (0.35 m) on a head-sized sphere, as in the thesis' shaking-head test,
+/// combed back from the face.
 pub fn thesis() -> Result<Groom> {
     grow(
         &thesis_scalp(),
@@ -30,6 +31,7 @@ pub fn thesis() -> Result<Groom> {
             gravity: Vec3::NEG_Y,
             direction_jitter: 0.15,
             segment_growth: 1.5,
+            comb: Vec3::new(0.0, 0.2, -0.8),
             seed: 2011,
         },
     )
