@@ -10,16 +10,22 @@ mod common;
 use common::Gpu;
 use vkhair::Error;
 
+/// The `thesis` scene's simulation at rest with its colliders, default parameters.
+fn thesis_sim(gpu: &Gpu) -> HairSim {
+    let groom = scenes::thesis().expect("thesis");
+    let mut sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    sim.set_colliders(&motion::thesis_colliders()).expect("colliders");
+    sim
+}
+
 /// Smoothed vertices equal a CPU evaluation of the same B-spline of the simulated
 /// key hairs: positions within 1e-5 m, tangents unit length within 1e-5 and within
 /// 1e-4 of the CPU's; root and tip at the key hair's root and tip.
 #[test]
 fn smoothing_matches_the_cpu_bspline() {
     let gpu = Gpu::new();
-    let groom = scenes::thesis().expect("thesis");
     let params = SimParams::default();
-    let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
-    sim.set_colliders(&motion::thesis_colliders()).expect("colliders");
+    let mut sim = thesis_sim(&gpu);
     sim.run(30, |i| motion::reference_motion((i + 1) as f32 * params.dt), None).expect("run");
     let state = sim.read_state().expect("state");
     for level in [4, 1, 7] {
@@ -77,10 +83,8 @@ fn smoothing_level_is_validated() {
 #[test]
 fn interpolation_grows_stable_clumps() {
     let gpu = Gpu::new();
-    let groom = scenes::thesis().expect("thesis");
     let params = SimParams::default();
-    let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
-    sim.set_colliders(&motion::thesis_colliders()).expect("colliders");
+    let mut sim = thesis_sim(&gpu);
     let render = RenderParams::default();
     let mut renderer = Renderer::new(gpu.ctx(), &sim, &render).expect("renderer");
     let (hairs, per_hair) = renderer.hair_counts();
@@ -160,8 +164,7 @@ struct Scene {
 }
 
 fn scene(gpu: &Gpu) -> Scene {
-    let groom = scenes::thesis().expect("thesis");
-    let sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    let sim = thesis_sim(gpu);
     let renderer = Renderer::new(gpu.ctx(), &sim, &RenderParams::default()).expect("renderer");
     let offscreen = Offscreen::new(gpu.ctx(), W, H).expect("offscreen");
     let center = scenes::THESIS_HEAD_CENTER;
@@ -434,9 +437,8 @@ fn supersampling_reduces_aliasing_and_keeps_depth_testing() {
 fn barycentric_interpolation_blends_three_key_hairs() {
     use vkhair::render::{scalp, InterpolationMode};
     let gpu = Gpu::new();
-    let groom = scenes::thesis().expect("thesis");
     let params = SimParams::default();
-    let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
+    let mut sim = thesis_sim(&gpu);
     let render = RenderParams { interpolation: InterpolationMode::Barycentric, ..RenderParams::default() };
     let mut renderer = Renderer::new(gpu.ctx(), &sim, &render).expect("renderer");
     let triangles = scalp::root_triangles(&sim.read_state().expect("state"));
