@@ -290,46 +290,19 @@ impl Renderer {
                 format!("{hair_size} bytes of interpolated strands exceed the device's storage range; lower the level or hair count"),
             ));
         }
-        let storage = |name: &str, size: u64| {
-            Buffer::new(
-                &device,
-                &BufferDesc {
-                    name,
-                    size,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
-                    location: MemoryLocation::GpuOnly,
-                },
-            )
-        };
+        let storage = |name: &str, size: u64| Buffer::storage(&device, name, size);
         let smoothed_positions = storage("vkhair smoothed positions", size)?;
         let smoothed_tangents = storage("vkhair smoothed tangents", size)?;
         let hair_positions = storage("vkhair hair positions", hair_size)?;
         let hair_tangents = storage("vkhair hair tangents", hair_size)?;
         let reference_data = interpolate::reference_vectors(sim.rest_shape());
-        let reference = Buffer::new(
-            &device,
-            &BufferDesc {
-                name: "vkhair key frames",
-                size: reference_data.len() as u64 * 16,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER
-                    | vk::BufferUsageFlags::TRANSFER_DST
-                    | vk::BufferUsageFlags::TRANSFER_SRC,
-                location: MemoryLocation::GpuOnly,
-            },
-        )?;
+        let reference = Buffer::storage(&device, "vkhair key frames", reference_data.len() as u64 * 16)?;
         device.upload_pod(&reference, &reference_data)?;
         let (halves, _) = sim.position_halves();
         let smooth = SmoothPass::new(&device, halves, &smoothed_positions, &smoothed_tangents)?;
         let triangle_data: Vec<[u32; 4]> = triangles.iter().map(|t| [t[0], t[1], t[2], 0]).collect();
-        let triangle_buffer = Buffer::new(
-            &device,
-            &BufferDesc {
-                name: "vkhair scalp triangles",
-                size: (triangle_data.len().max(1) * 16) as u64,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                location: MemoryLocation::GpuOnly,
-            },
-        )?;
+        let triangle_buffer =
+            Buffer::storage(&device, "vkhair scalp triangles", (triangle_data.len().max(1) * 16) as u64)?;
         device.upload_pod(&triangle_buffer, &triangle_data)?;
         let bindings = [
             (0, &smoothed_positions),

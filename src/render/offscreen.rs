@@ -6,14 +6,13 @@ use std::sync::Arc;
 
 use ash::vk;
 use glam::{Mat4, Quat, Vec3, Vec4};
-use gpu_allocator::MemoryLocation;
 
 use super::RenderTarget;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::groom::mesh::TriMesh;
 use crate::vk::barrier::{self, Access};
-use crate::vk::buffer::{Buffer, BufferDesc};
+use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc};
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
@@ -170,15 +169,7 @@ impl MeshDrawer {
             }
         }
         let storage = |name: &str, data: &[Vec4]| -> Result<Buffer> {
-            let b = Buffer::new(
-                &device,
-                &BufferDesc {
-                    name,
-                    size: (data.len() * 16) as u64,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                    location: MemoryLocation::GpuOnly,
-                },
-            )?;
+            let b = Buffer::storage(&device, name, (data.len() * 16) as u64)?;
             device.upload_pod(&b, data)?;
             Ok(b)
         };

@@ -181,19 +181,7 @@ impl GpuState {
                 ),
             ));
         }
-        let storage = |name: &str, size: u64| {
-            Buffer::new(
-                device,
-                &BufferDesc {
-                    name,
-                    size,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER
-                        | vk::BufferUsageFlags::TRANSFER_SRC
-                        | vk::BufferUsageFlags::TRANSFER_DST,
-                    location: MemoryLocation::GpuOnly,
-                },
-            )
-        };
+        let storage = |name: &str, size: u64| Buffer::storage(device, name, size);
         let gpu = GpuState {
             positions: [storage("vkhair sim positions 0", vec4_bytes)?, storage("vkhair sim positions 1", vec4_bytes)?],
             velocities: [

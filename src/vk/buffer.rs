@@ -70,6 +70,21 @@ impl Buffer {
         })
     }
 
+    /// A GPU-only storage buffer that transfers can fill and read back.
+    pub(crate) fn storage(device: &Arc<Device>, name: &str, size: u64) -> Result<Self> {
+        Self::new(
+            device,
+            &BufferDesc {
+                name,
+                size,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_SRC
+                    | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
+        )
+    }
+
     pub(crate) fn raw(&self) -> vk::Buffer {
         self.raw
     }

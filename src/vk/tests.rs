@@ -56,18 +56,7 @@ impl Drop for TestGpu {
 }
 
 fn storage(device: &Arc<Device>, name: &str, size: u64) -> Buffer {
-    Buffer::new(
-        device,
-        &BufferDesc {
-            name,
-            size,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER
-                | vk::BufferUsageFlags::TRANSFER_SRC
-                | vk::BufferUsageFlags::TRANSFER_DST,
-            location: MemoryLocation::GpuOnly,
-        },
-    )
-    .expect("buffer")
+    Buffer::storage(device, name, size).expect("buffer")
 }
 
 #[test]
