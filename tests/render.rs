@@ -180,6 +180,27 @@ fn scene(gpu: &Gpu) -> Scene {
     Scene { sim, renderer, offscreen, camera }
 }
 
+/// A scene lit by one white directional light travelling away from the camera.
+fn lit_scene(gpu: &Gpu) -> Scene {
+    let mut s = scene(gpu);
+    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    s
+}
+
+/// A green sphere the host draws between the camera and the hair, and the byte
+/// index of the pixel its centre projects to.
+fn blocker(gpu: &Gpu, s: &Scene) -> (MeshDrawer, usize) {
+    let center = scenes::THESIS_HEAD_CENTER + Vec3::new(0.0, -0.1, 0.5);
+    let mesh = MeshDrawer::new(gpu.ctx(), &TriMesh::uv_sphere(center, 0.05, 12, 16).expect("sphere")).expect("mesh");
+    let c = s.camera.projection * s.camera.view * center.extend(1.0);
+    let px = ((c.truncate().truncate() / c.w) * 0.5 + 0.5) * glam::Vec2::new(W as f32, H as f32);
+    (mesh, ((px.y as u32 * W + px.x as u32) * 4) as usize)
+}
+
+fn rgb_at(img: &[u8], i: usize) -> [u8; 3] {
+    [img[i], img[i + 1], img[i + 2]]
+}
+
 /// Renders the hair (and `blocker`, drawn first, if given) and returns RGBA8 rows.
 fn draw(gpu: &Gpu, s: &mut Scene, blocker: Option<&MeshDrawer>) -> Vec<u8> {
     let mut result = Ok(());
@@ -222,8 +243,7 @@ fn hair_pixels(rgba: &[u8]) -> Vec<(u32, u32, f32)> {
 #[test]
 fn hair_covers_its_projected_region_and_nothing_else() {
     let gpu = Gpu::new();
-    let mut s = scene(&gpu);
-    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    let mut s = lit_scene(&gpu);
     let rgba = draw(&gpu, &mut s, None);
     // Project every hair vertex: the drawn pixels must lie within their bounds
     // (plus the ribbon half-width and a pixel of rasterisation slack).
@@ -298,22 +318,12 @@ fn primary_highlight_moves_with_its_shift() {
 #[test]
 fn hair_is_hidden_behind_what_the_host_drew() {
     let gpu = Gpu::new();
-    let mut s = scene(&gpu);
-    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    let mut s = lit_scene(&gpu);
     let bare = draw(&gpu, &mut s, None);
-    // A green sphere between the camera and the hair.
-    let center = scenes::THESIS_HEAD_CENTER + Vec3::new(0.0, -0.1, 0.5);
-    let blocker = MeshDrawer::new(gpu.ctx(), &TriMesh::uv_sphere(center, 0.05, 12, 16).expect("sphere")).expect("mesh");
-    let blocked = draw(&gpu, &mut s, Some(&blocker));
-    let vp = s.camera.projection * s.camera.view;
-    let c = vp * center.extend(1.0);
-    let px = ((c.truncate().truncate() / c.w) * 0.5 + 0.5) * glam::Vec2::new(W as f32, H as f32);
-    let at = |img: &[u8]| {
-        let i = ((px.y as u32 * W + px.x as u32) * 4) as usize;
-        [img[i], img[i + 1], img[i + 2]]
-    };
-    assert_ne!(at(&bare), BACKGROUND, "hair is drawn there without the blocker");
-    let seen = at(&blocked);
+    let (sphere, pixel) = blocker(&gpu, &s);
+    let blocked = draw(&gpu, &mut s, Some(&sphere));
+    assert_ne!(rgb_at(&bare, pixel), BACKGROUND, "hair is drawn there without the blocker");
+    let seen = rgb_at(&blocked, pixel);
     assert!(seen[1] > 40 && seen[0] == 0 && seen[2] == 0, "the blocker is in front: {seen:?}");
 }
 
@@ -324,8 +334,7 @@ fn hair_is_hidden_behind_what_the_host_drew() {
 fn detail_falls_with_distance() {
     use vkhair::ash::vk;
     let gpu = Gpu::new();
-    let mut s = scene(&gpu);
-    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    let mut s = lit_scene(&gpu);
     let device = gpu.ctx().raw_device().clone();
     let info = vk::QueryPoolCreateInfo::default()
         .query_type(vk::QueryType::PIPELINE_STATISTICS)
@@ -403,8 +412,7 @@ fn total_variation(rgba: &[u8]) -> f64 {
 #[test]
 fn supersampling_reduces_aliasing_and_keeps_depth_testing() {
     let gpu = Gpu::new();
-    let mut s = scene(&gpu);
-    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    let mut s = lit_scene(&gpu);
     let plain = draw(&gpu, &mut s, None);
     let params = RenderParams { supersampling: true, ..s.renderer.params().clone() };
     s.renderer.set_params(&params).expect("params");
@@ -417,18 +425,9 @@ fn supersampling_reduces_aliasing_and_keeps_depth_testing() {
     assert!(tv_smooth < 0.8 * tv_plain, "supersampling must smooth edges: {tv_smooth} vs {tv_plain}");
     assert!(cov_smooth as f64 > 0.7 * cov_plain as f64, "the hair must stay where it was");
     // The host's depth still hides the hair behind its geometry.
-    let center = scenes::THESIS_HEAD_CENTER + Vec3::new(0.0, -0.1, 0.5);
-    let blocker = MeshDrawer::new(gpu.ctx(), &TriMesh::uv_sphere(center, 0.05, 12, 16).expect("sphere")).expect("mesh");
-    let blocked = draw(&gpu, &mut s, Some(&blocker));
-    let vp = s.camera.projection * s.camera.view;
-    let c = vp * center.extend(1.0);
-    let px = ((c.truncate().truncate() / c.w) * 0.5 + 0.5) * glam::Vec2::new(W as f32, H as f32);
-    let i = ((px.y as u32 * W + px.x as u32) * 4) as usize;
-    assert!(
-        blocked[i + 1] > 40 && blocked[i] == 0 && blocked[i + 2] == 0,
-        "the blocker is in front: {:?}",
-        &blocked[i..i + 3]
-    );
+    let (sphere, pixel) = blocker(&gpu, &s);
+    let seen = rgb_at(&draw(&gpu, &mut s, Some(&sphere)), pixel);
+    assert!(seen[1] > 40 && seen[0] == 0 && seen[2] == 0, "the blocker is in front: {seen:?}");
 }
 
 /// Barycentric mode: every hair vertex is the blend of the three key hairs of its
@@ -531,8 +530,7 @@ fn marschner_tables_match_the_cpu_and_follow_parameters() {
 fn lines_mode_draws_and_a_bad_camera_is_rejected() {
     use vkhair::render::Primitive;
     let gpu = Gpu::new();
-    let mut s = scene(&gpu);
-    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    let mut s = lit_scene(&gpu);
     let ribbons = hair_pixels(&draw(&gpu, &mut s, None)).len();
     let params = RenderParams { primitive: Primitive::Lines, ..s.renderer.params().clone() };
     s.renderer.set_params(&params).expect("params");
@@ -557,8 +555,7 @@ fn lines_mode_draws_and_a_bad_camera_is_rejected() {
 #[test]
 fn resizing_frees_old_images_frames_in_flight_later() {
     let gpu = Gpu::new();
-    let mut s = scene(&gpu);
-    s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE }]).expect("lights");
+    let mut s = lit_scene(&gpu);
     let params = RenderParams { supersampling: true, frames_in_flight: 2, ..s.renderer.params().clone() };
     s.renderer.set_params(&params).expect("params");
     let small = Offscreen::new(gpu.ctx(), 120, 90).expect("offscreen");
