@@ -201,9 +201,7 @@ impl GpuContext {
 
     /// Waits until the crate's queue is idle (headless use; hosts sync their own way).
     pub fn wait_idle(&self) -> Result<()> {
-        let _lock = self.device.lock_submit();
-        // SAFETY: the queue belongs to this device; access is serialised by the lock.
-        unsafe { self.device.raw.queue_wait_idle(self.device.graphics.raw) }.map_err(Error::vk("vkQueueWaitIdle"))
+        self.device.wait_idle()
     }
 }
 

@@ -171,6 +171,61 @@ pub(crate) struct MarschnerPush {
 }
 gpu_struct!(MarschnerPush => "MarschnerPush" { eta, alpha, beta, gamma_tt, gamma_trt, glint, size, pad0 });
 
+/// Per-sub-step parameters of the volume stage (`VolumeParams` in `glsl/include/volume.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct GpuVolumeParams {
+    /// World position → grid coordinates (cells), column-major.
+    pub grid_from_world: [[f32; 4]; 4],
+    /// Grid coordinates → world position.
+    pub world_from_grid: [[f32; 4]; 4],
+    /// Upper 3×3: world vector → grid axes.
+    pub axes: [[f32; 4]; 4],
+    /// Grid coordinates → velocity of the colliders' rigid motion along the grid axes (affine).
+    pub solid_velocity: [[f32; 4]; 4],
+    /// xyz cells per axis, w cell count.
+    pub dims: [u32; 4],
+    /// x particles, y first v face, z first w face, w face count.
+    pub counts: [u32; 4],
+    /// x FLIP ratio, y friction, z repulsion (m/s²), w repulsion threshold density.
+    pub transfer: [f32; 4],
+    /// x tolerance, y cell size (m), z time step (s), w mode.
+    pub solve: [f32; 4],
+    /// x iteration cap, y preconditioner, z multigrid levels, w colliders.
+    pub config: [u32; 4],
+}
+gpu_struct!(GpuVolumeParams => "VolumeParams" {
+    grid_from_world, world_from_grid, axes, solid_velocity, dims, counts, transfer, solve, config
+});
+
+/// Push constants of the volume kernels (`VolumePush` in `glsl/include/volume.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct VolumePush {
+    /// xyz cells of the level worked on, w its first cell.
+    pub dims: [u32; 4],
+    /// xyz cells of the next coarser level, w its first cell.
+    pub coarse: [u32; 4],
+    /// Kernel-specific.
+    pub op: [u32; 4],
+}
+gpu_struct!(VolumePush => "VolumePush" { dims, coarse, op });
+
+/// Scalars of the pressure solve (`PcgScalars` in `glsl/include/volume.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct PcgScalars {
+    pub sigma: f32,
+    pub alpha: f32,
+    pub beta: f32,
+    pub bmax: f32,
+    pub rmax: f32,
+    pub iterations: u32,
+    pub converged: u32,
+    pub status: u32,
+}
+gpu_struct!(PcgScalars => "PcgScalars" { sigma, alpha, beta, bmax, rmax, iterations, converged, status });
+
 /// Every Rust GPU struct with the shader-side name, for the layout test.
 #[cfg(test)]
 pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<String> {
@@ -192,5 +247,8 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<GpuLight>(reflection, &mut problems);
     check::<DrawParams>(reflection, &mut problems);
     check::<MarschnerPush>(reflection, &mut problems);
+    check::<GpuVolumeParams>(reflection, &mut problems);
+    check::<VolumePush>(reflection, &mut problems);
+    check::<PcgScalars>(reflection, &mut problems);
     problems
 }

@@ -18,6 +18,12 @@
 //! 3. **Integrate** ([`integrate`], `glsl/sim/integrate.comp`): velocity from
 //!    the position change (plus the DFTL correction), damping, and the final
 //!    state into the other half of the double buffer.
+//! 4. **Volume** ([`volume`], `glsl/sim/volume/`), when
+//!    [`SimParams::volume`] switches it on: particles sorted into a MAC grid,
+//!    then either FLIP (pressure projection with a GPU conjugate-gradient solve)
+//!    or density friction/repulsion corrects the new velocities. Four
+//!    timestamp scopes: [`SimStage::VolumeSort`], [`SimStage::VolumeTransfer`],
+//!    [`SimStage::VolumePressure`], [`SimStage::VolumeUpdate`].
 //!
 //! Parameters ([`SimParams`]), colliders ([`Collider`]) and the head transform
 //! ([`RigidTransform`]) are validated before any GPU work. [`CpuHairSim`] runs
@@ -33,6 +39,7 @@ pub mod predict;
 pub(crate) mod reference;
 pub mod solve;
 mod state;
+pub mod volume;
 
 use std::sync::Arc;
 
@@ -41,6 +48,7 @@ use ash::vk;
 pub use driver::{FixedStepDriver, StepPlan};
 pub use params::{Collider, RigidTransform, SimParams, SolverMode, MAX_COLLIDERS, MAX_SIM_POINTS};
 pub use state::SimState;
+pub use volume::{Preconditioner, VolumeGrid, VolumeMode, VolumeParams, VolumeStats};
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
@@ -61,11 +69,34 @@ pub enum SimStage {
     Solve,
     /// Stage 3: velocity update, damping, final state.
     Integrate,
+    /// Stage 4a: binning and counting sort of particles by grid cell.
+    VolumeSort,
+    /// Stage 4b: cell densities and labels, particle velocities to the MAC faces.
+    VolumeTransfer,
+    /// Stage 4c: pressure solve and projection (FLIP mode only).
+    VolumePressure,
+    /// Stage 4d: grid velocities back to the particles.
+    VolumeUpdate,
 }
 
 impl SimStage {
     /// Every stage in execution order.
-    pub const ALL: [SimStage; 3] = [SimStage::Predict, SimStage::Solve, SimStage::Integrate];
+    pub const ALL: [SimStage; 7] = [
+        SimStage::Predict,
+        SimStage::Solve,
+        SimStage::Integrate,
+        SimStage::VolumeSort,
+        SimStage::VolumeTransfer,
+        SimStage::VolumePressure,
+        SimStage::VolumeUpdate,
+    ];
+
+    /// The position-based dynamics stages, which always run.
+    const PBD: [SimStage; 3] = [SimStage::Predict, SimStage::Solve, SimStage::Integrate];
+
+    /// The scopes of the volume stage.
+    const VOLUME: [SimStage; 4] =
+        [SimStage::VolumeSort, SimStage::VolumeTransfer, SimStage::VolumePressure, SimStage::VolumeUpdate];
 
     /// The debug label and timestamp scope name of the stage.
     pub fn label(self) -> &'static str {
@@ -73,6 +104,10 @@ impl SimStage {
             SimStage::Predict => "vkhair sim: predict",
             SimStage::Solve => "vkhair sim: solve",
             SimStage::Integrate => "vkhair sim: integrate",
+            SimStage::VolumeSort => "vkhair sim: volume sort",
+            SimStage::VolumeTransfer => "vkhair sim: volume transfer",
+            SimStage::VolumePressure => "vkhair sim: volume pressure",
+            SimStage::VolumeUpdate => "vkhair sim: volume update",
         }
     }
 
@@ -81,11 +116,16 @@ impl SimStage {
         self as usize
     }
 
+    /// Whether the stage belongs to the volume step.
+    pub fn is_volume(self) -> bool {
+        Self::VOLUME.contains(&self)
+    }
+
     fn shader(self) -> &'static crate::vk::shaders::ShaderSource {
         match self {
             SimStage::Predict => predict::SHADER,
             SimStage::Solve => solve::SHADER,
-            SimStage::Integrate => integrate::SHADER,
+            _ => integrate::SHADER,
         }
     }
 
@@ -93,7 +133,7 @@ impl SimStage {
         match self {
             SimStage::Predict => predict::threads(strands, points, hairs_per_group),
             SimStage::Solve => solve::threads(strands, points, hairs_per_group),
-            SimStage::Integrate => integrate::threads(strands, points, hairs_per_group),
+            _ => integrate::threads(strands, points, hairs_per_group),
         }
     }
 }
@@ -117,6 +157,8 @@ pub struct HairSim {
     pending_rest: Vec<std::ops::Range<usize>>,
     /// The half of the double buffer holding the latest state.
     current: usize,
+    /// The volume stage, when switched on.
+    volume: Option<volume::VolumeStage>,
 }
 
 impl HairSim {
@@ -136,7 +178,7 @@ impl HairSim {
         let schedule = Schedule::new(params, head, state.strands, state.points, subgroup)?;
         let gpu = GpuState::new(&device, state)?;
         let mut stages = Vec::new();
-        for stage in SimStage::ALL {
+        for stage in SimStage::PBD {
             let full = stage == SimStage::Solve && device.full_subgroups;
             let pipeline = ComputePipeline::with_full_subgroups(&device, stage.shader(), 2, full)?;
             let sets = [
@@ -145,7 +187,39 @@ impl HairSim {
             ];
             stages.push(StagePipeline { stage, pipeline, sets });
         }
-        Ok(HairSim { device, gpu, stages, schedule, shape: state.clone(), pending_rest: Vec::new(), current: 0 })
+        let mut sim = HairSim {
+            device,
+            gpu,
+            stages,
+            schedule,
+            shape: state.clone(),
+            pending_rest: Vec::new(),
+            current: 0,
+            volume: None,
+        };
+        sim.configure_volume(&params.volume)?;
+        Ok(sim)
+    }
+
+    /// Creates, rebuilds (new resolution) or drops the volume stage for `params`.
+    fn configure_volume(&mut self, params: &VolumeParams) -> Result<()> {
+        if params.mode == VolumeMode::Off {
+            self.volume = None;
+            return Ok(());
+        }
+        if let Some(stage) = &mut self.volume {
+            if stage.params.resolution == params.resolution {
+                stage.params = params.clone();
+                return Ok(());
+            }
+        }
+        // The old stage's buffers may still be in use by submitted work.
+        self.device.wait_idle()?;
+        let grid = volume::grid::GridLayout::new(params, &self.shape)?;
+        let g = &self.gpu;
+        let particles = [(&g.positions[0], &g.velocities[0]), (&g.positions[1], &g.velocities[1])];
+        self.volume = Some(volume::VolumeStage::new(&self.device, grid, params, &g.colliders, &particles)?);
+        Ok(())
     }
 
     /// Current parameters.
@@ -154,7 +228,12 @@ impl HairSim {
     }
 
     /// Changes parameters from the next step on (validated first).
+    ///
+    /// Switching the volume stage on or changing its resolution creates its buffers
+    /// and waits for the device to be idle first.
     pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
+        params.validate()?;
+        self.configure_volume(&params.volume)?;
         self.schedule.set_params(params)
     }
 
@@ -206,6 +285,33 @@ impl HairSim {
         self.gpu.positions[1 - self.current].raw()
     }
 
+    /// The volume grid as placed for the latest step, when the volume stage is on.
+    pub fn volume_grid(&self) -> Option<VolumeGrid> {
+        self.volume.as_ref().map(|v| v.grid.describe(&self.schedule.head.matrix()))
+    }
+
+    /// The volume stage's cell buffer, when it is on: one vec4 per cell (index
+    /// i + nx·(j + ny·k)) holding the particles' mean velocity along the grid axes
+    /// (m/s) in xyz and the density (summed trilinear particle weights) in w, as of
+    /// the latest sub-step. Written by the compute stage (`SHADER_STORAGE_WRITE`) of
+    /// the last recorded step; a reader needs a barrier from `COMPUTE_SHADER`. Place
+    /// it in the world with [`HairSim::volume_grid`].
+    pub fn density_buffer(&self) -> Option<vk::Buffer> {
+        self.volume.as_ref().map(|v| v.buffers.cells.raw())
+    }
+
+    /// What the pressure solve of the latest sub-step did (FLIP mode; this waits for
+    /// the device to be idle and reads back). `None` when the volume stage is off.
+    pub fn volume_stats(&self) -> Result<Option<VolumeStats>> {
+        match &self.volume {
+            Some(v) => {
+                self.device.wait_idle()?;
+                v.read_stats().map(Some)
+            }
+            None => Ok(None),
+        }
+    }
+
     /// Records one step that ends with the head at `head` into `cmd`, with a debug
     /// label and (when a profiler is given) a timestamp scope per stage.
     ///
@@ -237,8 +343,11 @@ impl HairSim {
         let uploaded = barrier::memory(
             Access::TRANSFER_WRITE,
             Access {
-                stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
-                access: vk::AccessFlags2::UNIFORM_READ | vk::AccessFlags2::SHADER_STORAGE_READ,
+                stage: vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
+                access: vk::AccessFlags2::UNIFORM_READ
+                    | vk::AccessFlags2::SHADER_STORAGE_READ
+                    | vk::AccessFlags2::SHADER_STORAGE_WRITE
+                    | vk::AccessFlags2::INDIRECT_COMMAND_READ,
             },
         );
         let between = barrier::memory(Access::COMPUTE_WRITE, Access::COMPUTE_READ_WRITE);
@@ -257,6 +366,10 @@ impl HairSim {
                     update_chunked(d, cmd, self.gpu.rest.raw(), range.start as u64 * 16, rest);
                     update_chunked(d, cmd, self.gpu.rest_lengths.raw(), range.start as u64 * 4, lengths);
                 }
+                if let Some(volume) = &self.volume {
+                    let colliders = self.schedule.colliders.len() as u32;
+                    volume.record_uploads(cmd, &sub.volume_params(&volume.grid, &volume.params, colliders));
+                }
                 d.cmd_barrier(cmd, &[uploaded], &[], &[]);
             }
             let hairs_per_group = sub.params.layout_info[1];
@@ -270,7 +383,7 @@ impl HairSim {
                     }
                     stage.pipeline.bind(cmd, &[stage.sets[self.current]]);
                     stage.pipeline.dispatch_threads(cmd, [threads, 1, 1]);
-                    if k + 1 < self.stages.len() {
+                    if k + 1 < self.stages.len() || self.volume.is_some() {
                         d.cmd_barrier(cmd, &[between], &[], &[]);
                     }
                     match (profiler.as_deref_mut(), scope) {
@@ -278,6 +391,11 @@ impl HairSim {
                         _ => d.cmd_end_label(cmd),
                     }
                 }
+            }
+            if let Some(volume) = &self.volume {
+                let labels = SimStage::VOLUME.map(SimStage::label);
+                // SAFETY: as above; the barrier after integrate made its writes visible.
+                unsafe { volume.record(cmd, 1 - self.current, labels, profiler.as_deref_mut()) };
             }
             self.current = 1 - self.current;
         }
@@ -354,6 +472,9 @@ unsafe fn update_chunked(d: &Device, cmd: vk::CommandBuffer, buffer: vk::Buffer,
 pub struct CpuHairSim {
     schedule: Schedule,
     state: SimState,
+    volume: Option<volume::grid::GridLayout>,
+    /// Intermediate results of the latest volume step.
+    last_volume: Option<volume::reference::VolumeSnapshot>,
 }
 
 impl CpuHairSim {
@@ -367,11 +488,20 @@ impl CpuHairSim {
     pub fn from_state(state: SimState, params: &SimParams, head: &RigidTransform) -> Result<Self> {
         // The CPU runs the same constraint sets in the same order whatever the packing.
         let schedule = Schedule::new(params, head, state.strands, state.points, MAX_SIM_POINTS as u32)?;
-        Ok(CpuHairSim { schedule, state })
+        let volume = match params.volume.mode {
+            VolumeMode::Off => None,
+            _ => Some(volume::grid::GridLayout::new(&params.volume, &state)?),
+        };
+        Ok(CpuHairSim { schedule, state, volume, last_volume: None })
     }
 
     /// See [`HairSim::set_params`].
     pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
+        params.validate()?;
+        self.volume = match params.volume.mode {
+            VolumeMode::Off => None,
+            _ => Some(volume::grid::GridLayout::new(&params.volume, &self.state)?),
+        };
         self.schedule.set_params(params)
     }
 
@@ -388,8 +518,32 @@ impl CpuHairSim {
     /// Advances one step ending with the head at `head`.
     pub fn step(&mut self, head: &RigidTransform) -> Result<()> {
         let inputs = self.schedule.next(head)?;
-        reference::step(&mut self.state, &inputs);
+        for sub in &inputs {
+            reference::step(&mut self.state, std::slice::from_ref(sub));
+            if let Some(grid) = &self.volume {
+                let vp = &self.schedule.params.volume;
+                let gpu = sub.volume_params(grid, vp, self.schedule.colliders.len() as u32);
+                let snapshot = volume::reference::step(
+                    grid,
+                    &gpu,
+                    &sub.colliders,
+                    &self.state.positions,
+                    &mut self.state.velocities,
+                );
+                self.last_volume = Some(snapshot);
+            }
+        }
         Ok(())
+    }
+
+    /// The grid of the volume stage, when it is on.
+    pub fn volume_grid(&self) -> Option<VolumeGrid> {
+        self.volume.as_ref().map(|g| g.describe(&self.schedule.head.matrix()))
+    }
+
+    /// MIC(0)-PCG iterations of the latest volume step (FLIP mode).
+    pub fn volume_iterations(&self) -> Option<u32> {
+        self.last_volume.as_ref().map(|s| s.iterations)
     }
 
     /// The current state.

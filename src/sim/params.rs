@@ -5,6 +5,7 @@
 
 use glam::{Mat4, Quat, Vec3};
 
+use super::volume::VolumeParams;
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuCollider, SimStepParams};
 
@@ -81,6 +82,9 @@ pub struct SimParams {
     /// constraint set ends with a workgroup barrier. Same results either way.
     /// Default: true.
     pub subgroup_sync: bool,
+    /// The volume stage (hair-hair interaction on a grid) after each sub-step.
+    /// Default: off ([`VolumeParams::default`]).
+    pub volume: VolumeParams,
 }
 
 impl Default for SimParams {
@@ -108,6 +112,7 @@ impl Default for SimParams {
             pearl_radius_tip: 0.004,
             hairs_per_workgroup: 0,
             subgroup_sync: true,
+            volume: VolumeParams::default(),
         }
     }
 }
@@ -154,7 +159,7 @@ impl SimParams {
         if self.hairs_per_workgroup as usize > MAX_SIM_POINTS / 2 {
             return Err(Error::param("hairs_per_workgroup", format!("{} is above 32", self.hairs_per_workgroup)));
         }
-        Ok(())
+        self.volume.validate()
     }
 
     /// Sub-step length, seconds.
@@ -274,7 +279,23 @@ pub(crate) mod flags {
 /// Everything one sub-step needs, identical for the GPU stages and the CPU reference.
 pub(crate) struct SubstepInputs {
     pub params: SimStepParams,
+    /// World-from-head transform at the start of the sub-step.
+    pub previous_head: Mat4,
     pub colliders: Vec<GpuCollider>,
+}
+
+impl SubstepInputs {
+    /// The volume stage's uniform block for this sub-step.
+    pub(crate) fn volume_params(
+        &self,
+        grid: &super::volume::grid::GridLayout,
+        params: &VolumeParams,
+        colliders: u32,
+    ) -> crate::gpu_types::GpuVolumeParams {
+        let head = Mat4::from_cols_array_2d(&self.params.head);
+        let colliders = if self.params.counts[3] & flags::COLLISIONS != 0 { colliders } else { 0 };
+        grid.gpu_params(params, &self.previous_head, &head, self.params.gravity_dt[3], colliders)
+    }
 }
 
 /// The host-side bookkeeping shared by [`crate::sim::HairSim`] and
@@ -356,9 +377,11 @@ impl Schedule {
         let packing = self.packing();
         let inputs = (0..p.substeps)
             .map(|k| {
+                let previous_head = self.head.lerp(head, k as f32 / p.substeps as f32).matrix();
                 let head = self.head.lerp(head, (k + 1) as f32 / p.substeps as f32).matrix();
                 let t = (self.time + f64::from(dt) * f64::from(k + 1)) as f32;
                 SubstepInputs {
+                    previous_head,
                     params: SimStepParams {
                         head: head.to_cols_array_2d(),
                         gravity_dt: [p.gravity.x, p.gravity.y, p.gravity.z, dt],

@@ -198,6 +198,13 @@ impl Device {
     }
 
     /// Locks the crate's own submissions to the graphics queue.
+    /// Waits until the queue has finished all submitted work.
+    pub(crate) fn wait_idle(&self) -> Result<()> {
+        let _lock = self.lock_submit();
+        // SAFETY: the queue belongs to this device; access is serialised by the lock.
+        unsafe { self.raw.queue_wait_idle(self.graphics.raw) }.map_err(Error::vk("vkQueueWaitIdle"))
+    }
+
     pub(crate) fn lock_submit(&self) -> MutexGuard<'_, ()> {
         self.submit_lock.lock().unwrap_or_else(|e| e.into_inner())
     }

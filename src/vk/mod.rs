@@ -12,4 +12,4 @@ pub(crate) mod shaders;
 pub(crate) mod staging;
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -369,6 +369,18 @@ impl ComputePipeline {
         // SAFETY: guaranteed by the caller.
         unsafe { self.layout.device.raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
     }
+
+    /// Dispatches with the workgroup counts read from `buffer` at `offset` when the
+    /// command executes (a `VkDispatchIndirectCommand`).
+    ///
+    /// # Safety
+    /// `cmd` is recording with this pipeline bound; `buffer` has INDIRECT_BUFFER usage,
+    /// holds a command at `offset` (a multiple of 4) whose counts stay within the
+    /// device limits, and writes to it are made visible to DRAW_INDIRECT reads.
+    pub(crate) unsafe fn dispatch_indirect(&self, cmd: vk::CommandBuffer, buffer: vk::Buffer, offset: u64) {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.layout.device.raw.cmd_dispatch_indirect(cmd, buffer, offset) };
+    }
 }
 
 impl Layout {

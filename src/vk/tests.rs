@@ -166,6 +166,9 @@ fn every_shader_struct_matches_its_rust_twin() {
         gpu_types::GpuLight::GLSL_NAME,
         gpu_types::DrawParams::GLSL_NAME,
         gpu_types::MarschnerPush::GLSL_NAME,
+        gpu_types::GpuVolumeParams::GLSL_NAME,
+        gpu_types::VolumePush::GLSL_NAME,
+        gpu_types::PcgScalars::GLSL_NAME,
     ];
     let mut found = vec![0usize; names.len()];
     for shader in shaders::ALL {

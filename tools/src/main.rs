@@ -14,7 +14,10 @@ use vkhair::groom::grow::{grow, GrowParams, Scalp};
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::{scenes, Groom};
-use vkhair::sim::{motion, CpuHairSim, HairSim, RigidTransform, SimParams, SimStage, SolverMode};
+use vkhair::sim::{
+    motion, CpuHairSim, HairSim, Preconditioner, RigidTransform, SimParams, SimStage, SolverMode, VolumeMode,
+    VolumeParams,
+};
 use vkhair::{list_devices, ContextOptions, GpuContext, GpuProfiler};
 
 #[derive(Parser)]
@@ -81,6 +84,22 @@ struct SimulateArgs {
     /// Also run the CPU reference and report the largest position difference.
     #[arg(long)]
     check: bool,
+    /// Volume stage (hair-hair interaction): FLIP on a MAC grid, density friction, or off.
+    #[arg(long, value_enum, default_value = "flip")]
+    volume: VolumeArg,
+    /// Volume grid cells per axis.
+    #[arg(long, default_value_t = 32)]
+    grid: u32,
+    /// Use the Jacobi preconditioner instead of multigrid for the pressure solve.
+    #[arg(long)]
+    jacobi: bool,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum VolumeArg {
+    Off,
+    Flip,
+    Friction,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -343,9 +362,20 @@ fn simulate(a: &SimulateArgs) -> CliResult {
             (groom, Vec::new(), path.display().to_string(), pivot)
         }
     };
+    let volume = VolumeParams {
+        mode: match a.volume {
+            VolumeArg::Off => VolumeMode::Off,
+            VolumeArg::Flip => VolumeMode::Flip,
+            VolumeArg::Friction => VolumeMode::Friction,
+        },
+        resolution: [a.grid; 3],
+        preconditioner: if a.jacobi { Preconditioner::Jacobi } else { Preconditioner::Multigrid },
+        ..VolumeParams::default()
+    };
     let params = SimParams {
         iterations: a.iterations,
         solver: if a.dftl { SolverMode::Dftl } else { SolverMode::Pbd },
+        volume,
         ..SimParams::default()
     };
     let ctx = GpuContext::headless(&ContextOptions::default())?;
@@ -376,13 +406,25 @@ fn simulate(a: &SimulateArgs) -> CliResult {
         done += n;
     }
     let sum: f64 = totals.iter().sum();
-    println!("{:<24} {:>12} {:>8}", "stage", "ms/step", "share");
+    println!("{:<28} {:>12} {:>8}", "stage", "ms/step", "share");
     for (stage, ns) in SimStage::ALL.iter().zip(&totals) {
-        println!("{:<24} {:>12.3} {:>7.1}%", stage.label(), ns / 1e6 / a.steps as f64, 100.0 * ns / sum.max(1.0));
+        println!("{:<28} {:>12.3} {:>7.1}%", stage.label(), ns / 1e6 / a.steps as f64, 100.0 * ns / sum.max(1.0));
     }
-    println!("{:<24} {:>12.3}", "total", sum / 1e6 / a.steps as f64);
+    println!("{:<28} {:>12.3}", "total", sum / 1e6 / a.steps as f64);
     let state = sim.read_state()?;
     println!("kinetic energy {:.4} J/kg per particle", state.kinetic_energy() / state.positions.len() as f64);
+    if let (Some(grid), Some(stats)) = (sim.volume_grid(), sim.volume_stats()?) {
+        println!(
+            "volume grid {}×{}×{} cells of {:.1} mm; last pressure solve: {} iterations, residual {:.1e}{}",
+            grid.dims[0],
+            grid.dims[1],
+            grid.dims[2],
+            grid.cell_size * 1e3,
+            stats.iterations,
+            stats.relative_residual,
+            if stats.converged { "" } else { " (not converged)" }
+        );
+    }
     if a.check {
         let mut cpu = CpuHairSim::new(&groom, &params, &RigidTransform::default())?;
         cpu.set_colliders(&colliders)?;

@@ -1,10 +1,14 @@
-//! `vkhair plot`: the render benchmark's CSV (benches/render.rs) as a PNG chart —
-//! GPU ms per frame against camera distance, one line per resolution, with the
-//! drawn segment count on a second panel.
+//! `vkhair plot`: a benchmark CSV as a PNG chart.
+//!
+//! - `render.csv` (benches/render.rs): GPU ms per frame against camera distance,
+//!   one line per resolution, and the drawn segment count.
+//! - `volume.csv` (benches/volume.rs): GPU ms per simulation step against the
+//!   grid resolution, one line per solver, and PCG iterations per step.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
 /// Where Debian's fonts-dejavu-core puts the font the chart is labelled with.
@@ -12,87 +16,139 @@ const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
 #[derive(clap::Args)]
 pub struct PlotArgs {
-    /// CSV written by `cargo bench --bench render`.
+    /// CSV written by `cargo bench --bench render` or `--bench volume`.
     #[arg(default_value = "target/vkhair-bench/render.csv")]
     csv: PathBuf,
-    /// Output PNG.
-    #[arg(long, default_value = "target/vkhair-bench/render.png")]
-    out: PathBuf,
+    /// Output PNG (default: the CSV's path with a .png extension).
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
-type Series = BTreeMap<String, Vec<(f64, f64, f64)>>;
+type Lines = BTreeMap<String, Vec<(f64, f64)>>;
+type Error = Box<dyn std::error::Error>;
 
-fn read(path: &Path) -> Result<Series, Box<dyn std::error::Error>> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().ok_or("empty CSV")?.split(',').collect();
-    let column =
-        |name: &str| header.iter().position(|h| *h == name).ok_or_else(|| format!("CSV has no column {name:?}"));
-    let (w, h, d, seg, total) =
-        (column("width")?, column("height")?, column("distance_m")?, column("segments")?, column("total_ms")?);
-    let ssaa = column("ssaa").ok();
-    let mut series = Series::new();
-    for (n, line) in lines.enumerate() {
-        let cells: Vec<&str> = line.split(',').collect();
-        let cell = |i: usize| -> Result<f64, String> {
-            cells
-                .get(i)
-                .and_then(|c| c.trim().parse::<f64>().ok())
-                .ok_or_else(|| format!("line {}: bad value in column {i}", n + 2))
-        };
-        let supersampled = match ssaa {
-            Some(i) => cell(i)? > 0.0,
-            None => false,
-        };
-        let key = format!("{}×{}{}", cell(w)? as u32, cell(h)? as u32, if supersampled { " SSAA" } else { "" });
-        series.entry(key).or_default().push((cell(d)?, cell(total)?, cell(seg)?));
-    }
-    if series.is_empty() {
-        return Err("the CSV has no rows".into());
-    }
-    Ok(series)
+/// The CSV's header and rows of numbers (text cells kept as they are).
+struct Table {
+    header: Vec<String>,
+    rows: Vec<Vec<String>>,
 }
 
-pub fn plot(a: &PlotArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let series = read(&a.csv)?;
-    let font = std::fs::read(FONT).map_err(|e| format!("{FONT}: {e} (install fonts-dejavu-core)"))?;
-    plotters::style::register_font("sans-serif", FontStyle::Normal, Box::leak(font.into_boxed_slice()))
-        .map_err(|_| "the DejaVu font could not be loaded")?;
-    let all = series.values().flatten();
-    let max_d = all.clone().map(|p| p.0).fold(0.0, f64::max) * 1.05;
-    let max_ms = all.clone().map(|p| p.1).fold(0.0, f64::max) * 1.1;
-    let max_seg = all.map(|p| p.2).fold(0.0, f64::max) * 1.1;
-    let root = BitMapBackend::new(&a.out, (1100, 500)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let (left, right) = root.split_horizontally(600);
-    let mut chart = ChartBuilder::on(&left)
-        .caption("vkhair render: GPU ms per frame (thesis scene)", ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..max_d, 0.0..max_ms)?;
-    chart.configure_mesh().x_desc("camera distance (m)").y_desc("GPU ms (all hair passes)").draw()?;
-    for (k, (name, points)) in series.iter().enumerate() {
-        let color = Palette99::pick(k).to_rgba();
-        chart
-            .draw_series(LineSeries::new(points.iter().map(|p| (p.0, p.1)), color.stroke_width(2)))?
-            .label(name.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
-        chart.draw_series(points.iter().map(|p| Circle::new((p.0, p.1), 3, color.filled())))?;
+impl Table {
+    fn read(path: &Path) -> Result<Self, Error> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut lines = text.lines();
+        let header = lines.next().ok_or("empty CSV")?.split(',').map(str::to_owned).collect();
+        let rows: Vec<Vec<String>> = lines.map(|l| l.split(',').map(str::to_owned).collect()).collect();
+        if rows.is_empty() {
+            return Err("the CSV has no rows".into());
+        }
+        Ok(Table { header, rows })
     }
-    chart.configure_series_labels().border_style(BLACK).background_style(WHITE.mix(0.8)).draw()?;
-    let mut segments = ChartBuilder::on(&right)
-        .caption("segments drawn (level of detail)", ("sans-serif", 20))
+
+    fn column(&self, name: &str) -> Result<usize, Error> {
+        self.header.iter().position(|h| h == name).ok_or_else(|| format!("CSV has no column {name:?}").into())
+    }
+
+    fn number(&self, row: usize, column: usize) -> Result<f64, Error> {
+        self.rows[row]
+            .get(column)
+            .and_then(|c| c.trim().parse::<f64>().ok())
+            .ok_or_else(|| format!("line {}: bad value in column {column}", row + 2).into())
+    }
+}
+
+fn line_chart(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    caption: &str,
+    x_desc: &str,
+    y_desc: &str,
+    lines: &Lines,
+) -> Result<(), Error> {
+    let all = lines.values().flatten();
+    let max_x = all.clone().map(|p| p.0).fold(0.0, f64::max) * 1.05;
+    let max_y = all.map(|p| p.1).filter(|v| v.is_finite()).fold(0.0, f64::max) * 1.1;
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 20))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(70)
-        .build_cartesian_2d(0.0..max_d, 0.0..max_seg)?;
-    segments.configure_mesh().x_desc("camera distance (m)").y_desc("segments").draw()?;
-    if let Some(points) = series.values().next() {
-        segments.draw_series(LineSeries::new(points.iter().map(|p| (p.0, p.2)), BLUE.stroke_width(2)))?;
-        segments.draw_series(points.iter().map(|p| Circle::new((p.0, p.2), 3, BLUE.filled())))?;
+        .build_cartesian_2d(0.0..max_x.max(1e-9), 0.0..max_y.max(1e-9))?;
+    chart.configure_mesh().x_desc(x_desc).y_desc(y_desc).draw()?;
+    for (k, (name, points)) in lines.iter().enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        let points: Vec<(f64, f64)> = points.iter().copied().filter(|p| p.1.is_finite()).collect();
+        chart
+            .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))?
+            .label(name.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+        chart.draw_series(points.iter().map(|p| Circle::new(*p, 3, color.filled())))?;
+    }
+    if lines.len() > 1 {
+        chart.configure_series_labels().border_style(BLACK).background_style(WHITE.mix(0.8)).draw()?;
+    }
+    Ok(())
+}
+
+fn render_lines(t: &Table) -> Result<(Lines, Lines), Error> {
+    let (w, h, d) = (t.column("width")?, t.column("height")?, t.column("distance_m")?);
+    let (seg, total) = (t.column("segments")?, t.column("total_ms")?);
+    let ssaa = t.column("ssaa").ok();
+    let (mut ms, mut segments) = (Lines::new(), Lines::new());
+    let mut first_key = None;
+    for r in 0..t.rows.len() {
+        let supersampled = match ssaa {
+            Some(i) => t.number(r, i)? > 0.0,
+            None => false,
+        };
+        let key =
+            format!("{}×{}{}", t.number(r, w)? as u32, t.number(r, h)? as u32, if supersampled { " SSAA" } else { "" });
+        // One resolution's segment counts stand for all (LOD depends on distance only).
+        if *first_key.get_or_insert_with(|| key.clone()) == key {
+            segments.entry("segments".into()).or_default().push((t.number(r, d)?, t.number(r, seg)?));
+        }
+        ms.entry(key).or_default().push((t.number(r, d)?, t.number(r, total)?));
+    }
+    Ok((ms, segments))
+}
+
+fn volume_lines(t: &Table) -> Result<(Lines, Lines), Error> {
+    let (grid, config) = (t.column("grid")?, t.column("config")?);
+    let (ms, iterations) = (t.column("ms_per_step")?, t.column("pcg_iterations")?);
+    let (mut time, mut solves) = (Lines::new(), Lines::new());
+    for r in 0..t.rows.len() {
+        let n = t.number(r, grid)?;
+        if n <= 0.0 {
+            continue; // the baseline row without a grid
+        }
+        let name = t.rows[r].get(config).cloned().unwrap_or_default();
+        time.entry(name.clone()).or_default().push((n, t.number(r, ms)?));
+        if !name.contains("friction") {
+            solves.entry(name).or_default().push((n, t.number(r, iterations)?));
+        }
+    }
+    Ok((time, solves))
+}
+
+pub fn plot(a: &PlotArgs) -> Result<(), Error> {
+    let table = Table::read(&a.csv)?;
+    let font = std::fs::read(FONT).map_err(|e| format!("{FONT}: {e} (install fonts-dejavu-core)"))?;
+    plotters::style::register_font("sans-serif", FontStyle::Normal, Box::leak(font.into_boxed_slice()))
+        .map_err(|_| "the DejaVu font could not be loaded")?;
+    let out = a.out.clone().unwrap_or_else(|| a.csv.with_extension("png"));
+    let root = BitMapBackend::new(&out, (1100, 500)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (left, right) = root.split_horizontally(600);
+    if table.column("pcg_iterations").is_ok() {
+        let (time, solves) = volume_lines(&table)?;
+        line_chart(&left, "vkhair volume: GPU ms per step (thesis)", "grid cells per axis", "ms per step", &time)?;
+        line_chart(&right, "PCG iterations per step", "grid cells per axis", "iterations", &solves)?;
+    } else {
+        let (ms, segments) = render_lines(&table)?;
+        let caption = "vkhair render: GPU ms per frame (thesis scene)";
+        line_chart(&left, caption, "camera distance (m)", "GPU ms (all hair passes)", &ms)?;
+        line_chart(&right, "segments drawn (level of detail)", "camera distance (m)", "segments", &segments)?;
     }
     root.present()?;
-    println!("wrote {}", a.out.display());
+    println!("wrote {}", out.display());
     Ok(())
 }

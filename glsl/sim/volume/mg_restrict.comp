@@ -1,0 +1,46 @@
+#version 460
+// Multigrid preconditioner: the coarse right-hand side is half the sum of the
+// fine residuals rhs − A x over a coarse cell's fluid children (the factor
+// matches the coarse operator, which is the same stencil on cells twice as wide).
+//   dims: fine level;  coarse: coarse level (w their first cells).
+#include "volume.glsl"
+
+layout(local_size_x = 256) in;
+
+layout(push_constant) uniform Push { VolumePush pc; };
+layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };
+#include "volume_ops.glsl"
+layout(std430, set = 0, binding = 23) readonly buffer X { float x[]; };
+layout(std430, set = 0, binding = 25) buffer Rhs { float rhs[]; };
+
+void main() {
+    uint c = gl_GlobalInvocationID.x;
+    uvec3 cd = pc.coarse.xyz;
+    if (c >= cd.x * cd.y * cd.z) {
+        return;
+    }
+    uvec3 ijk = vol_cell_coords(c, cd);
+    precise float sum = 0.0;
+    if (labels[pc.coarse.w + c] == VOL_FLUID) {
+        for (uint k = 0u; k < 8u; ++k) {
+            uvec3 child = ijk * 2u + uvec3(k & 1u, (k >> 1u) & 1u, k >> 2u);
+            if (any(greaterThanEqual(child, pc.dims.xyz))) {
+                continue;
+            }
+            uint i = pc.dims.w + vol_cell_index(child, pc.dims.xyz);
+            if (labels[i] != VOL_FLUID) {
+                continue;
+            }
+            int fluid[6];
+            float diagonal = vol_stencil(child, pc.dims.xyz, pc.dims.w, fluid);
+            precise float residual = rhs[i] - diagonal * x[i];
+            for (uint n = 0u; n < 6u; ++n) {
+                if (fluid[n] >= 0) {
+                    residual += x[uint(fluid[n])];
+                }
+            }
+            sum += residual;
+        }
+    }
+    rhs[pc.coarse.w + c] = 0.5 * sum;
+}

@@ -1,0 +1,51 @@
+#version 460
+// Pressure solve, start: right-hand side b = −(net outflow) of every fluid
+// cell (the divergence times the cell size), r = b, pressure 0; with the
+// Jacobi preconditioner also z = r / diag. Per-workgroup partials (r·z, max |r|).
+#include "volume.glsl"
+#include "reduce.glsl"
+
+layout(local_size_x = 256) in;
+
+layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
+layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };
+#include "volume_ops.glsl"
+layout(std430, set = 0, binding = 17) readonly buffer FaceVel { float face_vel[]; };
+layout(std430, set = 0, binding = 20) writeonly buffer Pressure { float pressure[]; };
+layout(std430, set = 0, binding = 23) writeonly buffer Z { float z[]; };
+layout(std430, set = 0, binding = 25) writeonly buffer R { float r[]; };
+layout(std430, set = 0, binding = 27) writeonly buffer Partials { vec2 partials[]; };
+
+void main() {
+    uint c = gl_GlobalInvocationID.x;
+    uvec3 dims = vp.dims.xyz;
+    vec2 local = vec2(0.0);
+    if (c < vp.dims.w) {
+        uvec3 ijk = vol_cell_coords(c, dims);
+        precise float b = 0.0;
+        precise float zc = 0.0;
+        if (labels[c] == VOL_FLUID) {
+            precise float outflow = 0.0;
+            for (uint axis = 0u; axis < 3u; ++axis) {
+                uvec3 up = ijk;
+                up[axis] += 1u;
+                outflow += face_vel[vol_face_index(up, axis, dims, vp.counts)]
+                    - face_vel[vol_face_index(ijk, axis, dims, vp.counts)];
+            }
+            b = -outflow;
+            int fluid[6];
+            float diagonal = vol_stencil(ijk, dims, 0u, fluid);
+            if (vp.config.y == VOL_PRECOND_JACOBI && diagonal > 0.0) {
+                zc = b / diagonal;
+            }
+        }
+        r[c] = b;
+        z[c] = zc;
+        pressure[c] = 0.0;
+        local = vec2(b * zc, abs(b));
+    }
+    vec2 total = reduce_sum_max(local);
+    if (gl_LocalInvocationIndex == 0u) {
+        partials[gl_WorkGroupID.x] = total;
+    }
+}

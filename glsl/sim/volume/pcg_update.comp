@@ -1,0 +1,45 @@
+#version 460
+// Pressure solve: p += α d, r −= α q; with the Jacobi preconditioner also
+// z = r / diag and per-workgroup partials (r·z, max |r|).
+#include "volume.glsl"
+#include "reduce.glsl"
+
+layout(local_size_x = 256) in;
+
+layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
+layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };
+#include "volume_ops.glsl"
+layout(std430, set = 0, binding = 20) buffer Pressure { float pressure[]; };
+layout(std430, set = 0, binding = 21) readonly buffer D { float d[]; };
+layout(std430, set = 0, binding = 22) readonly buffer Q { float q[]; };
+layout(std430, set = 0, binding = 23) writeonly buffer Z { float z[]; };
+layout(std430, set = 0, binding = 25) buffer R { float r[]; };
+layout(std430, set = 0, binding = 26) readonly buffer Scalars { PcgScalars scalars; };
+layout(std430, set = 0, binding = 27) writeonly buffer Partials { vec2 partials[]; };
+
+void main() {
+    uint c = gl_GlobalInvocationID.x;
+    uvec3 dims = vp.dims.xyz;
+    vec2 local = vec2(0.0);
+    if (c < vp.dims.w) {
+        float alpha = scalars.alpha;
+        precise float pc = pressure[c] + alpha * d[c];
+        precise float rc = r[c] - alpha * q[c];
+        pressure[c] = pc;
+        r[c] = rc;
+        if (vp.config.y == VOL_PRECOND_JACOBI) {
+            precise float zc = 0.0;
+            if (labels[c] == VOL_FLUID) {
+                int fluid[6];
+                float diagonal = vol_stencil(vol_cell_coords(c, dims), dims, 0u, fluid);
+                zc = diagonal > 0.0 ? rc / diagonal : 0.0;
+            }
+            z[c] = zc;
+            local = vec2(rc * zc, abs(rc));
+        }
+    }
+    vec2 total = reduce_sum_max(local);
+    if (gl_LocalInvocationIndex == 0u) {
+        partials[gl_WorkGroupID.x] = total;
+    }
+}

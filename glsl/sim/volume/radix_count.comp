@@ -1,0 +1,34 @@
+#version 460
+// Counting sort by cell id, one radix digit per pass — histogram: each
+// workgroup counts the digits of its 256 keys and stores the counts digit-major
+// (table[digit · blocks + block]) so that one exclusive scan of the table gives
+// every (digit, block) its first output slot.
+//   op.x: 0 = keys in A, 1 = keys in B;  op.y: digit shift;  op.z: key count;
+//   op.w: blocks.  coarse.x: digit bits.
+#include "volume.glsl"
+
+layout(local_size_x = 256) in;
+
+layout(push_constant) uniform Push { VolumePush pc; };
+layout(std430, set = 0, binding = 4) readonly buffer KeysA { uint keys_a[]; };
+layout(std430, set = 0, binding = 6) readonly buffer KeysB { uint keys_b[]; };
+layout(std430, set = 0, binding = 8) writeonly buffer Table { uint table[]; };
+
+shared uint histogram[256];
+
+void main() {
+    uint t = gl_LocalInvocationID.x;
+    uint block = gl_WorkGroupID.x;
+    uint digits = 1u << pc.coarse.x;
+    histogram[t] = 0u;
+    barrier();
+    uint i = block * 256u + t;
+    if (i < pc.op.z) {
+        uint key = pc.op.x == 0u ? keys_a[i] : keys_b[i];
+        atomicAdd(histogram[(key >> pc.op.y) & (digits - 1u)], 1u);
+    }
+    barrier();
+    if (t < digits) {
+        table[t * pc.op.w + block] = histogram[t];
+    }
+}

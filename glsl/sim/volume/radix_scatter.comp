@@ -1,0 +1,49 @@
+#version 460
+// Counting sort pass — stable scatter: a key goes to its (digit, block) slot
+// from the scanned table plus the number of keys before it in the block with
+// the same digit, so equal keys keep their order and the result is the same on
+// every run. Push constants as in radix_count.comp; A → B when op.x = 0.
+#include "volume.glsl"
+
+layout(local_size_x = 256) in;
+
+layout(push_constant) uniform Push { VolumePush pc; };
+layout(std430, set = 0, binding = 4) buffer KeysA { uint keys_a[]; };
+layout(std430, set = 0, binding = 5) buffer ValsA { uint vals_a[]; };
+layout(std430, set = 0, binding = 6) buffer KeysB { uint keys_b[]; };
+layout(std430, set = 0, binding = 7) buffer ValsB { uint vals_b[]; };
+layout(std430, set = 0, binding = 8) readonly buffer Table { uint table[]; };
+
+shared uint block_digits[256];
+
+void main() {
+    uint t = gl_LocalInvocationID.x;
+    uint block = gl_WorkGroupID.x;
+    uint i = block * 256u + t;
+    bool live = i < pc.op.z;
+    uint key = 0u;
+    uint value = 0u;
+    uint digit = 0xffffffffu;
+    if (live) {
+        key = pc.op.x == 0u ? keys_a[i] : keys_b[i];
+        value = pc.op.x == 0u ? vals_a[i] : vals_b[i];
+        digit = (key >> pc.op.y) & ((1u << pc.coarse.x) - 1u);
+    }
+    block_digits[t] = digit;
+    barrier();
+    if (!live) {
+        return;
+    }
+    uint rank = 0u;
+    for (uint s = 0u; s < t; ++s) {
+        rank += block_digits[s] == digit ? 1u : 0u;
+    }
+    uint dst = table[digit * pc.op.w + block] + rank;
+    if (pc.op.x == 0u) {
+        keys_b[dst] = key;
+        vals_b[dst] = value;
+    } else {
+        keys_a[dst] = key;
+        vals_a[dst] = value;
+    }
+}

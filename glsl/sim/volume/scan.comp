@@ -1,0 +1,87 @@
+#version 460
+// Exclusive prefix sum of a uint array in tiles of 1024 (4 per invocation):
+//   op.x = 0: each workgroup stores the sum of its tile in tile_sums;
+//   op.x = 1: one workgroup scans tile_sums (op.w of them) in place;
+//   op.x = 2: each workgroup scans its tile and adds its tile's offset.
+//   op.z: element count.
+#include "volume.glsl"
+
+layout(local_size_x = 256) in;
+
+layout(push_constant) uniform Push { VolumePush pc; };
+layout(std430, set = 0, binding = 8) buffer Data { uint data[]; };
+layout(std430, set = 0, binding = 9) buffer TileSums { uint tile_sums[]; };
+
+shared uint scan_values[256];
+
+// Exclusive scan of one value per invocation across the workgroup; `total` gets the sum.
+uint workgroup_exclusive(uint value, out uint total) {
+    uint t = gl_LocalInvocationID.x;
+    scan_values[t] = value;
+    barrier();
+    for (uint offset = 1u; offset < 256u; offset <<= 1u) {
+        uint add = t >= offset ? scan_values[t - offset] : 0u;
+        barrier();
+        scan_values[t] += add;
+        barrier();
+    }
+    total = scan_values[255];
+    uint inclusive = scan_values[t];
+    barrier();
+    return inclusive - value;
+}
+
+// Scans the 4 values of invocation t in the tile at `base` of `array_len` elements;
+// returns the tile total.
+uint scan_tile(uint base, uint array_len, uint offset, bool tiles) {
+    uint t = gl_LocalInvocationID.x;
+    uint v[4];
+    uint own = 0u;
+    for (uint e = 0u; e < 4u; ++e) {
+        uint i = base + t * 4u + e;
+        uint x = 0u;
+        if (i < array_len) {
+            x = tiles ? tile_sums[i] : data[i];
+        }
+        v[e] = own;
+        own += x;
+    }
+    uint total;
+    uint before = workgroup_exclusive(own, total) + offset;
+    for (uint e = 0u; e < 4u; ++e) {
+        uint i = base + t * 4u + e;
+        if (i < array_len) {
+            if (tiles) {
+                tile_sums[i] = before + v[e];
+            } else {
+                data[i] = before + v[e];
+            }
+        }
+    }
+    return total;
+}
+
+void main() {
+    uint t = gl_LocalInvocationID.x;
+    uint tile = gl_WorkGroupID.x;
+    uint n = pc.op.z;
+    if (pc.op.x == 0u) {
+        uint own = 0u;
+        for (uint e = 0u; e < 4u; ++e) {
+            uint i = tile * 1024u + t * 4u + e;
+            own += i < n ? data[i] : 0u;
+        }
+        uint total;
+        workgroup_exclusive(own, total);
+        if (t == 0u) {
+            tile_sums[tile] = total;
+        }
+    } else if (pc.op.x == 1u) {
+        uint carry = 0u;
+        for (uint base = 0u; base < pc.op.w; base += 1024u) {
+            carry += scan_tile(base, pc.op.w, carry, true);
+        }
+    } else {
+        scan_tile(tile * 1024u, n, tile_sums[tile], false);
+    }
+}

@@ -1,0 +1,301 @@
+//! GPU buffers and kernels of the volume stage.
+
+use std::sync::Arc;
+
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+use super::grid::GridLayout;
+use crate::error::{Error, Result};
+use crate::gpu_types::{GpuVolumeParams, PcgScalars};
+use crate::vk::buffer::{Buffer, BufferDesc};
+use crate::vk::device::Device;
+use crate::vk::pipeline::ComputePipeline;
+use crate::vk::shaders::{self, ShaderSource};
+
+/// Binding numbers of `glsl/sim/volume/*.comp`.
+pub(crate) mod binding {
+    pub const PARAMS: u32 = 0;
+    pub const COLLIDERS: u32 = 1;
+    pub const POSITIONS: u32 = 2;
+    pub const VELOCITIES: u32 = 3;
+    pub const KEYS_A: u32 = 4;
+    pub const VALS_A: u32 = 5;
+    pub const KEYS_B: u32 = 6;
+    pub const VALS_B: u32 = 7;
+    pub const TABLE: u32 = 8;
+    pub const TILE_SUMS: u32 = 9;
+    pub const GRID_POS: u32 = 10;
+    pub const GRID_VEL: u32 = 11;
+    pub const SORTED_POS: u32 = 12;
+    pub const SORTED_VEL: u32 = 13;
+    pub const START: u32 = 14;
+    pub const CELLS: u32 = 15;
+    pub const LABELS: u32 = 16;
+    pub const FACE_VEL: u32 = 17;
+    pub const FACE_STAR: u32 = 18;
+    pub const FACE_WEIGHT: u32 = 19;
+    pub const PRESSURE: u32 = 20;
+    pub const DIRECTION: u32 = 21;
+    pub const PRODUCT: u32 = 22;
+    pub const X: u32 = 23;
+    pub const TMP: u32 = 24;
+    pub const RHS: u32 = 25;
+    pub const SCALARS: u32 = 26;
+    pub const PARTIALS: u32 = 27;
+    pub const INDIRECT: u32 = 28;
+}
+
+/// Keys per sort block (one workgroup of `radix_count`/`radix_scatter`).
+pub(crate) const SORT_BLOCK: u32 = 256;
+/// Elements per tile of `scan.comp`.
+pub(crate) const SCAN_TILE: u32 = 1024;
+/// Invocations of the per-cell kernels.
+pub(crate) const GROUP: u32 = 256;
+/// Bytes per indirect dispatch entry (a `VkDispatchIndirectCommand` padded to 16).
+pub(crate) const INDIRECT_STRIDE: u64 = 16;
+
+/// The volume stage's own buffers (the particle buffers belong to the simulation).
+pub(crate) struct VolumeBuffers {
+    pub params: Buffer,
+    pub keys_a: Buffer,
+    pub vals_a: Buffer,
+    pub keys_b: Buffer,
+    pub vals_b: Buffer,
+    pub table: Buffer,
+    pub tile_sums: Buffer,
+    pub grid_pos: Buffer,
+    pub grid_vel: Buffer,
+    pub sorted_pos: Buffer,
+    pub sorted_vel: Buffer,
+    pub start: Buffer,
+    pub cells: Buffer,
+    pub labels: Buffer,
+    pub face_vel: Buffer,
+    pub face_star: Buffer,
+    pub face_weight: Buffer,
+    pub pressure: Buffer,
+    pub direction: Buffer,
+    pub product: Buffer,
+    pub x: Buffer,
+    pub tmp: Buffer,
+    pub rhs: Buffer,
+    pub scalars: Buffer,
+    pub partials: Buffer,
+    pub indirect: Buffer,
+}
+
+impl VolumeBuffers {
+    pub(crate) fn new(device: &Arc<Device>, grid: &GridLayout) -> Result<Self> {
+        let n = u64::from(grid.particles);
+        let cells = u64::from(grid.cells());
+        let levels = u64::from(grid.level_cells());
+        let faces = u64::from(grid.faces[2]);
+        let blocks = n.div_ceil(u64::from(SORT_BLOCK));
+        let table = 256 * blocks;
+        let limit = u64::from(device.info.max_storage_buffer_range);
+        for (what, bytes) in [("particles", n * 16), ("cells", levels * 4), ("faces", faces * 4), ("cells", cells * 16)]
+        {
+            if bytes > limit {
+                return Err(Error::param(
+                    "volume grid",
+                    format!("{what} need {bytes} bytes per buffer, above the device's {limit} byte range"),
+                ));
+            }
+        }
+        let storage = |name: &str, size: u64| Buffer::storage(device, name, size.max(4));
+        Ok(VolumeBuffers {
+            params: Buffer::new(
+                device,
+                &BufferDesc {
+                    name: "vkhair volume params",
+                    size: std::mem::size_of::<GpuVolumeParams>() as u64,
+                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )?,
+            keys_a: storage("vkhair volume keys A", n * 4)?,
+            vals_a: storage("vkhair volume particles A", n * 4)?,
+            keys_b: storage("vkhair volume keys B", n * 4)?,
+            vals_b: storage("vkhair volume particles B", n * 4)?,
+            table: storage("vkhair volume digit table", table * 4)?,
+            tile_sums: storage("vkhair volume scan tiles", table.div_ceil(u64::from(SCAN_TILE)) * 4)?,
+            grid_pos: storage("vkhair volume grid positions", n * 16)?,
+            grid_vel: storage("vkhair volume grid velocities", n * 16)?,
+            sorted_pos: storage("vkhair volume sorted positions", n * 16)?,
+            sorted_vel: storage("vkhair volume sorted velocities", n * 16)?,
+            start: storage("vkhair volume cell start", (cells + 1) * 4)?,
+            cells: storage("vkhair volume density", cells * 16)?,
+            labels: storage("vkhair volume labels", levels * 4)?,
+            face_vel: storage("vkhair volume face velocities", faces * 4)?,
+            face_star: storage("vkhair volume transferred face velocities", faces * 4)?,
+            face_weight: storage("vkhair volume face weights", faces * 4)?,
+            pressure: storage("vkhair volume pressure", cells * 4)?,
+            direction: storage("vkhair volume search direction", cells * 4)?,
+            product: storage("vkhair volume matrix product", cells * 4)?,
+            x: storage("vkhair volume preconditioned residual", levels * 4)?,
+            tmp: storage("vkhair volume smoothing scratch", levels * 4)?,
+            rhs: storage("vkhair volume residual", levels * 4)?,
+            scalars: storage("vkhair volume solver scalars", std::mem::size_of::<PcgScalars>() as u64)?,
+            partials: storage("vkhair volume partial sums", cells.div_ceil(u64::from(GROUP)) * 8)?,
+            indirect: Buffer::new(
+                device,
+                &BufferDesc {
+                    name: "vkhair volume indirect dispatches",
+                    size: (grid.levels.len() as u64 + 1) * INDIRECT_STRIDE,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                        | vk::BufferUsageFlags::INDIRECT_BUFFER
+                        | vk::BufferUsageFlags::TRANSFER_DST
+                        | vk::BufferUsageFlags::TRANSFER_SRC,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )?,
+        })
+    }
+
+    /// Buffers by binding number, with the simulation's particle buffers and colliders.
+    pub(crate) fn table<'a>(
+        &'a self,
+        colliders: &'a Buffer,
+        positions: &'a Buffer,
+        velocities: &'a Buffer,
+    ) -> [(u32, &'a Buffer); 29] {
+        use binding::*;
+        [
+            (PARAMS, &self.params),
+            (COLLIDERS, colliders),
+            (POSITIONS, positions),
+            (VELOCITIES, velocities),
+            (KEYS_A, &self.keys_a),
+            (VALS_A, &self.vals_a),
+            (KEYS_B, &self.keys_b),
+            (VALS_B, &self.vals_b),
+            (TABLE, &self.table),
+            (TILE_SUMS, &self.tile_sums),
+            (GRID_POS, &self.grid_pos),
+            (GRID_VEL, &self.grid_vel),
+            (SORTED_POS, &self.sorted_pos),
+            (SORTED_VEL, &self.sorted_vel),
+            (START, &self.start),
+            (CELLS, &self.cells),
+            (LABELS, &self.labels),
+            (FACE_VEL, &self.face_vel),
+            (FACE_STAR, &self.face_star),
+            (FACE_WEIGHT, &self.face_weight),
+            (PRESSURE, &self.pressure),
+            (DIRECTION, &self.direction),
+            (PRODUCT, &self.product),
+            (X, &self.x),
+            (TMP, &self.tmp),
+            (RHS, &self.rhs),
+            (SCALARS, &self.scalars),
+            (PARTIALS, &self.partials),
+            (INDIRECT, &self.indirect),
+        ]
+    }
+}
+
+/// The kernels of the volume stage.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Kernel {
+    Bin,
+    RadixCount,
+    RadixScatter,
+    Scan,
+    Reorder,
+    Center,
+    Transfer,
+    Mark,
+    PcgInit,
+    PcgApply,
+    PcgUpdate,
+    PcgDot,
+    PcgDirection,
+    PcgReduce,
+    Gradient,
+    MgCoarsen,
+    MgSmooth,
+    MgRestrict,
+    MgProlong,
+    MgCoarsest,
+    G2p,
+}
+
+impl Kernel {
+    pub(crate) const ALL: [Kernel; 21] = [
+        Kernel::Bin,
+        Kernel::RadixCount,
+        Kernel::RadixScatter,
+        Kernel::Scan,
+        Kernel::Reorder,
+        Kernel::Center,
+        Kernel::Transfer,
+        Kernel::Mark,
+        Kernel::PcgInit,
+        Kernel::PcgApply,
+        Kernel::PcgUpdate,
+        Kernel::PcgDot,
+        Kernel::PcgDirection,
+        Kernel::PcgReduce,
+        Kernel::Gradient,
+        Kernel::MgCoarsen,
+        Kernel::MgSmooth,
+        Kernel::MgRestrict,
+        Kernel::MgProlong,
+        Kernel::MgCoarsest,
+        Kernel::G2p,
+    ];
+
+    fn shader(self) -> &'static ShaderSource {
+        use shaders::*;
+        match self {
+            Kernel::Bin => &SIM_VOLUME_BIN_COMP,
+            Kernel::RadixCount => &SIM_VOLUME_RADIX_COUNT_COMP,
+            Kernel::RadixScatter => &SIM_VOLUME_RADIX_SCATTER_COMP,
+            Kernel::Scan => &SIM_VOLUME_SCAN_COMP,
+            Kernel::Reorder => &SIM_VOLUME_REORDER_COMP,
+            Kernel::Center => &SIM_VOLUME_CENTER_COMP,
+            Kernel::Transfer => &SIM_VOLUME_TRANSFER_COMP,
+            Kernel::Mark => &SIM_VOLUME_MARK_COMP,
+            Kernel::PcgInit => &SIM_VOLUME_PCG_INIT_COMP,
+            Kernel::PcgApply => &SIM_VOLUME_PCG_APPLY_COMP,
+            Kernel::PcgUpdate => &SIM_VOLUME_PCG_UPDATE_COMP,
+            Kernel::PcgDot => &SIM_VOLUME_PCG_DOT_COMP,
+            Kernel::PcgDirection => &SIM_VOLUME_PCG_DIRECTION_COMP,
+            Kernel::PcgReduce => &SIM_VOLUME_PCG_REDUCE_COMP,
+            Kernel::Gradient => &SIM_VOLUME_GRADIENT_COMP,
+            Kernel::MgCoarsen => &SIM_VOLUME_MG_COARSEN_COMP,
+            Kernel::MgSmooth => &SIM_VOLUME_MG_SMOOTH_COMP,
+            Kernel::MgRestrict => &SIM_VOLUME_MG_RESTRICT_COMP,
+            Kernel::MgProlong => &SIM_VOLUME_MG_PROLONG_COMP,
+            Kernel::MgCoarsest => &SIM_VOLUME_MG_COARSEST_COMP,
+            Kernel::G2p => &SIM_VOLUME_G2P_COMP,
+        }
+    }
+}
+
+/// One kernel's pipeline and a descriptor set per particle-buffer variant.
+pub(crate) struct KernelPipeline {
+    pub pipeline: ComputePipeline,
+    pub sets: Vec<vk::DescriptorSet>,
+}
+
+/// Builds every kernel, with one descriptor set per `(positions, velocities)` variant.
+pub(crate) fn kernels(
+    device: &Arc<Device>,
+    buffers: &VolumeBuffers,
+    colliders: &Buffer,
+    particles: &[(&Buffer, &Buffer)],
+) -> Result<Vec<KernelPipeline>> {
+    Kernel::ALL
+        .iter()
+        .map(|kernel| {
+            let pipeline = ComputePipeline::new(device, kernel.shader(), particles.len() as u32)?;
+            let sets = particles
+                .iter()
+                .map(|(pos, vel)| pipeline.declared_buffer_set(0, &buffers.table(colliders, pos, vel)))
+                .collect::<Result<Vec<_>>>()?;
+            Ok(KernelPipeline { pipeline, sets })
+        })
+        .collect()
+}

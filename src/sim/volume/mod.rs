@@ -1,0 +1,71 @@
+//! The volume stage: hair-hair interaction on a staggered MAC grid (FLIP after
+//! Zhu & Bridson 2005, as McAdams et al. 2009 apply it to hair), or the cheaper
+//! density-based friction and repulsion from the same grid.
+//!
+//! It runs after the integrate stage of every sub-step, on the positions and
+//! velocities just written, and corrects the velocities in place (positions are
+//! left alone: the next sub-step's prediction carries the correction). Steps:
+//!
+//! 1. **Bin** (`bin.comp`): grid coordinates, velocity along the grid axes and
+//!    cell id per particle. Particles outside the grid get the cell count as
+//!    their id: the sort puts them last, nothing reads them and their velocity
+//!    stays as it is (they are *rejected*, not clamped).
+//! 2. **Sort** (`radix_count`, `scan`, `radix_scatter`): a stable counting sort
+//!    of (cell id, particle) pairs, one radix digit per pass (two 8-bit passes up
+//!    to 65,535 cells, else four 6-bit passes): per-block digit histograms, an
+//!    exclusive scan of the digit-major table, a scatter that ranks equal digits
+//!    by position. Integer-only and stable, so the order is the same every run.
+//! 3. **Reorder** (`reorder.comp`): particle data in cell order and the first
+//!    index of every occupied cell (empty cells keep the particle count).
+//! 4. **Cells** (`center.comp`): density and mean velocity around every cell
+//!    centre; labels solid (centre inside a collider), fluid (holds a
+//!    particle) or air.
+//! 5. **Transfer** (`transfer.comp`): every u/v/w face gathers its component
+//!    from the particles of the neighbouring cells with trilinear weights; faces
+//!    next to solid cells take the colliders' velocity. An air cell whose six
+//!    faces all carry particle weight becomes fluid (`mark.comp`): key-hair
+//!    particles are sparse, and the gaps between them must not be free surface.
+//! 6. **Pressure** (FLIP only, `pcg_*`, `mg_*`): the Poisson system over fluid
+//!    cells (air p = 0, solid faces Neumann with their velocity), solved by
+//!    preconditioned conjugate gradients entirely on the GPU: dot products
+//!    reduced per workgroup with subgroup operations and then in one workgroup
+//!    in a fixed order; the iteration cap is recorded and a reduction kernel
+//!    sets the indirect dispatches of the remaining iterations to zero once
+//!    max |r| ≤ tolerance · max |b|. The preconditioner is Jacobi or one
+//!    multigrid V-cycle. Then the pressure difference is subtracted on faces
+//!    between a fluid cell and a non-solid one (`gradient.comp`).
+//! 7. **Update** (`g2p.comp`): FLIP/PIC blend ṽ = α(v + Lerp(x, v − v*)) +
+//!    (1 − α)Lerp(x, v), or friction and repulsion from the cells.
+//!
+//! [`SimStage::VolumeSort`](super::SimStage) and the three stages after it name
+//! the debug labels and timestamp scopes (steps 1–3, 4–5, 6, 7). The cells'
+//! (mean velocity, density) stay in a GPU buffer for the renderer
+//! ([`HairSim::density_buffer`](super::HairSim::density_buffer)).
+//! [`reference`] is the CPU oracle, with modified incomplete Cholesky (MIC(0))
+//! as its preconditioner.
+
+mod buffers;
+pub(crate) mod grid;
+mod params;
+mod record;
+pub(crate) mod reference;
+#[cfg(test)]
+mod tests;
+
+pub use grid::VolumeGrid;
+pub use params::{Preconditioner, VolumeMode, VolumeParams, MAX_VOLUME_CELLS};
+pub(crate) use record::VolumeStage;
+
+/// What the latest pressure solve did (read back from the GPU).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VolumeStats {
+    /// Conjugate-gradient iterations of the latest sub-step.
+    pub iterations: u32,
+    /// Whether the residual reached the tolerance (false: the cap stopped it, or it
+    /// broke down).
+    pub converged: bool,
+    /// max |r| / max |b| at the end (0 when there was nothing to solve).
+    pub relative_residual: f32,
+    /// Whether the solve met non-finite numbers (the projection was then skipped).
+    pub non_finite: bool,
+}

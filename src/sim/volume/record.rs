@@ -1,0 +1,280 @@
+//! Recording of the volume stage's kernels.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::buffers::{self, Kernel, KernelPipeline, VolumeBuffers, GROUP, INDIRECT_STRIDE, SCAN_TILE, SORT_BLOCK};
+use super::grid::GridLayout;
+use super::params::{Preconditioner, VolumeMode, VolumeParams};
+use super::VolumeStats;
+use crate::error::Result;
+use crate::gpu_types::{GpuVolumeParams, PcgScalars, VolumePush};
+use crate::profiler::GpuProfiler;
+use crate::vk::barrier::{self, Access};
+use crate::vk::buffer::Buffer;
+use crate::vk::device::Device;
+
+/// Jacobi sweeps on the coarsest multigrid level (even, see `mg_coarsest.comp`).
+const COARSEST_SWEEPS: u32 = 16;
+
+/// How a kernel is dispatched.
+#[derive(Clone, Copy)]
+enum Launch {
+    /// Enough workgroups for this many invocations.
+    Threads(u32),
+    /// From indirect entry k (per multigrid level; the last is a single workgroup).
+    Indirect(usize),
+}
+
+/// The volume stage's GPU side: grid, buffers and kernels, recorded per sub-step.
+pub(crate) struct VolumeStage {
+    device: Arc<Device>,
+    pub grid: GridLayout,
+    pub buffers: VolumeBuffers,
+    kernels: Vec<KernelPipeline>,
+    pub params: VolumeParams,
+}
+
+impl VolumeStage {
+    /// Creates the stage for `grid`; `particles` lists the (positions, velocities)
+    /// buffer pairs it may run on (one descriptor-set variant each).
+    pub(crate) fn new(
+        device: &Arc<Device>,
+        grid: GridLayout,
+        params: &VolumeParams,
+        colliders: &Buffer,
+        particles: &[(&Buffer, &Buffer)],
+    ) -> Result<Self> {
+        params.validate()?;
+        let buffers = VolumeBuffers::new(device, &grid)?;
+        let kernels = buffers::kernels(device, &buffers, colliders, particles)?;
+        Ok(VolumeStage { device: device.clone(), grid, buffers, kernels, params: params.clone() })
+    }
+
+    fn kernel(&self, kernel: Kernel) -> &KernelPipeline {
+        &self.kernels[kernel as usize]
+    }
+
+    /// Records the transfers that start a sub-step: the uniform block, the indirect
+    /// dispatch sizes and the empty-cell marks of the start array. The caller orders
+    /// them after earlier use and before the kernels (TRANSFER_WRITE → COMPUTE_SHADER
+    /// and DRAW_INDIRECT).
+    ///
+    /// # Safety
+    /// `cmd` is recording, outside a render pass, on this device.
+    pub(crate) unsafe fn record_uploads(&self, cmd: vk::CommandBuffer, gpu: &GpuVolumeParams) {
+        let d = &self.device.raw;
+        let mut indirect: Vec<[u32; 4]> =
+            self.grid.levels.iter().map(|l| [l.cells().div_ceil(GROUP), 1, 1, 0]).collect();
+        indirect.push([1, 1, 1, 0]);
+        // SAFETY: guaranteed by the caller; sizes are multiples of 4 below 64 KiB and the
+        // buffers have TRANSFER_DST usage.
+        unsafe {
+            d.cmd_update_buffer(cmd, self.buffers.params.raw(), 0, bytemuck::bytes_of(gpu));
+            d.cmd_update_buffer(cmd, self.buffers.indirect.raw(), 0, bytemuck::cast_slice(&indirect));
+            d.cmd_fill_buffer(cmd, self.buffers.start.raw(), 0, vk::WHOLE_SIZE, self.grid.particles);
+        }
+    }
+
+    /// The barrier between two kernels: compute writes before compute reads and
+    /// writes, and before indirect-dispatch reads.
+    unsafe fn barrier(&self, cmd: vk::CommandBuffer) {
+        let b = barrier::memory(
+            Access::COMPUTE_WRITE,
+            Access {
+                stage: vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
+                access: vk::AccessFlags2::SHADER_STORAGE_READ
+                    | vk::AccessFlags2::SHADER_STORAGE_WRITE
+                    | vk::AccessFlags2::INDIRECT_COMMAND_READ,
+            },
+        );
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.device.cmd_barrier(cmd, &[b], &[], &[]) };
+    }
+
+    /// Binds, pushes and dispatches one kernel, then records the barrier after it.
+    unsafe fn run(&self, cmd: vk::CommandBuffer, kernel: Kernel, variant: usize, push: VolumePush, launch: Launch) {
+        let k = self.kernel(kernel);
+        // SAFETY: guaranteed by the caller; the indirect buffer is written only by
+        // record_uploads and pcg_reduce, both ordered before this by barriers.
+        unsafe {
+            k.pipeline.bind(cmd, &[k.sets[variant]]);
+            k.pipeline.push(cmd, &push);
+            match launch {
+                Launch::Threads(n) => k.pipeline.dispatch_threads(cmd, [n, 1, 1]),
+                Launch::Indirect(entry) => {
+                    k.pipeline.dispatch_indirect(cmd, self.buffers.indirect.raw(), entry as u64 * INDIRECT_STRIDE)
+                }
+            }
+            self.barrier(cmd);
+        }
+    }
+
+    /// Records steps 1–7 on particle variant `variant`, after a barrier that made the
+    /// particle buffers and the uploads visible. `labels` name the four timestamp
+    /// scopes (sort, transfer, pressure, update).
+    ///
+    /// # Safety
+    /// `cmd` is recording on this device outside a render pass; the profiler, when
+    /// given, had `begin_frame` called for this frame.
+    pub(crate) unsafe fn record(
+        &self,
+        cmd: vk::CommandBuffer,
+        variant: usize,
+        labels: [&str; 4],
+        mut profiler: Option<&mut GpuProfiler>,
+    ) {
+        let scoped = |profiler: &mut Option<&mut GpuProfiler>, label: &str, body: &dyn Fn()| {
+            // SAFETY: guaranteed by the caller.
+            unsafe {
+                match profiler.as_deref_mut() {
+                    Some(p) => {
+                        let scope = p.begin_scope(cmd, label);
+                        body();
+                        p.end_scope(cmd, scope);
+                    }
+                    None => {
+                        self.device.cmd_begin_label(cmd, label, crate::vk::debug::LabelColor::Compute);
+                        body();
+                        self.device.cmd_end_label(cmd);
+                    }
+                }
+            }
+        };
+        // SAFETY (all closures): guaranteed by the caller.
+        scoped(&mut profiler, labels[0], &|| unsafe { self.record_sort(cmd, variant) });
+        scoped(&mut profiler, labels[1], &|| unsafe {
+            self.run(cmd, Kernel::Center, variant, VolumePush::default(), Launch::Threads(self.grid.cells()));
+            self.run(cmd, Kernel::Transfer, variant, VolumePush::default(), Launch::Threads(self.grid.faces[2]));
+            self.run(cmd, Kernel::Mark, variant, VolumePush::default(), Launch::Threads(self.grid.cells()));
+        });
+        if self.params.mode == VolumeMode::Flip {
+            scoped(&mut profiler, labels[2], &|| unsafe { self.record_pressure(cmd, variant) });
+        }
+        scoped(&mut profiler, labels[3], &|| unsafe {
+            self.run(cmd, Kernel::G2p, variant, VolumePush::default(), Launch::Threads(self.grid.particles));
+        });
+    }
+
+    /// Steps 1–3: bin, sort, reorder.
+    unsafe fn record_sort(&self, cmd: vk::CommandBuffer, variant: usize) {
+        let n = self.grid.particles;
+        let none = VolumePush::default();
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.run(cmd, Kernel::Bin, variant, none, Launch::Threads(n)) };
+        let blocks = n.div_ceil(SORT_BLOCK);
+        let key_bits = 32 - self.grid.cells().leading_zeros();
+        let (digit_bits, passes) = if key_bits <= 16 { (8, 2) } else { (6, 4) };
+        for pass in 0..passes {
+            let push = VolumePush {
+                dims: [0; 4],
+                coarse: [digit_bits, 0, 0, 0],
+                op: [pass % 2, pass * digit_bits, n, blocks],
+            };
+            // SAFETY: guaranteed by the caller.
+            unsafe {
+                self.run(cmd, Kernel::RadixCount, variant, push, Launch::Threads(blocks * SORT_BLOCK));
+                self.record_scan(cmd, variant, (1 << digit_bits) * blocks);
+                self.run(cmd, Kernel::RadixScatter, variant, push, Launch::Threads(blocks * SORT_BLOCK));
+            }
+        }
+        // An even number of passes leaves the sorted pairs in A.
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.run(cmd, Kernel::Reorder, variant, none, Launch::Threads(n)) };
+    }
+
+    /// Exclusive scan of the first `len` entries of the digit table.
+    unsafe fn record_scan(&self, cmd: vk::CommandBuffer, variant: usize, len: u32) {
+        let tiles = len.div_ceil(SCAN_TILE);
+        let push = |mode: u32| VolumePush { dims: [0; 4], coarse: [0; 4], op: [mode, 0, len, tiles] };
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            self.run(cmd, Kernel::Scan, variant, push(0), Launch::Threads(tiles * GROUP));
+            self.run(cmd, Kernel::Scan, variant, push(1), Launch::Threads(GROUP));
+            self.run(cmd, Kernel::Scan, variant, push(2), Launch::Threads(tiles * GROUP));
+        }
+    }
+
+    fn level_push(&self, level: usize, op: [u32; 4]) -> VolumePush {
+        let l = self.grid.levels[level];
+        let coarse = self.grid.levels.get(level + 1).map_or([0; 4], |c| [c.dims[0], c.dims[1], c.dims[2], c.offset]);
+        VolumePush { dims: [l.dims[0], l.dims[1], l.dims[2], l.offset], coarse, op }
+    }
+
+    /// Step 6: the pressure solve and the gradient subtraction.
+    unsafe fn record_pressure(&self, cmd: vk::CommandBuffer, variant: usize) {
+        let levels = self.grid.levels.len();
+        let single = Launch::Indirect(levels);
+        let cells = Launch::Indirect(0);
+        let multigrid = self.params.preconditioner == Preconditioner::Multigrid;
+        let partials = self.grid.cells().div_ceil(GROUP);
+        let reduce =
+            |mode: u32| VolumePush { dims: [0; 4], coarse: [0; 4], op: [mode, 0, partials, levels as u32 + 1] };
+        let none = VolumePush::default();
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            if multigrid {
+                for level in 0..levels - 1 {
+                    let push = self.level_push(level, [0; 4]);
+                    self.run(cmd, Kernel::MgCoarsen, variant, push, Launch::Indirect(level + 1));
+                }
+            }
+            self.run(cmd, Kernel::PcgInit, variant, none, cells);
+            if multigrid {
+                self.record_vcycle(cmd, variant);
+                self.run(cmd, Kernel::PcgDot, variant, none, cells);
+            }
+            self.run(cmd, Kernel::PcgReduce, variant, reduce(0), single);
+            self.run(cmd, Kernel::PcgDirection, variant, none, cells);
+            for _ in 0..self.params.max_iterations {
+                self.run(cmd, Kernel::PcgApply, variant, none, cells);
+                self.run(cmd, Kernel::PcgReduce, variant, reduce(1), single);
+                self.run(cmd, Kernel::PcgUpdate, variant, none, cells);
+                if multigrid {
+                    self.record_vcycle(cmd, variant);
+                    self.run(cmd, Kernel::PcgDot, variant, none, cells);
+                }
+                self.run(cmd, Kernel::PcgReduce, variant, reduce(2), single);
+                self.run(cmd, Kernel::PcgDirection, variant, none, cells);
+            }
+            self.run(cmd, Kernel::Gradient, variant, none, Launch::Threads(self.grid.faces[2]));
+        }
+    }
+
+    /// z = V-cycle(r): damped Jacobi pre- and post-smoothing (2 sweeps each), half the
+    /// summed residual restricted, piecewise-constant prolongation, Jacobi sweeps on
+    /// the coarsest level. Symmetric, so conjugate gradients may use it.
+    unsafe fn record_vcycle(&self, cmd: vk::CommandBuffer, variant: usize) {
+        let levels = self.grid.levels.len();
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            for level in 0..levels - 1 {
+                let at = Launch::Indirect(level);
+                self.run(cmd, Kernel::MgSmooth, variant, self.level_push(level, [0; 4]), at);
+                self.run(cmd, Kernel::MgSmooth, variant, self.level_push(level, [1, 0, 0, 0]), at);
+                self.run(cmd, Kernel::MgRestrict, variant, self.level_push(level, [0; 4]), Launch::Indirect(level + 1));
+            }
+            let coarsest = self.level_push(levels - 1, [0, 0, COARSEST_SWEEPS, 0]);
+            self.run(cmd, Kernel::MgCoarsest, variant, coarsest, Launch::Indirect(levels));
+            for level in (0..levels - 1).rev() {
+                let at = Launch::Indirect(level);
+                self.run(cmd, Kernel::MgProlong, variant, self.level_push(level, [0; 4]), at);
+                self.run(cmd, Kernel::MgSmooth, variant, self.level_push(level, [2, 0, 0, 0]), at);
+                self.run(cmd, Kernel::MgSmooth, variant, self.level_push(level, [1, 0, 0, 0]), at);
+            }
+        }
+    }
+
+    /// Reads the solver scalars of the latest sub-step (submits and waits).
+    pub(crate) fn read_stats(&self) -> Result<VolumeStats> {
+        let s: Vec<PcgScalars> = self.device.readback_pod(&self.buffers.scalars, 1)?;
+        let s = s[0];
+        Ok(VolumeStats {
+            iterations: s.iterations,
+            converged: s.converged == 1 && s.status == 0,
+            relative_residual: if s.bmax > 0.0 { s.rmax / s.bmax } else { 0.0 },
+            non_finite: s.status == 2,
+        })
+    }
+}

@@ -1,0 +1,546 @@
+//! CPU reference of the volume stage: the oracle of the GPU tests.
+//!
+//! Binning, sort, cells and transfer repeat the GPU's f32 operations in the same
+//! order. The pressure solve is different on purpose: conjugate gradients in f64
+//! preconditioned with modified incomplete Cholesky (MIC(0), τ = 0.97,
+//! σ = 0.25, as in Bridson's fluid notes), the preconditioner the thesis' CPU
+//! version used; it converges in a handful of iterations and gives the GPU
+//! solvers an independent answer to agree with.
+
+use glam::{Vec3, Vec4, Vec4Swizzles};
+
+use super::grid::GridLayout;
+use crate::gpu_types::{GpuCollider, GpuVolumeParams};
+
+pub(crate) const AIR: u32 = 0;
+pub(crate) const FLUID: u32 = 1;
+pub(crate) const SOLID: u32 = 2;
+
+/// Every intermediate result of one volume step.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct VolumeSnapshot {
+    /// Sorted cell ids (the cell count for particles outside the grid).
+    pub keys: Vec<u32>,
+    /// Particle index of each sorted entry.
+    pub particles: Vec<u32>,
+    /// First sorted index per cell (particle count when empty), plus the outside entry.
+    pub start: Vec<u32>,
+    /// Per cell: mean velocity (grid axes), density.
+    pub cells: Vec<Vec4>,
+    pub labels: Vec<u32>,
+    /// Face velocities after the projection.
+    pub face_vel: Vec<f32>,
+    /// Face velocities as transferred.
+    pub face_star: Vec<f32>,
+    pub face_weight: Vec<f32>,
+    /// Pressure per cell (scaled: the face velocity changes by its difference).
+    pub pressure: Vec<f32>,
+    /// Right-hand side b per cell.
+    pub rhs: Vec<f32>,
+    /// MIC(0)-PCG iterations.
+    pub iterations: u32,
+}
+
+fn affine(m: &[[f32; 4]; 4], p: Vec3) -> Vec3 {
+    let c = |k: usize| Vec3::new(m[k][0], m[k][1], m[k][2]);
+    ((c(0) * p.x + c(1) * p.y) + c(2) * p.z) + c(3)
+}
+
+fn linear(m: &[[f32; 4]; 4], v: Vec3) -> Vec3 {
+    let c = |k: usize| Vec3::new(m[k][0], m[k][1], m[k][2]);
+    (c(0) * v.x + c(1) * v.y) + c(2) * v.z
+}
+
+fn weight(d: Vec3) -> f32 {
+    let a = (Vec3::ONE - d.abs()).max(Vec3::ZERO);
+    (a.x * a.y) * a.z
+}
+
+/// Cell grid shape helper.
+#[derive(Clone, Copy)]
+pub(crate) struct Dims(pub [u32; 3]);
+
+impl Dims {
+    pub(crate) fn count(self) -> usize {
+        self.0.iter().map(|&n| n as usize).product()
+    }
+    pub(crate) fn index(self, c: [i64; 3]) -> Option<usize> {
+        let [nx, ny, nz] = self.0.map(i64::from);
+        if c[0] < 0 || c[1] < 0 || c[2] < 0 || c[0] >= nx || c[1] >= ny || c[2] >= nz {
+            return None;
+        }
+        Some((c[0] + nx * (c[1] + ny * c[2])) as usize)
+    }
+    pub(crate) fn coords(self, c: usize) -> [i64; 3] {
+        let [nx, ny, _] = self.0.map(|n| n as usize);
+        [(c % nx) as i64, ((c / nx) % ny) as i64, (c / (nx * ny)) as i64]
+    }
+}
+
+/// Face grid of `axis` and the index of face `ijk` in the face arrays.
+pub(crate) fn face_index(grid: &GridLayout, axis: usize, ijk: [i64; 3]) -> Option<usize> {
+    let mut fd = grid.dims;
+    fd[axis] += 1;
+    let base = [0, grid.faces[0], grid.faces[1]][axis] as usize;
+    Dims(fd).index(ijk).map(|i| base + i)
+}
+
+fn cell_of(g: Vec3, dims: [u32; 3]) -> Option<[i64; 3]> {
+    let d = Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32);
+    if g.cmpge(Vec3::ZERO).all() && g.cmplt(d).all() {
+        Some([0, 1, 2].map(|a| (g[a] as u32).min(dims[a] - 1) as i64))
+    } else {
+        None
+    }
+}
+
+fn inside(colliders: &[GpuCollider], p: Vec3) -> bool {
+    colliders.iter().any(|c| {
+        let a = Vec3::from_slice(&c.a_radius[..3]);
+        let mut closest = a;
+        if c.b_kind[3] > 0.5 {
+            let ab = Vec3::from_slice(&c.b_kind[..3]) - a;
+            let len2 = ab.dot(ab);
+            let t = if len2 > 0.0 { ((p - a).dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+            closest = a + ab * t;
+        }
+        let d = p - closest;
+        d.dot(d) < c.a_radius[3] * c.a_radius[3]
+    })
+}
+
+/// Runs one volume step on `positions` / `velocities` (world space) and returns
+/// everything it computed; `velocities` get the update.
+pub(crate) fn step(
+    grid: &GridLayout,
+    p: &GpuVolumeParams,
+    colliders: &[GpuCollider],
+    positions: &[Vec4],
+    velocities: &mut [Vec4],
+) -> VolumeSnapshot {
+    let n = positions.len();
+    let dims = Dims(grid.dims);
+    let cells = dims.count();
+    let colliders = &colliders[..(p.config[3] as usize).min(colliders.len())];
+    // 1. Bin.
+    let grid_pos: Vec<Vec4> = positions.iter().map(|x| affine(&p.grid_from_world, x.xyz()).extend(x.w)).collect();
+    let grid_vel: Vec<Vec3> = velocities.iter().map(|v| linear(&p.axes, v.xyz())).collect();
+    let unsorted: Vec<u32> = grid_pos
+        .iter()
+        .map(|g| cell_of(g.xyz(), grid.dims).and_then(|c| dims.index(c)).map_or(cells as u32, |c| c as u32))
+        .collect();
+    // 2.–3. Stable sort, start index.
+    let mut particles: Vec<u32> = (0..n as u32).collect();
+    particles.sort_by_key(|&i| unsorted[i as usize]);
+    let keys: Vec<u32> = particles.iter().map(|&i| unsorted[i as usize]).collect();
+    let mut start = vec![n as u32; cells + 1];
+    for i in 0..n {
+        if i == 0 || keys[i - 1] != keys[i] {
+            start[keys[i] as usize] = i as u32;
+        }
+    }
+    let sorted_pos: Vec<Vec3> = particles.iter().map(|&i| grid_pos[i as usize].xyz()).collect();
+    let sorted_vel: Vec<Vec3> = particles.iter().map(|&i| grid_vel[i as usize]).collect();
+    let sorted_keys = &keys;
+    let cell_start = &start;
+    let in_cell = move |cell: usize| {
+        let first = cell_start[cell] as usize;
+        (first..n).take_while(move |&s| sorted_keys[s] as usize == cell)
+    };
+    // 4. Cells and labels.
+    let mut cell_data = vec![Vec4::ZERO; cells];
+    let mut labels = vec![AIR; cells];
+    for c in 0..cells {
+        let ijk = dims.coords(c);
+        let centre = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) + 0.5;
+        let mut density = 0.0f32;
+        let mut momentum = Vec3::ZERO;
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let Some(cell) = dims.index([ijk[0] + dx, ijk[1] + dy, ijk[2] + dz]) else { continue };
+                    for s in in_cell(cell) {
+                        let w = weight(sorted_pos[s] - centre);
+                        density += w;
+                        momentum += sorted_vel[s] * w;
+                    }
+                }
+            }
+        }
+        labels[c] = if (start[c] as usize) < n { FLUID } else { AIR };
+        if inside(colliders, affine(&p.world_from_grid, centre)) {
+            labels[c] = SOLID;
+        }
+        let mean = if density > 0.0 { momentum / density } else { Vec3::ZERO };
+        cell_data[c] = mean.extend(density);
+    }
+    // 5. Transfer.
+    let faces = grid.faces[2] as usize;
+    let mut face_vel = vec![0.0f32; faces];
+    let mut face_weight = vec![0.0f32; faces];
+    for axis in 0..3 {
+        let mut fd = grid.dims;
+        fd[axis] += 1;
+        let fdims = Dims(fd);
+        for local in 0..fdims.count() {
+            let ijk = fdims.coords(local);
+            let mut x = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) + 0.5;
+            x[axis] -= 0.5;
+            let lo = ijk.map(|v| v - 1);
+            let mut hi = ijk.map(|v| v + 1);
+            hi[axis] -= 1;
+            let mut sum = 0.0f32;
+            let mut wsum = 0.0f32;
+            for k in lo[2]..=hi[2] {
+                for j in lo[1]..=hi[1] {
+                    for i in lo[0]..=hi[0] {
+                        let Some(cell) = dims.index([i, j, k]) else { continue };
+                        for s in in_cell(cell) {
+                            let w = weight(sorted_pos[s] - x);
+                            wsum += w;
+                            sum += sorted_vel[s][axis] * w;
+                        }
+                    }
+                }
+            }
+            let mut u = if wsum > 0.0 { sum / wsum } else { 0.0 };
+            let mut below = ijk;
+            below[axis] -= 1;
+            let solid = [below, ijk].iter().any(|c| dims.index(*c).is_some_and(|c| labels[c] == SOLID));
+            if solid {
+                u = affine(&p.solid_velocity, x)[axis];
+            }
+            let f = face_index(grid, axis, ijk).unwrap_or(0);
+            face_vel[f] = u;
+            face_weight[f] = wsum;
+        }
+    }
+    // Air cells whose six faces all carry particle weight are fluid too.
+    for (c, label) in labels.iter_mut().enumerate() {
+        let ijk = dims.coords(c);
+        let covered = (0..3).all(|axis| {
+            let mut up = ijk;
+            up[axis] += 1;
+            [ijk, up].iter().all(|&q| face_index(grid, axis, q).is_some_and(|f| face_weight[f] > 0.0))
+        });
+        if *label == AIR && covered {
+            *label = FLUID;
+        }
+    }
+    let face_star = face_vel.clone();
+    let mut snapshot = VolumeSnapshot {
+        keys,
+        particles,
+        start,
+        cells: cell_data,
+        labels,
+        face_vel,
+        face_star,
+        face_weight,
+        pressure: vec![0.0; cells],
+        rhs: vec![0.0; cells],
+        iterations: 0,
+    };
+    // 6. Pressure.
+    let mode = p.solve[3];
+    if mode == 1.0 {
+        snapshot.rhs = rhs(grid, &snapshot.labels, &snapshot.face_vel);
+        let (pressure, iterations) = mic_pcg(grid, &snapshot.labels, &snapshot.rhs, p.solve[0].into(), 1000);
+        snapshot.pressure = pressure.iter().map(|&v| v as f32).collect();
+        snapshot.iterations = iterations;
+        subtract_gradient(grid, &snapshot.labels, &snapshot.pressure, &mut snapshot.face_vel);
+    }
+    // 7. Grid to particles.
+    for i in 0..n {
+        let g = grid_pos[i];
+        if g.w == 0.0 || cell_of(g.xyz(), grid.dims).is_none() {
+            continue;
+        }
+        let v = grid_to_particle(grid, p, &snapshot, g.xyz(), grid_vel[i]);
+        let to_world = glam::Mat3::from_cols(
+            Vec3::from_slice(&p.axes[0][..3]),
+            Vec3::from_slice(&p.axes[1][..3]),
+            Vec3::from_slice(&p.axes[2][..3]),
+        )
+        .transpose();
+        velocities[i] = (to_world * v).extend(0.0);
+    }
+    snapshot
+}
+
+/// b = −(net outflow) per fluid cell.
+pub(crate) fn rhs(grid: &GridLayout, labels: &[u32], face_vel: &[f32]) -> Vec<f32> {
+    let dims = Dims(grid.dims);
+    (0..dims.count())
+        .map(|c| {
+            if labels[c] != FLUID {
+                return 0.0;
+            }
+            let ijk = dims.coords(c);
+            let mut outflow = 0.0f32;
+            for axis in 0..3 {
+                let mut up = ijk;
+                up[axis] += 1;
+                let hi = face_vel[face_index(grid, axis, up).unwrap_or(0)];
+                let lo = face_vel[face_index(grid, axis, ijk).unwrap_or(0)];
+                outflow += hi - lo;
+            }
+            -outflow
+        })
+        .collect()
+}
+
+/// The 7-point pressure matrix over fluid cells (f64).
+pub(crate) struct Matrix {
+    dims: Dims,
+    pub diagonal: Vec<f64>,
+    /// −1 where the cell and its +x / +y / +z neighbour are both fluid.
+    pub plus: [Vec<f64>; 3],
+}
+
+impl Matrix {
+    pub(crate) fn new(grid: &GridLayout, labels: &[u32]) -> Self {
+        let dims = Dims(grid.dims);
+        let cells = dims.count();
+        let mut m =
+            Matrix { dims, diagonal: vec![0.0; cells], plus: [vec![0.0; cells], vec![0.0; cells], vec![0.0; cells]] };
+        for c in 0..cells {
+            if labels[c] != FLUID {
+                continue;
+            }
+            let ijk = dims.coords(c);
+            for axis in 0..3 {
+                for step in [-1, 1] {
+                    let mut q = ijk;
+                    q[axis] += step;
+                    let label = dims.index(q).map_or(AIR, |q| labels[q]);
+                    if label != SOLID {
+                        m.diagonal[c] += 1.0;
+                    }
+                    if step == 1 && label == FLUID {
+                        m.plus[axis][c] = -1.0;
+                    }
+                }
+            }
+        }
+        m
+    }
+
+    fn neighbour(&self, c: usize, axis: usize, step: i64) -> Option<usize> {
+        let mut q = self.dims.coords(c);
+        q[axis] += step;
+        self.dims.index(q)
+    }
+
+    /// y = A x.
+    pub(crate) fn apply(&self, x: &[f64]) -> Vec<f64> {
+        (0..x.len())
+            .map(|c| {
+                let mut y = self.diagonal[c] * x[c];
+                for axis in 0..3 {
+                    if let Some(q) = self.neighbour(c, axis, 1) {
+                        y += self.plus[axis][c] * x[q];
+                    }
+                    if let Some(q) = self.neighbour(c, axis, -1) {
+                        y += self.plus[axis][q] * x[q];
+                    }
+                }
+                y
+            })
+            .collect()
+    }
+}
+
+/// Solves A p = b with MIC(0)-preconditioned conjugate gradients until
+/// max |r| ≤ `tolerance` · max |b|; returns p and the iterations.
+pub(crate) fn mic_pcg(grid: &GridLayout, labels: &[u32], b: &[f32], tolerance: f64, cap: u32) -> (Vec<f64>, u32) {
+    const TAU: f64 = 0.97;
+    const SIGMA: f64 = 0.25;
+    let a = Matrix::new(grid, labels);
+    let cells = b.len();
+    let mut precon = vec![0.0f64; cells];
+    let back = |c: usize, axis: usize| a.neighbour(c, axis, -1);
+    for c in 0..cells {
+        if labels[c] != FLUID || a.diagonal[c] == 0.0 {
+            continue;
+        }
+        let mut e = a.diagonal[c];
+        for axis in 0..3 {
+            if let Some(q) = back(c, axis) {
+                let (o1, o2) = ((axis + 1) % 3, (axis + 2) % 3);
+                e -= (a.plus[axis][q] * precon[q]).powi(2);
+                e -= TAU * a.plus[axis][q] * (a.plus[o1][q] + a.plus[o2][q]) * precon[q].powi(2);
+            }
+        }
+        if e < SIGMA * a.diagonal[c] {
+            e = a.diagonal[c];
+        }
+        precon[c] = 1.0 / e.sqrt();
+    }
+    let apply_precon = |r: &[f64]| {
+        let mut q = vec![0.0f64; cells];
+        for c in 0..cells {
+            if precon[c] == 0.0 {
+                continue;
+            }
+            let mut t = r[c];
+            for axis in 0..3 {
+                if let Some(n) = back(c, axis) {
+                    t -= a.plus[axis][n] * precon[n] * q[n];
+                }
+            }
+            q[c] = t * precon[c];
+        }
+        let mut z = vec![0.0f64; cells];
+        for c in (0..cells).rev() {
+            if precon[c] == 0.0 {
+                continue;
+            }
+            let mut t = q[c];
+            for axis in 0..3 {
+                if let Some(n) = a.neighbour(c, axis, 1) {
+                    t -= a.plus[axis][c] * precon[c] * z[n];
+                }
+            }
+            z[c] = t * precon[c];
+        }
+        z
+    };
+    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+    let max_abs = |x: &[f64]| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut p = vec![0.0f64; cells];
+    let mut r: Vec<f64> = b.iter().map(|&v| f64::from(v)).collect();
+    let bmax = max_abs(&r);
+    if bmax == 0.0 {
+        return (p, 0);
+    }
+    let mut z = apply_precon(&r);
+    let mut s = z.clone();
+    let mut sigma = dot(&z, &r);
+    for iteration in 1..=cap {
+        let q = a.apply(&s);
+        let alpha = sigma / dot(&q, &s);
+        for c in 0..cells {
+            p[c] += alpha * s[c];
+            r[c] -= alpha * q[c];
+        }
+        if max_abs(&r) <= tolerance * bmax {
+            return (p, iteration);
+        }
+        z = apply_precon(&r);
+        let sigma_new = dot(&z, &r);
+        let beta = sigma_new / sigma;
+        for c in 0..cells {
+            s[c] = z[c] + beta * s[c];
+        }
+        sigma = sigma_new;
+    }
+    (p, cap)
+}
+
+/// Subtracts the pressure difference on faces between a fluid cell and a non-solid one.
+pub(crate) fn subtract_gradient(grid: &GridLayout, labels: &[u32], pressure: &[f32], face_vel: &mut [f32]) {
+    let dims = Dims(grid.dims);
+    for axis in 0..3 {
+        let mut fd = grid.dims;
+        fd[axis] += 1;
+        let fdims = Dims(fd);
+        for local in 0..fdims.count() {
+            let ijk = fdims.coords(local);
+            let mut below = ijk;
+            below[axis] -= 1;
+            let side = |c: [i64; 3]| {
+                dims.index(c).map_or((AIR, 0.0), |c| (labels[c], if labels[c] == FLUID { pressure[c] } else { 0.0 }))
+            };
+            let (bl, bp) = side(below);
+            let (al, ap) = side(ijk);
+            if (bl == FLUID || al == FLUID) && bl != SOLID && al != SOLID {
+                let f = face_index(grid, axis, ijk).unwrap_or(0);
+                face_vel[f] -= ap - bp;
+            }
+        }
+    }
+}
+
+/// Trilinear sample of component `axis` on its face grid: (Lerp(v), Lerp(v − v*)).
+pub(crate) fn sample_faces(grid: &GridLayout, face_vel: &[f32], face_star: &[f32], g: Vec3, axis: usize) -> (f32, f32) {
+    let mut fd = grid.dims;
+    fd[axis] += 1;
+    let mut q = g - 0.5;
+    q[axis] += 0.5;
+    let base = q.floor();
+    let t = q - base;
+    let mut result = (0.0f32, 0.0f32);
+    for k in 0..8usize {
+        let corner = [k & 1, (k >> 1) & 1, k >> 2];
+        let at = [0, 1, 2].map(|a| (base[a] as i64 + corner[a] as i64).clamp(0, i64::from(fd[a]) - 1));
+        let w3 = Vec3::new(
+            if corner[0] == 1 { t.x } else { 1.0 - t.x },
+            if corner[1] == 1 { t.y } else { 1.0 - t.y },
+            if corner[2] == 1 { t.z } else { 1.0 - t.z },
+        );
+        let w = (w3.x * w3.y) * w3.z;
+        let f = face_index(grid, axis, at).unwrap_or(0);
+        result.0 += face_vel[f] * w;
+        result.1 += (face_vel[f] - face_star[f]) * w;
+    }
+    result
+}
+
+fn sample_cells(grid: &GridLayout, cells: &[Vec4], g: Vec3) -> Vec4 {
+    let dims = Dims(grid.dims);
+    let q = g - 0.5;
+    let base = q.floor();
+    let t = q - base;
+    let mut result = Vec4::ZERO;
+    for k in 0..8usize {
+        let corner = [k & 1, (k >> 1) & 1, k >> 2];
+        let at = [0, 1, 2].map(|a| (base[a] as i64 + corner[a] as i64).clamp(0, i64::from(grid.dims[a]) - 1));
+        let w3 = Vec3::new(
+            if corner[0] == 1 { t.x } else { 1.0 - t.x },
+            if corner[1] == 1 { t.y } else { 1.0 - t.y },
+            if corner[2] == 1 { t.z } else { 1.0 - t.z },
+        );
+        let w = (w3.x * w3.y) * w3.z;
+        let cell = cells[dims.index(at).unwrap_or(0)];
+        result += (cell.xyz() * cell.w).extend(cell.w) * w;
+    }
+    result
+}
+
+/// The updated velocity (grid axes) of a particle at grid position `g` with velocity `v`.
+fn grid_to_particle(grid: &GridLayout, p: &GpuVolumeParams, s: &VolumeSnapshot, g: Vec3, v: Vec3) -> Vec3 {
+    if p.solve[3] == 1.0 {
+        let alpha = p.transfer[0];
+        let [u, vv, w] = [0, 1, 2].map(|a| sample_faces(grid, &s.face_vel, &s.face_star, g, a));
+        let pic = Vec3::new(u.0, vv.0, w.0);
+        let flip = v + Vec3::new(u.1, vv.1, w.1);
+        return flip * alpha + pic * (1.0 - alpha);
+    }
+    let cell = sample_cells(grid, &s.cells, g);
+    let mut v = v;
+    let friction = p.transfer[1];
+    if cell.w > 0.0 {
+        let mean = cell.xyz() / cell.w;
+        v = v * (1.0 - friction) + mean * friction;
+    }
+    let threshold = p.transfer[3];
+    if p.transfer[2] > 0.0 && cell.w > threshold {
+        let dims = Dims(grid.dims);
+        let c = [0, 1, 2].map(|a| (g[a] as i64).min(i64::from(grid.dims[a]) - 1));
+        let mut gradient = Vec3::ZERO;
+        for axis in 0..3 {
+            let (mut lo, mut hi) = (c, c);
+            lo[axis] = (c[axis] - 1).max(0);
+            hi[axis] = (c[axis] + 1).min(i64::from(grid.dims[axis]) - 1);
+            let density = |q: [i64; 3]| dims.index(q).map_or(0.0, |q| s.cells[q].w);
+            gradient[axis] = density(hi) - density(lo);
+        }
+        let len = gradient.length();
+        if len > 0.0 {
+            let excess = ((cell.w - threshold) / threshold.max(1e-6)).min(1.0);
+            v -= gradient * (p.transfer[2] * p.solve[2] * excess / len);
+        }
+    }
+    v
+}

@@ -1,0 +1,324 @@
+//! GPU tests of the volume stage against the CPU reference (lavapipe, validated).
+
+use glam::{Mat4, Vec3, Vec4, Vec4Swizzles};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg32;
+
+use super::grid::GridLayout;
+use super::reference::{self, face_index, Dims, VolumeSnapshot, FLUID, SOLID};
+use super::{Preconditioner, VolumeMode, VolumeParams, VolumeStage, VolumeStats};
+use crate::gpu_types::{GpuCollider, GpuVolumeParams};
+use crate::sim::MAX_COLLIDERS;
+use crate::vk::barrier::{self, Access};
+use crate::vk::buffer::{Buffer, BufferDesc};
+use crate::vk::tests::TestGpu;
+
+/// What one GPU volume step produced.
+struct GpuRun {
+    snapshot: VolumeSnapshot,
+    velocities: Vec<Vec4>,
+    stats: VolumeStats,
+}
+
+/// Runs one volume step on the GPU over the given particles.
+fn run_gpu(
+    gpu: &TestGpu,
+    grid: &GridLayout,
+    params: &VolumeParams,
+    block: &GpuVolumeParams,
+    colliders: &[GpuCollider],
+    positions: &[Vec4],
+    velocities: &[Vec4],
+) -> GpuRun {
+    let d = gpu.device();
+    let n = positions.len() as u64;
+    let pos = Buffer::storage(d, "test positions", n * 16).expect("buffer");
+    let vel = Buffer::storage(d, "test velocities", n * 16).expect("buffer");
+    d.upload_pod(&pos, positions).expect("upload");
+    d.upload_pod(&vel, velocities).expect("upload");
+    let collider_buffer = Buffer::new(
+        d,
+        &BufferDesc {
+            name: "test colliders",
+            size: (MAX_COLLIDERS * 32) as u64,
+            usage: ash::vk::BufferUsageFlags::UNIFORM_BUFFER | ash::vk::BufferUsageFlags::TRANSFER_DST,
+            location: gpu_allocator::MemoryLocation::GpuOnly,
+        },
+    )
+    .expect("buffer");
+    let mut padded = colliders.to_vec();
+    padded.resize(MAX_COLLIDERS, GpuCollider::default());
+    d.upload_pod(&collider_buffer, &padded).expect("upload");
+    let stage = VolumeStage::new(d, grid.clone(), params, &collider_buffer, &[(&pos, &vel)]).expect("stage");
+    let uploaded = barrier::memory(
+        Access::TRANSFER_WRITE,
+        Access {
+            stage: ash::vk::PipelineStageFlags2::COMPUTE_SHADER | ash::vk::PipelineStageFlags2::DRAW_INDIRECT,
+            access: ash::vk::AccessFlags2::MEMORY_READ | ash::vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        },
+    );
+    d.submit_once("volume test", |cmd| {
+        // SAFETY: a recording command buffer of this device; submit_once waited for
+        // all earlier work (the uploads).
+        unsafe {
+            stage.record_uploads(cmd, block);
+            d.cmd_barrier(cmd, &[uploaded], &[], &[]);
+            stage.record(cmd, 0, ["sort", "transfer", "pressure", "update"], None);
+        }
+    })
+    .expect("submit");
+    let b = &stage.buffers;
+    let cells = grid.cells() as usize;
+    let faces = grid.faces[2] as usize;
+    let snapshot = VolumeSnapshot {
+        keys: d.readback_pod(&b.keys_a, n as usize).expect("readback"),
+        particles: d.readback_pod(&b.vals_a, n as usize).expect("readback"),
+        start: d.readback_pod(&b.start, cells + 1).expect("readback"),
+        cells: d.readback_pod(&b.cells, cells).expect("readback"),
+        labels: d.readback_pod(&b.labels, cells).expect("readback"),
+        face_vel: d.readback_pod(&b.face_vel, faces).expect("readback"),
+        face_star: d.readback_pod(&b.face_star, faces).expect("readback"),
+        face_weight: d.readback_pod(&b.face_weight, faces).expect("readback"),
+        pressure: d.readback_pod(&b.pressure, cells).expect("readback"),
+        rhs: Vec::new(),
+        iterations: 0,
+    };
+    let stats = stage.read_stats().expect("stats");
+    let velocities = d.readback_pod(&vel, n as usize).expect("readback");
+    GpuRun { snapshot: VolumeSnapshot { iterations: stats.iterations, ..snapshot }, velocities, stats }
+}
+
+/// A grid whose coordinates are world coordinates (unit cells at the origin).
+fn unit_grid(dims: [u32; 3], particles: usize) -> GridLayout {
+    GridLayout::placed(dims, 1.0, Vec3::ZERO, particles as u32)
+}
+
+fn block(grid: &GridLayout, params: &VolumeParams, previous: Mat4, colliders: u32) -> GpuVolumeParams {
+    grid.gpu_params(params, &previous, &Mat4::IDENTITY, 1.0 / 60.0, colliders)
+}
+
+fn random_particles(rng: &mut Pcg32, n: usize, lo: Vec3, hi: Vec3, speed: f32) -> (Vec<Vec4>, Vec<Vec4>) {
+    let positions = (0..n)
+        .map(|_| {
+            let t = Vec3::new(rng.random(), rng.random(), rng.random());
+            (lo + (hi - lo) * t).extend(1.0)
+        })
+        .collect();
+    let velocities =
+        (0..n).map(|_| (Vec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - 1.0).extend(0.0) * speed).collect();
+    (positions, velocities)
+}
+
+fn assert_close(what: &str, gpu: &[f32], cpu: &[f32], tolerance: f32) {
+    assert_eq!(gpu.len(), cpu.len(), "{what}: length");
+    for (i, (g, c)) in gpu.iter().zip(cpu).enumerate() {
+        assert!((g - c).abs() <= tolerance * c.abs().max(1.0), "{what}[{i}]: GPU {g} vs CPU {c}");
+    }
+}
+
+fn cell_floats(cells: &[Vec4]) -> Vec<f32> {
+    cells.iter().flat_map(|c| c.to_array()).collect()
+}
+
+fn friction_params() -> VolumeParams {
+    VolumeParams { mode: VolumeMode::Friction, ..VolumeParams::default() }
+}
+
+#[test]
+fn sort_and_start_index_match_the_reference() {
+    let gpu = TestGpu::new();
+    let mut rng = Pcg32::seed_from_u64(5);
+    let grid_dims = [8, 6, 5];
+    // Random points inside, points exactly on cell boundaries, points outside the grid
+    // (below, above, NaN) and enough of them for several sort blocks.
+    let (mut positions, velocities) = random_particles(&mut rng, 1000, Vec3::ZERO, Vec3::new(8.0, 6.0, 5.0), 1.0);
+    for (k, p) in positions.iter_mut().enumerate().take(100) {
+        *p = Vec4::new((k % 9) as f32, (k % 7) as f32, (k % 6) as f32, 1.0);
+    }
+    positions[100] = Vec4::new(-0.001, 1.0, 1.0, 1.0);
+    positions[101] = Vec4::new(8.0, 1.0, 1.0, 1.0);
+    positions[102] = Vec4::new(f32::NAN, 1.0, 1.0, 1.0);
+    positions[103] = Vec4::new(1.0, f32::INFINITY, 1.0, 1.0);
+    let grid = unit_grid(grid_dims, positions.len());
+    let params = friction_params();
+    let b = block(&grid, &params, Mat4::IDENTITY, 0);
+    let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
+    let mut cpu_vel = velocities.clone();
+    let cpu = reference::step(&grid, &b, &[], &positions, &mut cpu_vel);
+    assert_eq!(run.snapshot.keys, cpu.keys, "sorted cell ids");
+    assert_eq!(run.snapshot.particles, cpu.particles, "sorted particle order (stable)");
+    assert_eq!(run.snapshot.start, cpu.start, "start index");
+    // The reference itself: sorted, stable, outside particles last, empty cells marked.
+    let cells = grid.cells();
+    assert!(cpu.keys.windows(2).all(|w| w[0] <= w[1]));
+    let d = Vec3::new(8.0, 6.0, 5.0);
+    let outside = positions.iter().filter(|p| !(p.xyz().cmpge(Vec3::ZERO).all() && p.xyz().cmplt(d).all())).count();
+    assert!(outside > 4, "boundary points on the far faces are outside too");
+    assert_eq!(cpu.keys.iter().filter(|&&k| k == cells).count(), outside);
+    assert!((0..cpu.keys.len() - 1).all(|i| cpu.keys[i] != cpu.keys[i + 1] || cpu.particles[i] < cpu.particles[i + 1]));
+    assert!(cpu.start[..cells as usize].contains(&1000), "some cells are empty");
+    // Rejected particles keep their velocity.
+    assert_eq!(run.velocities[100..104], velocities[100..104], "particles outside the grid keep their velocity");
+}
+
+#[test]
+fn all_particles_in_one_cell_sort_like_the_reference() {
+    let gpu = TestGpu::new();
+    let mut rng = Pcg32::seed_from_u64(6);
+    // 64³ cells: the four 6-bit passes.
+    let (positions, velocities) = random_particles(&mut rng, 700, Vec3::splat(30.1), Vec3::splat(30.9), 0.5);
+    let grid = unit_grid([64, 64, 64], positions.len());
+    let params = friction_params();
+    let b = block(&grid, &params, Mat4::IDENTITY, 0);
+    let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
+    let mut cpu_vel = velocities.clone();
+    let cpu = reference::step(&grid, &b, &[], &positions, &mut cpu_vel);
+    let cell = 30 + 64 * (30 + 64 * 30);
+    assert!(cpu.keys.iter().all(|&k| k == cell));
+    assert_eq!(run.snapshot.keys, cpu.keys);
+    assert_eq!(run.snapshot.particles, (0..700).collect::<Vec<u32>>());
+    assert_eq!(run.snapshot.start, cpu.start);
+    assert_eq!(run.snapshot.start[cell as usize], 0);
+}
+
+#[test]
+fn transfer_and_friction_match_the_reference() {
+    let gpu = TestGpu::new();
+    let mut rng = Pcg32::seed_from_u64(7);
+    let (positions, velocities) = random_particles(&mut rng, 3000, Vec3::splat(2.0), Vec3::new(10.0, 9.0, 7.0), 1.0);
+    let grid = unit_grid([12, 11, 9], positions.len());
+    let params = VolumeParams { repulsion_threshold: 2.0, repulsion: 5.0, friction: 0.3, ..friction_params() };
+    // A moving sphere marks solid cells and gives their faces a velocity.
+    let colliders = [GpuCollider { a_radius: [6.0, 5.0, 4.0, 2.2], b_kind: [6.0, 5.0, 4.0, 0.0] }];
+    let previous = Mat4::from_translation(Vec3::new(-0.01, 0.02, 0.0));
+    let b = block(&grid, &params, previous, 1);
+    let run = run_gpu(&gpu, &grid, &params, &b, &colliders, &positions, &velocities);
+    let mut cpu_vel = velocities.clone();
+    let cpu = reference::step(&grid, &b, &colliders, &positions, &mut cpu_vel);
+    assert_eq!(run.snapshot.labels, cpu.labels);
+    assert!(cpu.labels.contains(&SOLID) && cpu.labels.contains(&FLUID));
+    // Same operations in the same order: agreement to a few ulps (the division of a
+    // vector may be a multiply by the reciprocal on the GPU).
+    assert_close("cells", &cell_floats(&run.snapshot.cells), &cell_floats(&cpu.cells), 1e-6);
+    assert_close("face weights", &run.snapshot.face_weight, &cpu.face_weight, 1e-6);
+    assert_close("face velocities", &run.snapshot.face_star, &cpu.face_star, 1e-6);
+    let gpu_v: Vec<f32> = run.velocities.iter().flat_map(|v| v.to_array()).collect();
+    let cpu_v: Vec<f32> = cpu_vel.iter().flat_map(|v| v.to_array()).collect();
+    assert_close("friction velocities", &gpu_v, &cpu_v, 1e-5);
+    // Solid faces carry the sphere's velocity: (0.01, −0.02, 0) / dt.
+    let expected = Vec3::new(0.6, -1.2, 0.0);
+    let dims = Dims(grid.dims);
+    let mut solid_faces = 0;
+    for c in 0..dims.count() {
+        if cpu.labels[c] != SOLID {
+            continue;
+        }
+        let ijk = dims.coords(c);
+        for axis in 0..3 {
+            let f = face_index(&grid, axis, ijk).expect("face");
+            assert!((run.snapshot.face_star[f] - expected[axis]).abs() < 1e-4, "solid face {f}");
+            solid_faces += 1;
+        }
+    }
+    assert!(solid_faces > 0);
+}
+
+#[test]
+fn uniform_motion_transfers_to_a_uniform_field_and_stays_untouched() {
+    let gpu = TestGpu::new();
+    let mut rng = Pcg32::seed_from_u64(8);
+    let (positions, _) = random_particles(&mut rng, 2000, Vec3::splat(3.0), Vec3::splat(9.0), 0.0);
+    let v0 = Vec4::new(0.7, -0.3, 0.2, 0.0);
+    let velocities = vec![v0; positions.len()];
+    let grid = unit_grid([12, 12, 12], positions.len());
+    let params = VolumeParams::flip([12, 12, 12]);
+    let b = block(&grid, &params, Mat4::IDENTITY, 0);
+    let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
+    let mut weighted = 0;
+    for axis in 0..3 {
+        let range = [0, grid.faces[0], grid.faces[1], grid.faces[2]];
+        for f in range[axis] as usize..range[axis + 1] as usize {
+            if run.snapshot.face_weight[f] > 0.0 {
+                weighted += 1;
+                assert!((run.snapshot.face_star[f] - v0[axis]).abs() < 1e-6, "face {f}: {}", run.snapshot.face_star[f]);
+            }
+        }
+    }
+    assert!(weighted > 1000);
+    for (i, v) in run.velocities.iter().enumerate() {
+        assert!((*v - v0).length() < 1e-5, "particle {i}: {v} instead of {v0}");
+    }
+}
+
+/// Max |divergence| over fluid cells of a face field.
+fn max_divergence(grid: &GridLayout, labels: &[u32], faces: &[f32]) -> f32 {
+    reference::rhs(grid, labels, faces).iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+#[test]
+fn projection_is_divergence_free_and_agrees_with_mic_pcg() {
+    let gpu = TestGpu::new();
+    let mut rng = Pcg32::seed_from_u64(9);
+    let (positions, velocities) = random_particles(&mut rng, 6000, Vec3::new(2.0, 2.5, 3.0), Vec3::splat(14.0), 1.0);
+    let grid = unit_grid([16, 16, 16], positions.len());
+    let colliders = [GpuCollider { a_radius: [8.0, 8.0, 8.0, 3.0], b_kind: [8.0, 8.0, 8.0, 0.0] }];
+    let previous = Mat4::from_translation(Vec3::new(0.0, 0.01, 0.0));
+    let mut iterations = Vec::new();
+    for preconditioner in [Preconditioner::Jacobi, Preconditioner::Multigrid] {
+        let params = VolumeParams { preconditioner, max_iterations: 200, ..VolumeParams::flip([16, 16, 16]) };
+        let b = block(&grid, &params, previous, 1);
+        let run = run_gpu(&gpu, &grid, &params, &b, &colliders, &positions, &velocities);
+        let mut cpu_vel = velocities.clone();
+        let cpu = reference::step(&grid, &b, &colliders, &positions, &mut cpu_vel);
+        assert_eq!(run.snapshot.labels, cpu.labels);
+        let before = max_divergence(&grid, &cpu.labels, &cpu.face_star);
+        let after = max_divergence(&grid, &cpu.labels, &run.snapshot.face_vel);
+        let cpu_after = max_divergence(&grid, &cpu.labels, &cpu.face_vel);
+        eprintln!(
+            "{preconditioner:?}: {} iterations (MIC {}), divergence {before} -> GPU {after}, CPU {cpu_after}; {:?}",
+            run.stats.iterations, cpu.iterations, run.stats
+        );
+        assert!(run.stats.converged && run.stats.iterations < params.max_iterations, "{:?}", run.stats);
+        assert!(before > 1.0, "the random field is far from divergence free");
+        assert!(after <= 1e-5 * before * 4.0, "GPU divergence {after} from {before}");
+        let pmax = cpu.pressure.iter().fold(0.0f32, |m, p| m.max(p.abs()));
+        for (c, (g, r)) in run.snapshot.pressure.iter().zip(&cpu.pressure).enumerate() {
+            assert!((g - r).abs() <= 1e-3 * pmax, "pressure of cell {c}: GPU {g} vs MIC {r} (max {pmax})");
+        }
+        let gpu_v: Vec<f32> = run.velocities.iter().flat_map(|v| v.to_array()).collect();
+        let cpu_v: Vec<f32> = cpu_vel.iter().flat_map(|v| v.to_array()).collect();
+        assert_close("FLIP velocities", &gpu_v, &cpu_v, 1e-3);
+        iterations.push(run.stats.iterations);
+    }
+    assert!(
+        iterations[1] * 2 <= iterations[0],
+        "multigrid needs {} iterations, Jacobi {}",
+        iterations[1],
+        iterations[0]
+    );
+}
+
+#[test]
+fn flip_ratio_zero_is_pic_and_one_is_flip() {
+    let gpu = TestGpu::new();
+    let mut rng = Pcg32::seed_from_u64(10);
+    let (positions, velocities) = random_particles(&mut rng, 1500, Vec3::splat(2.0), Vec3::splat(8.0), 1.0);
+    let grid = unit_grid([10, 10, 10], positions.len());
+    for alpha in [0.0f32, 1.0] {
+        let params = VolumeParams { flip_ratio: alpha, ..VolumeParams::flip([10, 10, 10]) };
+        let b = block(&grid, &params, Mat4::IDENTITY, 0);
+        let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
+        let s = &run.snapshot;
+        let mut changed = 0;
+        for i in 0..positions.len() {
+            let g = positions[i].xyz();
+            let [u, v, w] = [0, 1, 2].map(|axis| reference::sample_faces(&grid, &s.face_vel, &s.face_star, g, axis));
+            let expected =
+                if alpha == 0.0 { Vec3::new(u.0, v.0, w.0) } else { velocities[i].xyz() + Vec3::new(u.1, v.1, w.1) };
+            let got = run.velocities[i].xyz();
+            assert!((got - expected).length() < 1e-5, "α = {alpha}, particle {i}: {got} vs {expected}");
+            changed += usize::from((got - velocities[i].xyz()).length() > 1e-3);
+        }
+        assert!(changed > positions.len() / 2, "the projection changed most velocities");
+    }
+}
