@@ -93,6 +93,9 @@ struct SimulateArgs {
     /// Use the Jacobi preconditioner instead of multigrid for the pressure solve.
     #[arg(long)]
     jacobi: bool,
+    /// Iteration cap of the pressure solve.
+    #[arg(long, default_value_t = 40)]
+    max_iterations: u32,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -370,6 +373,7 @@ fn simulate(a: &SimulateArgs) -> CliResult {
         },
         resolution: [a.grid; 3],
         preconditioner: if a.jacobi { Preconditioner::Jacobi } else { Preconditioner::Multigrid },
+        max_iterations: a.max_iterations,
         ..VolumeParams::default()
     };
     let params = SimParams {

@@ -203,8 +203,7 @@ pub(crate) enum Kernel {
     RadixScatter,
     Scan,
     Reorder,
-    Center,
-    Transfer,
+    Gather,
     Mark,
     PcgInit,
     PcgApply,
@@ -222,14 +221,13 @@ pub(crate) enum Kernel {
 }
 
 impl Kernel {
-    pub(crate) const ALL: [Kernel; 21] = [
+    pub(crate) const ALL: [Kernel; 20] = [
         Kernel::Bin,
         Kernel::RadixCount,
         Kernel::RadixScatter,
         Kernel::Scan,
         Kernel::Reorder,
-        Kernel::Center,
-        Kernel::Transfer,
+        Kernel::Gather,
         Kernel::Mark,
         Kernel::PcgInit,
         Kernel::PcgApply,
@@ -254,8 +252,7 @@ impl Kernel {
             Kernel::RadixScatter => &SIM_VOLUME_RADIX_SCATTER_COMP,
             Kernel::Scan => &SIM_VOLUME_SCAN_COMP,
             Kernel::Reorder => &SIM_VOLUME_REORDER_COMP,
-            Kernel::Center => &SIM_VOLUME_CENTER_COMP,
-            Kernel::Transfer => &SIM_VOLUME_TRANSFER_COMP,
+            Kernel::Gather => &SIM_VOLUME_GATHER_COMP,
             Kernel::Mark => &SIM_VOLUME_MARK_COMP,
             Kernel::PcgInit => &SIM_VOLUME_PCG_INIT_COMP,
             Kernel::PcgApply => &SIM_VOLUME_PCG_APPLY_COMP,

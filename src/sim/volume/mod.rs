@@ -17,12 +17,14 @@
 //!    by position. Integer-only and stable, so the order is the same every run.
 //! 3. **Reorder** (`reorder.comp`): particle data in cell order and the first
 //!    index of every occupied cell (empty cells keep the particle count).
-//! 4. **Cells** (`center.comp`): density and mean velocity around every cell
+//! 4. **Cells** (`gather.comp`): density and mean velocity around every cell
 //!    centre; labels solid (centre inside a collider), fluid (holds a
 //!    particle) or air.
-//! 5. **Transfer** (`transfer.comp`): every u/v/w face gathers its component
-//!    from the particles of the neighbouring cells with trilinear weights; faces
-//!    next to solid cells take the colliders' velocity. An air cell whose six
+//! 5. **Transfer** (`gather.comp`, the same pass): every u/v/w face gathers its
+//!    component from the particles of the neighbouring cells with trilinear
+//!    weights; faces next to solid cells take the colliders' velocity. One
+//!    invocation per cell visits its 27 neighbouring cells once for the centre
+//!    and its three lower faces. An air cell whose six
 //!    faces all carry particle weight becomes fluid (`mark.comp`): key-hair
 //!    particles are sparse, and the gaps between them must not be free surface.
 //! 6. **Pressure** (FLIP only, `pcg_*`, `mg_*`): the Poisson system over fluid

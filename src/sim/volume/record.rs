@@ -145,8 +145,9 @@ impl VolumeStage {
         // SAFETY (all closures): guaranteed by the caller.
         scoped(&mut profiler, labels[0], &|| unsafe { self.record_sort(cmd, variant) });
         scoped(&mut profiler, labels[1], &|| unsafe {
-            self.run(cmd, Kernel::Center, variant, VolumePush::default(), Launch::Threads(self.grid.cells()));
-            self.run(cmd, Kernel::Transfer, variant, VolumePush::default(), Launch::Threads(self.grid.faces[2]));
+            let [nx, ny, nz] = self.grid.dims;
+            let extended = (nx + 1) * (ny + 1) * (nz + 1);
+            self.run(cmd, Kernel::Gather, variant, VolumePush::default(), Launch::Threads(extended));
             self.run(cmd, Kernel::Mark, variant, VolumePush::default(), Launch::Threads(self.grid.cells()));
         });
         if self.params.mode == VolumeMode::Flip {

@@ -85,6 +85,16 @@ pub(crate) fn face_index(grid: &GridLayout, axis: usize, ijk: [i64; 3]) -> Optio
     Dims(fd).index(ijk).map(|i| base + i)
 }
 
+/// Every face as (axis, coordinates on that axis' face grid), in face-array order.
+fn faces(grid: &GridLayout) -> impl Iterator<Item = (usize, [i64; 3])> + '_ {
+    (0..3).flat_map(move |axis| {
+        let mut fd = grid.dims;
+        fd[axis] += 1;
+        let fdims = Dims(fd);
+        (0..fdims.count()).map(move |local| (axis, fdims.coords(local)))
+    })
+}
+
 fn cell_of(g: Vec3, dims: [u32; 3]) -> Option<[i64; 3]> {
     let d = Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32);
     if g.cmpge(Vec3::ZERO).all() && g.cmplt(d).all() {
@@ -175,45 +185,39 @@ pub(crate) fn step(
         cell_data[c] = mean.extend(density);
     }
     // 5. Transfer.
-    let faces = grid.faces[2] as usize;
-    let mut face_vel = vec![0.0f32; faces];
-    let mut face_weight = vec![0.0f32; faces];
-    for axis in 0..3 {
-        let mut fd = grid.dims;
-        fd[axis] += 1;
-        let fdims = Dims(fd);
-        for local in 0..fdims.count() {
-            let ijk = fdims.coords(local);
-            let mut x = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) + 0.5;
-            x[axis] -= 0.5;
-            let lo = ijk.map(|v| v - 1);
-            let mut hi = ijk.map(|v| v + 1);
-            hi[axis] -= 1;
-            let mut sum = 0.0f32;
-            let mut wsum = 0.0f32;
-            for k in lo[2]..=hi[2] {
-                for j in lo[1]..=hi[1] {
-                    for i in lo[0]..=hi[0] {
-                        let Some(cell) = dims.index([i, j, k]) else { continue };
-                        for s in in_cell(cell) {
-                            let w = weight(sorted_pos[s] - x);
-                            wsum += w;
-                            sum += sorted_vel[s][axis] * w;
-                        }
+    let face_count = grid.faces[2] as usize;
+    let mut face_vel = vec![0.0f32; face_count];
+    let mut face_weight = vec![0.0f32; face_count];
+    for (axis, ijk) in faces(grid) {
+        let mut x = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) + 0.5;
+        x[axis] -= 0.5;
+        let lo = ijk.map(|v| v - 1);
+        let mut hi = ijk.map(|v| v + 1);
+        hi[axis] -= 1;
+        let mut sum = 0.0f32;
+        let mut wsum = 0.0f32;
+        for k in lo[2]..=hi[2] {
+            for j in lo[1]..=hi[1] {
+                for i in lo[0]..=hi[0] {
+                    let Some(cell) = dims.index([i, j, k]) else { continue };
+                    for s in in_cell(cell) {
+                        let w = weight(sorted_pos[s] - x);
+                        wsum += w;
+                        sum += sorted_vel[s][axis] * w;
                     }
                 }
             }
-            let mut u = if wsum > 0.0 { sum / wsum } else { 0.0 };
-            let mut below = ijk;
-            below[axis] -= 1;
-            let solid = [below, ijk].iter().any(|c| dims.index(*c).is_some_and(|c| labels[c] == SOLID));
-            if solid {
-                u = affine(&p.solid_velocity, x)[axis];
-            }
-            let f = face_index(grid, axis, ijk).unwrap_or(0);
-            face_vel[f] = u;
-            face_weight[f] = wsum;
         }
+        let mut u = if wsum > 0.0 { sum / wsum } else { 0.0 };
+        let mut below = ijk;
+        below[axis] -= 1;
+        let solid = [below, ijk].iter().any(|c| dims.index(*c).is_some_and(|c| labels[c] == SOLID));
+        if solid {
+            u = affine(&p.solid_velocity, x)[axis];
+        }
+        let f = face_index(grid, axis, ijk).unwrap_or(0);
+        face_vel[f] = u;
+        face_weight[f] = wsum;
     }
     // Air cells whose six faces all carry particle weight are fluid too.
     for (c, label) in labels.iter_mut().enumerate() {
@@ -441,23 +445,17 @@ pub(crate) fn mic_pcg(grid: &GridLayout, labels: &[u32], b: &[f32], tolerance: f
 /// Subtracts the pressure difference on faces between a fluid cell and a non-solid one.
 pub(crate) fn subtract_gradient(grid: &GridLayout, labels: &[u32], pressure: &[f32], face_vel: &mut [f32]) {
     let dims = Dims(grid.dims);
-    for axis in 0..3 {
-        let mut fd = grid.dims;
-        fd[axis] += 1;
-        let fdims = Dims(fd);
-        for local in 0..fdims.count() {
-            let ijk = fdims.coords(local);
-            let mut below = ijk;
-            below[axis] -= 1;
-            let side = |c: [i64; 3]| {
-                dims.index(c).map_or((AIR, 0.0), |c| (labels[c], if labels[c] == FLUID { pressure[c] } else { 0.0 }))
-            };
-            let (bl, bp) = side(below);
-            let (al, ap) = side(ijk);
-            if (bl == FLUID || al == FLUID) && bl != SOLID && al != SOLID {
-                let f = face_index(grid, axis, ijk).unwrap_or(0);
-                face_vel[f] -= ap - bp;
-            }
+    for (axis, ijk) in faces(grid) {
+        let mut below = ijk;
+        below[axis] -= 1;
+        let side = |c: [i64; 3]| {
+            dims.index(c).map_or((AIR, 0.0), |c| (labels[c], if labels[c] == FLUID { pressure[c] } else { 0.0 }))
+        };
+        let (bl, bp) = side(below);
+        let (al, ap) = side(ijk);
+        if (bl == FLUID || al == FLUID) && bl != SOLID && al != SOLID {
+            let f = face_index(grid, axis, ijk).unwrap_or(0);
+            face_vel[f] -= ap - bp;
         }
     }
 }
