@@ -132,7 +132,7 @@ fn summary(steps: usize) {
                 cpu_ms / ms
             );
         };
-        row("cpu reference, MIC(0)", cpu_ms, f64::NAN, cpu_iterations);
+        row("cpu reference MIC(0)", cpu_ms, f64::NAN, cpu_iterations);
         for (config, preconditioner) in
             [("gpu jacobi", Preconditioner::Jacobi), ("gpu multigrid", Preconditioner::Multigrid)]
         {

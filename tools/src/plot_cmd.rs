@@ -63,6 +63,7 @@ fn line_chart(
     x_desc: &str,
     y_desc: &str,
     lines: &Lines,
+    palette: &[String],
 ) -> Result<(), Error> {
     let all = lines.values().flatten();
     let max_x = all.clone().map(|p| p.0).fold(0.0, f64::max) * 1.05;
@@ -74,8 +75,9 @@ fn line_chart(
         .y_label_area_size(70)
         .build_cartesian_2d(0.0..max_x.max(1e-9), 0.0..max_y.max(1e-9))?;
     chart.configure_mesh().x_desc(x_desc).y_desc(y_desc).draw()?;
-    for (k, (name, points)) in lines.iter().enumerate() {
-        let color = Palette99::pick(k).to_rgba();
+    for (name, points) in lines {
+        // The same name gets the same color in every panel.
+        let color = Palette99::pick(palette.iter().position(|p| p == name).unwrap_or(0)).to_rgba();
         let points: Vec<(f64, f64)> = points.iter().copied().filter(|p| p.1.is_finite()).collect();
         chart
             .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))?
@@ -140,13 +142,17 @@ pub fn plot(a: &PlotArgs) -> Result<(), Error> {
     let (left, right) = root.split_horizontally(600);
     if table.column("pcg_iterations").is_ok() {
         let (time, solves) = volume_lines(&table)?;
-        line_chart(&left, "vkhair volume: GPU ms per step (thesis)", "grid cells per axis", "ms per step", &time)?;
-        line_chart(&right, "PCG iterations per step", "grid cells per axis", "iterations", &solves)?;
+        let palette: Vec<String> = time.keys().cloned().collect();
+        let caption = "vkhair volume: ms per step (thesis)";
+        line_chart(&left, caption, "grid cells per axis", "ms per step", &time, &palette)?;
+        line_chart(&right, "PCG iterations per step", "grid cells per axis", "iterations", &solves, &palette)?;
     } else {
         let (ms, segments) = render_lines(&table)?;
+        let palette: Vec<String> = ms.keys().chain(segments.keys()).cloned().collect();
         let caption = "vkhair render: GPU ms per frame (thesis scene)";
-        line_chart(&left, caption, "camera distance (m)", "GPU ms (all hair passes)", &ms)?;
-        line_chart(&right, "segments drawn (level of detail)", "camera distance (m)", "segments", &segments)?;
+        line_chart(&left, caption, "camera distance (m)", "GPU ms (all hair passes)", &ms, &palette)?;
+        let caption = "segments drawn (level of detail)";
+        line_chart(&right, caption, "camera distance (m)", "segments", &segments, &palette)?;
     }
     root.present()?;
     println!("wrote {}", out.display());
