@@ -2,7 +2,7 @@
 # The main job: list devices, simulate and render the `thesis` scene headless
 # (1750 key hairs → 28,000 hairs, shaking-head motion, three lights): PNG frames,
 # a contact sheet and a per-pass GPU timing table in out/; then the simulation
-# alone against its CPU reference.
+# alone, with the FLIP volume stage on a 32³ grid, against its CPU reference.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup-debian.sh
