@@ -226,6 +226,35 @@ pub(crate) struct PcgScalars {
 }
 gpu_struct!(PcgScalars => "PcgScalars" { sigma, alpha, beta, bmax, rmax, iterations, converged, status });
 
+/// One light's deep opacity map (`ShadowMap` in `glsl/include/shadow.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct GpuShadowMap {
+    /// World → the light's clip space, column-major.
+    pub view_proj: [[f32; 4]; 4],
+    /// Light-space depth: dot(xyz, p) + w (m).
+    pub view_z: [f32; 4],
+    /// xyz layer ends behind z0 (m), w extinction k.
+    pub layers: [f32; 4],
+    /// xy first texel of the tile, zw its size (texels).
+    pub tile: [f32; 4],
+    /// x opacity per strand fragment, y PCF radius (texels).
+    pub params: [f32; 4],
+}
+gpu_struct!(GpuShadowMap => "ShadowMap" { view_proj, view_z, layers, tile, params });
+
+/// The shadow maps of a frame (`ShadowParams` in `glsl/include/shadow.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct GpuShadowParams {
+    pub maps: [GpuShadowMap; 4],
+    /// Map index per light (0xffffffff: none), four lights per vector.
+    pub light_map: [[u32; 4]; 2],
+    /// x hairs, y vertices per hair, z maps.
+    pub counts: [u32; 4],
+}
+gpu_struct!(GpuShadowParams => "ShadowParams" { maps, light_map, counts });
+
 /// Every Rust GPU struct with the shader-side name, for the layout test.
 #[cfg(test)]
 pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<String> {
@@ -250,5 +279,7 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<GpuVolumeParams>(reflection, &mut problems);
     check::<VolumePush>(reflection, &mut problems);
     check::<PcgScalars>(reflection, &mut problems);
+    check::<GpuShadowMap>(reflection, &mut problems);
+    check::<GpuShadowParams>(reflection, &mut problems);
     problems
 }

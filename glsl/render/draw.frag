@@ -14,6 +14,15 @@ layout(set = 0, binding = 3) uniform sampler2D noise;
 // N (cos φ, cos θd) → (N_R, N_TT, N_TRT).
 layout(set = 0, binding = 4) uniform sampler2D marschner_m;
 layout(set = 0, binding = 5) uniform sampler2D marschner_n;
+// Deep opacity maps of the shadow-casting lights (Renderer::record_shadows).
+layout(std140, set = 0, binding = 6) uniform Shadows { ShadowParams sp; };
+layout(set = 0, binding = 7) uniform sampler2D shadow_atlas;
+
+// Transmittance from light `light` to p: 1 for lights without a map.
+float shadow(vec3 p, uint light) {
+    uint map = sp.light_map[light / 4u][light % 4u];
+    return map < sp.counts.z ? shadow_transmittance(shadow_atlas, sp.maps[map], p) : 1.0;
+}
 
 layout(location = 0) in vec3 g_pos;
 layout(location = 1) in vec3 g_tan;

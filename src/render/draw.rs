@@ -52,14 +52,13 @@ impl DrawPass {
         Ok(DrawPass { device: device.clone(), pipelines: HashMap::new(), noise, sampler })
     }
 
-    /// The pipeline and descriptor set for `key`, made on first use.
+    /// The pipeline and descriptor set for `key`, made on first use with `buffers`
+    /// and `images` (by binding) besides the noise texture.
     pub(super) fn pipeline(
         &mut self,
         key: TargetKey,
-        params: &Buffer,
-        positions: &Buffer,
-        tangents: &Buffer,
-        tables: &[(u32, vk::ImageView, vk::Sampler)],
+        buffers: &[(u32, &Buffer)],
+        images: &[(u32, vk::ImageView, vk::Sampler)],
     ) -> Result<&(GraphicsPipeline, vk::DescriptorSet)> {
         if !self.pipelines.contains_key(&key) {
             let color_formats = [key.color];
@@ -85,11 +84,17 @@ impl DrawPass {
                 },
                 1,
             )?;
-            let mut images = vec![(3, self.noise.view(), self.sampler.raw)];
-            images.extend_from_slice(tables);
-            let set = pipeline.resource_set(0, &[(0, params), (1, positions), (2, tangents)], &images)?;
+            let mut all_images = vec![(3, self.noise.view(), self.sampler.raw)];
+            all_images.extend_from_slice(images);
+            let set = pipeline.resource_set(0, buffers, &all_images)?;
             self.pipelines.insert(key, (pipeline, set));
         }
         Ok(&self.pipelines[&key])
+    }
+
+    /// Drops every pipeline and set (their resources changed); the caller made sure
+    /// no pending work uses them.
+    pub(super) fn forget(&mut self) {
+        self.pipelines.clear();
     }
 }

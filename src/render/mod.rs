@@ -11,10 +11,14 @@
 //!    `hairs_per_key` hairs around every smoothed key hair, each offset in the
 //!    key hair's frame by a stable random clump coordinate.
 //!
-//! 3. **Draw** ([`draw`]): the hairs as camera-facing ribbons, Kajiya-Kay
+//! 3. **Shadows** ([`shadow`], optional): deep opacity maps of the
+//!    shadow-casting lights from the interpolated hairs — the depth where the
+//!    hair starts, then opacity accumulated into three layers behind it.
+//! 4. **Draw** ([`draw`]): the hairs as camera-facing ribbons, Kajiya-Kay
 //!    diffuse plus two shifted specular highlights ([`HairMaterial`]) for every
-//!    [`Light`], into the host's color and depth images ([`RenderTarget`]).
-//! 4. **Resolve** ([`resolve`], with [`RenderParams::supersampling`]): the draw
+//!    [`Light`], into the host's color and depth images ([`RenderTarget`]),
+//!    attenuated by the opacity maps.
+//! 5. **Resolve** ([`resolve`], with [`RenderParams::supersampling`]): the draw
 //!    goes to images twice the target's size, then a 5-tap filter blends it into
 //!    the host's target.
 
@@ -26,11 +30,13 @@ pub mod reference;
 pub mod resolve;
 pub mod scalp;
 mod shading;
+pub mod shadow;
 pub mod smooth;
 
 pub use marschner::MarschnerParams;
 pub use offscreen::{MeshDrawer, Offscreen, OFFSCREEN_COLOR, OFFSCREEN_DEPTH};
 pub use shading::{Camera, HairMaterial, Light, ShadingMode, MAX_LIGHTS};
+pub use shadow::{ShadowParams, MAX_SHADOW_MAPS, SHADOW_ATLAS_FORMAT};
 
 use std::sync::Arc;
 
@@ -61,6 +67,10 @@ pub enum RenderPass {
     Smooth,
     /// Pass 2: single-strand interpolation.
     Interpolate,
+    /// Shadows, pass 1: the depth where the hair starts, per light.
+    ShadowDepth,
+    /// Shadows, pass 2: opacity accumulated into three layers, per light.
+    ShadowOpacity,
     /// Pass 3: drawing and shading.
     Draw,
     /// Pass 4: supersampling resolve.
@@ -73,6 +83,8 @@ impl RenderPass {
         match self {
             RenderPass::Smooth => "vkhair render: smooth",
             RenderPass::Interpolate => "vkhair render: interpolate",
+            RenderPass::ShadowDepth => "vkhair render: shadow depth",
+            RenderPass::ShadowOpacity => "vkhair render: shadow opacity",
             RenderPass::Draw => "vkhair render: draw",
             RenderPass::Resolve => "vkhair render: resolve",
         }
@@ -248,6 +260,8 @@ pub struct Renderer {
     head_rotation: glam::Quat,
     /// Centre of the rest shape's bounds, head frame (LOD distance).
     rest_center: glam::Vec3,
+    /// `rest_center` in the world at the latest prepared frame.
+    head_center: glam::Vec3,
     /// The detail of the latest prepared frame.
     detail: Detail,
     /// Supersampling images for the current target size, made on first use.
@@ -263,6 +277,10 @@ pub struct Renderer {
     triangles: u32,
     _triangle_buffer: Buffer,
     interpolate_barycentric: InterpolatePass,
+    /// Deep opacity maps.
+    shadows: shadow::ShadowMaps,
+    /// Radius around `rest_center` that the hair can reach (roots plus strand length).
+    bound_radius: f32,
 }
 
 impl Renderer {
@@ -323,6 +341,19 @@ impl Renderer {
         }
         let marschner = marschner::MarschnerTables::new(&device)?;
         let draw = DrawPass::new(&device)?;
+        let shadows = shadow::ShadowMaps::new(&device, &ShadowParams::default(), &hair_positions)?;
+        let rest_shape = sim.rest_shape();
+        let (lo, hi) =
+            rest_shape.rest.iter().fold((glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)), |(lo, hi), p| {
+                (lo.min(p.truncate()), hi.max(p.truncate()))
+            });
+        let rest_center = 0.5 * (lo + hi);
+        let bound_radius = (0..rest_shape.strands)
+            .map(|s| {
+                let root = rest_shape.rest[s * rest_shape.points].truncate();
+                (root - rest_center).length() + rest_shape.rest_strand_length(s)
+            })
+            .fold(0.0f32, f32::max);
         let draw_params = Buffer::new(
             &device,
             &BufferDesc {
@@ -351,14 +382,7 @@ impl Renderer {
             material: HairMaterial::default(),
             lights: Vec::new(),
             head_rotation: sim.head().rotation.normalize(),
-            rest_center: {
-                let rest = &sim.rest_shape().rest;
-                let (lo, hi) =
-                    rest.iter().fold((glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)), |(lo, hi), p| {
-                        (lo.min(p.truncate()), hi.max(p.truncate()))
-                    });
-                0.5 * (lo + hi)
-            },
+            rest_center,
             detail: params.detail_at(0.0),
             supersampling: None,
             retired: Vec::new(),
@@ -367,6 +391,9 @@ impl Renderer {
             triangles: triangles.len() as u32,
             _triangle_buffer: triangle_buffer,
             interpolate_barycentric,
+            shadows,
+            bound_radius,
+            head_center: rest_center,
         })
     }
 
@@ -516,8 +543,8 @@ impl Renderer {
         let (_, half) = sim.position_halves();
         let head = sim.head();
         self.head_rotation = head.rotation.normalize();
-        let distance =
-            camera.map_or(0.0, |c| (c.position() - head.matrix().transform_point3(self.rest_center)).length());
+        self.head_center = head.matrix().transform_point3(self.rest_center);
+        let distance = camera.map_or(0.0, |c| (c.position() - self.head_center).length());
         self.detail = self.params.detail_at(distance);
         let d = &self.device;
         let entry = barrier::memory(
@@ -648,6 +675,89 @@ impl Renderer {
         }
     }
 
+    /// The shadow parameters.
+    pub fn shadows(&self) -> &ShadowParams {
+        &self.shadows.params
+    }
+
+    /// Chooses the shadow-casting lights and the maps' parameters (validated first).
+    /// A new atlas size (caster count or resolution) creates new images and waits for
+    /// the device to be idle first. Maps are drawn by [`Renderer::record_shadows`].
+    pub fn set_shadows(&mut self, params: &ShadowParams) -> Result<()> {
+        params.validate()?;
+        let resized = params.casters.len() != self.shadows.params.casters.len()
+            || (params.resolution != self.shadows.params.resolution && !params.casters.is_empty());
+        if resized {
+            self.device.wait_idle()?;
+            self.shadows = shadow::ShadowMaps::new(&self.device, params, &self.hair_positions)?;
+            self.draw.forget();
+        } else {
+            self.shadows.params = params.clone();
+        }
+        Ok(())
+    }
+
+    /// Records the opacity maps of the shadow-casting lights from the hairs of the
+    /// latest [`Renderer::record_prepare`] (nothing without casters). Call it every
+    /// frame after `record_prepare` and before [`Renderer::record_draw`]; the draw then
+    /// attenuates those lights. Afterwards the atlas ([`Renderer::shadow_atlas`]) is in
+    /// `SHADER_READ_ONLY_OPTIMAL`, written by `COLOR_ATTACHMENT_OUTPUT` and made
+    /// visible to fragment shaders, for a host that shades its own surfaces with it.
+    ///
+    /// # Safety
+    /// As for [`Renderer::record_prepare`], recorded after it in submission order; the
+    /// atlas is not in use by pending work of other frames in a conflicting way (the
+    /// usual frames-in-flight wait covers the renderer's own draws).
+    pub unsafe fn record_shadows(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        mut profiler: Option<&mut GpuProfiler>,
+    ) -> Result<()> {
+        let params = &self.shadows.params;
+        if params.casters.is_empty() {
+            return Ok(());
+        }
+        let (hairs, per_hair) = self.hair_counts();
+        let mut uniforms = shadow::no_shadows();
+        for (k, &light) in params.casters.iter().enumerate() {
+            let gpu = self.lights.get(light).ok_or_else(|| {
+                Error::param("shadow casters", format!("light {light} does not exist ({} lights)", self.lights.len()))
+            })?;
+            uniforms.maps[k] = shadow::light_map(gpu, light, self.head_center, self.bound_radius, params, k)?;
+            uniforms.light_map[light / 4][light % 4] = k as u32;
+        }
+        uniforms.counts = [hairs, per_hair, params.casters.len() as u32, 0];
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.shadows.record(cmd, &uniforms, hairs * (per_hair - 1) * 2, &mut profiler) };
+        Ok(())
+    }
+
+    /// The opacity atlas (format [`SHADOW_ATLAS_FORMAT`], one tile per caster, two tiles
+    /// per row) and a nearest sampler, for a host shading its own surfaces with
+    /// `glsl/include/shadow.glsl`.
+    pub fn shadow_atlas(&self) -> (vk::ImageView, vk::Sampler) {
+        (self.shadows.atlas.view(), self.shadows.sampler.raw)
+    }
+
+    /// Reads the opacity atlas back, row after row (this submits and waits): per texel
+    /// the opacity summed to the end of each layer and z0 (0 where no hair is).
+    pub fn read_shadow_atlas(&self) -> Result<(vk::Extent2D, Vec<[f32; 4]>)> {
+        let atlas = &self.shadows.atlas;
+        let bytes = self.device.readback_image(atlas, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, 16)?;
+        let texels = bytes
+            .chunks_exact(16)
+            .map(|t| std::array::from_fn(|k| f32::from_le_bytes([t[4 * k], t[4 * k + 1], t[4 * k + 2], t[4 * k + 3]])))
+            .collect();
+        Ok((atlas.extent, texels))
+    }
+
+    /// The uniform buffer holding the frame's `ShadowParams` (`glsl/include/shadow.glsl`;
+    /// std140), written by [`Renderer::record_shadows`] with a transfer and made
+    /// visible to vertex and fragment shaders.
+    pub fn shadow_uniforms(&self) -> vk::Buffer {
+        self.shadows.uniforms.raw()
+    }
+
     /// Sets of size-dependent images waiting for their frames to complete.
     pub fn retired_image_sets(&self) -> usize {
         self.retired.len()
@@ -680,8 +790,12 @@ impl Renderer {
             (4, self.marschner.m.view(), self.marschner.sampler.raw),
             (5, self.marschner.n.view(), self.marschner.sampler.raw),
         ];
-        let (pipeline, set) =
-            self.draw.pipeline(key, &self.draw_params, &self.hair_positions, &self.hair_tangents, &tables)?;
+        let shadow_atlas = (7, self.shadows.atlas.view(), self.shadows.sampler.raw);
+        let (pipeline, set) = self.draw.pipeline(
+            key,
+            &[(0, &self.draw_params), (1, &self.hair_positions), (2, &self.hair_tangents), (6, &self.shadows.uniforms)],
+            &[tables[0], tables[1], shadow_atlas],
+        )?;
         let before_update = barrier::memory(Access::ANY_WRITE, Access::TRANSFER_WRITE);
         let updated = barrier::memory(
             Access::TRANSFER_WRITE,

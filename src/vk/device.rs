@@ -45,6 +45,10 @@ pub struct DeviceInfo {
     pub max_storage_buffer_range: u32,
     /// Invocations per subgroup (SPIR-V 1.5 modules always see this size).
     pub subgroup_size: u32,
+    /// Largest 2D image side, texels.
+    pub max_image_dimension_2d: u32,
+    /// Whether RGBA32 float color attachments can blend (the opacity-map atlas).
+    pub rgba32f_blend: bool,
 }
 
 impl DeviceInfo {
@@ -77,6 +81,14 @@ impl DeviceInfo {
             max_tessellation_level: props.limits.max_tessellation_generation_level,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
             subgroup_size: subgroup.subgroup_size,
+            max_image_dimension_2d: props.limits.max_image_dimension2_d,
+            rgba32f_blend: {
+                // SAFETY: as above.
+                let f = unsafe {
+                    instance.get_physical_device_format_properties(physical, vk::Format::R32G32B32A32_SFLOAT)
+                };
+                f.optimal_tiling_features.contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND)
+            },
         }
     }
 }

@@ -211,6 +211,20 @@ impl Layout {
         Ok(())
     }
 
+    /// Allocates descriptor set `set` with buffer and combined image-sampler bindings.
+    fn resource_set(
+        &self,
+        set: u32,
+        kind: &str,
+        buffers: &[(u32, &Buffer)],
+        images: &[(u32, vk::ImageView, vk::Sampler)],
+    ) -> Result<vk::DescriptorSet> {
+        let target = self.allocate_set(set, &format!("{kind} set {set}"))?;
+        self.write_buffers(target, set, buffers)?;
+        self.write_images(target, set, images)?;
+        Ok(target)
+    }
+
     /// Points storage/uniform buffer bindings of `set` at whole buffers.
     fn write_buffers(&self, target: vk::DescriptorSet, set: u32, buffers: &[(u32, &Buffer)]) -> Result<()> {
         let infos: Vec<_> = buffers.iter().map(|(_, b)| [b.descriptor()]).collect();
@@ -328,6 +342,17 @@ impl ComputePipeline {
         Ok(target)
     }
 
+    /// Allocates descriptor set `set` with buffer and combined image-sampler bindings.
+    #[cfg(test)]
+    pub(crate) fn resource_set(
+        &self,
+        set: u32,
+        buffers: &[(u32, &Buffer)],
+        images: &[(u32, vk::ImageView, vk::Sampler)],
+    ) -> Result<vk::DescriptorSet> {
+        self.layout.resource_set(set, &self.name, buffers, images)
+    }
+
     /// Allocates descriptor set `set` and points its storage-image bindings at views
     /// (in GENERAL layout when dispatched).
     pub(crate) fn storage_image_set(&self, set: u32, images: &[(u32, vk::ImageView)]) -> Result<vk::DescriptorSet> {
@@ -437,6 +462,8 @@ pub(crate) enum Blend {
     Additive,
     /// Premultiplied alpha over the destination (`ONE`, `ONE_MINUS_SRC_ALPHA`).
     Premultiplied,
+    /// Add the color, keep the larger alpha (opacity layers with z0 in alpha).
+    AddColorMaxAlpha,
 }
 
 /// A graphics pipeline.
@@ -502,6 +529,15 @@ impl GraphicsPipeline {
                     .alpha_blend_op(vk::BlendOp::ADD)
                     .color_write_mask(vk::ColorComponentFlags::RGBA)
             }
+            Blend::AddColorMaxAlpha => vk::PipelineColorBlendAttachmentState::default()
+                .blend_enable(true)
+                .src_color_blend_factor(vk::BlendFactor::ONE)
+                .dst_color_blend_factor(vk::BlendFactor::ONE)
+                .color_blend_op(vk::BlendOp::ADD)
+                .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+                .alpha_blend_op(vk::BlendOp::MAX)
+                .color_write_mask(vk::ColorComponentFlags::RGBA),
         };
         let attachments = vec![attachment; desc.color_formats.len()];
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
@@ -551,10 +587,7 @@ impl GraphicsPipeline {
         buffers: &[(u32, &Buffer)],
         images: &[(u32, vk::ImageView, vk::Sampler)],
     ) -> Result<vk::DescriptorSet> {
-        let target = self.layout.allocate_set(set, &format!("graphics set {set}"))?;
-        self.layout.write_buffers(target, set, buffers)?;
-        self.layout.write_images(target, set, images)?;
-        Ok(target)
+        self.layout.resource_set(set, "graphics", buffers, images)
     }
 
     /// Binds the pipeline and descriptor sets (from set 0).

@@ -169,6 +169,8 @@ fn every_shader_struct_matches_its_rust_twin() {
         gpu_types::GpuVolumeParams::GLSL_NAME,
         gpu_types::VolumePush::GLSL_NAME,
         gpu_types::PcgScalars::GLSL_NAME,
+        gpu_types::GpuShadowMap::GLSL_NAME,
+        gpu_types::GpuShadowParams::GLSL_NAME,
     ];
     let mut found = vec![0usize; names.len()];
     for shader in shaders::ALL {

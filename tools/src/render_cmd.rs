@@ -11,7 +11,7 @@ use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::Groom;
 use vkhair::render::{
     Camera, HairMaterial, InterpolationMode, Light, MeshDrawer, Offscreen, Primitive, RenderParams, Renderer,
-    ShadingMode,
+    ShadingMode, ShadowParams,
 };
 use vkhair::sim::{motion, Collider, HairSim, RigidTransform, SimParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
@@ -67,6 +67,12 @@ pub struct RenderArgs {
     /// Draw one-pixel lines instead of ribbons.
     #[arg(long)]
     lines: bool,
+    /// No self-shadowing (by default the two spot lights cast deep opacity maps).
+    #[arg(long)]
+    no_shadows: bool,
+    /// Side of each light's opacity map, texels.
+    #[arg(long, default_value_t = 512)]
+    shadow_resolution: u32,
 }
 
 struct Scene {
@@ -199,6 +205,11 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     params.lod.enabled = !a.no_lod;
     let mut renderer = Renderer::new(&ctx, &sim, &params)?;
     renderer.set_lights(&lights(s.center))?;
+    if !a.no_shadows {
+        // The thesis' setup: both spot lights cast shadows through their own maps.
+        let shadows = ShadowParams { casters: vec![0, 1], resolution: a.shadow_resolution, ..ShadowParams::default() };
+        renderer.set_shadows(&shadows)?;
+    }
     if a.marschner {
         let material = HairMaterial { shading: ShadingMode::Marschner, ..HairMaterial::default() };
         renderer.set_material(&material)?;
@@ -264,6 +275,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
                 }
                 result
                     .and_then(|_| renderer.record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler)))
+                    .and_then(|_| renderer.record_shadows(cmd, Some(&mut profiler)))
                     .map(|_| {
                         offscreen.record_clear(cmd, Vec3::splat(0.02));
                         let scope = profiler.begin_scope(cmd, "host: head mesh");
