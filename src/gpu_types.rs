@@ -252,8 +252,14 @@ pub(crate) struct GpuShadowParams {
     pub light_map: [[u32; 4]; 2],
     /// x hairs, y vertices per hair, z maps.
     pub counts: [u32; 4],
+    /// The density volume: world → grid coordinates.
+    pub grid_from_world: [[f32; 4]; 4],
+    /// xyz cells, w 1 when present.
+    pub grid_dims: [u32; 4],
+    /// x cell size (m), y cross-section per particle / cell volume (1/m), z step (cells).
+    pub grid: [f32; 4],
 }
-gpu_struct!(GpuShadowParams => "ShadowParams" { maps, light_map, counts });
+gpu_struct!(GpuShadowParams => "ShadowParams" { maps, light_map, counts, grid_from_world, grid_dims, grid });
 
 /// Every Rust GPU struct with the shader-side name, for the layout test.
 #[cfg(test)]

@@ -210,7 +210,7 @@ fn draw(gpu: &Gpu, s: &mut Scene, blocker: Option<&MeshDrawer>) -> Vec<u8> {
             result = unsafe {
                 s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
                     // Nothing to record while no light casts a shadow.
-                    s.renderer.record_shadows(cmd, None)?;
+                    s.renderer.record_shadows(cmd, &s.sim, None)?;
                     s.offscreen.record_clear(cmd, Vec3::ZERO);
                     if let Some(mesh) = blocker {
                         let vp = s.camera.projection * s.camera.view;
@@ -597,7 +597,8 @@ fn self_shadowing_darkens_the_far_side_and_leaves_the_lit_side() {
     // far side of the hair.
     s.renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_X, color: Vec3::ONE }]).expect("lights");
     let off = draw(&gpu, &mut s, None);
-    s.renderer.set_shadows(&ShadowParams { casters: vec![0], ..ShadowParams::default() }).expect("shadows");
+    let shadows = ShadowParams { casters: vec![0.into()], ..ShadowParams::default() };
+    s.renderer.set_shadows(&s.sim, &shadows).expect("shadows");
     let on = draw(&gpu, &mut s, None);
     let pixels = hair_pixels(&off);
     let (lo, hi) = pixels.iter().fold((u32::MAX, 0), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
@@ -621,6 +622,6 @@ fn self_shadowing_darkens_the_far_side_and_leaves_the_lit_side() {
     assert!(far < 0.85, "the far side is darker with shadows ({far})");
     assert!(near > 0.95, "no acne on the lit side ({near})");
     // Switching the casters off again restores the unshadowed image exactly.
-    s.renderer.set_shadows(&ShadowParams::default()).expect("shadows off");
+    s.renderer.set_shadows(&s.sim, &ShadowParams::default()).expect("shadows off");
     assert_eq!(draw(&gpu, &mut s, None), off);
 }

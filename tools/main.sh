@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The main job: list devices, simulate and render the `thesis` scene headless
-# (1750 key hairs → 28,000 hairs, shaking-head motion, three lights): PNG frames,
+# (1750 key hairs → 28,000 hairs, shaking-head motion, three lights, two of them
+# casting self-shadows through deep opacity maps): PNG frames,
 # a contact sheet and a per-pass GPU timing table in out/; then the simulation
 # alone, with the FLIP volume stage on a 32³ grid, against its CPU reference.
 set -euo pipefail

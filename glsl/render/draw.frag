@@ -5,6 +5,11 @@
 // one in the light's color, the secondary one tinted and broken up by noise;
 // the shift is jittered per hair by a second noise channel.
 #include "render.glsl"
+
+// Transmittance toward each density-volume light at the density grid's cell
+// centres (Renderer::record_shadows computes it each frame).
+layout(std430, set = 0, binding = 8) readonly buffer Transmittance { float volume_transmittance[]; };
+#define VKHAIR_SHADOW_TRANSMITTANCE volume_transmittance
 #include "shadow.glsl"
 
 layout(std140, set = 0, binding = 0) uniform Draw { DrawParams dp; };
@@ -18,10 +23,16 @@ layout(set = 0, binding = 5) uniform sampler2D marschner_n;
 layout(std140, set = 0, binding = 6) uniform Shadows { ShadowParams sp; };
 layout(set = 0, binding = 7) uniform sampler2D shadow_atlas;
 
-// Transmittance from light `light` to p: 1 for lights without a map.
+// Transmittance from light `light` to p: 1 for lights that cast no shadow.
 float shadow(vec3 p, uint light) {
     uint map = sp.light_map[light / 4u][light % 4u];
-    return map < sp.counts.z ? shadow_transmittance(shadow_atlas, sp.maps[map], p) : 1.0;
+    if (map >= sp.counts.z) {
+        return 1.0;
+    }
+    if (uint(sp.maps[map].params.z) == SHADOW_DENSITY_VOLUME) {
+        return shadow_volume_lookup(sp, sp.maps[map], p);
+    }
+    return shadow_transmittance(shadow_atlas, sp.maps[map], p);
 }
 
 layout(location = 0) in vec3 g_pos;

@@ -36,7 +36,7 @@ pub mod smooth;
 pub use marschner::MarschnerParams;
 pub use offscreen::{MeshDrawer, Offscreen, OFFSCREEN_COLOR, OFFSCREEN_DEPTH};
 pub use shading::{Camera, HairMaterial, Light, ShadingMode, MAX_LIGHTS};
-pub use shadow::{ShadowParams, MAX_SHADOW_MAPS, SHADOW_ATLAS_FORMAT};
+pub use shadow::{ShadowCaster, ShadowMethod, ShadowParams, MAX_SHADOW_MAPS, SHADOW_ATLAS_FORMAT};
 
 use std::sync::Arc;
 
@@ -71,6 +71,8 @@ pub enum RenderPass {
     ShadowDepth,
     /// Shadows, pass 2: opacity accumulated into three layers, per light.
     ShadowOpacity,
+    /// Density-volume shadows: transmittance toward the light at every cell.
+    ShadowVolume,
     /// Pass 3: drawing and shading.
     Draw,
     /// Pass 4: supersampling resolve.
@@ -85,6 +87,7 @@ impl RenderPass {
             RenderPass::Interpolate => "vkhair render: interpolate",
             RenderPass::ShadowDepth => "vkhair render: shadow depth",
             RenderPass::ShadowOpacity => "vkhair render: shadow opacity",
+            RenderPass::ShadowVolume => "vkhair render: shadow volume",
             RenderPass::Draw => "vkhair render: draw",
             RenderPass::Resolve => "vkhair render: resolve",
         }
@@ -281,6 +284,8 @@ pub struct Renderer {
     shadows: shadow::ShadowMaps,
     /// Radius around `rest_center` that the hair can reach (roots plus strand length).
     bound_radius: f32,
+    /// Density-volume shadows (placeholder buffers while no light uses them).
+    volume_shadows: shadow::VolumeShadows,
 }
 
 impl Renderer {
@@ -342,6 +347,7 @@ impl Renderer {
         let marschner = marschner::MarschnerTables::new(&device)?;
         let draw = DrawPass::new(&device)?;
         let shadows = shadow::ShadowMaps::new(&device, &ShadowParams::default(), &hair_positions)?;
+        let volume_shadows = shadow::VolumeShadows::new(&device, &shadows.uniforms, 0, 0)?;
         let rest_shape = sim.rest_shape();
         let (lo, hi) =
             rest_shape.rest.iter().fold((glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)), |(lo, hi), p| {
@@ -394,6 +400,7 @@ impl Renderer {
             shadows,
             bound_radius,
             head_center: rest_center,
+            volume_shadows,
         })
     }
 
@@ -680,37 +687,58 @@ impl Renderer {
         &self.shadows.params
     }
 
-    /// Chooses the shadow-casting lights and the maps' parameters (validated first).
-    /// A new atlas size (caster count or resolution) creates new images and waits for
-    /// the device to be idle first. Maps are drawn by [`Renderer::record_shadows`].
-    pub fn set_shadows(&mut self, params: &ShadowParams) -> Result<()> {
+    /// Chooses the shadow-casting lights and the maps' parameters for `sim` (validated
+    /// first). A new atlas size (map count or resolution) or a larger density volume
+    /// creates new GPU resources and waits for the device to be idle first. Maps are
+    /// drawn by [`Renderer::record_shadows`].
+    pub fn set_shadows(&mut self, sim: &HairSim, params: &ShadowParams) -> Result<()> {
         params.validate()?;
-        let resized = params.casters.len() != self.shadows.params.casters.len()
-            || (params.resolution != self.shadows.params.resolution && !params.casters.is_empty());
-        if resized {
-            self.device.wait_idle()?;
-            self.shadows = shadow::ShadowMaps::new(&self.device, params, &self.hair_positions)?;
-            self.draw.forget();
+        let volume_lights = params.volume_casters();
+        let cells = if volume_lights > 0 {
+            let grid = sim.volume_grid().ok_or_else(|| {
+                Error::param(
+                    "shadow casters",
+                    "density-volume shadows need the simulation's volume stage (SimParams::volume)",
+                )
+            })?;
+            grid.dims.iter().product::<u32>()
         } else {
-            self.shadows.params = params.clone();
+            0
+        };
+        let new_atlas = params.atlas_extent() != self.shadows.params.atlas_extent();
+        let new_volume = self.volume_shadows.cells != cells
+            || self.volume_shadows.transmittance.size() < u64::from(cells) * u64::from(volume_lights) * 4;
+        if new_atlas || new_volume {
+            self.device.wait_idle()?;
+            if new_atlas {
+                self.shadows = shadow::ShadowMaps::new(&self.device, params, &self.hair_positions)?;
+            }
+            self.volume_shadows =
+                shadow::VolumeShadows::new(&self.device, &self.shadows.uniforms, cells, volume_lights)?;
+            self.draw.forget();
         }
+        self.shadows.params = params.clone();
         Ok(())
     }
 
-    /// Records the opacity maps of the shadow-casting lights from the hairs of the
-    /// latest [`Renderer::record_prepare`] (nothing without casters). Call it every
-    /// frame after `record_prepare` and before [`Renderer::record_draw`]; the draw then
-    /// attenuates those lights. Afterwards the atlas ([`Renderer::shadow_atlas`]) is in
-    /// `SHADER_READ_ONLY_OPTIMAL`, written by `COLOR_ATTACHMENT_OUTPUT` and made
-    /// visible to fragment shaders, for a host that shades its own surfaces with it.
+    /// Records the shadows of the casters for the hairs of the latest
+    /// [`Renderer::record_prepare`] of `sim`: the opacity maps, and a copy of `sim`'s
+    /// density volume for density-volume casters (nothing without casters). Call it
+    /// every frame after `record_prepare` and before [`Renderer::record_draw`]; the
+    /// draw then attenuates those lights. Afterwards the atlas
+    /// ([`Renderer::shadow_atlas`]) is in `SHADER_READ_ONLY_OPTIMAL`, written by
+    /// `COLOR_ATTACHMENT_OUTPUT` and made visible to fragment shaders, for a host that
+    /// shades its own surfaces with it.
     ///
     /// # Safety
-    /// As for [`Renderer::record_prepare`], recorded after it in submission order; the
-    /// atlas is not in use by pending work of other frames in a conflicting way (the
-    /// usual frames-in-flight wait covers the renderer's own draws).
+    /// As for [`Renderer::record_prepare`], recorded after it (and after `sim`'s step)
+    /// in submission order; the atlas is not in use by pending work of other frames in
+    /// a conflicting way (the usual frames-in-flight wait covers the renderer's own
+    /// draws).
     pub unsafe fn record_shadows(
         &mut self,
         cmd: vk::CommandBuffer,
+        sim: &HairSim,
         mut profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
         let params = &self.shadows.params;
@@ -719,16 +747,56 @@ impl Renderer {
         }
         let (hairs, per_hair) = self.hair_counts();
         let mut uniforms = shadow::no_shadows();
-        for (k, &light) in params.casters.iter().enumerate() {
-            let gpu = self.lights.get(light).ok_or_else(|| {
-                Error::param("shadow casters", format!("light {light} does not exist ({} lights)", self.lights.len()))
+        let (mut tile, mut slot) = (0, 0);
+        let mut volume_maps = Vec::new();
+        let cells = self.volume_shadows.cells;
+        for (k, caster) in params.casters.iter().enumerate() {
+            let gpu = self.lights.get(caster.light).ok_or_else(|| {
+                Error::param(
+                    "shadow casters",
+                    format!("light {} does not exist ({} lights)", caster.light, self.lights.len()),
+                )
             })?;
-            uniforms.maps[k] = shadow::light_map(gpu, light, self.head_center, self.bound_radius, params, k)?;
-            uniforms.light_map[light / 4][light % 4] = k as u32;
+            uniforms.maps[k] = match caster.method {
+                ShadowMethod::DeepOpacity => {
+                    tile += 1;
+                    shadow::light_map(gpu, caster.light, self.head_center, self.bound_radius, params, tile - 1)?
+                }
+                ShadowMethod::DensityVolume => {
+                    slot += 1;
+                    volume_maps.push(k as u32);
+                    shadow::volume_map(gpu, slot - 1, cells)
+                }
+            };
+            uniforms.light_map[caster.light / 4][caster.light % 4] = k as u32;
         }
         uniforms.counts = [hairs, per_hair, params.casters.len() as u32, 0];
+        let mut copy = None;
+        if !volume_maps.is_empty() {
+            let (grid, buffer) = sim.volume_grid().zip(sim.density_buffer()).ok_or_else(|| {
+                Error::param("shadow casters", "density-volume shadows need the simulation's volume stage")
+            })?;
+            if grid.dims.iter().product::<u32>() != cells {
+                return Err(Error::param(
+                    "shadow casters",
+                    "the simulation's volume grid changed; call set_shadows again",
+                ));
+            }
+            let h = grid.cell_size;
+            uniforms.grid_from_world = grid.world_from_grid.inverse().to_cols_array_2d();
+            uniforms.grid_dims = [grid.dims[0], grid.dims[1], grid.dims[2], 1];
+            uniforms.grid = [h, params.volume_cross_section / (h * h * h), params.volume_step, 0.0];
+            copy = Some((buffer, u64::from(cells) * 16));
+        }
         // SAFETY: guaranteed by the caller.
-        unsafe { self.shadows.record(cmd, &uniforms, hairs * (per_hair - 1) * 2, &mut profiler) };
+        unsafe {
+            self.shadows.record(cmd, &uniforms, hairs * (per_hair - 1) * 2, &mut profiler);
+            if let Some((source, bytes)) = copy {
+                let scope = begin_pass(&self.device, cmd, &mut profiler, RenderPass::ShadowVolume);
+                self.volume_shadows.record(cmd, source, bytes, &volume_maps);
+                end_pass(&self.device, cmd, &mut profiler, scope);
+            }
+        }
         Ok(())
     }
 
@@ -793,7 +861,13 @@ impl Renderer {
         let shadow_atlas = (7, self.shadows.atlas.view(), self.shadows.sampler.raw);
         let (pipeline, set) = self.draw.pipeline(
             key,
-            &[(0, &self.draw_params), (1, &self.hair_positions), (2, &self.hair_tangents), (6, &self.shadows.uniforms)],
+            &[
+                (0, &self.draw_params),
+                (1, &self.hair_positions),
+                (2, &self.hair_tangents),
+                (6, &self.shadows.uniforms),
+                (8, &self.volume_shadows.transmittance),
+            ],
             &[tables[0], tables[1], shadow_atlas],
         )?;
         let before_update = barrier::memory(Access::ANY_WRITE, Access::TRANSFER_WRITE);

@@ -69,6 +69,49 @@ pub fn key_frame(t: Vec3, reference: Vec3) -> (Vec3, Vec3) {
     (b1, t.cross(b1))
 }
 
+/// Bertails et al.'s light-oriented density map (2005), the CPU reference of
+/// density-volume shadows: `particles` splatted into cubic cells of side `ds` in a
+/// frame whose first axis is the light's direction of travel `light_dir`;
+/// transmittance at each of `points` = exp(−σ · Σ N / ds²) over the cells of its
+/// column strictly before its own cell along the light (N particles per cell, so
+/// Σ N / ds² is the particles per area crossed, ∫ particle density ds). The counts
+/// are box-filtered over (2·`filter` + 1)² neighbouring columns, the map's filtering
+/// step, which hides where the particle lattice happens to fall on the cells.
+pub fn light_oriented_transmittance(
+    particles: &[Vec3],
+    light_dir: Vec3,
+    cross_section: f32,
+    ds: f32,
+    filter: i64,
+    points: &[Vec3],
+) -> Vec<f32> {
+    let x = light_dir.normalize();
+    let helper = if x.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
+    let y = x.cross(helper).normalize();
+    let z = x.cross(y);
+    let cell = |p: Vec3| [p.dot(x), p.dot(y), p.dot(z)].map(|c| (c / ds).floor() as i64);
+    let mut columns: std::collections::HashMap<(i64, i64), Vec<i64>> = std::collections::HashMap::new();
+    for &p in particles {
+        let [i, j, k] = cell(p);
+        columns.entry((j, k)).or_default().push(i);
+    }
+    points
+        .iter()
+        .map(|&q| {
+            let [i, j, k] = cell(q);
+            let mut before = 0;
+            for dj in -filter..=filter {
+                for dk in -filter..=filter {
+                    let column = columns.get(&(j + dj, k + dk));
+                    before += column.map_or(0, |c| c.iter().filter(|&&ci| ci < i).count());
+                }
+            }
+            let columns_averaged = ((2 * filter + 1) * (2 * filter + 1)) as f32;
+            (-cross_section * before as f32 / columns_averaged / (ds * ds)).exp()
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -89,6 +89,10 @@ impl Buffer {
         self.raw
     }
 
+    pub(crate) fn size(&self) -> u64 {
+        self.size
+    }
+
     pub(crate) fn name(&self) -> &str {
         &self.name
     }

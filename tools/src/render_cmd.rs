@@ -11,9 +11,9 @@ use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::Groom;
 use vkhair::render::{
     Camera, HairMaterial, InterpolationMode, Light, MeshDrawer, Offscreen, Primitive, RenderParams, Renderer,
-    ShadingMode, ShadowParams,
+    ShadingMode, ShadowCaster, ShadowParams,
 };
-use vkhair::sim::{motion, Collider, HairSim, RigidTransform, SimParams};
+use vkhair::sim::{motion, Collider, HairSim, RigidTransform, SimParams, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
 #[derive(clap::Args)]
@@ -73,6 +73,10 @@ pub struct RenderArgs {
     /// Side of each light's opacity map, texels.
     #[arg(long, default_value_t = 512)]
     shadow_resolution: u32,
+    /// Shadow the spot lights through the simulation's density volume instead of
+    /// opacity maps (turns the simulation's FLIP volume stage on).
+    #[arg(long)]
+    volume_shadows: bool,
 }
 
 struct Scene {
@@ -191,7 +195,10 @@ fn contact_sheet(frames: &[Vec<u8>], width: u32, height: u32) -> (u32, u32, Vec<
 pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let s = scene(a)?;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
-    let sim_params = SimParams::default();
+    let mut sim_params = SimParams::default();
+    if a.volume_shadows {
+        sim_params.volume = VolumeParams::flip([32, 32, 32]);
+    }
     let mut sim = HairSim::new(&ctx, &s.groom, &sim_params, &RigidTransform::default())?;
     sim.set_colliders(&s.colliders)?;
     let mut params = RenderParams {
@@ -207,8 +214,13 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     renderer.set_lights(&lights(s.center))?;
     if !a.no_shadows {
         // The thesis' setup: both spot lights cast shadows through their own maps.
-        let shadows = ShadowParams { casters: vec![0, 1], resolution: a.shadow_resolution, ..ShadowParams::default() };
-        renderer.set_shadows(&shadows)?;
+        let casters = if a.volume_shadows {
+            vec![ShadowCaster::density_volume(0), ShadowCaster::density_volume(1)]
+        } else {
+            vec![0.into(), 1.into()]
+        };
+        let shadows = ShadowParams { casters, resolution: a.shadow_resolution, ..ShadowParams::default() };
+        renderer.set_shadows(&sim, &shadows)?;
     }
     if a.marschner {
         let material = HairMaterial { shading: ShadingMode::Marschner, ..HairMaterial::default() };
@@ -275,7 +287,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
                 }
                 result
                     .and_then(|_| renderer.record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler)))
-                    .and_then(|_| renderer.record_shadows(cmd, Some(&mut profiler)))
+                    .and_then(|_| renderer.record_shadows(cmd, &sim, Some(&mut profiler)))
                     .map(|_| {
                         offscreen.record_clear(cmd, Vec3::splat(0.02));
                         let scope = profiler.begin_scope(cmd, "host: head mesh");
