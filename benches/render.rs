@@ -163,8 +163,8 @@ fn shadow_table(
         String::from("width,height,config,shadow_depth_ms,shadow_opacity_ms,shadow_volume_ms,draw_ms,total_ms\n");
     println!("\n{} — thesis scene at 0.6 m, self-shadowing (512² maps), GPU ms per pass", ctx.info().name);
     println!(
-        "{:>10} {:<18} {:>12} {:>14} {:>9} {:>9}",
-        "size", "shadows", "shadow depth", "shadow opacity", "draw", "total"
+        "{:>10} {:<18} {:>12} {:>14} {:>13} {:>9} {:>9}",
+        "size", "shadows", "shadow depth", "shadow opacity", "shadow volume", "draw", "total"
     );
     for &(w, h) in resolutions {
         let offscreen = Offscreen::new(ctx, w, h).expect("offscreen");
