@@ -50,7 +50,7 @@ fn main() {
     let resolutions: &[(u32, u32)] =
         if quick { &[(800, 600)] } else { &[(800, 600), (1024, 712), (1152, 802), (1280, 968)] };
     let distances = [0.2f32, 0.4, 0.6, 1.0, 1.5, 3.0];
-    let frames = 3;
+    let frames = FRAMES;
     let mut csv = String::from(
         "width,height,ssaa,distance_m,hairs,segments,smooth_ms,interpolate_ms,draw_ms,resolve_ms,total_ms\n",
     );
@@ -76,29 +76,7 @@ fn main() {
                 20.0,
             )
             .expect("camera");
-            let mut sums = [0.0f64; 4];
-            for k in 0..=frames {
-                ctx.run_commands("bench frame", |cmd| {
-                    // SAFETY: a recording command buffer of the context's device; the
-                    // previous frame completed (run_commands waits).
-                    unsafe {
-                        profiler.begin_frame(cmd, frame);
-                        renderer.record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler)).expect("prepare");
-                        offscreen.record_clear(cmd, Vec3::ZERO);
-                        renderer
-                            .record_draw(cmd, frame, &offscreen.target(), &camera, Some(&mut profiler))
-                            .expect("draw");
-                    }
-                })
-                .expect("submit");
-                frame += 1;
-                let report = profiler.drain().pop().expect("timestamps");
-                if k > 0 {
-                    for (sum, pass) in sums.iter_mut().zip(PASSES) {
-                        *sum += report.pass(pass.label()).unwrap_or(0.0) / 1e6 / frames as f64;
-                    }
-                }
-            }
+            let sums = frames_mean(&ctx, &sim, &mut renderer, &mut profiler, &camera, &offscreen, &mut frame, &PASSES);
             let (hairs, per_hair) = renderer.hair_counts();
             let segments = u64::from(hairs) * u64::from(per_hair - 1);
             let total: f64 = sums.iter().sum();
@@ -132,6 +110,47 @@ fn main() {
     shadow_table(&ctx, &sim, &mut renderer, &mut profiler, quick, frame);
 }
 
+/// Frames measured per configuration, after one warm-up frame.
+const FRAMES: u32 = 3;
+
+/// Mean GPU ms of `passes` over `FRAMES` frames (prepare, shadows, draw).
+#[allow(clippy::too_many_arguments)]
+fn frames_mean(
+    ctx: &GpuContext,
+    sim: &HairSim,
+    renderer: &mut Renderer,
+    profiler: &mut GpuProfiler,
+    camera: &Camera,
+    offscreen: &Offscreen,
+    frame: &mut u64,
+    passes: &[RenderPass],
+) -> Vec<f64> {
+    let mut sums = vec![0.0f64; passes.len()];
+    for k in 0..=FRAMES {
+        ctx.run_commands("bench frame", |cmd| {
+            // SAFETY: a recording command buffer of the context's device; the
+            // previous frame completed (run_commands waits).
+            unsafe {
+                profiler.begin_frame(cmd, *frame);
+                renderer.record_prepare(cmd, sim, Some(camera), Some(&mut *profiler)).expect("prepare");
+                // Nothing is recorded while no light casts a shadow.
+                renderer.record_shadows(cmd, sim, Some(&mut *profiler)).expect("shadows");
+                offscreen.record_clear(cmd, Vec3::ZERO);
+                renderer.record_draw(cmd, *frame, &offscreen.target(), camera, Some(&mut *profiler)).expect("draw");
+            }
+        })
+        .expect("submit");
+        *frame += 1;
+        let report = profiler.drain().pop().expect("timestamps");
+        if k > 0 {
+            for (sum, pass) in sums.iter_mut().zip(passes) {
+                *sum += report.pass(pass.label()).unwrap_or(0.0) / 1e6 / f64::from(FRAMES);
+            }
+        }
+    }
+    sums
+}
+
 fn write_csv(name: &str, csv: &str) {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/vkhair-bench");
     if std::fs::create_dir_all(&dir).is_ok() && std::fs::write(dir.join(name), csv).is_ok() {
@@ -158,7 +177,6 @@ fn shadow_table(
     ];
     let passes = [RenderPass::ShadowDepth, RenderPass::ShadowOpacity, RenderPass::ShadowVolume, RenderPass::Draw];
     let resolutions: &[(u32, u32)] = if quick { &[(800, 600)] } else { &[(800, 600), (1280, 968)] };
-    let frames = 3;
     let mut csv =
         String::from("width,height,config,shadow_depth_ms,shadow_opacity_ms,shadow_volume_ms,draw_ms,total_ms\n");
     println!("\n{} — thesis scene at 0.6 m, self-shadowing (512² maps), GPU ms per pass", ctx.info().name);
@@ -181,30 +199,7 @@ fn shadow_table(
         for (name, casters) in &configs {
             let shadows = ShadowParams { casters: casters.clone(), ..ShadowParams::default() };
             renderer.set_shadows(sim, &shadows).expect("shadows");
-            let mut sums = [0.0f64; 4];
-            for k in 0..=frames {
-                ctx.run_commands("bench shadow frame", |cmd| {
-                    // SAFETY: a recording command buffer of the context's device; the
-                    // previous frame completed (run_commands waits).
-                    unsafe {
-                        profiler.begin_frame(cmd, frame);
-                        renderer.record_prepare(cmd, sim, Some(&camera), Some(&mut *profiler)).expect("prepare");
-                        renderer.record_shadows(cmd, sim, Some(&mut *profiler)).expect("shadows");
-                        offscreen.record_clear(cmd, Vec3::ZERO);
-                        renderer
-                            .record_draw(cmd, frame, &offscreen.target(), &camera, Some(&mut *profiler))
-                            .expect("draw");
-                    }
-                })
-                .expect("submit");
-                frame += 1;
-                let report = profiler.drain().pop().expect("timestamps");
-                if k > 0 {
-                    for (sum, pass) in sums.iter_mut().zip(passes) {
-                        *sum += report.pass(pass.label()).unwrap_or(0.0) / 1e6 / frames as f64;
-                    }
-                }
-            }
+            let sums = frames_mean(ctx, sim, renderer, profiler, &camera, &offscreen, &mut frame, &passes);
             let total: f64 = sums.iter().sum();
             println!(
                 "{:>10} {:<18} {:>12.3} {:>14.3} {:>13.3} {:>9.3} {:>9.3}",
