@@ -133,7 +133,7 @@ fn frames_mean(
             unsafe {
                 profiler.begin_frame(cmd, *frame);
                 renderer.record_prepare(cmd, sim, Some(camera), Some(&mut *profiler)).expect("prepare");
-                // Nothing is recorded while no light casts a shadow.
+                // Without casters this only marks every light unshadowed.
                 renderer.record_shadows(cmd, sim, Some(&mut *profiler)).expect("shadows");
                 offscreen.record_clear(cmd, Vec3::ZERO);
                 renderer.record_draw(cmd, *frame, &offscreen.target(), camera, Some(&mut *profiler)).expect("draw");

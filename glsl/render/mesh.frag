@@ -4,6 +4,7 @@ layout(push_constant) uniform Push {
     vec4 rotation;
     vec4 color;
     vec4 light;
+    vec4 translation;
 } pc;
 
 layout(location = 0) in vec3 v_normal;

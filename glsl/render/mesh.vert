@@ -8,14 +8,18 @@ layout(push_constant) uniform Push {
     vec4 rotation;        // model rotation quaternion (normals)
     vec4 color;           // rgb albedo
     vec4 light;           // xyz direction light travels, w ambient
+    vec4 translation;     // xyz model translation, w index of the light whose hair shadow falls on the mesh (−1: none)
 } pc;
 
 layout(location = 0) out vec3 v_normal;
+layout(location = 1) out vec3 v_world;
 
 void main() {
     vec4 p = vertices[gl_VertexIndex];
     vec3 n = normals[gl_VertexIndex].xyz;
     vec3 t = 2.0 * cross(pc.rotation.xyz, n);
     v_normal = n + pc.rotation.w * t + cross(pc.rotation.xyz, t);
+    vec3 tp = 2.0 * cross(pc.rotation.xyz, p.xyz);
+    v_world = p.xyz + pc.rotation.w * tp + cross(pc.rotation.xyz, tp) + pc.translation.xyz;
     gl_Position = pc.mvp * vec4(p.xyz, 1.0);
 }

@@ -722,8 +722,9 @@ impl Renderer {
     }
 
     /// Records the shadows of the casters for the hairs of the latest
-    /// [`Renderer::record_prepare`] of `sim`: the opacity maps, and a copy of `sim`'s
-    /// density volume for density-volume casters (nothing without casters). Call it
+    /// [`Renderer::record_prepare`] of `sim`: the frame's shadow uniforms, the opacity
+    /// maps, and a copy of `sim`'s density volume for density-volume casters (only the
+    /// uniforms without casters). Call it
     /// every frame after `record_prepare` and before [`Renderer::record_draw`]; the
     /// draw then attenuates those lights. Afterwards the atlas
     /// ([`Renderer::shadow_atlas`]) is in `SHADER_READ_ONLY_OPTIMAL`, written by
@@ -742,9 +743,6 @@ impl Renderer {
         mut profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
         let params = &self.shadows.params;
-        if params.casters.is_empty() {
-            return Ok(());
-        }
         let (hairs, per_hair) = self.hair_counts();
         let mut uniforms = shadow::no_shadows();
         let (mut tile, mut slot) = (0, 0);
@@ -824,6 +822,10 @@ impl Renderer {
     /// visible to vertex and fragment shaders.
     pub fn shadow_uniforms(&self) -> vk::Buffer {
         self.shadows.uniforms.raw()
+    }
+
+    pub(crate) fn shadow_uniform_buffer(&self) -> &Buffer {
+        &self.shadows.uniforms
     }
 
     /// Sets of size-dependent images waiting for their frames to complete.

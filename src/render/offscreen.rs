@@ -16,7 +16,7 @@ use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc};
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
-use crate::vk::shaders::{RENDER_MESH_FRAG, RENDER_MESH_VERT};
+use crate::vk::shaders::{RENDER_MESH_FRAG, RENDER_MESH_SHADOWED_FRAG, RENDER_MESH_VERT};
 
 /// Color format of [`Offscreen`] (shading is linear; the target encodes sRGB).
 pub const OFFSCREEN_COLOR: vk::Format = vk::Format::R8G8B8A8_SRGB;
@@ -143,6 +143,7 @@ struct MeshPush {
     rotation: [f32; 4],
     color: [f32; 4],
     light: [f32; 4],
+    translation: [f32; 4],
 }
 
 /// Draws a triangle mesh with one directional light (the host's head).
@@ -152,12 +153,33 @@ pub struct MeshDrawer {
     set: vk::DescriptorSet,
     vertices: u32,
     _buffers: [Buffer; 2],
+    /// The light whose hair shadow falls on the mesh (shadowed drawers only).
+    shadow_light: Option<usize>,
 }
 
 impl MeshDrawer {
     /// Uploads `mesh` (flat-shaded: one normal per triangle) for the [`Offscreen`]
     /// formats (this submits and waits).
     pub fn new(ctx: &GpuContext, mesh: &TriMesh) -> Result<Self> {
+        Self::build(ctx, mesh, None)
+    }
+
+    /// As [`MeshDrawer::new`], and the hair of `renderer` shadows the mesh from light
+    /// `light` (which must cast a deep-opacity-map shadow) the way a host would do
+    /// it: `glsl/include/shadow.glsl` with [`super::Renderer::shadow_uniforms`] and
+    /// [`super::Renderer::shadow_atlas`]. Make it after the renderer's
+    /// [`super::Renderer::set_shadows`]: a later change of the atlas size replaces the
+    /// images this drawer reads.
+    pub fn with_hair_shadows(
+        ctx: &GpuContext,
+        mesh: &TriMesh,
+        renderer: &super::Renderer,
+        light: usize,
+    ) -> Result<Self> {
+        Self::build(ctx, mesh, Some((renderer, light)))
+    }
+
+    fn build(ctx: &GpuContext, mesh: &TriMesh, shadows: Option<(&super::Renderer, usize)>) -> Result<Self> {
         let device = ctx.device.clone();
         let mut positions = Vec::with_capacity(mesh.triangles.len() * 3);
         let mut normals = Vec::with_capacity(mesh.triangles.len() * 3);
@@ -179,7 +201,10 @@ impl MeshDrawer {
             &device,
             &GraphicsDesc {
                 name: "mesh",
-                stages: &[&RENDER_MESH_VERT, &RENDER_MESH_FRAG],
+                stages: &[
+                    &RENDER_MESH_VERT,
+                    if shadows.is_some() { &RENDER_MESH_SHADOWED_FRAG } else { &RENDER_MESH_FRAG },
+                ],
                 topology: vk::PrimitiveTopology::TRIANGLE_LIST,
                 patch_control_points: 0,
                 color_formats: &color_formats,
@@ -192,8 +217,25 @@ impl MeshDrawer {
             },
             1,
         )?;
-        let set = pipeline.buffer_set(0, &[(0, &buffers[0]), (1, &buffers[1])])?;
-        Ok(MeshDrawer { device, pipeline, set, vertices: positions.len() as u32, _buffers: buffers })
+        let set = match shadows {
+            Some((renderer, _)) => {
+                let (view, sampler) = renderer.shadow_atlas();
+                pipeline.resource_set(
+                    0,
+                    &[(0, &buffers[0]), (1, &buffers[1]), (2, renderer.shadow_uniform_buffer())],
+                    &[(3, view, sampler)],
+                )?
+            }
+            None => pipeline.buffer_set(0, &[(0, &buffers[0]), (1, &buffers[1])])?,
+        };
+        Ok(MeshDrawer {
+            device,
+            pipeline,
+            set,
+            vertices: positions.len() as u32,
+            _buffers: buffers,
+            shadow_light: shadows.map(|(_, light)| light),
+        })
     }
 
     /// Records the mesh placed by `model` (rotation + translation) into `target`,
@@ -201,6 +243,10 @@ impl MeshDrawer {
     ///
     /// # Safety
     /// As for [`Offscreen::record_clear`], after it; `target` is an [`Offscreen`]'s.
+    /// A drawer made [`MeshDrawer::with_hair_shadows`] reads the renderer's shadow
+    /// atlas and uniforms: they are still the ones it was made with (no
+    /// `set_shadows` that changed the atlas size since), and the renderer's
+    /// `record_shadows` for this frame was recorded before.
     pub unsafe fn record(
         &self,
         cmd: vk::CommandBuffer,
@@ -217,6 +263,7 @@ impl MeshDrawer {
             rotation: model.0.to_array(),
             color: albedo.extend(1.0).to_array(),
             light: light_direction.extend(0.15).to_array(),
+            translation: model.1.extend(self.shadow_light.map_or(-1.0, |l| l as f32)).to_array(),
         };
         let written = barrier::memory(
             Access {

@@ -227,7 +227,13 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         renderer.set_material(&material)?;
     }
     let offscreen = Offscreen::new(&ctx, a.width, a.height)?;
-    let head = MeshDrawer::new(&ctx, &s.head_mesh)?;
+    // The head mesh (lit along the key spot light's direction) takes that light's hair
+    // shadow the way a host would, through glsl/include/shadow.glsl.
+    let head = if a.no_shadows || a.volume_shadows {
+        MeshDrawer::new(&ctx, &s.head_mesh)?
+    } else {
+        MeshDrawer::with_hair_shadows(&ctx, &s.head_mesh, &renderer, 0)?
+    };
     let aspect = a.width as f32 / a.height as f32;
     let camera = Camera::look_at(
         s.center + Vec3::new(0.0, 0.05, a.distance),
