@@ -66,16 +66,7 @@ fn main() {
         renderer.set_params(&params).expect("params");
         let offscreen = Offscreen::new(&ctx, w, h).expect("offscreen");
         for &distance in &distances {
-            let center = scenes::THESIS_HEAD_CENTER;
-            let camera = Camera::look_at(
-                center + Vec3::new(0.0, 0.0, distance),
-                center - Vec3::new(0.0, 0.1, 0.0),
-                0.7,
-                w as f32 / h as f32,
-                0.01,
-                20.0,
-            )
-            .expect("camera");
+            let camera = camera_at(w, h, distance);
             let sums = frames_mean(&ctx, &sim, &mut renderer, &mut profiler, &camera, &offscreen, &mut frame, &PASSES);
             let (hairs, per_hair) = renderer.hair_counts();
             let segments = u64::from(hairs) * u64::from(per_hair - 1);
@@ -108,6 +99,20 @@ fn main() {
         write_csv("render.csv", &csv);
     }
     shadow_table(&ctx, &sim, &mut renderer, &mut profiler, quick, frame);
+}
+
+/// A camera `distance` meters in front of the thesis head for a `w` × `h` image.
+fn camera_at(w: u32, h: u32, distance: f32) -> Camera {
+    let center = scenes::THESIS_HEAD_CENTER;
+    Camera::look_at(
+        center + Vec3::new(0.0, 0.0, distance),
+        center - Vec3::new(0.0, 0.1, 0.0),
+        0.7,
+        w as f32 / h as f32,
+        0.01,
+        20.0,
+    )
+    .expect("camera")
 }
 
 /// Frames measured per configuration, after one warm-up frame.
@@ -186,16 +191,7 @@ fn shadow_table(
     );
     for &(w, h) in resolutions {
         let offscreen = Offscreen::new(ctx, w, h).expect("offscreen");
-        let center = scenes::THESIS_HEAD_CENTER;
-        let camera = Camera::look_at(
-            center + Vec3::new(0.0, 0.0, 0.6),
-            center - Vec3::new(0.0, 0.1, 0.0),
-            0.7,
-            w as f32 / h as f32,
-            0.01,
-            20.0,
-        )
-        .expect("camera");
+        let camera = camera_at(w, h, 0.6);
         for (name, casters) in &configs {
             let shadows = ShadowParams { casters: casters.clone(), ..ShadowParams::default() };
             renderer.set_shadows(sim, &shadows).expect("shadows");
