@@ -8,6 +8,8 @@ layout(push_constant) uniform Push {
 } pc;
 
 layout(location = 0) in vec3 v_normal;
+// World position (read by mesh_shadowed.frag; declared so the interfaces match).
+layout(location = 1) in vec3 v_world;
 layout(location = 0) out vec4 out_color;
 
 void main() {
