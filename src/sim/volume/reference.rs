@@ -466,18 +466,8 @@ pub(crate) fn sample_faces(grid: &GridLayout, face_vel: &[f32], face_star: &[f32
     fd[axis] += 1;
     let mut q = g - 0.5;
     q[axis] += 0.5;
-    let base = q.floor();
-    let t = q - base;
     let mut result = (0.0f32, 0.0f32);
-    for k in 0..8usize {
-        let corner = [k & 1, (k >> 1) & 1, k >> 2];
-        let at = [0, 1, 2].map(|a| (base[a] as i64 + corner[a] as i64).clamp(0, i64::from(fd[a]) - 1));
-        let w3 = Vec3::new(
-            if corner[0] == 1 { t.x } else { 1.0 - t.x },
-            if corner[1] == 1 { t.y } else { 1.0 - t.y },
-            if corner[2] == 1 { t.z } else { 1.0 - t.z },
-        );
-        let w = (w3.x * w3.y) * w3.z;
+    for (at, w) in trilinear_corners(q, fd) {
         let f = face_index(grid, axis, at).unwrap_or(0);
         result.0 += face_vel[f] * w;
         result.1 += (face_vel[f] - face_star[f]) * w;
@@ -485,21 +475,27 @@ pub(crate) fn sample_faces(grid: &GridLayout, face_vel: &[f32], face_star: &[f32
     result
 }
 
-fn sample_cells(grid: &GridLayout, cells: &[Vec4], g: Vec3) -> Vec4 {
-    let dims = Dims(grid.dims);
-    let q = g - 0.5;
+/// The 8 grid points around `q` (clamped into `dims`) with their trilinear weights,
+/// in the order and rounding of the GPU's sampling loops.
+fn trilinear_corners(q: Vec3, dims: [u32; 3]) -> impl Iterator<Item = ([i64; 3], f32)> {
     let base = q.floor();
     let t = q - base;
-    let mut result = Vec4::ZERO;
-    for k in 0..8usize {
+    (0..8usize).map(move |k| {
         let corner = [k & 1, (k >> 1) & 1, k >> 2];
-        let at = [0, 1, 2].map(|a| (base[a] as i64 + corner[a] as i64).clamp(0, i64::from(grid.dims[a]) - 1));
+        let at = [0, 1, 2].map(|a| (base[a] as i64 + corner[a] as i64).clamp(0, i64::from(dims[a]) - 1));
         let w3 = Vec3::new(
             if corner[0] == 1 { t.x } else { 1.0 - t.x },
             if corner[1] == 1 { t.y } else { 1.0 - t.y },
             if corner[2] == 1 { t.z } else { 1.0 - t.z },
         );
-        let w = (w3.x * w3.y) * w3.z;
+        (at, (w3.x * w3.y) * w3.z)
+    })
+}
+
+fn sample_cells(grid: &GridLayout, cells: &[Vec4], g: Vec3) -> Vec4 {
+    let dims = Dims(grid.dims);
+    let mut result = Vec4::ZERO;
+    for (at, w) in trilinear_corners(g - 0.5, grid.dims) {
         let cell = cells[dims.index(at).unwrap_or(0)];
         result += (cell.xyz() * cell.w).extend(cell.w) * w;
     }
