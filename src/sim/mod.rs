@@ -467,6 +467,14 @@ unsafe fn update_chunked(d: &Device, cmd: vk::CommandBuffer, buffer: vk::Buffer,
     }
 }
 
+/// The grid of the CPU reference's volume stage for `params`, none when it is off.
+fn cpu_volume_grid(params: &SimParams, state: &SimState) -> Result<Option<volume::grid::GridLayout>> {
+    match params.volume.mode {
+        VolumeMode::Off => Ok(None),
+        _ => volume::grid::GridLayout::new(&params.volume, state).map(Some),
+    }
+}
+
 /// The CPU reference simulation: the same algorithm as [`HairSim`], one particle
 /// at a time. Used as the oracle of the GPU tests and as the benchmark baseline.
 pub struct CpuHairSim {
@@ -488,20 +496,14 @@ impl CpuHairSim {
     pub fn from_state(state: SimState, params: &SimParams, head: &RigidTransform) -> Result<Self> {
         // The CPU runs the same constraint sets in the same order whatever the packing.
         let schedule = Schedule::new(params, head, state.strands, state.points, MAX_SIM_POINTS as u32)?;
-        let volume = match params.volume.mode {
-            VolumeMode::Off => None,
-            _ => Some(volume::grid::GridLayout::new(&params.volume, &state)?),
-        };
+        let volume = cpu_volume_grid(params, &state)?;
         Ok(CpuHairSim { schedule, state, volume, last_volume: None })
     }
 
     /// See [`HairSim::set_params`].
     pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
         params.validate()?;
-        self.volume = match params.volume.mode {
-            VolumeMode::Off => None,
-            _ => Some(volume::grid::GridLayout::new(&params.volume, &self.state)?),
-        };
+        self.volume = cpu_volume_grid(params, &self.state)?;
         self.schedule.set_params(params)
     }
 

@@ -119,9 +119,14 @@ impl GridLayout {
         self.levels.iter().map(Level::cells).sum()
     }
 
+    /// Grid coordinates → head frame.
+    fn head_from_grid(&self) -> Mat4 {
+        Mat4::from_translation(self.origin) * Mat4::from_scale(Vec3::splat(self.cell_size))
+    }
+
     /// Grid coordinates → world position with the head at `head`.
     pub(crate) fn world_from_grid(&self, head: &Mat4) -> Mat4 {
-        *head * Mat4::from_translation(self.origin) * Mat4::from_scale(Vec3::splat(self.cell_size))
+        *head * self.head_from_grid()
     }
 
     /// The public description for the head at `head`.
@@ -145,9 +150,8 @@ impl GridLayout {
         let rotation = Mat4::from_quat(head.to_scale_rotation_translation().1);
         let axes = rotation.transpose();
         // Velocity of a point fixed in the head frame, as a function of grid coordinates:
-        // (head − previous) · grid_to_head / dt, turned into the grid axes.
-        let grid_to_head = Mat4::from_translation(self.origin) * Mat4::from_scale(Vec3::splat(self.cell_size));
-        let motion = (*head - *previous) * grid_to_head * (1.0 / dt);
+        // (head − previous) · head_from_grid / dt, turned into the grid axes.
+        let motion = (*head - *previous) * self.head_from_grid() * (1.0 / dt);
         let solid_velocity = axes * motion;
         let mode = match params.mode {
             VolumeMode::Off => 0.0,
