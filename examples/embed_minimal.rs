@@ -211,6 +211,7 @@ fn frames_with(
             allocator: Some(allocator.clone()),
             debug_utils: true,
             compute_full_subgroups: false,
+            enabled_extensions: Vec::new(),
         })
     }?;
     let params = SimParams::default();

@@ -74,7 +74,10 @@ pub struct HostDevice {
     pub device: ash::Device,
     /// A graphics+compute queue.
     pub graphics_queue: HostQueue,
-    /// A compute queue of another family for async compute, if the host offers one.
+    /// A compute-capable queue other than `graphics_queue` (of another family, or a
+    /// second queue of the same family) for async compute, if the host offers one.
+    /// vkhair's [`crate::schedule::FrameScheduler`] then submits the simulation to
+    /// it; the host must not use it concurrently with the scheduler's calls.
     pub compute_queue: Option<HostQueue>,
     /// The host's allocator to share; `None` makes vkhair create its own.
     pub allocator: Option<Arc<Mutex<Allocator>>>,
@@ -83,6 +86,10 @@ pub struct HostDevice {
     /// Whether the host enabled the optional `subgroupSizeControl` and
     /// `computeFullSubgroups` features (see [`crate::Requirements::optional_features`]).
     pub compute_full_subgroups: bool,
+    /// Which of [`crate::Requirements::optional_device_extensions`] the host enabled
+    /// (`VK_KHR_external_memory_fd` for the two-device hand-off without staging,
+    /// `VK_EXT_calibrated_timestamps` for profiles on the host clock). Others are ignored.
+    pub enabled_extensions: Vec<&'static CStr>,
 }
 
 /// vkhair's handle on a Vulkan device: owned (headless) or borrowed from a host.
@@ -129,6 +136,7 @@ impl GpuContext {
             compute,
             debug_utils,
             full_subgroups,
+            extensions: crate::vk::device::Extensions::from_names(&support.optional_extensions),
             allocator: None,
             owned: Some(owned),
         })?;
@@ -167,6 +175,14 @@ impl GpuContext {
             compute: host.compute_queue.map(|q| Queue { family: q.family, raw: q.queue }),
             debug_utils: host.debug_utils,
             full_subgroups: host.compute_full_subgroups && support.full_subgroups,
+            extensions: crate::vk::device::Extensions::from_names(
+                &host
+                    .enabled_extensions
+                    .iter()
+                    .copied()
+                    .filter(|n| support.optional_extensions.contains(n))
+                    .collect::<Vec<_>>(),
+            ),
             allocator: host.allocator,
             owned: None,
         })?;
@@ -197,6 +213,26 @@ impl GpuContext {
     /// and waits (headless use: tools, tests, examples; a host submits its own).
     pub fn run_commands(&self, name: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
         self.device.submit_once(name, record)
+    }
+
+    /// Records one frame into a fresh command buffer — `record` returns what the
+    /// submission must wait on ([`crate::schedule::FrameScheduler::record_frame`]'s
+    /// [`crate::schedule::FrameSync`]) — submits it to the graphics queue with those
+    /// waits and waits for it (headless use: tools, tests, benchmarks).
+    pub fn run_frame(
+        &self,
+        name: &str,
+        record: impl FnOnce(vk::CommandBuffer) -> Result<crate::schedule::FrameSync>,
+    ) -> Result<()> {
+        let mut result = Ok(());
+        self.device.submit_once_waiting(name, |cmd| match record(cmd) {
+            Ok(sync) => sync.wait_infos(),
+            Err(e) => {
+                result = Err(e);
+                Vec::new()
+            }
+        })?;
+        result
     }
 
     /// Waits until the crate's queue is idle (headless use; hosts sync their own way).
@@ -408,12 +444,17 @@ fn create_device(
     let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
     let graphics = requirements::graphics_family(&families)
         .ok_or_else(|| Error::MissingRequirement("a graphics+compute queue family".into()))?;
+    // Async compute: a compute family of its own, else a second queue of the graphics
+    // family, else none (lavapipe: one family with one queue).
     let compute = requirements::async_compute_family(&families, graphics);
-    let priorities = [1.0f32];
-    let mut queue_infos =
-        vec![vk::DeviceQueueCreateInfo::default().queue_family_index(graphics).queue_priorities(&priorities)];
+    let second_in_family = compute.is_none() && families[graphics as usize].queue_count >= 2;
+    let priorities = [1.0f32, 1.0];
+    let graphics_count = if second_in_family { 2 } else { 1 };
+    let mut queue_infos = vec![vk::DeviceQueueCreateInfo::default()
+        .queue_family_index(graphics)
+        .queue_priorities(&priorities[..graphics_count])];
     if let Some(c) = compute {
-        queue_infos.push(vk::DeviceQueueCreateInfo::default().queue_family_index(c).queue_priorities(&priorities));
+        queue_infos.push(vk::DeviceQueueCreateInfo::default().queue_family_index(c).queue_priorities(&priorities[..1]));
     }
     let req = requirements();
     let mut features = req.features;
@@ -429,10 +470,17 @@ fn create_device(
     let device = unsafe { instance.create_device(physical, &info, None) }.map_err(Error::vk("vkCreateDevice"))?;
     // SAFETY: the queues were requested above.
     let graphics_queue = Queue { family: graphics, raw: unsafe { device.get_device_queue(graphics, 0) } };
-    let compute_queue = compute.map(|family| Queue {
-        family,
-        // SAFETY: requested above.
-        raw: unsafe { device.get_device_queue(family, 0) },
-    });
+    let compute_queue = match compute {
+        Some(family) => Some(Queue {
+            family,
+            // SAFETY: requested above.
+            raw: unsafe { device.get_device_queue(family, 0) },
+        }),
+        // SAFETY: requested above (two queues of the graphics family).
+        None if second_in_family => {
+            Some(Queue { family: graphics, raw: unsafe { device.get_device_queue(graphics, 1) } })
+        }
+        None => None,
+    };
     Ok((device, graphics_queue, compute_queue))
 }

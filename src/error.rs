@@ -215,6 +215,23 @@ pub enum Error {
     /// A mesh cannot serve as a scalp (no triangles, or none selected).
     #[error("mesh cannot be used as a scalp: {0}")]
     BadScalp(String),
+
+    // ---- Frame scheduling ---------------------------------------------------
+    /// A scheduling mode was asked for that the device(s) cannot run.
+    #[error("schedule mode {mode} is not available: {reason}")]
+    ModeUnavailable {
+        /// The mode asked for.
+        mode: &'static str,
+        /// Why it cannot run.
+        reason: String,
+    },
+    /// The simulation side stopped (dropped, failed or timed out) while the host
+    /// still asked for frames.
+    #[error("the simulation side stopped: {0}")]
+    SimulationStopped(String),
+    /// Handing the simulation state over to the rendering side failed or timed out.
+    #[error("simulation hand-off failed: {0}")]
+    HandOff(String),
 }
 
 impl Error {

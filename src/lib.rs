@@ -12,6 +12,9 @@
 //!   images, staging, barriers, reflection, pipelines, debug names and labels.
 //! - [`render`]: drawing hair from the simulated key hairs ([`render::Renderer`]).
 //! - [`sim`]: the GPU simulation ([`sim::HairSim`]) and its CPU reference.
+//! - [`schedule`]: where the simulation runs — in order on one queue, on an async
+//!   compute queue, or on a second device with a worker thread — and the per-frame
+//!   hand-off to rendering ([`schedule::FrameScheduler`]).
 //! - [`groom`]: key-hair data — the [`Groom`] type, `.hair` and `.tfx` files,
 //!   procedural growth from a scalp, resampling and key-hair selection.
 //! - The public GPU API: [`GpuContext`] (owned headless device, or borrowed from a
@@ -37,6 +40,7 @@ mod hash;
 mod profiler;
 pub mod render;
 mod requirements;
+pub mod schedule;
 pub mod sim;
 pub(crate) mod vk;
 
@@ -45,7 +49,7 @@ pub use context::{
 };
 pub use error::{Error, FileFormat, Result};
 pub use groom::Groom;
-pub use profiler::{GpuProfiler, PassTiming, ProfileReport, ScopeId};
+pub use profiler::{Clock, GpuProfiler, PassTiming, ProfileReport, ScopeId};
 pub use requirements::{requirements, RequiredFeatures, Requirements, API_VERSION};
 pub use vk::debug::{Severity, ValidationLog, ValidationMessage};
 pub use vk::device::DeviceInfo;

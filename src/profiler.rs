@@ -28,6 +28,26 @@ pub struct PassTiming {
     pub depth: u32,
     /// GPU time in nanoseconds.
     pub nanoseconds: f64,
+    /// When the pass began, nanoseconds on the report's [`Clock`].
+    pub start_ns: f64,
+}
+
+impl PassTiming {
+    /// When the pass ended, nanoseconds on the report's [`Clock`].
+    pub fn end_ns(&self) -> f64 {
+        self.start_ns + self.nanoseconds
+    }
+}
+
+/// The clock that [`PassTiming::start_ns`] counts on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Clock {
+    /// The device's own timestamp counter (comparable only with reports of the same
+    /// device).
+    Device,
+    /// The host's `CLOCK_MONOTONIC`, through `VK_EXT_calibrated_timestamps`:
+    /// comparable across devices and with `std::time::Instant`-style host clocks.
+    HostMonotonic,
 }
 
 /// Per-pass GPU timings of one frame.
@@ -37,6 +57,8 @@ pub struct ProfileReport {
     pub frame: u64,
     /// Passes in the order they were recorded.
     pub passes: Vec<PassTiming>,
+    /// The clock of the passes' start times.
+    pub clock: Clock,
 }
 
 impl ProfileReport {
@@ -62,6 +84,57 @@ impl ProfileReport {
     pub fn pass(&self, name: &str) -> Option<f64> {
         self.passes.iter().find(|p| p.name == name).map(|p| p.nanoseconds)
     }
+
+    /// The interval from the first top-level pass's start to the last one's end,
+    /// nanoseconds on [`ProfileReport::clock`] (`None` without passes).
+    pub fn span(&self) -> Option<(f64, f64)> {
+        let top = self.passes.iter().filter(|p| p.depth == 0);
+        let start = top.clone().map(|p| p.start_ns).reduce(f64::min)?;
+        let end = top.map(PassTiming::end_ns).reduce(f64::max)?;
+        Some((start, end))
+    }
+
+    /// How long the top-level passes of `self` and `other` ran at the same time,
+    /// nanoseconds: the overlap of a simulation profile with a render profile. `None`
+    /// when the two are on different clocks that cannot be compared.
+    pub fn overlap_ns(&self, other: &ProfileReport) -> Option<f64> {
+        if self.clock != other.clock || self.clock == Clock::Device {
+            return None;
+        }
+        Some(overlap(&top_intervals(self), &top_intervals(other)))
+    }
+}
+
+/// The top-level passes' intervals, sorted and merged.
+fn top_intervals(report: &ProfileReport) -> Vec<(f64, f64)> {
+    let mut v: Vec<(f64, f64)> =
+        report.passes.iter().filter(|p| p.depth == 0).map(|p| (p.start_ns, p.end_ns())).collect();
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut merged: Vec<(f64, f64)> = Vec::new();
+    for (s, e) in v {
+        match merged.last_mut() {
+            Some(last) if s <= last.1 => last.1 = last.1.max(e),
+            _ => merged.push((s, e)),
+        }
+    }
+    merged
+}
+
+/// Total length of the intersection of two sorted, disjoint interval lists.
+fn overlap(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
+    let (mut i, mut j, mut total) = (0, 0, 0.0);
+    while i < a.len() && j < b.len() {
+        let (s, e) = (a[i].0.max(b[j].0), a[i].1.min(b[j].1));
+        if e > s {
+            total += e - s;
+        }
+        if a[i].1 < b[j].1 {
+            i += 1;
+        } else {
+            j += 1;
+        }
+    }
+    total
 }
 
 impl std::fmt::Display for ProfileReport {
@@ -107,19 +180,26 @@ pub struct GpuProfiler {
     period_ns: f64,
     valid_mask: u64,
     latest: Option<ProfileReport>,
+    /// Reads device and host clocks together, when calibrated timestamps are enabled
+    /// and offer both.
+    calibration: Option<ash::ext::calibrated_timestamps::Device>,
 }
 
 impl GpuProfiler {
     /// A profiler for `frames_in_flight` frames (1..=16) of at most
     /// `max_scopes` scopes (1..=1024) each.
     pub fn new(ctx: &GpuContext, frames_in_flight: u32, max_scopes: u32) -> Result<Self> {
+        Self::from_device(&ctx.device, frames_in_flight, max_scopes)
+    }
+
+    pub(crate) fn from_device(device: &Arc<Device>, frames_in_flight: u32, max_scopes: u32) -> Result<Self> {
         if !(1..=16).contains(&frames_in_flight) {
             return Err(Error::param("frames_in_flight", format!("{frames_in_flight} is outside 1..=16")));
         }
         if !(1..=1024).contains(&max_scopes) {
             return Err(Error::param("max_scopes", format!("{max_scopes} is outside 1..=1024")));
         }
-        let device = ctx.device.clone();
+        let device = device.clone();
         if device.info.timestamp_valid_bits == 0 {
             return Err(Error::MissingRequirement("timestamps on the graphics queue family".into()));
         }
@@ -131,7 +211,9 @@ impl GpuProfiler {
         let pool = unsafe { device.raw.create_query_pool(&info, None) }.map_err(Error::vk("vkCreateQueryPool"))?;
         device.set_name(pool, "vkhair timestamps");
         let bits = device.info.timestamp_valid_bits;
+        let calibration = calibration(&device);
         Ok(GpuProfiler {
+            calibration,
             pool,
             slots: (0..frames_in_flight).map(|_| Slot::default()).collect(),
             queries_per_slot,
@@ -275,6 +357,13 @@ impl GpuProfiler {
                 return None;
             }
         }
+        // Device time "now" against the host clock, to place the passes on it.
+        let now = self.calibration.as_ref().and_then(|c| {
+            let infos = [vk::TimeDomainEXT::DEVICE, vk::TimeDomainEXT::CLOCK_MONOTONIC]
+                .map(|d| vk::CalibratedTimestampInfoEXT::default().time_domain(d));
+            // SAFETY: both domains were reported calibrateable for this device.
+            unsafe { c.get_calibrated_timestamps(&infos) }.ok().map(|(t, _)| (t[0], t[1]))
+        });
         let mut passes = Vec::new();
         for s in &slot.scopes {
             let end = s.end?;
@@ -283,14 +372,39 @@ impl GpuProfiler {
                 return None;
             }
             let ticks = e[0].wrapping_sub(b[0]) & self.valid_mask;
+            let start_ns = match now {
+                Some((device_now, host_now)) => {
+                    let ago = device_now.wrapping_sub(b[0]) & self.valid_mask;
+                    host_now as f64 - ago as f64 * self.period_ns
+                }
+                None => (b[0] & self.valid_mask) as f64 * self.period_ns,
+            };
             passes.push(PassTiming {
                 name: s.name.clone(),
                 depth: s.depth,
                 nanoseconds: ticks as f64 * self.period_ns,
+                start_ns,
             });
         }
-        Some(ProfileReport { frame, passes })
+        let clock = if now.is_some() { Clock::HostMonotonic } else { Clock::Device };
+        Some(ProfileReport { frame, passes, clock })
     }
+}
+
+/// The calibrated-timestamps loader when the extension is enabled and both the
+/// device and the host's monotonic clock can be read together.
+fn calibration(device: &Device) -> Option<ash::ext::calibrated_timestamps::Device> {
+    if !device.extensions.calibrated_timestamps {
+        return None;
+    }
+    let instance_fns = ash::ext::calibrated_timestamps::Instance::new(&device.entry, &device.instance);
+    // SAFETY: the physical device belongs to the instance.
+    let domains = unsafe { instance_fns.get_physical_device_calibrateable_time_domains(device.physical) }.ok()?;
+    let wanted = [vk::TimeDomainEXT::DEVICE, vk::TimeDomainEXT::CLOCK_MONOTONIC];
+    wanted
+        .iter()
+        .all(|d| domains.contains(d))
+        .then(|| ash::ext::calibrated_timestamps::Device::new(&device.instance, &device.raw))
 }
 
 impl Drop for GpuProfiler {
@@ -298,5 +412,35 @@ impl Drop for GpuProfiler {
         // SAFETY: the pool belongs to this device; the host has finished the frames
         // that wrote it before dropping the profiler.
         unsafe { self.device.raw.destroy_query_pool(self.pool, None) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn report(clock: Clock, passes: &[(u32, f64, f64)]) -> ProfileReport {
+        let passes = passes
+            .iter()
+            .map(|&(depth, start_ns, nanoseconds)| PassTiming { name: "p".into(), depth, nanoseconds, start_ns })
+            .collect();
+        ProfileReport { frame: 0, passes, clock }
+    }
+
+    /// Overlap counts time where top-level passes of both reports run, merging each
+    /// report's own overlapping passes first and ignoring nested ones.
+    #[test]
+    fn overlap_of_two_profiles() {
+        let sim = report(Clock::HostMonotonic, &[(0, 0.0, 10.0), (1, 2.0, 50.0), (0, 5.0, 10.0), (0, 30.0, 10.0)]);
+        let render = report(Clock::HostMonotonic, &[(0, 12.0, 22.0), (0, 100.0, 1.0)]);
+        // sim covers [0, 15] ∪ [30, 40]; render [12, 34] ∪ [100, 101]: 3 + 4.
+        assert_eq!(sim.overlap_ns(&render), Some(7.0));
+        assert_eq!(render.overlap_ns(&sim), Some(7.0));
+        assert_eq!(sim.span(), Some((0.0, 40.0)));
+        let device = report(Clock::Device, &[(0, 0.0, 10.0)]);
+        assert_eq!(device.overlap_ns(&device), None);
+        assert_eq!(sim.overlap_ns(&device), None);
+        let apart = report(Clock::HostMonotonic, &[(0, 40.0, 5.0)]);
+        assert_eq!(sim.overlap_ns(&apart), Some(0.0));
     }
 }

@@ -132,6 +132,7 @@ impl Host {
             allocator,
             debug_utils: true,
             compute_full_subgroups: false,
+            enabled_extensions: Vec::new(),
         }
     }
 

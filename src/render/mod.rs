@@ -48,7 +48,7 @@ use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::gpu_types::{DrawParams, GpuLight, InterpolatePush, SmoothPush};
 use crate::profiler::GpuProfiler;
-use crate::sim::HairSim;
+use crate::sim::KeyHairs;
 use crate::vk::barrier::{self, Access};
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::debug::LabelColor;
@@ -286,13 +286,29 @@ pub struct Renderer {
     bound_radius: f32,
     /// Density-volume shadows (placeholder buffers while no light uses them).
     volume_shadows: shadow::VolumeShadows,
+    /// The key-hair buffers the smoothing pass is bound to.
+    source: [vk::Buffer; 2],
+}
+
+/// Rejects key hairs that live on another device than the renderer's.
+fn check_device(device: &Arc<Device>, sim: &KeyHairs<'_>) -> Result<()> {
+    if Arc::ptr_eq(device, sim.device) {
+        Ok(())
+    } else {
+        Err(Error::param("key hairs", "they live on another device than the renderer's context"))
+    }
 }
 
 impl Renderer {
-    /// Creates the passes and buffers for the key hairs of `sim`.
-    pub fn new(ctx: &GpuContext, sim: &HairSim, params: &RenderParams) -> Result<Self> {
+    /// Creates the passes and buffers for the key hairs of `sim`: a
+    /// [`crate::sim::HairSim`] (`&sim`) or a scheduler's hand-off copy
+    /// ([`crate::schedule::FrameScheduler::key_hairs`]). Later frames must come from
+    /// the same source.
+    pub fn new<'a>(ctx: &GpuContext, sim: impl Into<KeyHairs<'a>>, params: &RenderParams) -> Result<Self> {
+        let sim: KeyHairs<'a> = sim.into();
         params.validate()?;
         let device = ctx.device.clone();
+        check_device(&device, &sim)?;
         if device.info.max_tessellation_level < params.smoothing_level {
             return Err(Error::MissingRequirement(format!(
                 "tessellation level {} (device allows {})",
@@ -303,7 +319,7 @@ impl Renderer {
         // Sized for the level asked for at creation: level-of-detail only lowers it.
         let stride = (points as u64 - 1) * u64::from(params.smoothing_level) + 1;
         let size = strands as u64 * stride * 16;
-        let triangles = scalp::root_triangles(sim.rest_shape());
+        let triangles = scalp::root_triangles(sim.rest);
         // Room for either mode: key hairs or scalp triangles, each growing hairs.
         let units = (strands as u64).max(triangles.len() as u64);
         let hair_size = units * stride * 16 * u64::from(params.hairs_per_key);
@@ -318,11 +334,10 @@ impl Renderer {
         let smoothed_tangents = storage("vkhair smoothed tangents", size)?;
         let hair_positions = storage("vkhair hair positions", hair_size)?;
         let hair_tangents = storage("vkhair hair tangents", hair_size)?;
-        let reference_data = interpolate::reference_vectors(sim.rest_shape());
+        let reference_data = interpolate::reference_vectors(sim.rest);
         let reference = Buffer::storage(&device, "vkhair key frames", reference_data.len() as u64 * 16)?;
         device.upload_pod(&reference, &reference_data)?;
-        let (halves, _) = sim.position_halves();
-        let smooth = SmoothPass::new(&device, halves, &smoothed_positions, &smoothed_tangents)?;
+        let smooth = SmoothPass::new(&device, sim.halves, &smoothed_positions, &smoothed_tangents)?;
         let triangle_data: Vec<[u32; 4]> = triangles.iter().map(|t| [t[0], t[1], t[2], 0]).collect();
         let triangle_buffer =
             Buffer::storage(&device, "vkhair scalp triangles", (triangle_data.len().max(1) * 16) as u64)?;
@@ -348,7 +363,7 @@ impl Renderer {
         let draw = DrawPass::new(&device)?;
         let shadows = shadow::ShadowMaps::new(&device, &ShadowParams::default(), &hair_positions)?;
         let volume_shadows = shadow::VolumeShadows::new(&device, &shadows.uniforms, 0, 0)?;
-        let rest_shape = sim.rest_shape();
+        let rest_shape = sim.rest;
         let (lo, hi) =
             rest_shape.rest.iter().fold((glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)), |(lo, hi), p| {
                 (lo.min(p.truncate()), hi.max(p.truncate()))
@@ -387,7 +402,8 @@ impl Renderer {
             draw_params,
             material: HairMaterial::default(),
             lights: Vec::new(),
-            head_rotation: sim.head().rotation.normalize(),
+            head_rotation: sim.head.rotation.normalize(),
+            source: sim.bound_buffers(),
             rest_center,
             detail: params.detail_at(0.0),
             supersampling: None,
@@ -540,15 +556,20 @@ impl Renderer {
     /// outside a render pass, for a queue of the graphics family; `sim` is the
     /// simulation this renderer was created for. Work recorded earlier in submission
     /// order (the simulation step) is ordered before it by the recorded barriers.
-    pub unsafe fn record_prepare(
+    pub unsafe fn record_prepare<'a>(
         &mut self,
         cmd: vk::CommandBuffer,
-        sim: &HairSim,
+        sim: impl Into<KeyHairs<'a>>,
         camera: Option<&Camera>,
         mut profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
-        let (_, half) = sim.position_halves();
-        let head = sim.head();
+        let sim = sim.into();
+        check_device(&self.device, &sim)?;
+        if sim.bound_buffers() != self.source {
+            return Err(Error::param("key hairs", "they are not the ones this renderer was created for"));
+        }
+        let half = sim.current;
+        let head = sim.head;
         self.head_rotation = head.rotation.normalize();
         self.head_center = head.matrix().transform_point3(self.rest_center);
         let distance = camera.map_or(0.0, |c| (c.position() - self.head_center).length());
@@ -582,7 +603,8 @@ impl Renderer {
 
     /// Records [`Renderer::record_prepare`] in its own submission and waits (headless
     /// use: tests and tools).
-    pub fn prepare_now(&mut self, sim: &HairSim, camera: Option<&Camera>) -> Result<()> {
+    pub fn prepare_now<'a>(&mut self, sim: impl Into<KeyHairs<'a>>, camera: Option<&Camera>) -> Result<()> {
+        let sim = sim.into();
         let device = self.device.clone();
         let mut result = Ok(());
         device.submit_once("vkhair prepare", |cmd| {
@@ -691,7 +713,8 @@ impl Renderer {
     /// first). A new atlas size (map count or resolution) or a larger density volume
     /// creates new GPU resources and waits for the device to be idle first. Maps are
     /// drawn by [`Renderer::record_shadows`].
-    pub fn set_shadows(&mut self, sim: &HairSim, params: &ShadowParams) -> Result<()> {
+    pub fn set_shadows<'a>(&mut self, sim: impl Into<KeyHairs<'a>>, params: &ShadowParams) -> Result<()> {
+        let sim = sim.into();
         params.validate()?;
         let volume_lights = params.volume_casters();
         let cells = if volume_lights > 0 {
@@ -736,12 +759,13 @@ impl Renderer {
     /// in submission order; the atlas is not in use by pending work of other frames in
     /// a conflicting way (the usual frames-in-flight wait covers the renderer's own
     /// draws).
-    pub unsafe fn record_shadows(
+    pub unsafe fn record_shadows<'a>(
         &mut self,
         cmd: vk::CommandBuffer,
-        sim: &HairSim,
+        sim: impl Into<KeyHairs<'a>>,
         mut profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
+        let sim = sim.into();
         let params = &self.shadows.params;
         let (hairs, per_hair) = self.hair_counts();
         let mut uniforms = shadow::no_shadows();
@@ -771,7 +795,7 @@ impl Renderer {
         uniforms.counts = [hairs, per_hair, params.casters.len() as u32, 0];
         let mut copy = None;
         if !volume_maps.is_empty() {
-            let (grid, buffer) = sim.volume_grid().zip(sim.density_buffer()).ok_or_else(|| {
+            let (grid, buffer) = sim.volume.map(|(g, b)| (g, b.raw())).ok_or_else(|| {
                 Error::param("shadow casters", "density-volume shadows need the simulation's volume stage")
             })?;
             if grid.dims.iter().product::<u32>() != cells {

@@ -39,6 +39,7 @@ pub mod predict;
 pub(crate) mod reference;
 pub mod solve;
 mod state;
+mod view;
 pub mod volume;
 
 use std::sync::Arc;
@@ -46,8 +47,10 @@ use std::sync::Arc;
 use ash::vk;
 
 pub use driver::{FixedStepDriver, StepPlan};
+pub(crate) use params::validate_colliders;
 pub use params::{Collider, RigidTransform, SimParams, SolverMode, MAX_COLLIDERS, MAX_SIM_POINTS};
 pub use state::SimState;
+pub use view::KeyHairs;
 pub use volume::{Preconditioner, VolumeGrid, VolumeMode, VolumeParams, VolumeStats};
 
 use crate::context::GpuContext;
@@ -263,14 +266,26 @@ impl HairSim {
         self.gpu.positions[self.current].raw()
     }
 
-    /// Both halves of the double-buffered positions and the index of the latest one.
-    pub(crate) fn position_halves(&self) -> ([&crate::vk::buffer::Buffer; 2], usize) {
-        ([&self.gpu.positions[0], &self.gpu.positions[1]], self.current)
+    pub(crate) fn device(&self) -> &Arc<Device> {
+        &self.device
     }
 
-    /// The rest shape (head frame) and rest lengths as last uploaded.
-    pub(crate) fn rest_shape(&self) -> &SimState {
-        &self.shape
+    /// The latest state as a renderer reads it.
+    pub fn key_hairs(&self) -> KeyHairs<'_> {
+        KeyHairs {
+            device: &self.device,
+            rest: &self.shape,
+            halves: [&self.gpu.positions[0], &self.gpu.positions[1]],
+            current: self.current,
+            head: self.schedule.head,
+            volume: self.volume.as_ref().map(|v| (v.grid.describe(&self.schedule.head.matrix()), &v.buffers.cells)),
+        }
+    }
+
+    /// The latest positions and velocities and, with the volume stage, the density
+    /// cells: the buffers a hand-off copies (see the schedule module).
+    pub(crate) fn latest_buffers(&self) -> (&crate::vk::buffer::Buffer, Option<&crate::vk::buffer::Buffer>) {
+        (&self.gpu.positions[self.current], self.volume.as_ref().map(|v| &v.buffers.cells))
     }
 
     /// The head transform at the end of the latest recorded step.
@@ -317,7 +332,8 @@ impl HairSim {
     ///
     /// # Safety
     /// `cmd` is a command buffer of the context's device in the recording state,
-    /// outside a render pass, for a queue of the graphics family. The buffers of this
+    /// outside a render pass, for a queue of the graphics family (or the context's
+    /// compute queue, as [`crate::schedule::FrameScheduler`] uses it). The buffers of this
     /// simulation must not be in use by other pending work that conflicts with it
     /// (the recorded barriers order it after everything earlier in submission order).
     /// With a profiler, its `begin_frame` was called for the frame being recorded.

@@ -199,6 +199,14 @@ pub enum Collider {
     },
 }
 
+/// Checks a collider list: at most [`MAX_COLLIDERS`], each valid.
+pub(crate) fn validate_colliders(colliders: &[Collider]) -> Result<()> {
+    if colliders.len() > MAX_COLLIDERS {
+        return Err(Error::param("colliders", format!("{} exceed the limit of {MAX_COLLIDERS}", colliders.len())));
+    }
+    colliders.iter().try_for_each(Collider::validate)
+}
+
 impl Collider {
     pub(crate) fn validate(&self) -> Result<()> {
         let (points, radius) = match *self {
@@ -344,10 +352,7 @@ impl Schedule {
     }
 
     pub(crate) fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
-        if colliders.len() > MAX_COLLIDERS {
-            return Err(Error::param("colliders", format!("{} exceed the limit of {MAX_COLLIDERS}", colliders.len())));
-        }
-        colliders.iter().try_for_each(Collider::validate)?;
+        validate_colliders(colliders)?;
         self.colliders = colliders.to_vec();
         Ok(())
     }

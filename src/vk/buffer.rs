@@ -32,8 +32,18 @@ impl Buffer {
         if desc.size == 0 {
             return Err(Error::param("buffer size", format!("{:?} has size 0", desc.name)));
         }
-        let info =
-            vk::BufferCreateInfo::default().size(desc.size).usage(desc.usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // With an async compute queue of another family every buffer may be used on
+        // both queues: CONCURRENT sharing saves ownership transfers (see the schedule
+        // module for the choice).
+        let families = device.concurrent_families();
+        let info = match &families {
+            Some(f) => {
+                vk::BufferCreateInfo::default().sharing_mode(vk::SharingMode::CONCURRENT).queue_family_indices(f)
+            }
+            None => vk::BufferCreateInfo::default().sharing_mode(vk::SharingMode::EXCLUSIVE),
+        }
+        .size(desc.size)
+        .usage(desc.usage);
         // SAFETY: valid create info; the buffer is destroyed in Drop or below on error.
         let raw = unsafe { device.raw.create_buffer(&info, None) }.map_err(Error::vk("vkCreateBuffer"))?;
         // SAFETY: `raw` was just created from this device.

@@ -49,13 +49,22 @@ pub struct DeviceInfo {
     pub max_image_dimension_2d: u32,
     /// Whether RGBA32 float color attachments can blend (the opacity-map atlas).
     pub rgba32f_blend: bool,
+    /// `VkPhysicalDeviceIDProperties::deviceUUID`: devices with equal device and
+    /// driver UUIDs can share memory through opaque file descriptors.
+    pub device_uuid: [u8; 16],
+    /// `VkPhysicalDeviceIDProperties::driverUUID`.
+    pub driver_uuid: [u8; 16],
 }
 
 impl DeviceInfo {
     pub(crate) fn query(instance: &ash::Instance, physical: vk::PhysicalDevice, graphics_family: u32) -> Self {
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
         let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
-        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver).push_next(&mut subgroup);
+        let mut ids = vk::PhysicalDeviceIDProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default()
+            .push_next(&mut driver)
+            .push_next(&mut subgroup)
+            .push_next(&mut ids);
         // SAFETY: `physical` was enumerated from `instance`, which is alive.
         unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
         let props = props2.properties;
@@ -89,6 +98,27 @@ impl DeviceInfo {
                 };
                 f.optimal_tiling_features.contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND)
             },
+            device_uuid: ids.device_uuid,
+            driver_uuid: ids.driver_uuid,
+        }
+    }
+}
+
+/// Optional device extensions that are enabled on the device (the crate chooses
+/// paths by them).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Extensions {
+    /// `VK_KHR_external_memory_fd`: memory shared with a second device.
+    pub external_memory_fd: bool,
+    /// `VK_EXT_calibrated_timestamps`: timestamps placed on the host clock.
+    pub calibrated_timestamps: bool,
+}
+
+impl Extensions {
+    pub(crate) fn from_names(names: &[&std::ffi::CStr]) -> Self {
+        Extensions {
+            external_memory_fd: names.contains(&ash::khr::external_memory_fd::NAME),
+            calibrated_timestamps: names.contains(&ash::ext::calibrated_timestamps::NAME),
         }
     }
 }
@@ -103,13 +133,8 @@ pub(crate) struct Owned {
 /// The shared device record (see the module docs).
 pub(crate) struct Device {
     /// Keeps the Vulkan loader library loaded for as long as the device lives.
-    #[allow(dead_code, reason = "held for its Drop: unloading the loader would invalidate every handle")]
     pub entry: ash::Entry,
     pub instance: ash::Instance,
-    #[allow(
-        dead_code,
-        reason = "kept for stages that query the physical device (external memory, calibrated timestamps)"
-    )]
     pub physical: vk::PhysicalDevice,
     pub raw: ash::Device,
     pub graphics: Queue,
@@ -118,6 +143,8 @@ pub(crate) struct Device {
     pub debug_utils: Option<ash::ext::debug_utils::Device>,
     /// Whether `computeFullSubgroups` is enabled (pipelines may require full subgroups).
     pub full_subgroups: bool,
+    /// Optional extensions enabled on the device.
+    pub extensions: Extensions,
     allocator: Option<Arc<Mutex<Allocator>>>,
     /// Serialises the crate's own submissions to `graphics` (queue access must be
     /// externally synchronised).
@@ -134,6 +161,7 @@ pub(crate) struct DeviceParts {
     pub compute: Option<Queue>,
     pub debug_utils: bool,
     pub full_subgroups: bool,
+    pub extensions: Extensions,
     pub allocator: Option<Arc<Mutex<Allocator>>>,
     pub owned: Option<Owned>,
 }
@@ -172,6 +200,7 @@ impl Device {
                             info,
                             debug_utils,
                             full_subgroups: parts.full_subgroups,
+                            extensions: parts.extensions,
                             allocator: None,
                             submit_lock: Mutex::new(()),
                             owned: parts.owned,
@@ -192,6 +221,7 @@ impl Device {
             info,
             debug_utils,
             full_subgroups: parts.full_subgroups,
+            extensions: parts.extensions,
             allocator: Some(allocator),
             submit_lock: Mutex::new(()),
             owned: parts.owned,
@@ -209,7 +239,13 @@ impl Device {
         a.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// Locks the crate's own submissions to the graphics queue.
+    /// The queue families whose queues share the crate's buffers: graphics and the
+    /// async compute family when that is a different one (buffers are then created
+    /// with `CONCURRENT` sharing, see `Buffer::new`).
+    pub(crate) fn concurrent_families(&self) -> Option<[u32; 2]> {
+        self.compute.filter(|c| c.family != self.graphics.family).map(|c| [self.graphics.family, c.family])
+    }
+
     /// Waits until the queue has finished all submitted work.
     pub(crate) fn wait_idle(&self) -> Result<()> {
         let _lock = self.lock_submit();
@@ -217,6 +253,7 @@ impl Device {
         unsafe { self.raw.queue_wait_idle(self.graphics.raw) }.map_err(Error::vk("vkQueueWaitIdle"))
     }
 
+    /// Locks the crate's own submissions to the graphics queue.
     pub(crate) fn lock_submit(&self) -> MutexGuard<'_, ()> {
         self.submit_lock.lock().unwrap_or_else(|e| e.into_inner())
     }

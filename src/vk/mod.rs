@@ -5,11 +5,13 @@ pub(crate) mod barrier;
 pub(crate) mod buffer;
 pub(crate) mod debug;
 pub(crate) mod device;
+pub(crate) mod external;
 pub(crate) mod image;
 pub(crate) mod pipeline;
 pub(crate) mod reflect;
 pub(crate) mod shaders;
 pub(crate) mod staging;
+pub(crate) mod submit;
 
 #[cfg(test)]
 pub(crate) mod tests;

@@ -48,6 +48,19 @@ impl Device {
     /// Records `record` into a fresh command buffer, submits it to the graphics
     /// queue and waits for it.
     pub(crate) fn submit_once(&self, name: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+        self.submit_once_waiting(name, |cmd| {
+            record(cmd);
+            Vec::new()
+        })
+    }
+
+    /// As [`Device::submit_once`], with the submission waiting on the semaphores
+    /// `record` returns.
+    pub(crate) fn submit_once_waiting(
+        &self,
+        name: &str,
+        record: impl FnOnce(vk::CommandBuffer) -> Vec<vk::SemaphoreSubmitInfo<'static>>,
+    ) -> Result<()> {
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(self.graphics.family)
             .flags(vk::CommandPoolCreateFlags::TRANSIENT);
@@ -70,15 +83,16 @@ impl Device {
         self.set_name(guard.fence, &format!("{name} fence"));
         let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         // SAFETY: freshly allocated command buffer; recorded and submitted once here.
-        unsafe {
+        let waits = unsafe {
             self.raw.begin_command_buffer(cmd, &begin).map_err(Error::vk("vkBeginCommandBuffer"))?;
             self.cmd_barrier(cmd, &[barrier::memory(Access::ANY_WRITE, Access::ANY)], &[], &[]);
-            record(cmd);
+            let waits = record(cmd);
             self.cmd_barrier(cmd, &[barrier::memory(Access::ANY_WRITE, Access::ANY)], &[], &[]);
             self.raw.end_command_buffer(cmd).map_err(Error::vk("vkEndCommandBuffer"))?;
-        }
+            waits
+        };
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-        let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+        let submit = vk::SubmitInfo2::default().wait_semaphore_infos(&waits).command_buffer_infos(&cmds);
         {
             let _lock = self.lock_submit();
             // SAFETY: queue access is serialised by the lock (and the host contract of

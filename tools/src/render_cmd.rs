@@ -13,8 +13,33 @@ use vkhair::render::{
     Camera, HairMaterial, InterpolationMode, Light, MeshDrawer, Offscreen, Primitive, RenderParams, Renderer,
     ShadingMode, ShadowCaster, ShadowParams,
 };
-use vkhair::sim::{motion, Collider, HairSim, RigidTransform, SimParams, VolumeParams};
+use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, SchedulerOptions};
+use vkhair::sim::{motion, Collider, RigidTransform, SimParams, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
+
+/// `--schedule`: where the simulation runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Schedule {
+    /// Async compute when the device has a second queue, else single queue.
+    Auto,
+    /// Recorded in order with rendering on one queue.
+    Single,
+    /// On a second queue of the rendering device.
+    Async,
+    /// On a second logical device (same GPU, or --sim-device), worker thread.
+    SecondDevice,
+}
+
+/// `--hand-off`: how a second device's state reaches the rendering device.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum HandOffArg {
+    /// External memory when both devices can share it, else staging.
+    Auto,
+    /// VK_KHR_external_memory_fd shared memory.
+    External,
+    /// Host-visible staging buffers.
+    Staging,
+}
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
@@ -77,6 +102,49 @@ pub struct RenderArgs {
     /// opacity maps (turns the simulation's FLIP volume stage on).
     #[arg(long)]
     volume_shadows: bool,
+    /// Where the simulation runs.
+    #[arg(long, value_enum, default_value_t = Schedule::Auto)]
+    schedule: Schedule,
+    /// SECOND DEVICE hand-off.
+    #[arg(long, value_enum, default_value_t = HandOffArg::Auto)]
+    hand_off: HandOffArg,
+    /// Show each frame's own steps (latency) instead of the previous frame's while
+    /// this frame's run (throughput).
+    #[arg(long)]
+    latency: bool,
+    /// Device name substring for the simulation device of --schedule second-device
+    /// (default: a second logical device of the rendering GPU).
+    #[arg(long)]
+    sim_device: Option<String>,
+}
+
+/// The scheduler options the flags ask for (creating the simulation device).
+fn schedule_options(a: &RenderArgs) -> Result<SchedulerOptions, vkhair::Error> {
+    let mode = match a.schedule {
+        Schedule::Auto => None,
+        Schedule::Single => Some(ScheduleMode::SingleQueue),
+        Schedule::Async => Some(ScheduleMode::AsyncCompute),
+        Schedule::SecondDevice => Some(ScheduleMode::SecondDevice),
+    };
+    let sim_device = match a.schedule {
+        Schedule::SecondDevice => {
+            let options = ContextOptions { device_name: a.sim_device.clone(), ..ContextOptions::default() };
+            Some(GpuContext::headless(&options)?)
+        }
+        _ => None,
+    };
+    Ok(SchedulerOptions {
+        mode,
+        sim_device,
+        hand_off: match a.hand_off {
+            HandOffArg::Auto => None,
+            HandOffArg::External => Some(HandOff::ExternalMemory),
+            HandOffArg::Staging => Some(HandOff::HostStaging),
+        },
+        pipelining: if a.latency { Pipelining::Latency } else { Pipelining::Throughput },
+        frames_in_flight: 1,
+        ..SchedulerOptions::default()
+    })
 }
 
 struct Scene {
@@ -199,8 +267,9 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     if a.volume_shadows {
         sim_params.volume = VolumeParams::flip([32, 32, 32]);
     }
-    let mut sim = HairSim::new(&ctx, &s.groom, &sim_params, &RigidTransform::default())?;
-    sim.set_colliders(&s.colliders)?;
+    let options = schedule_options(a)?;
+    let mut sim = FrameScheduler::new(&ctx, &s.groom, &sim_params, &RigidTransform::default(), &s.colliders, &options)?;
+    println!("simulation: {} ({})", sim.mode().name(), sim.reason());
     let mut params = RenderParams {
         smoothing_level: a.level,
         hairs_per_key: a.hairs_per_key,
@@ -210,7 +279,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         ..RenderParams::default()
     };
     params.lod.enabled = !a.no_lod;
-    let mut renderer = Renderer::new(&ctx, &sim, &params)?;
+    let mut renderer = Renderer::new(&ctx, sim.key_hairs(), &params)?;
     renderer.set_lights(&lights(s.center))?;
     if !a.no_shadows {
         // The thesis' setup: both spot lights cast shadows through their own maps.
@@ -220,7 +289,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
             vec![0.into(), 1.into()]
         };
         let shadows = ShadowParams { casters, resolution: a.shadow_resolution, ..ShadowParams::default() };
-        renderer.set_shadows(&sim, &shadows)?;
+        renderer.set_shadows(sim.key_hairs(), &shadows)?;
     }
     if a.marschner {
         let material = HairMaterial { shading: ShadingMode::Marschner, ..HairMaterial::default() };
@@ -245,7 +314,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     )?;
     let mut profiler = GpuProfiler::new(&ctx, 1, 64)?;
     std::fs::create_dir_all(&a.out)?;
-    let (strands, points) = sim.size();
+    let (strands, points) = sim.key_hairs().size();
     let (hairs, per_hair) = renderer.hair_counts();
     println!(
         "{}: {strands} key hairs × {points} points → {hairs} hairs × {} segments ({} segments), {}×{}, {} frames",
@@ -275,50 +344,45 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         }
     };
     let mut frames = Vec::new();
-    let mut error = None;
+    let (mut sim_ns, mut overlap_ns, mut sim_reports) = (0.0, 0.0, 0u32);
     for frame in 0..a.frames {
         let first_step = frame * steps_per_frame;
-        ctx.run_commands("vkhair render frame", |cmd| {
-            // SAFETY: run_commands hands over a recording command buffer of the
-            // context's device and waits for the previous one.
-            let result = unsafe {
+        let heads: Vec<RigidTransform> = (0..steps_per_frame)
+            .map(|k| motion::shaking_head_about((first_step + k + 1) as f32 * sim_params.dt, 0.6, 1.0, s.pivot))
+            .collect();
+        ctx.run_frame("vkhair render frame", |cmd| {
+            // SAFETY: run_frame hands over a recording command buffer of the
+            // context's device, submits it with the returned waits and waits for it.
+            unsafe {
                 if let Some(report) = profiler.begin_frame(cmd, frame as u64) {
                     add(report);
                 }
-                let mut result = Ok(());
-                for k in 0..steps_per_frame {
-                    let t = (first_step + k + 1) as f32 * sim_params.dt;
-                    let motion = motion::shaking_head_about(t, 0.6, 1.0, s.pivot);
-                    result = result.and_then(|_| sim.record_step(cmd, &motion, Some(&mut profiler)));
-                }
-                result
-                    .and_then(|_| renderer.record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler)))
-                    .and_then(|_| renderer.record_shadows(cmd, &sim, Some(&mut profiler)))
-                    .map(|_| {
-                        offscreen.record_clear(cmd, Vec3::splat(0.02));
-                        let scope = profiler.begin_scope(cmd, "host: head mesh");
-                        let h = sim.head();
-                        let view_proj = camera.projection * camera.view;
-                        head.record(
-                            cmd,
-                            &offscreen.target(),
-                            view_proj,
-                            (h.rotation, h.translation),
-                            Vec3::new(0.55, 0.4, 0.32),
-                            Vec3::new(0.6, -0.5, -0.8),
-                        );
-                        profiler.end_scope(cmd, scope);
-                    })
-                    .and_then(|_| {
-                        renderer.record_draw(cmd, frame as u64, &offscreen.target(), &camera, Some(&mut profiler))
-                    })
-            };
-            if let Err(e) = result {
-                error = Some(e);
+                let sync = sim.record_frame(cmd, &heads, Some(&mut profiler))?;
+                renderer.record_prepare(cmd, sim.key_hairs(), Some(&camera), Some(&mut profiler))?;
+                renderer.record_shadows(cmd, sim.key_hairs(), Some(&mut profiler))?;
+                offscreen.record_clear(cmd, Vec3::splat(0.02));
+                let scope = profiler.begin_scope(cmd, "host: head mesh");
+                let h = sim.key_hairs().head();
+                let view_proj = camera.projection * camera.view;
+                head.record(
+                    cmd,
+                    &offscreen.target(),
+                    view_proj,
+                    (h.rotation, h.translation),
+                    Vec3::new(0.55, 0.4, 0.32),
+                    Vec3::new(0.6, -0.5, -0.8),
+                );
+                profiler.end_scope(cmd, scope);
+                renderer.record_draw(cmd, frame as u64, &offscreen.target(), &camera, Some(&mut profiler))?;
+                Ok(sync)
             }
         })?;
-        if let Some(e) = error.take() {
-            return Err(e.into());
+        // The simulation's own queue or device (ASYNC COMPUTE, SECOND DEVICE).
+        if let (Some(sim_report), Some(render_report)) = (sim.sim_profile(), profiler.drain().pop()) {
+            sim_ns += sim_report.total_nanoseconds();
+            overlap_ns += render_report.overlap_ns(&sim_report).unwrap_or(0.0);
+            sim_reports += 1;
+            add(render_report);
         }
         let rgba = offscreen.read_rgba8()?;
         write_png(&a.out.join(format!("frame_{frame:04}.png")), a.width, a.height, &rgba)?;
@@ -340,6 +404,11 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         println!("{name:<28} {:>10.3}", per_frame / 1e6);
     }
     println!("{:<28} {:>10.3}", "total", sum / 1e6);
+    if sim_reports > 0 {
+        let n = f64::from(sim_reports);
+        println!("{:<28} {:>10.3}", format!("simulation ({})", sim.mode().name()), sim_ns / n / 1e6);
+        println!("{:<28} {:>10.3}", "overlap with rendering", overlap_ns / n / 1e6);
+    }
     println!("wrote {} frames and contact_sheet.png to {}", frames.len(), a.out.display());
     if let Some(credit) = s.credit {
         println!("{credit}");

@@ -104,6 +104,10 @@ impl VolumeBuffers {
             }
         }
         let storage = |name: &str, size: u64| Buffer::storage(device, name, size.max(4));
+        // The density is read (shadows, hand-offs) before the first step writes it:
+        // it starts empty rather than undefined.
+        let density = storage("vkhair volume density", cells * 16)?;
+        device.upload(&density, 0, &vec![0u8; density.size() as usize])?;
         Ok(VolumeBuffers {
             params: Buffer::new(
                 device,
@@ -125,7 +129,7 @@ impl VolumeBuffers {
             sorted_pos: storage("vkhair volume sorted positions", n * 16)?,
             sorted_vel: storage("vkhair volume sorted velocities", n * 16)?,
             start: storage("vkhair volume cell start", (cells + 1) * 4)?,
-            cells: storage("vkhair volume density", cells * 16)?,
+            cells: density,
             labels: storage("vkhair volume labels", levels * 4)?,
             face_vel: storage("vkhair volume face velocities", faces * 4)?,
             face_star: storage("vkhair volume transferred face velocities", faces * 4)?,

@@ -1,0 +1,227 @@
+//! The rendering side's copy of the key-hair state, and the copies that pack a
+//! simulation's latest state into a hand-off buffer and unpack it again.
+//!
+//! A hand-off buffer holds the positions (vec4 per particle) followed, when the
+//! volume stage is on, by the density cells (vec4 per cell).
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use crate::error::Result;
+use crate::sim::{HairSim, KeyHairs, RigidTransform, SimState, VolumeGrid};
+use crate::vk::barrier::{self, Access};
+use crate::vk::buffer::{Buffer, BufferDesc};
+use crate::vk::device::Device;
+
+/// What travels with a hand-off besides the buffer contents.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Meta {
+    /// Steps the simulation has run in all.
+    pub steps: u64,
+    pub head: RigidTransform,
+    pub grid: Option<VolumeGrid>,
+}
+
+impl Meta {
+    pub(crate) fn of(sim: &HairSim, steps: u64) -> Meta {
+        Meta { steps, head: sim.head(), grid: sim.volume_grid() }
+    }
+}
+
+/// Byte sizes of the two parts of a hand-off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Layout {
+    pub positions: u64,
+    pub density: u64,
+}
+
+impl Layout {
+    pub(crate) fn of(sim: &HairSim) -> Layout {
+        let (positions, density) = sim.latest_buffers();
+        Layout { positions: positions.size(), density: density.map_or(0, Buffer::size) }
+    }
+
+    pub(crate) fn total(&self) -> u64 {
+        self.positions + self.density
+    }
+}
+
+/// Stages and accesses that read the mirror after a hand-off (the renderer's
+/// passes and the host's own copies).
+const READERS: Access = Access {
+    stage: vk::PipelineStageFlags2::from_raw(
+        vk::PipelineStageFlags2::VERTEX_SHADER.as_raw()
+            | vk::PipelineStageFlags2::TESSELLATION_EVALUATION_SHADER.as_raw()
+            | vk::PipelineStageFlags2::GEOMETRY_SHADER.as_raw()
+            | vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw()
+            | vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw()
+            | vk::PipelineStageFlags2::COPY.as_raw(),
+    ),
+    access: vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::SHADER_STORAGE_READ.as_raw() | vk::AccessFlags2::TRANSFER_READ.as_raw(),
+    ),
+};
+
+/// Before a copy: every earlier write is visible to it and every earlier access of
+/// its destination is done.
+fn before_copy() -> vk::MemoryBarrier2<'static> {
+    barrier::memory(
+        Access::ANY_WRITE,
+        Access {
+            stage: vk::PipelineStageFlags2::COPY,
+            access: vk::AccessFlags2::TRANSFER_READ | vk::AccessFlags2::TRANSFER_WRITE,
+        },
+    )
+}
+
+/// Records the copy of `sim`'s latest state into `dst` (a hand-off buffer of
+/// [`Layout::of`]`(sim)` bytes), after a barrier from every earlier write.
+///
+/// # Safety
+/// `cmd` is recording on `sim`'s device outside a render pass; `dst` belongs to that
+/// device, has `TRANSFER_DST` usage and room for the layout.
+pub(crate) unsafe fn record_pack(device: &Device, cmd: vk::CommandBuffer, sim: &HairSim, dst: vk::Buffer) {
+    let (positions, density) = sim.latest_buffers();
+    // SAFETY: guaranteed by the caller.
+    unsafe {
+        device.cmd_barrier(cmd, &[before_copy()], &[], &[]);
+        let region = vk::BufferCopy { src_offset: 0, dst_offset: 0, size: positions.size() };
+        device.raw.cmd_copy_buffer(cmd, positions.raw(), dst, &[region]);
+        if let Some(density) = density {
+            let region = vk::BufferCopy { src_offset: 0, dst_offset: positions.size(), size: density.size() };
+            device.raw.cmd_copy_buffer(cmd, density.raw(), dst, &[region]);
+        }
+    }
+}
+
+/// The rendering device's copy of the latest handed-off state: positions double
+/// buffered (a hand-off writes the half the previous frame did not read) and the
+/// density cells.
+pub(crate) struct Mirror {
+    device: Arc<Device>,
+    rest: SimState,
+    halves: [Buffer; 2],
+    density: Option<Buffer>,
+    current: usize,
+    meta: Meta,
+    layout: Layout,
+}
+
+impl Mirror {
+    /// A mirror on `device` holding `initial` (uploaded now; this submits and waits).
+    pub(crate) fn new(device: &Arc<Device>, initial: &SimState, meta: Meta, layout: Layout) -> Result<Self> {
+        let half = |i: usize| Buffer::storage(device, &format!("vkhair hand-off positions {i}"), layout.positions);
+        let halves = [half(0)?, half(1)?];
+        for h in &halves {
+            device.upload_pod(h, &initial.positions)?;
+        }
+        let density = match layout.density {
+            0 => None,
+            bytes => {
+                let b = Buffer::storage(device, "vkhair hand-off density", bytes)?;
+                device.upload(&b, 0, &vec![0u8; bytes as usize])?;
+                Some(b)
+            }
+        };
+        Ok(Mirror { device: device.clone(), rest: initial.clone(), halves, density, current: 0, meta, layout })
+    }
+
+    pub(crate) fn device(&self) -> &Arc<Device> {
+        &self.device
+    }
+
+    pub(crate) fn layout(&self) -> Layout {
+        self.layout
+    }
+
+    pub(crate) fn meta(&self) -> Meta {
+        self.meta
+    }
+
+    /// The state as a renderer reads it.
+    pub(crate) fn key_hairs(&self) -> KeyHairs<'_> {
+        KeyHairs {
+            device: &self.device,
+            rest: &self.rest,
+            halves: [&self.halves[0], &self.halves[1]],
+            current: self.current,
+            head: self.meta.head,
+            volume: self.meta.grid.zip(self.density.as_ref()),
+        }
+    }
+
+    /// Records the copy of a hand-off buffer `src` (on the mirror's device, laid out
+    /// as [`Layout`] from `offset`) into the mirror, then a barrier to the readers.
+    ///
+    /// # Safety
+    /// `cmd` is recording on the mirror's device outside a render pass; `src` is a
+    /// buffer of that device with `TRANSFER_SRC` usage, whose contents are ready
+    /// when the command runs (the caller's semaphores or acquire barriers).
+    pub(crate) unsafe fn record_unpack(&mut self, cmd: vk::CommandBuffer, src: vk::Buffer, meta: Meta) {
+        let next = 1 - self.current;
+        let d = &self.device;
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            d.cmd_barrier(cmd, &[before_copy()], &[], &[]);
+            let region = vk::BufferCopy { src_offset: 0, dst_offset: 0, size: self.layout.positions };
+            d.raw.cmd_copy_buffer(cmd, src, self.halves[next].raw(), &[region]);
+            if let Some(density) = &self.density {
+                let region =
+                    vk::BufferCopy { src_offset: self.layout.positions, dst_offset: 0, size: self.layout.density };
+                d.raw.cmd_copy_buffer(cmd, src, density.raw(), &[region]);
+            }
+            d.cmd_barrier(cmd, &[barrier::memory(Access::TRANSFER_WRITE, READERS)], &[], &[]);
+        }
+        self.current = next;
+        self.meta = meta;
+    }
+
+    /// Records the copy of `sim`'s latest state (same device) into the mirror.
+    ///
+    /// # Safety
+    /// As for [`Mirror::record_unpack`]; `sim` lives on the mirror's device and its
+    /// latest state is written by work earlier in submission order.
+    pub(crate) unsafe fn record_from_sim(&mut self, cmd: vk::CommandBuffer, sim: &HairSim, meta: Meta) {
+        let next = 1 - self.current;
+        let (positions, density) = sim.latest_buffers();
+        let d = &self.device;
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            d.cmd_barrier(cmd, &[before_copy()], &[], &[]);
+            let region = vk::BufferCopy { src_offset: 0, dst_offset: 0, size: self.layout.positions };
+            d.raw.cmd_copy_buffer(cmd, positions.raw(), self.halves[next].raw(), &[region]);
+            if let (Some(src), Some(dst)) = (density, &self.density) {
+                let region = vk::BufferCopy { src_offset: 0, dst_offset: 0, size: self.layout.density };
+                d.raw.cmd_copy_buffer(cmd, src.raw(), dst.raw(), &[region]);
+            }
+            d.cmd_barrier(cmd, &[barrier::memory(Access::TRANSFER_WRITE, READERS)], &[], &[]);
+        }
+        self.current = next;
+        self.meta = meta;
+    }
+
+    /// Reads the mirrored positions back (this submits and waits on the mirror's
+    /// device).
+    pub(crate) fn read_positions(&self) -> Result<Vec<glam::Vec4>> {
+        self.device.readback_pod(&self.halves[self.current], self.rest.positions.len())
+    }
+}
+
+/// A hand-off buffer on one device.
+pub(crate) fn slot_buffer(
+    device: &Arc<Device>,
+    name: &str,
+    layout: Layout,
+    location: gpu_allocator::MemoryLocation,
+) -> Result<Buffer> {
+    Buffer::new(
+        device,
+        &BufferDesc {
+            name,
+            size: layout.total(),
+            usage: vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
+            location,
+        },
+    )
+}

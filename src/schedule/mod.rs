@@ -1,0 +1,684 @@
+//! Where the simulation runs relative to rendering: the [`FrameScheduler`].
+//!
+//! Three modes ([`ScheduleMode`]), chosen automatically from what the devices
+//! offer and overridable through [`SchedulerOptions::mode`]:
+//!
+//! 1. **SINGLE QUEUE** — the simulation steps are recorded into the host's
+//!    command buffer, in order with rendering (one queue, e.g. lavapipe).
+//! 2. **ASYNC COMPUTE** — vkhair submits the steps to a second queue of the
+//!    rendering device (another family, or a second queue of the graphics
+//!    family); the host's frame waits on a timeline semaphore that
+//!    [`FrameScheduler::record_frame`] returns. Buffers are shared between the
+//!    families with `CONCURRENT` sharing rather than ownership transfers: the
+//!    state crosses queues every frame, and concurrent sharing needs no
+//!    release/acquire pair on both queues for each of the simulation's buffers.
+//! 3. **SECOND DEVICE** — the simulation lives on a second logical device (another
+//!    GPU, or a second device of the same GPU). A worker thread owns its
+//!    submissions (start / end / acknowledge, see `worker.rs`); the positions and
+//!    density reach the rendering device through memory shared with
+//!    `VK_KHR_external_memory_fd` when both devices can share it
+//!    ([`HandOff::ExternalMemory`], no host copy), else through host-visible
+//!    staging buffers ([`HandOff::HostStaging`]).
+//!
+//! Each frame ends with one **hand-off**: the latest state is copied into the
+//! scheduler's **mirror** on the rendering device, the buffers that
+//! [`FrameScheduler::key_hairs`] shows the renderer. With [`Pipelining::Latency`]
+//! frame N shows the state after frame N's steps; with [`Pipelining::Throughput`]
+//! it shows the state after frame N−1's steps, so frame N's steps (on another queue
+//! or device) run while frame N renders. All modes show the same state for the
+//! same pipelining choice: SINGLE QUEUE copies before its steps for throughput.
+//!
+//! ## The host's side
+//!
+//! Call [`FrameScheduler::record_frame`] once per frame, with the heads of the
+//! steps a [`crate::sim::FixedStepDriver`] planned, into the frame's command
+//! buffer before the renderer's passes; submit that command buffer waiting on
+//! [`FrameSync::waits`]. Frames in flight follow the usual contract: when recording
+//! frame N, the host has waited for frame N − `frames_in_flight` to complete. vkhair
+//! never submits to the host's graphics queue from these calls, never waits on it,
+//! and its teardown waits only for its own submissions.
+
+mod async_compute;
+mod mirror;
+mod worker;
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+use crate::context::GpuContext;
+use crate::error::{Error, Result};
+use crate::groom::Groom;
+use crate::profiler::{GpuProfiler, ProfileReport};
+use crate::sim::{Collider, HairSim, KeyHairs, RigidTransform, SimParams, SimState};
+use crate::vk::barrier::Access;
+use crate::vk::buffer::Buffer;
+use crate::vk::external::{self, ExternalBuffer};
+use crate::vk::submit::CommandRing;
+use async_compute::{AsyncSim, Pending};
+use mirror::{slot_buffer, Layout, Meta, Mirror};
+use worker::{external_barrier, SimSide, SimSlots, SimUpdate, Worker};
+
+/// Where the simulation runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ScheduleMode {
+    /// Recorded into the host's command buffer, in order with rendering.
+    SingleQueue,
+    /// Submitted by vkhair to a second queue of the rendering device.
+    AsyncCompute,
+    /// On a second logical device, driven by a worker thread.
+    SecondDevice,
+}
+
+impl ScheduleMode {
+    /// The mode's name in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            ScheduleMode::SingleQueue => "single queue",
+            ScheduleMode::AsyncCompute => "async compute",
+            ScheduleMode::SecondDevice => "second device",
+        }
+    }
+}
+
+/// How SECOND DEVICE mode moves the state to the rendering device.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HandOff {
+    /// Memory exported by the simulation device and imported by the rendering
+    /// device (`VK_KHR_external_memory_fd`): no host copy.
+    ExternalMemory,
+    /// Host-visible buffers on both devices, copied by the render thread.
+    HostStaging,
+}
+
+/// Which simulation step a frame shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pipelining {
+    /// Frame N shows the state after its own steps (rendering waits for them).
+    Latency,
+    /// Frame N shows the state after frame N−1's steps while frame N's run.
+    Throughput,
+}
+
+/// How a [`FrameScheduler`] is set up.
+#[derive(Debug, Clone)]
+pub struct SchedulerOptions {
+    /// The mode to use; `None` chooses: SECOND DEVICE when `sim_device` is given,
+    /// else ASYNC COMPUTE when the rendering context has a second queue, else SINGLE
+    /// QUEUE. Default: `None`.
+    pub mode: Option<ScheduleMode>,
+    /// Which step a frame shows. Default: [`Pipelining::Throughput`].
+    pub pipelining: Pipelining,
+    /// Frames the host keeps in flight (1..=8): the scheduler keeps one more
+    /// hand-off slot than this. Default: 2.
+    pub frames_in_flight: u32,
+    /// The simulation device for SECOND DEVICE mode. Default: `None`.
+    pub sim_device: Option<GpuContext>,
+    /// How SECOND DEVICE mode hands the state over; `None`: external memory when
+    /// both devices can share it, else host staging. Default: `None`.
+    pub hand_off: Option<HandOff>,
+    /// Lets ASYNC COMPUTE submit to the rendering context's graphics queue when it
+    /// has no second queue: nothing overlaps, but the semaphore hand-off runs on any
+    /// device (tests). The host must not submit to that queue concurrently with
+    /// [`FrameScheduler::record_frame`]. Default: `false`.
+    pub async_on_graphics_queue: bool,
+    /// Timestamp profiles of vkhair's own simulation submissions (ASYNC COMPUTE and
+    /// SECOND DEVICE; see [`FrameScheduler::sim_profile`]). Default: `true`.
+    pub profile: bool,
+    /// Longest wait for the simulation side before an error. Default: 10 s.
+    pub timeout: Duration,
+}
+
+impl Default for SchedulerOptions {
+    fn default() -> Self {
+        SchedulerOptions {
+            mode: None,
+            pipelining: Pipelining::Throughput,
+            frames_in_flight: 2,
+            sim_device: None,
+            hand_off: None,
+            async_on_graphics_queue: false,
+            profile: true,
+            timeout: Duration::from_secs(10),
+        }
+    }
+}
+
+/// A timeline-semaphore wait the host's submission of a frame must include.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SemaphoreWait {
+    /// A timeline semaphore of the rendering device.
+    pub semaphore: vk::Semaphore,
+    /// The value to wait for.
+    pub value: u64,
+    /// The stages that must wait (the hand-off copy).
+    pub stage: vk::PipelineStageFlags2,
+}
+
+/// What the host's submission of a frame must do for vkhair.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[must_use = "the host's submission must wait on these semaphores"]
+pub struct FrameSync {
+    /// Semaphores to wait on (ASYNC COMPUTE; empty otherwise).
+    pub waits: Vec<SemaphoreWait>,
+}
+
+impl FrameSync {
+    /// The waits as `VkSemaphoreSubmitInfo`s for `vkQueueSubmit2`.
+    pub fn wait_infos(&self) -> Vec<vk::SemaphoreSubmitInfo<'static>> {
+        self.waits
+            .iter()
+            .map(|w| vk::SemaphoreSubmitInfo::default().semaphore(w.semaphore).value(w.value).stage_mask(w.stage))
+            .collect()
+    }
+}
+
+/// The rendering side of SECOND DEVICE hand-off slots.
+enum RenderSlots {
+    /// The rendering device's imports of the simulation device's exports.
+    External(Vec<ExternalBuffer>),
+    /// The simulation device's host-visible copies and the rendering device's
+    /// upload buffers.
+    Staging { readback: Arc<Vec<Buffer>>, upload: Vec<Buffer> },
+}
+
+enum Backend {
+    Local { sim: Box<HairSim>, steps: u64 },
+    Async { sim: Box<AsyncSim>, pending: Option<Pending> },
+    Remote { worker: Worker, slots: RenderSlots, pending: Option<u64> },
+    Stopped(String),
+}
+
+/// Runs a [`HairSim`] in one of the [`ScheduleMode`]s and hands its state to the
+/// rendering device every frame (see the module docs).
+///
+/// Dropping it stops the worker thread (SECOND DEVICE) and waits for vkhair's own
+/// submissions only; the host's frames that used its buffers or waited on its
+/// semaphores must have completed, as for any resource of a frame in flight.
+pub struct FrameScheduler {
+    backend: Backend,
+    mirror: Mirror,
+    mode: ScheduleMode,
+    hand_off: Option<HandOff>,
+    reason: String,
+    pipelining: Pipelining,
+    slots: usize,
+    frames: u64,
+    sim_device: Option<GpuContext>,
+}
+
+impl std::fmt::Debug for FrameScheduler {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FrameScheduler")
+            .field("mode", &self.mode)
+            .field("hand_off", &self.hand_off)
+            .field("pipelining", &self.pipelining)
+            .field("frames", &self.frames)
+            .finish()
+    }
+}
+
+impl FrameScheduler {
+    /// Creates the simulation of `groom` (as [`HairSim::new`], with `colliders`) on
+    /// the device the mode needs and the hand-off buffers on `render`. This submits
+    /// uploads and waits for them. Forcing a mode the devices cannot run is an
+    /// [`Error::ModeUnavailable`] naming what is missing.
+    pub fn new(
+        render: &GpuContext,
+        groom: &Groom,
+        params: &SimParams,
+        head: &RigidTransform,
+        colliders: &[Collider],
+        options: &SchedulerOptions,
+    ) -> Result<Self> {
+        if !(1..=8).contains(&options.frames_in_flight) {
+            return Err(Error::param("frames_in_flight", format!("{} is outside 1..=8", options.frames_in_flight)));
+        }
+        if options.timeout.is_zero() {
+            return Err(Error::param("timeout", "must be longer than zero"));
+        }
+        let slots = options.frames_in_flight as usize + 1;
+        let (mode, reason) = choose_mode(render, options)?;
+        let device = render.device.clone();
+        let sim_ctx = match mode {
+            ScheduleMode::SecondDevice => {
+                options.sim_device.clone().ok_or_else(|| unavailable(mode, "no sim_device given"))?
+            }
+            _ => render.clone(),
+        };
+        let mut sim = HairSim::new(&sim_ctx, groom, params, head)?;
+        sim.set_colliders(colliders)?;
+        let initial = sim.read_state()?;
+        let layout = Layout::of(&sim);
+        let mirror = Mirror::new(&device, &initial, Meta::of(&sim, 0), layout)?;
+        let mut hand_off = None;
+        let backend = match mode {
+            ScheduleMode::SingleQueue => Backend::Local { sim: Box::new(sim), steps: 0 },
+            ScheduleMode::AsyncCompute => {
+                let queue = match device.compute {
+                    Some(q) => q,
+                    None => device.graphics,
+                };
+                let sim = AsyncSim::new(sim, queue, slots, options.profile, options.timeout)?;
+                Backend::Async { sim: Box::new(sim), pending: None }
+            }
+            ScheduleMode::SecondDevice => {
+                let sim_device = sim_ctx.device.clone();
+                let can_share = external::compatible(&sim_device, &device);
+                let chosen = match options.hand_off {
+                    Some(HandOff::ExternalMemory) if !can_share => return Err(unavailable(
+                        mode,
+                        "external memory needs VK_KHR_external_memory_fd on both devices and equal device/driver UUIDs",
+                    )),
+                    Some(h) => h,
+                    None if can_share => HandOff::ExternalMemory,
+                    None => HandOff::HostStaging,
+                };
+                hand_off = Some(chosen);
+                let (sim_slots, render_slots) = make_slots(&sim_device, &device, chosen, layout, slots)?;
+                let profiler = match options.profile && sim_device.info.timestamp_valid_bits > 0 {
+                    true => Some(GpuProfiler::from_device(&sim_device, 1, 1024)?),
+                    false => None,
+                };
+                let ring = CommandRing::new(&sim_device, sim_device.graphics, 2, "vkhair simulation device")?;
+                let side = SimSide { ring, sim, slots: sim_slots, profiler, device: sim_device, steps: 0 };
+                let worker = Worker::spawn(side, slots, options.timeout)?;
+                Backend::Remote { worker, slots: render_slots, pending: None }
+            }
+        };
+        log::info!("vkhair: simulation scheduled as {} ({reason})", mode.name());
+        Ok(FrameScheduler {
+            backend,
+            mirror,
+            mode,
+            hand_off,
+            reason,
+            pipelining: options.pipelining,
+            slots,
+            frames: 0,
+            sim_device: (mode == ScheduleMode::SecondDevice).then_some(sim_ctx),
+        })
+    }
+
+    /// The mode in use.
+    pub fn mode(&self) -> ScheduleMode {
+        self.mode
+    }
+
+    /// Why the mode was chosen (e.g. "no second queue: ...").
+    pub fn reason(&self) -> &str {
+        &self.reason
+    }
+
+    /// The hand-off of SECOND DEVICE mode.
+    pub fn hand_off(&self) -> Option<HandOff> {
+        self.hand_off
+    }
+
+    /// The pipelining choice.
+    pub fn pipelining(&self) -> Pipelining {
+        self.pipelining
+    }
+
+    /// The simulation device of SECOND DEVICE mode.
+    pub fn sim_device(&self) -> Option<&GpuContext> {
+        self.sim_device.as_ref()
+    }
+
+    /// The state the latest recorded frame shows, for [`crate::render::Renderer`]
+    /// (create the renderer from it, and pass it to each frame's passes).
+    pub fn key_hairs(&self) -> KeyHairs<'_> {
+        self.mirror.key_hairs()
+    }
+
+    /// Simulation steps behind the state the latest recorded frame shows.
+    pub fn shown_steps(&self) -> u64 {
+        self.mirror.meta().steps
+    }
+
+    /// Records frame `frame`'s part into the host's `cmd`: runs one step per entry
+    /// of `heads` (the head transform at the end of each step; none is fine) where
+    /// the mode runs them, and the hand-off into [`FrameScheduler::key_hairs`] for
+    /// the [`Pipelining`] choice. With a profiler, SINGLE QUEUE steps and the
+    /// hand-off get timestamp scopes in it.
+    ///
+    /// # Safety
+    /// `cmd` is a command buffer of the rendering context's device in the recording
+    /// state, outside a render pass, for the graphics queue family; it is submitted
+    /// with the returned [`FrameSync`]'s waits, after the calls of earlier frames'
+    /// command buffers. When recording, the host has waited for the frame recorded
+    /// `frames_in_flight` calls ago. The profiler, if any, had `begin_frame` called
+    /// for this frame.
+    pub unsafe fn record_frame(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        heads: &[RigidTransform],
+        mut profiler: Option<&mut GpuProfiler>,
+    ) -> Result<FrameSync> {
+        heads.iter().try_for_each(RigidTransform::validate)?;
+        let latency = self.pipelining == Pipelining::Latency;
+        let mut sync = FrameSync::default();
+        let label = "vkhair hand-off";
+        match &mut self.backend {
+            Backend::Stopped(why) => return Err(Error::SimulationStopped(why.clone())),
+            Backend::Local { sim, steps } => {
+                // SAFETY: guaranteed by the caller; the simulation lives on this device.
+                unsafe {
+                    if !latency {
+                        let meta = Meta::of(sim, *steps);
+                        scoped(&mut profiler, cmd, label, |_| self.mirror.record_from_sim(cmd, sim, meta));
+                    }
+                    for head in heads {
+                        sim.record_step(cmd, head, profiler.as_deref_mut())?;
+                        *steps += 1;
+                    }
+                    if latency {
+                        let meta = Meta::of(sim, *steps);
+                        scoped(&mut profiler, cmd, label, |_| self.mirror.record_from_sim(cmd, sim, meta));
+                    }
+                }
+            }
+            Backend::Async { sim, pending } => {
+                let take = match latency {
+                    true => Some(sim.submit(heads)?),
+                    false => pending.replace(sim.submit(heads)?),
+                };
+                if let Some(p) = take {
+                    let (buffer, wait) = sim.take(&p);
+                    // SAFETY: guaranteed by the caller; the slot is ready once the
+                    // returned wait is satisfied.
+                    unsafe { scoped(&mut profiler, cmd, label, |_| self.mirror.record_unpack(cmd, buffer, p.meta)) };
+                    sync.waits.push(SemaphoreWait { semaphore: wait.semaphore, value: wait.value, stage: wait.stage });
+                }
+            }
+            Backend::Remote { worker, slots, pending } => {
+                if latency {
+                    let job = worker.start(heads)?;
+                    let meta = worker.wait_end(job, self.slots)?;
+                    // SAFETY: guaranteed by the caller.
+                    unsafe { consume(&mut self.mirror, slots, cmd, job, self.slots, meta, &mut profiler) };
+                    worker.ack(job);
+                } else {
+                    if let Some(job) = pending.take() {
+                        let meta = worker.wait_end(job, self.slots)?;
+                        // SAFETY: guaranteed by the caller.
+                        unsafe { consume(&mut self.mirror, slots, cmd, job, self.slots, meta, &mut profiler) };
+                        worker.ack(job);
+                    }
+                    *pending = Some(worker.start(heads)?);
+                }
+            }
+        }
+        self.frames += 1;
+        Ok(sync)
+    }
+
+    /// The latest simulation state (waits for vkhair's own simulation work; this
+    /// submits readbacks on the simulation device and waits for them).
+    pub fn read_state(&self) -> Result<SimState> {
+        match &self.backend {
+            Backend::Local { sim, .. } => sim.read_state(),
+            Backend::Async { sim, .. } => {
+                sim.wait_idle()?;
+                sim.sim.read_state()
+            }
+            Backend::Remote { worker, .. } => worker.read_state(),
+            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
+        }
+    }
+
+    /// The positions the latest recorded frame shows (this submits a readback on the
+    /// rendering device and waits for it; the host's frames must be complete).
+    pub fn read_shown_positions(&self) -> Result<Vec<glam::Vec4>> {
+        self.mirror.read_positions()
+    }
+
+    /// The timestamp profile of vkhair's latest simulation submission whose results
+    /// are available (ASYNC COMPUTE and SECOND DEVICE with
+    /// [`SchedulerOptions::profile`]; SINGLE QUEUE steps are profiled in the host's
+    /// profiler). Place it next to the render profile with
+    /// [`ProfileReport::overlap_ns`].
+    pub fn sim_profile(&self) -> Option<ProfileReport> {
+        match &self.backend {
+            Backend::Async { sim, .. } => sim.report(),
+            Backend::Remote { worker, .. } => worker.report(),
+            _ => None,
+        }
+    }
+
+    /// Changes simulation parameters from the next step on (validated now). The
+    /// volume stage's mode and resolution are fixed for the scheduler's lifetime.
+    pub fn set_sim_params(&mut self, params: &SimParams) -> Result<()> {
+        params.validate()?;
+        let has_volume = self.mirror.layout().density > 0;
+        let grid = self.mirror.meta().grid.map(|g| g.dims);
+        let same = (params.volume.mode == crate::sim::VolumeMode::Off) != has_volume
+            && grid.is_none_or(|dims| dims == params.volume.resolution);
+        if !same {
+            return Err(Error::param("volume", "the volume stage's mode and resolution are fixed for a scheduler"));
+        }
+        match &mut self.backend {
+            Backend::Local { sim, .. } => sim.set_params(params),
+            Backend::Async { sim, .. } => sim.sim.set_params(params),
+            Backend::Remote { worker, .. } => worker.update(SimUpdate::Params(Box::new(params.clone()))),
+            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
+        }
+    }
+
+    /// Replaces the colliders (validated now) from the next step on.
+    pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
+        crate::sim::validate_colliders(colliders)?;
+        match &mut self.backend {
+            Backend::Local { sim, .. } => sim.set_colliders(colliders),
+            Backend::Async { sim, .. } => sim.sim.set_colliders(colliders),
+            Backend::Remote { worker, .. } => worker.update(SimUpdate::Colliders(colliders.to_vec())),
+            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
+        }
+    }
+
+    /// Stops and drops the simulation side now (its thread, its own submissions
+    /// waited for, its buffers; the mirror stays for frames still in flight). Later
+    /// frames get [`Error::SimulationStopped`].
+    pub fn stop_simulation(&mut self) {
+        let old =
+            std::mem::replace(&mut self.backend, Backend::Stopped("the simulation was stopped by the host".into()));
+        drop(old);
+        self.sim_device = None;
+    }
+
+    #[cfg(test)]
+    fn inject_worker_panic(&self) -> Result<()> {
+        match &self.backend {
+            Backend::Remote { worker, .. } => worker.inject_panic(),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Records `f` inside a profiler scope (or a debug label without a profiler).
+///
+/// # Safety
+/// `cmd` is recording; the profiler contract is the caller's.
+unsafe fn scoped(
+    profiler: &mut Option<&mut GpuProfiler>,
+    cmd: vk::CommandBuffer,
+    name: &str,
+    f: impl FnOnce(vk::CommandBuffer),
+) {
+    // SAFETY: guaranteed by the caller.
+    unsafe {
+        match profiler.as_deref_mut() {
+            Some(p) => {
+                let scope = p.begin_scope(cmd, name);
+                f(cmd);
+                p.end_scope(cmd, scope);
+            }
+            None => f(cmd),
+        }
+    }
+}
+
+/// Takes a finished SECOND DEVICE job's slot into the mirror.
+///
+/// # Safety
+/// `cmd` is recording on the mirror's device; the job is finished and not yet
+/// acknowledged.
+unsafe fn consume(
+    mirror: &mut Mirror,
+    slots: &mut RenderSlots,
+    cmd: vk::CommandBuffer,
+    job: u64,
+    count: usize,
+    meta: Meta,
+    profiler: &mut Option<&mut GpuProfiler>,
+) {
+    let slot = job as usize % count;
+    // SAFETY: guaranteed by the caller.
+    unsafe {
+        scoped(profiler, cmd, "vkhair hand-off", |cmd| match slots {
+            RenderSlots::External(buffers) => {
+                let b = buffers[slot].raw();
+                let family = mirror.device().graphics.family;
+                let read = Access { stage: vk::PipelineStageFlags2::COPY, access: vk::AccessFlags2::TRANSFER_READ };
+                let d = mirror.device().clone();
+                d.cmd_barrier(
+                    cmd,
+                    &[],
+                    &[external_barrier(b, Access::NONE, read, vk::QUEUE_FAMILY_EXTERNAL, family)],
+                    &[],
+                );
+                mirror.record_unpack(cmd, b, meta);
+                d.cmd_barrier(
+                    cmd,
+                    &[],
+                    &[external_barrier(b, read, Access::NONE, family, vk::QUEUE_FAMILY_EXTERNAL)],
+                    &[],
+                );
+            }
+            RenderSlots::Staging { readback, upload } => {
+                let bytes = mirror.layout().total() as usize;
+                if let (Some(src), Some(dst)) = (readback[slot].mapped(), upload[slot].mapped_mut()) {
+                    dst[..bytes].copy_from_slice(&src[..bytes]);
+                }
+                mirror.record_unpack(cmd, upload[slot].raw(), meta);
+            }
+        });
+    }
+}
+
+fn unavailable(mode: ScheduleMode, reason: &str) -> Error {
+    Error::ModeUnavailable { mode: mode.name(), reason: reason.to_owned() }
+}
+
+/// The mode for `options` on `render`, and why.
+fn choose_mode(render: &GpuContext, options: &SchedulerOptions) -> Result<(ScheduleMode, String)> {
+    let device = &render.device;
+    let second_queue = match device.compute {
+        Some(q) if q.family != device.graphics.family => Some(format!("compute queue family {}", q.family)),
+        Some(_) => Some(format!("a second queue of graphics family {}", device.graphics.family)),
+        None => None,
+    };
+    let no_queue = format!("{} offers no second queue (one queue family with one queue)", device.info.name);
+    match options.mode {
+        Some(ScheduleMode::SingleQueue) => Ok((ScheduleMode::SingleQueue, "forced by the host".into())),
+        Some(ScheduleMode::AsyncCompute) => match (second_queue, options.async_on_graphics_queue) {
+            (Some(q), _) => Ok((ScheduleMode::AsyncCompute, format!("forced by the host, on {q}"))),
+            (None, true) => {
+                Ok((ScheduleMode::AsyncCompute, format!("forced by the host on the graphics queue: {no_queue}")))
+            }
+            (None, false) => Err(unavailable(ScheduleMode::AsyncCompute, &no_queue)),
+        },
+        Some(ScheduleMode::SecondDevice) => match &options.sim_device {
+            Some(_) => Ok((ScheduleMode::SecondDevice, "forced by the host".into())),
+            None => Err(unavailable(ScheduleMode::SecondDevice, "no sim_device given")),
+        },
+        None => Ok(match (&options.sim_device, second_queue) {
+            (Some(s), _) => (ScheduleMode::SecondDevice, format!("the host gave simulation device {}", s.info().name)),
+            (None, Some(q)) => (ScheduleMode::AsyncCompute, format!("the device has {q}")),
+            (None, None) => (ScheduleMode::SingleQueue, no_queue),
+        }),
+    }
+}
+
+/// The hand-off slots of SECOND DEVICE mode on both devices.
+fn make_slots(
+    sim: &Arc<crate::vk::device::Device>,
+    render: &Arc<crate::vk::device::Device>,
+    hand_off: HandOff,
+    layout: Layout,
+    count: usize,
+) -> Result<(SimSlots, RenderSlots)> {
+    match hand_off {
+        HandOff::ExternalMemory => {
+            let mut exported = Vec::new();
+            let mut imported = Vec::new();
+            for i in 0..count {
+                let e = ExternalBuffer::export(sim, &format!("vkhair shared slot {i}"), layout.total())?;
+                let fd = e.export_fd()?;
+                imported.push(ExternalBuffer::import(render, &format!("vkhair shared slot {i} (imported)"), &e, fd)?);
+                exported.push(e);
+            }
+            Ok((SimSlots::External(exported), RenderSlots::External(imported)))
+        }
+        HandOff::HostStaging => {
+            let readback = (0..count)
+                .map(|i| slot_buffer(sim, &format!("vkhair staging slot {i}"), layout, MemoryLocation::GpuToCpu))
+                .collect::<Result<Vec<_>>>()?;
+            let upload = (0..count)
+                .map(|i| slot_buffer(render, &format!("vkhair upload slot {i}"), layout, MemoryLocation::CpuToGpu))
+                .collect::<Result<Vec<_>>>()?;
+            let readback = Arc::new(readback);
+            Ok((SimSlots::Staging(readback.clone()), RenderSlots::Staging { readback, upload }))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vk::tests::TestGpu;
+
+    /// A worker that dies (here: panics) mid-run turns into typed errors for the
+    /// host, in bounded time, for each pipelining choice; dropping the scheduler
+    /// afterwards joins the dead worker without hanging.
+    #[test]
+    fn a_dying_worker_gives_errors_not_hangs() {
+        let render = TestGpu::new();
+        let sim = TestGpu::new();
+        let strands: Vec<Vec<glam::Vec3>> = (0..8)
+            .map(|k| (0..4).map(|i| glam::Vec3::new(k as f32 * 0.02, 1.7 - 0.05 * i as f32, 0.0)).collect())
+            .collect();
+        let groom = Groom::from_strands(&strands).expect("groom");
+        for pipelining in [Pipelining::Latency, Pipelining::Throughput] {
+            let options = SchedulerOptions {
+                mode: Some(ScheduleMode::SecondDevice),
+                sim_device: Some(sim.ctx().clone()),
+                pipelining,
+                timeout: Duration::from_secs(20),
+                ..SchedulerOptions::default()
+            };
+            let head = RigidTransform::default();
+            let mut s = FrameScheduler::new(render.ctx(), &groom, &SimParams::default(), &head, &[], &options)
+                .expect("scheduler");
+            let frame = |s: &mut FrameScheduler| {
+                // SAFETY: recording command buffer of the rendering device, waited for.
+                render.ctx().run_frame("frame", |cmd| unsafe { s.record_frame(cmd, &[head], None) })
+            };
+            frame(&mut s).expect("first frame");
+            s.inject_worker_panic().expect("worker alive");
+            let started = std::time::Instant::now();
+            // Throughput may still take one finished job; within two frames the error comes.
+            let errors: Vec<_> = (0..2).map(|_| frame(&mut s)).collect();
+            assert!(
+                errors.iter().any(|e| matches!(e, Err(Error::SimulationStopped(m)) if m.contains("panicked"))),
+                "{errors:?}"
+            );
+            assert!(started.elapsed() < Duration::from_secs(15));
+            drop(s);
+        }
+        assert!(render.finish_with_messages().is_empty());
+        assert!(sim.finish_with_messages().is_empty());
+    }
+}
