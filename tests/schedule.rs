@@ -7,12 +7,13 @@ use std::sync::mpsc;
 use std::time::Duration;
 
 use glam::Vec3;
-use vkhair::groom::grow::{grow, GrowParams};
 use vkhair::groom::scenes;
 use vkhair::render::{Camera, Light, Offscreen, RenderParams, Renderer, ShadowCaster, ShadowParams};
 use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, SchedulerOptions};
 use vkhair::sim::{motion, FixedStepDriver, RigidTransform, SimParams, VolumeParams};
 use vkhair::{ContextOptions, Error, GpuContext, Groom, ValidationLog};
+
+mod common;
 
 /// A validated headless context whose log is checked after everything is dropped.
 struct Device {
@@ -27,15 +28,7 @@ fn device() -> Device {
 }
 
 fn groom(strands: usize, points: usize) -> Groom {
-    let p = GrowParams {
-        strands,
-        points_per_strand: points,
-        length: 0.3,
-        segment_growth: 1.5,
-        seed: 5,
-        ..GrowParams::default()
-    };
-    grow(&scenes::thesis_scalp(), &p).expect("groom")
+    common::grown_groom(strands, points, 5)
 }
 
 fn params() -> SimParams {

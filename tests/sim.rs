@@ -8,7 +8,6 @@
 //! they agree bit for bit, which the comparison also reports.
 
 use glam::{Vec3, Vec4};
-use vkhair::groom::grow::{grow, GrowParams};
 use vkhair::groom::{scenes, Groom};
 use vkhair::sim::{motion, Collider, CpuHairSim, HairSim, RigidTransform, SimParams, SimState, SolverMode};
 mod common;
@@ -76,7 +75,7 @@ fn gpu_matches_cpu_on_the_thesis_scene() {
 #[test]
 fn gpu_matches_cpu_with_substeps() {
     let gpu = Gpu::new();
-    let groom = small_groom(120, 6);
+    let groom = common::grown_groom(120, 6, 7);
     let params = SimParams { substeps: 4, iterations: 8, ..SimParams::default() };
     compare(gpu.ctx(), &groom, &params, &[1, 30]);
 }
@@ -89,23 +88,11 @@ fn gpu_matches_cpu_in_dftl_mode() {
     compare(gpu.ctx(), &groom, &params, &[1, 10, 100]);
 }
 
-fn small_groom(strands: usize, points: usize) -> Groom {
-    let p = GrowParams {
-        strands,
-        points_per_strand: points,
-        length: 0.35,
-        segment_growth: 1.5,
-        seed: 7,
-        ..GrowParams::default()
-    };
-    grow(&scenes::thesis_scalp(), &p).expect("groom")
-}
-
 #[test]
 fn gpu_matches_cpu_for_4_16_32_and_64_points() {
     let gpu = Gpu::new();
     for points in [4, 16, 32, 64] {
-        let groom = small_groom(40, points);
+        let groom = common::grown_groom(40, points, 7);
         let params =
             SimParams { iterations: 10, wind_enabled: true, wind: Vec3::new(3.0, 0.0, 1.0), ..SimParams::default() };
         compare(gpu.ctx(), &groom, &params, &[1, 20]);
@@ -131,7 +118,7 @@ fn max_relative_segment_error(state: &SimState) -> f32 {
 #[test]
 fn segment_length_error_is_bounded_and_falls_with_iterations() {
     let gpu = Gpu::new();
-    let groom = small_groom(200, 8);
+    let groom = common::grown_groom(200, 8, 7);
     let mut errors = Vec::new();
     for iterations in [1, 4, 20, 80] {
         let params = SimParams { iterations, ..SimParams::default() };
@@ -174,7 +161,7 @@ fn penetration(state: &SimState, head: &RigidTransform, colliders: &[Collider]) 
 #[test]
 fn no_particle_sinks_into_a_body_under_violent_motion() {
     let gpu = Gpu::new();
-    let groom = small_groom(300, 8);
+    let groom = common::grown_groom(300, 8, 7);
     let params = SimParams::default();
     let colliders = motion::thesis_colliders();
     let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
@@ -202,7 +189,7 @@ fn no_particle_sinks_into_a_body_under_violent_motion() {
 #[test]
 fn roots_follow_the_head_exactly() {
     let gpu = Gpu::new();
-    let groom = small_groom(100, 6);
+    let groom = common::grown_groom(100, 6, 7);
     let params = SimParams::default();
     let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
     sim.run(37, |i| head_at(i, &params), None).expect("run");
@@ -257,7 +244,7 @@ fn hanging_hair_stays_at_rest() {
 #[test]
 fn energy_stays_bounded_over_2000_shaking_steps() {
     let gpu = Gpu::new();
-    let groom = small_groom(100, 6);
+    let groom = common::grown_groom(100, 6, 7);
     let params = SimParams::default();
     let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
     sim.set_colliders(&motion::thesis_colliders()).expect("colliders");
@@ -296,7 +283,7 @@ fn runs_are_bitwise_deterministic() {
 #[test]
 fn changing_length_moves_only_tip_segments() {
     let gpu = Gpu::new();
-    let groom = small_groom(20, 9);
+    let groom = common::grown_groom(20, 9, 7);
     let params = SimParams { spring_enabled: false, ..SimParams::default() };
     let still = RigidTransform::default();
     let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &still).expect("sim");
@@ -337,7 +324,7 @@ fn changing_length_moves_only_tip_segments() {
 
 #[test]
 fn invalid_input_is_rejected_before_gpu_work() {
-    let groom = small_groom(10, 6);
+    let groom = common::grown_groom(10, 6, 7);
     let still = RigidTransform::default();
     let bad_params = [
         SimParams { dt: -0.01, ..SimParams::default() },
@@ -366,7 +353,7 @@ fn invalid_input_is_rejected_before_gpu_work() {
     let uneven =
         Groom::from_strands(&[vec![Vec3::ZERO, Vec3::X], vec![Vec3::Y, Vec3::ONE, Vec3::ONE * 2.0]]).expect("groom");
     assert!(matches!(CpuHairSim::new(&uneven, &SimParams::default(), &still), Err(Error::InvalidParameter { .. })));
-    let long = small_groom(2, 65);
+    let long = common::grown_groom(2, 65, 7);
     assert!(matches!(CpuHairSim::new(&long, &SimParams::default(), &still), Err(Error::InvalidParameter { .. })));
     // A state of the wrong size cannot be written.
     let gpu = Gpu::new();

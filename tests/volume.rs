@@ -8,8 +8,7 @@
 //! 1e-5), so positions are compared to 1 mm after 30 shaking steps.
 
 use glam::{Vec3, Vec4};
-use vkhair::groom::grow::{grow, GrowParams};
-use vkhair::groom::{scenes, Groom};
+use vkhair::groom::Groom;
 use vkhair::sim::{
     motion, CpuHairSim, HairSim, Preconditioner, RigidTransform, SimParams, SimState, VolumeMode, VolumeParams,
 };
@@ -17,18 +16,6 @@ use vkhair::Error;
 mod common;
 
 use common::Gpu;
-
-fn small_groom(strands: usize) -> Groom {
-    let p = GrowParams {
-        strands,
-        points_per_strand: 6,
-        length: 0.35,
-        segment_growth: 1.5,
-        seed: 11,
-        ..GrowParams::default()
-    };
-    grow(&scenes::thesis_scalp(), &p).expect("groom")
-}
 
 fn flip(resolution: u32) -> SimParams {
     SimParams { volume: VolumeParams::flip([resolution; 3]), ..SimParams::default() }
@@ -45,7 +32,7 @@ fn assert_finite(state: &SimState) {
 #[test]
 fn flip_simulation_follows_the_cpu_reference() {
     let gpu = Gpu::new();
-    let groom = small_groom(300);
+    let groom = common::grown_groom(300, 6, 11);
     for params in
         [flip(16), SimParams { volume: VolumeParams { mode: VolumeMode::Friction, ..flip(16).volume }, ..flip(16) }]
     {
@@ -190,7 +177,7 @@ fn uniform_motion_passes_through_untouched() {
 #[test]
 fn volume_simulation_is_deterministic_and_finite_for_2000_shaking_steps() {
     let gpu = Gpu::new();
-    let groom = small_groom(200);
+    let groom = common::grown_groom(200, 6, 11);
     let params =
         SimParams { volume: VolumeParams { preconditioner: Preconditioner::Multigrid, ..flip(16).volume }, ..flip(16) };
     let head0 = RigidTransform::default();
@@ -218,7 +205,7 @@ fn volume_simulation_is_deterministic_and_finite_for_2000_shaking_steps() {
 
 #[test]
 fn bad_volume_parameters_are_rejected_by_name() {
-    let groom = small_groom(10);
+    let groom = common::grown_groom(10, 6, 11);
     let head = RigidTransform::default();
     let cases: Vec<(VolumeParams, &str)> = vec![
         (VolumeParams { resolution: [3, 32, 32], ..VolumeParams::flip([32; 3]) }, "volume resolution"),
