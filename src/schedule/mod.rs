@@ -398,13 +398,13 @@ impl FrameScheduler {
                     let job = worker.start(heads)?;
                     let meta = worker.wait_end(job, self.slots)?;
                     // SAFETY: guaranteed by the caller.
-                    unsafe { consume(&mut self.mirror, slots, cmd, job, self.slots, meta, &mut profiler) };
+                    unsafe { consume(&mut self.mirror, slots, cmd, job, self.slots, meta, &mut profiler)? };
                     worker.ack(job);
                 } else {
                     if let Some(job) = pending.take() {
                         let meta = worker.wait_end(job, self.slots)?;
                         // SAFETY: guaranteed by the caller.
-                        unsafe { consume(&mut self.mirror, slots, cmd, job, self.slots, meta, &mut profiler) };
+                        unsafe { consume(&mut self.mirror, slots, cmd, job, self.slots, meta, &mut profiler)? };
                         worker.ack(job);
                     }
                     *pending = Some(worker.start(heads)?);
@@ -533,8 +533,15 @@ unsafe fn consume(
     count: usize,
     meta: Meta,
     profiler: &mut Option<&mut GpuProfiler>,
-) {
+) -> Result<()> {
     let slot = job as usize % count;
+    if let RenderSlots::Staging { readback, upload } = slots {
+        let bytes = mirror.layout().total() as usize;
+        match (readback[slot].mapped(), upload[slot].mapped_mut()) {
+            (Some(src), Some(dst)) => dst[..bytes].copy_from_slice(&src[..bytes]),
+            _ => return Err(Error::HandOff("staging memory could not be mapped".into())),
+        }
+    }
     // SAFETY: guaranteed by the caller.
     unsafe {
         scoped(profiler, cmd, "vkhair hand-off", |cmd| match slots {
@@ -557,15 +564,10 @@ unsafe fn consume(
                     &[],
                 );
             }
-            RenderSlots::Staging { readback, upload } => {
-                let bytes = mirror.layout().total() as usize;
-                if let (Some(src), Some(dst)) = (readback[slot].mapped(), upload[slot].mapped_mut()) {
-                    dst[..bytes].copy_from_slice(&src[..bytes]);
-                }
-                mirror.record_unpack(cmd, upload[slot].raw(), meta);
-            }
+            RenderSlots::Staging { upload, .. } => mirror.record_unpack(cmd, upload[slot].raw(), meta),
         });
     }
+    Ok(())
 }
 
 fn unavailable(mode: ScheduleMode, reason: &str) -> Error {
