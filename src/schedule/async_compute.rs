@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use ash::vk;
 
-use super::mirror::{record_pack, slot_buffer, Layout, Meta};
+use super::mirror::{record_copy, slot_buffer, Layout, Meta, Parts};
 use crate::error::Result;
 use crate::profiler::{GpuProfiler, ProfileReport};
 use crate::sim::{HairSim, RigidTransform};
@@ -77,7 +77,8 @@ impl AsyncSim {
                 for head in heads {
                     sim.record_step(cmd, head, profiler.as_mut())?;
                 }
-                record_pack(&device, cmd, sim, slots[slot].raw());
+                let layout = Layout::of(sim);
+                record_copy(&device, cmd, Parts::of_sim(sim), Parts::packed(slots[slot].raw(), layout), layout);
             }
             Ok(())
         })?;
@@ -85,11 +86,11 @@ impl AsyncSim {
         Ok(Pending { value, slot, meta: Meta::of(&self.sim, self.steps) })
     }
 
-    /// The slot buffer of a hand-off and the wait the host's frame needs for it.
-    pub(crate) fn take(&self, pending: &Pending) -> (vk::Buffer, Wait) {
+    /// The slot of a hand-off and the wait the host's frame needs for it.
+    pub(crate) fn take(&self, pending: &Pending) -> (Parts, Wait) {
         let wait =
             Wait { semaphore: self.ring.timeline.raw(), value: pending.value, stage: vk::PipelineStageFlags2::COPY };
-        (self.slots[pending.slot].raw(), wait)
+        (Parts::packed(self.slots[pending.slot].raw(), Layout::of(&self.sim)), wait)
     }
 
     /// Waits until every submission completed.

@@ -75,23 +75,44 @@ fn before_copy() -> vk::MemoryBarrier2<'static> {
     )
 }
 
-/// Records the copy of `sim`'s latest state into `dst` (a hand-off buffer of
-/// [`Layout::of`]`(sim)` bytes), after a barrier from every earlier write.
+/// Where the two parts of a state are: (buffer, byte offset) of the positions
+/// and, with the volume stage, of the density cells.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Parts {
+    positions: (vk::Buffer, u64),
+    density: Option<(vk::Buffer, u64)>,
+}
+
+impl Parts {
+    /// A simulation's latest state.
+    pub(crate) fn of_sim(sim: &HairSim) -> Parts {
+        let (positions, density) = sim.latest_buffers();
+        Parts { positions: (positions.raw(), 0), density: density.map(|d| (d.raw(), 0)) }
+    }
+
+    /// A hand-off buffer laid out as `layout`.
+    pub(crate) fn packed(buffer: vk::Buffer, layout: Layout) -> Parts {
+        Parts { positions: (buffer, 0), density: (layout.density > 0).then_some((buffer, layout.positions)) }
+    }
+}
+
+/// Records the copy of both parts from `src` to `dst`, after a barrier from every
+/// earlier write and access.
 ///
 /// # Safety
-/// `cmd` is recording on `sim`'s device outside a render pass; `dst` belongs to that
-/// device, has `TRANSFER_DST` usage and room for the layout.
-pub(crate) unsafe fn record_pack(device: &Device, cmd: vk::CommandBuffer, sim: &HairSim, dst: vk::Buffer) {
-    let (positions, density) = sim.latest_buffers();
+/// `cmd` is recording outside a render pass; all buffers belong to its device, with
+/// `TRANSFER_SRC`/`TRANSFER_DST` usage and room for `layout` at their offsets.
+pub(crate) unsafe fn record_copy(device: &Device, cmd: vk::CommandBuffer, src: Parts, dst: Parts, layout: Layout) {
+    let copy = |(from, src_offset): (vk::Buffer, u64), (to, dst_offset): (vk::Buffer, u64), size: u64| {
+        let region = vk::BufferCopy { src_offset, dst_offset, size };
+        // SAFETY: guaranteed by the caller.
+        unsafe { device.raw.cmd_copy_buffer(cmd, from, to, &[region]) };
+    };
     // SAFETY: guaranteed by the caller.
-    unsafe {
-        device.cmd_barrier(cmd, &[before_copy()], &[], &[]);
-        let region = vk::BufferCopy { src_offset: 0, dst_offset: 0, size: positions.size() };
-        device.raw.cmd_copy_buffer(cmd, positions.raw(), dst, &[region]);
-        if let Some(density) = density {
-            let region = vk::BufferCopy { src_offset: 0, dst_offset: positions.size(), size: density.size() };
-            device.raw.cmd_copy_buffer(cmd, density.raw(), dst, &[region]);
-        }
+    unsafe { device.cmd_barrier(cmd, &[before_copy()], &[], &[]) };
+    copy(src.positions, dst.positions, layout.positions);
+    if let (Some(from), Some(to)) = (src.density, dst.density) {
+        copy(from, to, layout.density);
     }
 }
 
@@ -151,50 +172,22 @@ impl Mirror {
         }
     }
 
-    /// Records the copy of a hand-off buffer `src` (on the mirror's device, laid out
-    /// as [`Layout`] from `offset`) into the mirror, then a barrier to the readers.
+    /// Records the copy of `src` (a simulation's latest state or a hand-off buffer,
+    /// on the mirror's device) into the mirror, then a barrier to the readers.
     ///
     /// # Safety
-    /// `cmd` is recording on the mirror's device outside a render pass; `src` is a
-    /// buffer of that device with `TRANSFER_SRC` usage, whose contents are ready
-    /// when the command runs (the caller's semaphores or acquire barriers).
-    pub(crate) unsafe fn record_unpack(&mut self, cmd: vk::CommandBuffer, src: vk::Buffer, meta: Meta) {
+    /// `cmd` is recording on the mirror's device outside a render pass; `src` lies in
+    /// buffers of that device with `TRANSFER_SRC` usage, whose contents are ready
+    /// when the command runs (earlier work in submission order, the caller's
+    /// semaphores or acquire barriers).
+    pub(crate) unsafe fn record_update(&mut self, cmd: vk::CommandBuffer, src: Parts, meta: Meta) {
         let next = 1 - self.current;
+        let dst =
+            Parts { positions: (self.halves[next].raw(), 0), density: self.density.as_ref().map(|d| (d.raw(), 0)) };
         let d = &self.device;
         // SAFETY: guaranteed by the caller.
         unsafe {
-            d.cmd_barrier(cmd, &[before_copy()], &[], &[]);
-            let region = vk::BufferCopy { src_offset: 0, dst_offset: 0, size: self.layout.positions };
-            d.raw.cmd_copy_buffer(cmd, src, self.halves[next].raw(), &[region]);
-            if let Some(density) = &self.density {
-                let region =
-                    vk::BufferCopy { src_offset: self.layout.positions, dst_offset: 0, size: self.layout.density };
-                d.raw.cmd_copy_buffer(cmd, src, density.raw(), &[region]);
-            }
-            d.cmd_barrier(cmd, &[barrier::memory(Access::TRANSFER_WRITE, READERS)], &[], &[]);
-        }
-        self.current = next;
-        self.meta = meta;
-    }
-
-    /// Records the copy of `sim`'s latest state (same device) into the mirror.
-    ///
-    /// # Safety
-    /// As for [`Mirror::record_unpack`]; `sim` lives on the mirror's device and its
-    /// latest state is written by work earlier in submission order.
-    pub(crate) unsafe fn record_from_sim(&mut self, cmd: vk::CommandBuffer, sim: &HairSim, meta: Meta) {
-        let next = 1 - self.current;
-        let (positions, density) = sim.latest_buffers();
-        let d = &self.device;
-        // SAFETY: guaranteed by the caller.
-        unsafe {
-            d.cmd_barrier(cmd, &[before_copy()], &[], &[]);
-            let region = vk::BufferCopy { src_offset: 0, dst_offset: 0, size: self.layout.positions };
-            d.raw.cmd_copy_buffer(cmd, positions.raw(), self.halves[next].raw(), &[region]);
-            if let (Some(src), Some(dst)) = (density, &self.density) {
-                let region = vk::BufferCopy { src_offset: 0, dst_offset: 0, size: self.layout.density };
-                d.raw.cmd_copy_buffer(cmd, src.raw(), dst.raw(), &[region]);
-            }
+            record_copy(d, cmd, src, dst, self.layout);
             d.cmd_barrier(cmd, &[barrier::memory(Access::TRANSFER_WRITE, READERS)], &[], &[]);
         }
         self.current = next;

@@ -58,7 +58,7 @@ use crate::vk::buffer::Buffer;
 use crate::vk::external::{self, ExternalBuffer};
 use crate::vk::submit::CommandRing;
 use async_compute::{AsyncSim, Pending};
-use mirror::{slot_buffer, Layout, Meta, Mirror};
+use mirror::{slot_buffer, Layout, Meta, Mirror, Parts};
 use worker::{external_barrier, SimSide, SimSlots, SimUpdate, Worker};
 
 /// Where the simulation runs.
@@ -368,7 +368,7 @@ impl FrameScheduler {
                 unsafe {
                     if !latency {
                         let meta = Meta::of(sim, *steps);
-                        scoped(&mut profiler, cmd, label, |_| self.mirror.record_from_sim(cmd, sim, meta));
+                        scoped(&mut profiler, cmd, label, |_| self.mirror.record_update(cmd, Parts::of_sim(sim), meta));
                     }
                     for head in heads {
                         sim.record_step(cmd, head, profiler.as_deref_mut())?;
@@ -376,7 +376,7 @@ impl FrameScheduler {
                     }
                     if latency {
                         let meta = Meta::of(sim, *steps);
-                        scoped(&mut profiler, cmd, label, |_| self.mirror.record_from_sim(cmd, sim, meta));
+                        scoped(&mut profiler, cmd, label, |_| self.mirror.record_update(cmd, Parts::of_sim(sim), meta));
                     }
                 }
             }
@@ -386,27 +386,26 @@ impl FrameScheduler {
                     false => pending.replace(sim.submit(heads)?),
                 };
                 if let Some(p) = take {
-                    let (buffer, wait) = sim.take(&p);
+                    let (parts, wait) = sim.take(&p);
                     // SAFETY: guaranteed by the caller; the slot is ready once the
                     // returned wait is satisfied.
-                    unsafe { scoped(&mut profiler, cmd, label, |_| self.mirror.record_unpack(cmd, buffer, p.meta)) };
+                    unsafe { scoped(&mut profiler, cmd, label, |_| self.mirror.record_update(cmd, parts, p.meta)) };
                     sync.waits.push(SemaphoreWait { semaphore: wait.semaphore, value: wait.value, stage: wait.stage });
                 }
             }
             Backend::Remote { worker, slots, pending } => {
-                if latency {
-                    let job = worker.start(heads)?;
+                // Latency takes this frame's job, throughput the previous frame's.
+                let take = match latency {
+                    true => Some(worker.start(heads)?),
+                    false => pending.take(),
+                };
+                if let Some(job) = take {
                     let meta = worker.wait_end(job, self.slots)?;
-                    // SAFETY: guaranteed by the caller.
+                    // SAFETY: guaranteed by the caller; the job is finished.
                     unsafe { consume(&mut self.mirror, slots, cmd, job, self.slots, meta, &mut profiler)? };
                     worker.ack(job);
-                } else {
-                    if let Some(job) = pending.take() {
-                        let meta = worker.wait_end(job, self.slots)?;
-                        // SAFETY: guaranteed by the caller.
-                        unsafe { consume(&mut self.mirror, slots, cmd, job, self.slots, meta, &mut profiler)? };
-                        worker.ack(job);
-                    }
+                }
+                if !latency {
                     *pending = Some(worker.start(heads)?);
                 }
             }
@@ -535,8 +534,9 @@ unsafe fn consume(
     profiler: &mut Option<&mut GpuProfiler>,
 ) -> Result<()> {
     let slot = job as usize % count;
+    let layout = mirror.layout();
     if let RenderSlots::Staging { readback, upload } = slots {
-        let bytes = mirror.layout().total() as usize;
+        let bytes = layout.total() as usize;
         match (readback[slot].mapped(), upload[slot].mapped_mut()) {
             (Some(src), Some(dst)) => dst[..bytes].copy_from_slice(&src[..bytes]),
             _ => return Err(Error::HandOff("staging memory could not be mapped".into())),
@@ -556,7 +556,7 @@ unsafe fn consume(
                     &[external_barrier(b, Access::NONE, read, vk::QUEUE_FAMILY_EXTERNAL, family)],
                     &[],
                 );
-                mirror.record_unpack(cmd, b, meta);
+                mirror.record_update(cmd, Parts::packed(b, layout), meta);
                 d.cmd_barrier(
                     cmd,
                     &[],
@@ -564,7 +564,9 @@ unsafe fn consume(
                     &[],
                 );
             }
-            RenderSlots::Staging { upload, .. } => mirror.record_unpack(cmd, upload[slot].raw(), meta),
+            RenderSlots::Staging { upload, .. } => {
+                mirror.record_update(cmd, Parts::packed(upload[slot].raw(), layout), meta)
+            }
         });
     }
     Ok(())

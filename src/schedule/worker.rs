@@ -23,7 +23,7 @@ use std::time::{Duration, Instant};
 
 use ash::vk;
 
-use super::mirror::{record_pack, Meta};
+use super::mirror::{record_copy, Layout, Meta, Parts};
 use crate::error::{Error, Result};
 use crate::profiler::{GpuProfiler, ProfileReport};
 use crate::sim::{Collider, HairSim, RigidTransform, SimParams, SimState};
@@ -296,6 +296,7 @@ fn step(
     }
     let SimSide { ring, sim, slots: sim_slots, profiler, device, steps } = side;
     let family = device.graphics.family;
+    let layout = Layout::of(sim);
     ring.submit(&[], timeout, |cmd| {
         // SAFETY: `cmd` is recording on the simulation device's graphics family; the
         // slot's previous contents were taken (acknowledged) by the render thread.
@@ -313,12 +314,13 @@ fn step(
                         Access { stage: vk::PipelineStageFlags2::COPY, access: vk::AccessFlags2::TRANSFER_WRITE };
                     let acquire = external_barrier(b, Access::NONE, copy, vk::QUEUE_FAMILY_EXTERNAL, family);
                     device.cmd_barrier(cmd, &[], &[acquire], &[]);
-                    record_pack(device, cmd, sim, b);
+                    record_copy(device, cmd, Parts::of_sim(sim), Parts::packed(b, layout), layout);
                     let release = external_barrier(b, copy, Access::NONE, family, vk::QUEUE_FAMILY_EXTERNAL);
                     device.cmd_barrier(cmd, &[], &[release], &[]);
                 }
                 SimSlots::Staging(buffers) => {
-                    record_pack(device, cmd, sim, buffers[slot].raw());
+                    let dst = Parts::packed(buffers[slot].raw(), layout);
+                    record_copy(device, cmd, Parts::of_sim(sim), dst, layout);
                     device.cmd_barrier(cmd, &[barrier::memory(Access::TRANSFER_WRITE, Access::HOST_READ)], &[], &[]);
                 }
             }
