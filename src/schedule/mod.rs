@@ -53,13 +53,13 @@ use crate::error::{Error, Result};
 use crate::groom::Groom;
 use crate::profiler::{GpuProfiler, ProfileReport};
 use crate::sim::{Collider, HairSim, KeyHairs, RigidTransform, SimParams, SimState};
-use crate::vk::barrier::Access;
+use crate::vk::barrier::{self, Access};
 use crate::vk::buffer::Buffer;
 use crate::vk::external::{self, ExternalBuffer};
 use crate::vk::submit::CommandRing;
 use async_compute::{AsyncSim, Pending};
 use mirror::{slot_buffer, Layout, Meta, Mirror, Parts};
-use worker::{external_barrier, SimSide, SimSlots, SimUpdate, Worker};
+use worker::{SimSide, SimSlots, SimUpdate, Worker};
 
 /// Where the simulation runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -553,14 +553,14 @@ unsafe fn consume(
                 d.cmd_barrier(
                     cmd,
                     &[],
-                    &[external_barrier(b, Access::NONE, read, vk::QUEUE_FAMILY_EXTERNAL, family)],
+                    &[barrier::ownership(b, Access::NONE, read, vk::QUEUE_FAMILY_EXTERNAL, family)],
                     &[],
                 );
                 mirror.record_update(cmd, Parts::packed(b, layout), meta);
                 d.cmd_barrier(
                     cmd,
                     &[],
-                    &[external_barrier(b, read, Access::NONE, family, vk::QUEUE_FAMILY_EXTERNAL)],
+                    &[barrier::ownership(b, read, Access::NONE, family, vk::QUEUE_FAMILY_EXTERNAL)],
                     &[],
                 );
             }

@@ -312,10 +312,10 @@ fn step(
                     let b = buffers[slot].raw();
                     let copy =
                         Access { stage: vk::PipelineStageFlags2::COPY, access: vk::AccessFlags2::TRANSFER_WRITE };
-                    let acquire = external_barrier(b, Access::NONE, copy, vk::QUEUE_FAMILY_EXTERNAL, family);
+                    let acquire = barrier::ownership(b, Access::NONE, copy, vk::QUEUE_FAMILY_EXTERNAL, family);
                     device.cmd_barrier(cmd, &[], &[acquire], &[]);
                     record_copy(device, cmd, Parts::of_sim(sim), Parts::packed(b, layout), layout);
-                    let release = external_barrier(b, copy, Access::NONE, family, vk::QUEUE_FAMILY_EXTERNAL);
+                    let release = barrier::ownership(b, copy, Access::NONE, family, vk::QUEUE_FAMILY_EXTERNAL);
                     device.cmd_barrier(cmd, &[], &[release], &[]);
                 }
                 SimSlots::Staging(buffers) => {
@@ -340,25 +340,4 @@ fn step(
     }
     shared.changed.notify_all();
     Ok(())
-}
-
-/// A queue-family ownership transfer of a whole shared buffer to or from
-/// `VK_QUEUE_FAMILY_EXTERNAL`.
-pub(crate) fn external_barrier(
-    buffer: vk::Buffer,
-    src: Access,
-    dst: Access,
-    from: u32,
-    to: u32,
-) -> vk::BufferMemoryBarrier2<'static> {
-    vk::BufferMemoryBarrier2::default()
-        .src_stage_mask(src.stage)
-        .src_access_mask(src.access)
-        .dst_stage_mask(dst.stage)
-        .dst_access_mask(dst.access)
-        .src_queue_family_index(from)
-        .dst_queue_family_index(to)
-        .buffer(buffer)
-        .offset(0)
-        .size(vk::WHOLE_SIZE)
 }

@@ -58,14 +58,27 @@ impl Access {
 
 /// A barrier on a whole buffer.
 pub(crate) fn buffer(buffer: &Buffer, src: Access, dst: Access) -> vk::BufferMemoryBarrier2<'static> {
+    ownership(buffer.raw(), src, dst, vk::QUEUE_FAMILY_IGNORED, vk::QUEUE_FAMILY_IGNORED)
+}
+
+/// A barrier on a whole buffer that also moves it from queue family `from` to `to`
+/// (a release on the `from` side, an acquire on the `to` side; `VK_QUEUE_FAMILY_EXTERNAL`
+/// for memory shared with another device).
+pub(crate) fn ownership(
+    buffer: vk::Buffer,
+    src: Access,
+    dst: Access,
+    from: u32,
+    to: u32,
+) -> vk::BufferMemoryBarrier2<'static> {
     vk::BufferMemoryBarrier2::default()
         .src_stage_mask(src.stage)
         .src_access_mask(src.access)
         .dst_stage_mask(dst.stage)
         .dst_access_mask(dst.access)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .buffer(buffer.raw())
+        .src_queue_family_index(from)
+        .dst_queue_family_index(to)
+        .buffer(buffer)
         .offset(0)
         .size(vk::WHOLE_SIZE)
 }
