@@ -27,6 +27,8 @@ use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, Schedu
 use vkhair::sim::{motion, RigidTransform, SimParams, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler, ProfileReport};
 
+mod common;
+
 const W: u32 = 640;
 const H: u32 = 480;
 
@@ -205,11 +207,5 @@ fn bench_schedule(c: &mut Criterion) {
 criterion_group!(benches, bench_schedule);
 
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let quick = args.iter().any(|a| a == "quick");
-    if !args.iter().any(|a| a == "summary" || a == "quick") {
-        benches();
-        Criterion::default().configure_from_args().final_summary();
-    }
-    summary(if quick { 4 } else { 12 });
+    common::criterion_then_summary(benches, |quick| summary(if quick { 4 } else { 12 }));
 }

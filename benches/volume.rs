@@ -21,6 +21,8 @@ use vkhair::sim::{
 };
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
+mod common;
+
 fn head(i: usize) -> RigidTransform {
     motion::reference_motion(i as f32 / 60.0)
 }
@@ -159,11 +161,5 @@ fn summary(steps: usize) {
 criterion_group!(benches, bench_volume);
 
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let quick = args.iter().any(|a| a == "quick");
-    if !args.iter().any(|a| a == "summary" || a == "quick") {
-        benches();
-        Criterion::default().configure_from_args().final_summary();
-    }
-    summary(if quick { 3 } else { 10 });
+    common::criterion_then_summary(benches, |quick| summary(if quick { 3 } else { 10 }));
 }
