@@ -17,7 +17,8 @@ use std::fmt::Write as _;
 
 use glam::Vec3;
 use vkhair::groom::scenes;
-use vkhair::render::{Camera, Light, Offscreen, RenderParams, RenderPass, Renderer, ShadowCaster, ShadowParams};
+use vkhair::headless::{Offscreen, Submit};
+use vkhair::render::{Camera, Light, RenderParams, RenderPass, Renderer, ShadowCaster, ShadowParams};
 
 const PASSES: [RenderPass; 4] = [RenderPass::Smooth, RenderPass::Interpolate, RenderPass::Draw, RenderPass::Resolve];
 use vkhair::sim::{motion, HairSim, RigidTransform, SimParams, VolumeMode, VolumeParams};

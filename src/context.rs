@@ -208,37 +208,6 @@ impl GpuContext {
     pub fn graphics_queue_family(&self) -> u32 {
         self.device.graphics.family
     }
-
-    /// Records `record` into a fresh command buffer, submits it to the graphics queue
-    /// and waits (headless use: tools, tests, examples; a host submits its own).
-    pub fn run_commands(&self, name: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
-        self.device.submit_once(name, record)
-    }
-
-    /// Records one frame into a fresh command buffer — `record` returns what the
-    /// submission must wait on ([`crate::schedule::FrameScheduler::record_frame`]'s
-    /// [`crate::schedule::FrameSync`]) — submits it to the graphics queue with those
-    /// waits and waits for it (headless use: tools, tests, benchmarks).
-    pub fn run_frame(
-        &self,
-        name: &str,
-        record: impl FnOnce(vk::CommandBuffer) -> Result<crate::schedule::FrameSync>,
-    ) -> Result<()> {
-        let mut result = Ok(());
-        self.device.submit_once_waiting(name, |cmd| match record(cmd) {
-            Ok(sync) => sync.wait_infos(),
-            Err(e) => {
-                result = Err(e);
-                Vec::new()
-            }
-        })?;
-        result
-    }
-
-    /// Waits until the crate's queue is idle (headless use; hosts sync their own way).
-    pub fn wait_idle(&self) -> Result<()> {
-        self.device.wait_idle()
-    }
 }
 
 /// Destroys instance-level objects if device creation fails half way.

@@ -37,6 +37,7 @@ mod error;
 pub(crate) mod gpu_types;
 pub mod groom;
 mod hash;
+pub mod headless;
 mod profiler;
 pub mod render;
 mod requirements;

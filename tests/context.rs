@@ -9,6 +9,7 @@ use std::ffi::CStr;
 use std::sync::{Arc, Mutex};
 
 use vkhair::ash::{self, vk};
+use vkhair::headless::Submit;
 use vkhair::{requirements, ContextOptions, GpuContext, GpuProfiler, HostDevice, HostQueue, ValidationLog};
 
 #[test]

@@ -3,6 +3,7 @@
 use glam::Vec3;
 use vkhair::groom::grow::{grow, GrowParams};
 use vkhair::groom::scenes;
+use vkhair::headless::{MeshDrawer, Offscreen, Submit};
 use vkhair::render::{reference, RenderParams, Renderer, ShadowParams};
 use vkhair::sim::{motion, HairSim, RigidTransform, SimParams};
 mod common;
@@ -144,7 +145,7 @@ fn interpolation_grows_stable_clumps() {
 // ---- Drawing -----------------------------------------------------------------
 
 use vkhair::groom::mesh::TriMesh;
-use vkhair::render::{Camera, HairMaterial, Light, MeshDrawer, Offscreen};
+use vkhair::render::{Camera, HairMaterial, Light};
 
 /// Frame indices for record_draw: every test frame is submitted and waited for.
 fn next_frame() -> u64 {

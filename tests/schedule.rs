@@ -8,7 +8,8 @@ use std::time::Duration;
 
 use glam::Vec3;
 use vkhair::groom::scenes;
-use vkhair::render::{Camera, Light, Offscreen, RenderParams, Renderer, ShadowCaster, ShadowParams};
+use vkhair::headless::{Offscreen, Submit};
+use vkhair::render::{Camera, Light, RenderParams, Renderer, ShadowCaster, ShadowParams};
 use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, SchedulerOptions};
 use vkhair::sim::{motion, FixedStepDriver, RigidTransform, SimParams, VolumeParams};
 use vkhair::{ContextOptions, Error, GpuContext, Groom, ValidationLog};

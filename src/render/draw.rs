@@ -1,22 +1,32 @@
-//! Pass 3 — drawing (`glsl/render/draw.*`): the interpolated hairs as
+//! Pass 4 — drawing (`glsl/render/draw.*`): the interpolated hairs as
 //! camera-facing ribbons expanded in the geometry stage, shaded with
 //! Kajiya-Kay diffuse and two shifted highlights for every light, into the
 //! host's color and depth images (dynamic rendering, depth-tested against what
 //! the host drew). Pipelines are made on first use for each combination of
-//! color format, depth format and sample count.
+//! color format, depth format, sample count and primitive. The pass owns the
+//! Marschner lookup tables it samples and rebuilds them when the material's
+//! parameters change.
 
 use std::collections::HashMap;
 use std::sync::Arc;
 
 use ash::vk;
+use glam::Vec4;
+use gpu_allocator::MemoryLocation;
 
-use super::shading::{noise_texels, NOISE_SIZE};
+use super::marschner::{MarschnerParams, MarschnerTables};
+use super::pass::RenderPass;
+use super::shading::{noise_texels, Camera, HairMaterial, MAX_LIGHTS, NOISE_SIZE};
+use super::Primitive;
 use crate::error::Result;
-use crate::vk::buffer::Buffer;
+use crate::gpu_types::{DrawParams, GpuLight};
+use crate::profiler::GpuProfiler;
+use crate::vk::barrier::{self, AccessKind};
+use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc, Sampler};
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
-use crate::vk::shaders::{RENDER_DRAW_FRAG, RENDER_DRAW_GEOM, RENDER_DRAW_VERT};
+use crate::vk::shaders::{ShaderSource, RENDER_DRAW_FRAG, RENDER_DRAW_GEOM, RENDER_DRAW_VERT};
 
 /// Formats, sample count and primitive a draw pipeline is made for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -24,14 +34,39 @@ pub(super) struct TargetKey {
     pub color: vk::Format,
     pub depth: vk::Format,
     pub samples: vk::SampleCountFlags,
-    pub primitive: super::Primitive,
+    pub primitive: Primitive,
 }
 
+/// The draw pass: its pipelines per target, the uniform block it reads, the
+/// noise texture and the Marschner tables.
 pub(super) struct DrawPass {
     device: Arc<Device>,
     pipelines: HashMap<TargetKey, (GraphicsPipeline, vk::DescriptorSet)>,
     noise: Image,
     sampler: Sampler,
+    /// The frame's [`DrawParams`], written by a transfer before the draw.
+    params: Buffer,
+    /// Marschner lookup tables, rebuilt when their parameters change.
+    marschner: MarschnerTables,
+}
+
+/// What the draw reads besides its own resources.
+pub(super) struct DrawInputs<'a> {
+    /// Interpolated hair positions and (tangent, t).
+    pub hairs: (&'a Buffer, &'a Buffer),
+    /// The frame's shadow uniforms.
+    pub shadow_uniforms: &'a Buffer,
+    /// The opacity atlas and its sampler.
+    pub atlas: (vk::ImageView, vk::Sampler),
+    /// Per-cell transmittance of density-volume lights.
+    pub transmittance: &'a Buffer,
+}
+
+/// Where the draw goes: a rendering instance of images with `key`'s formats.
+pub(super) struct DrawTarget<'a> {
+    pub key: TargetKey,
+    pub rendering: &'a vk::RenderingInfo<'a>,
+    pub extent: vk::Extent2D,
 }
 
 impl DrawPass {
@@ -49,12 +84,23 @@ impl DrawPass {
         )?;
         device.upload_image(&noise, &noise_texels())?;
         let sampler = Sampler::new(device, "vkhair noise sampler", true)?;
-        Ok(DrawPass { device: device.clone(), pipelines: HashMap::new(), noise, sampler })
+        let params = Buffer::new(
+            device,
+            &BufferDesc {
+                name: "vkhair draw params",
+                size: std::mem::size_of::<DrawParams>() as u64,
+                usage: vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?;
+        let marschner = MarschnerTables::new(device)?;
+        Ok(DrawPass { device: device.clone(), pipelines: HashMap::new(), noise, sampler, params, marschner })
     }
 
-    /// The pipeline and descriptor set for `key`, made on first use with `buffers`
-    /// and `images` (by binding) besides the noise texture.
-    pub(super) fn pipeline(
+    /// The pipeline and descriptor set for `key`, made on first use with the
+    /// pass's uniform block (binding 0), `buffers` and `images` (by binding) and the
+    /// noise texture (binding 3).
+    fn pipeline(
         &mut self,
         key: TargetKey,
         buffers: &[(u32, &Buffer)],
@@ -64,14 +110,13 @@ impl DrawPass {
             let color_formats = [key.color];
             // Lines skip the geometry stage: the fragment stage reads the vertex
             // stage's outputs at the same locations.
-            let ribbons: &[&crate::vk::shaders::ShaderSource] =
-                &[&RENDER_DRAW_VERT, &RENDER_DRAW_GEOM, &RENDER_DRAW_FRAG];
-            let lines: &[&crate::vk::shaders::ShaderSource] = &[&RENDER_DRAW_VERT, &RENDER_DRAW_FRAG];
+            let ribbons: &[&ShaderSource] = &[&RENDER_DRAW_VERT, &RENDER_DRAW_GEOM, &RENDER_DRAW_FRAG];
+            let lines: &[&ShaderSource] = &[&RENDER_DRAW_VERT, &RENDER_DRAW_FRAG];
             let pipeline = GraphicsPipeline::new(
                 &self.device,
                 &GraphicsDesc {
                     name: "vkhair hair draw",
-                    stages: if key.primitive == super::Primitive::Lines { lines } else { ribbons },
+                    stages: if key.primitive == Primitive::Lines { lines } else { ribbons },
                     topology: vk::PrimitiveTopology::LINE_LIST,
                     patch_control_points: 0,
                     color_formats: &color_formats,
@@ -84,9 +129,11 @@ impl DrawPass {
                 },
                 1,
             )?;
+            let mut all_buffers = vec![(0, &self.params)];
+            all_buffers.extend_from_slice(buffers);
             let mut all_images = vec![(3, self.noise.view(), self.sampler.raw)];
             all_images.extend_from_slice(images);
-            let set = pipeline.resource_set(0, buffers, &all_images)?;
+            let set = pipeline.resource_set(0, &all_buffers, &all_images)?;
             self.pipelines.insert(key, (pipeline, set));
         }
         Ok(&self.pipelines[&key])
@@ -96,5 +143,106 @@ impl DrawPass {
     /// no pending work uses them.
     pub(super) fn forget(&mut self) {
         self.pipelines.clear();
+    }
+
+    /// Records the draw in its own scope: first `before` (the barriers that make
+    /// the target ready), then the Marschner tables' rebuild if `marschner`
+    /// changed, the parameter update and one draw of `vertices` line vertices
+    /// into `target`.
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of this device outside a render pass;
+    /// after `before`, the target's attachments are in attachment layouts with
+    /// earlier writes visible; the inputs were written earlier in submission order
+    /// with barriers to the draw's stages (the capture and shadow passes leave them so).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) unsafe fn record(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        before: (&[vk::MemoryBarrier2<'_>], &[vk::ImageMemoryBarrier2<'_>]),
+        target: &DrawTarget<'_>,
+        inputs: &DrawInputs<'_>,
+        params: &DrawParams,
+        marschner: &MarschnerParams,
+        vertices: u32,
+        profiler: &mut Option<&mut GpuProfiler>,
+    ) -> Result<()> {
+        let device = self.device.clone();
+        let d = &device;
+        let sampler = self.marschner.sampler.raw;
+        let images = [
+            (4, self.marschner.m.view(), sampler),
+            (5, self.marschner.n.view(), sampler),
+            (7, inputs.atlas.0, inputs.atlas.1),
+        ];
+        let params_buffer = self.params.raw();
+        let buffers =
+            [(1, inputs.hairs.0), (2, inputs.hairs.1), (6, inputs.shadow_uniforms), (8, inputs.transmittance)];
+        let before_update = barrier::memory(&[AccessKind::AnyWrite], &[AccessKind::TransferWrite]);
+        let updated = barrier::memory(&[AccessKind::TransferWrite], UNIFORM_READERS);
+        // SAFETY: guaranteed by the caller; all objects belong to this device.
+        unsafe {
+            let scope = RenderPass::Draw.open(d, cmd, profiler);
+            d.cmd_barrier(cmd, before.0, &[], before.1);
+            // The draw pipeline may sample the Marschner tables: build them first.
+            self.marschner.record_update(d, cmd, marschner);
+            let drawn = self.pipeline(target.key, &buffers, &images).map(|(pipeline, set)| {
+                d.cmd_barrier(cmd, &[before_update], &[], &[]);
+                d.raw.cmd_update_buffer(cmd, params_buffer, 0, bytemuck::bytes_of(params));
+                d.cmd_barrier(cmd, &[updated], &[], &[]);
+                d.raw.cmd_begin_rendering(cmd, target.rendering);
+                d.cmd_set_full_viewport(cmd, target.extent);
+                pipeline.bind(cmd, &[*set]);
+                d.raw.cmd_draw(cmd, vertices, 1, 0, 0);
+                d.raw.cmd_end_rendering(cmd);
+            });
+            scope.close(d, cmd, profiler);
+            drawn
+        }
+    }
+
+    /// Builds the Marschner tables for `params` and reads them back (M, then N;
+    /// submits and waits).
+    pub(super) fn read_marschner_tables(&mut self, params: &MarschnerParams) -> Result<(Vec<Vec4>, Vec<Vec4>)> {
+        let device = self.device.clone();
+        device.submit_once("vkhair marschner tables", |cmd| {
+            // SAFETY: a recording command buffer of this device; earlier work completed.
+            unsafe { self.marschner.record_update(&device, cmd, params) };
+        })?;
+        Ok((self.marschner.read(&device, false)?, self.marschner.read(&device, true)?))
+    }
+}
+
+/// Stages that read the draw's uniform block.
+const UNIFORM_READERS: &[AccessKind] =
+    &[AccessKind::VertexUniformRead, AccessKind::GeometryUniformRead, AccessKind::FragmentUniformRead];
+
+/// The draw's uniform block for `hairs` hairs of `per_hair` vertices with
+/// `material`, `lights` and the width factor of the frame's detail, seen by
+/// `camera` into a target of `extent`.
+pub(super) fn draw_params(
+    material: &HairMaterial,
+    lights: &[GpuLight],
+    width_scale: f32,
+    (hairs, per_hair): (u32, u32),
+    camera: &Camera,
+    extent: vk::Extent2D,
+) -> DrawParams {
+    let m = material;
+    let mut gpu_lights = [GpuLight::default(); MAX_LIGHTS];
+    gpu_lights[..lights.len()].copy_from_slice(lights);
+    // World size of one pixel at distance 1.
+    let pixel = 2.0 * (0.5 * camera.fov_y).tan() / extent.height.max(1) as f32;
+    DrawParams {
+        view_proj: (camera.projection * camera.view).to_cols_array_2d(),
+        camera: camera.position().extend(pixel).to_array(),
+        root_color: m.root_color.extend(m.ambient).to_array(),
+        tip_color: m.tip_color.extend(m.diffuse_wrap).to_array(),
+        primary: m.primary_color.extend(m.primary_exponent).to_array(),
+        secondary: m.secondary_color.extend(m.secondary_exponent).to_array(),
+        shifts: [m.primary_shift, m.secondary_shift, m.shift_jitter, m.highlight_breakup],
+        widths: [m.root_width * width_scale, m.tip_width * width_scale, m.least_pixel_width, 0.0],
+        counts: [hairs, per_hair, lights.len() as u32, m.shading as u32],
+        lights: gpu_lights,
     }
 }

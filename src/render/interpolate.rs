@@ -6,24 +6,35 @@
 //! disk, fixed per hair) × clump width × mix(root width, tip width) along the
 //! strand. The frame is built on the GPU from the smoothed tangent and the key
 //! hair's rest-plane normal turned with the head, so it does not flip.
+//!
+//! In [`InterpolationMode::Barycentric`] the patches are triangles of key-hair
+//! roots instead ([`super::scalp`]), each hair blending three key hairs with
+//! stable random weights.
 
 use std::sync::Arc;
 
 use ash::vk;
 use glam::{Vec3, Vec4};
 
-use crate::error::Result;
+use super::pass::{self, RenderPass};
+use super::smooth::SmoothPass;
+use super::InterpolationMode;
+use crate::error::{Error, Result};
 use crate::gpu_types::InterpolatePush;
+use crate::profiler::GpuProfiler;
 use crate::sim::SimState;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::pipeline::GraphicsPipeline;
-use crate::vk::shaders::{ShaderSource, RENDER_INTERPOLATE_TESC, RENDER_INTERPOLATE_VERT};
+use crate::vk::shaders::{
+    ShaderSource, RENDER_INTERPOLATE_BARY_TESE, RENDER_INTERPOLATE_TESC, RENDER_INTERPOLATE_TESE,
+    RENDER_INTERPOLATE_VERT,
+};
 
 /// Per key hair, the normal of the plane its rest shape lies in (head frame):
 /// root tangent × (tip − root), or any perpendicular of the root tangent for a
 /// straight hair.
-pub(super) fn reference_vectors(rest: &SimState) -> Vec<Vec4> {
+fn reference_vectors(rest: &SimState) -> Vec<Vec4> {
     (0..rest.strands)
         .map(|s| {
             let base = s * rest.points;
@@ -36,37 +47,138 @@ pub(super) fn reference_vectors(rest: &SimState) -> Vec<Vec4> {
         .collect()
 }
 
+/// The interpolation pass: its two pipelines, the key frames and scalp
+/// triangles it reads, and the hairs it stores.
 pub(super) struct InterpolatePass {
+    device: Arc<Device>,
+    single_strand: Pipeline,
+    barycentric: Pipeline,
+    /// Per key hair, its rest-plane normal (head frame).
+    reference: Buffer,
+    /// Scalp triangles between key-hair roots (barycentric mode).
+    _triangle_buffer: Buffer,
+    triangles: u32,
+    /// Interpolated positions, hair after hair.
+    positions: Buffer,
+    /// Interpolated (tangent, t along the hair), as `positions`.
+    tangents: Buffer,
+}
+
+struct Pipeline {
     pipeline: GraphicsPipeline,
     set: vk::DescriptorSet,
 }
 
 impl InterpolatePass {
-    /// `evaluation` is the single-strand or the barycentric evaluation stage; the
-    /// buffers are bound by number (0–2 smoothed data and key frames, 3–4 output,
-    /// 5 scalp triangles) where the stage declares them.
-    pub(super) fn new(device: &Arc<Device>, evaluation: &ShaderSource, buffers: &[(u32, &Buffer)]) -> Result<Self> {
-        let pipeline = super::capture_pipeline(
-            device,
-            evaluation.name,
-            &[&RENDER_INTERPOLATE_VERT, &RENDER_INTERPOLATE_TESC, evaluation],
-            1,
-            1,
-        )?;
-        let set = pipeline.declared_buffer_set(0, buffers)?;
-        Ok(InterpolatePass { pipeline, set })
+    /// The pass growing hairs from `smooth`'s output for the key hairs of `rest`
+    /// (or the scalp `triangles` between their roots), with room for
+    /// `hair_vertices` vertices.
+    pub(super) fn new(
+        device: &Arc<Device>,
+        rest: &SimState,
+        triangles: &[[u32; 3]],
+        smooth: &SmoothPass,
+        hair_vertices: u64,
+    ) -> Result<Self> {
+        let storage = |name: &str, size: u64| Buffer::storage(device, name, size);
+        let positions = storage("vkhair hair positions", hair_vertices * 16)?;
+        let tangents = storage("vkhair hair tangents", hair_vertices * 16)?;
+        let reference_data = reference_vectors(rest);
+        let reference = storage("vkhair key frames", reference_data.len() as u64 * 16)?;
+        device.upload_pod(&reference, &reference_data)?;
+        let triangle_data: Vec<[u32; 4]> = triangles.iter().map(|t| [t[0], t[1], t[2], 0]).collect();
+        let triangle_buffer = storage("vkhair scalp triangles", (triangle_data.len().max(1) * 16) as u64)?;
+        device.upload_pod(&triangle_buffer, &triangle_data)?;
+        let (smoothed_positions, smoothed_tangents) = smooth.outputs();
+        let bindings = [
+            (0, smoothed_positions),
+            (1, smoothed_tangents),
+            (2, &reference),
+            (3, &positions),
+            (4, &tangents),
+            (5, &triangle_buffer),
+        ];
+        let pipeline = |evaluation: &ShaderSource| -> Result<Pipeline> {
+            let pipeline = pass::capture_pipeline(
+                device,
+                evaluation.name,
+                &[&RENDER_INTERPOLATE_VERT, &RENDER_INTERPOLATE_TESC, evaluation],
+                1,
+                1,
+            )?;
+            // Each evaluation stage declares the bindings it uses.
+            let set = pipeline.declared_buffer_set(0, &bindings)?;
+            Ok(Pipeline { pipeline, set })
+        };
+        Ok(InterpolatePass {
+            device: device.clone(),
+            single_strand: pipeline(&RENDER_INTERPOLATE_TESE)?,
+            barycentric: pipeline(&RENDER_INTERPOLATE_BARY_TESE)?,
+            reference,
+            _triangle_buffer: triangle_buffer,
+            triangles: triangles.len() as u32,
+            positions,
+            tangents,
+        })
     }
 
-    /// # Safety
-    /// `cmd` is recording inside a dynamic rendering instance with viewport and
-    /// scissor set, after the smoothing pass's writes were made visible.
-    pub(super) unsafe fn record(&self, device: &Device, cmd: vk::CommandBuffer, push: &InterpolatePush) {
-        // SAFETY: guaranteed by the caller. `strands` counts key hairs, or scalp
-        // triangles in barycentric mode: one patch per key segment of each.
-        unsafe {
-            self.pipeline.bind(cmd, &[self.set]);
-            self.pipeline.push(cmd, push);
-            device.raw.cmd_draw(cmd, push.strands * (push.points - 1), 1, 0, 0);
+    /// Scalp triangles between key-hair roots.
+    pub(super) fn triangles(&self) -> u32 {
+        self.triangles
+    }
+
+    /// Rejects `mode` when it cannot grow hairs from these key hairs.
+    pub(super) fn check_mode(&self, mode: InterpolationMode) -> Result<()> {
+        if mode == InterpolationMode::Barycentric && self.triangles == 0 {
+            return Err(Error::param(
+                "interpolation",
+                "barycentric mode needs at least 3 key hairs forming a triangle",
+            ));
         }
+        Ok(())
+    }
+
+    /// The interpolated hairs: positions and (tangent, t).
+    pub(super) fn hairs(&self) -> (&Buffer, &Buffer) {
+        (&self.positions, &self.tangents)
+    }
+
+    /// Records the pass in its own capture instance and scope; its stores are
+    /// visible to every later shader stage after it.
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of this device outside a render pass,
+    /// after the smoothing pass. `push.strands` counts key hairs, or scalp
+    /// triangles in barycentric mode.
+    pub(super) unsafe fn record(
+        &self,
+        cmd: vk::CommandBuffer,
+        mode: InterpolationMode,
+        push: &InterpolatePush,
+        profiler: &mut Option<&mut GpuProfiler>,
+    ) {
+        let d = &self.device;
+        let p = match mode {
+            InterpolationMode::SingleStrand => &self.single_strand,
+            InterpolationMode::Barycentric => &self.barycentric,
+        };
+        // SAFETY: guaranteed by the caller: one patch per key segment of each unit.
+        unsafe {
+            pass::record_capture(d, cmd, RenderPass::Interpolate, profiler, |cmd| {
+                p.pipeline.bind(cmd, &[p.set]);
+                p.pipeline.push(cmd, push);
+                d.raw.cmd_draw(cmd, push.strands * (push.points - 1), 1, 0, 0);
+            });
+        }
+    }
+
+    /// Reads `n` hair vertices back: positions and (tangent, t) (submits and waits).
+    pub(super) fn read(&self, n: usize) -> Result<(Vec<Vec4>, Vec<Vec4>)> {
+        Ok((self.device.readback_pod(&self.positions, n)?, self.device.readback_pod(&self.tangents, n)?))
+    }
+
+    /// Reads the `n` key hairs' reference vectors back (submits and waits).
+    pub(super) fn read_reference(&self, n: usize) -> Result<Vec<Vec4>> {
+        self.device.readback_pod(&self.reference, n)
     }
 }

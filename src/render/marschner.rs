@@ -170,11 +170,9 @@ impl MarschnerTables {
         if self.built.as_ref() == Some(params) {
             return;
         }
-        use crate::vk::barrier::{self, Access};
-        let sampled =
-            Access { stage: vk::PipelineStageFlags2::FRAGMENT_SHADER, access: vk::AccessFlags2::SHADER_SAMPLED_READ };
-        let write =
-            Access { stage: vk::PipelineStageFlags2::COMPUTE_SHADER, access: vk::AccessFlags2::SHADER_STORAGE_WRITE };
+        use crate::vk::barrier::{self, AccessKind};
+        let sampled = &[AccessKind::FragmentSampledRead];
+        let write = &[AccessKind::ComputeWrite];
         let before: Vec<_> = [&self.m, &self.n]
             .iter()
             .map(|t| barrier::image(t, sampled, write, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL))

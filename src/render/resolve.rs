@@ -1,19 +1,27 @@
-//! Pass 4 (optional) — supersampling (`glsl/render/resolve.*`): the hair is drawn
+//! Pass 5 (optional) — supersampling (`glsl/render/resolve.*`): the hair is drawn
 //! at twice the target's size into the renderer's own color and depth images,
 //! then resolved into the host's target with a 5-tap filter as premultiplied
 //! coverage, writing the nearest hair depth so the host's depth test still
 //! applies (see the shader for the filter).
+//!
+//! The pass owns the images for the current target size; when the size changes,
+//! the old images are retired and freed once the frames that used them are
+//! `frames_in_flight` behind.
 
 use std::collections::HashMap;
 use std::sync::Arc;
 
 use ash::vk;
 
-use super::draw::TargetKey;
+use super::draw::{DrawTarget, TargetKey};
+use super::pass::RenderPass;
 use crate::error::Result;
+use crate::profiler::GpuProfiler;
+use crate::vk::barrier::{self, AccessKind};
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc, Sampler};
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
+use crate::vk::rendering::{self, Load};
 use crate::vk::shaders::{RENDER_RESOLVE_FRAG, RENDER_RESOLVE_VERT};
 
 /// Color format of the supersampled hair image (linear, with coverage in alpha).
@@ -21,12 +29,13 @@ pub(super) const SUPERSAMPLED_COLOR: vk::Format = vk::Format::R16G16B16A16_SFLOA
 /// Depth format of the supersampled hair image.
 pub(super) const SUPERSAMPLED_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
 
+/// Images twice the host target's size and the resolve pipelines reading them.
 pub(super) struct Supersampling {
     device: Arc<Device>,
     /// Size of the host's target these images are twice as large as.
     pub target_extent: vk::Extent2D,
-    pub color: Image,
-    pub depth: Image,
+    color: Image,
+    depth: Image,
     linear: Sampler,
     nearest: Sampler,
     pipelines: HashMap<TargetKey, (GraphicsPipeline, vk::DescriptorSet)>,
@@ -69,7 +78,7 @@ impl Supersampling {
     }
 
     /// The resolve pipeline for the host's target formats, made on first use.
-    pub(super) fn pipeline(&mut self, key: TargetKey) -> Result<&(GraphicsPipeline, vk::DescriptorSet)> {
+    fn pipeline(&mut self, key: TargetKey) -> Result<&(GraphicsPipeline, vk::DescriptorSet)> {
         if !self.pipelines.contains_key(&key) {
             let color_formats = [key.color];
             let pipeline = GraphicsPipeline::new(
@@ -97,5 +106,145 @@ impl Supersampling {
             self.pipelines.insert(key, (pipeline, set));
         }
         Ok(&self.pipelines[&key])
+    }
+}
+
+impl Supersampling {
+    /// The extent the hair is drawn at: twice the target's.
+    pub(super) fn extent(&self) -> vk::Extent2D {
+        self.color.extent
+    }
+
+    /// The draw's attachments: colour cleared to transparent, depth to 1.
+    pub(super) fn attachments(
+        &self,
+    ) -> ([vk::RenderingAttachmentInfo<'static>; 1], vk::RenderingAttachmentInfo<'static>) {
+        (
+            [rendering::color(self.color.view(), Load::color([0.0; 4]))],
+            rendering::depth(self.depth.view(), Load::depth(1.0)),
+        )
+    }
+
+    /// Barriers before the draw: both images from the last resolve's sampling to
+    /// attachments (contents discarded).
+    pub(super) fn to_attachments(&self) -> [vk::ImageMemoryBarrier2<'static>; 2] {
+        let sampled = &[AccessKind::FragmentSampledRead];
+        [
+            barrier::image(
+                &self.color,
+                sampled,
+                barrier::COLOR_ATTACHMENT,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            ),
+            barrier::image(
+                &self.depth,
+                sampled,
+                barrier::DEPTH_ATTACHMENT,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+            ),
+        ]
+    }
+
+    /// Barriers after the draw: both images to fragment-shader sampling.
+    fn to_sampled(&self) -> [vk::ImageMemoryBarrier2<'static>; 2] {
+        let sampled = &[AccessKind::FragmentSampledRead];
+        [
+            barrier::image(
+                &self.color,
+                barrier::COLOR_ATTACHMENT,
+                sampled,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            ),
+            barrier::image(
+                &self.depth,
+                barrier::DEPTH_ATTACHMENT,
+                sampled,
+                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            ),
+        ]
+    }
+}
+
+/// The resolve pass: the supersampling images of the current target size and
+/// those of earlier sizes still in use by frames in flight.
+pub(super) struct ResolvePass {
+    device: Arc<Device>,
+    current: Option<Supersampling>,
+    /// Images of earlier target sizes with the last frame that used them.
+    retired: Vec<(u64, Supersampling)>,
+}
+
+impl ResolvePass {
+    pub(super) fn new(device: &Arc<Device>) -> Self {
+        ResolvePass { device: device.clone(), current: None, retired: Vec::new() }
+    }
+
+    /// Frees retired images whose last frame is `frames_in_flight` frames before
+    /// `frame`.
+    pub(super) fn collect_retired(&mut self, frame: u64, frames_in_flight: u32) {
+        let keep = u64::from(frames_in_flight);
+        self.retired.retain(|(last, _)| last.saturating_add(keep) > frame);
+    }
+
+    /// Sets of images waiting for their frames to complete.
+    pub(super) fn retired_count(&self) -> usize {
+        self.retired.len()
+    }
+
+    /// Takes the images for a target of `extent` in frame `frame` (made on first
+    /// use; the images of another size are retired). Give them back with
+    /// [`ResolvePass::restore`].
+    pub(super) fn take(&mut self, frame: u64, extent: vk::Extent2D) -> Result<Supersampling> {
+        if let Some(old) = self.current.take_if(|s| s.target_extent != extent) {
+            // Frames up to the previous one may still be using the old images.
+            self.retired.push((frame.saturating_sub(1), old));
+        }
+        match self.current.take() {
+            Some(images) => Ok(images),
+            None => Supersampling::new(&self.device, extent),
+        }
+    }
+
+    /// Gives the images taken by [`ResolvePass::take`] back.
+    pub(super) fn restore(&mut self, images: Supersampling) {
+        self.current = Some(images);
+    }
+
+    /// Records the resolve of `images` into the host's `target` in its own scope,
+    /// after `attachments` (the barrier ordering the host's earlier attachment
+    /// writes).
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of this device outside a render pass,
+    /// after the draw into `images`; the host's attachments are in attachment
+    /// layouts.
+    pub(super) unsafe fn record(
+        &self,
+        cmd: vk::CommandBuffer,
+        images: &mut Supersampling,
+        target: &DrawTarget<'_>,
+        attachments: vk::MemoryBarrier2<'_>,
+        profiler: &mut Option<&mut GpuProfiler>,
+    ) -> Result<()> {
+        let d = &self.device;
+        let to_sampled = images.to_sampled();
+        // SAFETY: guaranteed by the caller; the images are this pass's.
+        unsafe {
+            let scope = RenderPass::Resolve.open(d, cmd, profiler);
+            let resolved = images.pipeline(target.key).map(|(pipeline, set)| {
+                d.cmd_barrier(cmd, &[attachments], &[], &to_sampled);
+                d.raw.cmd_begin_rendering(cmd, target.rendering);
+                d.cmd_set_full_viewport(cmd, target.extent);
+                pipeline.bind(cmd, &[*set]);
+                d.raw.cmd_draw(cmd, 3, 1, 0, 0);
+                d.raw.cmd_end_rendering(cmd);
+            });
+            scope.close(d, cmd, profiler);
+            resolved
+        }
     }
 }

@@ -2,7 +2,8 @@
 //! patches of 4 control points; the control stage sets `level` segments per
 //! key segment, the isolines evaluation stage evaluates the uniform cubic
 //! B-spline and stores position and tangent (storage writes from the
-//! pipeline; rasterization is off).
+//! pipeline; rasterization is off). Mirrored phantom points put the curve
+//! exactly through root and tip.
 //!
 //! Storage writes rather than transform feedback: both work on lavapipe, but
 //! writes go to any index (each smoothed vertex is stored exactly once, in
@@ -12,23 +13,36 @@
 use std::sync::Arc;
 
 use ash::vk;
+use glam::Vec4;
 
+use super::pass::{self, RenderPass};
 use crate::error::Result;
 use crate::gpu_types::SmoothPush;
+use crate::profiler::GpuProfiler;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::pipeline::GraphicsPipeline;
 use crate::vk::shaders::{RENDER_SMOOTH_TESC, RENDER_SMOOTH_TESE, RENDER_SMOOTH_VERT};
 
+/// The smoothing pass and the smoothed key hairs it stores.
 pub(super) struct SmoothPass {
+    device: Arc<Device>,
     pipeline: GraphicsPipeline,
     /// One set per half of the simulation's double-buffered positions.
     sets: [vk::DescriptorSet; 2],
+    /// Smoothed positions, strand after strand.
+    positions: Buffer,
+    /// Smoothed unit tangents, as `positions`.
+    tangents: Buffer,
 }
 
 impl SmoothPass {
-    pub(super) fn new(device: &Arc<Device>, keys: [&Buffer; 2], positions: &Buffer, tangents: &Buffer) -> Result<Self> {
-        let pipeline = super::capture_pipeline(
+    /// The pass reading the simulation's two position buffers `keys`, with room
+    /// for `vertices` smoothed vertices.
+    pub(super) fn new(device: &Arc<Device>, keys: [&Buffer; 2], vertices: u64) -> Result<Self> {
+        let positions = Buffer::storage(device, "vkhair smoothed positions", vertices * 16)?;
+        let tangents = Buffer::storage(device, "vkhair smoothed tangents", vertices * 16)?;
+        let pipeline = pass::capture_pipeline(
             device,
             "vkhair smoothing",
             &[&RENDER_SMOOTH_VERT, &RENDER_SMOOTH_TESC, &RENDER_SMOOTH_TESE],
@@ -36,24 +50,45 @@ impl SmoothPass {
             2,
         )?;
         let sets = [
-            pipeline.buffer_set(0, &[(0, keys[0]), (1, positions), (2, tangents)])?,
-            pipeline.buffer_set(0, &[(0, keys[1]), (1, positions), (2, tangents)])?,
+            pipeline.buffer_set(0, &[(0, keys[0]), (1, &positions), (2, &tangents)])?,
+            pipeline.buffer_set(0, &[(0, keys[1]), (1, &positions), (2, &tangents)])?,
         ];
-        Ok(SmoothPass { pipeline, sets })
+        Ok(SmoothPass { device: device.clone(), pipeline, sets, positions, tangents })
     }
 
-    /// Records the draw (inside an attachment-less rendering instance).
+    /// The smoothed positions and tangents (what the interpolation pass reads).
+    pub(super) fn outputs(&self) -> (&Buffer, &Buffer) {
+        (&self.positions, &self.tangents)
+    }
+
+    /// Records the pass in its own capture instance and scope; its stores are
+    /// visible to every later shader stage after it.
     ///
     /// # Safety
-    /// `cmd` is recording inside a dynamic rendering instance with viewport and
-    /// scissor set; `half` names the simulation half holding the latest state.
-    pub(super) unsafe fn record(&self, device: &Device, cmd: vk::CommandBuffer, half: usize, push: &SmoothPush) {
+    /// `cmd` is a recording command buffer of this device outside a render pass,
+    /// the simulation's writes to half `half` (the latest state) made visible to
+    /// vertex shaders before.
+    pub(super) unsafe fn record(
+        &self,
+        cmd: vk::CommandBuffer,
+        half: usize,
+        push: &SmoothPush,
+        profiler: &mut Option<&mut GpuProfiler>,
+    ) {
+        let d = &self.device;
         let vertices = push.strands * (push.points - 1) * 4;
         // SAFETY: guaranteed by the caller.
         unsafe {
-            self.pipeline.bind(cmd, &[self.sets[half]]);
-            self.pipeline.push(cmd, push);
-            device.raw.cmd_draw(cmd, vertices, 1, 0, 0);
+            pass::record_capture(d, cmd, RenderPass::Smooth, profiler, |cmd| {
+                self.pipeline.bind(cmd, &[self.sets[half]]);
+                self.pipeline.push(cmd, push);
+                d.raw.cmd_draw(cmd, vertices, 1, 0, 0);
+            });
         }
+    }
+
+    /// Reads `n` smoothed positions and tangents back (submits and waits).
+    pub(super) fn read(&self, n: usize) -> Result<(Vec<Vec4>, Vec<Vec4>)> {
+        Ok((self.device.readback_pod(&self.positions, n)?, self.device.readback_pod(&self.tangents, n)?))
     }
 }

@@ -10,7 +10,7 @@ use ash::vk;
 
 use crate::error::Result;
 use crate::sim::{HairSim, KeyHairs, RigidTransform, SimState, VolumeGrid};
-use crate::vk::barrier::{self, Access};
+use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::device::Device;
 
@@ -49,30 +49,19 @@ impl Layout {
 
 /// Stages and accesses that read the mirror after a hand-off (the renderer's
 /// passes and the host's own copies).
-const READERS: Access = Access {
-    stage: vk::PipelineStageFlags2::from_raw(
-        vk::PipelineStageFlags2::VERTEX_SHADER.as_raw()
-            | vk::PipelineStageFlags2::TESSELLATION_EVALUATION_SHADER.as_raw()
-            | vk::PipelineStageFlags2::GEOMETRY_SHADER.as_raw()
-            | vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw()
-            | vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw()
-            | vk::PipelineStageFlags2::COPY.as_raw(),
-    ),
-    access: vk::AccessFlags2::from_raw(
-        vk::AccessFlags2::SHADER_STORAGE_READ.as_raw() | vk::AccessFlags2::TRANSFER_READ.as_raw(),
-    ),
-};
+const READERS: &[AccessKind] = &[
+    AccessKind::VertexRead,
+    AccessKind::TessellationRead,
+    AccessKind::GeometryRead,
+    AccessKind::FragmentRead,
+    AccessKind::ComputeRead,
+    AccessKind::TransferRead,
+];
 
 /// Before a copy: every earlier write is visible to it and every earlier access of
 /// its destination is done.
 fn before_copy() -> vk::MemoryBarrier2<'static> {
-    barrier::memory(
-        Access::ANY_WRITE,
-        Access {
-            stage: vk::PipelineStageFlags2::COPY,
-            access: vk::AccessFlags2::TRANSFER_READ | vk::AccessFlags2::TRANSFER_WRITE,
-        },
-    )
+    barrier::memory(&[AccessKind::AnyWrite], &[AccessKind::TransferRead, AccessKind::TransferWrite])
 }
 
 /// Where the two parts of a state are: (buffer, byte offset) of the positions
@@ -188,7 +177,7 @@ impl Mirror {
         // SAFETY: guaranteed by the caller.
         unsafe {
             record_copy(d, cmd, src, dst, self.layout);
-            d.cmd_barrier(cmd, &[barrier::memory(Access::TRANSFER_WRITE, READERS)], &[], &[]);
+            d.cmd_barrier(cmd, &[barrier::memory(&[AccessKind::TransferWrite], READERS)], &[], &[]);
         }
         self.current = next;
         self.meta = meta;

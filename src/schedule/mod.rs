@@ -52,9 +52,11 @@ use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::groom::Groom;
 use crate::profiler::{GpuProfiler, ProfileReport};
+use crate::profiler::{PassScope, ScopeKind};
 use crate::sim::{Collider, HairSim, KeyHairs, RigidTransform, SimParams, SimState};
-use crate::vk::barrier::{self, Access};
+use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
+use crate::vk::device::Device;
 use crate::vk::external::{self, ExternalBuffer};
 use crate::vk::submit::CommandRing;
 use async_compute::{AsyncSim, Pending};
@@ -361,6 +363,7 @@ impl FrameScheduler {
         let latency = self.pipelining == Pipelining::Latency;
         let mut sync = FrameSync::default();
         let label = "vkhair hand-off";
+        let device = self.mirror.device().clone();
         match &mut self.backend {
             Backend::Stopped(why) => return Err(Error::SimulationStopped(why.clone())),
             Backend::Local { sim, steps } => {
@@ -368,7 +371,9 @@ impl FrameScheduler {
                 unsafe {
                     if !latency {
                         let meta = Meta::of(sim, *steps);
-                        scoped(&mut profiler, cmd, label, |_| self.mirror.record_update(cmd, Parts::of_sim(sim), meta));
+                        scoped(&device, &mut profiler, cmd, label, |_| {
+                            self.mirror.record_update(cmd, Parts::of_sim(sim), meta)
+                        });
                     }
                     for head in heads {
                         sim.record_step(cmd, head, profiler.as_deref_mut())?;
@@ -376,7 +381,9 @@ impl FrameScheduler {
                     }
                     if latency {
                         let meta = Meta::of(sim, *steps);
-                        scoped(&mut profiler, cmd, label, |_| self.mirror.record_update(cmd, Parts::of_sim(sim), meta));
+                        scoped(&device, &mut profiler, cmd, label, |_| {
+                            self.mirror.record_update(cmd, Parts::of_sim(sim), meta)
+                        });
                     }
                 }
             }
@@ -389,7 +396,9 @@ impl FrameScheduler {
                     let (parts, wait) = sim.take(&p);
                     // SAFETY: guaranteed by the caller; the slot is ready once the
                     // returned wait is satisfied.
-                    unsafe { scoped(&mut profiler, cmd, label, |_| self.mirror.record_update(cmd, parts, p.meta)) };
+                    unsafe {
+                        scoped(&device, &mut profiler, cmd, label, |_| self.mirror.record_update(cmd, parts, p.meta))
+                    };
                     sync.waits.push(SemaphoreWait { semaphore: wait.semaphore, value: wait.value, stage: wait.stage });
                 }
             }
@@ -496,27 +505,21 @@ impl FrameScheduler {
     }
 }
 
-/// Records `f` inside a profiler scope (or a debug label without a profiler).
+/// Records `f` inside the hand-off's scope (a timestamp scope with a profiler,
+/// else a debug label).
 ///
 /// # Safety
-/// `cmd` is recording; the profiler contract is the caller's.
+/// `cmd` is a recording command buffer of `device`; the profiler contract is the
+/// caller's.
 unsafe fn scoped(
+    device: &Device,
     profiler: &mut Option<&mut GpuProfiler>,
     cmd: vk::CommandBuffer,
     name: &str,
     f: impl FnOnce(vk::CommandBuffer),
 ) {
     // SAFETY: guaranteed by the caller.
-    unsafe {
-        match profiler.as_deref_mut() {
-            Some(p) => {
-                let scope = p.begin_scope(cmd, name);
-                f(cmd);
-                p.end_scope(cmd, scope);
-            }
-            None => f(cmd),
-        }
-    }
+    unsafe { PassScope::record(device, cmd, profiler, name, ScopeKind::Transfer, || f(cmd)) }
 }
 
 /// Takes a finished SECOND DEVICE job's slot into the mirror.
@@ -544,23 +547,24 @@ unsafe fn consume(
     }
     // SAFETY: guaranteed by the caller.
     unsafe {
-        scoped(profiler, cmd, "vkhair hand-off", |cmd| match slots {
+        let device = mirror.device().clone();
+        scoped(&device, profiler, cmd, "vkhair hand-off", |cmd| match slots {
             RenderSlots::External(buffers) => {
                 let b = buffers[slot].raw();
                 let family = mirror.device().graphics.family;
-                let read = Access { stage: vk::PipelineStageFlags2::COPY, access: vk::AccessFlags2::TRANSFER_READ };
+                let read = &[AccessKind::TransferRead];
                 let d = mirror.device().clone();
                 d.cmd_barrier(
                     cmd,
                     &[],
-                    &[barrier::ownership(b, Access::NONE, read, vk::QUEUE_FAMILY_EXTERNAL, family)],
+                    &[barrier::ownership(b, barrier::NOTHING, read, vk::QUEUE_FAMILY_EXTERNAL, family)],
                     &[],
                 );
                 mirror.record_update(cmd, Parts::packed(b, layout), meta);
                 d.cmd_barrier(
                     cmd,
                     &[],
-                    &[barrier::ownership(b, read, Access::NONE, family, vk::QUEUE_FAMILY_EXTERNAL)],
+                    &[barrier::ownership(b, read, barrier::NOTHING, family, vk::QUEUE_FAMILY_EXTERNAL)],
                     &[],
                 );
             }
@@ -642,6 +646,7 @@ fn make_slots(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::headless::Submit;
     use crate::vk::tests::TestGpu;
 
     /// A worker that dies (here: panics) mid-run turns into typed errors for the

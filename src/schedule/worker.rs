@@ -27,7 +27,7 @@ use super::mirror::{record_copy, Layout, Meta, Parts};
 use crate::error::{Error, Result};
 use crate::profiler::{GpuProfiler, ProfileReport};
 use crate::sim::{Collider, HairSim, RigidTransform, SimParams, SimState};
-use crate::vk::barrier::{self, Access};
+use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::external::ExternalBuffer;
@@ -310,18 +310,22 @@ fn step(
             match sim_slots {
                 SimSlots::External(buffers) => {
                     let b = buffers[slot].raw();
-                    let copy =
-                        Access { stage: vk::PipelineStageFlags2::COPY, access: vk::AccessFlags2::TRANSFER_WRITE };
-                    let acquire = barrier::ownership(b, Access::NONE, copy, vk::QUEUE_FAMILY_EXTERNAL, family);
+                    let copy = &[AccessKind::TransferWrite];
+                    let acquire = barrier::ownership(b, barrier::NOTHING, copy, vk::QUEUE_FAMILY_EXTERNAL, family);
                     device.cmd_barrier(cmd, &[], &[acquire], &[]);
                     record_copy(device, cmd, Parts::of_sim(sim), Parts::packed(b, layout), layout);
-                    let release = barrier::ownership(b, copy, Access::NONE, family, vk::QUEUE_FAMILY_EXTERNAL);
+                    let release = barrier::ownership(b, copy, barrier::NOTHING, family, vk::QUEUE_FAMILY_EXTERNAL);
                     device.cmd_barrier(cmd, &[], &[release], &[]);
                 }
                 SimSlots::Staging(buffers) => {
                     let dst = Parts::packed(buffers[slot].raw(), layout);
                     record_copy(device, cmd, Parts::of_sim(sim), dst, layout);
-                    device.cmd_barrier(cmd, &[barrier::memory(Access::TRANSFER_WRITE, Access::HOST_READ)], &[], &[]);
+                    device.cmd_barrier(
+                        cmd,
+                        &[barrier::memory(&[AccessKind::TransferWrite], &[AccessKind::HostRead])],
+                        &[],
+                        &[],
+                    );
                 }
             }
         }

@@ -57,7 +57,8 @@ use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::groom::Groom;
 use crate::profiler::GpuProfiler;
-use crate::vk::barrier::{self, Access};
+use crate::profiler::{PassScope, ScopeKind};
+use crate::vk::barrier::{self, AccessKind};
 use crate::vk::device::Device;
 use crate::vk::pipeline::ComputePipeline;
 use params::Schedule;
@@ -347,26 +348,24 @@ impl HairSim {
         let (strands, points) = (self.schedule.strands, self.schedule.points);
         let d = &self.device;
         let entry = barrier::memory(
-            Access::ANY_WRITE,
-            Access {
-                stage: vk::PipelineStageFlags2::COPY | vk::PipelineStageFlags2::COMPUTE_SHADER,
-                access: vk::AccessFlags2::TRANSFER_WRITE
-                    | vk::AccessFlags2::SHADER_STORAGE_READ
-                    | vk::AccessFlags2::SHADER_STORAGE_WRITE
-                    | vk::AccessFlags2::UNIFORM_READ,
-            },
+            &[AccessKind::AnyWrite],
+            &[
+                AccessKind::TransferWrite,
+                AccessKind::ComputeRead,
+                AccessKind::ComputeWrite,
+                AccessKind::ComputeUniformRead,
+            ],
         );
         let uploaded = barrier::memory(
-            Access::TRANSFER_WRITE,
-            Access {
-                stage: vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
-                access: vk::AccessFlags2::UNIFORM_READ
-                    | vk::AccessFlags2::SHADER_STORAGE_READ
-                    | vk::AccessFlags2::SHADER_STORAGE_WRITE
-                    | vk::AccessFlags2::INDIRECT_COMMAND_READ,
-            },
+            &[AccessKind::TransferWrite],
+            &[
+                AccessKind::ComputeUniformRead,
+                AccessKind::ComputeRead,
+                AccessKind::ComputeWrite,
+                AccessKind::IndirectRead,
+            ],
         );
-        let between = barrier::memory(Access::COMPUTE_WRITE, Access::COMPUTE_READ_WRITE);
+        let between = barrier::memory(&[AccessKind::ComputeWrite], barrier::COMPUTE_READ_WRITE);
         for sub in &inputs {
             // SAFETY: guaranteed by the caller; all buffers belong to this device, and
             // update sizes are multiples of 4 below 64 KiB (checked by construction).
@@ -393,19 +392,14 @@ impl HairSim {
                 let threads = stage.stage.threads(strands, points, hairs_per_group);
                 // SAFETY: as above; the profiler contract is the caller's.
                 unsafe {
-                    let scope = profiler.as_deref_mut().map(|p| p.begin_scope(cmd, stage.stage.label()));
-                    if profiler.is_none() {
-                        d.cmd_begin_label(cmd, stage.stage.label(), crate::vk::debug::LabelColor::Compute);
-                    }
-                    stage.pipeline.bind(cmd, &[stage.sets[self.current]]);
-                    stage.pipeline.dispatch_threads(cmd, [threads, 1, 1]);
-                    if k + 1 < self.stages.len() || self.volume.is_some() {
-                        d.cmd_barrier(cmd, &[between], &[], &[]);
-                    }
-                    match (profiler.as_deref_mut(), scope) {
-                        (Some(p), Some(scope)) => p.end_scope(cmd, scope),
-                        _ => d.cmd_end_label(cmd),
-                    }
+                    let last = k + 1 == self.stages.len() && self.volume.is_none();
+                    PassScope::record(d, cmd, &mut profiler, stage.stage.label(), ScopeKind::Compute, || {
+                        stage.pipeline.bind(cmd, &[stage.sets[self.current]]);
+                        stage.pipeline.dispatch_threads(cmd, [threads, 1, 1]);
+                        if !last {
+                            d.cmd_barrier(cmd, &[between], &[], &[]);
+                        }
+                    });
                 }
             }
             if let Some(volume) = &self.volume {

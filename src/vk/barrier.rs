@@ -1,4 +1,9 @@
-//! A small synchronization2 barrier helper.
+//! Synchronization2 barriers written with access kinds.
+//!
+//! Every barrier in the crate names what came before and what comes after as a
+//! list of [`AccessKind`]s (a pipeline stage together with the accesses made
+//! there, as `vk-sync` does); [`AccessKind::mask`] maps a list to the stage and
+//! access masks. No call site writes mask literals.
 
 use ash::vk;
 
@@ -6,58 +11,140 @@ use super::buffer::Buffer;
 use super::device::Device;
 use super::image::Image;
 
-/// A pipeline stage together with the accesses made there.
+type Stage = vk::PipelineStageFlags2;
+type Acc = vk::AccessFlags2;
+
+/// One kind of access: a pipeline stage and what it does to memory there.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct Access {
-    pub stage: vk::PipelineStageFlags2,
-    pub access: vk::AccessFlags2,
+pub(crate) enum AccessKind {
+    /// Storage-buffer or storage-image reads in compute shaders.
+    ComputeRead,
+    /// Storage writes in compute shaders.
+    ComputeWrite,
+    /// Uniform-buffer reads in compute shaders.
+    ComputeUniformRead,
+    /// Indirect dispatch or draw arguments.
+    IndirectRead,
+    /// Storage reads in vertex shaders.
+    VertexRead,
+    /// Uniform reads in vertex shaders.
+    VertexUniformRead,
+    /// Storage reads in tessellation evaluation shaders.
+    TessellationRead,
+    /// Storage writes in tessellation evaluation shaders (the capture passes).
+    TessellationWrite,
+    /// Storage reads in geometry shaders.
+    GeometryRead,
+    /// Uniform reads in geometry shaders.
+    GeometryUniformRead,
+    /// Storage reads in fragment shaders.
+    FragmentRead,
+    /// Storage writes in fragment shaders.
+    FragmentWrite,
+    /// Uniform reads in fragment shaders.
+    FragmentUniformRead,
+    /// Sampled-image reads in fragment shaders.
+    FragmentSampledRead,
+    /// Sampled-image reads in compute shaders.
+    ComputeSampledRead,
+    /// Colour attachment reads (blending, load).
+    ColorAttachmentRead,
+    /// Colour attachment writes.
+    ColorAttachmentWrite,
+    /// Depth attachment reads (tests, load).
+    DepthAttachmentRead,
+    /// Depth attachment writes.
+    DepthAttachmentWrite,
+    /// Copy sources.
+    TransferRead,
+    /// Copy destinations.
+    TransferWrite,
+    /// Clear destinations (`vkCmdClear*Image`, `vkCmdFillBuffer`).
+    ClearWrite,
+    /// Writes by any transfer command (copies, clears, updates, blits).
+    AnyTransferWrite,
+    /// Host reads of mapped memory.
+    HostRead,
+    /// Every earlier write, for one-shot submissions that know nothing of prior use.
+    AnyWrite,
+    /// Every later read, for one-shot submissions that know nothing of later use.
+    AnyRead,
 }
 
-impl Access {
-    pub const NONE: Access = Access { stage: vk::PipelineStageFlags2::NONE, access: vk::AccessFlags2::NONE };
-    pub const COMPUTE_WRITE: Access =
-        Access { stage: vk::PipelineStageFlags2::COMPUTE_SHADER, access: vk::AccessFlags2::SHADER_STORAGE_WRITE };
-    pub const COMPUTE_READ_WRITE: Access = Access {
-        stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
-        access: vk::AccessFlags2::from_raw(
-            vk::AccessFlags2::SHADER_STORAGE_READ.as_raw() | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw(),
-        ),
-    };
-    pub const TRANSFER_READ: Access =
-        Access { stage: vk::PipelineStageFlags2::COPY, access: vk::AccessFlags2::TRANSFER_READ };
-    pub const TRANSFER_WRITE: Access =
-        Access { stage: vk::PipelineStageFlags2::COPY, access: vk::AccessFlags2::TRANSFER_WRITE };
-    pub const HOST_READ: Access = Access { stage: vk::PipelineStageFlags2::HOST, access: vk::AccessFlags2::HOST_READ };
-    pub const COLOR_ATTACHMENT_WRITE: Access = Access {
-        stage: vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-        access: vk::AccessFlags2::from_raw(
-            vk::AccessFlags2::COLOR_ATTACHMENT_WRITE.as_raw() | vk::AccessFlags2::COLOR_ATTACHMENT_READ.as_raw(),
-        ),
-    };
-    pub const DEPTH_ATTACHMENT: Access = Access {
-        stage: vk::PipelineStageFlags2::from_raw(
-            vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS.as_raw()
-                | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS.as_raw(),
-        ),
-        access: vk::AccessFlags2::from_raw(
-            vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ.as_raw()
-                | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw(),
-        ),
-    };
-    /// Every earlier write, for one-shot submissions that know nothing about prior use.
-    pub const ANY_WRITE: Access =
-        Access { stage: vk::PipelineStageFlags2::ALL_COMMANDS, access: vk::AccessFlags2::MEMORY_WRITE };
-    /// Any later access, for one-shot submissions that know nothing about later use.
-    pub const ANY: Access = Access {
-        stage: vk::PipelineStageFlags2::ALL_COMMANDS,
-        access: vk::AccessFlags2::from_raw(
-            vk::AccessFlags2::MEMORY_READ.as_raw() | vk::AccessFlags2::MEMORY_WRITE.as_raw(),
-        ),
-    };
+impl AccessKind {
+    /// The stage and access of this kind.
+    const fn parts(self) -> (Stage, Acc) {
+        use AccessKind::*;
+        match self {
+            ComputeRead => (Stage::COMPUTE_SHADER, Acc::SHADER_STORAGE_READ),
+            ComputeWrite => (Stage::COMPUTE_SHADER, Acc::SHADER_STORAGE_WRITE),
+            ComputeUniformRead => (Stage::COMPUTE_SHADER, Acc::UNIFORM_READ),
+            ComputeSampledRead => (Stage::COMPUTE_SHADER, Acc::SHADER_SAMPLED_READ),
+            IndirectRead => (Stage::DRAW_INDIRECT, Acc::INDIRECT_COMMAND_READ),
+            VertexRead => (Stage::VERTEX_SHADER, Acc::SHADER_STORAGE_READ),
+            VertexUniformRead => (Stage::VERTEX_SHADER, Acc::UNIFORM_READ),
+            TessellationRead => (Stage::TESSELLATION_EVALUATION_SHADER, Acc::SHADER_STORAGE_READ),
+            TessellationWrite => (Stage::TESSELLATION_EVALUATION_SHADER, Acc::SHADER_STORAGE_WRITE),
+            GeometryRead => (Stage::GEOMETRY_SHADER, Acc::SHADER_STORAGE_READ),
+            GeometryUniformRead => (Stage::GEOMETRY_SHADER, Acc::UNIFORM_READ),
+            FragmentRead => (Stage::FRAGMENT_SHADER, Acc::SHADER_STORAGE_READ),
+            FragmentWrite => (Stage::FRAGMENT_SHADER, Acc::SHADER_STORAGE_WRITE),
+            FragmentUniformRead => (Stage::FRAGMENT_SHADER, Acc::UNIFORM_READ),
+            FragmentSampledRead => (Stage::FRAGMENT_SHADER, Acc::SHADER_SAMPLED_READ),
+            ColorAttachmentRead => (Stage::COLOR_ATTACHMENT_OUTPUT, Acc::COLOR_ATTACHMENT_READ),
+            ColorAttachmentWrite => (Stage::COLOR_ATTACHMENT_OUTPUT, Acc::COLOR_ATTACHMENT_WRITE),
+            DepthAttachmentRead => (
+                Stage::from_raw(Stage::EARLY_FRAGMENT_TESTS.as_raw() | Stage::LATE_FRAGMENT_TESTS.as_raw()),
+                Acc::DEPTH_STENCIL_ATTACHMENT_READ,
+            ),
+            DepthAttachmentWrite => (
+                Stage::from_raw(Stage::EARLY_FRAGMENT_TESTS.as_raw() | Stage::LATE_FRAGMENT_TESTS.as_raw()),
+                Acc::DEPTH_STENCIL_ATTACHMENT_WRITE,
+            ),
+            TransferRead => (Stage::COPY, Acc::TRANSFER_READ),
+            TransferWrite => (Stage::COPY, Acc::TRANSFER_WRITE),
+            ClearWrite => (Stage::CLEAR, Acc::TRANSFER_WRITE),
+            AnyTransferWrite => (Stage::ALL_TRANSFER, Acc::TRANSFER_WRITE),
+            HostRead => (Stage::HOST, Acc::HOST_READ),
+            AnyWrite => (Stage::ALL_COMMANDS, Acc::MEMORY_WRITE),
+            AnyRead => (Stage::ALL_COMMANDS, Acc::MEMORY_READ),
+        }
+    }
+
+    /// The stage and access masks of `kinds` together (none for an empty list).
+    pub(crate) const fn mask(kinds: &[AccessKind]) -> (Stage, Acc) {
+        let (mut stage, mut access) = (0u64, 0u64);
+        let mut i = 0;
+        while i < kinds.len() {
+            let (s, a) = kinds[i].parts();
+            stage |= s.as_raw();
+            access |= a.as_raw();
+            i += 1;
+        }
+        (Stage::from_raw(stage), Acc::from_raw(access))
+    }
 }
+
+/// Nothing before or after (ownership releases and acquires, first uses).
+pub(crate) const NOTHING: &[AccessKind] = &[];
+/// Colour and depth attachment reads and writes: a rendering instance that loads.
+pub(crate) const ATTACHMENTS: &[AccessKind] = &[
+    AccessKind::ColorAttachmentRead,
+    AccessKind::ColorAttachmentWrite,
+    AccessKind::DepthAttachmentRead,
+    AccessKind::DepthAttachmentWrite,
+];
+/// Colour attachment reads and writes.
+pub(crate) const COLOR_ATTACHMENT: &[AccessKind] = &[AccessKind::ColorAttachmentRead, AccessKind::ColorAttachmentWrite];
+/// Depth attachment reads and writes.
+pub(crate) const DEPTH_ATTACHMENT: &[AccessKind] = &[AccessKind::DepthAttachmentRead, AccessKind::DepthAttachmentWrite];
+/// Compute-shader storage reads and writes.
+pub(crate) const COMPUTE_READ_WRITE: &[AccessKind] = &[AccessKind::ComputeRead, AccessKind::ComputeWrite];
+/// Any later access.
+pub(crate) const ANY: &[AccessKind] = &[AccessKind::AnyRead, AccessKind::AnyWrite];
 
 /// A barrier on a whole buffer.
-pub(crate) fn buffer(buffer: &Buffer, src: Access, dst: Access) -> vk::BufferMemoryBarrier2<'static> {
+pub(crate) fn buffer(buffer: &Buffer, src: &[AccessKind], dst: &[AccessKind]) -> vk::BufferMemoryBarrier2<'static> {
     ownership(buffer.raw(), src, dst, vk::QUEUE_FAMILY_IGNORED, vk::QUEUE_FAMILY_IGNORED)
 }
 
@@ -66,16 +153,17 @@ pub(crate) fn buffer(buffer: &Buffer, src: Access, dst: Access) -> vk::BufferMem
 /// for memory shared with another device).
 pub(crate) fn ownership(
     buffer: vk::Buffer,
-    src: Access,
-    dst: Access,
+    src: &[AccessKind],
+    dst: &[AccessKind],
     from: u32,
     to: u32,
 ) -> vk::BufferMemoryBarrier2<'static> {
+    let ((src_stage, src_access), (dst_stage, dst_access)) = (AccessKind::mask(src), AccessKind::mask(dst));
     vk::BufferMemoryBarrier2::default()
-        .src_stage_mask(src.stage)
-        .src_access_mask(src.access)
-        .dst_stage_mask(dst.stage)
-        .dst_access_mask(dst.access)
+        .src_stage_mask(src_stage)
+        .src_access_mask(src_access)
+        .dst_stage_mask(dst_stage)
+        .dst_access_mask(dst_access)
         .src_queue_family_index(from)
         .dst_queue_family_index(to)
         .buffer(buffer)
@@ -86,16 +174,17 @@ pub(crate) fn ownership(
 /// A barrier and layout transition on a whole image.
 pub(crate) fn image(
     image: &Image,
-    src: Access,
-    dst: Access,
+    src: &[AccessKind],
+    dst: &[AccessKind],
     old: vk::ImageLayout,
     new: vk::ImageLayout,
 ) -> vk::ImageMemoryBarrier2<'static> {
+    let ((src_stage, src_access), (dst_stage, dst_access)) = (AccessKind::mask(src), AccessKind::mask(dst));
     vk::ImageMemoryBarrier2::default()
-        .src_stage_mask(src.stage)
-        .src_access_mask(src.access)
-        .dst_stage_mask(dst.stage)
-        .dst_access_mask(dst.access)
+        .src_stage_mask(src_stage)
+        .src_access_mask(src_access)
+        .dst_stage_mask(dst_stage)
+        .dst_access_mask(dst_access)
         .old_layout(old)
         .new_layout(new)
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
@@ -105,12 +194,13 @@ pub(crate) fn image(
 }
 
 /// A global memory barrier.
-pub(crate) fn memory(src: Access, dst: Access) -> vk::MemoryBarrier2<'static> {
+pub(crate) fn memory(src: &[AccessKind], dst: &[AccessKind]) -> vk::MemoryBarrier2<'static> {
+    let ((src_stage, src_access), (dst_stage, dst_access)) = (AccessKind::mask(src), AccessKind::mask(dst));
     vk::MemoryBarrier2::default()
-        .src_stage_mask(src.stage)
-        .src_access_mask(src.access)
-        .dst_stage_mask(dst.stage)
-        .dst_access_mask(dst.access)
+        .src_stage_mask(src_stage)
+        .src_access_mask(src_access)
+        .dst_stage_mask(dst_stage)
+        .dst_access_mask(dst_access)
 }
 
 impl Device {
@@ -131,5 +221,27 @@ impl Device {
             .image_memory_barriers(images);
         // SAFETY: guaranteed by the caller.
         unsafe { self.raw.cmd_pipeline_barrier2(cmd, &info) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_combine_into_masks() {
+        let (stage, access) = AccessKind::mask(&[AccessKind::TransferWrite, AccessKind::ComputeRead]);
+        assert_eq!(stage, Stage::COPY | Stage::COMPUTE_SHADER);
+        assert_eq!(access, Acc::TRANSFER_WRITE | Acc::SHADER_STORAGE_READ);
+        assert_eq!(AccessKind::mask(NOTHING), (Stage::NONE, Acc::NONE));
+        let (stage, access) = AccessKind::mask(ATTACHMENTS);
+        assert_eq!(stage, Stage::COLOR_ATTACHMENT_OUTPUT | Stage::EARLY_FRAGMENT_TESTS | Stage::LATE_FRAGMENT_TESTS);
+        assert_eq!(
+            access,
+            Acc::COLOR_ATTACHMENT_READ
+                | Acc::COLOR_ATTACHMENT_WRITE
+                | Acc::DEPTH_STENCIL_ATTACHMENT_READ
+                | Acc::DEPTH_STENCIL_ATTACHMENT_WRITE
+        );
     }
 }

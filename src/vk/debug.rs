@@ -160,6 +160,8 @@ pub(crate) fn messenger_info(log: &ValidationLog) -> vk::DebugUtilsMessengerCrea
 pub(crate) enum LabelColor {
     Compute,
     Graphics,
+    Transfer,
+    Host,
 }
 
 impl LabelColor {
@@ -167,6 +169,8 @@ impl LabelColor {
         match self {
             LabelColor::Compute => [0.35, 0.65, 1.0, 1.0],
             LabelColor::Graphics => [1.0, 0.6, 0.2, 1.0],
+            LabelColor::Transfer => [0.5, 0.85, 0.4, 1.0],
+            LabelColor::Host => [0.8, 0.8, 0.8, 1.0],
         }
     }
 }

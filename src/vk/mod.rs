@@ -9,6 +9,7 @@ pub(crate) mod external;
 pub(crate) mod image;
 pub(crate) mod pipeline;
 pub(crate) mod reflect;
+pub(crate) mod rendering;
 pub(crate) mod shaders;
 pub(crate) mod staging;
 pub(crate) mod submit;

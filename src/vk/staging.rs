@@ -13,7 +13,7 @@ use std::time::Duration;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use super::barrier::{self, Access};
+use super::barrier::{self, AccessKind};
 use super::buffer::{Buffer, BufferDesc};
 use super::device::Device;
 use super::image::Image;
@@ -85,9 +85,9 @@ impl Device {
         // SAFETY: freshly allocated command buffer; recorded and submitted once here.
         let waits = unsafe {
             self.raw.begin_command_buffer(cmd, &begin).map_err(Error::vk("vkBeginCommandBuffer"))?;
-            self.cmd_barrier(cmd, &[barrier::memory(Access::ANY_WRITE, Access::ANY)], &[], &[]);
+            self.cmd_barrier(cmd, &[barrier::memory(&[AccessKind::AnyWrite], barrier::ANY)], &[], &[]);
             let waits = record(cmd);
-            self.cmd_barrier(cmd, &[barrier::memory(Access::ANY_WRITE, Access::ANY)], &[], &[]);
+            self.cmd_barrier(cmd, &[barrier::memory(&[AccessKind::AnyWrite], barrier::ANY)], &[], &[]);
             self.raw.end_command_buffer(cmd).map_err(Error::vk("vkEndCommandBuffer"))?;
             waits
         };
@@ -153,7 +153,7 @@ impl Device {
                 self.cmd_barrier(
                     cmd,
                     &[],
-                    &[barrier::buffer(&staging, Access::TRANSFER_WRITE, Access::HOST_READ)],
+                    &[barrier::buffer(&staging, &[AccessKind::TransferWrite], &[AccessKind::HostRead])],
                     &[],
                 );
             }
@@ -194,8 +194,8 @@ impl Device {
                     &[],
                     &[barrier::image(
                         image,
-                        Access::NONE,
-                        Access::TRANSFER_WRITE,
+                        barrier::NOTHING,
+                        &[AccessKind::TransferWrite],
                         vk::ImageLayout::UNDEFINED,
                         vk::ImageLayout::TRANSFER_DST_OPTIMAL,
                     )],
@@ -213,8 +213,8 @@ impl Device {
                     &[],
                     &[barrier::image(
                         image,
-                        Access::TRANSFER_WRITE,
-                        Access::ANY,
+                        &[AccessKind::TransferWrite],
+                        barrier::ANY,
                         vk::ImageLayout::TRANSFER_DST_OPTIMAL,
                         vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
                     )],
@@ -243,8 +243,8 @@ impl Device {
                     &[],
                     &[barrier::image(
                         image,
-                        Access::ANY_WRITE,
-                        Access::TRANSFER_READ,
+                        &[AccessKind::AnyWrite],
+                        &[AccessKind::TransferRead],
                         layout,
                         vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
                     )],
@@ -259,11 +259,11 @@ impl Device {
                 self.cmd_barrier(
                     cmd,
                     &[],
-                    &[barrier::buffer(&staging, Access::TRANSFER_WRITE, Access::HOST_READ)],
+                    &[barrier::buffer(&staging, &[AccessKind::TransferWrite], &[AccessKind::HostRead])],
                     &[barrier::image(
                         image,
-                        Access::TRANSFER_READ,
-                        Access::ANY,
+                        &[AccessKind::TransferRead],
+                        barrier::ANY,
                         vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
                         layout,
                     )],

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use ash::vk;
 
-use super::barrier::{self, Access};
+use super::barrier::{self, AccessKind};
 use super::device::{Device, Queue};
 use crate::error::{Error, Result};
 
@@ -146,12 +146,12 @@ impl CommandRing {
                 .reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
                 .map_err(Error::vk("vkResetCommandBuffer"))?;
             d.raw.begin_command_buffer(cmd, &begin).map_err(Error::vk("vkBeginCommandBuffer"))?;
-            d.cmd_barrier(cmd, &[barrier::memory(Access::ANY_WRITE, Access::ANY)], &[], &[]);
+            d.cmd_barrier(cmd, &[barrier::memory(&[AccessKind::AnyWrite], barrier::ANY)], &[], &[]);
         }
         let recorded = record(cmd);
         // SAFETY: as above; ended even when recording failed, so the pool stays usable.
         let ended = unsafe {
-            d.cmd_barrier(cmd, &[barrier::memory(Access::ANY_WRITE, Access::ANY)], &[], &[]);
+            d.cmd_barrier(cmd, &[barrier::memory(&[AccessKind::AnyWrite], barrier::ANY)], &[], &[]);
             d.raw.end_command_buffer(cmd)
         };
         recorded?;

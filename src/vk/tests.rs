@@ -7,7 +7,7 @@ use std::sync::Arc;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use super::barrier::{self, Access};
+use super::barrier::{self, AccessKind};
 use super::buffer::{Buffer, BufferDesc};
 use super::device::Device;
 use super::image::{Image, ImageDesc};
@@ -306,8 +306,8 @@ fn graphics_pipeline_draws_with_dynamic_rendering() {
                 &[],
                 &[barrier::image(
                     &target,
-                    Access::NONE,
-                    Access::COLOR_ATTACHMENT_WRITE,
+                    barrier::NOTHING,
+                    barrier::COLOR_ATTACHMENT,
                     vk::ImageLayout::UNDEFINED,
                     vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
                 )],
@@ -456,7 +456,12 @@ fn profiler_reports_passes_frames_in_flight_later() {
                     pipeline.bind(cmd, &[set]);
                     pipeline.push(cmd, &push);
                     pipeline.dispatch_threads(cmd, [n as u32, 1, 1]);
-                    d.cmd_barrier(cmd, &[barrier::memory(Access::COMPUTE_WRITE, Access::COMPUTE_READ_WRITE)], &[], &[]);
+                    d.cmd_barrier(
+                        cmd,
+                        &[barrier::memory(&[AccessKind::ComputeWrite], barrier::COMPUTE_READ_WRITE)],
+                        &[],
+                        &[],
+                    );
                     profiler.end_scope(cmd, scope);
                 }
                 profiler.end_scope(cmd, outer);

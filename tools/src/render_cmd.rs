@@ -9,9 +9,10 @@ use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::scenes::{self, THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS};
 use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::Groom;
+use vkhair::headless::{MeshDrawer, Offscreen, Submit};
 use vkhair::render::{
-    Camera, HairMaterial, InterpolationMode, Light, MeshDrawer, Offscreen, Primitive, RenderParams, Renderer,
-    ShadingMode, ShadowCaster, ShadowParams,
+    Camera, HairMaterial, InterpolationMode, Light, Primitive, RenderParams, Renderer, ShadingMode, ShadowCaster,
+    ShadowParams,
 };
 use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, SchedulerOptions};
 use vkhair::sim::{motion, Collider, RigidTransform, SimParams, VolumeParams};

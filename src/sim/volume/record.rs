@@ -11,7 +11,8 @@ use super::VolumeStats;
 use crate::error::Result;
 use crate::gpu_types::{GpuVolumeParams, PcgScalars, VolumePush};
 use crate::profiler::GpuProfiler;
-use crate::vk::barrier::{self, Access};
+use crate::profiler::{PassScope, ScopeKind};
+use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 
@@ -81,13 +82,8 @@ impl VolumeStage {
     /// writes, and before indirect-dispatch reads.
     unsafe fn barrier(&self, cmd: vk::CommandBuffer) {
         let b = barrier::memory(
-            Access::COMPUTE_WRITE,
-            Access {
-                stage: vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
-                access: vk::AccessFlags2::SHADER_STORAGE_READ
-                    | vk::AccessFlags2::SHADER_STORAGE_WRITE
-                    | vk::AccessFlags2::INDIRECT_COMMAND_READ,
-            },
+            &[AccessKind::ComputeWrite],
+            &[AccessKind::ComputeRead, AccessKind::ComputeWrite, AccessKind::IndirectRead],
         );
         // SAFETY: guaranteed by the caller.
         unsafe { self.device.cmd_barrier(cmd, &[b], &[], &[]) };
@@ -127,20 +123,7 @@ impl VolumeStage {
     ) {
         let scoped = |profiler: &mut Option<&mut GpuProfiler>, label: &str, body: &dyn Fn()| {
             // SAFETY: guaranteed by the caller.
-            unsafe {
-                match profiler.as_deref_mut() {
-                    Some(p) => {
-                        let scope = p.begin_scope(cmd, label);
-                        body();
-                        p.end_scope(cmd, scope);
-                    }
-                    None => {
-                        self.device.cmd_begin_label(cmd, label, crate::vk::debug::LabelColor::Compute);
-                        body();
-                        self.device.cmd_end_label(cmd);
-                    }
-                }
-            }
+            unsafe { PassScope::record(&self.device, cmd, profiler, label, ScopeKind::Compute, body) }
         };
         // SAFETY (all closures): guaranteed by the caller.
         scoped(&mut profiler, labels[0], &|| unsafe { self.record_sort(cmd, variant) });

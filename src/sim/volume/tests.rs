@@ -9,7 +9,7 @@ use super::reference::{self, face_index, Dims, VolumeSnapshot, FLUID, SOLID};
 use super::{Preconditioner, VolumeMode, VolumeParams, VolumeStage, VolumeStats};
 use crate::gpu_types::{GpuCollider, GpuVolumeParams};
 use crate::sim::MAX_COLLIDERS;
-use crate::vk::barrier::{self, Access};
+use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::tests::TestGpu;
 
@@ -51,11 +51,8 @@ fn run_gpu(
     d.upload_pod(&collider_buffer, &padded).expect("upload");
     let stage = VolumeStage::new(d, grid.clone(), params, &collider_buffer, &[(&pos, &vel)]).expect("stage");
     let uploaded = barrier::memory(
-        Access::TRANSFER_WRITE,
-        Access {
-            stage: ash::vk::PipelineStageFlags2::COMPUTE_SHADER | ash::vk::PipelineStageFlags2::DRAW_INDIRECT,
-            access: ash::vk::AccessFlags2::MEMORY_READ | ash::vk::AccessFlags2::SHADER_STORAGE_WRITE,
-        },
+        &[AccessKind::TransferWrite],
+        &[AccessKind::ComputeRead, AccessKind::ComputeUniformRead, AccessKind::ComputeWrite, AccessKind::IndirectRead],
     );
     d.submit_once("volume test", |cmd| {
         // SAFETY: a recording command buffer of this device; submit_once waited for

@@ -1,0 +1,118 @@
+//! An offscreen colour + depth target standing in for a host's swapchain image.
+
+use std::sync::Arc;
+
+use ash::vk;
+use glam::Vec3;
+
+use crate::context::GpuContext;
+use crate::error::{Error, Result};
+use crate::render::RenderTarget;
+use crate::vk::barrier;
+use crate::vk::device::Device;
+use crate::vk::image::{Image, ImageDesc};
+use crate::vk::rendering::{self, Load};
+
+/// Color format of [`Offscreen`] (shading is linear; the target encodes sRGB).
+pub const OFFSCREEN_COLOR: vk::Format = vk::Format::R8G8B8A8_SRGB;
+/// Depth format of [`Offscreen`].
+pub const OFFSCREEN_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
+
+/// An offscreen single-sample color + depth target.
+pub struct Offscreen {
+    device: Arc<Device>,
+    color: Image,
+    depth: Image,
+}
+
+impl Offscreen {
+    /// A `width` × `height` target (1..=8192 each).
+    pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Result<Self> {
+        if !(1..=8192).contains(&width) || !(1..=8192).contains(&height) {
+            return Err(Error::param("extent", format!("{width}×{height} is outside 1..=8192")));
+        }
+        let device = ctx.device.clone();
+        let extent = vk::Extent2D { width, height };
+        let color = Image::new(
+            &device,
+            &ImageDesc {
+                name: "offscreen color",
+                extent,
+                format: OFFSCREEN_COLOR,
+                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT
+                    | vk::ImageUsageFlags::TRANSFER_SRC
+                    | vk::ImageUsageFlags::SAMPLED,
+                samples: vk::SampleCountFlags::TYPE_1,
+                aspect: vk::ImageAspectFlags::COLOR,
+            },
+        )?;
+        let depth = Image::new(
+            &device,
+            &ImageDesc {
+                name: "offscreen depth",
+                extent,
+                format: OFFSCREEN_DEPTH,
+                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+                samples: vk::SampleCountFlags::TYPE_1,
+                aspect: vk::ImageAspectFlags::DEPTH,
+            },
+        )?;
+        Ok(Offscreen { device, color, depth })
+    }
+
+    /// The target for [`crate::render::Renderer::record_draw`] and [`super::MeshDrawer::record`].
+    pub fn target(&self) -> RenderTarget {
+        RenderTarget {
+            color: self.color.view(),
+            color_format: OFFSCREEN_COLOR,
+            depth: self.depth.view(),
+            depth_format: OFFSCREEN_DEPTH,
+            extent: self.color.extent,
+            samples: vk::SampleCountFlags::TYPE_1,
+        }
+    }
+
+    /// Records a clear of color (to `rgb`, linear) and depth (to 1), leaving both in
+    /// attachment layouts. Earlier contents are discarded.
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of the context's device, outside a render
+    /// pass; earlier work on this target was submitted before it on the same queue.
+    pub unsafe fn record_clear(&self, cmd: vk::CommandBuffer, rgb: Vec3) {
+        let d = &self.device;
+        let to_color = barrier::image(
+            &self.color,
+            barrier::ANY,
+            barrier::COLOR_ATTACHMENT,
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+        );
+        let to_depth = barrier::image(
+            &self.depth,
+            barrier::ANY,
+            barrier::DEPTH_ATTACHMENT,
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+        );
+        let color = [rendering::color(self.color.view(), Load::color([rgb.x, rgb.y, rgb.z, 1.0]))];
+        let depth = rendering::depth(self.depth.view(), Load::depth(1.0));
+        let rendering = rendering::info(self.color.extent, &color, Some(&depth));
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            d.cmd_barrier(cmd, &[], &[], &[to_color, to_depth]);
+            d.raw.cmd_begin_rendering(cmd, &rendering);
+            d.raw.cmd_end_rendering(cmd);
+        }
+    }
+
+    /// Reads the color image back as sRGB-encoded RGBA8 rows, top to bottom
+    /// (this submits and waits).
+    pub fn read_rgba8(&self) -> Result<Vec<u8>> {
+        self.device.readback_image(&self.color, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, 4)
+    }
+
+    /// Width and height.
+    pub fn size(&self) -> (u32, u32) {
+        (self.color.extent.width, self.color.extent.height)
+    }
+}

@@ -1,0 +1,119 @@
+//! One helper for every pass and stage: a debug label, and a timestamp pair
+//! when a profiler records the frame.
+
+use ash::vk;
+
+use super::{GpuProfiler, ScopeId};
+use crate::vk::debug::LabelColor;
+use crate::vk::device::Device;
+
+/// What a scope's commands are: picks the label colour and the pipeline stage
+/// of the closing timestamp.
+///
+/// The opening timestamp is written at `ALL_COMMANDS` (once every earlier command
+/// has finished, so a pass's time never includes its predecessor's); the closing
+/// one at the last stage the pass's commands use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ScopeKind {
+    /// Compute dispatches (the simulation's stages, the volume step, lookup tables).
+    Compute,
+    /// Draws (the render passes).
+    Graphics,
+    /// Copies and clears (the hand-off to rendering).
+    Transfer,
+    /// A host's own scope through [`GpuProfiler::begin_scope`]: anything.
+    Host,
+}
+
+impl ScopeKind {
+    /// Stage of every opening timestamp.
+    pub(crate) const BEGIN_STAGE: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::ALL_COMMANDS;
+
+    /// Stage of the closing timestamp.
+    pub(crate) fn end_stage(self) -> vk::PipelineStageFlags2 {
+        match self {
+            ScopeKind::Compute => vk::PipelineStageFlags2::COMPUTE_SHADER,
+            ScopeKind::Graphics => vk::PipelineStageFlags2::ALL_GRAPHICS,
+            ScopeKind::Transfer => vk::PipelineStageFlags2::ALL_TRANSFER,
+            ScopeKind::Host => vk::PipelineStageFlags2::ALL_COMMANDS,
+        }
+    }
+
+    pub(crate) fn label_color(self) -> LabelColor {
+        match self {
+            ScopeKind::Compute => LabelColor::Compute,
+            ScopeKind::Graphics => LabelColor::Graphics,
+            ScopeKind::Transfer => LabelColor::Transfer,
+            ScopeKind::Host => LabelColor::Host,
+        }
+    }
+}
+
+/// An open pass: a timestamp scope of the frame's profiler (which also opens the
+/// label), or just the label without a profiler.
+#[must_use = "a pass scope must be closed"]
+pub(crate) struct PassScope {
+    id: Option<ScopeId>,
+}
+
+impl PassScope {
+    /// Opens `label` as a `kind` pass.
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of `device`; with a profiler, its frame
+    /// was begun in this command buffer's submission order.
+    pub(crate) unsafe fn open(
+        device: &Device,
+        cmd: vk::CommandBuffer,
+        profiler: &mut Option<&mut GpuProfiler>,
+        label: &str,
+        kind: ScopeKind,
+    ) -> PassScope {
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            match profiler.as_deref_mut() {
+                Some(p) => PassScope { id: Some(p.begin_scope_as(cmd, label, kind)) },
+                None => {
+                    device.cmd_begin_label(cmd, label, kind.label_color());
+                    PassScope { id: None }
+                }
+            }
+        }
+    }
+
+    /// Closes the scope.
+    ///
+    /// # Safety
+    /// As for [`PassScope::open`], in the same command buffer and with the same
+    /// profiler, scopes closed innermost first.
+    pub(crate) unsafe fn close(self, device: &Device, cmd: vk::CommandBuffer, profiler: &mut Option<&mut GpuProfiler>) {
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            match (profiler.as_deref_mut(), self.id) {
+                (Some(p), Some(id)) => p.end_scope(cmd, id),
+                _ => device.cmd_end_label(cmd),
+            }
+        }
+    }
+
+    /// Records `body` inside a `kind` scope named `label`.
+    ///
+    /// # Safety
+    /// As for [`PassScope::open`]; `body` records only valid commands into `cmd`.
+    pub(crate) unsafe fn record<T>(
+        device: &Device,
+        cmd: vk::CommandBuffer,
+        profiler: &mut Option<&mut GpuProfiler>,
+        label: &str,
+        kind: ScopeKind,
+        body: impl FnOnce() -> T,
+    ) -> T {
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            let scope = PassScope::open(device, cmd, profiler, label, kind);
+            let out = body();
+            scope.close(device, cmd, profiler);
+            out
+        }
+    }
+}

@@ -1,0 +1,169 @@
+//! What the renderer draws: counts, widths, level of detail, supersampling,
+//! interpolation mode and primitive.
+
+use crate::error::{Error, Result};
+
+/// Most smoothed segments per key segment (the tessellation level limit vkhair uses).
+pub const MAX_SMOOTHING_LEVEL: u32 = 64;
+
+/// Most hairs grown around (or between) key hairs.
+pub const MAX_HAIRS_PER_KEY: u32 = 64;
+
+/// Rendering parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderParams {
+    /// Smoothed segments per key segment (1..=64). Default: 4 (a 6-point key hair
+    /// becomes 20 segments, as in the thesis scene).
+    pub smoothing_level: u32,
+    /// Hairs grown around each key hair (1..=64). Default: 16 (1750 key hairs give
+    /// 28,000 hairs, as in the thesis scene).
+    pub hairs_per_key: u32,
+    /// Radius of a clump around its key hair, meters (≥ 0). Default: 0.012.
+    pub clump_width: f32,
+    /// Fraction of `clump_width` at the root (≥ 0). Default: 0.3.
+    pub root_width: f32,
+    /// Fraction of `clump_width` at the tip (≥ 0). Default: 1.0.
+    pub tip_width: f32,
+    /// Level of detail by camera distance.
+    pub lod: LodParams,
+    /// Draw at twice the target's width and height and resolve with a 5-tap filter
+    /// (thesis 3.5). Default: false (a host may use MSAA targets instead).
+    pub supersampling: bool,
+    /// How hairs are grown from key hairs. Default: [`InterpolationMode::SingleStrand`].
+    pub interpolation: InterpolationMode,
+    /// What each hair segment is drawn as. Default: [`Primitive::Ribbons`].
+    pub primitive: Primitive,
+    /// Frames the host has in flight (1..=16): images a new target size makes
+    /// obsolete are freed this many frames after their last use. Default: 2.
+    pub frames_in_flight: u32,
+}
+
+/// What the draw pass turns each hair segment into.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+pub enum Primitive {
+    /// Camera-facing quads from the geometry stage, [`super::HairMaterial`] widths.
+    #[default]
+    Ribbons,
+    /// One-pixel lines (no geometry stage; cheapest).
+    Lines,
+}
+
+/// How the interpolation pass grows hairs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum InterpolationMode {
+    /// `hairs_per_key` hairs around each key hair, offset in its frame (thesis 3.2).
+    #[default]
+    SingleStrand,
+    /// `hairs_per_key` hairs inside each triangle of key-hair roots, blending the
+    /// three key hairs with stable random barycentric weights (Nalu).
+    Barycentric,
+}
+
+impl Default for RenderParams {
+    fn default() -> Self {
+        RenderParams {
+            smoothing_level: 4,
+            hairs_per_key: 16,
+            clump_width: 0.012,
+            root_width: 0.3,
+            tip_width: 1.0,
+            lod: LodParams::default(),
+            supersampling: false,
+            interpolation: InterpolationMode::SingleStrand,
+            primitive: Primitive::Ribbons,
+            frames_in_flight: 2,
+        }
+    }
+}
+
+/// Level of detail by camera distance d (to the centre of the hair), stepped:
+/// with d0 = `full_detail_distance`, hairs per key = round(full · (d0/d)²) (they
+/// cover screen area) and segments per key segment = round(full · d0/d) (they
+/// follow screen length), each clamped between its minimum and the full count of
+/// [`RenderParams`]; ribbon width grows by √(full hairs / hairs) to keep coverage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LodParams {
+    /// Whether detail falls with distance. Default: true.
+    pub enabled: bool,
+    /// Distance up to which full detail is drawn, meters (> 0). Default: 0.6.
+    pub full_detail_distance: f32,
+    /// Fewest hairs per key hair (≥ 1). Default: 2.
+    pub min_hairs_per_key: u32,
+    /// Lowest smoothing level (≥ 1). Default: 1.
+    pub min_smoothing_level: u32,
+}
+
+impl Default for LodParams {
+    fn default() -> Self {
+        LodParams { enabled: true, full_detail_distance: 0.6, min_hairs_per_key: 2, min_smoothing_level: 1 }
+    }
+}
+
+/// The detail actually drawn (see [`LodParams`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Detail {
+    /// Smoothed segments per key segment.
+    pub smoothing_level: u32,
+    /// Hairs per key hair.
+    pub hairs_per_key: u32,
+    /// Ribbon width factor.
+    pub width_scale: f32,
+}
+
+impl RenderParams {
+    /// The detail at camera distance `distance` (full detail when LOD is off).
+    pub fn detail_at(&self, distance: f32) -> Detail {
+        let full =
+            Detail { smoothing_level: self.smoothing_level, hairs_per_key: self.hairs_per_key, width_scale: 1.0 };
+        if !self.lod.enabled || !distance.is_finite() || distance <= self.lod.full_detail_distance {
+            return full;
+        }
+        let ratio = self.lod.full_detail_distance / distance;
+        let hairs = ((self.hairs_per_key as f32 * ratio * ratio).round() as u32)
+            .clamp(self.lod.min_hairs_per_key.min(self.hairs_per_key), self.hairs_per_key);
+        let level = ((self.smoothing_level as f32 * ratio).round() as u32)
+            .clamp(self.lod.min_smoothing_level.min(self.smoothing_level), self.smoothing_level);
+        Detail {
+            smoothing_level: level,
+            hairs_per_key: hairs,
+            width_scale: (self.hairs_per_key as f32 / hairs as f32).sqrt(),
+        }
+    }
+}
+
+impl RenderParams {
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<()> {
+        if !(1..=MAX_SMOOTHING_LEVEL).contains(&self.smoothing_level) {
+            return Err(Error::param(
+                "smoothing_level",
+                format!("{} is outside 1..={MAX_SMOOTHING_LEVEL}", self.smoothing_level),
+            ));
+        }
+        if !(1..=MAX_HAIRS_PER_KEY).contains(&self.hairs_per_key) {
+            return Err(Error::param(
+                "hairs_per_key",
+                format!("{} is outside 1..={MAX_HAIRS_PER_KEY}", self.hairs_per_key),
+            ));
+        }
+        for (name, v) in
+            [("clump_width", self.clump_width), ("root_width", self.root_width), ("tip_width", self.tip_width)]
+        {
+            if !(v.is_finite() && (0.0..=1e3).contains(&v)) {
+                return Err(Error::param(name, format!("{v} is outside 0..=1000")));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Detail {
+    /// This detail, lowered where `params` allows less.
+    pub(super) fn min_with(self, params: &RenderParams) -> Detail {
+        Detail {
+            smoothing_level: self.smoothing_level.min(params.smoothing_level),
+            hairs_per_key: self.hairs_per_key.min(params.hairs_per_key),
+            width_scale: self.width_scale,
+        }
+    }
+}

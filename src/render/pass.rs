@@ -1,0 +1,166 @@
+//! What the render passes share: their names and timestamp slots, and the
+//! attachment-less "capture" instance the geometry passes store from.
+//!
+//! ## The pass convention
+//!
+//! Every pass is a plain struct in its own file ([`super::smooth`],
+//! [`super::interpolate`], [`super::shadow`], [`super::draw`], [`super::resolve`])
+//! that
+//!
+//! - makes its pipelines, descriptor sets and the buffers and images it writes
+//!   in `new`, and owns them (a later pass borrows what it reads through an
+//!   accessor of the pass that wrote it);
+//! - records itself in `unsafe fn record(…)`, inside its own [`PassScope`] named
+//!   by its [`RenderPass`], with the barriers that make its inputs visible to it;
+//! - states in its `# Safety` section what must have been recorded before.
+//!
+//! There is no `Pass` trait: the passes take different inputs each frame
+//! (a simulation half, a camera, the host's target), and a trait would force
+//! them through one grab-bag argument. [`super::Renderer`] lists the passes in
+//! frame order and hands each what it needs.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use crate::error::Result;
+use crate::profiler::{GpuProfiler, PassScope, ScopeKind};
+use crate::vk::barrier::{self, AccessKind};
+use crate::vk::device::Device;
+use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
+use crate::vk::rendering;
+use crate::vk::shaders::ShaderSource;
+
+/// The passes of a frame, in recording order: their debug labels and
+/// timestamp scopes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum RenderPass {
+    /// Pass 1: B-spline smoothing of the key hairs.
+    Smooth,
+    /// Pass 2: strand interpolation.
+    Interpolate,
+    /// Pass 3a: shadows, the depth where the hair starts, per light.
+    ShadowDepth,
+    /// Pass 3b: shadows, opacity accumulated into three layers, per light.
+    ShadowOpacity,
+    /// Pass 3c: density-volume shadows, transmittance toward the light at every cell.
+    ShadowVolume,
+    /// Pass 4: drawing and shading.
+    Draw,
+    /// Pass 5: supersampling resolve.
+    Resolve,
+}
+
+impl RenderPass {
+    /// Every pass, in recording order.
+    pub const ALL: [RenderPass; 7] = [
+        RenderPass::Smooth,
+        RenderPass::Interpolate,
+        RenderPass::ShadowDepth,
+        RenderPass::ShadowOpacity,
+        RenderPass::ShadowVolume,
+        RenderPass::Draw,
+        RenderPass::Resolve,
+    ];
+
+    /// The debug label and timestamp scope name of the pass.
+    pub fn label(self) -> &'static str {
+        match self {
+            RenderPass::Smooth => "vkhair render: smooth",
+            RenderPass::Interpolate => "vkhair render: interpolate",
+            RenderPass::ShadowDepth => "vkhair render: shadow depth",
+            RenderPass::ShadowOpacity => "vkhair render: shadow opacity",
+            RenderPass::ShadowVolume => "vkhair render: shadow volume",
+            RenderPass::Draw => "vkhair render: draw",
+            RenderPass::Resolve => "vkhair render: resolve",
+        }
+    }
+
+    /// What the pass's commands are (label colour, closing timestamp stage).
+    pub(crate) fn kind(self) -> ScopeKind {
+        match self {
+            RenderPass::ShadowVolume => ScopeKind::Compute,
+            _ => ScopeKind::Graphics,
+        }
+    }
+
+    /// Opens the pass's scope.
+    ///
+    /// # Safety
+    /// As for [`PassScope::open`].
+    pub(crate) unsafe fn open(
+        self,
+        device: &Device,
+        cmd: vk::CommandBuffer,
+        profiler: &mut Option<&mut GpuProfiler>,
+    ) -> PassScope {
+        // SAFETY: guaranteed by the caller.
+        unsafe { PassScope::open(device, cmd, profiler, self.label(), self.kind()) }
+    }
+}
+
+/// A pipeline of tessellation stages that only store (rasterization off), for the
+/// geometry passes.
+pub(super) fn capture_pipeline(
+    device: &Arc<Device>,
+    name: &str,
+    stages: &[&ShaderSource],
+    patch_control_points: u32,
+    max_sets: u32,
+) -> Result<GraphicsPipeline> {
+    GraphicsPipeline::new(
+        device,
+        &GraphicsDesc {
+            name,
+            stages,
+            topology: vk::PrimitiveTopology::PATCH_LIST,
+            patch_control_points,
+            color_formats: &[],
+            depth_format: vk::Format::UNDEFINED,
+            samples: vk::SampleCountFlags::TYPE_1,
+            depth_test: false,
+            depth_write: false,
+            blend: Blend::None,
+            rasterizer_discard: true,
+        },
+        max_sets,
+    )
+}
+
+/// Shader stages that read what a capture pass stored.
+const CAPTURE_READERS: &[AccessKind] = &[
+    AccessKind::VertexRead,
+    AccessKind::TessellationRead,
+    AccessKind::GeometryRead,
+    AccessKind::FragmentRead,
+    AccessKind::ComputeRead,
+];
+
+/// Records one storing pass: its scope, an attachment-less rendering instance
+/// around `record`, then a barrier making its tessellation-stage storage writes
+/// visible to every later shader stage.
+///
+/// # Safety
+/// `cmd` is a recording command buffer of `device`, outside a render pass;
+/// `record` records draws of capture pipelines only.
+pub(super) unsafe fn record_capture(
+    device: &Device,
+    cmd: vk::CommandBuffer,
+    pass: RenderPass,
+    profiler: &mut Option<&mut GpuProfiler>,
+    record: impl FnOnce(vk::CommandBuffer),
+) {
+    let written = barrier::memory(&[AccessKind::TessellationWrite], CAPTURE_READERS);
+    let extent = vk::Extent2D { width: 1, height: 1 };
+    let rendering = rendering::info(extent, &[], None);
+    // SAFETY: guaranteed by the caller; every object belongs to this device.
+    unsafe {
+        let scope = pass.open(device, cmd, profiler);
+        device.raw.cmd_begin_rendering(cmd, &rendering);
+        device.cmd_set_full_viewport(cmd, extent);
+        record(cmd);
+        device.raw.cmd_end_rendering(cmd);
+        device.cmd_barrier(cmd, &[written], &[], &[]);
+        scope.close(device, cmd, profiler);
+    }
+}

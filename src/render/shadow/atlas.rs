@@ -1,0 +1,211 @@
+//! The opacity atlas: one tile per deep-opacity-map caster, two tiles per row,
+//! with the light-space depth (z0) image and the depth buffer its first pass
+//! draws into.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::{ShadowParams, SHADOW_ATLAS_FORMAT};
+use crate::error::{Error, Result};
+use crate::vk::barrier::{self, AccessKind};
+use crate::vk::device::Device;
+use crate::vk::image::{Image, ImageDesc, Sampler};
+use crate::vk::rendering::{self, Load};
+
+/// Format of the z0 atlas the depth pass writes.
+pub(super) const Z0_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+/// Format of the depth pass's depth buffer.
+pub(super) const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+impl ShadowParams {
+    /// Atlas size in texels: two tiles per row (1 × 1 without map casters).
+    pub(crate) fn atlas_extent(&self) -> vk::Extent2D {
+        let maps = self.map_casters().count() as u32;
+        let res = if maps == 0 { 1 } else { self.resolution };
+        let n = maps.max(1);
+        vk::Extent2D { width: n.min(2) * res, height: n.div_ceil(2) * res }
+    }
+
+    /// Tile `index` of the atlas: x, y, width, height in texels.
+    pub(crate) fn tile(&self, index: usize) -> [f32; 4] {
+        let res = self.resolution as f32;
+        [(index % 2) as f32 * res, (index / 2) as f32 * res, res, res]
+    }
+}
+
+/// The atlas images and the sampler the draw reads the atlas with.
+pub(super) struct ShadowAtlas {
+    device: Arc<Device>,
+    z0: Image,
+    depth: Image,
+    atlas: Image,
+    sampler: Sampler,
+}
+
+impl ShadowAtlas {
+    /// The images for `params`' atlas size; the opacity atlas starts cleared and
+    /// ready for sampling (this submits and waits).
+    pub(super) fn new(device: &Arc<Device>, params: &ShadowParams) -> Result<Self> {
+        let extent = params.atlas_extent();
+        let limit = device.info.max_image_dimension_2d;
+        if extent.width > limit || extent.height > limit {
+            return Err(Error::param("shadow resolution", format!("atlas {extent:?} exceeds the device's {limit}")));
+        }
+        let image = |name: &str, format, usage, aspect| {
+            Image::new(
+                device,
+                &ImageDesc { name, extent, format, usage, samples: vk::SampleCountFlags::TYPE_1, aspect },
+            )
+        };
+        let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        let z0 = image("vkhair shadow z0 atlas", Z0_FORMAT, color, vk::ImageAspectFlags::COLOR)?;
+        let depth = image(
+            "vkhair shadow depth atlas",
+            DEPTH_FORMAT,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            vk::ImageAspectFlags::DEPTH,
+        )?;
+        let atlas = image(
+            "vkhair shadow opacity atlas",
+            SHADOW_ATLAS_FORMAT,
+            color | vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::TRANSFER_SRC,
+            vk::ImageAspectFlags::COLOR,
+        )?;
+        let sampler = Sampler::nearest(device, "vkhair shadow atlas sampler")?;
+        let atlas = ShadowAtlas { device: device.clone(), z0, depth, atlas, sampler };
+        atlas.clear()?;
+        Ok(atlas)
+    }
+
+    /// The opacity atlas's view and the nearest sampler.
+    pub(super) fn sampled(&self) -> (vk::ImageView, vk::Sampler) {
+        (self.atlas.view(), self.sampler.raw)
+    }
+
+    /// The z0 atlas's view and the nearest sampler (what the opacity pass reads).
+    pub(super) fn z0_sampled(&self) -> (vk::ImageView, vk::Sampler) {
+        (self.z0.view(), self.sampler.raw)
+    }
+
+    /// Size in texels.
+    pub(super) fn extent(&self) -> vk::Extent2D {
+        self.atlas.extent
+    }
+
+    /// Clears the opacity atlas (no hair anywhere) and leaves it ready for sampling.
+    fn clear(&self) -> Result<()> {
+        let d = &self.device;
+        let clear = &[AccessKind::ClearWrite];
+        d.submit_once("vkhair shadow atlas clear", |cmd| {
+            let to_clear = barrier::image(
+                &self.atlas,
+                barrier::NOTHING,
+                clear,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            );
+            let to_read = barrier::image(
+                &self.atlas,
+                clear,
+                barrier::ANY,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            );
+            // SAFETY: a recording command buffer of this device; the atlas is new.
+            unsafe {
+                d.cmd_barrier(cmd, &[], &[], &[to_clear]);
+                d.raw.cmd_clear_color_image(
+                    cmd,
+                    self.atlas.raw(),
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &vk::ClearColorValue { float32: [0.0; 4] },
+                    &[self.atlas.full_range()],
+                );
+                d.cmd_barrier(cmd, &[], &[], &[to_read]);
+            }
+        })
+    }
+
+    /// Reads the opacity atlas back, row after row (submits and waits): per texel
+    /// the opacity summed to the end of each layer and z0 (0 where no hair is).
+    pub(super) fn read(&self) -> Result<(vk::Extent2D, Vec<[f32; 4]>)> {
+        let bytes = self.device.readback_image(&self.atlas, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, 16)?;
+        let texels = bytes
+            .chunks_exact(16)
+            .map(|t| std::array::from_fn(|k| f32::from_le_bytes([t[4 * k], t[4 * k + 1], t[4 * k + 2], t[4 * k + 3]])))
+            .collect();
+        Ok((self.atlas.extent, texels))
+    }
+
+    /// Barriers before the depth pass: z0 and depth from the last frame's use to
+    /// attachments (contents discarded).
+    pub(super) fn to_depth_pass(&self) -> [vk::ImageMemoryBarrier2<'static>; 2] {
+        [
+            barrier::image(
+                &self.z0,
+                FRAGMENT_SAMPLED,
+                barrier::COLOR_ATTACHMENT,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            ),
+            barrier::image(
+                &self.depth,
+                barrier::DEPTH_ATTACHMENT,
+                barrier::DEPTH_ATTACHMENT,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+            ),
+        ]
+    }
+
+    /// Barriers between the passes: z0 to sampling, the opacity atlas from the
+    /// last frame's sampling to an attachment (contents discarded).
+    pub(super) fn to_opacity_pass(&self) -> [vk::ImageMemoryBarrier2<'static>; 2] {
+        [
+            barrier::image(
+                &self.z0,
+                barrier::COLOR_ATTACHMENT,
+                FRAGMENT_SAMPLED,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            ),
+            barrier::image(
+                &self.atlas,
+                FRAGMENT_SAMPLED,
+                barrier::COLOR_ATTACHMENT,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            ),
+        ]
+    }
+
+    /// Barrier after the opacity pass: the atlas to fragment-shader sampling.
+    pub(super) fn to_sampled(&self) -> vk::ImageMemoryBarrier2<'static> {
+        barrier::image(
+            &self.atlas,
+            barrier::COLOR_ATTACHMENT,
+            FRAGMENT_SAMPLED,
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        )
+    }
+
+    /// The depth pass's attachments: z0 cleared to 0, depth to 1 (not stored).
+    pub(super) fn depth_pass_attachments(
+        &self,
+    ) -> ([vk::RenderingAttachmentInfo<'static>; 1], vk::RenderingAttachmentInfo<'static>) {
+        (
+            [rendering::color(self.z0.view(), Load::color([0.0; 4]))],
+            rendering::depth(self.depth.view(), Load::depth(1.0)).store_op(vk::AttachmentStoreOp::DONT_CARE),
+        )
+    }
+
+    /// The opacity pass's attachment: the atlas cleared to 0.
+    pub(super) fn opacity_pass_attachment(&self) -> [vk::RenderingAttachmentInfo<'static>; 1] {
+        [rendering::color(self.atlas.view(), Load::color([0.0; 4]))]
+    }
+}
+
+/// Fragment-shader sampling: how the draw and the opacity pass read the images.
+const FRAGMENT_SAMPLED: &[AccessKind] = &[AccessKind::FragmentSampledRead];

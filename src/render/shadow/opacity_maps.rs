@@ -1,0 +1,221 @@
+//! Deep opacity maps (Yuksel & Keyser 2008, `glsl/render/shadow*`): two passes
+//! over the interpolated hairs per shadow-casting light, into its atlas tile.
+//!
+//! 1. **Shadow depth** ([`RenderPass::ShadowDepth`]): the hairs as lines seen
+//!    from the light; the depth test keeps the nearest light-space depth z0
+//!    (meters along the light's axis) in an R32 float atlas.
+//! 2. **Shadow opacity** ([`RenderPass::ShadowOpacity`]): the same lines again,
+//!    additive and without a depth test: a fragment at depth d adds the strand
+//!    opacity to the layer d − z0 falls in and to every layer behind it, z0 goes
+//!    to alpha (MAX blending).
+//!
+//! Directional lights get an orthographic map fitted to the hair's bounding
+//! sphere; spot lights a perspective map from their position aimed at it.
+
+use std::sync::Arc;
+
+use ash::vk;
+use glam::{Vec3, Vec4};
+
+use super::atlas::{ShadowAtlas, DEPTH_FORMAT, Z0_FORMAT};
+use super::{ShadowParams, SHADOW_ATLAS_FORMAT};
+use crate::error::{Error, Result};
+use crate::gpu_types::{GpuLight, GpuShadowMap, GpuShadowParams};
+use crate::profiler::GpuProfiler;
+use crate::render::pass::RenderPass;
+use crate::vk::buffer::Buffer;
+use crate::vk::device::Device;
+use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
+use crate::vk::rendering;
+use crate::vk::shaders::{ShaderSource, RENDER_SHADOW_DEPTH_FRAG, RENDER_SHADOW_OPACITY_FRAG, RENDER_SHADOW_VERT};
+
+/// The two passes' pipelines over one atlas.
+pub(super) struct OpacityMaps {
+    device: Arc<Device>,
+    pub(super) atlas: ShadowAtlas,
+    depth_pass: (GraphicsPipeline, vk::DescriptorSet),
+    opacity_pass: (GraphicsPipeline, vk::DescriptorSet),
+}
+
+impl OpacityMaps {
+    /// The atlas for `params` (a 1 × 1 atlas without casters) and the passes
+    /// reading the frame's `uniforms` and hairs from `hair_positions`.
+    pub(super) fn new(
+        device: &Arc<Device>,
+        params: &ShadowParams,
+        uniforms: &Buffer,
+        hair_positions: &Buffer,
+    ) -> Result<Self> {
+        if !device.info.rgba32f_blend {
+            return Err(Error::MissingRequirement("blending into R32G32B32A32_SFLOAT attachments".into()));
+        }
+        let atlas = ShadowAtlas::new(device, params)?;
+        let pipeline = |name, fragment: &ShaderSource, color_format, depth_format, blend| {
+            GraphicsPipeline::new(
+                device,
+                &GraphicsDesc {
+                    name,
+                    stages: &[&RENDER_SHADOW_VERT, fragment],
+                    topology: vk::PrimitiveTopology::LINE_LIST,
+                    patch_control_points: 0,
+                    color_formats: &[color_format],
+                    depth_format,
+                    samples: vk::SampleCountFlags::TYPE_1,
+                    depth_test: depth_format != vk::Format::UNDEFINED,
+                    depth_write: depth_format != vk::Format::UNDEFINED,
+                    blend,
+                    rasterizer_discard: false,
+                },
+                1,
+            )
+        };
+        let depth_pipeline =
+            pipeline("vkhair shadow depth", &RENDER_SHADOW_DEPTH_FRAG, Z0_FORMAT, DEPTH_FORMAT, Blend::None)?;
+        let depth_set = depth_pipeline.resource_set(0, &[(0, uniforms), (1, hair_positions)], &[])?;
+        let opacity_pipeline = pipeline(
+            "vkhair shadow opacity",
+            &RENDER_SHADOW_OPACITY_FRAG,
+            SHADOW_ATLAS_FORMAT,
+            vk::Format::UNDEFINED,
+            Blend::AddColorMaxAlpha,
+        )?;
+        let (z0_view, sampler) = atlas.z0_sampled();
+        let opacity_set =
+            opacity_pipeline.resource_set(0, &[(0, uniforms), (1, hair_positions)], &[(2, z0_view, sampler)])?;
+        Ok(OpacityMaps {
+            device: device.clone(),
+            atlas,
+            depth_pass: (depth_pipeline, depth_set),
+            opacity_pass: (opacity_pipeline, opacity_set),
+        })
+    }
+
+    /// Records both passes for the maps of `uniforms` over `vertices` line
+    /// vertices, each in its scope, leaving the atlas in SHADER_READ_ONLY_OPTIMAL
+    /// for fragment shaders. `before` (the uniform update's barrier) is recorded
+    /// first, together with the atlas's own transitions.
+    ///
+    /// # Safety
+    /// `cmd` is recording outside a render pass on this device; the hair positions
+    /// were written before with a barrier to vertex-shader reads and `uniforms`
+    /// were written to the uniform buffer the passes read before `before`.
+    pub(super) unsafe fn record(
+        &self,
+        cmd: vk::CommandBuffer,
+        before: vk::MemoryBarrier2<'_>,
+        uniforms: &GpuShadowParams,
+        vertices: u32,
+        profiler: &mut Option<&mut GpuProfiler>,
+    ) {
+        let d = &self.device;
+        let maps = uniforms.counts[2] as usize;
+        let extent = self.atlas.extent();
+        let (z0_attachment, depth_attachment) = self.atlas.depth_pass_attachments();
+        let depth_rendering = rendering::info(extent, &z0_attachment, Some(&depth_attachment));
+        let atlas_attachment = self.atlas.opacity_pass_attachment();
+        let opacity_rendering = rendering::info(extent, &atlas_attachment, None);
+        let draw_tiles = |cmd: vk::CommandBuffer, pass: &(GraphicsPipeline, vk::DescriptorSet)| {
+            // SAFETY: inside the rendering instance recorded below.
+            unsafe {
+                pass.0.bind(cmd, &[pass.1]);
+                for (k, map) in uniforms.maps.iter().enumerate().take(maps) {
+                    if map.params[2] != 0.0 {
+                        continue; // density volume: no map
+                    }
+                    let [x, y, w, h] = map.tile;
+                    let viewport = vk::Viewport { x, y, width: w, height: h, min_depth: 0.0, max_depth: 1.0 };
+                    let scissor = vk::Rect2D {
+                        offset: vk::Offset2D { x: x as i32, y: y as i32 },
+                        extent: vk::Extent2D { width: w as u32, height: h as u32 },
+                    };
+                    d.raw.cmd_set_viewport(cmd, 0, &[viewport]);
+                    d.raw.cmd_set_scissor(cmd, 0, &[scissor]);
+                    pass.0.push(cmd, &(k as u32));
+                    d.raw.cmd_draw(cmd, vertices, 1, 0, 0);
+                }
+            }
+        };
+        // SAFETY: guaranteed by the caller; every object belongs to this device.
+        unsafe {
+            d.cmd_barrier(cmd, &[before], &[], &self.atlas.to_depth_pass());
+            let scope = RenderPass::ShadowDepth.open(d, cmd, profiler);
+            d.raw.cmd_begin_rendering(cmd, &depth_rendering);
+            draw_tiles(cmd, &self.depth_pass);
+            d.raw.cmd_end_rendering(cmd);
+            d.cmd_barrier(cmd, &[], &[], &self.atlas.to_opacity_pass());
+            scope.close(d, cmd, profiler);
+            let scope = RenderPass::ShadowOpacity.open(d, cmd, profiler);
+            d.raw.cmd_begin_rendering(cmd, &opacity_rendering);
+            draw_tiles(cmd, &self.opacity_pass);
+            d.raw.cmd_end_rendering(cmd);
+            d.cmd_barrier(cmd, &[], &[], &[self.atlas.to_sampled()]);
+            scope.close(d, cmd, profiler);
+        }
+    }
+}
+
+/// The light's map for hair within the sphere (`centre`, `radius`): matrices
+/// fitted to the sphere, layers and filter from `params`, atlas tile `index`.
+pub(crate) fn light_map(
+    light: &GpuLight,
+    light_index: usize,
+    centre: Vec3,
+    radius: f32,
+    params: &ShadowParams,
+    index: usize,
+) -> Result<GpuShadowMap> {
+    let kind = light.position_kind[3] as u32;
+    let direction = Vec3::from_slice(&light.direction_cone[..3]).normalize_or_zero();
+    let radius = radius.max(1e-4);
+    let (view, projection) = match kind {
+        0 => {
+            let eye = centre - direction * (2.0 * radius);
+            let view = glam::camera::rh::view::look_at_mat4(eye, centre, up_for(direction));
+            (
+                view,
+                glam::camera::rh::proj::vulkan::orthographic(
+                    -radius,
+                    radius,
+                    -radius,
+                    radius,
+                    radius * 0.5,
+                    radius * 3.5,
+                ),
+            )
+        }
+        2 => {
+            let eye = Vec3::from_slice(&light.position_kind[..3]);
+            let to_centre = centre - eye;
+            let distance = to_centre.length();
+            let outer = light.direction_cone[3].clamp(-1.0, 1.0).acos();
+            let fit = if distance > radius * 1.01 { (radius / distance).asin() } else { outer };
+            let half = fit.min(outer.max(0.05)).clamp(0.01, 1.45);
+            let aim = if distance > 1e-6 { to_centre / distance } else { direction };
+            let near = (distance - radius).max(radius * 0.01);
+            let view = glam::camera::rh::view::look_at_mat4(eye, eye + aim, up_for(aim));
+            (view, glam::camera::rh::proj::vulkan::perspective(2.0 * half, 1.0, near, distance + radius))
+        }
+        _ => {
+            return Err(Error::param(
+                "shadow casters",
+                format!("light {light_index} is not a directional or spot light (point lights cast no maps)"),
+            ))
+        }
+    };
+    let row = view.row(2);
+    Ok(GpuShadowMap {
+        view_proj: (projection * view).to_cols_array_2d(),
+        view_z: (-row).to_array(),
+        layers: Vec4::new(params.layers[0], params.layers[1], params.layers[2], params.extinction).to_array(),
+        tile: params.tile(index),
+        params: [params.opacity, params.pcf_radius as f32, 0.0, 0.0],
+    })
+}
+
+fn up_for(direction: Vec3) -> Vec3 {
+    if direction.y.abs() > 0.95 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    }
+}
