@@ -8,10 +8,15 @@
 //! - Any compiler warning fails the build; every module is checked with
 //!   `spirv-val` (from Debian's `spirv-tools`, pulled in by `libshaderc-dev`).
 //! - Files under `glsl/include/` are headers and are not compiled alone.
+//! - Every constant of `src/limits.rs` is defined for every shader as a macro
+//!   (`-DNAME=VALUEu`); a shader or header that declares one of those names
+//!   itself fails the build, so the Rust side and the shaders share one value.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+include!("src/limits.rs");
 
 const STAGES: &[(&str, shaderc::ShaderKind, &str)] = &[
     ("comp", shaderc::ShaderKind::Compute, "Compute"),
@@ -29,9 +34,18 @@ fn main() {
     let out_dir = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
     println!("cargo:rerun-if-changed=glsl");
 
+    println!("cargo:rerun-if-changed=src/limits.rs");
+
     let mut sources = Vec::new();
     collect(&glsl, &include_dir, &mut sources);
     sources.sort();
+    let mut redeclared = Vec::new();
+    for path in sources.iter().chain(headers(&include_dir).iter()) {
+        redeclared.extend(redeclared_constants(path));
+    }
+    if !redeclared.is_empty() {
+        panic!("shaders declare constants that build.rs injects from src/limits.rs:\n{}", redeclared.join("\n"));
+    }
 
     let compiler = shaderc::Compiler::new().expect("shaderc compiler could not be created");
     let mut errors = Vec::new();
@@ -94,6 +108,36 @@ fn collect(dir: &Path, include_dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
+/// The headers under `glsl/include/`.
+fn headers(include_dir: &Path) -> Vec<PathBuf> {
+    let entries = std::fs::read_dir(include_dir).unwrap_or_else(|e| panic!("read {}: {e}", include_dir.display()));
+    entries.map(|e| e.expect("directory entry").path()).filter(|p| p.is_file()).collect()
+}
+
+/// Lines of `path` that declare a name of [`SHADER_CONSTANTS`] (`const … NAME`
+/// or `#define NAME`).
+fn redeclared_constants(path: &Path) -> Vec<String> {
+    let Ok(source) = std::fs::read_to_string(path) else { return Vec::new() };
+    let mut found = Vec::new();
+    for (number, line) in source.lines().enumerate() {
+        let code = line.split("//").next().unwrap_or_default();
+        let words: Vec<&str> = code
+            .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '#'))
+            .filter(|w| !w.is_empty())
+            .collect();
+        let declares = |name: &str| {
+            words.windows(2).any(|w| w[0] == "#define" && w[1] == name)
+                || (words.first() == Some(&"const") && words.iter().skip(1).take(3).any(|w| *w == name))
+        };
+        for (name, _) in SHADER_CONSTANTS {
+            if declares(name) {
+                found.push(format!("{}:{}: declares {name}", path.display(), number + 1));
+            }
+        }
+    }
+    found
+}
+
 fn compile(
     compiler: &shaderc::Compiler,
     path: &Path,
@@ -108,6 +152,9 @@ fn compile(
     options.set_target_spirv(shaderc::SpirvVersion::V1_5);
     options.set_source_language(shaderc::SourceLanguage::GLSL);
     options.set_warnings_as_errors();
+    for (name, value) in SHADER_CONSTANTS {
+        options.add_macro_definition(name, Some(&format!("{value}u")));
+    }
     // Unoptimised SPIR-V keeps every OpName/OpMemberName (reflection checks
     // struct members by name) and keeps float operation order as written,
     // which the CPU reference implementations mirror. Drivers optimise anyway.

@@ -78,11 +78,41 @@ pub enum Error {
         reason: String,
     },
     /// An argument is outside its documented range.
-    #[error("invalid parameter {name}: {reason}")]
+    #[error("invalid parameter {name}: {value} (allowed: {allowed})")]
     InvalidParameter {
         /// The parameter.
         name: &'static str,
-        /// Why it was rejected.
+        /// The value given, as text.
+        value: String,
+        /// What the parameter accepts.
+        allowed: String,
+    },
+    /// A call does not fit the object it was made on: key hairs of another device
+    /// or simulation, a frame index that went backwards, a size the object was not
+    /// created for, a state of the wrong size.
+    #[error("{what}: {reason}")]
+    Incompatible {
+        /// What was passed or asked for.
+        what: &'static str,
+        /// Why it does not fit.
+        reason: String,
+    },
+    /// The device cannot do what was asked within its limits (buffer ranges, image
+    /// sizes, mappable memory).
+    #[error("the device cannot hold {what}: {reason}")]
+    Device {
+        /// The resource or operation.
+        what: &'static str,
+        /// The limit it ran into.
+        reason: String,
+    },
+    /// A feature combination vkhair does not implement (point lights with deep
+    /// opacity maps, barycentric interpolation without a scalp triangle).
+    #[error("{what} is not supported: {reason}")]
+    UnsupportedFeature {
+        /// The feature.
+        what: &'static str,
+        /// Why, and what to use instead.
         reason: String,
     },
     /// A buffer access would run past the end of the buffer.
@@ -101,6 +131,16 @@ pub enum Error {
     },
 
     // ---- Files ------------------------------------------------------------
+    /// A file could not be read as the asset it should be: the file, and what
+    /// was wrong with its contents ([`Error::BadMagic`], [`Error::Truncated`],
+    /// [`Error::Malformed`], [`Error::Unsupported`] or a groom check).
+    #[error("{}: {source}", path.display())]
+    Asset {
+        /// The file.
+        path: PathBuf,
+        /// What was wrong with it.
+        source: Box<Error>,
+    },
     /// Reading or writing a file failed.
     #[error("{path}: {source}")]
     Io {
@@ -240,8 +280,31 @@ impl Error {
         move |result| Error::Vulkan { call, result }
     }
 
-    /// Builds an [`Error::InvalidParameter`].
-    pub(crate) fn param(name: &'static str, reason: impl Into<String>) -> Error {
-        Error::InvalidParameter { name, reason: reason.into() }
+    /// Builds an [`Error::InvalidParameter`]: `value` of `name` is not in `allowed`.
+    pub(crate) fn param(name: &'static str, value: impl std::fmt::Display, allowed: impl Into<String>) -> Error {
+        Error::InvalidParameter { name, value: value.to_string(), allowed: allowed.into() }
+    }
+
+    /// Builds an [`Error::Incompatible`].
+    pub(crate) fn incompatible(what: &'static str, reason: impl Into<String>) -> Error {
+        Error::Incompatible { what, reason: reason.into() }
+    }
+
+    /// Builds an [`Error::Device`].
+    pub(crate) fn device(what: &'static str, reason: impl Into<String>) -> Error {
+        Error::Device { what, reason: reason.into() }
+    }
+
+    /// Builds an [`Error::UnsupportedFeature`].
+    pub(crate) fn unsupported(what: &'static str, reason: impl Into<String>) -> Error {
+        Error::UnsupportedFeature { what, reason: reason.into() }
+    }
+
+    /// This error as the reason the file at `path` could not be read.
+    pub(crate) fn in_asset(self, path: &std::path::Path) -> Error {
+        match self {
+            e @ (Error::Io { .. } | Error::Asset { .. }) => e,
+            e => Error::Asset { path: path.to_path_buf(), source: Box::new(e) },
+        }
     }
 }

@@ -3,9 +3,16 @@
 //! Every struct is `#[repr(C)]` + `bytemuck::Pod` and implements
 //! `GpuStruct`; `vk::tests` reflects the SPIR-V of every shader and checks
 //! member offsets, sizes and array strides against these definitions.
+//!
+//! The GLSL side packs scalars into `vec4`/`uvec4` members (std140 alignment);
+//! the named accessors below are the one place that knows which slot holds
+//! what, so Rust call sites never index into the packing.
 
 use bytemuck::{Pod, Zeroable};
 
+use glam::Vec3;
+
+use crate::limits;
 use crate::vk::reflect::gpu_struct;
 
 /// Push constants of `core/scale_add.comp`.
@@ -53,6 +60,45 @@ pub(crate) struct SimStepParams {
 }
 gpu_struct!(SimStepParams => "SimStepParams" { head, gravity_dt, wind, wind_noise, bending, counts, layout_info });
 
+impl SimStepParams {
+    /// Gravity, m/s².
+    pub fn gravity(&self) -> Vec3 {
+        Vec3::new(self.gravity_dt[0], self.gravity_dt[1], self.gravity_dt[2])
+    }
+    /// Time step, s.
+    pub fn dt(&self) -> f32 {
+        self.gravity_dt[3]
+    }
+    /// Bending stiffness per iteration at the root and at the tip.
+    pub fn bending_root_tip(&self) -> (f32, f32) {
+        (self.bending[0], self.bending[1])
+    }
+    /// Damping of the DFTL velocity correction.
+    pub fn dftl_damping(&self) -> f32 {
+        self.bending[2]
+    }
+    /// Key hairs.
+    pub fn strands(&self) -> u32 {
+        self.counts[0]
+    }
+    /// Points per key hair.
+    pub fn points(&self) -> u32 {
+        self.counts[1]
+    }
+    /// Constraint iterations.
+    pub fn iterations(&self) -> u32 {
+        self.counts[2]
+    }
+    /// `SIM_*` flags.
+    pub fn flags(&self) -> u32 {
+        self.counts[3]
+    }
+    /// Hairs per solver workgroup.
+    pub fn hairs_per_group(&self) -> u32 {
+        self.layout_info[1]
+    }
+}
+
 /// A collider in world space (`Collider` in `glsl/include/sim.glsl`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
@@ -63,6 +109,25 @@ pub(crate) struct GpuCollider {
     pub b_kind: [f32; 4],
 }
 gpu_struct!(GpuCollider => "Collider" { a_radius, b_kind });
+
+impl GpuCollider {
+    /// Centre (sphere) or first end (capsule).
+    pub fn a(&self) -> Vec3 {
+        Vec3::new(self.a_radius[0], self.a_radius[1], self.a_radius[2])
+    }
+    /// Second end (capsules).
+    pub fn b(&self) -> Vec3 {
+        Vec3::new(self.b_kind[0], self.b_kind[1], self.b_kind[2])
+    }
+    /// Radius, m.
+    pub fn radius(&self) -> f32 {
+        self.a_radius[3]
+    }
+    /// Whether it is a capsule (else a sphere).
+    pub fn is_capsule(&self) -> bool {
+        self.b_kind[3] > 0.5
+    }
+}
 
 /// Push constants of the smoothing pass (`SmoothPush` in `glsl/include/render.glsl`).
 #[repr(C)]
@@ -119,6 +184,25 @@ pub(crate) struct GpuLight {
 }
 gpu_struct!(GpuLight => "Light" { position_kind, direction_cone, color_range });
 
+impl GpuLight {
+    /// `LIGHT_*` kind: 0 directional, 1 point, 2 spot.
+    pub fn kind(&self) -> u32 {
+        self.position_kind[3] as u32
+    }
+    /// Position (point and spot lights).
+    pub fn position(&self) -> Vec3 {
+        Vec3::new(self.position_kind[0], self.position_kind[1], self.position_kind[2])
+    }
+    /// Direction of travel (directional and spot lights).
+    pub fn direction(&self) -> Vec3 {
+        Vec3::new(self.direction_cone[0], self.direction_cone[1], self.direction_cone[2])
+    }
+    /// Cosine of a spot light's outer half-angle.
+    pub fn cos_outer(&self) -> f32 {
+        self.direction_cone[3]
+    }
+}
+
 /// Uniform block of the draw pass (`DrawParams` in `glsl/include/render.glsl`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
@@ -142,7 +226,7 @@ pub(crate) struct DrawParams {
     /// Hairs, vertices per hair, lights.
     pub counts: [u32; 4],
     /// The lights.
-    pub lights: [GpuLight; 8],
+    pub lights: [GpuLight; limits::MAX_LIGHTS as usize],
 }
 gpu_struct!(DrawParams => "DrawParams" {
     view_proj, camera, root_color, tip_color, primary, secondary, shifts, widths, counts, lights
@@ -198,6 +282,41 @@ gpu_struct!(GpuVolumeParams => "VolumeParams" {
     grid_from_world, world_from_grid, axes, solid_velocity, dims, counts, transfer, solve, config
 });
 
+impl GpuVolumeParams {
+    /// FLIP ratio (0 PIC, 1 FLIP).
+    pub fn flip_ratio(&self) -> f32 {
+        self.transfer[0]
+    }
+    /// Friction of the friction mode.
+    pub fn friction(&self) -> f32 {
+        self.transfer[1]
+    }
+    /// Repulsion, m/s².
+    pub fn repulsion(&self) -> f32 {
+        self.transfer[2]
+    }
+    /// Density above which repulsion acts.
+    pub fn repulsion_threshold(&self) -> f32 {
+        self.transfer[3]
+    }
+    /// Pressure solve tolerance.
+    pub fn tolerance(&self) -> f32 {
+        self.solve[0]
+    }
+    /// Time step, s.
+    pub fn dt(&self) -> f32 {
+        self.solve[2]
+    }
+    /// `VOL_MODE_*` mode, as stored.
+    pub fn mode(&self) -> f32 {
+        self.solve[3]
+    }
+    /// Colliders the stage sees.
+    pub fn colliders(&self) -> u32 {
+        self.config[3]
+    }
+}
+
 /// Push constants of the volume kernels (`VolumePush` in `glsl/include/volume.glsl`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
@@ -243,11 +362,18 @@ pub(crate) struct GpuShadowMap {
 }
 gpu_struct!(GpuShadowMap => "ShadowMap" { view_proj, view_z, layers, tile, params });
 
+impl GpuShadowMap {
+    /// Whether the entry is a density-volume light rather than a map.
+    pub fn is_density_volume(&self) -> bool {
+        self.params[2] != 0.0
+    }
+}
+
 /// The shadow maps of a frame (`ShadowParams` in `glsl/include/shadow.glsl`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub(crate) struct GpuShadowParams {
-    pub maps: [GpuShadowMap; 4],
+    pub maps: [GpuShadowMap; limits::MAX_SHADOW_MAPS as usize],
     /// Map index per light (0xffffffff: none), four lights per vector.
     pub light_map: [[u32; 4]; 2],
     /// x hairs, y vertices per hair, z maps.
@@ -260,6 +386,13 @@ pub(crate) struct GpuShadowParams {
     pub grid: [f32; 4],
 }
 gpu_struct!(GpuShadowParams => "ShadowParams" { maps, light_map, counts, grid_from_world, grid_dims, grid });
+
+impl GpuShadowParams {
+    /// Entries of `maps` in use.
+    pub fn map_count(&self) -> usize {
+        self.counts[2] as usize
+    }
+}
 
 /// Every Rust GPU struct with the shader-side name, for the layout test.
 #[cfg(test)]

@@ -38,6 +38,7 @@ pub(crate) mod gpu_types;
 pub mod groom;
 mod hash;
 pub mod headless;
+pub(crate) mod limits;
 mod profiler;
 pub mod render;
 mod requirements;

@@ -346,3 +346,36 @@ fn sintel_bust_loads() {
     let (lo, hi) = m.bounds();
     assert!((hi.y - lo.y) > 20.0 && (hi.y - lo.y) < 80.0, "about 50 units tall: {lo} {hi}");
 }
+
+/// A file that is read but cannot be parsed names the file and keeps the parser's
+/// typed error as its source; a missing file is an I/O error naming it.
+#[test]
+fn unreadable_assets_name_their_file() {
+    let dir = std::env::temp_dir().join(format!("vkhair-asset-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let cases: [(&str, &[u8]); 3] = [("bad.hair", b"HAIX"), ("bad.tfx", b"\x01"), ("bad.obj", b"f 1 2 3\n")];
+    for (name, bytes) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).expect("write");
+        let result = match name {
+            "bad.hair" => HairFile::open(&path).map(|_| ()),
+            "bad.tfx" => TfxFile::open(&path).map(|_| ()),
+            _ => TriMesh::load_obj(&path).map(|_| ()),
+        };
+        match result {
+            Err(Error::Asset { path: p, source }) => {
+                assert_eq!(p, path);
+                assert!(
+                    matches!(*source, Error::BadMagic { .. } | Error::Truncated { .. } | Error::Malformed { .. }),
+                    "{name}: {source:?}"
+                );
+                let message = Error::Asset { path: p, source }.to_string();
+                assert!(message.starts_with(&path.display().to_string()), "{message}");
+            }
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+    let missing = dir.join("missing.hair");
+    assert!(matches!(HairFile::open(&missing), Err(Error::Io { path, .. }) if path == missing));
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}

@@ -587,7 +587,7 @@ fn resizing_frees_old_images_frames_in_flight_later() {
     frame_with(&mut s, &large, 13).expect("frame 13");
     assert_eq!(s.renderer.retired_image_sets(), 0, "freed two frames after their last use");
     assert!(hair_pixels(&large.read_rgba8().expect("readback")).len() > 1000);
-    assert!(matches!(frame_with(&mut s, &large, 3), Err(Error::InvalidParameter { name: "frame", .. })));
+    assert!(matches!(frame_with(&mut s, &large, 3), Err(Error::Incompatible { what: "frame", .. })));
 }
 
 #[test]

@@ -3,7 +3,7 @@
 // dst[i] = scale * src[i] + bias for i < count.
 #include "common.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = ITEM_GROUP) in;
 
 layout(std430, set = 0, binding = 0) readonly buffer Src { float src[]; };
 layout(std430, set = 0, binding = 1) writeonly buffer Dst { float dst[]; };

@@ -3,7 +3,7 @@
 // shadow_transmittance() of map `map`; 1 shadow_volume_transmittance() toward
 // `to_light`; 2 shadow_volume_lookup() of map `map`.
 
-layout(local_size_x = 64) in;
+layout(local_size_x = ITEM_GROUP) in;
 
 layout(std430, set = 0, binding = 4) readonly buffer Density { vec4 density_cells[]; };
 layout(std430, set = 0, binding = 5) readonly buffer Transmittance { float volume_transmittance[]; };

@@ -66,8 +66,7 @@ void key_frame(vec3 t, vec3 reference, out vec3 b1, out vec3 b2) {
     b2 = cross(t, b1);
 }
 
-// Most lights of the draw pass (render::MAX_LIGHTS).
-const uint MAX_LIGHTS = 8u;
+// MAX_LIGHTS (render::MAX_LIGHTS) is injected by build.rs from src/limits.rs.
 const uint LIGHT_DIRECTIONAL = 0u;
 const uint LIGHT_POINT = 1u;
 const uint LIGHT_SPOT = 2u;

@@ -9,8 +9,7 @@
 #ifndef VKHAIR_SHADOW_GLSL
 #define VKHAIR_SHADOW_GLSL
 
-// Most shadow-casting lights (render::MAX_SHADOW_MAPS).
-const uint MAX_SHADOW_MAPS = 4u;
+// MAX_SHADOW_MAPS (render::MAX_SHADOW_MAPS) is injected by build.rs from src/limits.rs.
 
 // One light's map. Twin: gpu_types::GpuShadowMap.
 struct ShadowMap {

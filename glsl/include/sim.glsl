@@ -31,11 +31,9 @@ const uint SIM_BENDING = 8u;
 const uint SIM_COLLISIONS = 16u;
 const uint SIM_DFTL = 32u;
 
-// Most colliders (sim::MAX_COLLIDERS).
-const uint SIM_MAX_COLLIDERS = 64u;
+// SIM_MAX_COLLIDERS (sim::MAX_COLLIDERS) and SIM_WORKGROUP are injected by
+// build.rs from src/limits.rs.
 
-// Points of the fixed-size workgroup of the constraint solver.
-const uint SIM_WORKGROUP = 64u;
 
 // head * vec4(p, 1), written out so that the CPU reference can match it.
 vec3 sim_transform_point(mat4 m, vec3 p) {

@@ -50,7 +50,8 @@ const uint VOL_STATUS_BREAKDOWN = 1u;
 const uint VOL_STATUS_NONFINITE = 2u;
 
 // Workgroup size of every per-cell, per-face and per-particle kernel.
-const uint VOL_GROUP = 256u;
+// VOL_GROUP, VOL_SORT_BLOCK and VOL_SCAN_TILE are injected by build.rs from
+// src/limits.rs.
 
 // Scalars of the conjugate-gradient solve, kept on the GPU between kernels.
 struct PcgScalars {

@@ -5,7 +5,7 @@
 // as in Bertails et al.'s light-oriented map so that shading needs one
 // trilinear lookup).
 
-layout(local_size_x = 64) in;
+layout(local_size_x = ITEM_GROUP) in;
 
 layout(std430, set = 0, binding = 1) readonly buffer Density { vec4 density_cells[]; };
 #define VKHAIR_SHADOW_DENSITY density_cells

@@ -5,7 +5,7 @@
 // Pinned particles (inverse mass 0) follow the head: x* = head · rest.
 #include "sim.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = SIM_WORKGROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { SimStepParams params; };
 layout(std430, set = 0, binding = 1) readonly buffer PosIn { vec4 pos_in[]; };

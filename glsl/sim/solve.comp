@@ -25,7 +25,7 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #include "sim.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = SIM_WORKGROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { SimStepParams params; };
 layout(std430, set = 0, binding = 3) buffer Predicted { vec4 predicted[]; };

@@ -101,12 +101,13 @@ impl Default for GrowParams {
 impl GrowParams {
     fn validate(&self) -> Result<()> {
         if !(1..=MAX_STRANDS).contains(&self.strands) {
-            return Err(Error::param("strands", format!("{} is outside 1..={MAX_STRANDS}", self.strands)));
+            return Err(Error::param("strands", self.strands, format!("1..={MAX_STRANDS}")));
         }
         if !(2..=MAX_POINTS_PER_STRAND).contains(&self.points_per_strand) {
             return Err(Error::param(
                 "points_per_strand",
-                format!("{} is outside 2..={MAX_POINTS_PER_STRAND}", self.points_per_strand),
+                self.points_per_strand,
+                format!("2..={MAX_POINTS_PER_STRAND}"),
             ));
         }
         if self.strands.saturating_mul(self.points_per_strand) > MAX_POINTS {
@@ -119,33 +120,33 @@ impl GrowParams {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(Error::param(name, format!("{v} must be finite and > 0")))
+                Err(Error::param(name, v, "finite and > 0"))
             }
         };
         positive("length", self.length)?;
         positive("segment_growth", self.segment_growth)?;
         if !(self.length_jitter.is_finite() && (0.0..1.0).contains(&self.length_jitter)) {
-            return Err(Error::param("length_jitter", format!("{} is outside 0..1", self.length_jitter)));
+            return Err(Error::param("length_jitter", self.length_jitter, "0..1"));
         }
         if !(self.droop.is_finite() && self.droop >= 0.0) {
-            return Err(Error::param("droop", format!("{} must be finite and ≥ 0", self.droop)));
+            return Err(Error::param("droop", self.droop, "finite and ≥ 0"));
         }
         if !(self.direction_jitter.is_finite() && (0.0..=std::f32::consts::FRAC_PI_2).contains(&self.direction_jitter))
         {
-            return Err(Error::param("direction_jitter", format!("{} is outside 0..=π/2", self.direction_jitter)));
+            return Err(Error::param("direction_jitter", self.direction_jitter, "0..=π/2"));
         }
         if !self.comb.is_finite() || self.comb.length() > 100.0 {
-            return Err(Error::param("comb", format!("{} must be finite and at most 100 long", self.comb)));
+            return Err(Error::param("comb", self.comb, "finite and at most 100 long"));
         }
         if !self.gravity.is_finite() || self.gravity.length_squared() < 1e-12 {
-            return Err(Error::param("gravity", format!("{} must be finite and non-zero", self.gravity)));
+            return Err(Error::param("gravity", self.gravity, "finite and non-zero"));
         }
         Ok(())
     }
 }
 
 fn unit(name: &'static str, v: Vec3) -> Result<Vec3> {
-    v.try_normalize().filter(|n| n.is_finite()).ok_or_else(|| Error::param(name, format!("{v} is not a direction")))
+    v.try_normalize().filter(|n| n.is_finite()).ok_or_else(|| Error::param(name, v, "a direction"))
 }
 
 /// Root positions and normals on the scalp.
@@ -158,7 +159,7 @@ fn roots(scalp: &Scalp, count: usize, rng: &mut Pcg64Mcg) -> Result<Vec<(Vec3, V
                 )));
             }
             if !(max_angle.is_finite() && *max_angle > 0.0) {
-                return Err(Error::param("max_angle", format!("{max_angle} must be > 0")));
+                return Err(Error::param("max_angle", max_angle, "> 0"));
             }
             let up = unit("up", *up)?;
             let face = match face {
@@ -193,10 +194,10 @@ fn roots(scalp: &Scalp, count: usize, rng: &mut Pcg64Mcg) -> Result<Vec<(Vec3, V
         Scalp::Mesh { mesh, up, min_height, min_up_dot } => {
             let up = unit("up", *up)?;
             if !(min_height.is_finite() && (0.0..=1.0).contains(min_height)) {
-                return Err(Error::param("min_height", format!("{min_height} is outside 0..=1")));
+                return Err(Error::param("min_height", min_height, "0..=1"));
             }
             if !(min_up_dot.is_finite() && (-1.0..=1.0).contains(min_up_dot)) {
-                return Err(Error::param("min_up_dot", format!("{min_up_dot} is outside -1..=1")));
+                return Err(Error::param("min_up_dot", min_up_dot, "-1..=1"));
             }
             let heights = mesh.positions.iter().map(|p| p.dot(up));
             let (lo, hi) = heights.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), h| (a.min(h), b.max(h)));

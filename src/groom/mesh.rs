@@ -42,7 +42,7 @@ impl TriMesh {
     pub fn load_obj(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
-        Self::parse_obj(&data)
+        Self::parse_obj(&data).map_err(|e| e.in_asset(path))
     }
 
     /// Parses OBJ text (materials are ignored).
@@ -70,7 +70,11 @@ impl TriMesh {
             || slices < 3
             || stacks * slices > 1 << 20
         {
-            return Err(Error::param("sphere", format!("centre {center}, radius {radius}, {stacks}×{slices}")));
+            return Err(Error::param(
+                "sphere",
+                format!("centre {center}, radius {radius}, {stacks}×{slices}"),
+                "finite centre, radius > 0, at least 3×3 and at most 2²⁰ quads",
+            ));
         }
         let mut positions = Vec::new();
         for i in 0..=stacks {

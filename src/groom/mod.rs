@@ -317,7 +317,7 @@ impl Groom {
     /// Every `stride`-th strand starting at strand 0 (key hairs from a dense groom).
     pub fn every_nth(&self, stride: usize) -> Result<Groom> {
         if stride == 0 {
-            return Err(Error::param("stride", "must be at least 1"));
+            return Err(Error::param("stride", stride, "at least 1"));
         }
         let indices: Vec<usize> = (0..self.strand_count()).step_by(stride).collect();
         self.select(&indices)
@@ -327,7 +327,7 @@ impl Groom {
     pub fn select_evenly(&self, count: usize) -> Result<Groom> {
         let n = self.strand_count();
         if count == 0 || count > n {
-            return Err(Error::param("key hair count", format!("{count} is outside 1..={n}")));
+            return Err(Error::param("key hair count", count, format!("1..={n}")));
         }
         let indices: Vec<usize> = (0..count).map(|i| i * n / count).collect();
         self.select(&indices)

@@ -19,7 +19,7 @@ impl Groom {
     /// (root and tip kept exactly); attributes are interpolated linearly.
     pub fn resampled(&self, points: usize) -> Result<Groom> {
         if !(2..=MAX_POINTS_PER_STRAND).contains(&points) {
-            return Err(Error::param("points per strand", format!("{points} is outside 2..={MAX_POINTS_PER_STRAND}")));
+            return Err(Error::param("points per strand", points, format!("2..={MAX_POINTS_PER_STRAND}")));
         }
         let total = points.checked_mul(self.strand_count()).filter(|&t| t <= super::MAX_POINTS).ok_or(
             Error::TooManyPoints { count: (points as u64) * self.strand_count() as u64, max: super::MAX_POINTS as u64 },

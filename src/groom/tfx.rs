@@ -36,7 +36,7 @@ impl TfxFile {
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
-        Self::parse(&data)
+        Self::parse(&data).map_err(|e| e.in_asset(path))
     }
 
     /// Parses `.tfx` bytes.

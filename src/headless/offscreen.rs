@@ -29,7 +29,7 @@ impl Offscreen {
     /// A `width` × `height` target (1..=8192 each).
     pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Result<Self> {
         if !(1..=8192).contains(&width) || !(1..=8192).contains(&height) {
-            return Err(Error::param("extent", format!("{width}×{height} is outside 1..=8192")));
+            return Err(Error::param("extent", format!("{width}×{height}"), "1..=8192 × 1..=8192"));
         }
         let device = ctx.device.clone();
         let extent = vk::Extent2D { width, height };

@@ -72,10 +72,10 @@ impl GpuProfiler {
 
     pub(crate) fn from_device(device: &Arc<Device>, frames_in_flight: u32, max_scopes: u32) -> Result<Self> {
         if !(1..=16).contains(&frames_in_flight) {
-            return Err(Error::param("frames_in_flight", format!("{frames_in_flight} is outside 1..=16")));
+            return Err(Error::param("frames_in_flight", frames_in_flight, "1..=16"));
         }
         if !(1..=1024).contains(&max_scopes) {
-            return Err(Error::param("max_scopes", format!("{max_scopes} is outside 1..=1024")));
+            return Err(Error::param("max_scopes", max_scopes, "1..=1024"));
         }
         let device = device.clone();
         if device.info.timestamp_valid_bits == 0 {

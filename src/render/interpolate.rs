@@ -130,9 +130,9 @@ impl InterpolatePass {
     /// Rejects `mode` when it cannot grow hairs from these key hairs.
     pub(super) fn check_mode(&self, mode: InterpolationMode) -> Result<()> {
         if mode == InterpolationMode::Barycentric && self.triangles == 0 {
-            return Err(Error::param(
-                "interpolation",
-                "barycentric mode needs at least 3 key hairs forming a triangle",
+            return Err(Error::unsupported(
+                "barycentric interpolation",
+                "it needs at least 3 key hairs whose roots form a triangle",
             ));
         }
         Ok(())

@@ -54,7 +54,7 @@ impl MarschnerParams {
         ];
         for (name, v, lo, hi) in ranges {
             if !(v.is_finite() && v >= lo && v <= hi) {
-                return Err(Error::param(name, format!("{v} is outside {lo}..={hi}")));
+                return Err(Error::param(name, v, format!("{lo}..={hi}")));
             }
         }
         Ok(())

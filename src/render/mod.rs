@@ -141,7 +141,7 @@ fn check_device(device: &Arc<Device>, sim: &KeyHairs<'_>) -> Result<()> {
     if Arc::ptr_eq(device, sim.device) {
         Ok(())
     } else {
-        Err(Error::param("key hairs", "they live on another device than the renderer's context"))
+        Err(Error::incompatible("key hairs", "they live on another device than the renderer's context"))
     }
 }
 
@@ -170,10 +170,10 @@ impl Renderer {
         let units = (strands as u64).max(triangles.len() as u64);
         let hair_vertices = units * stride * u64::from(params.hairs_per_key);
         if hair_vertices * 16 > u64::from(device.info.max_storage_buffer_range) {
-            return Err(Error::param(
-                "hairs_per_key",
+            return Err(Error::device(
+                "the interpolated hairs",
                 format!(
-                    "{} bytes of interpolated strands exceed the device's storage range; lower the level or hair count",
+                    "{} bytes exceed the device's storage range; lower the smoothing level or hairs_per_key",
                     hair_vertices * 16
                 ),
             ));
@@ -217,14 +217,16 @@ impl Renderer {
         if params.smoothing_level > self.capacity_level {
             return Err(Error::param(
                 "smoothing_level",
-                format!("{} exceeds the {} this renderer was created for", params.smoothing_level, self.capacity_level),
+                params.smoothing_level,
+                format!("at most {}, the level this renderer was created for", self.capacity_level),
             ));
         }
         self.interpolate.check_mode(params.interpolation)?;
         if params.hairs_per_key > self.capacity_hairs {
             return Err(Error::param(
                 "hairs_per_key",
-                format!("{} exceeds the {} this renderer was created for", params.hairs_per_key, self.capacity_hairs),
+                params.hairs_per_key,
+                format!("at most {}, the count this renderer was created for", self.capacity_hairs),
             ));
         }
         self.params = params.clone();
@@ -247,7 +249,7 @@ impl Renderer {
     /// Replaces the lights (at most [`MAX_LIGHTS`]).
     pub fn set_lights(&mut self, lights: &[Light]) -> Result<()> {
         if lights.len() > MAX_LIGHTS {
-            return Err(Error::param("lights", format!("{} exceed the limit of {MAX_LIGHTS}", lights.len())));
+            return Err(Error::param("lights", lights.len(), format!("at most {MAX_LIGHTS}")));
         }
         self.lights = lights.iter().map(|l| l.to_gpu()).collect::<Result<_>>()?;
         Ok(())
@@ -360,7 +362,7 @@ impl Renderer {
         let sim = sim.into();
         check_device(&self.device, &sim)?;
         if sim.bound_buffers() != self.source {
-            return Err(Error::param("key hairs", "they are not the ones this renderer was created for"));
+            return Err(Error::incompatible("key hairs", "they are not the ones this renderer was created for"));
         }
         let head = sim.head;
         self.placement.head_rotation = head.rotation.normalize();
@@ -479,16 +481,27 @@ impl Renderer {
         mut profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
         if target.extent.width == 0 || target.extent.height == 0 {
-            return Err(Error::param("render target", "extent is zero"));
+            return Err(Error::param(
+                "render target extent",
+                format!("{:?}", target.extent),
+                "non-zero width and height",
+            ));
         }
         if self.last_frame.is_some_and(|last| frame < last) {
-            return Err(Error::param("frame", format!("{frame} is before the previous frame {:?}", self.last_frame)));
+            return Err(Error::incompatible(
+                "frame",
+                format!("{frame} is before the previous frame {:?}", self.last_frame),
+            ));
         }
         self.last_frame = Some(frame);
         self.resolve.collect_retired(frame, self.params.frames_in_flight);
         let finite = camera.view.is_finite() && camera.projection.is_finite() && camera.fov_y.is_finite();
         if !finite {
-            return Err(Error::param("camera", "view, projection and field of view must be finite"));
+            return Err(Error::param(
+                "camera",
+                "a non-finite matrix or field of view",
+                "finite view, projection and field of view",
+            ));
         }
         let host_key = TargetKey {
             color: target.color_format,

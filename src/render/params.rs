@@ -135,22 +135,16 @@ impl RenderParams {
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<()> {
         if !(1..=MAX_SMOOTHING_LEVEL).contains(&self.smoothing_level) {
-            return Err(Error::param(
-                "smoothing_level",
-                format!("{} is outside 1..={MAX_SMOOTHING_LEVEL}", self.smoothing_level),
-            ));
+            return Err(Error::param("smoothing_level", self.smoothing_level, format!("1..={MAX_SMOOTHING_LEVEL}")));
         }
         if !(1..=MAX_HAIRS_PER_KEY).contains(&self.hairs_per_key) {
-            return Err(Error::param(
-                "hairs_per_key",
-                format!("{} is outside 1..={MAX_HAIRS_PER_KEY}", self.hairs_per_key),
-            ));
+            return Err(Error::param("hairs_per_key", self.hairs_per_key, format!("1..={MAX_HAIRS_PER_KEY}")));
         }
         for (name, v) in
             [("clump_width", self.clump_width), ("root_width", self.root_width), ("tip_width", self.tip_width)]
         {
             if !(v.is_finite() && (0.0..=1e3).contains(&v)) {
-                return Err(Error::param(name, format!("{v} is outside 0..=1000")));
+                return Err(Error::param(name, v, "0..=1000"));
             }
         }
         Ok(())

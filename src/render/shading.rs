@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::gpu_types::GpuLight;
 
 /// Most lights the draw pass shades with.
-pub const MAX_LIGHTS: usize = 8;
+pub const MAX_LIGHTS: usize = crate::limits::MAX_LIGHTS as usize;
 
 /// A perspective camera (Vulkan clip space: y down, depth 0..1).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,6 +35,7 @@ impl Camera {
             return Err(Error::param(
                 "camera",
                 format!("eye {eye}, target {target}, fov {fov_y}, aspect {aspect}, near {near}, far {far}"),
+                "finite, eye ≠ target, fov in 0.01..3.1, aspect > 0, 0 < near < far",
             ));
         }
         Ok(Camera {
@@ -84,7 +85,7 @@ pub enum Light {
 
 impl Light {
     pub(crate) fn to_gpu(self) -> Result<GpuLight> {
-        let bad = || Error::param("light", format!("{self:?} is not finite or has a zero direction"));
+        let bad = || Error::param("light", format!("{self:?}"), "finite with a non-zero direction");
         Ok(match self {
             Light::Directional { direction, color } => {
                 let d = direction.try_normalize().ok_or_else(bad)?;
@@ -214,7 +215,7 @@ impl HairMaterial {
         ];
         for (name, c) in colors {
             if !c.is_finite() || c.min_element() < 0.0 {
-                return Err(Error::param(name, format!("{c} must be finite and ≥ 0")));
+                return Err(Error::param(name, c, "finite and ≥ 0"));
             }
         }
         let ranges = [
@@ -232,7 +233,7 @@ impl HairMaterial {
         ];
         for (name, v, lo, hi) in ranges {
             if !(v.is_finite() && v >= lo && v <= hi) {
-                return Err(Error::param(name, format!("{v} is outside {lo}..={hi}")));
+                return Err(Error::param(name, v, format!("{lo}..={hi}")));
             }
         }
         self.marschner.validate()

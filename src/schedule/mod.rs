@@ -40,10 +40,11 @@
 
 mod async_compute;
 mod mirror;
+mod mode;
+mod options;
 mod worker;
 
 use std::sync::Arc;
-use std::time::Duration;
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -63,119 +64,8 @@ use async_compute::{AsyncSim, Pending};
 use mirror::{slot_buffer, Layout, Meta, Mirror, Parts};
 use worker::{SimSide, SimSlots, SimUpdate, Worker};
 
-/// Where the simulation runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ScheduleMode {
-    /// Recorded into the host's command buffer, in order with rendering.
-    SingleQueue,
-    /// Submitted by vkhair to a second queue of the rendering device.
-    AsyncCompute,
-    /// On a second logical device, driven by a worker thread.
-    SecondDevice,
-}
-
-impl ScheduleMode {
-    /// The mode's name in reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            ScheduleMode::SingleQueue => "single queue",
-            ScheduleMode::AsyncCompute => "async compute",
-            ScheduleMode::SecondDevice => "second device",
-        }
-    }
-}
-
-/// How SECOND DEVICE mode moves the state to the rendering device.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum HandOff {
-    /// Memory exported by the simulation device and imported by the rendering
-    /// device (`VK_KHR_external_memory_fd`): no host copy.
-    ExternalMemory,
-    /// Host-visible buffers on both devices, copied by the render thread.
-    HostStaging,
-}
-
-/// Which simulation step a frame shows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Pipelining {
-    /// Frame N shows the state after its own steps (rendering waits for them).
-    Latency,
-    /// Frame N shows the state after frame N−1's steps while frame N's run.
-    Throughput,
-}
-
-/// How a [`FrameScheduler`] is set up.
-#[derive(Debug, Clone)]
-pub struct SchedulerOptions {
-    /// The mode to use; `None` chooses: SECOND DEVICE when `sim_device` is given,
-    /// else ASYNC COMPUTE when the rendering context has a second queue, else SINGLE
-    /// QUEUE. Default: `None`.
-    pub mode: Option<ScheduleMode>,
-    /// Which step a frame shows. Default: [`Pipelining::Throughput`].
-    pub pipelining: Pipelining,
-    /// Frames the host keeps in flight (1..=8): the scheduler keeps one more
-    /// hand-off slot than this. Default: 2.
-    pub frames_in_flight: u32,
-    /// The simulation device for SECOND DEVICE mode. Default: `None`.
-    pub sim_device: Option<GpuContext>,
-    /// How SECOND DEVICE mode hands the state over; `None`: external memory when
-    /// both devices can share it, else host staging. Default: `None`.
-    pub hand_off: Option<HandOff>,
-    /// Lets ASYNC COMPUTE submit to the rendering context's graphics queue when it
-    /// has no second queue: nothing overlaps, but the semaphore hand-off runs on any
-    /// device (tests). The host must not submit to that queue concurrently with
-    /// [`FrameScheduler::record_frame`]. Default: `false`.
-    pub async_on_graphics_queue: bool,
-    /// Timestamp profiles of vkhair's own simulation submissions (ASYNC COMPUTE and
-    /// SECOND DEVICE; see [`FrameScheduler::sim_profile`]). Default: `true`.
-    pub profile: bool,
-    /// Longest wait for the simulation side before an error. Default: 10 s.
-    pub timeout: Duration,
-}
-
-impl Default for SchedulerOptions {
-    fn default() -> Self {
-        SchedulerOptions {
-            mode: None,
-            pipelining: Pipelining::Throughput,
-            frames_in_flight: 2,
-            sim_device: None,
-            hand_off: None,
-            async_on_graphics_queue: false,
-            profile: true,
-            timeout: Duration::from_secs(10),
-        }
-    }
-}
-
-/// A timeline-semaphore wait the host's submission of a frame must include.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct SemaphoreWait {
-    /// A timeline semaphore of the rendering device.
-    pub semaphore: vk::Semaphore,
-    /// The value to wait for.
-    pub value: u64,
-    /// The stages that must wait (the hand-off copy).
-    pub stage: vk::PipelineStageFlags2,
-}
-
-/// What the host's submission of a frame must do for vkhair.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-#[must_use = "the host's submission must wait on these semaphores"]
-pub struct FrameSync {
-    /// Semaphores to wait on (ASYNC COMPUTE; empty otherwise).
-    pub waits: Vec<SemaphoreWait>,
-}
-
-impl FrameSync {
-    /// The waits as `VkSemaphoreSubmitInfo`s for `vkQueueSubmit2`.
-    pub fn wait_infos(&self) -> Vec<vk::SemaphoreSubmitInfo<'static>> {
-        self.waits
-            .iter()
-            .map(|w| vk::SemaphoreSubmitInfo::default().semaphore(w.semaphore).value(w.value).stage_mask(w.stage))
-            .collect()
-    }
-}
+use mode::{choose_mode, unavailable};
+pub use options::{FrameSync, HandOff, Pipelining, ScheduleMode, SchedulerOptions, SemaphoreWait};
 
 /// The rendering side of SECOND DEVICE hand-off slots.
 enum RenderSlots {
@@ -236,10 +126,10 @@ impl FrameScheduler {
         options: &SchedulerOptions,
     ) -> Result<Self> {
         if !(1..=8).contains(&options.frames_in_flight) {
-            return Err(Error::param("frames_in_flight", format!("{} is outside 1..=8", options.frames_in_flight)));
+            return Err(Error::param("frames_in_flight", options.frames_in_flight, "1..=8"));
         }
         if options.timeout.is_zero() {
-            return Err(Error::param("timeout", "must be longer than zero"));
+            return Err(Error::param("timeout", format!("{:?}", options.timeout), "longer than zero"));
         }
         let slots = options.frames_in_flight as usize + 1;
         let (mode, reason) = choose_mode(render, options)?;
@@ -465,7 +355,10 @@ impl FrameScheduler {
         let same = (params.volume.mode == crate::sim::VolumeMode::Off) != has_volume
             && grid.is_none_or(|dims| dims == params.volume.resolution);
         if !same {
-            return Err(Error::param("volume", "the volume stage's mode and resolution are fixed for a scheduler"));
+            return Err(Error::incompatible(
+                "volume",
+                "the volume stage's mode and resolution are fixed for a scheduler",
+            ));
         }
         match &mut self.backend {
             Backend::Local { sim, .. } => sim.set_params(params),
@@ -576,40 +469,6 @@ unsafe fn consume(
     Ok(())
 }
 
-fn unavailable(mode: ScheduleMode, reason: &str) -> Error {
-    Error::ModeUnavailable { mode: mode.name(), reason: reason.to_owned() }
-}
-
-/// The mode for `options` on `render`, and why.
-fn choose_mode(render: &GpuContext, options: &SchedulerOptions) -> Result<(ScheduleMode, String)> {
-    let device = &render.device;
-    let second_queue = match device.compute {
-        Some(q) if q.family != device.graphics.family => Some(format!("compute queue family {}", q.family)),
-        Some(_) => Some(format!("a second queue of graphics family {}", device.graphics.family)),
-        None => None,
-    };
-    let no_queue = format!("{} offers no second queue (one queue family with one queue)", device.info.name);
-    match options.mode {
-        Some(ScheduleMode::SingleQueue) => Ok((ScheduleMode::SingleQueue, "forced by the host".into())),
-        Some(ScheduleMode::AsyncCompute) => match (second_queue, options.async_on_graphics_queue) {
-            (Some(q), _) => Ok((ScheduleMode::AsyncCompute, format!("forced by the host, on {q}"))),
-            (None, true) => {
-                Ok((ScheduleMode::AsyncCompute, format!("forced by the host on the graphics queue: {no_queue}")))
-            }
-            (None, false) => Err(unavailable(ScheduleMode::AsyncCompute, &no_queue)),
-        },
-        Some(ScheduleMode::SecondDevice) => match &options.sim_device {
-            Some(_) => Ok((ScheduleMode::SecondDevice, "forced by the host".into())),
-            None => Err(unavailable(ScheduleMode::SecondDevice, "no sim_device given")),
-        },
-        None => Ok(match (&options.sim_device, second_queue) {
-            (Some(s), _) => (ScheduleMode::SecondDevice, format!("the host gave simulation device {}", s.info().name)),
-            (None, Some(q)) => (ScheduleMode::AsyncCompute, format!("the device has {q}")),
-            (None, None) => (ScheduleMode::SingleQueue, no_queue),
-        }),
-    }
-}
-
 /// The hand-off slots of SECOND DEVICE mode on both devices.
 fn make_slots(
     sim: &Arc<crate::vk::device::Device>,
@@ -645,6 +504,8 @@ fn make_slots(
 
 #[cfg(test)]
 mod tests {
+    use std::time::Duration;
+
     use super::*;
     use crate::headless::Submit;
     use crate::vk::tests::TestGpu;

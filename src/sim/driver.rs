@@ -30,10 +30,10 @@ impl FixedStepDriver {
     /// steps per frame.
     pub fn new(step: f64, max_steps: u32) -> Result<Self> {
         if !(step.is_finite() && step > 0.0) {
-            return Err(Error::param("step", format!("{step} must be finite and > 0")));
+            return Err(Error::param("step", step, "finite and > 0"));
         }
         if max_steps == 0 {
-            return Err(Error::param("max_steps", "must be at least 1"));
+            return Err(Error::param("max_steps", max_steps, "at least 1"));
         }
         Ok(FixedStepDriver { step, max_steps, accumulator: 0.0 })
     }

@@ -387,7 +387,7 @@ impl HairSim {
                 }
                 d.cmd_barrier(cmd, &[uploaded], &[], &[]);
             }
-            let hairs_per_group = sub.params.layout_info[1];
+            let hairs_per_group = sub.params.hairs_per_group();
             for (k, stage) in self.stages.iter().enumerate() {
                 let threads = stage.stage.threads(strands, points, hairs_per_group);
                 // SAFETY: as above; the profiler contract is the caller's.
@@ -427,7 +427,7 @@ impl HairSim {
             || state.positions.len() != self.shape.positions.len()
             || state.velocities.len() != self.shape.positions.len()
         {
-            return Err(Error::param("state", "size differs from the simulation's"));
+            return Err(Error::incompatible("state", "its size differs from the simulation's"));
         }
         self.gpu.upload(&self.device, state, self.current)
     }

@@ -10,9 +10,9 @@ use crate::error::{Error, Result};
 use crate::gpu_types::{GpuCollider, SimStepParams};
 
 /// Most colliders a simulation may have.
-pub const MAX_COLLIDERS: usize = 64;
+pub const MAX_COLLIDERS: usize = crate::limits::SIM_MAX_COLLIDERS as usize;
 /// Most points per key hair the GPU solver handles (one 64-invocation workgroup).
-pub const MAX_SIM_POINTS: usize = 64;
+pub const MAX_SIM_POINTS: usize = crate::limits::SIM_WORKGROUP as usize;
 
 /// How the constraints are solved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -121,7 +121,7 @@ fn finite_vec(name: &'static str, v: Vec3) -> Result<()> {
     if v.is_finite() {
         Ok(())
     } else {
-        Err(Error::param(name, format!("{v} is not finite")))
+        Err(Error::param(name, v, "finite"))
     }
 }
 
@@ -129,7 +129,7 @@ fn in_range(name: &'static str, v: f32, lo: f32, hi: f32) -> Result<()> {
     if v.is_finite() && v >= lo && v <= hi {
         Ok(())
     } else {
-        Err(Error::param(name, format!("{v} is outside {lo}..={hi}")))
+        Err(Error::param(name, v, format!("{lo}..={hi}")))
     }
 }
 
@@ -137,13 +137,13 @@ impl SimParams {
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<()> {
         if !(self.dt.is_finite() && self.dt > 0.0 && self.dt <= 0.1) {
-            return Err(Error::param("dt", format!("{} is outside (0, 0.1] seconds", self.dt)));
+            return Err(Error::param("dt", self.dt, "(0, 0.1] seconds"));
         }
         if !(1..=64).contains(&self.substeps) {
-            return Err(Error::param("substeps", format!("{} is outside 1..=64", self.substeps)));
+            return Err(Error::param("substeps", self.substeps, "1..=64"));
         }
         if !(1..=1000).contains(&self.iterations) {
-            return Err(Error::param("iterations", format!("{} is outside 1..=1000", self.iterations)));
+            return Err(Error::param("iterations", self.iterations, "1..=1000"));
         }
         finite_vec("gravity", self.gravity)?;
         finite_vec("wind", self.wind)?;
@@ -157,7 +157,7 @@ impl SimParams {
         in_range("pearl_radius_root", self.pearl_radius_root, 0.0, 1e6)?;
         in_range("pearl_radius_tip", self.pearl_radius_tip, 0.0, 1e6)?;
         if self.hairs_per_workgroup as usize > MAX_SIM_POINTS / 2 {
-            return Err(Error::param("hairs_per_workgroup", format!("{} is above 32", self.hairs_per_workgroup)));
+            return Err(Error::param("hairs_per_workgroup", self.hairs_per_workgroup, "at most 32"));
         }
         self.volume.validate()
     }
@@ -202,7 +202,7 @@ pub enum Collider {
 /// Checks a collider list: at most [`MAX_COLLIDERS`], each valid.
 pub(crate) fn validate_colliders(colliders: &[Collider]) -> Result<()> {
     if colliders.len() > MAX_COLLIDERS {
-        return Err(Error::param("colliders", format!("{} exceed the limit of {MAX_COLLIDERS}", colliders.len())));
+        return Err(Error::param("colliders", colliders.len(), format!("at most {MAX_COLLIDERS}")));
     }
     colliders.iter().try_for_each(Collider::validate)
 }
@@ -216,7 +216,7 @@ impl Collider {
         finite_vec("collider position", points[0])?;
         finite_vec("collider position", points[1])?;
         if !(radius.is_finite() && radius > 0.0) {
-            return Err(Error::param("collider radius", format!("{radius} must be finite and > 0")));
+            return Err(Error::param("collider radius", radius, "finite and > 0"));
         }
         Ok(())
     }
@@ -255,7 +255,7 @@ impl RigidTransform {
     /// Checks for NaN/Inf and a degenerate rotation.
     pub fn validate(&self) -> Result<()> {
         if !self.translation.is_finite() || !self.rotation.is_finite() || self.rotation.length_squared() < 1e-12 {
-            return Err(Error::param("head transform", format!("{self:?} is not a finite rigid transform")));
+            return Err(Error::param("head transform", format!("{self:?}"), "a finite rigid transform"));
         }
         Ok(())
     }
@@ -301,8 +301,8 @@ impl SubstepInputs {
         colliders: u32,
     ) -> crate::gpu_types::GpuVolumeParams {
         let head = Mat4::from_cols_array_2d(&self.params.head);
-        let colliders = if self.params.counts[3] & flags::COLLISIONS != 0 { colliders } else { 0 };
-        grid.gpu_params(params, &self.previous_head, &head, self.params.gravity_dt[3], colliders)
+        let colliders = if self.params.flags() & flags::COLLISIONS != 0 { colliders } else { 0 };
+        grid.gpu_params(params, &self.previous_head, &head, self.params.dt(), colliders)
     }
 }
 

@@ -37,17 +37,17 @@ pub(crate) fn noise(t: f32, strand: u32) -> f32 {
 }
 
 fn collide(c: &GpuCollider, p: Vec3, radius: f32) -> Vec3 {
-    let a = Vec3::new(c.a_radius[0], c.a_radius[1], c.a_radius[2]);
+    let a = c.a();
     let mut closest = a;
-    if c.b_kind[3] > 0.5 {
-        let ab = Vec3::new(c.b_kind[0], c.b_kind[1], c.b_kind[2]) - a;
+    if c.is_capsule() {
+        let ab = c.b() - a;
         let len2 = dot(ab, ab);
         let t = if len2 > 0.0 { (dot(p - a, ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
         closest = a + ab * t;
     }
     let d = p - closest;
     let dist = dot(d, d).sqrt();
-    let reach = c.a_radius[3] + radius;
+    let reach = c.radius() + radius;
     if dist < reach && dist > 0.0 {
         closest + d * (reach / dist)
     } else {
@@ -78,10 +78,10 @@ fn project(s: &mut [Vec4], i: usize, j: usize, rest_d: f32, k: f32) {
 
 /// Stage 1: forces and prediction.
 fn predict(p: &SimStepParams, state: &SimState, predicted: &mut [Vec4]) {
-    let points = p.counts[1] as usize;
-    let dt = p.gravity_dt[3];
-    let flags = p.counts[3];
-    let gravity = Vec3::new(p.gravity_dt[0], p.gravity_dt[1], p.gravity_dt[2]);
+    let points = p.points() as usize;
+    let dt = p.dt();
+    let flags = p.flags();
+    let gravity = p.gravity();
     let wind = Vec3::new(p.wind[0], p.wind[1], p.wind[2]);
     for (index, out) in predicted.iter_mut().enumerate() {
         let strand = (index / points) as u32;
@@ -115,12 +115,12 @@ fn solve(
     predicted: &mut [Vec4],
     correction: &mut [Vec4],
 ) {
-    let points = p.counts[1] as usize;
-    let flags = p.counts[3];
+    let points = p.points() as usize;
+    let flags = p.flags();
     let collisions = flags & flags::COLLISIONS != 0;
     let mut s = vec![Vec4::ZERO; points];
     let mut bend = vec![(0.0f32, 0.0f32); points];
-    for strand in 0..p.counts[0] as usize {
+    for strand in 0..p.strands() as usize {
         let base = strand * points;
         s.copy_from_slice(&predicted[base..base + points]);
         let lengths = &state.rest_lengths[base..base + points];
@@ -151,11 +151,14 @@ fn solve(
             if i > 0 && i + 1 < points {
                 let r = state.rest[base + i + 1].truncate() - state.rest[base + i - 1].truncate();
                 let t = i as f32 / (points - 1) as f32;
-                *b = (dot(r, r).sqrt(), p.bending[0] + (p.bending[1] - p.bending[0]) * t);
+                *b = (dot(r, r).sqrt(), {
+                    let (root, tip) = p.bending_root_tip();
+                    root + (tip - root) * t
+                });
             }
         }
         let bending = flags & flags::BENDING != 0;
-        for _ in 0..p.counts[2] {
+        for _ in 0..p.iterations() {
             for i in (0..points - 1).step_by(2) {
                 project(&mut s, i, i + 1, lengths[i], 1.0);
             }
@@ -185,15 +188,15 @@ fn solve(
 
 /// Stage 3: velocity update, damping, final state.
 fn integrate(p: &SimStepParams, state: &mut SimState, predicted: &[Vec4], correction: &[Vec4]) {
-    let points = p.counts[1] as usize;
-    let dt = p.gravity_dt[3];
-    let dftl = p.counts[3] & flags::DFTL != 0;
+    let points = p.points() as usize;
+    let dt = p.dt();
+    let dftl = p.flags() & flags::DFTL != 0;
     for index in 0..predicted.len() {
         let i = index % points;
         let solved = predicted[index];
         let mut v = (solved.truncate() - state.positions[index].truncate()) / dt;
         if dftl && i + 1 < points {
-            v -= correction[index + 1].truncate() * (p.bending[2] / dt);
+            v -= correction[index + 1].truncate() * (p.dftl_damping() / dt);
         }
         v *= 1.0 - p.wind_noise[3];
         state.positions[index] = solved;

@@ -53,12 +53,13 @@ impl SimState {
         params.validate()?;
         head.validate()?;
         let points = groom.uniform_points_per_strand().ok_or_else(|| {
-            Error::param("key hairs", "strands differ in point count; resample them with Groom::resampled")
+            Error::incompatible("key hairs", "strands differ in point count; resample them with Groom::resampled")
         })?;
         if points > MAX_SIM_POINTS {
             return Err(Error::param(
-                "key hairs",
-                format!("{points} points per strand exceed {MAX_SIM_POINTS}; resample them with Groom::resampled"),
+                "points per key hair",
+                points,
+                format!("at most {MAX_SIM_POINTS}; resample the groom with Groom::resampled"),
             ));
         }
         let m = head.matrix();
@@ -127,7 +128,8 @@ impl SimState {
         if !(length.is_finite() && length > minimum && length < 1e6) {
             return Err(Error::param(
                 "strand length",
-                format!("{length} must be finite and above {minimum} (root segments plus 5 % of the tip segments)"),
+                length,
+                format!("finite and above {minimum} (root segments plus 5 % of the tip segments)"),
             ));
         }
         let scale = (length - root_part) / tip_part;
@@ -173,8 +175,8 @@ impl GpuState {
         let n = state.positions.len() as u64;
         let vec4_bytes = n * 16;
         if vec4_bytes > u64::from(device.info.max_storage_buffer_range) {
-            return Err(Error::param(
-                "key hairs",
+            return Err(Error::device(
+                "the key hairs",
                 format!(
                     "{n} particles need {vec4_bytes} bytes per buffer, above the device's {} byte range",
                     device.info.max_storage_buffer_range

@@ -30,7 +30,7 @@ pub(crate) struct Buffer {
 impl Buffer {
     pub(crate) fn new(device: &Arc<Device>, desc: &BufferDesc<'_>) -> Result<Self> {
         if desc.size == 0 {
-            return Err(Error::param("buffer size", format!("{:?} has size 0", desc.name)));
+            return Err(Error::param("buffer size", format!("0 for {:?}", desc.name), "at least 1 byte"));
         }
         // With an async compute queue of another family every buffer may be used on
         // both queues: CONCURRENT sharing saves ownership transfers (see the schedule

@@ -33,7 +33,11 @@ pub(crate) struct Image {
 impl Image {
     pub(crate) fn new(device: &Arc<Device>, desc: &ImageDesc<'_>) -> Result<Self> {
         if desc.extent.width == 0 || desc.extent.height == 0 {
-            return Err(Error::param("image extent", format!("{:?} has extent {:?}", desc.name, desc.extent)));
+            return Err(Error::param(
+                "image extent",
+                format!("{:?} for {:?}", desc.extent, desc.name),
+                "non-zero width and height",
+            ));
         }
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)

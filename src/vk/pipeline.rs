@@ -113,7 +113,7 @@ impl Layout {
         let layout = *self
             .set_layouts
             .get(set as usize)
-            .ok_or_else(|| Error::param("descriptor set", format!("{name}: set {set} is not declared")))?;
+            .ok_or_else(|| Error::incompatible("descriptor set", format!("{name}: set {set} is not declared")))?;
         let layouts = [layout];
         let info = vk::DescriptorSetAllocateInfo::default().descriptor_pool(self.pool).set_layouts(&layouts);
         // SAFETY: pool and layout belong to this device; sets are freed with the pool.
@@ -134,39 +134,8 @@ impl Layout {
 
     /// Points storage-image bindings of `set` at views in GENERAL layout.
     fn write_storage_images(&self, target: vk::DescriptorSet, set: u32, images: &[(u32, vk::ImageView)]) -> Result<()> {
-        let infos: Vec<_> = images
-            .iter()
-            .map(|(_, view)| {
-                [vk::DescriptorImageInfo {
-                    sampler: vk::Sampler::null(),
-                    image_view: *view,
-                    image_layout: vk::ImageLayout::GENERAL,
-                }]
-            })
-            .collect();
-        let mut writes = Vec::new();
-        for ((binding, _), info) in images.iter().zip(&infos) {
-            let declared = self
-                .bindings
-                .iter()
-                .any(|(b, _)| b.set == set && b.binding == *binding && b.ty == vk::DescriptorType::STORAGE_IMAGE);
-            if !declared {
-                return Err(Error::param(
-                    "descriptor binding",
-                    format!("set {set} binding {binding} is not a storage image"),
-                ));
-            }
-            writes.push(
-                vk::WriteDescriptorSet::default()
-                    .dst_set(target)
-                    .dst_binding(*binding)
-                    .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
-                    .image_info(info),
-            );
-        }
-        // SAFETY: as in write_buffers; the views are alive.
-        unsafe { self.device.raw.update_descriptor_sets(&writes, &[]) };
-        Ok(())
+        let images: Vec<_> = images.iter().map(|&(binding, view)| (binding, view, vk::Sampler::null())).collect();
+        self.write_image_bindings(target, set, vk::DescriptorType::STORAGE_IMAGE, &images)
     }
 
     /// Points combined image-sampler bindings of `set` at (view, sampler) pairs
@@ -177,32 +146,41 @@ impl Layout {
         set: u32,
         images: &[(u32, vk::ImageView, vk::Sampler)],
     ) -> Result<()> {
+        self.write_image_bindings(target, set, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, images)
+    }
+
+    /// Points image bindings of type `ty` of `set` at (view, sampler) pairs: storage
+    /// images in GENERAL layout (null samplers), sampled ones in
+    /// SHADER_READ_ONLY_OPTIMAL.
+    fn write_image_bindings(
+        &self,
+        target: vk::DescriptorSet,
+        set: u32,
+        ty: vk::DescriptorType,
+        images: &[(u32, vk::ImageView, vk::Sampler)],
+    ) -> Result<()> {
+        let (layout, what) = match ty {
+            vk::DescriptorType::STORAGE_IMAGE => (vk::ImageLayout::GENERAL, "a storage image"),
+            _ => (vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, "a sampled image"),
+        };
         let infos: Vec<_> = images
             .iter()
-            .map(|(_, view, sampler)| {
-                [vk::DescriptorImageInfo {
-                    sampler: *sampler,
-                    image_view: *view,
-                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                }]
-            })
+            .map(|&(_, image_view, sampler)| [vk::DescriptorImageInfo { sampler, image_view, image_layout: layout }])
             .collect();
         let mut writes = Vec::new();
         for ((binding, _, _), info) in images.iter().zip(&infos) {
-            let declared = self.bindings.iter().any(|(b, _)| {
-                b.set == set && b.binding == *binding && b.ty == vk::DescriptorType::COMBINED_IMAGE_SAMPLER
-            });
+            let declared = self.bindings.iter().any(|(b, _)| b.set == set && b.binding == *binding && b.ty == ty);
             if !declared {
-                return Err(Error::param(
+                return Err(Error::incompatible(
                     "descriptor binding",
-                    format!("set {set} binding {binding} is not a sampled image"),
+                    format!("set {set} binding {binding} is not {what}"),
                 ));
             }
             writes.push(
                 vk::WriteDescriptorSet::default()
                     .dst_set(target)
                     .dst_binding(*binding)
-                    .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                    .descriptor_type(ty)
                     .image_info(info),
             );
         }
@@ -232,10 +210,13 @@ impl Layout {
         for ((binding, _), info) in buffers.iter().zip(&infos) {
             let (b, _) =
                 self.bindings.iter().find(|(b, _)| b.set == set && b.binding == *binding).ok_or_else(|| {
-                    Error::param("descriptor binding", format!("set {set} binding {binding} is not declared"))
+                    Error::incompatible("descriptor binding", format!("set {set} binding {binding} is not declared"))
                 })?;
             if !matches!(b.ty, vk::DescriptorType::STORAGE_BUFFER | vk::DescriptorType::UNIFORM_BUFFER) {
-                return Err(Error::param("descriptor binding", format!("set {set} binding {binding} is not a buffer")));
+                return Err(Error::incompatible(
+                    "descriptor binding",
+                    format!("set {set} binding {binding} is not a buffer"),
+                ));
             }
             writes.push(
                 vk::WriteDescriptorSet::default()

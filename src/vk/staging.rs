@@ -128,7 +128,7 @@ impl Device {
             self.staging(&format!("{} upload staging", dst.name()), bytes.len() as u64, MemoryLocation::CpuToGpu)?;
         let mapped = staging
             .mapped_mut()
-            .ok_or_else(|| Error::param("staging memory", "host-visible memory could not be mapped"))?;
+            .ok_or_else(|| Error::device("staging memory", "host-visible memory could not be mapped"))?;
         mapped.copy_from_slice(bytes);
         let region = vk::BufferCopy { src_offset: 0, dst_offset: offset, size: bytes.len() as u64 };
         self.submit_once(&format!("upload {}", dst.name()), |cmd| {
@@ -161,7 +161,7 @@ impl Device {
         staging
             .mapped()
             .map(<[u8]>::to_vec)
-            .ok_or_else(|| Error::param("staging memory", "host-visible memory could not be mapped"))
+            .ok_or_else(|| Error::device("staging memory", "host-visible memory could not be mapped"))
     }
 
     /// Uploads a slice of plain-old-data values at element offset 0.
@@ -182,7 +182,7 @@ impl Device {
         let mut staging = self.staging("image upload staging", texels.len() as u64, MemoryLocation::CpuToGpu)?;
         staging
             .mapped_mut()
-            .ok_or_else(|| Error::param("staging memory", "host-visible memory could not be mapped"))?
+            .ok_or_else(|| Error::device("staging memory", "host-visible memory could not be mapped"))?
             .copy_from_slice(texels);
         let region = whole_image_region(image);
         self.submit_once("upload image", |cmd| {
@@ -273,7 +273,7 @@ impl Device {
         staging
             .mapped()
             .map(<[u8]>::to_vec)
-            .ok_or_else(|| Error::param("staging memory", "host-visible memory could not be mapped"))
+            .ok_or_else(|| Error::device("staging memory", "host-visible memory could not be mapped"))
     }
 }
 

@@ -491,3 +491,48 @@ fn profiler_rejects_bad_parameters() {
     assert!(matches!(GpuProfiler::new(gpu.ctx(), 2, 0), Err(crate::Error::InvalidParameter { .. })));
     assert!(matches!(GpuProfiler::new(gpu.ctx(), 17, 4), Err(crate::Error::InvalidParameter { .. })));
 }
+
+/// The workgroup sizes the shaders were compiled with are the constants of
+/// `src/limits.rs` that build.rs injects, and every injected constant is used by
+/// some shader (none is left stale on one side only).
+#[test]
+fn shaders_are_built_with_the_shared_constants() {
+    use crate::limits;
+    let expected = |name: &str| -> Option<u32> {
+        let sim = ["sim/predict.comp", "sim/solve.comp", "sim/integrate.comp"];
+        let item = ["render/shadow_volume.comp", "core/scale_add.comp", "core/shadow_probe.comp"];
+        if sim.contains(&name) {
+            Some(limits::SIM_WORKGROUP)
+        } else if item.contains(&name) {
+            Some(limits::ITEM_GROUP)
+        } else if name.starts_with("sim/volume/") {
+            Some(limits::VOL_GROUP)
+        } else {
+            None
+        }
+    };
+    let mut checked = 0;
+    for shader in shaders::ALL {
+        let Some(size) = expected(shader.name) else { continue };
+        let reflection = reflect(shader).expect("reflect");
+        assert_eq!(reflection.workgroup_size, Some([size, 1, 1]), "{}", shader.name);
+        checked += 1;
+    }
+    assert_eq!(checked, 26, "3 simulation, 3 per-item and 20 volume kernels");
+    let glsl = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
+    let mut sources = String::new();
+    let mut dirs = vec![glsl];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).expect("glsl folder") {
+            let path = entry.expect("entry").path();
+            if path.is_dir() {
+                dirs.push(path);
+            } else {
+                sources.push_str(&std::fs::read_to_string(&path).expect("shader source"));
+            }
+        }
+    }
+    for (name, _) in limits::SHADER_CONSTANTS {
+        assert!(sources.contains(name), "{name} is injected but no shader uses it");
+    }
+}

@@ -7,7 +7,7 @@
 // Lerp samples each component trilinearly on its own face grid.
 #include "volume.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
 layout(std430, set = 0, binding = 3) buffer Vel { vec4 vel[]; };

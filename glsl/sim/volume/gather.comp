@@ -13,7 +13,7 @@
 // the order the CPU reference does.
 #include "volume.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
 layout(std140, set = 0, binding = 1) uniform Colliders { Collider colliders[SIM_MAX_COLLIDERS]; };

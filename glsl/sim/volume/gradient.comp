@@ -5,7 +5,7 @@
 // non-finite numbers, so that no NaN reaches the particles.
 #include "volume.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
 layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };

@@ -6,7 +6,7 @@
 // holds a measured velocity, so its divergence is meaningful.
 #include "volume.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
 layout(std430, set = 0, binding = 16) buffer Labels { uint labels[]; };

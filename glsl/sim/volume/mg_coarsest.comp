@@ -4,7 +4,7 @@
 //   dims: the level (w its first cell).
 #include "volume.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(push_constant) uniform Push { VolumePush pc; };
 layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };
@@ -12,7 +12,7 @@ layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };
 layout(std430, set = 0, binding = 23) writeonly buffer X { float x[]; };
 layout(std430, set = 0, binding = 25) readonly buffer Rhs { float rhs[]; };
 
-shared float values[2][256];
+shared float values[2][VOL_GROUP];
 
 const float OMEGA = 2.0 / 3.0;
 

@@ -5,7 +5,7 @@
 //   dims: fine level;  coarse: coarse level (w their first cells).
 #include "volume.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(push_constant) uniform Push { VolumePush pc; };
 layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };

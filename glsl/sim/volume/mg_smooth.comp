@@ -5,7 +5,7 @@
 //   op.x = 0: from x = 0 into tmp;  1: tmp → x;  2: x → tmp.
 #include "volume.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(push_constant) uniform Push { VolumePush pc; };
 layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };

@@ -2,7 +2,7 @@
 // Pressure solve: d = z + β d.
 #include "volume.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
 layout(std430, set = 0, binding = 21) buffer D { float d[]; };

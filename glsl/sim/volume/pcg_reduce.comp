@@ -10,7 +10,7 @@
 // remaining recorded iterations is set to zero workgroups.
 #include "volume.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(push_constant) uniform Push { VolumePush pc; };
 layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
@@ -18,12 +18,12 @@ layout(std430, set = 0, binding = 26) buffer Scalars { PcgScalars scalars; };
 layout(std430, set = 0, binding = 27) readonly buffer Partials { vec2 partials[]; };
 layout(std430, set = 0, binding = 28) buffer Indirect { uvec4 indirect[]; };
 
-shared vec2 sums[256];
+shared vec2 sums[VOL_GROUP];
 
 void main() {
     uint t = gl_LocalInvocationID.x;
     vec2 own = vec2(0.0);
-    for (uint k = t; k < pc.op.z; k += 256u) {
+    for (uint k = t; k < pc.op.z; k += VOL_GROUP) {
         own.x += partials[k].x;
         own.y = max(own.y, partials[k].y);
     }

@@ -4,7 +4,7 @@
 #include "volume.glsl"
 #include "reduce.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
 layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };

@@ -7,7 +7,7 @@
 //   op.w: blocks.  coarse.x: digit bits.
 #include "volume.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(push_constant) uniform Push { VolumePush pc; };
 layout(std430, set = 0, binding = 4) readonly buffer KeysA { uint keys_a[]; };
@@ -22,7 +22,7 @@ void main() {
     uint digits = 1u << pc.coarse.x;
     histogram[t] = 0u;
     barrier();
-    uint i = block * 256u + t;
+    uint i = block * VOL_SORT_BLOCK + t;
     if (i < pc.op.z) {
         uint key = pc.op.x == 0u ? keys_a[i] : keys_b[i];
         atomicAdd(histogram[(key >> pc.op.y) & (digits - 1u)], 1u);

@@ -5,7 +5,7 @@
 // every run. Push constants as in radix_count.comp; A → B when op.x = 0.
 #include "volume.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(push_constant) uniform Push { VolumePush pc; };
 layout(std430, set = 0, binding = 4) buffer KeysA { uint keys_a[]; };
@@ -14,12 +14,12 @@ layout(std430, set = 0, binding = 6) buffer KeysB { uint keys_b[]; };
 layout(std430, set = 0, binding = 7) buffer ValsB { uint vals_b[]; };
 layout(std430, set = 0, binding = 8) readonly buffer Table { uint table[]; };
 
-shared uint block_digits[256];
+shared uint block_digits[VOL_SORT_BLOCK];
 
 void main() {
     uint t = gl_LocalInvocationID.x;
     uint block = gl_WorkGroupID.x;
-    uint i = block * 256u + t;
+    uint i = block * VOL_SORT_BLOCK + t;
     bool live = i < pc.op.z;
     uint key = 0u;
     uint value = 0u;

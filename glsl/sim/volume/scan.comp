@@ -6,20 +6,20 @@
 //   op.z: element count.
 #include "volume.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = VOL_GROUP) in;
 
 layout(push_constant) uniform Push { VolumePush pc; };
 layout(std430, set = 0, binding = 8) buffer Data { uint data[]; };
 layout(std430, set = 0, binding = 9) buffer TileSums { uint tile_sums[]; };
 
-shared uint scan_values[256];
+shared uint scan_values[VOL_GROUP];
 
 // Exclusive scan of one value per invocation across the workgroup; `total` gets the sum.
 uint workgroup_exclusive(uint value, out uint total) {
     uint t = gl_LocalInvocationID.x;
     scan_values[t] = value;
     barrier();
-    for (uint offset = 1u; offset < 256u; offset <<= 1u) {
+    for (uint offset = 1u; offset < VOL_GROUP; offset <<= 1u) {
         uint add = t >= offset ? scan_values[t - offset] : 0u;
         barrier();
         scan_values[t] += add;
@@ -68,7 +68,7 @@ void main() {
     if (pc.op.x == 0u) {
         uint own = 0u;
         for (uint e = 0u; e < 4u; ++e) {
-            uint i = tile * 1024u + t * 4u + e;
+            uint i = tile * VOL_SCAN_TILE + t * 4u + e;
             own += i < n ? data[i] : 0u;
         }
         uint total;
@@ -78,10 +78,10 @@ void main() {
         }
     } else if (pc.op.x == 1u) {
         uint carry = 0u;
-        for (uint base = 0u; base < pc.op.w; base += 1024u) {
+        for (uint base = 0u; base < pc.op.w; base += VOL_SCAN_TILE) {
             carry += scan_tile(base, pc.op.w, carry, true);
         }
     } else {
-        scan_tile(tile * 1024u, n, tile_sums[tile], false);
+        scan_tile(tile * VOL_SCAN_TILE, n, tile_sums[tile], false);
     }
 }

@@ -50,7 +50,10 @@ impl ShadowAtlas {
         let extent = params.atlas_extent();
         let limit = device.info.max_image_dimension_2d;
         if extent.width > limit || extent.height > limit {
-            return Err(Error::param("shadow resolution", format!("atlas {extent:?} exceeds the device's {limit}")));
+            return Err(Error::device(
+                "the shadow atlas",
+                format!("{extent:?} exceeds the device's image limit {limit}"),
+            ));
         }
         let image = |name: &str, format, usage, aspect| {
             Image::new(

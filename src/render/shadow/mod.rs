@@ -38,7 +38,7 @@ use volume::VolumeShadows;
 pub(crate) use opacity_maps::light_map;
 
 /// Most lights that cast shadows.
-pub const MAX_SHADOW_MAPS: usize = 4;
+pub const MAX_SHADOW_MAPS: usize = crate::limits::MAX_SHADOW_MAPS as usize;
 
 /// Format of the opacity atlas: three layer sums and z0.
 pub const SHADOW_ATLAS_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
@@ -123,43 +123,38 @@ impl ShadowParams {
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<()> {
         if self.casters.len() > MAX_SHADOW_MAPS {
-            return Err(Error::param(
-                "shadow casters",
-                format!("{} exceed the limit of {MAX_SHADOW_MAPS}", self.casters.len()),
-            ));
+            return Err(Error::param("shadow casters", self.casters.len(), format!("at most {MAX_SHADOW_MAPS}")));
         }
         for (k, c) in self.casters.iter().enumerate() {
             if c.light >= MAX_LIGHTS || self.casters[..k].iter().any(|o| o.light == c.light) {
                 return Err(Error::param(
                     "shadow casters",
-                    format!("light {} is out of range or listed twice", c.light),
+                    format!("light {}", c.light),
+                    format!("each light below {MAX_LIGHTS} listed once"),
                 ));
             }
         }
         if !(16..=4096).contains(&self.resolution) {
-            return Err(Error::param("shadow resolution", format!("{} is outside 16..=4096", self.resolution)));
+            return Err(Error::param("shadow resolution", self.resolution, "16..=4096"));
         }
         let [a, b, c] = self.layers;
         if !(a.is_finite() && c.is_finite() && 0.0 < a && a < b && b < c) {
-            return Err(Error::param("shadow layers", format!("{:?} must be finite, > 0 and increasing", self.layers)));
+            return Err(Error::param("shadow layers", format!("{:?}", self.layers), "finite, > 0 and increasing"));
         }
         if !(self.opacity.is_finite() && (0.0..=1.0).contains(&self.opacity)) {
-            return Err(Error::param("shadow opacity", format!("{} is outside 0..=1", self.opacity)));
+            return Err(Error::param("shadow opacity", self.opacity, "0..=1"));
         }
         if !(self.extinction.is_finite() && (0.0..=100.0).contains(&self.extinction)) {
-            return Err(Error::param("shadow extinction", format!("{} is outside 0..=100", self.extinction)));
+            return Err(Error::param("shadow extinction", self.extinction, "0..=100"));
         }
         if self.pcf_radius > 3 {
-            return Err(Error::param("shadow pcf_radius", format!("{} is above 3", self.pcf_radius)));
+            return Err(Error::param("shadow pcf_radius", self.pcf_radius, "at most 3"));
         }
         if !(self.volume_cross_section.is_finite() && self.volume_cross_section >= 0.0) {
-            return Err(Error::param(
-                "shadow volume_cross_section",
-                format!("{} must be finite and ≥ 0", self.volume_cross_section),
-            ));
+            return Err(Error::param("shadow volume_cross_section", self.volume_cross_section, "finite and ≥ 0"));
         }
         if !(self.volume_step.is_finite() && (0.1..=2.0).contains(&self.volume_step)) {
-            return Err(Error::param("shadow volume_step", format!("{} is outside 0.1..=2", self.volume_step)));
+            return Err(Error::param("shadow volume_step", self.volume_step, "0.1..=2"));
         }
         Ok(())
     }
@@ -270,7 +265,7 @@ impl Shadows {
         let volume_lights = params.volume_casters();
         let cells = if volume_lights > 0 {
             let grid = sim.volume_grid().ok_or_else(|| {
-                Error::param(
+                Error::incompatible(
                     "shadow casters",
                     "density-volume shadows need the simulation's volume stage (SimParams::volume)",
                 )
@@ -320,7 +315,7 @@ impl Shadows {
         let cells = self.volume.cells;
         for (k, caster) in params.casters.iter().enumerate() {
             let gpu = lights.get(caster.light).ok_or_else(|| {
-                Error::param(
+                Error::incompatible(
                     "shadow casters",
                     format!("light {} does not exist ({} lights)", caster.light, lights.len()),
                 )
@@ -342,10 +337,10 @@ impl Shadows {
         let mut copy = None;
         if !volume_maps.is_empty() {
             let (grid, buffer) = sim.volume.map(|(g, b)| (g, b.raw())).ok_or_else(|| {
-                Error::param("shadow casters", "density-volume shadows need the simulation's volume stage")
+                Error::incompatible("shadow casters", "density-volume shadows need the simulation's volume stage")
             })?;
             if grid.dims.iter().product::<u32>() != cells {
-                return Err(Error::param(
+                return Err(Error::incompatible(
                     "shadow casters",
                     "the simulation's volume grid changed; call set_shadows again",
                 ));
@@ -359,7 +354,7 @@ impl Shadows {
         let d = &self.device;
         let before_update = barrier::memory(SHADOW_READERS, &[AccessKind::TransferWrite]);
         let updated = barrier::memory(&[AccessKind::TransferWrite], SHADOW_READERS);
-        let any_map = uniforms.maps.iter().take(params.casters.len()).any(|m| m.params[2] == 0.0);
+        let any_map = uniforms.maps.iter().take(params.casters.len()).any(|m| !m.is_density_volume());
         // SAFETY: guaranteed by the caller.
         unsafe {
             d.cmd_barrier(cmd, &[before_update], &[], &[]);

@@ -22,11 +22,9 @@ use crate::vk::shaders::RENDER_SHADOW_VOLUME_COMP;
 /// position, and where its transmittance starts in the per-cell array (`slot` ·
 /// `cells`).
 pub(super) fn volume_map(light: &GpuLight, slot: usize, cells: u32) -> GpuShadowMap {
-    let directional = light.position_kind[3] == 0.0;
-    let view_z = if directional {
-        [light.direction_cone[0], light.direction_cone[1], light.direction_cone[2], 0.0]
-    } else {
-        [light.position_kind[0], light.position_kind[1], light.position_kind[2], 1.0]
+    let view_z = match light.kind() {
+        0 => light.direction().extend(0.0).to_array(),
+        _ => light.position().extend(1.0).to_array(),
     };
     GpuShadowMap {
         view_z,

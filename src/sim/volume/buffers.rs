@@ -47,11 +47,11 @@ pub(crate) mod binding {
 }
 
 /// Keys per sort block (one workgroup of `radix_count`/`radix_scatter`).
-pub(crate) const SORT_BLOCK: u32 = 256;
+pub(crate) const SORT_BLOCK: u32 = crate::limits::VOL_SORT_BLOCK;
 /// Elements per tile of `scan.comp`.
-pub(crate) const SCAN_TILE: u32 = 1024;
+pub(crate) const SCAN_TILE: u32 = crate::limits::VOL_SCAN_TILE;
 /// Invocations of the per-cell kernels.
-pub(crate) const GROUP: u32 = 256;
+pub(crate) const GROUP: u32 = crate::limits::VOL_GROUP;
 /// Bytes per indirect dispatch entry (a `VkDispatchIndirectCommand` padded to 16).
 pub(crate) const INDIRECT_STRIDE: u64 = 16;
 
@@ -97,8 +97,8 @@ impl VolumeBuffers {
         for (what, bytes) in [("particles", n * 16), ("cells", levels * 4), ("faces", faces * 4), ("cells", cells * 16)]
         {
             if bytes > limit {
-                return Err(Error::param(
-                    "volume grid",
+                return Err(Error::device(
+                    "the volume grid",
                     format!("{what} need {bytes} bytes per buffer, above the device's {limit} byte range"),
                 ));
             }

@@ -16,7 +16,7 @@ use crate::gpu_types::GpuVolumeParams;
 use crate::sim::SimState;
 
 /// Most cells of the coarsest multigrid level (solved by one workgroup).
-pub(crate) const COARSEST_CELLS: u32 = 256;
+pub(crate) const COARSEST_CELLS: u32 = crate::limits::VOL_GROUP;
 
 /// One level of the multigrid hierarchy (level 0 is the pressure grid).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -62,7 +62,7 @@ impl GridLayout {
     pub(crate) fn new(params: &VolumeParams, rest: &SimState) -> Result<Self> {
         params.validate()?;
         if rest.strands == 0 || rest.points < 2 {
-            return Err(Error::param("key hairs", "the volume stage needs at least one strand of two points"));
+            return Err(Error::incompatible("key hairs", "the volume stage needs at least one strand of two points"));
         }
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
@@ -75,7 +75,7 @@ impl GridLayout {
             reach = reach.max(rest.rest_strand_length(s) + pearls);
         }
         if !(lo.is_finite() && hi.is_finite() && reach.is_finite()) {
-            return Err(Error::param("key hairs", "rest shape is not finite"));
+            return Err(Error::incompatible("key hairs", "the rest shape is not finite"));
         }
         let extent = (hi - lo) + Vec3::splat(2.0 * reach);
         let dims = params.resolution;
@@ -84,7 +84,7 @@ impl GridLayout {
             cell_size = cell_size.max(extent[axis] / (n - 2) as f32);
         }
         if !(cell_size.is_finite() && cell_size > 0.0) {
-            return Err(Error::param("key hairs", "the hair spans no volume"));
+            return Err(Error::incompatible("key hairs", "the hair spans no volume"));
         }
         let centre = (lo + hi) * 0.5;
         let size = Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32) * cell_size;

@@ -90,39 +90,37 @@ impl VolumeParams {
     pub fn validate(&self) -> Result<()> {
         for (axis, &n) in ["x", "y", "z"].iter().zip(&self.resolution) {
             if !(4..=256).contains(&n) {
-                return Err(Error::param("volume resolution", format!("{n} cells along {axis} is outside 4..=256")));
+                return Err(Error::param("volume resolution", format!("{n} cells along {axis}"), "4..=256 per axis"));
             }
         }
         let cells: u64 = self.resolution.iter().map(|&n| u64::from(n)).product();
         if cells > MAX_VOLUME_CELLS {
             return Err(Error::param(
                 "volume resolution",
-                format!("{cells} cells exceed the limit of {MAX_VOLUME_CELLS}"),
+                format!("{cells} cells"),
+                format!("at most {MAX_VOLUME_CELLS}"),
             ));
         }
         let unit = |name: &'static str, v: f32| {
             if v.is_finite() && (0.0..=1.0).contains(&v) {
                 Ok(())
             } else {
-                Err(Error::param(name, format!("{v} is outside 0..=1")))
+                Err(Error::param(name, v, "0..=1"))
             }
         };
         unit("volume flip_ratio", self.flip_ratio)?;
         unit("volume friction", self.friction)?;
         if !(self.tolerance.is_finite() && self.tolerance > 0.0 && self.tolerance < 1.0) {
-            return Err(Error::param("volume tolerance", format!("{} is outside (0, 1)", self.tolerance)));
+            return Err(Error::param("volume tolerance", self.tolerance, "(0, 1)"));
         }
         if !(1..=1000).contains(&self.max_iterations) {
-            return Err(Error::param("volume max_iterations", format!("{} is outside 1..=1000", self.max_iterations)));
+            return Err(Error::param("volume max_iterations", self.max_iterations, "1..=1000"));
         }
         if !(self.repulsion.is_finite() && self.repulsion >= 0.0 && self.repulsion <= 1e6) {
-            return Err(Error::param("volume repulsion", format!("{} is outside 0..=1e6 m/s²", self.repulsion)));
+            return Err(Error::param("volume repulsion", self.repulsion, "0..=1e6 m/s²"));
         }
         if !(self.repulsion_threshold.is_finite() && self.repulsion_threshold > 0.0) {
-            return Err(Error::param(
-                "volume repulsion_threshold",
-                format!("{} must be finite and > 0", self.repulsion_threshold),
-            ));
+            return Err(Error::param("volume repulsion_threshold", self.repulsion_threshold, "finite and > 0"));
         }
         Ok(())
     }

@@ -108,14 +108,14 @@ fn inside(colliders: &[GpuCollider], p: Vec3) -> bool {
     colliders.iter().any(|c| {
         let a = Vec3::from_slice(&c.a_radius[..3]);
         let mut closest = a;
-        if c.b_kind[3] > 0.5 {
+        if c.is_capsule() {
             let ab = Vec3::from_slice(&c.b_kind[..3]) - a;
             let len2 = ab.dot(ab);
             let t = if len2 > 0.0 { ((p - a).dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
             closest = a + ab * t;
         }
         let d = p - closest;
-        d.dot(d) < c.a_radius[3] * c.a_radius[3]
+        d.dot(d) < c.radius() * c.radius()
     })
 }
 
@@ -131,7 +131,7 @@ pub(crate) fn step(
     let n = positions.len();
     let dims = Dims(grid.dims);
     let cells = dims.count();
-    let colliders = &colliders[..(p.config[3] as usize).min(colliders.len())];
+    let colliders = &colliders[..(p.colliders() as usize).min(colliders.len())];
     // 1. Bin.
     let grid_pos: Vec<Vec4> = positions.iter().map(|x| affine(&p.grid_from_world, x.xyz()).extend(x.w)).collect();
     let grid_vel: Vec<Vec3> = velocities.iter().map(|v| linear(&p.axes, v.xyz())).collect();
@@ -246,10 +246,10 @@ pub(crate) fn step(
         iterations: 0,
     };
     // 6. Pressure.
-    let mode = p.solve[3];
+    let mode = p.mode();
     if mode == 1.0 {
         snapshot.rhs = rhs(grid, &snapshot.labels, &snapshot.face_vel);
-        let (pressure, iterations) = mic_pcg(grid, &snapshot.labels, &snapshot.rhs, p.solve[0].into(), 1000);
+        let (pressure, iterations) = mic_pcg(grid, &snapshot.labels, &snapshot.rhs, p.tolerance().into(), 1000);
         snapshot.pressure = pressure.iter().map(|&v| v as f32).collect();
         snapshot.iterations = iterations;
         subtract_gradient(grid, &snapshot.labels, &snapshot.pressure, &mut snapshot.face_vel);
@@ -504,8 +504,8 @@ fn sample_cells(grid: &GridLayout, cells: &[Vec4], g: Vec3) -> Vec4 {
 
 /// The updated velocity (grid axes) of a particle at grid position `g` with velocity `v`.
 fn grid_to_particle(grid: &GridLayout, p: &GpuVolumeParams, s: &VolumeSnapshot, g: Vec3, v: Vec3) -> Vec3 {
-    if p.solve[3] == 1.0 {
-        let alpha = p.transfer[0];
+    if p.mode() == 1.0 {
+        let alpha = p.flip_ratio();
         let [u, vv, w] = [0, 1, 2].map(|a| sample_faces(grid, &s.face_vel, &s.face_star, g, a));
         let pic = Vec3::new(u.0, vv.0, w.0);
         let flip = v + Vec3::new(u.1, vv.1, w.1);
@@ -513,13 +513,13 @@ fn grid_to_particle(grid: &GridLayout, p: &GpuVolumeParams, s: &VolumeSnapshot, 
     }
     let cell = sample_cells(grid, &s.cells, g);
     let mut v = v;
-    let friction = p.transfer[1];
+    let friction = p.friction();
     if cell.w > 0.0 {
         let mean = cell.xyz() / cell.w;
         v = v * (1.0 - friction) + mean * friction;
     }
-    let threshold = p.transfer[3];
-    if p.transfer[2] > 0.0 && cell.w > threshold {
+    let threshold = p.repulsion_threshold();
+    if p.repulsion() > 0.0 && cell.w > threshold {
         let dims = Dims(grid.dims);
         let c = [0, 1, 2].map(|a| (g[a] as i64).min(i64::from(grid.dims[a]) - 1));
         let mut gradient = Vec3::ZERO;
@@ -533,7 +533,7 @@ fn grid_to_particle(grid: &GridLayout, p: &GpuVolumeParams, s: &VolumeSnapshot, 
         let len = gradient.length();
         if len > 0.0 {
             let excess = ((cell.w - threshold) / threshold.max(1e-6)).min(1.0);
-            v -= gradient * (p.transfer[2] * p.solve[2] * excess / len);
+            v -= gradient * (p.repulsion() * p.dt() * excess / len);
         }
     }
     v

@@ -1,0 +1,41 @@
+// Constants shared by the Rust side and the shaders, defined here once.
+//
+// build.rs includes this file (`include!`) and injects every entry of
+// `SHADER_CONSTANTS` into every shader as a macro of the same name, an
+// unsigned literal (`-DSIM_MAX_COLLIDERS=64u`); the build fails when a shader
+// declares one of these names itself. The crate uses the same constants, so
+// the two sides cannot drift. Plain items only: no `crate::` paths, no inner
+// doc comments (the file is compiled in two places).
+
+/// Most colliders (spheres and capsules) a simulation takes.
+pub const SIM_MAX_COLLIDERS: u32 = 64;
+/// Invocations of a simulation workgroup (predict, solve, integrate); the
+/// constraint solver holds one strand point per invocation, so this is also the
+/// most points a simulated strand can have.
+pub const SIM_WORKGROUP: u32 = 64;
+/// Most lights the draw pass shades with.
+pub const MAX_LIGHTS: u32 = 8;
+/// Most shadow-casting lights.
+pub const MAX_SHADOW_MAPS: u32 = 4;
+/// Invocations of a volume-stage workgroup.
+pub const VOL_GROUP: u32 = 256;
+/// Keys one radix-sort block ranks, one per invocation.
+pub const VOL_SORT_BLOCK: u32 = 256;
+/// Elements of one prefix-sum tile, four per invocation.
+pub const VOL_SCAN_TILE: u32 = 1024;
+/// Invocations of the per-item compute kernels of the renderer and the tests.
+#[cfg_attr(not(test), allow(dead_code))] // the pipelines read it back from the SPIR-V
+pub const ITEM_GROUP: u32 = 64;
+
+/// Every constant above with the name the shaders see it by.
+#[cfg_attr(not(test), allow(dead_code))] // used by build.rs and the tests
+pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
+    ("SIM_MAX_COLLIDERS", SIM_MAX_COLLIDERS),
+    ("SIM_WORKGROUP", SIM_WORKGROUP),
+    ("MAX_LIGHTS", MAX_LIGHTS),
+    ("MAX_SHADOW_MAPS", MAX_SHADOW_MAPS),
+    ("VOL_GROUP", VOL_GROUP),
+    ("VOL_SORT_BLOCK", VOL_SORT_BLOCK),
+    ("VOL_SCAN_TILE", VOL_SCAN_TILE),
+    ("ITEM_GROUP", ITEM_GROUP),
+];
