@@ -96,6 +96,21 @@ pub struct HostDevice {
 ///
 /// Every vkhair GPU object keeps the context's device record alive, so dropping the
 /// `GpuContext` while objects still exist is safe: the device goes with the last one.
+///
+/// A headless context with validation on (a host wraps its own device with
+/// [`GpuContext::from_host`]; `examples/embed_minimal.rs`, run as a test, does it):
+///
+/// ```
+/// use vkhair::{ContextOptions, GpuContext, ValidationLog};
+///
+/// let log = ValidationLog::new();
+/// let ctx = GpuContext::headless(&ContextOptions::validated(&log))?;
+/// println!("{} ({})", ctx.info().name, ctx.info().driver);
+/// assert!(ctx.is_owned());
+/// drop(ctx);
+/// log.assert_clean();
+/// # Ok::<(), vkhair::Error>(())
+/// ```
 #[derive(Clone)]
 pub struct GpuContext {
     pub(crate) device: Arc<Device>,

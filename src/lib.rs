@@ -28,6 +28,52 @@
 //! destroyed by vkhair), and records vkhair's passes into its own command buffers.
 //! A headless context ([`GpuContext::headless`]) owns its instance and device and
 //! is what tools and tests use; on machines without a GPU it runs on lavapipe.
+//! [`headless`] stands in for the rest of a host (submission, an offscreen
+//! target); `examples/embed_minimal.rs` shows a host that owns everything.
+//!
+//! ## A frame, headless
+//!
+//! Key hairs grown on the thesis scalp are simulated for one step and drawn
+//! into an offscreen target; validation is on and must stay silent.
+//!
+//! ```
+//! use glam::Vec3;
+//! use vkhair::headless::{Offscreen, Submit};
+//! use vkhair::render::{Camera, Light, RenderParams, Renderer};
+//! use vkhair::sim::{HairSim, RigidTransform, SimParams};
+//! use vkhair::{groom, ContextOptions, GpuContext, ValidationLog};
+//!
+//! let log = ValidationLog::new();
+//! {
+//!     let ctx = GpuContext::headless(&ContextOptions::validated(&log))?;
+//!     let params = groom::grow::GrowParams { strands: 64, points_per_strand: 6, ..Default::default() };
+//!     let groom = groom::grow::grow(&groom::scenes::thesis_scalp(), &params)?;
+//!     let head = RigidTransform::default();
+//!     let mut sim = HairSim::new(&ctx, &groom, &SimParams::default(), &head)?;
+//!     let mut renderer = Renderer::new(&ctx, &sim, &RenderParams::default())?;
+//!     renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Y, color: Vec3::ONE }])?;
+//!     let target = Offscreen::new(&ctx, 64, 64)?;
+//!     let eye = Vec3::new(0.0, 1.6, 0.6);
+//!     let camera = Camera::look_at(eye, Vec3::new(0.0, 1.6, 0.0), 0.8, 1.0, 0.01, 10.0)?;
+//!     let mut result = Ok(());
+//!     ctx.run_commands("frame", |cmd| {
+//!         // SAFETY: a recording command buffer of `ctx`'s device; everything
+//!         // recorded belongs to it, and the frame is waited for before reuse.
+//!         result = unsafe {
+//!             target.record_clear(cmd, Vec3::ZERO);
+//!             sim.record_step(cmd, &head, None)
+//!                 .and_then(|_| renderer.record_prepare(cmd, &sim, Some(&camera), None))
+//!                 .and_then(|_| renderer.record_shadows(cmd, &sim, None))
+//!                 .and_then(|_| renderer.record_draw(cmd, 0, &target.target(), &camera, None))
+//!         };
+//!     })?;
+//!     result?;
+//!     let pixels = target.read_rgba8()?;
+//!     assert!(pixels.chunks(4).any(|p| p[0] > 0), "hair was drawn");
+//! }
+//! log.assert_clean(); // after everything was dropped: no message, no leak
+//! # Ok::<(), vkhair::Error>(())
+//! ```
 
 #![deny(unsafe_op_in_unsafe_fn)]
 #![warn(missing_docs)]

@@ -106,6 +106,14 @@ pub struct Requirements {
 
 /// What vkhair needs from a device. Enable these when creating the device that
 /// is passed to [`crate::GpuContext::from_host`].
+///
+/// ```
+/// let req = vkhair::requirements();
+/// assert!(req.api_version >= ash::vk::API_VERSION_1_2);
+/// for name in &req.device_extensions {
+///     println!("enable {}", name.to_string_lossy());
+/// }
+/// ```
 pub fn requirements() -> Requirements {
     let mut features = RequiredFeatures::default();
     features.require_all();

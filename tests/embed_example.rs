@@ -1,8 +1,8 @@
-//! Runs `examples/embed_minimal.rs` — a host with its own instance, device,
+//! Runs `examples/embed_minimal/` — a host with its own instance, device,
 //! allocator, images, pipeline and head mesh embedding vkhair through
 //! `GpuContext::from_host` — under validation, and checks what it drew.
 
-#[path = "../examples/embed_minimal.rs"]
+#[path = "../examples/embed_minimal/main.rs"]
 mod embed;
 
 #[test]

@@ -44,6 +44,21 @@ pub const MAX_POINTS_PER_STRAND: usize = 1 << 16;
 pub const MIN_SEGMENT_FRACTION: f32 = 1e-6;
 
 /// A set of hair strands (see the module docs for the invariants).
+///
+/// ```
+/// use glam::Vec3;
+/// use vkhair::groom::grow::{grow, GrowParams};
+/// use vkhair::groom::scenes::thesis_scalp;
+/// use vkhair::{Error, Groom};
+///
+/// let groom = Groom::from_strands(&[vec![Vec3::ZERO, Vec3::X, 2.0 * Vec3::X]])?;
+/// assert_eq!((groom.strand_count(), groom.point_count()), (1, 3));
+/// let grown = grow(&thesis_scalp(), &GrowParams { strands: 100, points_per_strand: 8, ..Default::default() })?;
+/// assert_eq!(grown.strand_count(), 100);
+/// // Broken input is a typed error, never a panic.
+/// assert!(matches!(Groom::from_strands(&[vec![Vec3::ZERO, Vec3::NAN]]), Err(Error::NonFinite { .. })));
+/// # Ok::<(), vkhair::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Groom {
     positions: Vec<Vec3>,

@@ -11,17 +11,23 @@
 //! - [`MeshDrawer`]: the head mesh drawn the way a host draws its geometry,
 //!   optionally shadowed by the hair.
 //!
-//! ```no_run
+//! ```
 //! use vkhair::headless::{Offscreen, Submit};
-//! use vkhair::{ContextOptions, GpuContext};
+//! use vkhair::{ContextOptions, GpuContext, ValidationLog};
 //!
-//! let ctx = GpuContext::headless(&ContextOptions::default())?;
-//! let target = Offscreen::new(&ctx, 64, 64)?;
-//! ctx.run_commands("clear", |cmd| {
-//!     // SAFETY: a recording command buffer of the context's device.
-//!     unsafe { target.record_clear(cmd, glam::Vec3::new(0.1, 0.2, 0.3)) }
-//! })?;
-//! assert_eq!(target.read_rgba8()?.len(), 64 * 64 * 4);
+//! let log = ValidationLog::new();
+//! {
+//!     let ctx = GpuContext::headless(&ContextOptions::validated(&log))?;
+//!     let target = Offscreen::new(&ctx, 64, 64)?;
+//!     ctx.run_commands("clear", |cmd| {
+//!         // SAFETY: a recording command buffer of the context's device.
+//!         unsafe { target.record_clear(cmd, glam::Vec3::new(0.0, 1.0, 0.0)) }
+//!     })?;
+//!     let pixels = target.read_rgba8()?;
+//!     assert_eq!(pixels.len(), 64 * 64 * 4);
+//!     assert_eq!(&pixels[..4], &[0, 255, 0, 255]);
+//! }
+//! log.assert_clean();
 //! # Ok::<(), vkhair::Error>(())
 //! ```
 

@@ -48,6 +48,43 @@ struct Slot {
 }
 
 /// Timestamp-query profiler for passes recorded into the host's command buffers.
+///
+/// vkhair's passes and stages open their scopes in the profiler they are given;
+/// a host opens its own with [`GpuProfiler::begin_scope`]. Reports come back
+/// `frames_in_flight` frames later, or from [`GpuProfiler::drain`]:
+///
+/// ```
+/// use glam::Vec3;
+/// use vkhair::headless::Submit;
+/// use vkhair::sim::{HairSim, RigidTransform, SimParams, SimStage};
+/// use vkhair::{ContextOptions, GpuContext, GpuProfiler, Groom, ValidationLog};
+///
+/// let log = ValidationLog::new();
+/// {
+///     let ctx = GpuContext::headless(&ContextOptions::validated(&log))?;
+///     let strand: Vec<Vec3> = (0..6).map(|i| Vec3::new(0.02 * i as f32, 0.0, 0.0)).collect();
+///     let head = RigidTransform::default();
+///     let mut sim = HairSim::new(&ctx, &Groom::from_strands(&[strand])?, &SimParams::default(), &head)?;
+///     let mut profiler = GpuProfiler::new(&ctx, 2, 64)?;
+///     let mut result = Ok(());
+///     ctx.run_commands("frame 0", |cmd| {
+///         // SAFETY: a recording command buffer of the context's device.
+///         result = unsafe {
+///             let _ = profiler.begin_frame(cmd, 0);
+///             let frame = profiler.begin_scope(cmd, "host: frame");
+///             let stepped = sim.record_step(cmd, &head, Some(&mut profiler));
+///             profiler.end_scope(cmd, frame);
+///             stepped
+///         };
+///     })?;
+///     result?;
+///     let report = profiler.drain().pop().expect("frame 0 has completed");
+///     assert!(report.pass(SimStage::Solve.label()).is_some());
+///     println!("{report}");
+/// }
+/// log.assert_clean();
+/// # Ok::<(), vkhair::Error>(())
+/// ```
 pub struct GpuProfiler {
     device: Arc<Device>,
     pool: vk::QueryPool,

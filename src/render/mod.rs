@@ -1,24 +1,24 @@
 //! Rendering a full head of hair from the simulated key hairs.
 //!
 //! [`Renderer`] is the orchestrator: it owns one value of each pass type (see
-//! [`pass`] for the convention they follow) and records them in frame order.
+//! `render/pass.rs` for the convention they follow) and records them in frame order.
 //! [`RenderPass`] names their debug labels and timestamp scopes.
 //!
-//! 1. **Smooth** ([`smooth`]): key hairs straight from the simulation's GPU
+//! 1. **Smooth** (`smooth.rs`): key hairs straight from the simulation's GPU
 //!    buffers, as patches of 4 control points, tessellated as isolines into
 //!    uniform cubic B-splines; positions and tangents stored for the next passes.
-//! 2. **Interpolate** ([`interpolate`]): a draw with no vertex buffer grows
+//! 2. **Interpolate** (`interpolate.rs`): a draw with no vertex buffer grows
 //!    `hairs_per_key` hairs around every smoothed key hair (or inside every
 //!    triangle of key-hair roots), each offset in the key hair's frame by a
 //!    stable random clump coordinate.
-//! 3. **Shadows** ([`shadow`], optional): deep opacity maps of the
+//! 3. **Shadows** (`shadow/`, optional): deep opacity maps of the
 //!    shadow-casting lights from the interpolated hairs, or the transmittance
 //!    through the simulation's density volume.
-//! 4. **Draw** ([`draw`]): the hairs as camera-facing ribbons (or lines),
+//! 4. **Draw** (`draw.rs`): the hairs as camera-facing ribbons (or lines),
 //!    Kajiya-Kay diffuse plus two shifted specular highlights, or Marschner
 //!    ([`HairMaterial`]), for every [`Light`], into the host's color and depth
 //!    images ([`RenderTarget`]), attenuated by the shadows.
-//! 5. **Resolve** ([`resolve`], with [`RenderParams::supersampling`]): the draw
+//! 5. **Resolve** (`resolve.rs`, with [`RenderParams::supersampling`]): the draw
 //!    goes to images twice the target's size, then a 5-tap filter blends it into
 //!    the host's target.
 //!
@@ -30,12 +30,14 @@ mod interpolate;
 pub mod marschner;
 mod params;
 pub(crate) mod pass;
+mod readback;
 pub mod reference;
 mod resolve;
 pub mod scalp;
 mod shading;
 mod shadow;
 mod smooth;
+mod target;
 
 pub use marschner::MarschnerParams;
 pub use params::{
@@ -50,7 +52,6 @@ pub use shadow::{
 use std::sync::Arc;
 
 use ash::vk;
-use glam::{Quat, Vec3, Vec4};
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
@@ -66,25 +67,54 @@ use interpolate::InterpolatePass;
 use resolve::{ResolvePass, SUPERSAMPLED_COLOR, SUPERSAMPLED_DEPTH};
 use shadow::{Bounds, Shadows};
 use smooth::SmoothPass;
-
-/// The host's images the hair is drawn into.
-#[derive(Debug, Clone, Copy)]
-pub struct RenderTarget {
-    /// Color attachment view, in `COLOR_ATTACHMENT_OPTIMAL`.
-    pub color: vk::ImageView,
-    /// Its format.
-    pub color_format: vk::Format,
-    /// Depth attachment view (in `DEPTH_ATTACHMENT_OPTIMAL`), or null for none.
-    pub depth: vk::ImageView,
-    /// Its format (`UNDEFINED` for none).
-    pub depth_format: vk::Format,
-    /// Extent of both.
-    pub extent: vk::Extent2D,
-    /// Sample count of both.
-    pub samples: vk::SampleCountFlags,
-}
+use target::Placement;
+pub use target::RenderTarget;
 
 /// Renders hair from a [`crate::sim::HairSim`]'s key hairs into the host's images.
+///
+/// The crate-level example records a whole frame; this one adds a
+/// shadow-casting light, supersampling and per-pass timings:
+///
+/// ```
+/// use glam::Vec3;
+/// use vkhair::headless::{Offscreen, Submit};
+/// use vkhair::render::{Camera, Light, RenderParams, RenderPass, Renderer, ShadowParams};
+/// use vkhair::sim::{HairSim, RigidTransform, SimParams};
+/// use vkhair::{groom, ContextOptions, GpuContext, GpuProfiler, ValidationLog};
+///
+/// let log = ValidationLog::new();
+/// {
+///     let ctx = GpuContext::headless(&ContextOptions::validated(&log))?;
+///     let params = groom::grow::GrowParams { strands: 32, points_per_strand: 6, ..Default::default() };
+///     let groom = groom::grow::grow(&groom::scenes::thesis_scalp(), &params)?;
+///     let sim = HairSim::new(&ctx, &groom, &SimParams::default(), &RigidTransform::default())?;
+///     let mut renderer = Renderer::new(&ctx, &sim, &RenderParams { supersampling: true, ..Default::default() })?;
+///     renderer.set_lights(&[Light::Directional { direction: Vec3::NEG_Y, color: Vec3::ONE }])?;
+///     renderer.set_shadows(&sim, &ShadowParams { casters: vec![0.into()], resolution: 64, ..Default::default() })?;
+///     let target = Offscreen::new(&ctx, 32, 32)?;
+///     let camera = Camera::look_at(Vec3::new(0.0, 1.6, 0.6), Vec3::new(0.0, 1.6, 0.0), 0.8, 1.0, 0.01, 10.0)?;
+///     let mut profiler = GpuProfiler::new(&ctx, 1, 16)?;
+///     let mut result = Ok(());
+///     ctx.run_commands("frame", |cmd| {
+///         // SAFETY: a recording command buffer of the context's device.
+///         result = unsafe {
+///             let _ = profiler.begin_frame(cmd, 0);
+///             target.record_clear(cmd, Vec3::ZERO);
+///             renderer
+///                 .record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler))
+///                 .and_then(|_| renderer.record_shadows(cmd, &sim, Some(&mut profiler)))
+///                 .and_then(|_| renderer.record_draw(cmd, 0, &target.target(), &camera, Some(&mut profiler)))
+///         };
+///     })?;
+///     result?;
+///     let report = profiler.drain().pop().expect("the frame completed");
+///     for pass in [RenderPass::Smooth, RenderPass::ShadowOpacity, RenderPass::Draw, RenderPass::Resolve] {
+///         assert!(report.pass(pass.label()).is_some(), "{pass:?} was timed");
+///     }
+/// }
+/// log.assert_clean();
+/// # Ok::<(), vkhair::Error>(())
+/// ```
 pub struct Renderer {
     device: Arc<Device>,
     params: RenderParams,
@@ -108,32 +138,6 @@ pub struct Renderer {
     source: [vk::Buffer; 2],
     /// The last frame index `record_draw` was given.
     last_frame: Option<u64>,
-}
-
-/// Where the hair is, for the level of detail and the shadow maps' fit.
-#[derive(Debug, Clone, Copy)]
-struct Placement {
-    /// Centre of the rest shape's bounds, head frame.
-    rest_center: Vec3,
-    /// Radius around `rest_center` that the hair can reach (roots plus strand length).
-    bound_radius: f32,
-    /// Head rotation of the latest prepared frame.
-    head_rotation: Quat,
-    /// `rest_center` in the world at the latest prepared frame.
-    head_center: Vec3,
-}
-
-impl Placement {
-    fn of(rest: &crate::sim::SimState, head_rotation: Quat) -> Placement {
-        let (lo, hi) = rest.rest.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| {
-            (lo.min(p.truncate()), hi.max(p.truncate()))
-        });
-        let rest_center = 0.5 * (lo + hi);
-        let bound_radius = (0..rest.strands)
-            .map(|s| (rest.rest[s * rest.points].truncate() - rest_center).length() + rest.rest_strand_length(s))
-            .fold(0.0f32, f32::max);
-        Placement { rest_center, bound_radius, head_rotation, head_center: rest_center }
-    }
 }
 
 /// Rejects key hairs that live on another device than the renderer's.
@@ -578,32 +582,3 @@ impl Renderer {
 /// Writes a host may have made to its attachments before the draw.
 const HOST_ATTACHMENT_WRITES: &[AccessKind] =
     &[AccessKind::ColorAttachmentWrite, AccessKind::DepthAttachmentWrite, AccessKind::AnyTransferWrite];
-
-/// Read-backs for tests and tools (each submits and waits).
-impl Renderer {
-    /// Reads the smoothed positions and unit tangents back, strand after strand
-    /// ([`Renderer::smoothed_vertices_per_strand`] each; this submits and waits).
-    pub fn read_smoothed(&self) -> Result<(Vec<Vec4>, Vec<Vec4>)> {
-        self.smooth.read(self.strands as usize * self.smoothed_vertices_per_strand() as usize)
-    }
-
-    /// Reads the interpolated hairs back: positions and (tangent, t along the hair),
-    /// hair after hair ([`Renderer::hair_counts`]; this submits and waits).
-    pub fn read_hairs(&self) -> Result<(Vec<Vec4>, Vec<Vec4>)> {
-        let (hairs, per_hair) = self.hair_counts();
-        self.interpolate.read(hairs as usize * per_hair as usize)
-    }
-
-    /// The key hairs' reference vectors (rest-plane normals, head frame).
-    pub fn reference_vectors(&self) -> Result<Vec<Vec4>> {
-        self.interpolate.read_reference(self.strands as usize)
-    }
-
-    /// Builds the Marschner tables for the current material and reads them back
-    /// (M indexed by sin θi, sin θo; N by cos φ, cos θd; rows of
-    /// [`marschner::TABLE_SIZE`] texels) — for tests and tools (submits and waits).
-    pub fn read_marschner_tables(&mut self) -> Result<(Vec<Vec4>, Vec<Vec4>)> {
-        let params = self.material.marschner;
-        self.draw.read_marschner_tables(&params)
-    }
-}

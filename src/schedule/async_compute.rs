@@ -97,7 +97,7 @@ impl AsyncSim {
     pub(crate) fn wait_idle(&self) -> Result<()> {
         match self.ring.wait_all(self.timeout)? {
             true => Ok(()),
-            false => Err(crate::Error::HandOff("the async simulation did not finish in time".into())),
+            false => Err(crate::error::Error::HandOff("the async simulation did not finish in time".into())),
         }
     }
 

@@ -89,6 +89,41 @@ enum Backend {
 /// Dropping it stops the worker thread (SECOND DEVICE) and waits for vkhair's own
 /// submissions only; the host's frames that used its buffers or waited on its
 /// semaphores must have completed, as for any resource of a frame in flight.
+///
+/// Each frame, [`FrameScheduler::record_frame`] runs the steps a
+/// [`crate::sim::FixedStepDriver`] planned and hands the state to the renderer,
+/// which reads [`FrameScheduler::key_hairs`]; the host's submission waits on the
+/// returned [`FrameSync`]:
+///
+/// ```
+/// use glam::Vec3;
+/// use vkhair::headless::Submit;
+/// use vkhair::schedule::{FrameScheduler, SchedulerOptions};
+/// use vkhair::sim::{FixedStepDriver, RigidTransform, SimParams};
+/// use vkhair::{ContextOptions, GpuContext, Groom, ValidationLog};
+///
+/// let log = ValidationLog::new();
+/// {
+///     let ctx = GpuContext::headless(&ContextOptions::validated(&log))?;
+///     let strand: Vec<Vec3> = (0..6).map(|i| Vec3::new(0.02 * i as f32, 0.0, 0.0)).collect();
+///     let groom = Groom::from_strands(&[strand])?;
+///     let head = RigidTransform::default();
+///     let options = SchedulerOptions::default();
+///     let mut scheduler = FrameScheduler::new(&ctx, &groom, &SimParams::default(), &head, &[], &options)?;
+///     println!("simulation: {:?}, because {}", scheduler.mode(), scheduler.reason());
+///     let mut driver = FixedStepDriver::new(1.0 / 60.0, 4)?;
+///     for _ in 0..3 {
+///         let heads = vec![head; driver.advance(1.0 / 60.0).steps as usize];
+///         // SAFETY: a recording command buffer of the rendering device; the
+///         // previous frame completed (run_frame waits).
+///         ctx.run_frame("frame", |cmd| unsafe { scheduler.record_frame(cmd, &heads, None) })?;
+///     }
+///     let shown = scheduler.read_shown_positions()?;
+///     assert!(shown[5].y < 0.0, "the renderer sees the simulated tip");
+/// }
+/// log.assert_clean();
+/// # Ok::<(), vkhair::Error>(())
+/// ```
 pub struct FrameScheduler {
     backend: Backend,
     mirror: Mirror,

@@ -47,7 +47,7 @@ pub enum Pipelining {
     Throughput,
 }
 
-/// How a [`FrameScheduler`] is set up.
+/// How a [`FrameScheduler`](super::FrameScheduler) is set up.
 #[derive(Debug, Clone)]
 pub struct SchedulerOptions {
     /// The mode to use; `None` chooses: SECOND DEVICE when `sim_device` is given,
@@ -67,10 +67,10 @@ pub struct SchedulerOptions {
     /// Lets ASYNC COMPUTE submit to the rendering context's graphics queue when it
     /// has no second queue: nothing overlaps, but the semaphore hand-off runs on any
     /// device (tests). The host must not submit to that queue concurrently with
-    /// [`FrameScheduler::record_frame`]. Default: `false`.
+    /// [`FrameScheduler::record_frame`](super::FrameScheduler::record_frame). Default: `false`.
     pub async_on_graphics_queue: bool,
     /// Timestamp profiles of vkhair's own simulation submissions (ASYNC COMPUTE and
-    /// SECOND DEVICE; see [`FrameScheduler::sim_profile`]). Default: `true`.
+    /// SECOND DEVICE; see [`FrameScheduler::sim_profile`](super::FrameScheduler::sim_profile)). Default: `true`.
     pub profile: bool,
     /// Longest wait for the simulation side before an error. Default: 10 s.
     pub timeout: Duration,

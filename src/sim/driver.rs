@@ -18,6 +18,14 @@ pub struct StepPlan {
 }
 
 /// Turns frame times into fixed simulation steps.
+///
+/// ```
+/// let mut driver = vkhair::sim::FixedStepDriver::new(1.0 / 60.0, 4)?;
+/// let plan = driver.advance(1.0 / 30.0); // a 30 Hz frame: two 60 Hz steps
+/// assert_eq!(plan.steps, 2);
+/// assert!(plan.alpha < 1e-3 && plan.dropped == 0.0);
+/// # Ok::<(), vkhair::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct FixedStepDriver {
     step: f64,

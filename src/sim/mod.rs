@@ -5,17 +5,17 @@
 //! A step is `substeps` sub-steps, each running these stages in order (the
 //! [`SimStage`] enum names their debug labels and timestamp scopes):
 //!
-//! 1. **Predict** ([`predict`], `glsl/sim/predict.comp`): external forces —
+//! 1. **Predict** (`predict.rs`, `glsl/sim/predict.comp`): external forces —
 //!    gravity, wind with deterministic gust noise, a spring toward the rest
 //!    shape in the head frame, each switchable — then v* = v + dt·a,
 //!    x* = x + dt·v*. Pinned particles (roots) follow the head transform.
-//! 2. **Solve** ([`solve`], `glsl/sim/solve.comp`): ONE dispatch, one
+//! 2. **Solve** (`solve.rs`, `glsl/sim/solve.comp`): ONE dispatch, one
 //!    workgroup per group of key hairs, positions in shared memory; for N
 //!    iterations the even then odd distance constraints, two sets of bending
 //!    constraints and the body collisions, separated by `barrier()`; one
 //!    global write at the end. DFTL mode replaces this with one
 //!    follow-the-leader sweep and stores correction vectors.
-//! 3. **Integrate** ([`integrate`], `glsl/sim/integrate.comp`): velocity from
+//! 3. **Integrate** (`integrate.rs`, `glsl/sim/integrate.comp`): velocity from
 //!    the position change (plus the DFTL correction), damping, and the final
 //!    state into the other half of the double buffer.
 //! 4. **Volume** ([`volume`], `glsl/sim/volume/`), when
@@ -31,13 +31,14 @@
 //! oracle and benchmark baseline); [`FixedStepDriver`] turns frame times into
 //! a number of fixed steps.
 
+mod cpu;
 mod driver;
-pub mod integrate;
+mod integrate;
 pub mod motion;
 mod params;
-pub mod predict;
+mod predict;
 pub(crate) mod reference;
-pub mod solve;
+mod solve;
 mod state;
 mod view;
 pub mod volume;
@@ -46,6 +47,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
+pub use cpu::CpuHairSim;
 pub use driver::{FixedStepDriver, StepPlan};
 pub(crate) use params::validate_colliders;
 pub use params::{Collider, RigidTransform, SimParams, SolverMode, MAX_COLLIDERS, MAX_SIM_POINTS};
@@ -61,7 +63,7 @@ use crate::profiler::{PassScope, ScopeKind};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::device::Device;
 use crate::vk::pipeline::ComputePipeline;
-use params::Schedule;
+use params::SubstepPlanner;
 use state::GpuState;
 
 /// The stages of a simulation sub-step, in order.
@@ -150,11 +152,40 @@ struct StagePipeline {
 }
 
 /// The GPU hair simulation (see the module docs for the stage list).
+///
+/// Steps are recorded into the caller's command buffer with
+/// [`HairSim::record_step`]; here one step is recorded into a headless
+/// submission and read back:
+///
+/// ```
+/// use glam::Vec3;
+/// use vkhair::headless::Submit;
+/// use vkhair::sim::{HairSim, RigidTransform, SimParams};
+/// use vkhair::{ContextOptions, GpuContext, Groom, ValidationLog};
+///
+/// let log = ValidationLog::new();
+/// {
+///     let ctx = GpuContext::headless(&ContextOptions::validated(&log))?;
+///     let strand: Vec<Vec3> = (0..6).map(|i| Vec3::new(0.02 * i as f32, 0.0, 0.0)).collect();
+///     let groom = Groom::from_strands(&[strand])?;
+///     let head = RigidTransform::default();
+///     let mut sim = HairSim::new(&ctx, &groom, &SimParams::default(), &head)?;
+///     let mut result = Ok(());
+///     // SAFETY: a recording command buffer of the context's device.
+///     ctx.run_commands("step", |cmd| result = unsafe { sim.record_step(cmd, &head, None) })?;
+///     result?;
+///     let state = sim.read_state()?;
+///     assert_eq!(state.positions[0].truncate(), Vec3::ZERO, "the root is pinned");
+///     assert!(state.positions[5].y < 0.0, "the tip falls");
+/// }
+/// log.assert_clean();
+/// # Ok::<(), vkhair::Error>(())
+/// ```
 pub struct HairSim {
     device: Arc<Device>,
     gpu: GpuState,
     stages: Vec<StagePipeline>,
-    schedule: Schedule,
+    planner: SubstepPlanner,
     /// Rest shape and lengths as last uploaded (positions unused).
     shape: SimState,
     /// Particle ranges of `shape` to upload with the next step.
@@ -179,7 +210,7 @@ impl HairSim {
         // Subgroup-synchronised solving needs full subgroups; without them the solver
         // synchronises whole workgroups.
         let subgroup = if device.full_subgroups { device.info.subgroup_size } else { 0 };
-        let schedule = Schedule::new(params, head, state.strands, state.points, subgroup)?;
+        let planner = SubstepPlanner::new(params, head, state.strands, state.points, subgroup)?;
         let gpu = GpuState::new(&device, state)?;
         let mut stages = Vec::new();
         for stage in SimStage::PBD {
@@ -195,7 +226,7 @@ impl HairSim {
             device,
             gpu,
             stages,
-            schedule,
+            planner,
             shape: state.clone(),
             pending_rest: Vec::new(),
             current: 0,
@@ -228,7 +259,7 @@ impl HairSim {
 
     /// Current parameters.
     pub fn params(&self) -> &SimParams {
-        &self.schedule.params
+        &self.planner.params
     }
 
     /// Changes parameters from the next step on (validated first).
@@ -238,12 +269,12 @@ impl HairSim {
     pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
         params.validate()?;
         self.configure_volume(&params.volume)?;
-        self.schedule.set_params(params)
+        self.planner.set_params(params)
     }
 
     /// Replaces the colliders (in the head frame; at most [`MAX_COLLIDERS`]).
     pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
-        self.schedule.set_colliders(colliders)
+        self.planner.set_colliders(colliders)
     }
 
     /// Changes the rest length of key hair `strand`; only its tip segments change.
@@ -278,8 +309,8 @@ impl HairSim {
             rest: &self.shape,
             halves: [&self.gpu.positions[0], &self.gpu.positions[1]],
             current: self.current,
-            head: self.schedule.head,
-            volume: self.volume.as_ref().map(|v| (v.grid.describe(&self.schedule.head.matrix()), &v.buffers.cells)),
+            head: self.planner.head,
+            volume: self.volume.as_ref().map(|v| (v.grid.describe(&self.planner.head.matrix()), &v.buffers.cells)),
         }
     }
 
@@ -291,7 +322,7 @@ impl HairSim {
 
     /// The head transform at the end of the latest recorded step.
     pub fn head(&self) -> RigidTransform {
-        self.schedule.head
+        self.planner.head
     }
 
     /// The positions buffer holding the state before the latest step (for drawing
@@ -303,7 +334,7 @@ impl HairSim {
 
     /// The volume grid as placed for the latest step, when the volume stage is on.
     pub fn volume_grid(&self) -> Option<VolumeGrid> {
-        self.volume.as_ref().map(|v| v.grid.describe(&self.schedule.head.matrix()))
+        self.volume.as_ref().map(|v| v.grid.describe(&self.planner.head.matrix()))
     }
 
     /// The volume stage's cell buffer, when it is on: one vec4 per cell (index
@@ -344,8 +375,8 @@ impl HairSim {
         head: &RigidTransform,
         mut profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
-        let inputs = self.schedule.next(head)?;
-        let (strands, points) = (self.schedule.strands, self.schedule.points);
+        let inputs = self.planner.next(head)?;
+        let (strands, points) = (self.planner.strands, self.planner.points);
         let d = &self.device;
         let entry = barrier::memory(
             &[AccessKind::AnyWrite],
@@ -382,7 +413,7 @@ impl HairSim {
                     update_chunked(d, cmd, self.gpu.rest_lengths.raw(), range.start as u64 * 4, lengths);
                 }
                 if let Some(volume) = &self.volume {
-                    let colliders = self.schedule.colliders.len() as u32;
+                    let colliders = self.planner.colliders.len() as u32;
                     volume.record_uploads(cmd, &sub.volume_params(&volume.grid, &volume.params, colliders));
                 }
                 d.cmd_barrier(cmd, &[uploaded], &[], &[]);
@@ -441,7 +472,7 @@ impl HairSim {
         steps: usize,
         mut head: impl FnMut(usize) -> RigidTransform,
         mut profiler: Option<&mut GpuProfiler>,
-    ) -> Result<Option<crate::ProfileReport>> {
+    ) -> Result<Option<crate::profiler::ProfileReport>> {
         let device = self.device.clone();
         let mut result = Ok(());
         device.submit_once("vkhair sim run", |cmd| {
@@ -474,92 +505,5 @@ unsafe fn update_chunked(d: &Device, cmd: vk::CommandBuffer, buffer: vk::Buffer,
     for (k, chunk) in data.chunks(65536).enumerate() {
         // SAFETY: guaranteed by the caller.
         unsafe { d.raw.cmd_update_buffer(cmd, buffer, offset + k as u64 * 65536, chunk) };
-    }
-}
-
-/// The grid of the CPU reference's volume stage for `params`, none when it is off.
-fn cpu_volume_grid(params: &SimParams, state: &SimState) -> Result<Option<volume::grid::GridLayout>> {
-    match params.volume.mode {
-        VolumeMode::Off => Ok(None),
-        _ => volume::grid::GridLayout::new(&params.volume, state).map(Some),
-    }
-}
-
-/// The CPU reference simulation: the same algorithm as [`HairSim`], one particle
-/// at a time. Used as the oracle of the GPU tests and as the benchmark baseline.
-pub struct CpuHairSim {
-    schedule: Schedule,
-    state: SimState,
-    volume: Option<volume::grid::GridLayout>,
-    /// Intermediate results of the latest volume step.
-    last_volume: Option<volume::reference::VolumeSnapshot>,
-}
-
-impl CpuHairSim {
-    /// See [`HairSim::new`].
-    pub fn new(groom: &Groom, params: &SimParams, head: &RigidTransform) -> Result<Self> {
-        let state = SimState::from_groom(groom, params, head)?;
-        Self::from_state(state, params, head)
-    }
-
-    /// See [`HairSim::from_state`].
-    pub fn from_state(state: SimState, params: &SimParams, head: &RigidTransform) -> Result<Self> {
-        // The CPU runs the same constraint sets in the same order whatever the packing.
-        let schedule = Schedule::new(params, head, state.strands, state.points, MAX_SIM_POINTS as u32)?;
-        let volume = cpu_volume_grid(params, &state)?;
-        Ok(CpuHairSim { schedule, state, volume, last_volume: None })
-    }
-
-    /// See [`HairSim::set_params`].
-    pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
-        params.validate()?;
-        self.volume = cpu_volume_grid(params, &self.state)?;
-        self.schedule.set_params(params)
-    }
-
-    /// See [`HairSim::set_colliders`].
-    pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
-        self.schedule.set_colliders(colliders)
-    }
-
-    /// See [`HairSim::set_strand_length`].
-    pub fn set_strand_length(&mut self, strand: usize, length: f32) -> Result<()> {
-        self.state.set_strand_length(strand, length).map(|_| ())
-    }
-
-    /// Advances one step ending with the head at `head`.
-    pub fn step(&mut self, head: &RigidTransform) -> Result<()> {
-        let inputs = self.schedule.next(head)?;
-        for sub in &inputs {
-            reference::step(&mut self.state, std::slice::from_ref(sub));
-            if let Some(grid) = &self.volume {
-                let vp = &self.schedule.params.volume;
-                let gpu = sub.volume_params(grid, vp, self.schedule.colliders.len() as u32);
-                let snapshot = volume::reference::step(
-                    grid,
-                    &gpu,
-                    &sub.colliders,
-                    &self.state.positions,
-                    &mut self.state.velocities,
-                );
-                self.last_volume = Some(snapshot);
-            }
-        }
-        Ok(())
-    }
-
-    /// The grid of the volume stage, when it is on.
-    pub fn volume_grid(&self) -> Option<VolumeGrid> {
-        self.volume.as_ref().map(|g| g.describe(&self.schedule.head.matrix()))
-    }
-
-    /// MIC(0)-PCG iterations of the latest volume step (FLIP mode).
-    pub fn volume_iterations(&self) -> Option<u32> {
-        self.last_volume.as_ref().map(|s| s.iterations)
-    }
-
-    /// The current state.
-    pub fn state(&self) -> &SimState {
-        &self.state
     }
 }

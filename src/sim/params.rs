@@ -311,7 +311,7 @@ impl SubstepInputs {
 /// previous step, simulated time and the sub-step counter. Both turn a step into
 /// the same [`SubstepInputs`], so GPU and CPU run on identical numbers.
 #[derive(Debug, Clone)]
-pub(crate) struct Schedule {
+pub(crate) struct SubstepPlanner {
     pub params: SimParams,
     pub colliders: Vec<Collider>,
     pub head: RigidTransform,
@@ -323,7 +323,7 @@ pub(crate) struct Schedule {
     pub subgroup_size: u32,
 }
 
-impl Schedule {
+impl SubstepPlanner {
     pub(crate) fn new(
         params: &SimParams,
         head: &RigidTransform,
@@ -333,7 +333,7 @@ impl Schedule {
     ) -> Result<Self> {
         params.validate()?;
         head.validate()?;
-        Ok(Schedule {
+        Ok(SubstepPlanner {
             params: params.clone(),
             colliders: Vec::new(),
             head: *head,

@@ -167,42 +167,43 @@ pub(crate) fn light_map(
     let kind = light.kind();
     let direction = light.direction().normalize_or_zero();
     let radius = radius.max(1e-4);
-    let (view, projection) =
-        match kind {
-            0 => {
-                let eye = centre - direction * (2.0 * radius);
-                let view = glam::camera::rh::view::look_at_mat4(eye, centre, up_for(direction));
-                (
-                    view,
-                    glam::camera::rh::proj::vulkan::orthographic(
-                        -radius,
-                        radius,
-                        -radius,
-                        radius,
-                        radius * 0.5,
-                        radius * 3.5,
-                    ),
-                )
-            }
-            2 => {
-                let eye = light.position();
-                let to_centre = centre - eye;
-                let distance = to_centre.length();
-                let outer = light.cos_outer().clamp(-1.0, 1.0).acos();
-                let fit = if distance > radius * 1.01 { (radius / distance).asin() } else { outer };
-                let half = fit.min(outer.max(0.05)).clamp(0.01, 1.45);
-                let aim = if distance > 1e-6 { to_centre / distance } else { direction };
-                let near = (distance - radius).max(radius * 0.01);
-                let view = glam::camera::rh::view::look_at_mat4(eye, eye + aim, up_for(aim));
-                (view, glam::camera::rh::proj::vulkan::perspective(2.0 * half, 1.0, near, distance + radius))
-            }
-            _ => return Err(Error::unsupported(
+    let (view, projection) = match kind {
+        0 => {
+            let eye = centre - direction * (2.0 * radius);
+            let view = glam::camera::rh::view::look_at_mat4(eye, centre, up_for(direction));
+            (
+                view,
+                glam::camera::rh::proj::vulkan::orthographic(
+                    -radius,
+                    radius,
+                    -radius,
+                    radius,
+                    radius * 0.5,
+                    radius * 3.5,
+                ),
+            )
+        }
+        2 => {
+            let eye = light.position();
+            let to_centre = centre - eye;
+            let distance = to_centre.length();
+            let outer = light.cos_outer().clamp(-1.0, 1.0).acos();
+            let fit = if distance > radius * 1.01 { (radius / distance).asin() } else { outer };
+            let half = fit.min(outer.max(0.05)).clamp(0.01, 1.45);
+            let aim = if distance > 1e-6 { to_centre / distance } else { direction };
+            let near = (distance - radius).max(radius * 0.01);
+            let view = glam::camera::rh::view::look_at_mat4(eye, eye + aim, up_for(aim));
+            (view, glam::camera::rh::proj::vulkan::perspective(2.0 * half, 1.0, near, distance + radius))
+        }
+        _ => {
+            return Err(Error::unsupported(
                 "deep opacity maps of point lights",
                 format!(
                     "light {light_index} is a point light; use a directional or spot light, or a density-volume caster"
                 ),
-            )),
-        };
+            ))
+        }
+    };
     let row = view.row(2);
     Ok(GpuShadowMap {
         view_proj: (projection * view).to_cols_array_2d(),

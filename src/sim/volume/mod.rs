@@ -43,7 +43,7 @@
 //! the debug labels and timestamp scopes (steps 1–3, 4–5, 6, 7). The cells'
 //! (mean velocity, density) stay in a GPU buffer for the renderer
 //! ([`HairSim::density_buffer`](super::HairSim::density_buffer)).
-//! [`reference`] is the CPU oracle, with modified incomplete Cholesky (MIC(0))
+//! `reference.rs` is the CPU oracle, with modified incomplete Cholesky (MIC(0))
 //! as its preconditioner.
 
 mod buffers;

@@ -12,12 +12,12 @@
 //! `cargo run --example embed_minimal` writes `embed_minimal.png`; the test
 //! `tests/embed_example.rs` runs the same code under validation.
 
-use std::ffi::{c_void, CStr};
+use std::ffi::c_void;
 use std::sync::{Arc, Mutex};
 
 use ash::vk;
 use glam::Vec3;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme, Allocator, AllocatorCreateDesc};
+use gpu_allocator::vulkan::{Allocation, Allocator, AllocatorCreateDesc};
 use gpu_allocator::MemoryLocation;
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::scenes;
@@ -31,7 +31,10 @@ const COLOR: vk::Format = vk::Format::R8G8B8A8_UNORM;
 const DEPTH: vk::Format = vk::Format::D32_SFLOAT;
 const HEAD_RGB: [u8; 3] = [140, 105, 85];
 
-type BoxError = Box<dyn std::error::Error>;
+#[path = "host.rs"]
+mod host;
+
+use host::{allocate, cleared, compile, on_message, transition, BoxError, Memory, HEAD_FRAG, HEAD_VERT};
 
 /// What a run produced.
 pub struct Outcome {
@@ -41,78 +44,6 @@ pub struct Outcome {
     pub validation_messages: Vec<String>,
     /// The per-pass timings of the last frame.
     pub timings: String,
-}
-
-unsafe extern "system" fn on_message(
-    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
-    _: vk::DebugUtilsMessageTypeFlagsEXT,
-    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
-    user: *mut c_void,
-) -> vk::Bool32 {
-    if severity
-        .intersects(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR)
-    {
-        // SAFETY: the loader passes valid data; `user` is the host's boxed mutex.
-        let text = unsafe { CStr::from_ptr((*data).p_message) }.to_string_lossy().into_owned();
-        // SAFETY: as above; the box outlives the messenger.
-        let log = unsafe { &*(user as *const Mutex<Vec<String>>) };
-        log.lock().unwrap_or_else(|e| e.into_inner()).push(text);
-    }
-    vk::FALSE
-}
-
-const HEAD_VERT: &str = r#"#version 460
-layout(location = 0) in vec3 position;
-layout(location = 1) in vec3 normal;
-layout(push_constant) uniform Push { mat4 mvp; mat4 model; } pc;
-layout(location = 0) out vec3 v_normal;
-void main() {
-    v_normal = mat3(pc.model) * normal;
-    gl_Position = pc.mvp * vec4(position, 1.0);
-}
-"#;
-
-const HEAD_FRAG: &str = r#"#version 460
-layout(location = 0) in vec3 v_normal;
-layout(location = 0) out vec4 color;
-void main() {
-    float l = max(dot(normalize(v_normal), normalize(vec3(0.3, 0.4, 0.9))), 0.0);
-    color = vec4(vec3(0.55, 0.41, 0.33) * (0.35 + 0.65 * l), 1.0);
-}
-"#;
-
-fn compile(source: &str, kind: shaderc::ShaderKind, name: &str) -> Result<Vec<u32>, BoxError> {
-    let compiler = shaderc::Compiler::new()?;
-    let mut options = shaderc::CompileOptions::new()?;
-    options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
-    Ok(compiler.compile_into_spirv(source, kind, name, "main", Some(&options))?.as_binary().to_vec())
-}
-
-/// A host buffer or image with its allocation.
-struct Memory(Option<Allocation>);
-
-impl Memory {
-    fn free(&mut self, allocator: &Mutex<Allocator>) {
-        if let Some(a) = self.0.take() {
-            let _ = allocator.lock().unwrap_or_else(|e| e.into_inner()).free(a);
-        }
-    }
-}
-
-fn allocate(
-    allocator: &Mutex<Allocator>,
-    name: &str,
-    requirements: vk::MemoryRequirements,
-    location: MemoryLocation,
-    linear: bool,
-) -> Result<Allocation, BoxError> {
-    Ok(allocator.lock().unwrap_or_else(|e| e.into_inner()).allocate(&AllocationCreateDesc {
-        name,
-        requirements,
-        location,
-        linear,
-        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-    })?)
 }
 
 /// Runs `frames` frames of the `thesis` scene; `validation` enables the layer.
@@ -449,43 +380,29 @@ fn frames_with(
             sim.record_step(cmd, &head, Some(&mut profiler))?;
             renderer.record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler))?;
             // Host: clear and draw the head.
+            let depth_tests =
+                vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS;
+            let depth_access =
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ;
             let to_attachment = [
-                vk::ImageMemoryBarrier2::default()
-                    .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-                    .src_access_mask(vk::AccessFlags2::MEMORY_READ)
-                    .dst_stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)
-                    .dst_access_mask(vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
-                    .old_layout(vk::ImageLayout::UNDEFINED)
-                    .new_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .image(color)
-                    .subresource_range(color_range),
-                vk::ImageMemoryBarrier2::default()
-                    .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-                    .dst_stage_mask(
-                        vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
-                    )
-                    .dst_access_mask(
-                        vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE
-                            | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ,
-                    )
-                    .old_layout(vk::ImageLayout::UNDEFINED)
-                    .new_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-                    .image(depth)
-                    .subresource_range(depth_range),
+                transition(
+                    (color, color_range),
+                    (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_READ),
+                    (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
+                    (vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
+                ),
+                transition(
+                    (depth, depth_range),
+                    (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::NONE),
+                    (depth_tests, depth_access),
+                    (vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL),
+                ),
             ];
             device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&to_attachment));
-            let color_attachment = [vk::RenderingAttachmentInfo::default()
-                .image_view(color_view)
-                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.05, 0.06, 0.08, 1.0] } })];
-            let depth_attachment = vk::RenderingAttachmentInfo::default()
-                .image_view(depth_view)
-                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+            let clear_color = vk::ClearValue { color: vk::ClearColorValue { float32: [0.05, 0.06, 0.08, 1.0] } };
+            let clear_depth = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
+            let color_attachment = [cleared(color_view, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, clear_color)];
+            let depth_attachment = cleared(depth_view, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL, clear_depth);
             let rendering = vk::RenderingInfo::default()
                 .render_area(scissor)
                 .layer_count(1)
@@ -511,15 +428,12 @@ fn frames_with(
             };
             renderer.record_draw(cmd, frame as u64, &target, &camera, Some(&mut profiler))?;
             // Host: copy the image out.
-            let to_copy = [vk::ImageMemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)
-                .src_access_mask(vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::COPY)
-                .dst_access_mask(vk::AccessFlags2::TRANSFER_READ)
-                .old_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                .new_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
-                .image(color)
-                .subresource_range(color_range)];
+            let to_copy = [transition(
+                (color, color_range),
+                (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
+                (vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_READ),
+                (vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
+            )];
             device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&to_copy));
             let region = vk::BufferImageCopy::default()
                 .image_subresource(vk::ImageSubresourceLayers {

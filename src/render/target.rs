@@ -1,0 +1,50 @@
+//! Where the hair is drawn (the host's target) and where it is (its bounds and
+//! the head pose of the latest prepared frame).
+
+use ash::vk;
+use glam::{Quat, Vec3};
+
+use crate::sim::SimState;
+
+/// The host's images the hair is drawn into.
+#[derive(Debug, Clone, Copy)]
+pub struct RenderTarget {
+    /// Color attachment view, in `COLOR_ATTACHMENT_OPTIMAL`.
+    pub color: vk::ImageView,
+    /// Its format.
+    pub color_format: vk::Format,
+    /// Depth attachment view (in `DEPTH_ATTACHMENT_OPTIMAL`), or null for none.
+    pub depth: vk::ImageView,
+    /// Its format (`UNDEFINED` for none).
+    pub depth_format: vk::Format,
+    /// Extent of both.
+    pub extent: vk::Extent2D,
+    /// Sample count of both.
+    pub samples: vk::SampleCountFlags,
+}
+
+/// Where the hair is, for the level of detail and the shadow maps' fit.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Placement {
+    /// Centre of the rest shape's bounds, head frame.
+    pub(super) rest_center: Vec3,
+    /// Radius around `rest_center` that the hair can reach (roots plus strand length).
+    pub(super) bound_radius: f32,
+    /// Head rotation of the latest prepared frame.
+    pub(super) head_rotation: Quat,
+    /// `rest_center` in the world at the latest prepared frame.
+    pub(super) head_center: Vec3,
+}
+
+impl Placement {
+    pub(super) fn of(rest: &SimState, head_rotation: Quat) -> Placement {
+        let (lo, hi) = rest.rest.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| {
+            (lo.min(p.truncate()), hi.max(p.truncate()))
+        });
+        let rest_center = 0.5 * (lo + hi);
+        let bound_radius = (0..rest.strands)
+            .map(|s| (rest.rest[s * rest.points].truncate() - rest_center).length() + rest.rest_strand_length(s))
+            .fold(0.0f32, f32::max);
+        Placement { rest_center, bound_radius, head_rotation, head_center: rest_center }
+    }
+}

@@ -1,0 +1,106 @@
+//! The CPU reference simulation.
+
+use super::params::SubstepPlanner;
+use super::{reference, volume, Collider, RigidTransform, SimParams, SimState, VolumeGrid, VolumeMode, MAX_SIM_POINTS};
+use crate::error::Result;
+use crate::groom::Groom;
+
+/// The CPU reference simulation: the same algorithm as [`HairSim`], one particle
+/// at a time. Used as the oracle of the GPU tests and as the benchmark baseline.
+///
+/// ```
+/// use glam::Vec3;
+/// use vkhair::sim::{CpuHairSim, RigidTransform, SimParams};
+/// use vkhair::Groom;
+///
+/// let strand: Vec<Vec3> = (0..6).map(|i| Vec3::new(0.02 * i as f32, 0.0, 0.0)).collect();
+/// let head = RigidTransform::default();
+/// let mut cpu = CpuHairSim::new(&Groom::from_strands(&[strand])?, &SimParams::default(), &head)?;
+/// cpu.step(&head)?;
+/// assert!(cpu.state().positions[5].y < 0.0);
+/// # Ok::<(), vkhair::Error>(())
+/// ```
+pub struct CpuHairSim {
+    planner: SubstepPlanner,
+    state: SimState,
+    volume: Option<volume::grid::GridLayout>,
+    /// Intermediate results of the latest volume step.
+    last_volume: Option<volume::reference::VolumeSnapshot>,
+}
+
+impl CpuHairSim {
+    /// See [`HairSim::new`].
+    pub fn new(groom: &Groom, params: &SimParams, head: &RigidTransform) -> Result<Self> {
+        let state = SimState::from_groom(groom, params, head)?;
+        Self::from_state(state, params, head)
+    }
+
+    /// See [`HairSim::from_state`].
+    pub fn from_state(state: SimState, params: &SimParams, head: &RigidTransform) -> Result<Self> {
+        // The CPU runs the same constraint sets in the same order whatever the packing.
+        let planner = SubstepPlanner::new(params, head, state.strands, state.points, MAX_SIM_POINTS as u32)?;
+        let volume = cpu_volume_grid(params, &state)?;
+        Ok(CpuHairSim { planner, state, volume, last_volume: None })
+    }
+
+    /// See [`HairSim::set_params`].
+    pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
+        params.validate()?;
+        self.volume = cpu_volume_grid(params, &self.state)?;
+        self.planner.set_params(params)
+    }
+
+    /// See [`HairSim::set_colliders`].
+    pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
+        self.planner.set_colliders(colliders)
+    }
+
+    /// See [`HairSim::set_strand_length`].
+    pub fn set_strand_length(&mut self, strand: usize, length: f32) -> Result<()> {
+        self.state.set_strand_length(strand, length).map(|_| ())
+    }
+
+    /// Advances one step ending with the head at `head`.
+    pub fn step(&mut self, head: &RigidTransform) -> Result<()> {
+        let inputs = self.planner.next(head)?;
+        for sub in &inputs {
+            reference::step(&mut self.state, std::slice::from_ref(sub));
+            if let Some(grid) = &self.volume {
+                let vp = &self.planner.params.volume;
+                let gpu = sub.volume_params(grid, vp, self.planner.colliders.len() as u32);
+                let snapshot = volume::reference::step(
+                    grid,
+                    &gpu,
+                    &sub.colliders,
+                    &self.state.positions,
+                    &mut self.state.velocities,
+                );
+                self.last_volume = Some(snapshot);
+            }
+        }
+        Ok(())
+    }
+
+    /// The grid of the volume stage, when it is on.
+    pub fn volume_grid(&self) -> Option<VolumeGrid> {
+        self.volume.as_ref().map(|g| g.describe(&self.planner.head.matrix()))
+    }
+
+    /// MIC(0)-PCG iterations of the latest volume step (FLIP mode).
+    pub fn volume_iterations(&self) -> Option<u32> {
+        self.last_volume.as_ref().map(|s| s.iterations)
+    }
+
+    /// The current state.
+    pub fn state(&self) -> &SimState {
+        &self.state
+    }
+}
+
+/// The grid of the CPU reference's volume stage for `params`, none when it is off.
+fn cpu_volume_grid(params: &SimParams, state: &SimState) -> Result<Option<volume::grid::GridLayout>> {
+    match params.volume.mode {
+        VolumeMode::Off => Ok(None),
+        _ => volume::grid::GridLayout::new(&params.volume, state).map(Some),
+    }
+}

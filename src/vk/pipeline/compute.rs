@@ -1,0 +1,154 @@
+//! Compute pipelines: workgroup size from reflection, dispatches in threads.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::{shader_module, Layout};
+use crate::error::{Error, Result};
+use crate::vk::buffer::Buffer;
+use crate::vk::device::Device;
+use crate::vk::reflect::reflect;
+use crate::vk::shaders::ShaderSource;
+
+/// A compute pipeline.
+pub(crate) struct ComputePipeline {
+    layout: Layout,
+    raw: vk::Pipeline,
+    workgroup_size: [u32; 3],
+    name: String,
+}
+
+impl ComputePipeline {
+    /// Creates the pipeline; `max_sets` descriptor sets (of each set index) can be allocated.
+    pub(crate) fn new(device: &Arc<Device>, shader: &ShaderSource, max_sets: u32) -> Result<Self> {
+        Self::with_full_subgroups(device, shader, max_sets, false)
+    }
+
+    /// As [`ComputePipeline::new`]; with `full_subgroups` (only when the device has
+    /// `computeFullSubgroups` enabled) every subgroup of a workgroup is full.
+    pub(crate) fn with_full_subgroups(
+        device: &Arc<Device>,
+        shader: &ShaderSource,
+        max_sets: u32,
+        full_subgroups: bool,
+    ) -> Result<Self> {
+        if full_subgroups && !device.full_subgroups {
+            return Err(Error::MissingRequirement("computeFullSubgroups".into()));
+        }
+        let reflection = reflect(shader)?;
+        let workgroup_size = reflection
+            .workgroup_size
+            .ok_or_else(|| Error::Shader { shader: shader.name.to_owned(), reason: "not a compute shader".into() })?;
+        let layout = Layout::new(device, shader.name, &[reflection], max_sets)?;
+        let module = shader_module(device, shader)?;
+        let flags = if full_subgroups {
+            vk::PipelineShaderStageCreateFlags::REQUIRE_FULL_SUBGROUPS
+        } else {
+            vk::PipelineShaderStageCreateFlags::empty()
+        };
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .flags(flags)
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module)
+            .name(c"main");
+        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout.raw);
+        // SAFETY: module and layout are alive; the module is destroyed right after.
+        let result = unsafe { device.raw.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
+        // SAFETY: the module is no longer needed once the pipeline exists.
+        unsafe { device.raw.destroy_shader_module(module, None) };
+        let raw = result.map_err(|(_, r)| Error::Vulkan { call: "vkCreateComputePipelines", result: r })?[0];
+        device.set_name(raw, shader.name);
+        Ok(ComputePipeline { layout, raw, workgroup_size, name: shader.name.to_owned() })
+    }
+
+    #[cfg(test)]
+    pub(crate) fn workgroup_size(&self) -> [u32; 3] {
+        self.workgroup_size
+    }
+
+    /// Allocates descriptor set `set` and binds those of `buffers` that the shader
+    /// declares (stages sharing one binding table each use a subset of it).
+    pub(crate) fn declared_buffer_set(&self, set: u32, buffers: &[(u32, &Buffer)]) -> Result<vk::DescriptorSet> {
+        self.buffer_set(set, &self.layout.declared(set, buffers))
+    }
+
+    /// Allocates descriptor set `set` and points its buffer bindings at `buffers`.
+    pub(crate) fn buffer_set(&self, set: u32, buffers: &[(u32, &Buffer)]) -> Result<vk::DescriptorSet> {
+        let target = self.layout.allocate_set(set, &format!("{} set {set}", self.name))?;
+        self.layout.write_buffers(target, set, buffers)?;
+        Ok(target)
+    }
+
+    /// Allocates descriptor set `set` with buffer and combined image-sampler bindings.
+    #[cfg(test)]
+    pub(crate) fn resource_set(
+        &self,
+        set: u32,
+        buffers: &[(u32, &Buffer)],
+        images: &[(u32, vk::ImageView, vk::Sampler)],
+    ) -> Result<vk::DescriptorSet> {
+        self.layout.resource_set(set, &self.name, buffers, images)
+    }
+
+    /// Allocates descriptor set `set` and points its storage-image bindings at views
+    /// (in GENERAL layout when dispatched).
+    pub(crate) fn storage_image_set(&self, set: u32, images: &[(u32, vk::ImageView)]) -> Result<vk::DescriptorSet> {
+        let target = self.layout.allocate_set(set, &format!("{} set {set}", self.name))?;
+        self.layout.write_storage_images(target, set, images)?;
+        Ok(target)
+    }
+
+    /// Binds the pipeline and the descriptor sets (from set 0).
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of this device.
+    pub(crate) unsafe fn bind(&self, cmd: vk::CommandBuffer, sets: &[vk::DescriptorSet]) {
+        let d = &self.layout.device.raw;
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw);
+            if !sets.is_empty() {
+                d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout.raw, 0, sets, &[]);
+            }
+        }
+    }
+
+    /// Records push constants; their size must equal the shader's block.
+    ///
+    /// # Safety
+    /// `cmd` is recording with this pipeline bound.
+    pub(crate) unsafe fn push<P: bytemuck::Pod>(&self, cmd: vk::CommandBuffer, push: &P) {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.layout.push(cmd, push) };
+    }
+
+    /// Dispatches enough workgroups to cover `threads` invocations in each dimension.
+    ///
+    /// # Safety
+    /// `cmd` is recording with this pipeline bound.
+    pub(crate) unsafe fn dispatch_threads(&self, cmd: vk::CommandBuffer, threads: [u32; 3]) {
+        let groups = [0, 1, 2].map(|i| threads[i].div_ceil(self.workgroup_size[i]));
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.layout.device.raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
+    }
+
+    /// Dispatches with the workgroup counts read from `buffer` at `offset` when the
+    /// command executes (a `VkDispatchIndirectCommand`).
+    ///
+    /// # Safety
+    /// `cmd` is recording with this pipeline bound; `buffer` has INDIRECT_BUFFER usage,
+    /// holds a command at `offset` (a multiple of 4) whose counts stay within the
+    /// device limits, and writes to it are made visible to DRAW_INDIRECT reads.
+    pub(crate) unsafe fn dispatch_indirect(&self, cmd: vk::CommandBuffer, buffer: vk::Buffer, offset: u64) {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.layout.device.raw.cmd_dispatch_indirect(cmd, buffer, offset) };
+    }
+}
+
+impl Drop for ComputePipeline {
+    fn drop(&mut self) {
+        // SAFETY: pipeline of this device, no longer used by pending work.
+        unsafe { self.layout.device.raw.destroy_pipeline(self.raw, None) };
+    }
+}

@@ -1,0 +1,128 @@
+//! The crate's shape, checked on its sources: modules depend only downward
+//! (no import cycle), and no source file outside the tests grows past 600 lines.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+/// Top-level modules from the bottom up; a module may use only those in
+/// earlier layers (the crate root, `lib.rs`, re-exports from all of them).
+const LAYERS: &[&[&str]] = &[
+    &["error", "hash", "limits"],
+    &["vk", "groom"],
+    &["gpu_types", "requirements"],
+    &["context"],
+    &["profiler"],
+    &["sim"],
+    &["render"],
+    &["schedule"],
+    &["headless"],
+];
+
+fn layer_of(module: &str) -> Option<usize> {
+    LAYERS.iter().position(|layer| layer.contains(&module))
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("source folder") {
+        let path = entry.expect("entry").path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// Test code: `tests.rs` files and what follows a `#[cfg(test)]` line.
+fn is_test_file(path: &Path) -> bool {
+    path.file_name().is_some_and(|n| n == "tests.rs")
+}
+
+/// The top-level modules `source` names through `crate::`, outside comments and tests.
+fn crate_references(source: &str) -> BTreeSet<String> {
+    let mut found = BTreeSet::new();
+    for line in source.lines() {
+        let code = line.trim_start();
+        if code.starts_with("#[cfg(test)]") {
+            break;
+        }
+        if code.starts_with("//") {
+            continue;
+        }
+        let code = code.split("//").next().unwrap_or_default();
+        for (i, _) in code.match_indices("crate::") {
+            let name: String =
+                code[i + 7..].chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+            let before = code[..i].chars().next_back();
+            if !before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_') && !name.is_empty() {
+                found.insert(name);
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn modules_depend_only_on_lower_layers() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let mut edges = 0;
+    let mut violations = Vec::new();
+    for file in &files {
+        let relative = file.strip_prefix(&src).expect("under src");
+        let top = relative.iter().next().and_then(|c| c.to_str()).expect("component");
+        let module = top.trim_end_matches(".rs");
+        if module == "lib" || is_test_file(file) {
+            continue;
+        }
+        let Some(own) = layer_of(module) else {
+            violations.push(format!("{}: module {module} is in no layer of this test", relative.display()));
+            continue;
+        };
+        let source = std::fs::read_to_string(file).expect("source");
+        for used in crate_references(&source) {
+            if used == module {
+                continue;
+            }
+            edges += 1;
+            match layer_of(&used) {
+                Some(layer) if layer < own => {}
+                _ if used.starts_with(char::is_uppercase) => {
+                    violations.push(format!("{}: crate::{used} hides its module; name the module", relative.display()))
+                }
+                _ => violations.push(format!("{}: {module} uses {used}, which is not below it", relative.display())),
+            }
+        }
+    }
+    assert!(violations.is_empty(), "layering broken:\n{}", violations.join("\n"));
+    assert!(edges > 30, "the scan found only {edges} dependencies: it reads nothing");
+}
+
+#[test]
+fn the_layer_check_sees_an_upward_reference() {
+    let upward = "use crate::error::Result;\n// crate::schedule in a comment\nuse crate::schedule::FrameSync;\n";
+    let found = crate_references(upward);
+    assert_eq!(found, BTreeSet::from(["error".to_string(), "schedule".to_string()]));
+    let tests_only = "use crate::vk::Device;\n#[cfg(test)]\nmod tests { use crate::headless::Submit; }\n";
+    assert_eq!(crate_references(tests_only), BTreeSet::from(["vk".to_string()]));
+}
+
+#[test]
+fn no_source_file_outside_the_tests_exceeds_600_lines() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    for dir in ["src", "examples", "benches", "tools/src"] {
+        rust_files(&root.join(dir), &mut files);
+    }
+    assert!(files.len() > 50, "found only {} files", files.len());
+    let long: Vec<String> = files
+        .iter()
+        .filter(|f| !is_test_file(f))
+        .filter_map(|f| {
+            let lines = std::fs::read_to_string(f).expect("source").lines().count();
+            (lines > 600).then(|| format!("{}: {lines} lines", f.strip_prefix(root).unwrap_or(f).display()))
+        })
+        .collect();
+    assert!(long.is_empty(), "split these files:\n{}", long.join("\n"));
+}
