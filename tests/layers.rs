@@ -51,8 +51,7 @@ fn crate_references(source: &str) -> BTreeSet<String> {
         }
         let code = code.split("//").next().unwrap_or_default();
         for (i, _) in code.match_indices("crate::") {
-            let name: String =
-                code[i + 7..].chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+            let name: String = code[i + 7..].chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
             let before = code[..i].chars().next_back();
             if !before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_') && !name.is_empty() {
                 found.insert(name);

@@ -12,7 +12,6 @@ use std::sync::Arc;
 
 use ash::vk;
 use glam::Vec4;
-use gpu_allocator::MemoryLocation;
 
 use super::marschner::{MarschnerParams, MarschnerTables};
 use super::pass::RenderPass;
@@ -22,7 +21,7 @@ use crate::error::Result;
 use crate::gpu_types::{DrawParams, GpuLight};
 use crate::profiler::GpuProfiler;
 use crate::vk::barrier::{self, AccessKind};
-use crate::vk::buffer::{Buffer, BufferDesc};
+use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc, Sampler};
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
@@ -84,15 +83,7 @@ impl DrawPass {
         )?;
         device.upload_image(&noise, &noise_texels())?;
         let sampler = Sampler::new(device, "vkhair noise sampler", true)?;
-        let params = Buffer::new(
-            device,
-            &BufferDesc {
-                name: "vkhair draw params",
-                size: std::mem::size_of::<DrawParams>() as u64,
-                usage: vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                location: MemoryLocation::GpuOnly,
-            },
-        )?;
+        let params = Buffer::uniform(device, "vkhair draw params", std::mem::size_of::<DrawParams>() as u64)?;
         let marschner = MarschnerTables::new(device)?;
         Ok(DrawPass { device: device.clone(), pipelines: HashMap::new(), noise, sampler, params, marschner })
     }

@@ -18,15 +18,13 @@
 
 use std::sync::Arc;
 
-use ash::vk;
 use glam::{Vec3, Vec4};
-use gpu_allocator::MemoryLocation;
 
 use super::params::{RigidTransform, SimParams, MAX_COLLIDERS, MAX_SIM_POINTS};
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuCollider, SimStepParams};
 use crate::groom::Groom;
-use crate::vk::buffer::{Buffer, BufferDesc};
+use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 
 /// Simulation state on the CPU.
@@ -194,24 +192,12 @@ impl GpuState {
             correction: storage("vkhair sim correction", vec4_bytes)?,
             rest: storage("vkhair sim rest", vec4_bytes)?,
             rest_lengths: storage("vkhair sim rest lengths", n * 4)?,
-            colliders: Buffer::new(
+            colliders: Buffer::uniform(
                 device,
-                &BufferDesc {
-                    name: "vkhair sim colliders",
-                    size: (MAX_COLLIDERS * std::mem::size_of::<GpuCollider>()) as u64,
-                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                    location: MemoryLocation::GpuOnly,
-                },
+                "vkhair sim colliders",
+                (MAX_COLLIDERS * std::mem::size_of::<GpuCollider>()) as u64,
             )?,
-            params: Buffer::new(
-                device,
-                &BufferDesc {
-                    name: "vkhair sim params",
-                    size: std::mem::size_of::<SimStepParams>() as u64,
-                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                    location: MemoryLocation::GpuOnly,
-                },
-            )?,
+            params: Buffer::uniform(device, "vkhair sim params", std::mem::size_of::<SimStepParams>() as u64)?,
         };
         gpu.upload(device, state, 0)?;
         device.upload_pod(&gpu.rest, &state.rest)?;

@@ -222,6 +222,22 @@ impl Device {
         // SAFETY: guaranteed by the caller.
         unsafe { self.raw.cmd_pipeline_barrier2(cmd, &info) };
     }
+
+    /// Records one barrier and layout transition (`layouts`: old, new) on a whole image.
+    ///
+    /// # Safety
+    /// As for [`Device::cmd_barrier`].
+    pub(crate) unsafe fn cmd_transition(
+        &self,
+        cmd: vk::CommandBuffer,
+        image: &Image,
+        src: &[AccessKind],
+        dst: &[AccessKind],
+        layouts: (vk::ImageLayout, vk::ImageLayout),
+    ) {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.cmd_barrier(cmd, &[], &[], &[self::image(image, src, dst, layouts.0, layouts.1)]) };
+    }
 }
 
 #[cfg(test)]

@@ -80,6 +80,20 @@ impl Buffer {
         })
     }
 
+    /// A GPU-only uniform buffer of `size` bytes, written by transfers
+    /// (`vkCmdUpdateBuffer` or uploads).
+    pub(crate) fn uniform(device: &Arc<Device>, name: &str, size: u64) -> Result<Self> {
+        Buffer::new(
+            device,
+            &BufferDesc {
+                name,
+                size,
+                usage: vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
+        )
+    }
+
     /// A GPU-only storage buffer that transfers can fill and read back.
     pub(crate) fn storage(device: &Arc<Device>, name: &str, size: u64) -> Result<Self> {
         Self::new(

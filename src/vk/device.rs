@@ -171,47 +171,7 @@ impl Device {
     pub(crate) fn new(parts: DeviceParts) -> Result<Arc<Self>> {
         let info = DeviceInfo::query(&parts.instance, parts.physical, parts.graphics.family);
         let debug_utils = parts.debug_utils.then(|| ash::ext::debug_utils::Device::new(&parts.instance, &parts.raw));
-        let allocator = match parts.allocator {
-            Some(a) => a,
-            None => {
-                let desc = gpu_allocator::vulkan::AllocatorCreateDesc {
-                    instance: parts.instance.clone(),
-                    device: parts.raw.clone(),
-                    physical_device: parts.physical,
-                    debug_settings: {
-                        let mut d = gpu_allocator::AllocatorDebugSettings::default();
-                        d.log_leaks_on_shutdown = true;
-                        d
-                    },
-                    buffer_device_address: false,
-                    allocation_sizes: gpu_allocator::AllocationSizes::default(),
-                };
-                match Allocator::new(&desc) {
-                    Ok(a) => Arc::new(Mutex::new(a)),
-                    Err(source) => {
-                        // Tear down what we own before reporting.
-                        let record = Device {
-                            entry: parts.entry,
-                            instance: parts.instance,
-                            physical: parts.physical,
-                            raw: parts.raw,
-                            graphics: parts.graphics,
-                            compute: parts.compute,
-                            info,
-                            debug_utils,
-                            full_subgroups: parts.full_subgroups,
-                            extensions: parts.extensions,
-                            allocator: None,
-                            submit_lock: Mutex::new(()),
-                            owned: parts.owned,
-                        };
-                        drop(record);
-                        return Err(Error::Allocation { name: "allocator".into(), source });
-                    }
-                }
-            }
-        };
-        Ok(Arc::new(Device {
+        let mut record = Device {
             entry: parts.entry,
             instance: parts.instance,
             physical: parts.physical,
@@ -222,10 +182,29 @@ impl Device {
             debug_utils,
             full_subgroups: parts.full_subgroups,
             extensions: parts.extensions,
-            allocator: Some(allocator),
+            allocator: parts.allocator,
             submit_lock: Mutex::new(()),
             owned: parts.owned,
-        }))
+        };
+        if record.allocator.is_none() {
+            let desc = gpu_allocator::vulkan::AllocatorCreateDesc {
+                instance: record.instance.clone(),
+                device: record.raw.clone(),
+                physical_device: record.physical,
+                debug_settings: {
+                    let mut d = gpu_allocator::AllocatorDebugSettings::default();
+                    d.log_leaks_on_shutdown = true;
+                    d
+                },
+                buffer_device_address: false,
+                allocation_sizes: gpu_allocator::AllocationSizes::default(),
+            };
+            // On failure, dropping the record tears down what it owns before reporting.
+            let allocator =
+                Allocator::new(&desc).map_err(|source| Error::Allocation { name: "allocator".into(), source })?;
+            record.allocator = Some(Arc::new(Mutex::new(allocator)));
+        }
+        Ok(Arc::new(record))
     }
 
     /// True when the crate created (and will destroy) instance and device.

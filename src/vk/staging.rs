@@ -188,17 +188,12 @@ impl Device {
         self.submit_once("upload image", |cmd| {
             // SAFETY: resources of this device; layouts are transitioned around the copy.
             unsafe {
-                self.cmd_barrier(
+                self.cmd_transition(
                     cmd,
-                    &[],
-                    &[],
-                    &[barrier::image(
-                        image,
-                        barrier::NOTHING,
-                        &[AccessKind::TransferWrite],
-                        vk::ImageLayout::UNDEFINED,
-                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    )],
+                    image,
+                    barrier::NOTHING,
+                    &[AccessKind::TransferWrite],
+                    (vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL),
                 );
                 self.raw.cmd_copy_buffer_to_image(
                     cmd,
@@ -207,17 +202,12 @@ impl Device {
                     vk::ImageLayout::TRANSFER_DST_OPTIMAL,
                     &[region],
                 );
-                self.cmd_barrier(
+                self.cmd_transition(
                     cmd,
-                    &[],
-                    &[],
-                    &[barrier::image(
-                        image,
-                        &[AccessKind::TransferWrite],
-                        barrier::ANY,
-                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                        vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                    )],
+                    image,
+                    &[AccessKind::TransferWrite],
+                    barrier::ANY,
+                    (vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
                 );
             }
         })
@@ -237,17 +227,12 @@ impl Device {
         self.submit_once("readback image", |cmd| {
             // SAFETY: resources of this device; layouts are transitioned around the copy.
             unsafe {
-                self.cmd_barrier(
+                self.cmd_transition(
                     cmd,
-                    &[],
-                    &[],
-                    &[barrier::image(
-                        image,
-                        &[AccessKind::AnyWrite],
-                        &[AccessKind::TransferRead],
-                        layout,
-                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    )],
+                    image,
+                    &[AccessKind::AnyWrite],
+                    &[AccessKind::TransferRead],
+                    (layout, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
                 );
                 self.raw.cmd_copy_image_to_buffer(
                     cmd,

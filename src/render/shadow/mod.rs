@@ -22,7 +22,6 @@ use std::sync::Arc;
 
 use ash::vk;
 use glam::Vec3;
-use gpu_allocator::MemoryLocation;
 
 use super::shading::MAX_LIGHTS;
 use crate::error::{Error, Result};
@@ -30,7 +29,7 @@ use crate::gpu_types::{GpuLight, GpuShadowParams};
 use crate::profiler::GpuProfiler;
 use crate::sim::KeyHairs;
 use crate::vk::barrier::{self, AccessKind};
-use crate::vk::buffer::{Buffer, BufferDesc};
+use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use opacity_maps::OpacityMaps;
 use volume::VolumeShadows;
@@ -236,15 +235,7 @@ impl Shadows {
     /// No casters yet, reading hairs from `hair_positions`.
     pub(super) fn new(device: &Arc<Device>, hair_positions: &Buffer) -> Result<Self> {
         let params = ShadowParams::default();
-        let uniforms = Buffer::new(
-            device,
-            &BufferDesc {
-                name: "vkhair shadow params",
-                size: std::mem::size_of::<GpuShadowParams>() as u64,
-                usage: vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                location: MemoryLocation::GpuOnly,
-            },
-        )?;
+        let uniforms = Buffer::uniform(device, "vkhair shadow params", std::mem::size_of::<GpuShadowParams>() as u64)?;
         device.upload_pod(&uniforms, &[no_shadows()])?;
         let maps = OpacityMaps::new(device, &params, &uniforms, hair_positions)?;
         let volume = VolumeShadows::new(device, &uniforms, 0, 0)?;

@@ -109,15 +109,7 @@ impl VolumeBuffers {
         let density = storage("vkhair volume density", cells * 16)?;
         device.upload(&density, 0, &vec![0u8; density.size() as usize])?;
         Ok(VolumeBuffers {
-            params: Buffer::new(
-                device,
-                &BufferDesc {
-                    name: "vkhair volume params",
-                    size: std::mem::size_of::<GpuVolumeParams>() as u64,
-                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                    location: MemoryLocation::GpuOnly,
-                },
-            )?,
+            params: Buffer::uniform(device, "vkhair volume params", std::mem::size_of::<GpuVolumeParams>() as u64)?,
             keys_a: storage("vkhair volume keys A", n * 4)?,
             vals_a: storage("vkhair volume particles A", n * 4)?,
             keys_b: storage("vkhair volume keys B", n * 4)?,

@@ -104,14 +104,8 @@ impl ComputePipeline {
     /// # Safety
     /// `cmd` is a recording command buffer of this device.
     pub(crate) unsafe fn bind(&self, cmd: vk::CommandBuffer, sets: &[vk::DescriptorSet]) {
-        let d = &self.layout.device.raw;
         // SAFETY: guaranteed by the caller.
-        unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw);
-            if !sets.is_empty() {
-                d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout.raw, 0, sets, &[]);
-            }
-        }
+        unsafe { self.layout.bind(cmd, vk::PipelineBindPoint::COMPUTE, self.raw, sets) };
     }
 
     /// Records push constants; their size must equal the shader's block.

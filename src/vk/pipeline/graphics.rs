@@ -174,14 +174,8 @@ impl GraphicsPipeline {
     /// `cmd` is recording inside a dynamic rendering instance compatible with the
     /// pipeline's formats.
     pub(crate) unsafe fn bind(&self, cmd: vk::CommandBuffer, sets: &[vk::DescriptorSet]) {
-        let d = &self.layout.device.raw;
         // SAFETY: guaranteed by the caller.
-        unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.raw);
-            if !sets.is_empty() {
-                d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout.raw, 0, sets, &[]);
-            }
-        }
+        unsafe { self.layout.bind(cmd, vk::PipelineBindPoint::GRAPHICS, self.raw, sets) };
     }
 
     /// Records push constants; their size must equal the shaders' block.

@@ -261,6 +261,28 @@ fn shader_module(device: &Device, shader: &ShaderSource) -> Result<vk::ShaderMod
 }
 
 impl Layout {
+    /// Binds `pipeline` (of this layout) at `point` and `sets` from set 0.
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of this device (inside a compatible
+    /// rendering instance for graphics pipelines).
+    unsafe fn bind(
+        &self,
+        cmd: vk::CommandBuffer,
+        point: vk::PipelineBindPoint,
+        pipeline: vk::Pipeline,
+        sets: &[vk::DescriptorSet],
+    ) {
+        let d = &self.device.raw;
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            d.cmd_bind_pipeline(cmd, point, pipeline);
+            if !sets.is_empty() {
+                d.cmd_bind_descriptor_sets(cmd, point, self.raw, 0, sets, &[]);
+            }
+        }
+    }
+
     /// # Safety
     /// `cmd` is recording with a pipeline of this layout bound.
     unsafe fn push<P: bytemuck::Pod>(&self, cmd: vk::CommandBuffer, push: &P) {
