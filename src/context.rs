@@ -98,7 +98,7 @@ pub struct HostDevice {
 /// `GpuContext` while objects still exist is safe: the device goes with the last one.
 ///
 /// A headless context with validation on (a host wraps its own device with
-/// [`GpuContext::from_host`]; `examples/embed_minimal.rs`, run as a test, does it):
+/// [`GpuContext::from_host`]; `examples/embed_minimal/`, run as a test, does it):
 ///
 /// ```
 /// use vkhair::{ContextOptions, GpuContext, ValidationLog};

@@ -29,7 +29,7 @@
 //! A headless context ([`GpuContext::headless`]) owns its instance and device and
 //! is what tools and tests use; on machines without a GPU it runs on lavapipe.
 //! [`headless`] stands in for the rest of a host (submission, an offscreen
-//! target); `examples/embed_minimal.rs` shows a host that owns everything.
+//! target); `examples/embed_minimal/` shows a host that owns everything.
 //!
 //! ## A frame, headless
 //!

@@ -38,13 +38,16 @@ fn is_test_file(path: &Path) -> bool {
     path.file_name().is_some_and(|n| n == "tests.rs")
 }
 
-/// The top-level modules `source` names through `crate::`, outside comments and tests.
+/// The top-level modules `source` names through `crate::`, outside comments and
+/// the items marked `#[cfg(test)]` (a `mod x;` line, or a braced block).
 fn crate_references(source: &str) -> BTreeSet<String> {
     let mut found = BTreeSet::new();
-    for line in source.lines() {
+    let mut lines = source.lines();
+    while let Some(line) = lines.next() {
         let code = line.trim_start();
         if code.starts_with("#[cfg(test)]") {
-            break;
+            skip_item(&mut lines);
+            continue;
         }
         if code.starts_with("//") {
             continue;
@@ -59,6 +62,19 @@ fn crate_references(source: &str) -> BTreeSet<String> {
         }
     }
     found
+}
+
+/// Skips the item after a `#[cfg(test)]` line: up to its `;`, or to the brace
+/// closing its block.
+fn skip_item<'a>(lines: &mut impl Iterator<Item = &'a str>) {
+    let mut depth = 0i32;
+    for line in lines {
+        let code = line.split("//").next().unwrap_or_default();
+        depth += code.matches('{').count() as i32 - code.matches('}').count() as i32;
+        if depth <= 0 && (code.contains('}') || code.trim_end().ends_with(';')) {
+            return;
+        }
+    }
 }
 
 #[test]
@@ -103,8 +119,11 @@ fn the_layer_check_sees_an_upward_reference() {
     let upward = "use crate::error::Result;\n// crate::schedule in a comment\nuse crate::schedule::FrameSync;\n";
     let found = crate_references(upward);
     assert_eq!(found, BTreeSet::from(["error".to_string(), "schedule".to_string()]));
-    let tests_only = "use crate::vk::Device;\n#[cfg(test)]\nmod tests { use crate::headless::Submit; }\n";
+    let tests_only = "use crate::vk::Device;\n#[cfg(test)]\nmod tests {\n    use crate::headless::Submit;\n}\n";
     assert_eq!(crate_references(tests_only), BTreeSet::from(["vk".to_string()]));
+    // A `#[cfg(test)] mod tests;` line at the top hides only itself.
+    let declared_first = "#[cfg(test)]\nmod tests;\nuse crate::schedule::FrameSync;\n";
+    assert_eq!(crate_references(declared_first), BTreeSet::from(["schedule".to_string()]));
 }
 
 #[test]

@@ -10,6 +10,11 @@
 #define VKHAIR_SHADOW_GLSL
 
 // MAX_SHADOW_MAPS (render::MAX_SHADOW_MAPS) is injected by build.rs from src/limits.rs.
+// A host including this header in its own shaders defines it when compiling
+// them: -DMAX_SHADOW_MAPS=4u (glslc, shaderc's add_macro_definition).
+#if !defined(MAX_SHADOW_MAPS)
+#error "define MAX_SHADOW_MAPS as vkhair::render::MAX_SHADOW_MAPS (-DMAX_SHADOW_MAPS=4u) before including shadow.glsl"
+#endif
 
 // One light's map. Twin: gpu_types::GpuShadowMap.
 struct ShadowMap {

@@ -10,7 +10,7 @@
 //! Every scope also opens a debug-utils label, so RenderDoc/Nsight show the same
 //! pass names whether profiling is enabled or not. vkhair's own passes and stages
 //! open their scopes through one helper, [`PassScope`], whose [`ScopeKind`] picks
-//! the label colour and the stage of the closing timestamp.
+//! the label colour; both timestamps are written at `ALL_COMMANDS`.
 
 use std::sync::Arc;
 
@@ -36,7 +36,6 @@ struct Scope {
     depth: u32,
     begin: u32,
     end: Option<u32>,
-    kind: ScopeKind,
 }
 
 #[derive(Default)]
@@ -189,7 +188,7 @@ impl GpuProfiler {
     }
 
     /// [`GpuProfiler::begin_scope`] for a pass of a known kind: the label's colour
-    /// and the stage of the end timestamp follow `kind`.
+    /// follows `kind`.
     ///
     /// # Safety
     /// As for [`GpuProfiler::begin_scope`].
@@ -205,10 +204,10 @@ impl GpuProfiler {
         }
         let query = slot.queries;
         slot.queries += 2;
-        slot.scopes.push(Scope { name: name.to_owned(), depth: slot.open, begin: query, end: None, kind });
+        slot.scopes.push(Scope { name: name.to_owned(), depth: slot.open, begin: query, end: None });
         slot.open += 1;
         // SAFETY: guaranteed by the caller; the query was reset in begin_frame.
-        unsafe { self.device.raw.cmd_write_timestamp2(cmd, ScopeKind::BEGIN_STAGE, self.pool, first + query) };
+        unsafe { self.device.raw.cmd_write_timestamp2(cmd, ScopeKind::TIMESTAMP_STAGE, self.pool, first + query) };
         ScopeId(Some(slot.scopes.len() as u32 - 1))
     }
 
@@ -225,7 +224,9 @@ impl GpuProfiler {
                 let query = s.begin + 1;
                 s.end = Some(query);
                 // SAFETY: guaranteed by the caller; the query was reset in begin_frame.
-                unsafe { self.device.raw.cmd_write_timestamp2(cmd, s.kind.end_stage(), self.pool, first + query) };
+                unsafe {
+                    self.device.raw.cmd_write_timestamp2(cmd, ScopeKind::TIMESTAMP_STAGE, self.pool, first + query)
+                };
             }
         }
         // SAFETY: guaranteed by the caller (matching begin_scope).

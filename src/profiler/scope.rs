@@ -7,12 +7,14 @@ use super::{GpuProfiler, ScopeId};
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 
-/// What a scope's commands are: picks the label colour and the pipeline stage
-/// of the closing timestamp.
+/// What a scope's commands are: picks the label colour.
 ///
-/// The opening timestamp is written at `ALL_COMMANDS` (once every earlier command
-/// has finished, so a pass's time never includes its predecessor's); the closing
-/// one at the last stage the pass's commands use.
+/// Both timestamps of a scope are written at [`ScopeKind::TIMESTAMP_STAGE`],
+/// `ALL_COMMANDS`: the opening one once every earlier command has finished (a
+/// pass's time never includes its predecessor's), the closing one once the pass's
+/// own commands have. A narrower closing stage (`COMPUTE_SHADER` for a compute
+/// pass) would not wait for earlier work of other stages, so the end could be
+/// stamped before the start.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum ScopeKind {
     /// Compute dispatches (the simulation's stages, the volume step, lookup tables).
@@ -26,18 +28,8 @@ pub(crate) enum ScopeKind {
 }
 
 impl ScopeKind {
-    /// Stage of every opening timestamp.
-    pub(crate) const BEGIN_STAGE: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::ALL_COMMANDS;
-
-    /// Stage of the closing timestamp.
-    pub(crate) fn end_stage(self) -> vk::PipelineStageFlags2 {
-        match self {
-            ScopeKind::Compute => vk::PipelineStageFlags2::COMPUTE_SHADER,
-            ScopeKind::Graphics => vk::PipelineStageFlags2::ALL_GRAPHICS,
-            ScopeKind::Transfer => vk::PipelineStageFlags2::ALL_TRANSFER,
-            ScopeKind::Host => vk::PipelineStageFlags2::ALL_COMMANDS,
-        }
-    }
+    /// Stage of both timestamps of every scope.
+    pub(crate) const TIMESTAMP_STAGE: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::ALL_COMMANDS;
 
     pub(crate) fn label_color(self) -> LabelColor {
         match self {

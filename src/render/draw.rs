@@ -171,25 +171,26 @@ impl DrawPass {
             [(1, inputs.hairs.0), (2, inputs.hairs.1), (6, inputs.shadow_uniforms), (8, inputs.transmittance)];
         let before_update = barrier::memory(&[AccessKind::AnyWrite], &[AccessKind::TransferWrite]);
         let updated = barrier::memory(&[AccessKind::TransferWrite], UNIFORM_READERS);
+        // Made (or found) before anything is recorded: a failure leaves `cmd` as it was.
+        self.pipeline(target.key, &buffers, &images)?;
         // SAFETY: guaranteed by the caller; all objects belong to this device.
         unsafe {
             let scope = RenderPass::Draw.open(d, cmd, profiler);
             d.cmd_barrier(cmd, before.0, &[], before.1);
             // The draw pipeline may sample the Marschner tables: build them first.
             self.marschner.record_update(d, cmd, marschner);
-            let drawn = self.pipeline(target.key, &buffers, &images).map(|(pipeline, set)| {
-                d.cmd_barrier(cmd, &[before_update], &[], &[]);
-                d.raw.cmd_update_buffer(cmd, params_buffer, 0, bytemuck::bytes_of(params));
-                d.cmd_barrier(cmd, &[updated], &[], &[]);
-                d.raw.cmd_begin_rendering(cmd, target.rendering);
-                d.cmd_set_full_viewport(cmd, target.extent);
-                pipeline.bind(cmd, &[*set]);
-                d.raw.cmd_draw(cmd, vertices, 1, 0, 0);
-                d.raw.cmd_end_rendering(cmd);
-            });
+            let (pipeline, set) = &self.pipelines[&target.key];
+            d.cmd_barrier(cmd, &[before_update], &[], &[]);
+            d.raw.cmd_update_buffer(cmd, params_buffer, 0, bytemuck::bytes_of(params));
+            d.cmd_barrier(cmd, &[updated], &[], &[]);
+            d.raw.cmd_begin_rendering(cmd, target.rendering);
+            d.cmd_set_full_viewport(cmd, target.extent);
+            pipeline.bind(cmd, &[*set]);
+            d.raw.cmd_draw(cmd, vertices, 1, 0, 0);
+            d.raw.cmd_end_rendering(cmd);
             scope.close(d, cmd, profiler);
-            drawn
         }
+        Ok(())
     }
 
     /// Builds the Marschner tables for `params` and reads them back (M, then N;

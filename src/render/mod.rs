@@ -270,11 +270,13 @@ impl Renderer {
     /// drawn by [`Renderer::record_shadows`].
     pub fn set_shadows<'a>(&mut self, sim: impl Into<KeyHairs<'a>>, params: &ShadowParams) -> Result<()> {
         let sim = sim.into();
-        if self.shadows.set(&sim, params, self.interpolate.hairs().0)? {
-            // The draw's descriptor sets name the replaced images and buffers.
+        let changed = self.shadows.set(&sim, params, self.interpolate.hairs().0);
+        if !matches!(changed, Ok(false)) {
+            // The draw's descriptor sets name images and buffers that were (or, after
+            // a failure half way, may have been) replaced.
             self.draw.forget();
         }
-        Ok(())
+        changed.map(|_| ())
     }
 }
 
@@ -348,8 +350,9 @@ impl Renderer {
 impl Renderer {
     /// Records the geometry passes (smoothing, interpolation) for `sim`'s latest
     /// state into `cmd`, at the detail for `camera` ([`LodParams`]; full detail
-    /// without a camera). Leaves no state bound that a host relies on: the
-    /// passes bind their own pipelines and set their own viewport and scissor.
+    /// without a camera). Leaves the interpolation pipeline bound and a 1 × 1
+    /// viewport and scissor set: a host binds its own pipeline and state again
+    /// afterwards.
     ///
     /// # Safety
     /// `cmd` is a command buffer of the context's device in the recording state,
@@ -411,7 +414,8 @@ impl Renderer {
     /// Afterwards the atlas ([`Renderer::shadow_atlas`]) is in
     /// `SHADER_READ_ONLY_OPTIMAL`, written by `COLOR_ATTACHMENT_OUTPUT` and made
     /// visible to fragment shaders, for a host that shades its own surfaces with it.
-    /// Viewport and scissor are left set to the last map's tile.
+    /// When a map was drawn, the viewport and scissor are left set to its tile and
+    /// a shadow pipeline stays bound.
     ///
     /// # Safety
     /// As for [`Renderer::record_prepare`], recorded after it (and after `sim`'s step)

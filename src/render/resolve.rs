@@ -232,19 +232,19 @@ impl ResolvePass {
     ) -> Result<()> {
         let d = &self.device;
         let to_sampled = images.to_sampled();
+        // Made (or found) before anything is recorded: a failure leaves `cmd` as it was.
+        let (pipeline, set) = images.pipeline(target.key)?;
         // SAFETY: guaranteed by the caller; the images are this pass's.
         unsafe {
             let scope = RenderPass::Resolve.open(d, cmd, profiler);
-            let resolved = images.pipeline(target.key).map(|(pipeline, set)| {
-                d.cmd_barrier(cmd, &[attachments], &[], &to_sampled);
-                d.raw.cmd_begin_rendering(cmd, target.rendering);
-                d.cmd_set_full_viewport(cmd, target.extent);
-                pipeline.bind(cmd, &[*set]);
-                d.raw.cmd_draw(cmd, 3, 1, 0, 0);
-                d.raw.cmd_end_rendering(cmd);
-            });
+            d.cmd_barrier(cmd, &[attachments], &[], &to_sampled);
+            d.raw.cmd_begin_rendering(cmd, target.rendering);
+            d.cmd_set_full_viewport(cmd, target.extent);
+            pipeline.bind(cmd, &[*set]);
+            d.raw.cmd_draw(cmd, 3, 1, 0, 0);
+            d.raw.cmd_end_rendering(cmd);
             scope.close(d, cmd, profiler);
-            resolved
         }
+        Ok(())
     }
 }

@@ -536,3 +536,30 @@ fn shaders_are_built_with_the_shared_constants() {
         assert!(sources.contains(name), "{name} is injected but no shader uses it");
     }
 }
+
+/// A host including `glsl/include/shadow.glsl` in its own shaders must define
+/// MAX_SHADOW_MAPS, as the README says: without it the header stops compilation
+/// with a message naming the macro; with it, the host's shader compiles.
+#[test]
+fn shadow_header_needs_the_documented_macro() {
+    let include = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl/include");
+    let source = "#version 460\n#include \"shadow.glsl\"\nlayout(location = 0) out vec4 color;\nvoid main() { color = vec4(1.0); }\n";
+    let compile = |define: bool| {
+        let compiler = shaderc::Compiler::new().expect("compiler");
+        let mut options = shaderc::CompileOptions::new().expect("options");
+        options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
+        if define {
+            options.add_macro_definition("MAX_SHADOW_MAPS", Some(&format!("{}u", crate::render::MAX_SHADOW_MAPS)));
+        }
+        let include = include.clone();
+        options.set_include_callback(move |name, _, _, _| {
+            let path = include.join(name);
+            let content = std::fs::read_to_string(&path).map_err(|e| e.to_string())?;
+            Ok(shaderc::ResolvedInclude { resolved_name: path.to_string_lossy().into_owned(), content })
+        });
+        compiler.compile_into_spirv(source, shaderc::ShaderKind::Fragment, "host.frag", "main", Some(&options))
+    };
+    let error = compile(false).err().expect("fails without the macro").to_string();
+    assert!(error.contains("MAX_SHADOW_MAPS"), "{error}");
+    compile(true).expect("compiles with the macro");
+}
