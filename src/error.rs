@@ -149,6 +149,19 @@ pub enum Error {
         /// The OS error.
         source: std::io::Error,
     },
+    /// A parameter file has an unknown key, a value of the wrong type or one outside
+    /// its range: the file, the line (1-based, when known) and the key.
+    #[error("{}{}: {key}: {reason}", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Config {
+        /// The file.
+        path: PathBuf,
+        /// The line of the key, counting from 1.
+        line: Option<usize>,
+        /// The key, with its section (`sim.volume.resolution`).
+        key: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// The file does not start with the format's signature.
     #[error("not a {format} file: {reason}")]
     BadMagic {

@@ -14,7 +14,7 @@ const LAYERS: &[&[&str]] = &[
     &["profiler"],
     &["sim"],
     &["render"],
-    &["schedule"],
+    &["schedule", "config"],
     &["headless"],
 ];
 

@@ -19,7 +19,8 @@ use crate::vk::shaders::RENDER_MARSCHNER_LUT_COMP;
 pub const TABLE_SIZE: u32 = 128;
 
 /// Marschner model parameters (angles in radians).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct MarschnerParams {
     /// Index of refraction of the fiber (1.2..=2.5). Default: 1.55.
     pub eta: f32,

@@ -10,7 +10,8 @@ pub const MAX_SMOOTHING_LEVEL: u32 = 64;
 pub const MAX_HAIRS_PER_KEY: u32 = 64;
 
 /// Rendering parameters.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct RenderParams {
     /// Smoothed segments per key segment (1..=64). Default: 4 (a 6-point key hair
     /// becomes 20 segments, as in the thesis scene).
@@ -39,7 +40,8 @@ pub struct RenderParams {
 }
 
 /// What the draw pass turns each hair segment into.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Primitive {
     /// Camera-facing quads from the geometry stage, [`super::HairMaterial`] widths.
     #[default]
@@ -49,7 +51,8 @@ pub enum Primitive {
 }
 
 /// How the interpolation pass grows hairs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum InterpolationMode {
     /// `hairs_per_key` hairs around each key hair, offset in its frame (thesis 3.2).
     #[default]
@@ -81,7 +84,8 @@ impl Default for RenderParams {
 /// cover screen area) and segments per key segment = round(full · d0/d) (they
 /// follow screen length), each clamped between its minimum and the full count of
 /// [`RenderParams`]; ribbon width grows by √(full hairs / hairs) to keep coverage.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct LodParams {
     /// Whether detail falls with distance. Default: true.
     pub enabled: bool,

@@ -52,7 +52,8 @@ impl Camera {
 }
 
 /// A light.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Light {
     /// Parallel light travelling along `direction`.
     Directional {
@@ -129,7 +130,8 @@ impl Light {
 }
 
 /// How hair is shaded.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ShadingMode {
     /// Kajiya-Kay diffuse and two shifted highlights (Scheuermann; the thesis).
     #[default]
@@ -140,7 +142,8 @@ pub enum ShadingMode {
 }
 
 /// Hair material (Kajiya-Kay diffuse and two shifted specular highlights).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct HairMaterial {
     /// Albedo at the root, linear RGB. Default: dark brown (0.10, 0.05, 0.02).
     pub root_color: Vec3,

@@ -15,7 +15,8 @@ pub const MAX_COLLIDERS: usize = crate::limits::SIM_MAX_COLLIDERS as usize;
 pub const MAX_SIM_POINTS: usize = crate::limits::SIM_WORKGROUP as usize;
 
 /// How the constraints are solved.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum SolverMode {
     /// Position-based dynamics: alternating even/odd distance constraints, bending
     /// and collisions, `iterations` times (the thesis' solver).
@@ -27,7 +28,8 @@ pub enum SolverMode {
 }
 
 /// Tunable simulation parameters (a technical artist's knobs).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct SimParams {
     /// Time step of one simulation step, seconds (0 < dt ≤ 0.1). Default: 1/60.
     pub dt: f32,

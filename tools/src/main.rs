@@ -9,6 +9,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 use glam::Vec3;
 use vkhair::ash::vk;
+use vkhair::config::Config;
 use vkhair::groom::cyhair::HairFile;
 use vkhair::groom::grow::{grow, GrowParams, Scalp};
 use vkhair::groom::mesh::TriMesh;
@@ -43,6 +44,8 @@ enum Command {
     /// Simulate and render a head of hair headless: PNG frames, a contact sheet and a
     /// per-pass GPU timing table.
     Render(render_cmd::RenderArgs),
+    /// Print the default parameters as commented TOML, a starting point for --config.
+    Config,
     /// Chart the render benchmark's CSV (cargo bench --bench render) as a PNG.
     Plot(plot_cmd::PlotArgs),
     /// Resample and/or pick key hairs from a .hair or .tfx file; write a .hair file.
@@ -75,27 +78,31 @@ struct SimulateArgs {
     /// Simulation steps (1/60 s each).
     #[arg(long, default_value_t = 120)]
     steps: usize,
-    /// Constraint iterations.
-    #[arg(long, default_value_t = 20)]
-    iterations: u32,
+    /// Parameter file (TOML, see `vkhair config`); the flags below win over it.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Constraint iterations [default: 20].
+    #[arg(long)]
+    iterations: Option<u32>,
     /// Use the DFTL solver instead of PBD iterations.
     #[arg(long)]
     dftl: bool,
     /// Also run the CPU reference and report the largest position difference.
     #[arg(long)]
     check: bool,
-    /// Volume stage (hair-hair interaction): FLIP on a MAC grid, density friction, or off.
-    #[arg(long, value_enum, default_value = "flip")]
-    volume: VolumeArg,
-    /// Volume grid cells per axis.
-    #[arg(long, default_value_t = 32)]
-    grid: u32,
+    /// Volume stage (hair-hair interaction): FLIP on a MAC grid, density friction,
+    /// or off [default: flip].
+    #[arg(long, value_enum)]
+    volume: Option<VolumeArg>,
+    /// Volume grid cells per axis [default: 32].
+    #[arg(long)]
+    grid: Option<u32>,
     /// Use the Jacobi preconditioner instead of multigrid for the pressure solve.
     #[arg(long)]
     jacobi: bool,
-    /// Iteration cap of the pressure solve.
-    #[arg(long, default_value_t = 40)]
-    max_iterations: u32,
+    /// Iteration cap of the pressure solve [default: 40].
+    #[arg(long)]
+    max_iterations: Option<u32>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -169,6 +176,7 @@ fn main() -> ExitCode {
         Command::Grow(args) => grow_cmd(&args),
         Command::Simulate(args) => simulate(&args),
         Command::Render(args) => render_cmd::render(&args),
+        Command::Config => Config::default().to_commented_toml().map(|text| print!("{text}")).map_err(Into::into),
         Command::Plot(args) => plot_cmd::plot(&args),
         Command::Convert { input, points, key_hairs, out } => convert(&input, points, key_hairs, &out),
     };
@@ -351,6 +359,44 @@ fn convert(input: &Path, points: Option<usize>, key_hairs: Option<usize>, out: &
     Ok(())
 }
 
+/// The simulation parameters: the tool's defaults (FLIP at 32³), then the
+/// `--config` file, then the flags given. Checked before any GPU work.
+fn simulate_params(a: &SimulateArgs) -> Result<SimParams, vkhair::Error> {
+    let base = Config {
+        sim: SimParams { volume: VolumeParams::flip([32, 32, 32]), ..SimParams::default() },
+        ..Config::default()
+    };
+    let config = match &a.config {
+        Some(path) => base.load_over(path)?,
+        None => base,
+    };
+    let mut params = config.sim;
+    if let Some(iterations) = a.iterations {
+        params.iterations = iterations;
+    }
+    if a.dftl {
+        params.solver = SolverMode::Dftl;
+    }
+    if let Some(volume) = a.volume {
+        params.volume.mode = match volume {
+            VolumeArg::Off => VolumeMode::Off,
+            VolumeArg::Flip => VolumeMode::Flip,
+            VolumeArg::Friction => VolumeMode::Friction,
+        };
+    }
+    if let Some(grid) = a.grid {
+        params.volume.resolution = [grid; 3];
+    }
+    if a.jacobi {
+        params.volume.preconditioner = Preconditioner::Jacobi;
+    }
+    if let Some(cap) = a.max_iterations {
+        params.volume.max_iterations = cap;
+    }
+    params.validate()?;
+    Ok(params)
+}
+
 fn simulate(a: &SimulateArgs) -> CliResult {
     let (groom, colliders, label, pivot) = match &a.input {
         None => (scenes::thesis()?, motion::thesis_colliders(), "thesis scene".to_owned(), motion::NECK_PIVOT),
@@ -365,23 +411,7 @@ fn simulate(a: &SimulateArgs) -> CliResult {
             (groom, Vec::new(), path.display().to_string(), pivot)
         }
     };
-    let volume = VolumeParams {
-        mode: match a.volume {
-            VolumeArg::Off => VolumeMode::Off,
-            VolumeArg::Flip => VolumeMode::Flip,
-            VolumeArg::Friction => VolumeMode::Friction,
-        },
-        resolution: [a.grid; 3],
-        preconditioner: if a.jacobi { Preconditioner::Jacobi } else { Preconditioner::Multigrid },
-        max_iterations: a.max_iterations,
-        ..VolumeParams::default()
-    };
-    let params = SimParams {
-        iterations: a.iterations,
-        solver: if a.dftl { SolverMode::Dftl } else { SolverMode::Pbd },
-        volume,
-        ..SimParams::default()
-    };
+    let params = simulate_params(a)?;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let head = |i: usize| motion::shaking_head_about((i + 1) as f32 * params.dt, 0.6, 1.0, pivot);
     let mut sim = HairSim::new(&ctx, &groom, &params, &RigidTransform::default())?;
@@ -393,6 +423,14 @@ fn simulate(a: &SimulateArgs) -> CliResult {
         ctx.info().name,
         a.steps,
         params.dt
+    );
+    println!(
+        "parameters: {} iterations, {:?} solver, volume {:?} at {:?}{}",
+        params.iterations,
+        params.solver,
+        params.volume.mode,
+        params.volume.resolution,
+        a.config.as_ref().map(|c| format!(" (from {} and the flags)", c.display())).unwrap_or_default()
     );
     let mut totals = vec![0.0f64; SimStage::ALL.len()];
     let chunk = 100;

@@ -4,18 +4,16 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
+use vkhair::config::Config;
 use vkhair::groom::cyhair::HairFile;
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::scenes::{self, THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS};
 use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::Groom;
 use vkhair::headless::{MeshDrawer, Offscreen, Submit};
-use vkhair::render::{
-    Camera, HairMaterial, InterpolationMode, Light, Primitive, RenderParams, Renderer, ShadingMode, ShadowCaster,
-    ShadowParams,
-};
+use vkhair::render::{Camera, InterpolationMode, Light, Primitive, Renderer, ShadingMode, ShadowCaster, ShadowParams};
 use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, SchedulerOptions};
-use vkhair::sim::{motion, Collider, RigidTransform, SimParams, VolumeParams};
+use vkhair::sim::{motion, Collider, RigidTransform, VolumeMode, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
 /// `--schedule`: where the simulation runs.
@@ -68,12 +66,16 @@ pub struct RenderArgs {
     /// Resample input strands to this many points (at most 64).
     #[arg(long, default_value_t = 16)]
     points: usize,
-    /// Hairs grown per key hair.
-    #[arg(long, default_value_t = 16)]
-    hairs_per_key: u32,
-    /// Smoothed segments per key segment.
-    #[arg(long, default_value_t = 4)]
-    level: u32,
+    /// Parameter file (TOML, see `vkhair config`): [sim], [render], [[lights]],
+    /// [material]; the flags below win over it.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Hairs grown per key hair [default: 16].
+    #[arg(long)]
+    hairs_per_key: Option<u32>,
+    /// Smoothed segments per key segment [default: 4].
+    #[arg(long)]
+    level: Option<u32>,
     /// Camera distance from the head, meters.
     #[arg(long, default_value_t = 0.9)]
     distance: f32,
@@ -261,27 +263,52 @@ fn contact_sheet(frames: &[Vec<u8>], width: u32, height: u32) -> (u32, u32, Vec<
     (sw, sh, sheet)
 }
 
+/// The parameters: vkhair's defaults, then the `--config` file, then the flags
+/// given; the tool's lights when the file lists none. Checked before any GPU work.
+fn parameters(a: &RenderArgs, center: Vec3) -> Result<Config, vkhair::Error> {
+    let mut config = match &a.config {
+        Some(path) => Config::default().load_over(path)?,
+        None => Config::default(),
+    };
+    let r = &mut config.render;
+    if let Some(level) = a.level {
+        r.smoothing_level = level;
+    }
+    if let Some(hairs) = a.hairs_per_key {
+        r.hairs_per_key = hairs;
+    }
+    r.supersampling |= a.ssaa;
+    r.lod.enabled &= !a.no_lod;
+    if a.barycentric {
+        r.interpolation = InterpolationMode::Barycentric;
+    }
+    if a.lines {
+        r.primitive = Primitive::Lines;
+    }
+    if a.marschner {
+        config.material.shading = ShadingMode::Marschner;
+    }
+    if a.volume_shadows && config.sim.volume.mode == VolumeMode::Off {
+        config.sim.volume = VolumeParams::flip([32, 32, 32]);
+    }
+    if config.lights.is_empty() {
+        config.lights = lights(center);
+    }
+    config.validate()?;
+    Ok(config)
+}
+
 pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let s = scene(a)?;
+    let config = parameters(a, s.center)?;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
-    let mut sim_params = SimParams::default();
-    if a.volume_shadows {
-        sim_params.volume = VolumeParams::flip([32, 32, 32]);
-    }
+    let sim_params = config.sim.clone();
     let options = schedule_options(a)?;
     let mut sim = FrameScheduler::new(&ctx, &s.groom, &sim_params, &RigidTransform::default(), &s.colliders, &options)?;
     println!("simulation: {} ({})", sim.mode().name(), sim.reason());
-    let mut params = RenderParams {
-        smoothing_level: a.level,
-        hairs_per_key: a.hairs_per_key,
-        supersampling: a.ssaa,
-        interpolation: if a.barycentric { InterpolationMode::Barycentric } else { InterpolationMode::SingleStrand },
-        primitive: if a.lines { Primitive::Lines } else { Primitive::Ribbons },
-        ..RenderParams::default()
-    };
-    params.lod.enabled = !a.no_lod;
+    let params = config.render.clone();
     let mut renderer = Renderer::new(&ctx, sim.key_hairs(), &params)?;
-    renderer.set_lights(&lights(s.center))?;
+    renderer.set_lights(&config.lights)?;
     if !a.no_shadows {
         // The thesis' setup: both spot lights cast shadows through their own maps.
         let casters = if a.volume_shadows {
@@ -292,10 +319,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         let shadows = ShadowParams { casters, resolution: a.shadow_resolution, ..ShadowParams::default() };
         renderer.set_shadows(sim.key_hairs(), &shadows)?;
     }
-    if a.marschner {
-        let material = HairMaterial { shading: ShadingMode::Marschner, ..HairMaterial::default() };
-        renderer.set_material(&material)?;
-    }
+    renderer.set_material(&config.material)?;
     let offscreen = Offscreen::new(&ctx, a.width, a.height)?;
     // The head mesh (lit along the key spot light's direction) takes that light's hair
     // shadow the way a host would, through glsl/include/shadow.glsl.

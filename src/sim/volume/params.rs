@@ -6,7 +6,8 @@ use crate::error::{Error, Result};
 pub const MAX_VOLUME_CELLS: u64 = 1 << 22;
 
 /// What the volume stage does with the grid.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum VolumeMode {
     /// No volume stage: key hairs do not interact (the cheapest).
     #[default]
@@ -21,7 +22,8 @@ pub enum VolumeMode {
 }
 
 /// Preconditioner of the conjugate-gradient pressure solve on the GPU.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Preconditioner {
     /// The diagonal of the matrix: cheap per iteration, many iterations.
     Jacobi,
@@ -32,7 +34,8 @@ pub enum Preconditioner {
 }
 
 /// Parameters of the volume stage (hair-hair interaction on a grid).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct VolumeParams {
     /// What the stage does. Default: [`VolumeMode::Off`].
     pub mode: VolumeMode,

@@ -1,0 +1,289 @@
+//! Parameter files: TOML whose keys are the parameter structs' field names.
+//!
+//! | section | struct |
+//! | --- | --- |
+//! | `[sim]` | [`SimParams`] |
+//! | `[sim.volume]` | [`crate::sim::VolumeParams`] |
+//! | `[render]`, `[render.lod]` | [`RenderParams`], [`crate::render::LodParams`] |
+//! | `[[lights]]` | [`Light`], with `kind = "directional"`, `"point"` or `"spot"` |
+//! | `[material]`, `[material.marschner]` | [`HairMaterial`], [`crate::render::MarschnerParams`] |
+//!
+//! Every key is optional: a file sets what it names and keeps everything else
+//! from the configuration it is applied to ([`Config::default`], or a tool's
+//! own defaults). Vectors are arrays (`wind = [5.0, 0.0, 0.0]`), enums are
+//! snake-case strings (`mode = "flip"`). A `[[lights]]` list replaces the
+//! lights as a whole. Units and ranges are those documented on each field.
+//!
+//! An unknown key, a value of the wrong type and a value outside its range are
+//! each an [`Error::Config`] naming the file, the line and the key; nothing
+//! reaches the GPU before a file has been checked.
+//!
+//! ```
+//! use vkhair::config::Config;
+//!
+//! let text = "[sim]\nwind = [5.0, 0.0, 0.0]\nwind_enabled = true\n\n[sim.volume]\nmode = \"flip\"\n";
+//! let config = Config::default().apply(text, "styled.toml".as_ref())?;
+//! assert!(config.sim.wind_enabled);
+//! assert_eq!(config.sim.volume.mode, vkhair::sim::VolumeMode::Flip);
+//! assert_eq!(config.sim.iterations, 20, "unnamed keys keep their defaults");
+//!
+//! let error = Config::default().apply("[sim]\nitrations = 4\n", "typo.toml".as_ref()).unwrap_err();
+//! assert_eq!(error.to_string().lines().next(), Some("typo.toml:2: sim.itrations: unknown key"));
+//! # Ok::<(), vkhair::Error>(())
+//! ```
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::render::{HairMaterial, Light, RenderParams, MAX_LIGHTS};
+use crate::sim::SimParams;
+
+/// Everything a parameter file can set.
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Config {
+    /// Simulation parameters (`[sim]`, `[sim.volume]`).
+    pub sim: SimParams,
+    /// Rendering parameters (`[render]`, `[render.lod]`).
+    pub render: RenderParams,
+    /// The lights (`[[lights]]`, at most [`MAX_LIGHTS`]). Default: none, which
+    /// leaves the choice to the program (the `vkhair` tool lights the head with
+    /// its own three).
+    pub lights: Vec<Light>,
+    /// The hair material (`[material]`, `[material.marschner]`).
+    pub material: HairMaterial,
+}
+
+impl Config {
+    /// Reads `path` and applies it over `self` (see [`Config::apply`]).
+    pub fn load_over(&self, path: &Path) -> Result<Config> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.into(), source })?;
+        self.apply(&text, path)
+    }
+
+    /// Applies the TOML `text` of the file `path` over `self`: the keys the file
+    /// names replace those of `self`. The file is checked on its own first (every
+    /// key known, every value of its field's type), then the result is validated;
+    /// either failure is an [`Error::Config`] naming `path`, the line and the key.
+    pub fn apply(&self, text: &str, path: &Path) -> Result<Config> {
+        let error = |offset: Option<usize>, key: Option<String>, reason: String| {
+            let line = offset.map(|o| line_of(text, o));
+            let key = key.or_else(|| offset.map(|o| key_at(text, o))).unwrap_or_default();
+            Error::Config { path: path.into(), line, key, reason }
+        };
+        let file: toml::Table = text
+            .parse()
+            .map_err(|e: toml::de::Error| error(e.span().map(|s| s.start), None, e.message().trim().to_owned()))?;
+        // On its own, so that unknown keys and wrong types come with their place.
+        toml::from_str::<Config>(text).map_err(|e| error(e.span().map(|s| s.start), None, describe(e.message())))?;
+        let mut merged = toml::Table::try_from(self).map_err(|e| error(None, None, e.to_string()))?;
+        merge(&mut merged, file);
+        let config: Config =
+            merged.try_into().map_err(|e: toml::de::Error| error(None, None, e.message().trim().to_owned()))?;
+        config.validate().map_err(|e| match e {
+            Error::InvalidParameter { name, value, allowed } => {
+                let (offset, key) = find_key(text, name);
+                error(offset, Some(key), format!("{value} is not allowed ({allowed})"))
+            }
+            other => error(None, None, other.to_string()),
+        })?;
+        Ok(config)
+    }
+
+    /// Checks every parameter; the error names the first bad one.
+    pub fn validate(&self) -> Result<()> {
+        self.sim.validate()?;
+        self.render.validate()?;
+        self.material.validate()?;
+        if self.lights.len() > MAX_LIGHTS {
+            return Err(Error::param("lights", self.lights.len(), format!("at most {MAX_LIGHTS}")));
+        }
+        self.lights.iter().try_for_each(|l| l.to_gpu().map(|_| ()))
+    }
+
+    /// This configuration as TOML with every key commented out, under a header
+    /// that says how to use it: what `vkhair config` prints (for the defaults).
+    pub fn to_commented_toml(&self) -> Result<String> {
+        let body = toml::to_string(self)
+            .map_err(|e| Error::param("config", "a configuration", format!("one TOML can hold: {e}")))?;
+        let mut out = String::from(
+            "# vkhair parameters. Uncomment and change the keys you need; every key is\n\
+             # optional and keeps the value shown when left out. Units and ranges are\n\
+             # documented on the fields of SimParams ([sim]), VolumeParams ([sim.volume]),\n\
+             # RenderParams ([render]), Light ([[lights]]) and HairMaterial ([material]).\n",
+        );
+        for line in body.lines() {
+            let header = line.starts_with('[') && !line.starts_with("[[");
+            match (line.trim().is_empty(), header) {
+                (true, _) => out.push('\n'),
+                (false, true) => {
+                    out.push_str(line);
+                    out.push('\n');
+                }
+                (false, false) => {
+                    out.push_str("# ");
+                    out.push_str(line);
+                    out.push('\n');
+                }
+            }
+        }
+        if self.lights.is_empty() {
+            out.push_str(
+                "\n# Lights, when listed, replace the program's own; for example:\n\
+                 #     [[lights]]\n\
+                 #     kind = \"directional\"\n\
+                 #     direction = [0.0, -1.0, -1.0]\n\
+                 #     color = [1.0, 1.0, 1.0]\n",
+            );
+        }
+        Ok(out)
+    }
+}
+
+/// Puts every key of `file` into `base`, descending into tables both have.
+fn merge(base: &mut toml::Table, file: toml::Table) {
+    for (key, value) in file {
+        match (base.get_mut(&key), value) {
+            (Some(toml::Value::Table(inner)), toml::Value::Table(value)) => merge(inner, value),
+            (_, value) => {
+                base.insert(key, value);
+            }
+        }
+    }
+}
+
+/// serde's "unknown field `x`, expected one of …" as "unknown key"; other
+/// messages as they are.
+fn describe(message: &str) -> String {
+    let message = message.trim();
+    if message.starts_with("unknown field") {
+        "unknown key".to_owned()
+    } else {
+        message.to_owned()
+    }
+}
+
+/// The 1-based line of byte `offset`.
+fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+/// The dotted key of the line holding `offset` (`section.key`), from the last
+/// `[section]` header above it.
+fn key_at(text: &str, offset: usize) -> String {
+    let line = line_of(text, offset);
+    let lines: Vec<&str> = text.lines().collect();
+    let own = lines.get(line - 1).copied().unwrap_or_default();
+    let key = own.split('=').next().unwrap_or_default().trim().trim_matches(['[', ']']).trim();
+    let section = lines[..line.saturating_sub(1).min(lines.len())]
+        .iter()
+        .rev()
+        .map(|l| l.trim())
+        .find(|l| l.starts_with('['))
+        .map(|l| l.trim_matches(['[', ']']).trim().to_owned());
+    match section {
+        Some(s) if !s.is_empty() && !key.starts_with(&s) => format!("{s}.{key}"),
+        _ => key.to_owned(),
+    }
+}
+
+/// Where the parameter a validation error names is set in `text`: its last
+/// word is the field (`"volume resolution"` → `resolution`). The byte offset of
+/// the first line setting it, and its dotted key.
+fn find_key(text: &str, name: &str) -> (Option<usize>, String) {
+    let field = name.rsplit(' ').next().unwrap_or(name);
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        let key = line.split('=').next().unwrap_or_default().trim();
+        if line.contains('=') && key == field {
+            return (Some(offset), key_at(text, offset));
+        }
+        offset += line.len();
+    }
+    (None, field.to_owned())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn apply(text: &str) -> Result<Config> {
+        Config::default().apply(text, Path::new("test.toml"))
+    }
+
+    fn config_error(text: &str) -> (Option<usize>, String, String) {
+        match apply(text) {
+            Err(Error::Config { path, line, key, reason }) => {
+                assert_eq!(path, Path::new("test.toml"));
+                (line, key, reason)
+            }
+            other => panic!("expected a config error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn the_defaults_round_trip() {
+        let defaults = Config::default();
+        let text = toml::to_string(&defaults).expect("serialise");
+        assert_eq!(apply(&text).expect("parse"), defaults);
+        // The commented form parses (every key commented out) and, uncommented,
+        // gives the defaults back.
+        let commented = defaults.to_commented_toml().expect("commented");
+        assert_eq!(apply(&commented).expect("parse commented"), defaults);
+        let uncommented: String = commented
+            .lines()
+            .map(|l| l.strip_prefix("# ").filter(|r| r.contains(" = ") && !r.starts_with(' ')).unwrap_or(l))
+            .collect::<Vec<_>>()
+            .join("\n");
+        assert_eq!(apply(&uncommented).expect("parse uncommented"), defaults);
+    }
+
+    #[test]
+    fn a_file_sets_only_what_it_names() {
+        let base = Config { sim: SimParams { iterations: 7, ..SimParams::default() }, ..Config::default() };
+        let text = "[sim]\nwind = [5.0, 0.0, 0.0]\nwind_enabled = true\n[sim.volume]\nresolution = [16, 16, 8]\n\
+                    [[lights]]\nkind = \"spot\"\nposition = [0.0, 2.0, 1.0]\ndirection = [0.0, -1.0, -0.5]\n\
+                    outer_angle = 0.5\ninner_angle = 0.3\ncolor = [2.0, 2.0, 2.0]\n";
+        let c = base.apply(text, Path::new("test.toml")).expect("apply");
+        assert_eq!(c.sim.iterations, 7, "kept from the base");
+        assert_eq!(c.sim.wind, glam::Vec3::new(5.0, 0.0, 0.0));
+        assert!(c.sim.wind_enabled);
+        assert_eq!(c.sim.volume.resolution, [16, 16, 8]);
+        assert_eq!(c.sim.volume.mode, crate::sim::VolumeMode::Off, "kept from the base");
+        assert!(matches!(c.lights.as_slice(), [Light::Spot { outer_angle, .. }] if *outer_angle == 0.5));
+    }
+
+    #[test]
+    fn an_unknown_key_names_its_line_and_key() {
+        let (line, key, reason) = config_error("[sim]\ndt = 0.01\n\n[sim.volume]\nresolutoin = [8, 8, 8]\n");
+        assert_eq!((line, key.as_str(), reason.as_str()), (Some(5), "sim.volume.resolutoin", "unknown key"));
+        let (line, key, _) = config_error("colour = 1\n");
+        assert_eq!((line, key.as_str()), (Some(1), "colour"));
+    }
+
+    #[test]
+    fn a_wrong_type_names_its_line_and_key() {
+        let (line, key, reason) = config_error("[render]\nhairs_per_key = 16\nsupersampling = \"yes\"\n");
+        assert_eq!((line, key.as_str()), (Some(3), "render.supersampling"));
+        assert!(reason.contains("bool"), "{reason}");
+        let (line, key, _) = config_error("[sim.volume]\nmode = \"turbulent\"\n");
+        assert_eq!((line, key.as_str()), (Some(2), "sim.volume.mode"));
+    }
+
+    #[test]
+    fn an_out_of_range_value_names_its_line_and_key() {
+        let (line, key, reason) = config_error("[sim]\nwind_enabled = true\niterations = 0\n");
+        assert_eq!((line, key.as_str()), (Some(3), "sim.iterations"));
+        assert!(reason.contains("1..=1000"), "{reason}");
+        let (line, key, _) = config_error("[material]\nambient = 2.0\n");
+        assert_eq!((line, key.as_str()), (Some(2), "material.ambient"));
+        let (line, key, _) = config_error("[sim.volume]\nresolution = [8, 8, 300]\n");
+        assert_eq!((line, key.as_str()), (Some(2), "sim.volume.resolution"));
+    }
+
+    #[test]
+    fn a_syntax_error_names_its_line() {
+        let (line, _, _) = config_error("[sim]\ndt = 0.01\nwind = [1.0, 2.0\n");
+        assert!(matches!(line, Some(3) | Some(4)), "{line:?}");
+    }
+}

@@ -1,0 +1,73 @@
+//! `vkhair config` and `--config` as a user meets them: the printed defaults
+//! are a valid file, a bad file is rejected with its place before any GPU
+//! work, and flags win over the file.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn vkhair() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_vkhair"))
+}
+
+fn temp(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("vkhair-config-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join(name);
+    std::fs::write(&path, text).expect("write");
+    path
+}
+
+#[test]
+fn printed_defaults_are_a_valid_parameter_file() {
+    let out = vkhair().arg("config").output().expect("run");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).expect("utf-8");
+    assert!(text.contains("[sim.volume]") && text.contains("# iterations = 20"), "{text}");
+    // Uncommented, it is a file that sets every default explicitly.
+    let uncommented: String = text
+        .lines()
+        .map(|l| l.strip_prefix("# ").filter(|r| r.contains(" = ") && !r.starts_with(' ')).unwrap_or(l))
+        .filter(|l| !l.starts_with("# ") && !l.starts_with('#'))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let path = temp("defaults.toml", &uncommented);
+    let out =
+        vkhair().args(["simulate", "--steps", "1", "--volume", "off", "--config"]).arg(&path).output().expect("run");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("parameters: 20 iterations, Pbd solver, volume Off"), "{stdout}");
+}
+
+#[test]
+fn a_bad_file_is_rejected_with_its_place_before_any_gpu_work() {
+    let cases = [
+        ("unknown.toml", "[sim]\ndt = 0.01\nitrations = 4\n", "unknown.toml:3: sim.itrations: unknown key"),
+        ("type.toml", "[sim.volume]\nmode = 3\n", "type.toml:2: sim.volume.mode"),
+        ("range.toml", "[render]\nhairs_per_key = 99\n", "range.toml:2: render.hairs_per_key: 99 is not allowed"),
+    ];
+    for (name, text, expected) in cases {
+        let path = temp(name, text);
+        for command in ["simulate", "render"] {
+            let out = vkhair().args([command, "--config"]).arg(&path).output().expect("run");
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(1), "{command} {name}: {stderr}");
+            assert!(stderr.contains(expected), "{command} {name}: {stderr}");
+            let stdout = String::from_utf8_lossy(&out.stdout);
+            assert!(!stdout.contains("simulation") && !stdout.contains("key hairs"), "GPU work started: {stdout}");
+        }
+    }
+}
+
+#[test]
+fn flags_win_over_the_file() {
+    let path = temp("styled.toml", "[sim]\niterations = 5\nwind = [5.0, 0.0, 0.0]\nwind_enabled = true\n[sim.volume]\nmode = \"friction\"\nresolution = [8, 8, 8]\n");
+    let run = |extra: &[&str]| {
+        let out = vkhair().args(["simulate", "--steps", "1", "--config"]).arg(&path).args(extra).output().expect("run");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let from_file = run(&[]);
+    assert!(from_file.contains("parameters: 5 iterations, Pbd solver, volume Friction at [8, 8, 8]"), "{from_file}");
+    let overridden = run(&["--iterations", "7", "--volume", "off"]);
+    assert!(overridden.contains("parameters: 7 iterations, Pbd solver, volume Off at [8, 8, 8]"), "{overridden}");
+}
