@@ -9,3 +9,6 @@ export VKHAIR_VALIDATION=1
 # Quiet loader noise about XDG_RUNTIME_DIR on headless machines.
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-$(mktemp -d)}
 cargo test --workspace --locked "$@"
+# The documentation builds without a warning (broken links, missing docs).
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked --quiet
+echo "docs: cargo doc has no warnings"

@@ -5,7 +5,7 @@ use super::{reference, volume, Collider, RigidTransform, SimParams, SimState, Vo
 use crate::error::Result;
 use crate::groom::Groom;
 
-/// The CPU reference simulation: the same algorithm as [`HairSim`], one particle
+/// The CPU reference simulation: the same algorithm as [`HairSim`](super::HairSim), one particle
 /// at a time. Used as the oracle of the GPU tests and as the benchmark baseline.
 ///
 /// ```
@@ -29,13 +29,13 @@ pub struct CpuHairSim {
 }
 
 impl CpuHairSim {
-    /// See [`HairSim::new`].
+    /// See [`HairSim::new`](super::HairSim::new).
     pub fn new(groom: &Groom, params: &SimParams, head: &RigidTransform) -> Result<Self> {
         let state = SimState::from_groom(groom, params, head)?;
         Self::from_state(state, params, head)
     }
 
-    /// See [`HairSim::from_state`].
+    /// See [`HairSim::from_state`](super::HairSim::from_state).
     pub fn from_state(state: SimState, params: &SimParams, head: &RigidTransform) -> Result<Self> {
         // The CPU runs the same constraint sets in the same order whatever the packing.
         let planner = SubstepPlanner::new(params, head, state.strands, state.points, MAX_SIM_POINTS as u32)?;
@@ -43,19 +43,19 @@ impl CpuHairSim {
         Ok(CpuHairSim { planner, state, volume, last_volume: None })
     }
 
-    /// See [`HairSim::set_params`].
+    /// See [`HairSim::set_params`](super::HairSim::set_params).
     pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
         params.validate()?;
         self.volume = cpu_volume_grid(params, &self.state)?;
         self.planner.set_params(params)
     }
 
-    /// See [`HairSim::set_colliders`].
+    /// See [`HairSim::set_colliders`](super::HairSim::set_colliders).
     pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
         self.planner.set_colliders(colliders)
     }
 
-    /// See [`HairSim::set_strand_length`].
+    /// See [`HairSim::set_strand_length`](super::HairSim::set_strand_length).
     pub fn set_strand_length(&mut self, strand: usize, length: f32) -> Result<()> {
         self.state.set_strand_length(strand, length).map(|_| ())
     }

@@ -66,8 +66,8 @@ pub struct RenderArgs {
     /// Resample input strands to this many points (at most 64).
     #[arg(long, default_value_t = 16)]
     points: usize,
-    /// Parameter file (TOML, see `vkhair config`): [sim], [render], [[lights]],
-    /// [material]; the flags below win over it.
+    /// Parameter file (TOML, see `vkhair config`): simulation, rendering, lights and
+    /// material; the flags below win over it.
     #[arg(long)]
     config: Option<PathBuf>,
     /// Hairs grown per key hair [default: 16].
