@@ -57,8 +57,11 @@ pub(crate) struct SimStepParams {
     pub counts: [u32; 4],
     /// x colliders, y hairs per workgroup, z step index, w solver sync group size.
     pub layout_info: [u32; 4],
+    /// x global shape stiffness per iteration at full strength, y its range
+    /// (fraction of the strand from the root).
+    pub shape: [f32; 4],
 }
-gpu_struct!(SimStepParams => "SimStepParams" { head, gravity_dt, wind, wind_noise, bending, counts, layout_info });
+gpu_struct!(SimStepParams => "SimStepParams" { head, gravity_dt, wind, wind_noise, bending, counts, layout_info, shape });
 
 impl SimStepParams {
     /// Gravity, m/s².
@@ -96,6 +99,10 @@ impl SimStepParams {
     /// Hairs per solver workgroup.
     pub fn hairs_per_group(&self) -> u32 {
         self.layout_info[1]
+    }
+    /// Global shape stiffness per iteration at full strength, and its range.
+    pub fn global_shape(&self) -> (f32, f32) {
+        (self.shape[0], self.shape[1])
     }
 }
 

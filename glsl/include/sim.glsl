@@ -16,6 +16,7 @@ struct SimStepParams {
     vec4 bending;         // x stiffness per iteration at the root, y at the tip, z DFTL velocity damping, w unused
     uvec4 counts;         // x strands, y points per strand, z iterations, w flags (SIM_*)
     uvec4 layout_info;    // x colliders, y hairs per workgroup, z step index, w sync group size
+    vec4 shape;           // x global shape stiffness per iteration, y its range (strand fraction), zw unused
 };
 
 // One collider in world space. Twin: gpu_types::GpuCollider.
@@ -30,6 +31,7 @@ const uint SIM_SPRING = 4u;
 const uint SIM_BENDING = 8u;
 const uint SIM_COLLISIONS = 16u;
 const uint SIM_DFTL = 32u;
+const uint SIM_GLOBAL_SHAPE = 64u;
 
 // SIM_MAX_COLLIDERS (sim::MAX_COLLIDERS) and SIM_WORKGROUP are injected by
 // build.rs from src/limits.rs.
@@ -75,6 +77,16 @@ vec3 sim_collide(Collider c, vec3 p, float radius) {
         return out_p;
     }
     return p;
+}
+
+// Weight of the global shape constraint at strand parameter t (0 root, 1 tip):
+// 1 up to `range`, falling linearly to 0 over the next quarter of the strand.
+float sim_shape_weight(float t, float range) {
+    if (t <= range) {
+        return 1.0;
+    }
+    precise float w = (range + 0.25 - t) * 4.0;
+    return max(w, 0.0);
 }
 
 #endif

@@ -8,7 +8,9 @@
 //   1. distance constraints of even segments, 2. of odd segments,
 //   3. bending (distance between points i−1 and i+1, rest from the rest shape,
 //      stiffness from root to tip) centred on i mod 4 ∈ {0,1}, 4. on {2,3},
-//   5. body collisions (spheres, capsules; each particle has its own radius),
+//   5. the global shape constraint (each point pulled toward its rest position in
+//      the head's frame; it touches only the own point) and body collisions
+//      (spheres, capsules; each particle has its own radius),
 // then writes the hairs back once.
 //
 // Both ends of a constraint compute the same correction from the same two
@@ -108,6 +110,9 @@ void main() {
     uint base = strand * points;
 
     bool collisions = (flags & SIM_COLLISIONS) != 0u;
+    bool global_shape = (flags & SIM_GLOBAL_SHAPE) != 0u;
+    vec3 shape_target = vec3(0.0);
+    float shape_k = 0.0;
     bool bending = (flags & SIM_BENDING) != 0u;
     vec4 own = vec4(0.0);
     float radius = 0.0;
@@ -122,6 +127,12 @@ void main() {
         s_pos[0][lid] = own;
         s_length[lid] = rest_length[index];
         radius = rest[index].w;
+        if (global_shape) {
+            shape_target = sim_transform_point(params.head, rest[index].xyz);
+            precise float t = float(i) / float(points - 1u);
+            precise float k = params.shape.x * sim_shape_weight(t, params.shape.y);
+            shape_k = k;
+        }
         bool has_next = i + 1u < points;
         float len_next = rest_length[index];
         float len_prev = i > 0u ? rest_length[index - 1u] : 0.0;
@@ -198,6 +209,10 @@ void main() {
         sync(group);
         src = 1u - src;
         own = project_end(own, lid, off_bend_b, first_bend_b, bend_b.x, bend_b.y, src);
+        if (global_shape && live && own.w > 0.0 && shape_k > 0.0) {
+            precise vec3 pulled = own.xyz + (shape_target - own.xyz) * shape_k;
+            own.xyz = pulled;
+        }
         if (collisions && live && own.w > 0.0) {
             own.xyz = collide_all(own.xyz, radius);
         }

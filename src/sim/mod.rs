@@ -12,7 +12,9 @@
 //! 2. **Solve** (`solve.rs`, `glsl/sim/solve.comp`): ONE dispatch, one
 //!    workgroup per group of key hairs, positions in shared memory; for N
 //!    iterations the even then odd distance constraints, two sets of bending
-//!    constraints and the body collisions, separated by `barrier()`; one
+//!    constraints, the global shape constraint (each particle pulled toward its
+//!    rest position in the head frame, [`SimParams::global_shape_stiffness`]) and
+//!    the body collisions, separated by `barrier()`; one
 //!    global write at the end. DFTL mode replaces this with one
 //!    follow-the-leader sweep and stores correction vectors.
 //! 3. **Integrate** (`integrate.rs`, `glsl/sim/integrate.comp`): velocity from

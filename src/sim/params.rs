@@ -64,6 +64,16 @@ pub struct SimParams {
     pub bending_tip: f32,
     /// Whether bending constraints act. Default: true.
     pub bending_enabled: bool,
+    /// Global shape constraint (PBD solver): fraction of each particle's offset from
+    /// its rest position in the head's frame removed per sub-step, independent of
+    /// the iteration count (0..=1; 0 switches it off). What holds a styled groom's
+    /// shape near the scalp against gravity; see `global_shape_range`. Default: 0.
+    pub global_shape_stiffness: f32,
+    /// Fraction of each strand, from the root, where the global shape constraint
+    /// acts at full strength (0..=1); beyond it the constraint fades linearly to
+    /// nothing over the next quarter of the strand, so that the rest swings freely.
+    /// 1 holds the whole strand. Default: 0.5.
+    pub global_shape_range: f32,
     /// Whether body collisions act. Default: true.
     pub collisions_enabled: bool,
     /// Fraction of velocity removed per sub-step (0..1). Default: 0.02.
@@ -107,6 +117,8 @@ impl Default for SimParams {
             bending_root: 0.6,
             bending_tip: 0.1,
             bending_enabled: true,
+            global_shape_stiffness: 0.0,
+            global_shape_range: 0.5,
             collisions_enabled: true,
             damping: 0.02,
             dftl_damping: 0.9,
@@ -154,6 +166,8 @@ impl SimParams {
         in_range("spring_stiffness", self.spring_stiffness, 0.0, 1e6)?;
         in_range("bending_root", self.bending_root, 0.0, 1.0)?;
         in_range("bending_tip", self.bending_tip, 0.0, 1.0)?;
+        in_range("global_shape_stiffness", self.global_shape_stiffness, 0.0, 1.0)?;
+        in_range("global_shape_range", self.global_shape_range, 0.0, 1.0)?;
         in_range("damping", self.damping, 0.0, 0.999)?;
         in_range("dftl_damping", self.dftl_damping, 0.0, 1.0)?;
         in_range("pearl_radius_root", self.pearl_radius_root, 0.0, 1e6)?;
@@ -284,6 +298,7 @@ pub(crate) mod flags {
     pub const BENDING: u32 = 8;
     pub const COLLISIONS: u32 = 16;
     pub const DFTL: u32 = 32;
+    pub const GLOBAL_SHAPE: u32 = 64;
 }
 
 /// Everything one sub-step needs, identical for the GPU stages and the CPU reference.
@@ -381,6 +396,7 @@ impl SubstepPlanner {
         flags |= if p.bending_enabled { flags::BENDING } else { 0 };
         flags |= if p.collisions_enabled { flags::COLLISIONS } else { 0 };
         flags |= if p.solver == SolverMode::Dftl { flags::DFTL } else { 0 };
+        flags |= if p.global_shape_stiffness > 0.0 { flags::GLOBAL_SHAPE } else { 0 };
         let packing = self.packing();
         let inputs = (0..p.substeps)
             .map(|k| {
@@ -396,6 +412,7 @@ impl SubstepPlanner {
                         wind_noise: [p.wind_frequency, t, p.spring_stiffness, p.damping],
                         bending: [p.per_iteration(p.bending_root), p.per_iteration(p.bending_tip), p.dftl_damping, 0.0],
                         counts: [self.strands, self.points, p.iterations, flags],
+                        shape: [p.per_iteration(p.global_shape_stiffness), p.global_shape_range, 0.0, 0.0],
                         layout_info: [
                             self.colliders.len() as u32,
                             packing.hairs_per_group,

@@ -62,6 +62,16 @@ fn collide_all(colliders: &[GpuCollider], mut p: Vec3, radius: f32) -> Vec3 {
     p
 }
 
+/// Weight of the global shape constraint at strand parameter `t`, as
+/// `sim_shape_weight` in `glsl/include/sim.glsl`.
+pub(crate) fn shape_weight(t: f32, range: f32) -> f32 {
+    if t <= range {
+        1.0
+    } else {
+        ((range + 0.25 - t) * 4.0).max(0.0)
+    }
+}
+
 fn project(s: &mut [Vec4], i: usize, j: usize, rest_d: f32, k: f32) {
     let (a, b) = (s[i], s[j]);
     let w = a.w + b.w;
@@ -158,6 +168,18 @@ fn solve(
             }
         }
         let bending = flags & flags::BENDING != 0;
+        let global_shape = flags & flags::GLOBAL_SHAPE != 0;
+        let (shape_stiffness, shape_range) = p.global_shape();
+        let shape: Vec<(Vec3, f32)> = (0..points)
+            .map(|i| {
+                if !global_shape {
+                    return (Vec3::ZERO, 0.0);
+                }
+                let target = transform_point(&p.head, state.rest[base + i].truncate());
+                let t = i as f32 / (points - 1) as f32;
+                (target, shape_stiffness * shape_weight(t, shape_range))
+            })
+            .collect();
         for _ in 0..p.iterations() {
             for i in (0..points - 1).step_by(2) {
                 project(&mut s, i, i + 1, lengths[i], 1.0);
@@ -171,6 +193,13 @@ fn solve(
                         if k > 0.0 && (i & 3) >= phase && (i & 3) < phase + 2 {
                             project(&mut s, i - 1, i + 1, rest_d, k);
                         }
+                    }
+                }
+            }
+            if global_shape {
+                for (q, &(target, k)) in s.iter_mut().zip(&shape) {
+                    if q.w > 0.0 && k > 0.0 {
+                        *q = (q.truncate() + (target - q.truncate()) * k).extend(q.w);
                     }
                 }
             }
