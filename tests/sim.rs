@@ -390,39 +390,106 @@ fn gpu_matches_cpu_with_the_global_shape_constraint() {
     compare(gpu.ctx(), &common::grown_groom(150, 12, 5), &params, &[1, 60]);
 }
 
-/// Tip displacement from the rest shape after `steps` still steps, as fractions
-/// of the strand length (10 cm), sorted.
-fn tip_drift(gpu: &Gpu, params: &SimParams, steps: usize) -> Vec<f32> {
-    let groom = mohawk(200, 8);
-    let still = RigidTransform::default();
-    let mut sim = HairSim::new(gpu.ctx(), &groom, params, &still).expect("sim");
-    sim.set_colliders(&head_sphere()).expect("colliders");
-    sim.run(steps, |_| still, None).expect("run");
-    let state = sim.read_state().expect("readback");
-    assert_finite(&state);
+/// Helix curls: `strands` strands of 16 points standing out from the top of the
+/// head sphere, each a helix of 1 cm radius and 2.5 cm pitch around its normal,
+/// about 10 cm long along the axis.
+fn curls(strands: usize) -> Groom {
+    let strands: Vec<Vec<Vec3>> = (0..strands)
+        .map(|s| {
+            let a = s as f32 * 2.399; // golden-angle spiral over a cap
+            let r = 0.6 * ((s as f32 + 0.5) / strands as f32).sqrt();
+            let normal = Vec3::new(r * a.cos(), 1.0, r * a.sin()).normalize();
+            let (u, v) = normal.any_orthonormal_pair();
+            (0..16)
+                .map(|i| {
+                    let t = i as f32 / 15.0;
+                    let turn = std::f32::consts::TAU * 4.0 * t;
+                    let radius = 0.01 * t.min(0.1) * 10.0; // grows out of the root
+                    normal * (0.1 + 0.1 * t) + (u * turn.cos() + v * turn.sin() - u) * radius
+                })
+                .collect()
+        })
+        .collect();
+    Groom::from_strands(&strands).expect("curls")
+}
+
+/// Style parameters a groom holds its shape with: a soft global shape
+/// constraint over the whole strand, with the sag-free rest state (default).
+fn styled() -> SimParams {
+    SimParams { global_shape_stiffness: 0.15, global_shape_range: 1.0, ..SimParams::default() }
+}
+
+/// Per strand, the largest distance of a tip from where the rest shape carried
+/// rigidly by the head puts it, as a fraction of the strand's rest length,
+/// sorted.
+fn tip_drift_of(state: &SimState, head: &RigidTransform) -> Vec<f32> {
+    let m = head.matrix();
     let mut drift: Vec<f32> = (0..state.strands)
         .map(|s| {
             let tip = s * state.points + state.points - 1;
-            (state.positions[tip] - state.rest[tip]).truncate().length() / 0.1
+            let length = state.rest_strand_length(s);
+            (state.positions[tip].truncate() - m.transform_point3(state.rest[tip].truncate())).length() / length
         })
         .collect();
     drift.sort_by(f32::total_cmp);
     drift
 }
 
-/// The global shape constraint over the whole strand holds an upright mohawk
-/// against gravity (tip drift p95 ≤ 2 % of the strand length after 300 still
-/// steps); without it the same mohawk falls over.
+fn p(drift: &[f32], percent: usize) -> f32 {
+    drift[(drift.len() - 1) * percent / 100]
+}
+
+/// Tip drift after `steps` steps of `groom` on the head sphere with the head at `head(i)`.
+fn run_on_sphere(
+    gpu: &Gpu,
+    groom: &Groom,
+    params: &SimParams,
+    steps: usize,
+    head: impl Fn(usize) -> RigidTransform,
+) -> Vec<f32> {
+    let start = RigidTransform::default();
+    let mut sim = HairSim::new(gpu.ctx(), groom, params, &start).expect("sim");
+    sim.set_colliders(&head_sphere()).expect("colliders");
+    sim.run(steps, &head, None).expect("run");
+    let state = sim.read_state().expect("readback");
+    assert_finite(&state);
+    tip_drift_of(&state, &head(steps - 1))
+}
+
+/// With the head still for 300 steps, styled grooms keep their shape: tip drift
+/// p95 ≤ 2 % of the strand length for an upright mohawk, helix curls and a bob;
+/// without the global shape constraint the mohawk falls over.
 #[test]
-fn the_global_shape_constraint_holds_an_upright_mohawk() {
+fn styled_grooms_hold_their_shape_with_the_head_still() {
     let gpu = Gpu::new();
-    let held = SimParams { global_shape_stiffness: 0.9, global_shape_range: 1.0, ..SimParams::default() };
-    let drift = tip_drift(&gpu, &held, 300);
-    let p95 = drift[drift.len() * 95 / 100];
-    eprintln!("held: tip drift p50 {:.4}, p95 {p95:.4} of the strand length", drift[drift.len() / 2]);
-    assert!(p95 <= 0.02, "tip drift p95 {p95} with the global shape constraint");
-    let free = tip_drift(&gpu, &SimParams::default(), 300);
-    let free_p50 = free[free.len() / 2];
-    eprintln!("free: tip drift p50 {free_p50:.4}");
-    assert!(free_p50 > 0.2, "without the constraint the mohawk should fall: p50 {free_p50}");
+    let still = |_| RigidTransform::default();
+    for (name, groom) in [("mohawk", mohawk(200, 8)), ("curls", curls(60)), ("bob", common::grown_groom(200, 12, 3))] {
+        let drift = run_on_sphere(&gpu, &groom, &styled(), 300, still);
+        eprintln!("{name}: tip drift p50 {:.4}, p95 {:.4} of the strand length", p(&drift, 50), p(&drift, 95));
+        assert!(p(&drift, 95) <= 0.02, "{name}: tip drift p95 {}", p(&drift, 95));
+    }
+    let free = run_on_sphere(&gpu, &mohawk(200, 8), &SimParams::default(), 300, still);
+    eprintln!("mohawk without the constraint: tip drift p50 {:.4}", p(&free, 50));
+    assert!(p(&free, 50) > 0.2, "without the constraint the mohawk should fall: {}", p(&free, 50));
+    let sagging = SimParams { sag_free: false, ..styled() };
+    let sag = run_on_sphere(&gpu, &mohawk(200, 8), &sagging, 300, still);
+    eprintln!("mohawk without the sag-free rest state: tip drift p50 {:.4}", p(&sag, 50));
+    assert!(p(&sag, 50) > 2.0 * p(&run_on_sphere(&gpu, &mohawk(200, 8), &styled(), 300, still), 50));
+}
+
+/// The style is not a rigid helmet: wind of 5 m/s² moves the mohawk's tips by at
+/// least 3 % of their length, and while the head shakes the tips lag it.
+#[test]
+fn styled_grooms_still_move() {
+    let gpu = Gpu::new();
+    let windy = SimParams { wind: Vec3::new(5.0, 0.0, 0.0), wind_enabled: true, ..styled() };
+    let drift = run_on_sphere(&gpu, &mohawk(200, 8), &windy, 300, |_| RigidTransform::default());
+    eprintln!("mohawk in wind: tip drift p50 {:.4}", p(&drift, 50));
+    assert!(p(&drift, 50) >= 0.03, "wind moved the tips by only {}", p(&drift, 50));
+    let params = styled();
+    let shake = |i: usize| motion::shaking_head_about((i + 1) as f32 * params.dt, 0.6, 1.0, Vec3::ZERO);
+    // A quarter period in: the head turns fastest.
+    let lag = run_on_sphere(&gpu, &mohawk(200, 8), &params, 15, shake);
+    eprintln!("mohawk shaken: tip lag p50 {:.4}", p(&lag, 50));
+    assert!(p(&lag, 50) >= 0.03, "the tips followed the head rigidly: lag {}", p(&lag, 50));
 }

@@ -32,6 +32,7 @@ const uint SIM_BENDING = 8u;
 const uint SIM_COLLISIONS = 16u;
 const uint SIM_DFTL = 32u;
 const uint SIM_GLOBAL_SHAPE = 64u;
+const uint SIM_SAG_FREE = 128u;
 
 // SIM_MAX_COLLIDERS (sim::MAX_COLLIDERS) and SIM_WORKGROUP are injected by
 // build.rs from src/limits.rs.
@@ -87,6 +88,32 @@ float sim_shape_weight(float t, float range) {
     }
     precise float w = (range + 0.25 - t) * 4.0;
     return max(w, 0.0);
+}
+
+// The global shape constraint's target for a particle whose rest position is
+// `target` (world) and whose per-iteration stiffness is k. With SIM_SAG_FREE
+// the target is raised against gravity by the particle's static sag, so that a
+// still head holds the authored shape: per sub-step gravity moves a particle
+// by g·dt², and N iterations of stiffness k remove the fraction
+// s = 1 − (1 − k)^N of its offset, so the offset at rest is g·dt²·(1/s − 1).
+// Fractions below 1 % (a nearly free particle) get no compensation.
+vec3 sim_shape_target(vec3 target, float k, uint iterations, uint flags, vec3 gravity, float dt) {
+    if ((flags & SIM_SAG_FREE) == 0u || (flags & SIM_GRAVITY) == 0u || k <= 0.0) {
+        return target;
+    }
+    precise float keep = 1.0;
+    for (uint n = 0u; n < iterations; n++) {
+        keep = keep * (1.0 - k);
+    }
+    precise float s = 1.0 - keep;
+    if (s < 0.01) {
+        return target;
+    }
+    precise float f = 1.0 / s - 1.0;
+    precise vec3 step_sag = gravity * (dt * dt);
+    precise vec3 sag = step_sag * f;
+    precise vec3 raised = target - sag;
+    return raised;
 }
 
 #endif

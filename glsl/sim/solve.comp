@@ -128,10 +128,11 @@ void main() {
         s_length[lid] = rest_length[index];
         radius = rest[index].w;
         if (global_shape) {
-            shape_target = sim_transform_point(params.head, rest[index].xyz);
             precise float t = float(i) / float(points - 1u);
             precise float k = params.shape.x * sim_shape_weight(t, params.shape.y);
             shape_k = k;
+            vec3 at_rest = sim_transform_point(params.head, rest[index].xyz);
+            shape_target = sim_shape_target(at_rest, k, params.counts.z, flags, params.gravity_dt.xyz, params.gravity_dt.w);
         }
         bool has_next = i + 1u < points;
         float len_next = rest_length[index];

@@ -74,6 +74,13 @@ pub struct SimParams {
     /// nothing over the next quarter of the strand, so that the rest swings freely.
     /// 1 holds the whole strand. Default: 0.5.
     pub global_shape_range: f32,
+    /// Sag-free rest state: the global shape constraint's targets are raised
+    /// against gravity by each particle's static sag, so that with a still head
+    /// the groom keeps its authored shape while motion and wind still move it
+    /// (see `glsl/include/sim.glsl`, `sim_shape_target`). Particles the
+    /// constraint barely holds (under 1 % of their offset removed per sub-step)
+    /// are left uncompensated. Default: true.
+    pub sag_free: bool,
     /// Whether body collisions act. Default: true.
     pub collisions_enabled: bool,
     /// Fraction of velocity removed per sub-step (0..1). Default: 0.02.
@@ -119,6 +126,7 @@ impl Default for SimParams {
             bending_enabled: true,
             global_shape_stiffness: 0.0,
             global_shape_range: 0.5,
+            sag_free: true,
             collisions_enabled: true,
             damping: 0.02,
             dftl_damping: 0.9,
@@ -299,6 +307,7 @@ pub(crate) mod flags {
     pub const COLLISIONS: u32 = 16;
     pub const DFTL: u32 = 32;
     pub const GLOBAL_SHAPE: u32 = 64;
+    pub const SAG_FREE: u32 = 128;
 }
 
 /// Everything one sub-step needs, identical for the GPU stages and the CPU reference.
@@ -397,6 +406,7 @@ impl SubstepPlanner {
         flags |= if p.collisions_enabled { flags::COLLISIONS } else { 0 };
         flags |= if p.solver == SolverMode::Dftl { flags::DFTL } else { 0 };
         flags |= if p.global_shape_stiffness > 0.0 { flags::GLOBAL_SHAPE } else { 0 };
+        flags |= if p.sag_free { flags::SAG_FREE } else { 0 };
         let packing = self.packing();
         let inputs = (0..p.substeps)
             .map(|k| {

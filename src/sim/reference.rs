@@ -72,6 +72,27 @@ pub(crate) fn shape_weight(t: f32, range: f32) -> f32 {
     }
 }
 
+/// The global shape constraint's target, as `sim_shape_target` in
+/// `glsl/include/sim.glsl` (raised against gravity by the static sag with
+/// `flags::SAG_FREE`).
+fn shape_target(target: Vec3, k: f32, iterations: u32, flags: u32, gravity: Vec3, dt: f32) -> Vec3 {
+    if flags & flags::SAG_FREE == 0 || flags & flags::GRAVITY == 0 || k <= 0.0 {
+        return target;
+    }
+    let mut keep = 1.0f32;
+    for _ in 0..iterations {
+        keep *= 1.0 - k;
+    }
+    let s = 1.0 - keep;
+    if s < 0.01 {
+        return target;
+    }
+    let f = 1.0 / s - 1.0;
+    let step_sag = gravity * (dt * dt);
+    let sag = step_sag * f;
+    target - sag
+}
+
 fn project(s: &mut [Vec4], i: usize, j: usize, rest_d: f32, k: f32) {
     let (a, b) = (s[i], s[j]);
     let w = a.w + b.w;
@@ -175,9 +196,10 @@ fn solve(
                 if !global_shape {
                     return (Vec3::ZERO, 0.0);
                 }
-                let target = transform_point(&p.head, state.rest[base + i].truncate());
                 let t = i as f32 / (points - 1) as f32;
-                (target, shape_stiffness * shape_weight(t, shape_range))
+                let k = shape_stiffness * shape_weight(t, shape_range);
+                let at_rest = transform_point(&p.head, state.rest[base + i].truncate());
+                (shape_target(at_rest, k, p.iterations(), flags, p.gravity(), p.dt()), k)
             })
             .collect();
         for _ in 0..p.iterations() {
