@@ -16,7 +16,7 @@ use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::{scenes, Groom};
 use vkhair::sim::{
-    motion, CpuHairSim, HairSim, Preconditioner, RigidTransform, SimParams, SimStage, SolverMode, VolumeMode,
+    motion, CpuHairSim, HairSim, Preconditioner, RigidTransform, SimParams, SimStage, SimState, SolverMode, VolumeMode,
     VolumeParams,
 };
 use vkhair::{list_devices, ContextOptions, GpuContext, GpuProfiler};
@@ -103,6 +103,22 @@ struct SimulateArgs {
     /// Iteration cap of the pressure solve [default: 40].
     #[arg(long)]
     max_iterations: Option<u32>,
+    /// Head motion: still, the shake (0.6 rad at 1 Hz) or a violent shake
+    /// (1 rad at 2 Hz), about the neck.
+    #[arg(long, value_enum, default_value = "shake")]
+    motion: MotionArg,
+    /// Write the simulated strands after the last step as a .hair file: in the
+    /// input's frame (the head's motion undone) and units (--scale undone), one
+    /// strand per input strand with --points points each.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum MotionArg {
+    Still,
+    Shake,
+    Violent,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -397,6 +413,35 @@ fn simulate_params(a: &SimulateArgs) -> Result<SimParams, vkhair::Error> {
     Ok(params)
 }
 
+/// Per strand, the tip's distance from the rest shape carried by `head`, as a
+/// fraction of the strand's rest length, sorted.
+fn tip_drift(state: &SimState, head: &RigidTransform) -> Vec<f32> {
+    let m = head.matrix();
+    let mut drift: Vec<f32> = (0..state.strands)
+        .map(|s| {
+            let tip = s * state.points + state.points - 1;
+            let moved = m.transform_point3(state.rest[tip].truncate());
+            (state.positions[tip].truncate() - moved).length() / state.rest_strand_length(s).max(f32::MIN_POSITIVE)
+        })
+        .collect();
+    drift.sort_by(f32::total_cmp);
+    drift
+}
+
+fn percentile(sorted: &[f32], percent: usize) -> Option<f32> {
+    (!sorted.is_empty()).then(|| sorted[(sorted.len() - 1) * percent / 100])
+}
+
+/// The simulated strands in the input's frame and units, as a .hair file.
+fn write_final(path: &Path, state: &SimState, head: &RigidTransform, scale: f32) -> CliResult {
+    let back = head.matrix().inverse();
+    let positions: Vec<Vec3> = state.positions.iter().map(|p| back.transform_point3(p.truncate()) / scale).collect();
+    let counts = vec![state.points as u32; state.strands];
+    let groom = Groom::new(positions, &counts)?;
+    HairFile::new(groom, "vkhair simulate: strands after the last step").save(path)?;
+    Ok(())
+}
+
 fn simulate(a: &SimulateArgs) -> CliResult {
     let (groom, colliders, label, pivot) = match &a.input {
         None => (scenes::thesis()?, motion::thesis_colliders(), "thesis scene".to_owned(), motion::NECK_PIVOT),
@@ -413,7 +458,14 @@ fn simulate(a: &SimulateArgs) -> CliResult {
     };
     let params = simulate_params(a)?;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
-    let head = |i: usize| motion::shaking_head_about((i + 1) as f32 * params.dt, 0.6, 1.0, pivot);
+    let head = |i: usize| {
+        let t = (i + 1) as f32 * params.dt;
+        match a.motion {
+            MotionArg::Still => RigidTransform::default(),
+            MotionArg::Shake => motion::shaking_head_about(t, 0.6, 1.0, pivot),
+            MotionArg::Violent => motion::shaking_head_about(t, 1.0, 2.0, pivot),
+        }
+    };
     let mut sim = HairSim::new(&ctx, &groom, &params, &RigidTransform::default())?;
     sim.set_colliders(&colliders)?;
     let mut profiler = GpuProfiler::new(&ctx, 1, 1024)?;
@@ -455,6 +507,15 @@ fn simulate(a: &SimulateArgs) -> CliResult {
     println!("{:<28} {:>12.3}", "total", sum / 1e6 / a.steps as f64);
     let state = sim.read_state()?;
     println!("kinetic energy {:.4} J/kg per particle", state.kinetic_energy() / state.positions.len() as f64);
+    let last_head = head(a.steps.saturating_sub(1));
+    let drift = tip_drift(&state, &last_head);
+    if let (Some(p50), Some(p95)) = (percentile(&drift, 50), percentile(&drift, 95)) {
+        println!("tip drift from rest: p50 {:.2} % p95 {:.2} % of strand length", 100.0 * p50, 100.0 * p95);
+    }
+    if let Some(out) = &a.out {
+        write_final(out, &state, &last_head, a.scale)?;
+        println!("wrote {}: {strands} strands × {points} points", out.display());
+    }
     if let (Some(grid), Some(stats)) = (sim.volume_grid(), sim.volume_stats()?) {
         println!(
             "volume grid {}×{}×{} cells of {:.1} mm; last pressure solve: {} iterations, residual {:.1e}{}",

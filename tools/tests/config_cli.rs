@@ -71,3 +71,32 @@ fn flags_win_over_the_file() {
     let overridden = run(&["--iterations", "7", "--volume", "off"]);
     assert!(overridden.contains("parameters: 7 iterations, Pbd solver, volume Off at [8, 8, 8]"), "{overridden}");
 }
+
+/// `simulate --motion still --out` with the bob preset: the drift line says the
+/// style held, and the written file has one strand per input strand.
+#[test]
+fn simulate_reports_the_drift_and_writes_the_final_strands() {
+    let out_path = temp("final.hair", "");
+    let preset = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../presets/bob.toml");
+    let run = |extra: &[&str]| {
+        let out = vkhair()
+            .args(["simulate", "--steps", "60", "--volume", "off", "--motion", "still", "--out"])
+            .arg(&out_path)
+            .args(extra)
+            .output()
+            .expect("run");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        let line = stdout.lines().find(|l| l.starts_with("tip drift from rest:")).expect("drift line").to_owned();
+        let p95: f32 =
+            line.split("p95 ").nth(1).and_then(|r| r.split(' ').next()).and_then(|v| v.parse().ok()).expect("p95");
+        p95
+    };
+    let styled = run(&["--config", preset.to_str().expect("path")]);
+    let unstyled = run(&[]);
+    assert!(styled < 2.0, "the bob preset let the tips drift {styled} %");
+    assert!(unstyled > 10.0 * styled, "defaults {unstyled} % against the preset's {styled} %");
+    let file = vkhair::groom::cyhair::HairFile::open(&out_path).expect("written file");
+    assert_eq!(file.groom.strand_count(), 1750);
+    assert_eq!(file.groom.point_count(), 1750 * 6);
+}
