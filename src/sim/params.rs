@@ -349,6 +349,19 @@ pub(crate) struct SubstepPlanner {
     pub subgroup_size: u32,
 }
 
+/// Says, through `log`, when the sag-free rest state is asked for but cannot be
+/// met: a shape stiffness under 1 % per sub-step leaves every particle
+/// uncompensated (see `sim_shape_target`), so the groom sags as without it.
+fn warn_unmet_sag_free(params: &SimParams) {
+    let k = params.global_shape_stiffness;
+    if params.sag_free && params.gravity_enabled && k > 0.0 && k < 0.01 {
+        log::warn!(
+            "vkhair: sag-free rest state not met: global_shape_stiffness {k} holds less than 1 % per sub-step, \
+             so no particle is compensated and the groom sags under gravity"
+        );
+    }
+}
+
 impl SubstepPlanner {
     pub(crate) fn new(
         params: &SimParams,
@@ -359,6 +372,7 @@ impl SubstepPlanner {
     ) -> Result<Self> {
         params.validate()?;
         head.validate()?;
+        warn_unmet_sag_free(params);
         Ok(SubstepPlanner {
             params: params.clone(),
             colliders: Vec::new(),
@@ -373,6 +387,7 @@ impl SubstepPlanner {
 
     pub(crate) fn set_params(&mut self, params: &SimParams) -> Result<()> {
         params.validate()?;
+        warn_unmet_sag_free(params);
         self.params = params.clone();
         Ok(())
     }
