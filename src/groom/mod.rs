@@ -25,6 +25,7 @@ pub mod cyhair;
 pub mod grow;
 pub mod mesh;
 pub mod scenes;
+pub mod sdf;
 pub mod tfx;
 
 mod resample;
