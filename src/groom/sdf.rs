@@ -78,7 +78,7 @@ impl MeshSdf {
     /// Per grid point, the distance to its closest triangle found and that triangle.
     fn closest_triangles(&self, mesh: &TriMesh) -> Vec<(f32, u32)> {
         let [nx, ny, nz] = self.dims;
-        let mut best = vec![(f32::INFINITY, u32::MAX); (nx * ny * nz) as usize];
+        let mut best = vec![(f32::INFINITY, u32::MAX); self.values_len()];
         // Seeds: the grid points within 1.5 cells of each triangle's box.
         for t in 0..mesh.triangles.len() {
             let [a, b, c] = mesh.corners(t);

@@ -9,8 +9,8 @@
 //!
 //! Every scope also opens a debug-utils label, so RenderDoc/Nsight show the same
 //! pass names whether profiling is enabled or not. vkhair's own passes and stages
-//! open their scopes through one helper, [`PassScope`], whose [`ScopeKind`] picks
-//! the label colour; both timestamps are written at `ALL_COMMANDS`.
+//! open their scopes through one helper, [`PassScope`], coloured by the kind of
+//! work; both timestamps are written at `ALL_COMMANDS`.
 
 use std::sync::Arc;
 
@@ -23,8 +23,10 @@ use crate::vk::device::Device;
 mod report;
 mod scope;
 
+use crate::vk::debug::LabelColor;
 pub use report::{Clock, PassTiming, ProfileReport};
-pub(crate) use scope::{PassScope, ScopeKind};
+pub(crate) use scope::PassScope;
+use scope::TIMESTAMP_STAGE;
 
 /// Handle of an open scope, returned by [`GpuProfiler::begin_scope`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -184,7 +186,7 @@ impl GpuProfiler {
     /// As for [`GpuProfiler::begin_frame`], after it was called for this frame.
     pub unsafe fn begin_scope(&mut self, cmd: vk::CommandBuffer, name: &str) -> ScopeId {
         // SAFETY: guaranteed by the caller.
-        unsafe { self.begin_scope_as(cmd, name, ScopeKind::Host) }
+        unsafe { self.begin_scope_as(cmd, name, LabelColor::Host) }
     }
 
     /// [`GpuProfiler::begin_scope`] for a pass of a known kind: the label's colour
@@ -192,9 +194,9 @@ impl GpuProfiler {
     ///
     /// # Safety
     /// As for [`GpuProfiler::begin_scope`].
-    pub(crate) unsafe fn begin_scope_as(&mut self, cmd: vk::CommandBuffer, name: &str, kind: ScopeKind) -> ScopeId {
+    pub(crate) unsafe fn begin_scope_as(&mut self, cmd: vk::CommandBuffer, name: &str, kind: LabelColor) -> ScopeId {
         // SAFETY: guaranteed by the caller.
-        unsafe { self.device.cmd_begin_label(cmd, name, kind.label_color()) };
+        unsafe { self.device.cmd_begin_label(cmd, name, kind) };
         let Some(index) = self.current.filter(|_| self.enabled) else { return ScopeId(None) };
         let first = index as u32 * self.queries_per_slot;
         let slot = &mut self.slots[index];
@@ -207,7 +209,7 @@ impl GpuProfiler {
         slot.scopes.push(Scope { name: name.to_owned(), depth: slot.open, begin: query, end: None });
         slot.open += 1;
         // SAFETY: guaranteed by the caller; the query was reset in begin_frame.
-        unsafe { self.device.raw.cmd_write_timestamp2(cmd, ScopeKind::TIMESTAMP_STAGE, self.pool, first + query) };
+        unsafe { self.device.raw.cmd_write_timestamp2(cmd, TIMESTAMP_STAGE, self.pool, first + query) };
         ScopeId(Some(slot.scopes.len() as u32 - 1))
     }
 
@@ -224,9 +226,7 @@ impl GpuProfiler {
                 let query = s.begin + 1;
                 s.end = Some(query);
                 // SAFETY: guaranteed by the caller; the query was reset in begin_frame.
-                unsafe {
-                    self.device.raw.cmd_write_timestamp2(cmd, ScopeKind::TIMESTAMP_STAGE, self.pool, first + query)
-                };
+                unsafe { self.device.raw.cmd_write_timestamp2(cmd, TIMESTAMP_STAGE, self.pool, first + query) };
             }
         }
         // SAFETY: guaranteed by the caller (matching begin_scope).

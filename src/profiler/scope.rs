@@ -7,39 +7,13 @@ use super::{GpuProfiler, ScopeId};
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 
-/// What a scope's commands are: picks the label colour.
-///
-/// Both timestamps of a scope are written at [`ScopeKind::TIMESTAMP_STAGE`],
-/// `ALL_COMMANDS`: the opening one once every earlier command has finished (a
-/// pass's time never includes its predecessor's), the closing one once the pass's
-/// own commands have. A narrower closing stage (`COMPUTE_SHADER` for a compute
-/// pass) would not wait for earlier work of other stages, so the end could be
-/// stamped before the start.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum ScopeKind {
-    /// Compute dispatches (the simulation's stages, the volume step, lookup tables).
-    Compute,
-    /// Draws (the render passes).
-    Graphics,
-    /// Copies and clears (the hand-off to rendering).
-    Transfer,
-    /// A host's own scope through [`GpuProfiler::begin_scope`]: anything.
-    Host,
-}
-
-impl ScopeKind {
-    /// Stage of both timestamps of every scope.
-    pub(crate) const TIMESTAMP_STAGE: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::ALL_COMMANDS;
-
-    pub(crate) fn label_color(self) -> LabelColor {
-        match self {
-            ScopeKind::Compute => LabelColor::Compute,
-            ScopeKind::Graphics => LabelColor::Graphics,
-            ScopeKind::Transfer => LabelColor::Transfer,
-            ScopeKind::Host => LabelColor::Host,
-        }
-    }
-}
+/// Stage of both timestamps of every scope: `ALL_COMMANDS`, the opening one
+/// once every earlier command has finished (a pass's time never includes its
+/// predecessor's), the closing one once the pass's own commands have. A
+/// narrower closing stage (`COMPUTE_SHADER` for a compute pass) would not wait
+/// for earlier work of other stages, so the end could be stamped before the
+/// start.
+pub(crate) const TIMESTAMP_STAGE: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::ALL_COMMANDS;
 
 /// An open pass: a timestamp scope of the frame's profiler (which also opens the
 /// label), or just the label without a profiler.
@@ -59,14 +33,14 @@ impl PassScope {
         cmd: vk::CommandBuffer,
         profiler: &mut Option<&mut GpuProfiler>,
         label: &str,
-        kind: ScopeKind,
+        kind: LabelColor,
     ) -> PassScope {
         // SAFETY: guaranteed by the caller.
         unsafe {
             match profiler.as_deref_mut() {
                 Some(p) => PassScope { id: Some(p.begin_scope_as(cmd, label, kind)) },
                 None => {
-                    device.cmd_begin_label(cmd, label, kind.label_color());
+                    device.cmd_begin_label(cmd, label, kind);
                     PassScope { id: None }
                 }
             }
@@ -97,7 +71,7 @@ impl PassScope {
         cmd: vk::CommandBuffer,
         profiler: &mut Option<&mut GpuProfiler>,
         label: &str,
-        kind: ScopeKind,
+        kind: LabelColor,
         body: impl FnOnce() -> T,
     ) -> T {
         // SAFETY: guaranteed by the caller.

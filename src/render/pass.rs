@@ -24,8 +24,9 @@ use std::sync::Arc;
 use ash::vk;
 
 use crate::error::Result;
-use crate::profiler::{GpuProfiler, PassScope, ScopeKind};
+use crate::profiler::{GpuProfiler, PassScope};
 use crate::vk::barrier::{self, AccessKind};
+use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
 use crate::vk::rendering;
@@ -76,11 +77,11 @@ impl RenderPass {
         }
     }
 
-    /// What the pass's commands are (label colour, closing timestamp stage).
-    pub(crate) fn kind(self) -> ScopeKind {
+    /// What the pass's commands are (its label colour).
+    pub(crate) fn kind(self) -> LabelColor {
         match self {
-            RenderPass::ShadowVolume => ScopeKind::Compute,
-            _ => ScopeKind::Graphics,
+            RenderPass::ShadowVolume => LabelColor::Compute,
+            _ => LabelColor::Graphics,
         }
     }
 

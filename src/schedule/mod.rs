@@ -52,11 +52,12 @@ use gpu_allocator::MemoryLocation;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::groom::Groom;
+use crate::profiler::PassScope;
 use crate::profiler::{GpuProfiler, ProfileReport};
-use crate::profiler::{PassScope, ScopeKind};
 use crate::sim::{Collider, HairSim, KeyHairs, RigidTransform, SimParams, SimState};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
+use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 use crate::vk::external::{self, ExternalBuffer};
 use crate::vk::submit::CommandRing;
@@ -447,7 +448,7 @@ unsafe fn scoped(
     f: impl FnOnce(vk::CommandBuffer),
 ) {
     // SAFETY: guaranteed by the caller.
-    unsafe { PassScope::record(device, cmd, profiler, name, ScopeKind::Transfer, || f(cmd)) }
+    unsafe { PassScope::record(device, cmd, profiler, name, LabelColor::Transfer, || f(cmd)) }
 }
 
 /// Takes a finished SECOND DEVICE job's slot into the mirror.

@@ -61,8 +61,9 @@ use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::groom::Groom;
 use crate::profiler::GpuProfiler;
-use crate::profiler::{PassScope, ScopeKind};
+use crate::profiler::PassScope;
 use crate::vk::barrier::{self, AccessKind};
+use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 use crate::vk::pipeline::ComputePipeline;
 use params::SubstepPlanner;
@@ -426,7 +427,7 @@ impl HairSim {
                 // SAFETY: as above; the profiler contract is the caller's.
                 unsafe {
                     let last = k + 1 == self.stages.len() && self.volume.is_none();
-                    PassScope::record(d, cmd, &mut profiler, stage.stage.label(), ScopeKind::Compute, || {
+                    PassScope::record(d, cmd, &mut profiler, stage.stage.label(), LabelColor::Compute, || {
                         stage.pipeline.bind(cmd, &[stage.sets[self.current]]);
                         stage.pipeline.dispatch_threads(cmd, [threads, 1, 1]);
                         if !last {

@@ -151,6 +151,10 @@ fn solve(
     let collisions = flags & flags::COLLISIONS != 0;
     let mut s = vec![Vec4::ZERO; points];
     let mut bend = vec![(0.0f32, 0.0f32); points];
+    // Per point of the strand: the global shape constraint's target and stiffness.
+    let global_shape = flags & flags::GLOBAL_SHAPE != 0;
+    let (shape_stiffness, shape_range) = p.global_shape();
+    let mut shape = vec![(Vec3::ZERO, 0.0f32); points];
     for strand in 0..p.strands() as usize {
         let base = strand * points;
         s.copy_from_slice(&predicted[base..base + points]);
@@ -189,19 +193,14 @@ fn solve(
             }
         }
         let bending = flags & flags::BENDING != 0;
-        let global_shape = flags & flags::GLOBAL_SHAPE != 0;
-        let (shape_stiffness, shape_range) = p.global_shape();
-        let shape: Vec<(Vec3, f32)> = (0..points)
-            .map(|i| {
-                if !global_shape {
-                    return (Vec3::ZERO, 0.0);
-                }
+        if global_shape {
+            for (i, slot) in shape.iter_mut().enumerate() {
                 let t = i as f32 / (points - 1) as f32;
                 let k = shape_stiffness * shape_weight(t, shape_range);
                 let at_rest = transform_point(&p.head, state.rest[base + i].truncate());
-                (shape_target(at_rest, k, p.iterations(), flags, p.gravity(), p.dt()), k)
-            })
-            .collect();
+                *slot = (shape_target(at_rest, k, p.iterations(), flags, p.gravity(), p.dt()), k);
+            }
+        }
         for _ in 0..p.iterations() {
             for i in (0..points - 1).step_by(2) {
                 project(&mut s, i, i + 1, lengths[i], 1.0);

@@ -155,12 +155,16 @@ pub(crate) fn messenger_info(log: &ValidationLog) -> vk::DebugUtilsMessengerCrea
         .user_data(log.user_data())
 }
 
-/// Colors for pass labels, by kind of work.
-#[derive(Debug, Clone, Copy)]
+/// What a labelled pass's commands are; picks the label's colour.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum LabelColor {
+    /// Compute dispatches (the simulation's stages, the volume step, lookup tables).
     Compute,
+    /// Draws (the render passes).
     Graphics,
+    /// Copies and clears (the hand-off to rendering).
     Transfer,
+    /// A host's own scope through `GpuProfiler::begin_scope`: anything.
     Host,
 }
 

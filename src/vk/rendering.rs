@@ -27,11 +27,7 @@ impl Load {
 }
 
 /// An attachment of `view` in `layout`, loaded as `load` and stored.
-pub(crate) fn attachment(
-    view: vk::ImageView,
-    layout: vk::ImageLayout,
-    load: Load,
-) -> vk::RenderingAttachmentInfo<'static> {
+fn attachment(view: vk::ImageView, layout: vk::ImageLayout, load: Load) -> vk::RenderingAttachmentInfo<'static> {
     let info = vk::RenderingAttachmentInfo::default()
         .image_view(view)
         .image_layout(layout)

@@ -11,9 +11,10 @@ use super::VolumeStats;
 use crate::error::Result;
 use crate::gpu_types::{GpuVolumeParams, PcgScalars, VolumePush};
 use crate::profiler::GpuProfiler;
-use crate::profiler::{PassScope, ScopeKind};
+use crate::profiler::PassScope;
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
+use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 
 /// Jacobi sweeps on the coarsest multigrid level (even, see `mg_coarsest.comp`).
@@ -123,7 +124,7 @@ impl VolumeStage {
     ) {
         let scoped = |profiler: &mut Option<&mut GpuProfiler>, label: &str, body: &dyn Fn()| {
             // SAFETY: guaranteed by the caller.
-            unsafe { PassScope::record(&self.device, cmd, profiler, label, ScopeKind::Compute, body) }
+            unsafe { PassScope::record(&self.device, cmd, profiler, label, LabelColor::Compute, body) }
         };
         // SAFETY (all closures): guaranteed by the caller.
         scoped(&mut profiler, labels[0], &|| unsafe { self.record_sort(cmd, variant) });
