@@ -106,6 +106,19 @@ impl SimStepParams {
     }
 }
 
+/// Push constants of the mesh collider's build kernels (`SdfPush` in `glsl/include/sdf.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct SdfPush {
+    /// xyz grid point (0, 0, 0) in the mesh frame, w cell edge.
+    pub origin_cell: [f32; 4],
+    /// xyz grid points per axis, w triangles.
+    pub dims: [u32; 4],
+    /// x seed mode (0 distance, 1 triangle) or flood step, y ray axis.
+    pub pass_info: [u32; 4],
+}
+gpu_struct!(SdfPush => "SdfPush" { origin_cell, dims, pass_info });
+
 /// A collider in world space (`Collider` in `glsl/include/sim.glsl`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
@@ -417,6 +430,7 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<LayoutProbe>(reflection, &mut problems);
     check::<SimStepParams>(reflection, &mut problems);
     check::<GpuCollider>(reflection, &mut problems);
+    check::<SdfPush>(reflection, &mut problems);
     check::<SmoothPush>(reflection, &mut problems);
     check::<InterpolatePush>(reflection, &mut problems);
     check::<GpuLight>(reflection, &mut problems);

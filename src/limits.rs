@@ -27,6 +27,9 @@ pub const VOL_SCAN_TILE: u32 = 1024;
 #[cfg_attr(not(test), allow(dead_code))] // the pipelines read it back from the SPIR-V
 pub const ITEM_GROUP: u32 = 64;
 
+/// Most grid points per axis of a mesh collider's distance field.
+pub const SDF_MAX_RESOLUTION: u32 = 256;
+
 /// Every constant above with the name the shaders see it by.
 #[cfg_attr(not(test), allow(dead_code))] // used by build.rs and the tests
 pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
@@ -38,4 +41,5 @@ pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
     ("VOL_SORT_BLOCK", VOL_SORT_BLOCK),
     ("VOL_SCAN_TILE", VOL_SCAN_TILE),
     ("ITEM_GROUP", ITEM_GROUP),
+    ("SDF_MAX_RESOLUTION", SDF_MAX_RESOLUTION),
 ];

@@ -5,12 +5,15 @@
 //!   the longest axis gets `resolution` cells. Values live at the cell corners
 //!   and are sampled trilinearly.
 //! - **Distance:** at every grid point, the exact Euclidean distance to a
-//!   triangle of the mesh, chosen by closest-triangle propagation. Points near
-//!   a triangle start from it; raster sweeps forward and backward then offer
-//!   every point its neighbours' closest triangles, each measured exactly. This
-//!   finds the nearest triangle wherever its region reaches the point through
-//!   neighbouring grid points. `tests/sdf.rs` compares samples against a
-//!   brute-force distance to every triangle, within half a voxel diagonal.
+//!   triangle of the mesh, chosen by jump flooding. Points within 1.5 cells of a
+//!   triangle's box start from the nearest such triangle; then each pass offers
+//!   every point the triangles of its 26 neighbours `step` points away, each
+//!   measured exactly, for steps of half the grid down to 1 and a last pass at
+//!   1 again. A pass reads the previous pass's choices only (no order
+//!   dependence), ties go to the lower triangle index, so the GPU build
+//!   ([`crate::sim::MeshCollider`]) makes the same choices. `tests/sdf.rs`
+//!   compares samples against a brute-force distance to every triangle, within
+//!   half a voxel diagonal.
 //! - **Sign:** ray parity along each of the three axes, with a majority vote.
 //!   One ray per grid line and axis counts the crossings on each side of every
 //!   point. An open mesh, such as a bust cut at the chest, misleads the rays
@@ -24,7 +27,7 @@ use super::mesh::TriMesh;
 use crate::error::{Error, Result};
 
 /// Most grid points per axis.
-pub const MAX_SDF_RESOLUTION: u32 = 256;
+pub const MAX_SDF_RESOLUTION: u32 = crate::limits::SDF_MAX_RESOLUTION;
 
 /// A mesh's signed distance field (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -44,11 +47,39 @@ impl MeshSdf {
     /// its bounds (8..=[`MAX_SDF_RESOLUTION`]), the bounds grown by `margin` on every
     /// side (≥ 0, the mesh's units; at least two cells are always added).
     pub fn build(mesh: &TriMesh, resolution: u32, margin: f32) -> Result<MeshSdf> {
+        let (origin, cell, dims) = Self::placement(mesh, resolution, margin)?;
+        let mut sdf = MeshSdf { origin, cell, dims, values: Vec::new() };
+        let closest = sdf.closest_triangles(mesh);
+        let inside = sdf.inside(mesh);
+        let mut values = Vec::with_capacity(closest.len());
+        for (k, (&t, &inside)) in closest.iter().zip(&inside).enumerate() {
+            // Unreachable: the seeds cover the mesh and the floods reach every point.
+            let d = if t == u32::MAX {
+                f32::MAX
+            } else {
+                let [a, b, c] = mesh.corners(t as usize);
+                triangle_distance(sdf.point(sdf.grid_point(k)), a, b, c)
+            };
+            values.push(if inside { -d } else { d });
+        }
+        sdf.values = values;
+        Ok(sdf)
+    }
+
+    /// Where the grid of `mesh`'s field lies: origin, cell edge and points per axis
+    /// (see [`MeshSdf::build`] for the arguments).
+    pub fn placement(mesh: &TriMesh, resolution: u32, margin: f32) -> Result<(Vec3, f32, [u32; 3])> {
         if !(8..=MAX_SDF_RESOLUTION).contains(&resolution) {
             return Err(Error::param("sdf resolution", resolution, format!("8..={MAX_SDF_RESOLUTION}")));
         }
         if !(margin.is_finite() && margin >= 0.0) {
             return Err(Error::param("sdf margin", margin, "finite and ≥ 0"));
+        }
+        if let Some(bad) = mesh.positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::incompatible("mesh", format!("vertex {bad} is not finite")));
+        }
+        if mesh.triangles.is_empty() {
+            return Err(Error::incompatible("mesh", "it has no triangles"));
         }
         let (lo, hi) = mesh.bounds();
         let extent = (hi - lo).max_element();
@@ -60,23 +91,40 @@ impl MeshSdf {
         let origin = lo - pad;
         let span = hi + pad - origin;
         let dims = [0, 1, 2].map(|a| ((span[a] / cell).ceil() as u32 + 1).min(MAX_SDF_RESOLUTION));
-        let mut sdf = MeshSdf { origin, cell, dims, values: Vec::new() };
-        let closest = sdf.closest_triangles(mesh);
-        let inside = sdf.inside(mesh);
-        sdf.values = closest.iter().zip(&inside).map(|(&(d, _), &inside)| if inside { -d } else { d }).collect();
-        Ok(sdf)
+        Ok((origin, cell, dims))
+    }
+
+    /// The jump-flooding steps, largest first: half the grid's longest axis
+    /// (rounded up to a power of two) down to 1, then 1 again.
+    pub(crate) fn flood_steps(dims: [u32; 3]) -> Vec<u32> {
+        let longest = dims.iter().copied().max().unwrap_or(1).max(2);
+        let mut steps = Vec::new();
+        let mut step = longest.next_power_of_two() / 2;
+        while step >= 1 {
+            steps.push(step);
+            step /= 2;
+        }
+        steps.push(1);
+        steps
     }
 
     fn point(&self, [x, y, z]: [u32; 3]) -> Vec3 {
         self.origin + Vec3::new(x as f32, y as f32, z as f32) * self.cell
     }
 
+    fn grid_point(&self, k: usize) -> [u32; 3] {
+        let k = k as u32;
+        let [nx, ny, _] = self.dims;
+        [k % nx, (k / nx) % ny, k / (nx * ny)]
+    }
+
     fn index(&self, [x, y, z]: [u32; 3]) -> usize {
         ((z * self.dims[1] + y) * self.dims[0] + x) as usize
     }
 
-    /// Per grid point, the distance to its closest triangle found and that triangle.
-    fn closest_triangles(&self, mesh: &TriMesh) -> Vec<(f32, u32)> {
+    /// Per grid point, the closest triangle found by jump flooding (see the module
+    /// docs). Every point has one: the seeds cover the mesh and floods reach all.
+    fn closest_triangles(&self, mesh: &TriMesh) -> Vec<u32> {
         let [nx, ny, nz] = self.dims;
         let mut best = vec![(f32::INFINITY, u32::MAX); self.values_len()];
         // Seeds: the grid points within 1.5 cells of each triangle's box.
@@ -99,37 +147,44 @@ impl MeshSdf {
                 }
             }
         }
-        // Propagation: each point tries its neighbours' closest triangles.
-        for pass in 0..4 {
-            let forward = pass % 2 == 0;
-            for k in 0..nx * ny * nz {
-                let k = if forward { k } else { nx * ny * nz - 1 - k };
-                let g = [k % nx, (k / nx) % ny, k / (nx * ny)];
+        let mut ids: Vec<u32> = best.iter().map(|&(_, t)| t).collect();
+        let mut next = ids.clone();
+        for step in Self::flood_steps(self.dims) {
+            for (k, out) in next.iter_mut().enumerate() {
+                let g = self.grid_point(k);
                 let p = self.point(g);
-                let mut slot = best[k as usize];
+                let own = ids[k];
+                let mut slot = if own == u32::MAX {
+                    (f32::INFINITY, own)
+                } else {
+                    let [a, b, c] = mesh.corners(own as usize);
+                    (triangle_distance(p, a, b, c), own)
+                };
                 for dz in -1i32..=1 {
                     for dy in -1i32..=1 {
                         for dx in -1i32..=1 {
-                            let q = [g[0] as i32 + dx, g[1] as i32 + dy, g[2] as i32 + dz];
+                            let s = step as i32;
+                            let q = [g[0] as i32 + dx * s, g[1] as i32 + dy * s, g[2] as i32 + dz * s];
                             if q.iter().zip(&self.dims).any(|(&c, &n)| c < 0 || c >= n as i32) {
                                 continue;
                             }
-                            let t = best[self.index(q.map(|c| c as u32))].1;
+                            let t = ids[self.index(q.map(|c| c as u32))];
                             if t == u32::MAX || t == slot.1 {
                                 continue;
                             }
                             let [a, b, c] = mesh.corners(t as usize);
                             let d = triangle_distance(p, a, b, c);
-                            if d < slot.0 {
+                            if d < slot.0 || (d == slot.0 && t < slot.1) {
                                 slot = (d, t);
                             }
                         }
                     }
                 }
-                best[k as usize] = slot;
+                *out = slot.1;
             }
+            std::mem::swap(&mut ids, &mut next);
         }
-        best
+        ids
     }
 
     /// Per grid point, whether at least two of the three axis rays through it

@@ -36,6 +36,7 @@
 mod cpu;
 mod driver;
 mod integrate;
+mod mesh_collider;
 pub mod motion;
 mod params;
 mod predict;
@@ -51,6 +52,7 @@ use ash::vk;
 
 pub use cpu::CpuHairSim;
 pub use driver::{FixedStepDriver, StepPlan};
+pub use mesh_collider::{MeshCollider, MeshColliderParams, MESH_COLLIDER_BUILD_LABEL};
 pub(crate) use params::validate_colliders;
 pub use params::{Collider, RigidTransform, SimParams, SolverMode, MAX_COLLIDERS, MAX_SIM_POINTS};
 pub use state::SimState;
