@@ -58,10 +58,19 @@ pub(crate) struct SimStepParams {
     /// x colliders, y hairs per workgroup, z step index, w solver sync group size.
     pub layout_info: [u32; 4],
     /// x global shape stiffness per iteration at full strength, y its range
-    /// (fraction of the strand from the root).
+    /// (fraction of the strand from the root), z local shape stiffness per
+    /// iteration, w mesh collider friction.
     pub shape: [f32; 4],
+    /// World-from-head transform at the start of the step, column-major.
+    pub previous_head: [[f32; 4]; 4],
+    /// Mesh collider: xyz grid point (0, 0, 0) in the head frame, w cell edge.
+    pub mesh_grid: [f32; 4],
+    /// Mesh collider: xyz grid points per axis, w 1 when set.
+    pub mesh_dims: [u32; 4],
 }
-gpu_struct!(SimStepParams => "SimStepParams" { head, gravity_dt, wind, wind_noise, bending, counts, layout_info, shape });
+gpu_struct!(SimStepParams => "SimStepParams" {
+    head, gravity_dt, wind, wind_noise, bending, counts, layout_info, shape, previous_head, mesh_grid, mesh_dims
+});
 
 impl SimStepParams {
     /// Gravity, m/s².
@@ -103,6 +112,14 @@ impl SimStepParams {
     /// Global shape stiffness per iteration at full strength, and its range.
     pub fn global_shape(&self) -> (f32, f32) {
         (self.shape[0], self.shape[1])
+    }
+    /// Local shape stiffness per iteration.
+    pub fn local_shape(&self) -> f32 {
+        self.shape[2]
+    }
+    /// Friction against the mesh collider (0..=1).
+    pub fn mesh_friction(&self) -> f32 {
+        self.shape[3]
     }
 }
 
@@ -297,9 +314,16 @@ pub(crate) struct GpuVolumeParams {
     pub solve: [f32; 4],
     /// x iteration cap, y preconditioner, z multigrid levels, w colliders.
     pub config: [u32; 4],
+    /// Grid coordinates → the mesh collider's frame (the head frame).
+    pub mesh_from_grid: [[f32; 4]; 4],
+    /// Mesh collider: xyz grid point (0, 0, 0), w cell edge.
+    pub mesh_grid: [f32; 4],
+    /// Mesh collider: xyz grid points per axis, w 1 when its cells count as solid.
+    pub mesh_dims: [u32; 4],
 }
 gpu_struct!(GpuVolumeParams => "VolumeParams" {
-    grid_from_world, world_from_grid, axes, solid_velocity, dims, counts, transfer, solve, config
+    grid_from_world, world_from_grid, axes, solid_velocity, dims, counts, transfer, solve, config, mesh_from_grid,
+    mesh_grid, mesh_dims
 });
 
 impl GpuVolumeParams {

@@ -1,13 +1,16 @@
 //! The mesh collider on the GPU: its field against the CPU reference
-//! ([`MeshSdf::build`]), and the simulation colliding with it.
+//! ([`MeshSdf::build`]), the simulation colliding with it, and the local shape
+//! constraint.
 
 mod common;
 
-use common::Gpu;
+use common::{curls, mohawk, p, tip_drift_of, Gpu};
 use glam::Vec3;
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::sdf::MeshSdf;
-use vkhair::sim::{MeshCollider, MeshColliderParams};
+use vkhair::sim::{
+    motion, Collider, CpuHairSim, HairSim, MeshCollider, MeshColliderParams, RigidTransform, SimParams, SimState,
+};
 
 /// The GPU field against the CPU reference: every grid point within `tolerance`
 /// (both measure the same triangle exactly; only `sqrt` and division may round
@@ -72,4 +75,137 @@ fn bad_meshes_are_rejected_before_gpu_work() {
         MeshCollider::new(gpu.ctx(), &mesh, &params),
         Err(vkhair::Error::InvalidParameter { name: "sdf resolution", .. })
     ));
+}
+
+/// A 10 cm head sphere at the origin as a mesh (fine enough that its facets
+/// stay within 0.3 mm of the true sphere).
+fn sphere_mesh() -> TriMesh {
+    TriMesh::uv_sphere(Vec3::ZERO, 0.1, 32, 48).expect("sphere")
+}
+
+/// The shake of `vkhair simulate --motion shake` about the sphere's centre.
+fn shake(step: usize, params: &SimParams) -> RigidTransform {
+    motion::shaking_head_about((step + 1) as f32 * params.dt, 0.6, 1.0, Vec3::new(0.0, -0.1, 0.0))
+}
+
+/// GPU and CPU agree with the mesh collider, its friction and the local shape
+/// constraint, through a shake: positions within 1e-4 m (as `tests/sim.rs`:
+/// drivers may round `sqrt` and division differently; lavapipe agrees bit for bit).
+#[test]
+fn gpu_matches_cpu_with_the_mesh_collider_and_the_local_shape_constraint() {
+    let gpu = Gpu::new();
+    let mesh = sphere_mesh();
+    let collider_params = MeshColliderParams { resolution: 40, margin: 0.02 };
+    let params = SimParams { local_shape_stiffness: 0.3, ..SimParams::default() };
+    let groom = mohawk(60, 12);
+    let start = RigidTransform::default();
+    let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &start).expect("gpu sim");
+    let mut cpu = CpuHairSim::new(&groom, &params, &start).expect("cpu sim");
+    sim.set_mesh_collider(Some(MeshCollider::new(gpu.ctx(), &mesh, &collider_params).expect("collider"))).expect("set");
+    cpu.set_mesh_collider(Some(MeshSdf::build(&mesh, 40, 0.02).expect("reference field")));
+    let mut done = 0;
+    for target in [1, 30, 60] {
+        let from = done;
+        sim.run(target - done, |i| shake(from + i, &params), None).expect("gpu run");
+        for i in done..target {
+            cpu.step(&shake(i, &params)).expect("cpu step");
+        }
+        done = target;
+        let g = sim.read_state().expect("readback");
+        let (mut worst, mut equal) = (0.0f32, 0);
+        for (a, b) in g.positions.iter().zip(&cpu.state().positions) {
+            assert!(a.is_finite(), "NaN or Inf on the GPU");
+            worst = worst.max((*a - *b).length());
+            equal += usize::from(a == b);
+        }
+        eprintln!("step {target}: max |gpu − cpu| = {worst:e}, {equal}/{} bitwise equal", g.positions.len());
+        assert!(worst <= 1e-4, "step {target}: GPU and CPU differ by {worst} m");
+    }
+}
+
+/// Share of free particles deeper than 1 mm inside the 10 cm sphere.
+fn share_inside(state: &SimState, head: &RigidTransform) -> f32 {
+    let to_head = head.matrix().inverse();
+    let free: Vec<Vec3> = state.positions.iter().filter(|p| p.w > 0.0).map(|p| p.truncate()).collect();
+    let deep = free.iter().filter(|p| to_head.transform_point3(**p).length() < 0.1 - 0.001).count();
+    deep as f32 / free.len() as f32
+}
+
+/// During the shake, an unstyled mohawk (which falls onto the head) stays out of
+/// a sphere given only as a mesh: at most 0.1 % of the points more than 1 mm
+/// inside at any of the checked steps. Without the collider most of it sinks in.
+#[test]
+fn points_stay_out_of_the_mesh_during_the_shake() {
+    let gpu = Gpu::new();
+    let params = SimParams::default();
+    let groom = mohawk(200, 12);
+    let start = RigidTransform::default();
+    let run = |with_mesh: bool| {
+        let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &start).expect("sim");
+        if with_mesh {
+            let collider = MeshCollider::new(gpu.ctx(), &sphere_mesh(), &MeshColliderParams::default()).expect("mesh");
+            sim.set_mesh_collider(Some(collider)).expect("set");
+        }
+        let mut worst = 0.0f32;
+        for chunk in 0..12 {
+            sim.run(8, |i| shake(chunk * 8 + i, &params), None).expect("run");
+            let state = sim.read_state().expect("readback");
+            worst = worst.max(share_inside(&state, &shake(chunk * 8 + 7, &params)));
+        }
+        worst
+    };
+    let with = run(true);
+    let without = run(false);
+    eprintln!(
+        "points > 1 mm inside, worst of 12 checks: {:.4} % with the mesh collider, {:.1} % without",
+        with * 100.0,
+        without * 100.0
+    );
+    assert!(without > 0.2, "the test needs a groom that falls into the head: {without}");
+    assert!(with <= 0.001, "{} % of the points are more than 1 mm inside", with * 100.0);
+}
+
+/// Mean over interior points of |cos θ − cos θ_rest|, θ the angle between a
+/// point's two segments: how far the strands' curvature is from the rest shape's.
+fn curvature_error(state: &SimState) -> f32 {
+    let mut sum = 0.0;
+    let mut count = 0;
+    let cos = |a: Vec3, b: Vec3, c: Vec3| (b - a).normalize().dot((c - b).normalize());
+    for s in 0..state.strands {
+        let at = |i: usize| state.positions[s * state.points + i].truncate();
+        let rest = |i: usize| state.rest[s * state.points + i].truncate();
+        for i in 1..state.points - 1 {
+            sum += (cos(at(i - 1), at(i), at(i + 1)) - cos(rest(i - 1), rest(i), rest(i + 1))).abs();
+            count += 1;
+        }
+    }
+    sum / count as f32
+}
+
+/// The local shape constraint alone (no global shape, no rest-shape spring)
+/// keeps helix curls curled and holds a mohawk up, and its effect does not
+/// depend on the iteration count.
+#[test]
+fn the_local_shape_constraint_keeps_curls_curled() {
+    let gpu = Gpu::new();
+    let still = RigidTransform::default();
+    let run = |groom: &vkhair::Groom, params: &SimParams| {
+        let mut sim = HairSim::new(gpu.ctx(), groom, params, &still).expect("sim");
+        sim.set_colliders(&[Collider::Sphere { center: Vec3::ZERO, radius: 0.1 }]).expect("colliders");
+        sim.run(200, |_| still, None).expect("run");
+        sim.read_state().expect("readback")
+    };
+    let free = SimParams { spring_enabled: false, ..SimParams::default() };
+    let local = SimParams { local_shape_stiffness: 0.9, ..free.clone() };
+    let curled = curvature_error(&run(&curls(60), &local));
+    let loose = curvature_error(&run(&curls(60), &free));
+    eprintln!("curls: curvature error {curled:.4} with the local shape constraint, {loose:.4} without");
+    assert!(curled < 0.3 * loose, "curls lost their shape: {curled} against {loose} without the constraint");
+    let up = p(&tip_drift_of(&run(&mohawk(100, 8), &local), &still), 50);
+    let fallen = p(&tip_drift_of(&run(&mohawk(100, 8), &free), &still), 50);
+    let more_iterations = SimParams { iterations: 60, ..local.clone() };
+    let up_60 = p(&tip_drift_of(&run(&mohawk(100, 8), &more_iterations), &still), 50);
+    eprintln!("mohawk tip drift p50: {up:.4} with it (20 iterations), {up_60:.4} (60 iterations), {fallen:.4} without");
+    assert!(up < 0.25 * fallen, "the mohawk fell: {up} against {fallen}");
+    assert!((up - up_60).abs() < 0.3 * up.max(0.01), "iteration count changed the sag: {up} against {up_60}");
 }

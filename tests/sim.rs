@@ -12,7 +12,7 @@ use vkhair::groom::{scenes, Groom};
 use vkhair::sim::{motion, Collider, CpuHairSim, HairSim, RigidTransform, SimParams, SimState, SolverMode};
 mod common;
 
-use common::Gpu;
+use common::{curls, mohawk, p, tip_drift_of, Gpu};
 use vkhair::{Error, GpuContext};
 
 const POSITION_TOLERANCE: f32 = 1e-4;
@@ -363,22 +363,6 @@ fn invalid_input_is_rejected_before_gpu_work() {
     assert!(matches!(sim.write_state(&other), Err(Error::Incompatible { what: "state", .. })));
 }
 
-/// A mohawk: `strands` straight strands of 10 cm standing out radially from a
-/// band of roots over the top of a 10 cm head sphere centred at the origin.
-fn mohawk(strands: usize, points: usize) -> Groom {
-    let strands: Vec<Vec<Vec3>> = (0..strands)
-        .map(|s| {
-            let along = s as f32 / (strands - 1) as f32;
-            let angle = (along - 0.5) * 2.0; // ±57° from the top, in the y-z plane
-            let side = ((s % 5) as f32 - 2.0) * 0.006;
-            let normal = Vec3::new(side * 3.0, angle.cos(), angle.sin()).normalize();
-            let root = normal * 0.1;
-            (0..points).map(|i| root + normal * (0.1 * i as f32 / (points - 1) as f32)).collect()
-        })
-        .collect();
-    Groom::from_strands(&strands).expect("mohawk")
-}
-
 fn head_sphere() -> Vec<Collider> {
     vec![Collider::Sphere { center: Vec3::ZERO, radius: 0.1 }]
 }
@@ -390,53 +374,10 @@ fn gpu_matches_cpu_with_the_global_shape_constraint() {
     compare(gpu.ctx(), &common::grown_groom(150, 12, 5), &params, &[1, 60]);
 }
 
-/// Helix curls: `strands` strands of 16 points standing out from the top of the
-/// head sphere, each a helix of 1 cm radius and 2.5 cm pitch around its normal,
-/// about 10 cm long along the axis.
-fn curls(strands: usize) -> Groom {
-    let strands: Vec<Vec<Vec3>> = (0..strands)
-        .map(|s| {
-            let a = s as f32 * 2.399; // golden-angle spiral over a cap
-            let r = 0.6 * ((s as f32 + 0.5) / strands as f32).sqrt();
-            let normal = Vec3::new(r * a.cos(), 1.0, r * a.sin()).normalize();
-            let (u, v) = normal.any_orthonormal_pair();
-            (0..16)
-                .map(|i| {
-                    let t = i as f32 / 15.0;
-                    let turn = std::f32::consts::TAU * 4.0 * t;
-                    let radius = 0.01 * t.min(0.1) * 10.0; // grows out of the root
-                    normal * (0.1 + 0.1 * t) + (u * turn.cos() + v * turn.sin() - u) * radius
-                })
-                .collect()
-        })
-        .collect();
-    Groom::from_strands(&strands).expect("curls")
-}
-
 /// Style parameters a groom holds its shape with: a soft global shape
 /// constraint over the whole strand, with the sag-free rest state (default).
 fn styled() -> SimParams {
     SimParams { global_shape_stiffness: 0.15, global_shape_range: 1.0, ..SimParams::default() }
-}
-
-/// Per strand, the largest distance of a tip from where the rest shape carried
-/// rigidly by the head puts it, as a fraction of the strand's rest length,
-/// sorted.
-fn tip_drift_of(state: &SimState, head: &RigidTransform) -> Vec<f32> {
-    let m = head.matrix();
-    let mut drift: Vec<f32> = (0..state.strands)
-        .map(|s| {
-            let tip = s * state.points + state.points - 1;
-            let length = state.rest_strand_length(s);
-            (state.positions[tip].truncate() - m.transform_point3(state.rest[tip].truncate())).length() / length
-        })
-        .collect();
-    drift.sort_by(f32::total_cmp);
-    drift
-}
-
-fn p(drift: &[f32], percent: usize) -> f32 {
-    drift[(drift.len() - 1) * percent / 100]
 }
 
 /// Tip drift after `steps` steps of `groom` on the head sphere with the head at `head(i)`.

@@ -16,7 +16,11 @@ struct SimStepParams {
     vec4 bending;         // x stiffness per iteration at the root, y at the tip, z DFTL velocity damping, w unused
     uvec4 counts;         // x strands, y points per strand, z iterations, w flags (SIM_*)
     uvec4 layout_info;    // x colliders, y hairs per workgroup, z step index, w sync group size
-    vec4 shape;           // x global shape stiffness per iteration, y its range (strand fraction), zw unused
+    vec4 shape;           // x global shape stiffness per iteration, y its range (strand fraction),
+                          // z local shape stiffness per iteration, w mesh collider friction (0..1)
+    mat4 previous_head;   // world-from-head transform at the start of this step
+    vec4 mesh_grid;       // mesh collider: xyz grid point (0, 0, 0) in the head frame, w cell edge
+    uvec4 mesh_dims;      // xyz grid points per axis, w 1 when a mesh collider is set
 };
 
 // One collider in world space. Twin: gpu_types::GpuCollider.
@@ -33,6 +37,8 @@ const uint SIM_COLLISIONS = 16u;
 const uint SIM_DFTL = 32u;
 const uint SIM_GLOBAL_SHAPE = 64u;
 const uint SIM_SAG_FREE = 128u;
+const uint SIM_LOCAL_SHAPE = 256u;
+const uint SIM_MESH = 512u;
 
 // SIM_MAX_COLLIDERS (sim::MAX_COLLIDERS) and SIM_WORKGROUP are injected by
 // build.rs from src/limits.rs.
@@ -78,6 +84,40 @@ vec3 sim_collide(Collider c, vec3 p, float radius) {
         return out_p;
     }
     return p;
+}
+
+// head⁻¹ · p for a rigid `m` (rotation and translation): Rᵀ(p − t), written out.
+vec3 sim_to_head(mat4 m, vec3 p) {
+    precise vec3 d = p - m[3].xyz;
+    precise float x = (m[0].x * d.x + m[0].y * d.y) + m[0].z * d.z;
+    precise float y = (m[1].x * d.x + m[1].y * d.y) + m[1].z * d.z;
+    precise float z = (m[2].x * d.x + m[2].y * d.y) + m[2].z * d.z;
+    return vec3(x, y, z);
+}
+
+// R · v for the rotation of a rigid `m`, written out.
+vec3 sim_rotate(mat4 m, vec3 v) {
+    precise vec3 r = (m[0].xyz * v.x + m[1].xyz * v.y) + m[2].xyz * v.z;
+    return r;
+}
+
+float sim_dot(vec3 a, vec3 b) {
+    precise float r = (a.x * b.x + a.y * b.y) + a.z * b.z;
+    return r;
+}
+
+// v rotated by the smallest rotation taking unit vector a onto unit vector b
+// (Rodrigues with axis a × b, unnormalised): v·c + (a×b)×v + (a×b)((a×b)·v)/(1 + c).
+// Unchanged when a and b are (nearly) opposite, where that rotation is undefined.
+vec3 sim_rotate_between(vec3 a, vec3 b, vec3 v) {
+    precise float c = sim_dot(a, b);
+    if (c <= -0.999) {
+        return v;
+    }
+    precise vec3 axis = vec3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+    precise vec3 cross_v = vec3(axis.y * v.z - axis.z * v.y, axis.z * v.x - axis.x * v.z, axis.x * v.y - axis.y * v.x);
+    precise vec3 r = (v * c + cross_v) + axis * (sim_dot(axis, v) / (1.0 + c));
+    return r;
 }
 
 // Weight of the global shape constraint at strand parameter t (0 root, 1 tip):

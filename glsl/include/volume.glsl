@@ -25,6 +25,9 @@ struct VolumeParams {
     vec4 transfer;         // x FLIP ratio α, y friction (0..1), z repulsion (m/s²), w repulsion threshold density
     vec4 solve;            // x tolerance (relative max-norm residual), y cell size (m), z time step (s), w mode (VOL_MODE_*)
     uvec4 config;          // x iteration cap, y preconditioner (VOL_PRECOND_*), z multigrid levels, w colliders
+    mat4 mesh_from_grid;   // grid coordinates → the mesh collider's frame (the head frame)
+    vec4 mesh_grid;        // mesh collider: xyz grid point (0, 0, 0), w cell edge
+    uvec4 mesh_dims;       // xyz grid points per axis, w 1 when its cells count as solid
 };
 
 // Push constants shared by the volume kernels. Twin: gpu_types::VolumePush.

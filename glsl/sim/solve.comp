@@ -8,10 +8,18 @@
 //   1. distance constraints of even segments, 2. of odd segments,
 //   3. bending (distance between points i−1 and i+1, rest from the rest shape,
 //      stiffness from root to tip) centred on i mod 4 ∈ {0,1}, 4. on {2,3},
-//   5. the global shape constraint (each point pulled toward its rest position in
+//   5. (with SIM_LOCAL_SHAPE) the local shape constraint: each point i ≥ 1 is
+//      pulled toward where its rest offset from its parent puts it, the offset
+//      carried along by the smallest rotation taking the parent segment's rest
+//      direction onto its current one (parallel transport of the rest frame;
+//      the root's frame is the head's); it reads its parent and grandparent
+//      and moves only itself,
+//   6. the global shape constraint (each point pulled toward its rest position in
 //      the head's frame; it touches only the own point) and body collisions
-//      (spheres, capsules; each particle has its own radius),
-// then writes the hairs back once.
+//      (spheres, capsules and, with SIM_MESH, the mesh collider's field; each
+//      particle has its own radius),
+// then, with the mesh collider, friction against it (once per sub-step), and
+// writes the hairs back once.
 //
 // Both ends of a constraint compute the same correction from the same two
 // positions, and each keeps its own result: every invocation holds its point
@@ -30,12 +38,15 @@
 layout(local_size_x = SIM_WORKGROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { SimStepParams params; };
+layout(std430, set = 0, binding = 1) readonly buffer PosIn { vec4 pos_in[]; };
 layout(std430, set = 0, binding = 3) buffer Predicted { vec4 predicted[]; };
 layout(std430, set = 0, binding = 4) writeonly buffer Correction { vec4 correction[]; };
 layout(std430, set = 0, binding = 5) readonly buffer Rest { vec4 rest[]; };
 layout(std430, set = 0, binding = 6) readonly buffer RestLength { float rest_length[]; };
 // Uniform: every invocation reads the same collider at the same time.
 layout(std140, set = 0, binding = 7) uniform Colliders { Collider colliders[SIM_MAX_COLLIDERS]; };
+layout(std430, set = 0, binding = 10) readonly buffer MeshField { float mesh_field[]; };
+#include "mesh_sdf.glsl"
 
 shared vec4 s_pos[2][SIM_WORKGROUP];
 shared float s_length[SIM_WORKGROUP];
@@ -53,6 +64,9 @@ void sync(uint group) {
 vec3 collide_all(vec3 p, float radius) {
     for (uint c = 0u; c < params.layout_info.x; c++) {
         p = sim_collide(colliders[c], p, radius);
+    }
+    if ((params.counts.w & SIM_MESH) != 0u) {
+        p = mesh_collide(params.head, params.mesh_grid, params.mesh_dims, p, radius);
     }
     return p;
 }
@@ -81,6 +95,23 @@ vec4 project_end(vec4 own, uint lid, int offset, bool first, float rest_d, float
         }
     }
     return own;
+}
+
+// The local shape constraint for point i ≥ 1 (see the header), reading its
+// parent and grandparent from half `src`.
+vec3 local_shape_project(vec3 own, uint lid, uint i, vec3 rest_dir, vec3 offset, uint src) {
+    precise vec3 parent = s_pos[src][lid - 1u].xyz;
+    precise vec3 carried = offset;
+    if (i >= 2u && sim_dot(rest_dir, rest_dir) > 0.0) {
+        precise vec3 d = parent - s_pos[src][lid - 2u].xyz;
+        precise float len = sqrt(sim_dot(d, d));
+        if (len > 0.0) {
+            carried = sim_rotate_between(rest_dir, d / len, offset);
+        }
+    }
+    precise vec3 target = parent + carried;
+    precise vec3 moved = own + (target - own) * params.shape.z;
+    return moved;
 }
 
 // Rest distance and stiffness of the bending constraint centred on point c.
@@ -114,6 +145,12 @@ void main() {
     vec3 shape_target = vec3(0.0);
     float shape_k = 0.0;
     bool bending = (flags & SIM_BENDING) != 0u;
+    bool local_shape = (flags & SIM_LOCAL_SHAPE) != 0u;
+    // Local shape: the parent segment's rest direction (world, unit; zero for
+    // the first point, whose parent is the root) and the own rest offset from
+    // the parent (world).
+    vec3 local_dir = vec3(0.0);
+    vec3 local_offset = vec3(0.0);
     vec4 own = vec4(0.0);
     float radius = 0.0;
     // Per set: partner offset (0 = none), whether own is the pair's first point,
@@ -133,6 +170,15 @@ void main() {
             shape_k = k;
             vec3 at_rest = sim_transform_point(params.head, rest[index].xyz);
             shape_target = sim_shape_target(at_rest, k, params.counts.z, flags, params.gravity_dt.xyz, params.gravity_dt.w);
+        }
+        if (local_shape && i >= 1u) {
+            precise vec3 offset = rest[index].xyz - rest[index - 1u].xyz;
+            local_offset = sim_rotate(params.head, offset);
+            if (i >= 2u) {
+                precise vec3 parent = sim_rotate(params.head, rest[index - 1u].xyz - rest[index - 2u].xyz);
+                precise float len = sqrt(sim_dot(parent, parent));
+                local_dir = len > 0.0 ? parent / len : vec3(0.0);
+            }
         }
         bool has_next = i + 1u < points;
         float len_next = rest_length[index];
@@ -210,6 +256,14 @@ void main() {
         sync(group);
         src = 1u - src;
         own = project_end(own, lid, off_bend_b, first_bend_b, bend_b.x, bend_b.y, src);
+        if (local_shape) {
+            if (live) { s_pos[1u - src][lid] = own; }
+            sync(group);
+            src = 1u - src;
+            if (live && i >= 1u && own.w > 0.0) {
+                own.xyz = local_shape_project(own.xyz, lid, i, local_dir, local_offset, src);
+            }
+        }
         if (global_shape && live && own.w > 0.0 && shape_k > 0.0) {
             precise vec3 pulled = own.xyz + (shape_target - own.xyz) * shape_k;
             own.xyz = pulled;
@@ -220,6 +274,10 @@ void main() {
         if (live) { s_pos[1u - src][lid] = own; }
         sync(group);
         src = 1u - src;
+    }
+    if ((flags & SIM_MESH) != 0u && collisions && live && own.w > 0.0) {
+        own.xyz = mesh_friction(params.head, params.previous_head, params.mesh_grid, params.mesh_dims, own.xyz,
+                                pos_in[index].xyz, radius, params.shape.w);
     }
     if (live) {
         predicted[index] = own;

@@ -3,6 +3,7 @@
 use super::params::SubstepPlanner;
 use super::{reference, volume, Collider, RigidTransform, SimParams, SimState, VolumeGrid, VolumeMode, MAX_SIM_POINTS};
 use crate::error::Result;
+use crate::groom::sdf::MeshSdf;
 use crate::groom::Groom;
 
 /// The CPU reference simulation: the same algorithm as [`HairSim`](super::HairSim), one particle
@@ -26,6 +27,8 @@ pub struct CpuHairSim {
     volume: Option<volume::grid::GridLayout>,
     /// Intermediate results of the latest volume step.
     last_volume: Option<volume::reference::VolumeSnapshot>,
+    /// The mesh collider's field, when set.
+    mesh: Option<MeshSdf>,
 }
 
 impl CpuHairSim {
@@ -40,7 +43,7 @@ impl CpuHairSim {
         // The CPU runs the same constraint sets in the same order whatever the packing.
         let planner = SubstepPlanner::new(params, head, state.strands, state.points, MAX_SIM_POINTS as u32)?;
         let volume = cpu_volume_grid(params, &state)?;
-        Ok(CpuHairSim { planner, state, volume, last_volume: None })
+        Ok(CpuHairSim { planner, state, volume, last_volume: None, mesh: None })
     }
 
     /// See [`HairSim::set_params`](super::HairSim::set_params).
@@ -55,6 +58,13 @@ impl CpuHairSim {
         self.planner.set_colliders(colliders)
     }
 
+    /// See [`HairSim::set_mesh_collider`](super::HairSim::set_mesh_collider); the
+    /// field is the CPU reference's ([`MeshSdf::build`]) with the same grid.
+    pub fn set_mesh_collider(&mut self, mesh: Option<MeshSdf>) -> Option<MeshSdf> {
+        self.planner.mesh = mesh.as_ref().map(|m| super::mesh_collider::grid_of(m.origin, m.cell, m.dims));
+        std::mem::replace(&mut self.mesh, mesh)
+    }
+
     /// See [`HairSim::set_strand_length`](super::HairSim::set_strand_length).
     pub fn set_strand_length(&mut self, strand: usize, length: f32) -> Result<()> {
         self.state.set_strand_length(strand, length).map(|_| ())
@@ -64,7 +74,8 @@ impl CpuHairSim {
     pub fn step(&mut self, head: &RigidTransform) -> Result<()> {
         let inputs = self.planner.next(head)?;
         for sub in &inputs {
-            reference::step(&mut self.state, std::slice::from_ref(sub));
+            let mesh = self.mesh.as_ref().map(reference::MeshField::new);
+            reference::step(&mut self.state, std::slice::from_ref(sub), mesh);
             if let Some(grid) = &self.volume {
                 let vp = &self.planner.params.volume;
                 let gpu = sub.volume_params(grid, vp, self.planner.colliders.len() as u32);
@@ -72,6 +83,7 @@ impl CpuHairSim {
                     grid,
                     &gpu,
                     &sub.colliders,
+                    mesh,
                     &self.state.positions,
                     &mut self.state.velocities,
                 );

@@ -59,6 +59,12 @@ impl Default for MeshColliderParams {
     }
 }
 
+/// A field's grid as the simulation's parameters carry it (see `mesh_sample` in
+/// `glsl/include/mesh_sdf.glsl`).
+pub(crate) fn grid_of(origin: Vec3, cell: f32, dims: [u32; 3]) -> ([f32; 4], [u32; 4]) {
+    (origin.extend(cell).to_array(), [dims[0], dims[1], dims[2], 1])
+}
+
 /// Label and timestamp scope of the build.
 pub const MESH_COLLIDER_BUILD_LABEL: &str = "vkhair mesh collider: build";
 
@@ -69,7 +75,7 @@ pub struct MeshCollider {
     origin: Vec3,
     cell: f32,
     dims: [u32; 3],
-    device: Arc<Device>,
+    pub(crate) device: Arc<Device>,
 }
 
 impl std::fmt::Debug for MeshCollider {
@@ -126,7 +132,7 @@ impl MeshCollider {
     /// The grid as the simulation's parameters carry it: origin and cell edge, and
     /// points per axis.
     pub(crate) fn grid(&self) -> ([f32; 4], [u32; 4]) {
-        (self.origin.extend(self.cell).to_array(), [self.dims[0], self.dims[1], self.dims[2], 1])
+        grid_of(self.origin, self.cell, self.dims)
     }
 
     fn build(

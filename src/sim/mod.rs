@@ -199,6 +199,8 @@ pub struct HairSim {
     current: usize,
     /// The volume stage, when switched on.
     volume: Option<volume::VolumeStage>,
+    /// The mesh collider, when set.
+    mesh: Option<MeshCollider>,
 }
 
 impl HairSim {
@@ -222,8 +224,8 @@ impl HairSim {
             let full = stage == SimStage::Solve && device.full_subgroups;
             let pipeline = ComputePipeline::with_full_subgroups(&device, stage.shader(), 2, full)?;
             let sets = [
-                pipeline.declared_buffer_set(0, &gpu.bindings(0))?,
-                pipeline.declared_buffer_set(0, &gpu.bindings(1))?,
+                pipeline.declared_buffer_set(0, &gpu.bindings(0, None))?,
+                pipeline.declared_buffer_set(0, &gpu.bindings(1, None))?,
             ];
             stages.push(StagePipeline { stage, pipeline, sets });
         }
@@ -236,6 +238,7 @@ impl HairSim {
             pending_rest: Vec::new(),
             current: 0,
             volume: None,
+            mesh: None,
         };
         sim.configure_volume(&params.volume)?;
         Ok(sim)
@@ -258,7 +261,8 @@ impl HairSim {
         let grid = volume::grid::GridLayout::new(params, &self.shape)?;
         let g = &self.gpu;
         let particles = [(&g.positions[0], &g.velocities[0]), (&g.positions[1], &g.velocities[1])];
-        self.volume = Some(volume::VolumeStage::new(&self.device, grid, params, &g.colliders, &particles)?);
+        let mesh_field = self.mesh.as_ref().map_or(&g.no_mesh, |m| &m.field);
+        self.volume = Some(volume::VolumeStage::new(&self.device, grid, params, &g.colliders, mesh_field, &particles)?);
         Ok(())
     }
 
@@ -280,6 +284,38 @@ impl HairSim {
     /// Replaces the colliders (in the head frame; at most [`MAX_COLLIDERS`]).
     pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
         self.planner.set_colliders(colliders)
+    }
+
+    /// Sets (or with `None` removes) the mesh collider: from the next step on,
+    /// particles are projected out of its field along the gradient and rub against
+    /// it with [`SimParams::mesh_friction`], alongside the spheres and capsules,
+    /// when [`SimParams::collisions_enabled`]. Its field is in the head frame and
+    /// moves with the head transform. The collider must come from this
+    /// simulation's context. This waits for the device to be idle (the solver's
+    /// descriptors are rewritten) and returns the previous collider.
+    pub fn set_mesh_collider(&mut self, mesh: Option<MeshCollider>) -> Result<Option<MeshCollider>> {
+        if let Some(m) = &mesh {
+            if !Arc::ptr_eq(&m.device, &self.device) {
+                return Err(Error::incompatible("mesh collider", "it was built on another context's device"));
+            }
+        }
+        self.device.wait_idle()?;
+        let field = mesh.as_ref().map(|m| &m.field);
+        for stage in &self.stages {
+            for (parity, &set) in stage.sets.iter().enumerate() {
+                // SAFETY: the set was allocated by this pipeline for set 0, and the
+                // device is idle; recording happens only through `&mut self`.
+                unsafe { stage.pipeline.rewrite_declared(set, 0, &self.gpu.bindings(parity, field))? };
+            }
+        }
+        self.planner.mesh = mesh.as_ref().map(MeshCollider::grid);
+        let previous = std::mem::replace(&mut self.mesh, mesh);
+        // The volume stage binds the field too: rebuild it around the new one.
+        if self.volume.take().is_some() {
+            let params = self.planner.params.volume.clone();
+            self.configure_volume(&params)?;
+        }
+        Ok(previous)
     }
 
     /// Changes the rest length of key hair `strand`; only its tip segments change.

@@ -81,7 +81,19 @@ pub struct SimParams {
     /// constraint barely holds (under 1 % of their offset removed per sub-step)
     /// are left uncompensated. Default: true.
     pub sag_free: bool,
-    /// Whether body collisions act. Default: true.
+    /// Local shape constraint: the fraction of each point's deviation from where
+    /// its rest offset from its parent puts it (the offset carried along with the
+    /// parent segment's rotation, i.e. the rest frames parallel-transported along
+    /// the current strand) removed per sub-step, independent of the iteration
+    /// count (0..=1; 0 switches it off). What keeps curls curled and a mohawk up
+    /// without holding the strand rigidly in place. Default: 0.
+    pub local_shape_stiffness: f32,
+    /// Friction against the mesh collider: the fraction of a touching particle's
+    /// motion along the surface, relative to the mesh, removed per sub-step
+    /// (0..=1). Default: 0.3.
+    pub mesh_friction: f32,
+    /// Whether body collisions act (spheres, capsules and the mesh collider).
+    /// Default: true.
     pub collisions_enabled: bool,
     /// Fraction of velocity removed per sub-step (0..1). Default: 0.02.
     pub damping: f32,
@@ -127,6 +139,8 @@ impl Default for SimParams {
             global_shape_stiffness: 0.0,
             global_shape_range: 0.5,
             sag_free: true,
+            local_shape_stiffness: 0.0,
+            mesh_friction: 0.3,
             collisions_enabled: true,
             damping: 0.02,
             dftl_damping: 0.9,
@@ -176,6 +190,8 @@ impl SimParams {
         in_range("bending_tip", self.bending_tip, 0.0, 1.0)?;
         in_range("global_shape_stiffness", self.global_shape_stiffness, 0.0, 1.0)?;
         in_range("global_shape_range", self.global_shape_range, 0.0, 1.0)?;
+        in_range("local_shape_stiffness", self.local_shape_stiffness, 0.0, 1.0)?;
+        in_range("mesh_friction", self.mesh_friction, 0.0, 1.0)?;
         in_range("damping", self.damping, 0.0, 0.999)?;
         in_range("dftl_damping", self.dftl_damping, 0.0, 1.0)?;
         in_range("pearl_radius_root", self.pearl_radius_root, 0.0, 1e6)?;
@@ -308,6 +324,8 @@ pub(crate) mod flags {
     pub const DFTL: u32 = 32;
     pub const GLOBAL_SHAPE: u32 = 64;
     pub const SAG_FREE: u32 = 128;
+    pub const LOCAL_SHAPE: u32 = 256;
+    pub const MESH: u32 = 512;
 }
 
 /// Everything one sub-step needs, identical for the GPU stages and the CPU reference.
@@ -328,7 +346,8 @@ impl SubstepInputs {
     ) -> crate::gpu_types::GpuVolumeParams {
         let head = Mat4::from_cols_array_2d(&self.params.head);
         let colliders = if self.params.flags() & flags::COLLISIONS != 0 { colliders } else { 0 };
-        grid.gpu_params(params, &self.previous_head, &head, self.params.dt(), colliders)
+        let mesh = (self.params.flags() & flags::MESH != 0).then_some((self.params.mesh_grid, self.params.mesh_dims));
+        grid.gpu_params(params, &self.previous_head, &head, self.params.dt(), colliders, mesh)
     }
 }
 
@@ -340,6 +359,8 @@ impl SubstepInputs {
 pub(crate) struct SubstepPlanner {
     pub params: SimParams,
     pub colliders: Vec<Collider>,
+    /// The mesh collider's grid (origin and cell edge, points per axis), when set.
+    pub mesh: Option<([f32; 4], [u32; 4])>,
     pub head: RigidTransform,
     pub time: f64,
     pub substep: u32,
@@ -376,6 +397,7 @@ impl SubstepPlanner {
         Ok(SubstepPlanner {
             params: params.clone(),
             colliders: Vec::new(),
+            mesh: None,
             head: *head,
             time: 0.0,
             substep: 0,
@@ -422,6 +444,9 @@ impl SubstepPlanner {
         flags |= if p.solver == SolverMode::Dftl { flags::DFTL } else { 0 };
         flags |= if p.global_shape_stiffness > 0.0 { flags::GLOBAL_SHAPE } else { 0 };
         flags |= if p.sag_free { flags::SAG_FREE } else { 0 };
+        flags |= if p.local_shape_stiffness > 0.0 && p.solver == SolverMode::Pbd { flags::LOCAL_SHAPE } else { 0 };
+        flags |= if self.mesh.is_some() && p.collisions_enabled { flags::MESH } else { 0 };
+        let (mesh_grid, mesh_dims) = self.mesh.unwrap_or(([0.0, 0.0, 0.0, 1.0], [0; 4]));
         let packing = self.packing();
         let inputs = (0..p.substeps)
             .map(|k| {
@@ -437,7 +462,15 @@ impl SubstepPlanner {
                         wind_noise: [p.wind_frequency, t, p.spring_stiffness, p.damping],
                         bending: [p.per_iteration(p.bending_root), p.per_iteration(p.bending_tip), p.dftl_damping, 0.0],
                         counts: [self.strands, self.points, p.iterations, flags],
-                        shape: [p.per_iteration(p.global_shape_stiffness), p.global_shape_range, 0.0, 0.0],
+                        shape: [
+                            p.per_iteration(p.global_shape_stiffness),
+                            p.global_shape_range,
+                            p.per_iteration(p.local_shape_stiffness),
+                            p.mesh_friction,
+                        ],
+                        previous_head: previous_head.to_cols_array_2d(),
+                        mesh_grid,
+                        mesh_dims,
                         layout_info: [
                             self.colliders.len() as u32,
                             packing.hairs_per_group,

@@ -11,6 +11,7 @@ use glam::{Vec3, Vec4};
 use super::params::{flags, SubstepInputs};
 use super::state::SimState;
 use crate::gpu_types::{GpuCollider, SimStepParams};
+use crate::groom::sdf::MeshSdf;
 
 fn dot(a: Vec3, b: Vec3) -> f32 {
     (a.x * b.x + a.y * b.y) + a.z * b.z
@@ -19,6 +20,116 @@ fn dot(a: Vec3, b: Vec3) -> f32 {
 fn transform_point(m: &[[f32; 4]; 4], p: Vec3) -> Vec3 {
     let c = |i: usize| Vec3::new(m[i][0], m[i][1], m[i][2]);
     ((c(0) * p.x + c(1) * p.y) + c(2) * p.z) + c(3)
+}
+
+/// `sim_to_head`: Rᵀ(p − t) for a rigid `m`.
+fn to_head(m: &[[f32; 4]; 4], p: Vec3) -> Vec3 {
+    let d = p - Vec3::new(m[3][0], m[3][1], m[3][2]);
+    let row = |i: usize| (m[i][0] * d.x + m[i][1] * d.y) + m[i][2] * d.z;
+    Vec3::new(row(0), row(1), row(2))
+}
+
+/// `sim_rotate`: R · v.
+fn rotate(m: &[[f32; 4]; 4], v: Vec3) -> Vec3 {
+    let c = |i: usize| Vec3::new(m[i][0], m[i][1], m[i][2]);
+    (c(0) * v.x + c(1) * v.y) + c(2) * v.z
+}
+
+fn cross(a: Vec3, b: Vec3) -> Vec3 {
+    Vec3::new(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x)
+}
+
+/// `sim_rotate_between`: v rotated by the smallest rotation taking a onto b.
+fn rotate_between(a: Vec3, b: Vec3, v: Vec3) -> Vec3 {
+    let c = dot(a, b);
+    if c <= -0.999 {
+        return v;
+    }
+    let axis = cross(a, b);
+    (v * c + cross(axis, v)) + axis * (dot(axis, v) / (1.0 + c))
+}
+
+/// The mesh collider's field as the solver sees it.
+#[derive(Clone, Copy)]
+pub(crate) struct MeshField<'a> {
+    pub grid: [f32; 4],
+    pub dims: [u32; 4],
+    pub values: &'a [f32],
+}
+
+impl<'a> MeshField<'a> {
+    pub(crate) fn new(sdf: &'a MeshSdf) -> Self {
+        let (grid, dims) = super::mesh_collider::grid_of(sdf.origin, sdf.cell, sdf.dims);
+        MeshField { grid, dims, values: &sdf.values }
+    }
+
+    /// `mesh_sample`: trilinear value and its gradient (per cell) at q, head frame.
+    pub(crate) fn sample(&self, q: Vec3) -> (Vec3, f32) {
+        let g = (q - Vec3::new(self.grid[0], self.grid[1], self.grid[2])) / self.grid[3];
+        let top = Vec3::new(self.dims[0] as f32, self.dims[1] as f32, self.dims[2] as f32) - 1.0;
+        if g.cmplt(Vec3::ZERO).any() || g.cmpgt(top).any() {
+            return (Vec3::ZERO, 1e30);
+        }
+        let base = g.floor().min(top - 1.0);
+        let f = g - base;
+        let (sx, sy, sz) = (1usize, self.dims[0] as usize, (self.dims[0] * self.dims[1]) as usize);
+        let k = ((base.z as usize * self.dims[1] as usize) + base.y as usize) * self.dims[0] as usize + base.x as usize;
+        let v = |o: usize| self.values[k + o];
+        let (c000, c100, c010, c110) = (v(0), v(sx), v(sy), v(sx + sy));
+        let (c001, c101, c011, c111) = (v(sz), v(sx + sz), v(sy + sz), v(sx + sy + sz));
+        let x00 = c000 + (c100 - c000) * f.x;
+        let x10 = c010 + (c110 - c010) * f.x;
+        let x01 = c001 + (c101 - c001) * f.x;
+        let x11 = c011 + (c111 - c011) * f.x;
+        let y0 = x00 + (x10 - x00) * f.y;
+        let y1 = x01 + (x11 - x01) * f.y;
+        let value = y0 + (y1 - y0) * f.z;
+        let gx0 = (c100 - c000) + ((c110 - c010) - (c100 - c000)) * f.y;
+        let gx1 = (c101 - c001) + ((c111 - c011) - (c101 - c001)) * f.y;
+        let gx = gx0 + (gx1 - gx0) * f.z;
+        let gy = (x10 - x00) + ((x11 - x01) - (x10 - x00)) * f.z;
+        let gz = y1 - y0;
+        (Vec3::new(gx, gy, gz), value)
+    }
+
+    /// `mesh_collide`.
+    fn collide(&self, head: &[[f32; 4]; 4], p: Vec3, radius: f32) -> Vec3 {
+        let q = to_head(head, p);
+        let (gradient, value) = self.sample(q);
+        if value < radius {
+            let len = dot(gradient, gradient).sqrt();
+            if len > 0.0 {
+                return transform_point(head, q + gradient * ((radius - value) / len));
+            }
+        }
+        p
+    }
+
+    /// `mesh_friction`.
+    #[allow(clippy::too_many_arguments, reason = "mirrors the shader function")]
+    fn friction(
+        &self,
+        head: &[[f32; 4]; 4],
+        previous_head: &[[f32; 4]; 4],
+        p: Vec3,
+        from: Vec3,
+        radius: f32,
+        friction: f32,
+    ) -> Vec3 {
+        let q = to_head(head, p);
+        let (gradient, value) = self.sample(q);
+        let contact = radius + 0.1 * self.grid[3];
+        let len = dot(gradient, gradient).sqrt();
+        // Written to treat NaN as the shader does: no contact.
+        let touching = value < contact && len > 0.0;
+        if !touching || friction <= 0.0 {
+            return p;
+        }
+        let n = gradient / len;
+        let moved = q - to_head(previous_head, from);
+        let along = moved - n * dot(n, moved);
+        transform_point(head, q - along * friction)
+    }
 }
 
 fn hash(x: u32) -> f32 {
@@ -55,11 +166,25 @@ fn collide(c: &GpuCollider, p: Vec3, radius: f32) -> Vec3 {
     }
 }
 
-fn collide_all(colliders: &[GpuCollider], mut p: Vec3, radius: f32) -> Vec3 {
-    for c in colliders {
-        p = collide(c, p, radius);
+/// The bodies a particle collides with: spheres and capsules, and the mesh
+/// collider when `SIM_MESH` is set.
+#[derive(Clone, Copy)]
+struct Bodies<'a> {
+    colliders: &'a [GpuCollider],
+    mesh: Option<MeshField<'a>>,
+    head: &'a [[f32; 4]; 4],
+}
+
+impl Bodies<'_> {
+    fn collide(&self, mut p: Vec3, radius: f32) -> Vec3 {
+        for c in self.colliders {
+            p = collide(c, p, radius);
+        }
+        if let Some(mesh) = &self.mesh {
+            p = mesh.collide(self.head, p, radius);
+        }
+        p
     }
-    p
 }
 
 /// Weight of the global shape constraint at strand parameter `t`, as
@@ -142,6 +267,7 @@ fn predict(p: &SimStepParams, state: &SimState, predicted: &mut [Vec4]) {
 fn solve(
     p: &SimStepParams,
     colliders: &[GpuCollider],
+    mesh: Option<MeshField<'_>>,
     state: &SimState,
     predicted: &mut [Vec4],
     correction: &mut [Vec4],
@@ -149,6 +275,13 @@ fn solve(
     let points = p.points() as usize;
     let flags = p.flags();
     let collisions = flags & flags::COLLISIONS != 0;
+    let mesh = mesh.filter(|_| flags & flags::MESH != 0);
+    let bodies = Bodies { colliders, mesh, head: &p.head };
+    // Per point of the strand: the local shape constraint's parent rest direction
+    // and rest offset (world), and the positions the set reads.
+    let local_shape = flags & flags::LOCAL_SHAPE != 0;
+    let mut local = vec![(Vec3::ZERO, Vec3::ZERO); points];
+    let mut before = vec![Vec4::ZERO; points];
     let mut s = vec![Vec4::ZERO; points];
     let mut bend = vec![(0.0f32, 0.0f32); points];
     // Per point of the strand: the global shape constraint's target and stiffness.
@@ -170,7 +303,7 @@ fn solve(
                     let mut placed =
                         if len > 0.0 { parent.truncate() + d * (lengths[k - 1] / len) } else { q.truncate() };
                     if collisions {
-                        placed = collide_all(colliders, placed, radius(k));
+                        placed = bodies.collide(placed, radius(k));
                     }
                     s[k] = placed.extend(q.w);
                 }
@@ -201,6 +334,19 @@ fn solve(
                 *slot = (shape_target(at_rest, k, p.iterations(), flags, p.gravity(), p.dt()), k);
             }
         }
+        if local_shape {
+            for (i, slot) in local.iter_mut().enumerate().skip(1) {
+                let rest = |j: usize| state.rest[base + j].truncate();
+                let offset = rotate(&p.head, rest(i) - rest(i - 1));
+                let mut dir = Vec3::ZERO;
+                if i >= 2 {
+                    let parent = rotate(&p.head, rest(i - 1) - rest(i - 2));
+                    let len = dot(parent, parent).sqrt();
+                    dir = if len > 0.0 { parent / len } else { Vec3::ZERO };
+                }
+                *slot = (dir, offset);
+            }
+        }
         for _ in 0..p.iterations() {
             for i in (0..points - 1).step_by(2) {
                 project(&mut s, i, i + 1, lengths[i], 1.0);
@@ -217,6 +363,26 @@ fn solve(
                     }
                 }
             }
+            if local_shape {
+                before.copy_from_slice(&s);
+                for i in 1..points {
+                    if s[i].w > 0.0 {
+                        let (dir, offset) = local[i];
+                        let parent = before[i - 1].truncate();
+                        let mut carried = offset;
+                        if i >= 2 && dot(dir, dir) > 0.0 {
+                            let d = parent - before[i - 2].truncate();
+                            let len = dot(d, d).sqrt();
+                            if len > 0.0 {
+                                carried = rotate_between(dir, d / len, offset);
+                            }
+                        }
+                        let own = s[i].truncate();
+                        let target = parent + carried;
+                        s[i] = (own + (target - own) * p.local_shape()).extend(s[i].w);
+                    }
+                }
+            }
             if global_shape {
                 for (q, &(target, k)) in s.iter_mut().zip(&shape) {
                     if q.w > 0.0 && k > 0.0 {
@@ -227,8 +393,18 @@ fn solve(
             if collisions {
                 for (i, q) in s.iter_mut().enumerate() {
                     if q.w > 0.0 {
-                        *q = collide_all(colliders, q.truncate(), radius(i)).extend(q.w);
+                        *q = bodies.collide(q.truncate(), radius(i)).extend(q.w);
                     }
+                }
+            }
+        }
+        if let (Some(mesh), true) = (&mesh, collisions) {
+            for (i, q) in s.iter_mut().enumerate() {
+                if q.w > 0.0 {
+                    let from = state.positions[base + i].truncate();
+                    let held =
+                        mesh.friction(&p.head, &p.previous_head, q.truncate(), from, radius(i), p.mesh_friction());
+                    *q = held.extend(q.w);
                 }
             }
         }
@@ -254,14 +430,14 @@ fn integrate(p: &SimStepParams, state: &mut SimState, predicted: &[Vec4], correc
     }
 }
 
-/// Advances `state` by the given sub-steps.
-pub(crate) fn step(state: &mut SimState, substeps: &[SubstepInputs]) {
+/// Advances `state` by the given sub-steps, with the mesh collider's field when set.
+pub(crate) fn step(state: &mut SimState, substeps: &[SubstepInputs], mesh: Option<MeshField<'_>>) {
     let n = state.positions.len();
     let mut predicted = vec![Vec4::ZERO; n];
     let mut correction = vec![Vec4::ZERO; n];
     for sub in substeps {
         predict(&sub.params, state, &mut predicted);
-        solve(&sub.params, &sub.colliders, state, &mut predicted, &mut correction);
+        solve(&sub.params, &sub.colliders, mesh, state, &mut predicted, &mut correction);
         integrate(&sub.params, state, &predicted, &correction);
     }
 }

@@ -151,6 +151,8 @@ pub(crate) struct GpuState {
     pub rest_lengths: Buffer,
     pub colliders: Buffer,
     pub params: Buffer,
+    /// Bound as the mesh collider's field while none is set (never read then).
+    pub no_mesh: Buffer,
 }
 
 /// Binding numbers shared by the stage shaders (see `glsl/sim/*.comp`).
@@ -165,6 +167,7 @@ pub(crate) mod binding {
     pub const COLLIDERS: u32 = 7;
     pub const POS_OUT: u32 = 8;
     pub const VEL_OUT: u32 = 9;
+    pub const MESH_FIELD: u32 = 10;
 }
 
 impl GpuState {
@@ -198,6 +201,7 @@ impl GpuState {
                 (MAX_COLLIDERS * std::mem::size_of::<GpuCollider>()) as u64,
             )?,
             params: Buffer::uniform(device, "vkhair sim params", std::mem::size_of::<SimStepParams>() as u64)?,
+            no_mesh: storage("vkhair sim no mesh collider", 16)?,
         };
         gpu.upload(device, state, 0)?;
         device.upload_pod(&gpu.rest, &state.rest)?;
@@ -213,8 +217,9 @@ impl GpuState {
         device.upload_pod(&self.velocities[parity], &state.velocities)
     }
 
-    /// Buffers by binding number for half `parity` (reads `parity`, writes the other).
-    pub(crate) fn bindings(&self, parity: usize) -> [(u32, &Buffer); 10] {
+    /// Buffers by binding number for half `parity` (reads `parity`, writes the other),
+    /// with `mesh` as the mesh collider's field (none: the placeholder).
+    pub(crate) fn bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 11] {
         use binding::*;
         [
             (PARAMS, &self.params),
@@ -227,6 +232,7 @@ impl GpuState {
             (COLLIDERS, &self.colliders),
             (POS_OUT, &self.positions[1 - parity]),
             (VEL_OUT, &self.velocities[1 - parity]),
+            (MESH_FIELD, mesh.unwrap_or(&self.no_mesh)),
         ]
     }
 }

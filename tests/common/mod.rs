@@ -1,7 +1,9 @@
 //! Shared by the integration tests: a validated headless context.
 
+use glam::Vec3;
 use vkhair::groom::grow::{grow, GrowParams};
 use vkhair::groom::scenes;
+use vkhair::sim::{RigidTransform, SimState};
 use vkhair::{ContextOptions, GpuContext, Groom, ValidationLog};
 
 /// Key hairs grown on the `thesis` scalp: `strands` × `points`, 0.35 m long with
@@ -47,4 +49,67 @@ impl Drop for Gpu {
             self.log.assert_clean();
         }
     }
+}
+
+/// A mohawk: `strands` straight strands of 10 cm standing out radially from a
+/// band of roots over the top of a 10 cm head sphere centred at the origin.
+#[allow(dead_code, reason = "not every test file uses every groom")]
+pub fn mohawk(strands: usize, points: usize) -> Groom {
+    let strands: Vec<Vec<Vec3>> = (0..strands)
+        .map(|s| {
+            let along = s as f32 / (strands - 1) as f32;
+            let angle = (along - 0.5) * 2.0; // ±57° from the top, in the y-z plane
+            let side = ((s % 5) as f32 - 2.0) * 0.006;
+            let normal = Vec3::new(side * 3.0, angle.cos(), angle.sin()).normalize();
+            let root = normal * 0.1;
+            (0..points).map(|i| root + normal * (0.1 * i as f32 / (points - 1) as f32)).collect()
+        })
+        .collect();
+    Groom::from_strands(&strands).expect("mohawk")
+}
+
+/// Helix curls: `strands` strands of 16 points standing out from the top of the
+/// head sphere, each a helix of 1 cm radius and 2.5 cm pitch around its normal,
+/// about 10 cm long along the axis.
+#[allow(dead_code, reason = "not every test file uses every groom")]
+pub fn curls(strands: usize) -> Groom {
+    let strands: Vec<Vec<Vec3>> = (0..strands)
+        .map(|s| {
+            let a = s as f32 * 2.399; // golden-angle spiral over a cap
+            let r = 0.6 * ((s as f32 + 0.5) / strands as f32).sqrt();
+            let normal = Vec3::new(r * a.cos(), 1.0, r * a.sin()).normalize();
+            let (u, v) = normal.any_orthonormal_pair();
+            (0..16)
+                .map(|i| {
+                    let t = i as f32 / 15.0;
+                    let turn = std::f32::consts::TAU * 4.0 * t;
+                    let radius = 0.01 * t.min(0.1) * 10.0; // grows out of the root
+                    normal * (0.1 + 0.1 * t) + (u * turn.cos() + v * turn.sin() - u) * radius
+                })
+                .collect()
+        })
+        .collect();
+    Groom::from_strands(&strands).expect("curls")
+}
+
+/// Per strand, the largest distance of a tip from where the rest shape carried
+/// rigidly by the head puts it, as a fraction of the strand's rest length,
+/// sorted.
+#[allow(dead_code, reason = "not every test file uses every groom")]
+pub fn tip_drift_of(state: &SimState, head: &RigidTransform) -> Vec<f32> {
+    let m = head.matrix();
+    let mut drift: Vec<f32> = (0..state.strands)
+        .map(|s| {
+            let tip = s * state.points + state.points - 1;
+            let length = state.rest_strand_length(s);
+            (state.positions[tip].truncate() - m.transform_point3(state.rest[tip].truncate())).length() / length
+        })
+        .collect();
+    drift.sort_by(f32::total_cmp);
+    drift
+}
+
+#[allow(dead_code, reason = "not every test file uses every groom")]
+pub fn p(drift: &[f32], percent: usize) -> f32 {
+    drift[(drift.len() - 1) * percent / 100]
 }

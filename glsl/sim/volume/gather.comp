@@ -3,7 +3,8 @@
 // larger than the cells along every axis visits the particles of the 3 × 3 × 3
 // cells around cell (i, j, k) once and accumulates, each with trilinear weights:
 //   - the density and mean velocity around the centre of cell (i, j, k), and its
-//     label (solid when the centre lies inside a collider, else fluid when a
+//     label (solid when the centre lies inside a collider or the mesh
+//     collider's field, else fluid when a
 //     particle lies in it, else air);
 //   - the u, v and w faces (i, j, k) — each component on its own grid, shifted
 //     by half a cell — whose supports (2 × 3 × 3 cells) lie inside those 27.
@@ -26,6 +27,8 @@ layout(std430, set = 0, binding = 16) writeonly buffer Labels { uint labels[]; }
 layout(std430, set = 0, binding = 17) writeonly buffer FaceVel { float face_vel[]; };
 layout(std430, set = 0, binding = 18) writeonly buffer FaceStar { float face_star[]; };
 layout(std430, set = 0, binding = 19) writeonly buffer FaceWeight { float face_weight[]; };
+layout(std430, set = 0, binding = 29) readonly buffer MeshField { float mesh_field[]; };
+#include "mesh_sdf.glsl"
 
 bool inside_collider(vec3 p) {
     for (uint k = 0u; k < vp.config.w; ++k) {
@@ -50,7 +53,11 @@ bool solid_cell(ivec3 q) {
     if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, ivec3(vp.dims.xyz)))) {
         return false;
     }
-    return inside_collider(vol_affine(vp.world_from_grid, vec3(q) + 0.5));
+    vec3 centre = vec3(q) + 0.5;
+    if (vp.mesh_dims.w == 1u && mesh_sample(vp.mesh_grid, vp.mesh_dims, vol_affine(vp.mesh_from_grid, centre)).w < 0.0) {
+        return true;
+    }
+    return inside_collider(vol_affine(vp.world_from_grid, centre));
 }
 
 void main() {

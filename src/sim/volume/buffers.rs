@@ -44,6 +44,7 @@ pub(crate) mod binding {
     pub const SCALARS: u32 = 26;
     pub const PARTIALS: u32 = 27;
     pub const INDIRECT: u32 = 28;
+    pub const MESH_FIELD: u32 = 29;
 }
 
 /// Keys per sort block (one workgroup of `radix_count`/`radix_scatter`).
@@ -153,12 +154,14 @@ impl VolumeBuffers {
     pub(crate) fn table<'a>(
         &'a self,
         colliders: &'a Buffer,
+        mesh_field: &'a Buffer,
         positions: &'a Buffer,
         velocities: &'a Buffer,
-    ) -> [(u32, &'a Buffer); 29] {
+    ) -> [(u32, &'a Buffer); 30] {
         use binding::*;
         [
             (PARAMS, &self.params),
+            (MESH_FIELD, mesh_field),
             (COLLIDERS, colliders),
             (POSITIONS, positions),
             (VELOCITIES, velocities),
@@ -278,6 +281,7 @@ pub(crate) fn kernels(
     device: &Arc<Device>,
     buffers: &VolumeBuffers,
     colliders: &Buffer,
+    mesh_field: &Buffer,
     particles: &[(&Buffer, &Buffer)],
 ) -> Result<Vec<KernelPipeline>> {
     Kernel::ALL
@@ -286,7 +290,7 @@ pub(crate) fn kernels(
             let pipeline = ComputePipeline::new(device, kernel.shader(), particles.len() as u32)?;
             let sets = particles
                 .iter()
-                .map(|(pos, vel)| pipeline.declared_buffer_set(0, &buffers.table(colliders, pos, vel)))
+                .map(|(pos, vel)| pipeline.declared_buffer_set(0, &buffers.table(colliders, mesh_field, pos, vel)))
                 .collect::<Result<Vec<_>>>()?;
             Ok(KernelPipeline { pipeline, sets })
         })

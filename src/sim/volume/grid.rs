@@ -143,7 +143,9 @@ impl GridLayout {
         head: &Mat4,
         dt: f32,
         colliders: u32,
+        mesh: Option<([f32; 4], [u32; 4])>,
     ) -> GpuVolumeParams {
+        let (mesh_grid, mesh_dims) = mesh.unwrap_or(([0.0, 0.0, 0.0, 1.0], [0; 4]));
         let world_from_grid = self.world_from_grid(head);
         let grid_from_world = world_from_grid.inverse();
         // Head rotation only (the head transform is rigid).
@@ -172,6 +174,9 @@ impl GridLayout {
             transfer: [params.flip_ratio, params.friction, params.repulsion, params.repulsion_threshold],
             solve: [params.tolerance, self.cell_size, dt, mode],
             config: [params.max_iterations, preconditioner, self.levels.len() as u32, colliders],
+            mesh_from_grid: self.head_from_grid().to_cols_array_2d(),
+            mesh_grid,
+            mesh_dims,
         }
     }
 }

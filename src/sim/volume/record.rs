@@ -46,11 +46,12 @@ impl VolumeStage {
         grid: GridLayout,
         params: &VolumeParams,
         colliders: &Buffer,
+        mesh_field: &Buffer,
         particles: &[(&Buffer, &Buffer)],
     ) -> Result<Self> {
         params.validate()?;
         let buffers = VolumeBuffers::new(device, &grid)?;
-        let kernels = buffers::kernels(device, &buffers, colliders, particles)?;
+        let kernels = buffers::kernels(device, &buffers, colliders, mesh_field, particles)?;
         Ok(VolumeStage { device: device.clone(), grid, buffers, kernels, params: params.clone() })
     }
 

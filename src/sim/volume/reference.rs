@@ -11,6 +11,7 @@ use glam::{Vec3, Vec4, Vec4Swizzles};
 
 use super::grid::GridLayout;
 use crate::gpu_types::{GpuCollider, GpuVolumeParams};
+use crate::sim::reference::MeshField;
 
 pub(crate) const AIR: u32 = 0;
 pub(crate) const FLUID: u32 = 1;
@@ -105,6 +106,7 @@ fn cell_of(g: Vec3, dims: [u32; 3]) -> Option<[i64; 3]> {
 }
 
 fn inside(colliders: &[GpuCollider], p: Vec3) -> bool {
+    // (the mesh collider is checked by the caller, in the head frame)
     colliders.iter().any(|c| {
         let a = Vec3::from_slice(&c.a_radius[..3]);
         let mut closest = a;
@@ -125,9 +127,11 @@ pub(crate) fn step(
     grid: &GridLayout,
     p: &GpuVolumeParams,
     colliders: &[GpuCollider],
+    mesh: Option<MeshField<'_>>,
     positions: &[Vec4],
     velocities: &mut [Vec4],
 ) -> VolumeSnapshot {
+    let mesh = mesh.filter(|_| p.mesh_dims[3] == 1);
     let n = positions.len();
     let dims = Dims(grid.dims);
     let cells = dims.count();
@@ -178,7 +182,8 @@ pub(crate) fn step(
             }
         }
         labels[c] = if (start[c] as usize) < n { FLUID } else { AIR };
-        if inside(colliders, affine(&p.world_from_grid, centre)) {
+        let in_mesh = mesh.is_some_and(|m| m.sample(affine(&p.mesh_from_grid, centre)).1 < 0.0);
+        if in_mesh || inside(colliders, affine(&p.world_from_grid, centre)) {
             labels[c] = SOLID;
         }
         let mean = if density > 0.0 { momentum / density } else { Vec3::ZERO };

@@ -49,7 +49,8 @@ fn run_gpu(
     let mut padded = colliders.to_vec();
     padded.resize(MAX_COLLIDERS, GpuCollider::default());
     d.upload_pod(&collider_buffer, &padded).expect("upload");
-    let stage = VolumeStage::new(d, grid.clone(), params, &collider_buffer, &[(&pos, &vel)]).expect("stage");
+    let no_mesh = Buffer::storage(d, "test no mesh collider", 16).expect("buffer");
+    let stage = VolumeStage::new(d, grid.clone(), params, &collider_buffer, &no_mesh, &[(&pos, &vel)]).expect("stage");
     let uploaded = barrier::memory(
         &[AccessKind::TransferWrite],
         &[AccessKind::ComputeRead, AccessKind::ComputeUniformRead, AccessKind::ComputeWrite, AccessKind::IndirectRead],
@@ -91,7 +92,7 @@ fn unit_grid(dims: [u32; 3], particles: usize) -> GridLayout {
 }
 
 fn block(grid: &GridLayout, params: &VolumeParams, previous: Mat4, colliders: u32) -> GpuVolumeParams {
-    grid.gpu_params(params, &previous, &Mat4::IDENTITY, 1.0 / 60.0, colliders)
+    grid.gpu_params(params, &previous, &Mat4::IDENTITY, 1.0 / 60.0, colliders, None)
 }
 
 fn random_particles(rng: &mut Pcg32, n: usize, lo: Vec3, hi: Vec3, speed: f32) -> (Vec<Vec4>, Vec<Vec4>) {
@@ -141,7 +142,7 @@ fn sort_and_start_index_match_the_reference() {
     let b = block(&grid, &params, Mat4::IDENTITY, 0);
     let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
     let mut cpu_vel = velocities.clone();
-    let cpu = reference::step(&grid, &b, &[], &positions, &mut cpu_vel);
+    let cpu = reference::step(&grid, &b, &[], None, &positions, &mut cpu_vel);
     assert_eq!(run.snapshot.keys, cpu.keys, "sorted cell ids");
     assert_eq!(run.snapshot.particles, cpu.particles, "sorted particle order (stable)");
     assert_eq!(run.snapshot.start, cpu.start, "start index");
@@ -169,7 +170,7 @@ fn all_particles_in_one_cell_sort_like_the_reference() {
     let b = block(&grid, &params, Mat4::IDENTITY, 0);
     let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
     let mut cpu_vel = velocities.clone();
-    let cpu = reference::step(&grid, &b, &[], &positions, &mut cpu_vel);
+    let cpu = reference::step(&grid, &b, &[], None, &positions, &mut cpu_vel);
     let cell = 30 + 64 * (30 + 64 * 30);
     assert!(cpu.keys.iter().all(|&k| k == cell));
     assert_eq!(run.snapshot.keys, cpu.keys);
@@ -191,7 +192,7 @@ fn transfer_and_friction_match_the_reference() {
     let b = block(&grid, &params, previous, 1);
     let run = run_gpu(&gpu, &grid, &params, &b, &colliders, &positions, &velocities);
     let mut cpu_vel = velocities.clone();
-    let cpu = reference::step(&grid, &b, &colliders, &positions, &mut cpu_vel);
+    let cpu = reference::step(&grid, &b, &colliders, None, &positions, &mut cpu_vel);
     assert_eq!(run.snapshot.labels, cpu.labels);
     assert!(cpu.labels.contains(&SOLID) && cpu.labels.contains(&FLUID));
     // Same operations in the same order: agreement to a few ulps (the division of a
@@ -266,7 +267,7 @@ fn projection_is_divergence_free_and_agrees_with_mic_pcg() {
         let b = block(&grid, &params, previous, 1);
         let run = run_gpu(&gpu, &grid, &params, &b, &colliders, &positions, &velocities);
         let mut cpu_vel = velocities.clone();
-        let cpu = reference::step(&grid, &b, &colliders, &positions, &mut cpu_vel);
+        let cpu = reference::step(&grid, &b, &colliders, None, &positions, &mut cpu_vel);
         assert_eq!(run.snapshot.labels, cpu.labels);
         let before = max_divergence(&grid, &cpu.labels, &cpu.face_star);
         let after = max_divergence(&grid, &cpu.labels, &run.snapshot.face_vel);

@@ -73,6 +73,21 @@ impl ComputePipeline {
         self.buffer_set(set, &self.layout.declared(set, buffers))
     }
 
+    /// Points those of `buffers` that the shader declares in set `set` at new buffers,
+    /// in an existing descriptor set `target`.
+    ///
+    /// # Safety
+    /// `target` was allocated by this pipeline for set `set`, and no pending or
+    /// recording command buffer uses it.
+    pub(crate) unsafe fn rewrite_declared(
+        &self,
+        target: vk::DescriptorSet,
+        set: u32,
+        buffers: &[(u32, &Buffer)],
+    ) -> Result<()> {
+        self.layout.write_buffers(target, set, &self.layout.declared(set, buffers))
+    }
+
     /// Allocates descriptor set `set` and points its buffer bindings at `buffers`.
     pub(crate) fn buffer_set(&self, set: u32, buffers: &[(u32, &Buffer)]) -> Result<vk::DescriptorSet> {
         let target = self.layout.allocate_set(set, &format!("{} set {set}", self.name))?;
