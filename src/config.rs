@@ -7,6 +7,7 @@
 //! | `[render]`, `[render.lod]` | [`RenderParams`], [`crate::render::LodParams`] |
 //! | `[[lights]]` | [`Light`], with `kind = "directional"`, `"point"` or `"spot"` |
 //! | `[material]`, `[material.marschner]` | [`HairMaterial`], [`crate::render::MarschnerParams`] |
+//! | `[mesh_collider]` | [`MeshColliderParams`] |
 //!
 //! Every key is optional: a file sets what it names and keeps everything else
 //! from the configuration it is applied to ([`Config::default`], or a tool's
@@ -36,7 +37,7 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 use crate::render::{HairMaterial, Light, RenderParams, MAX_LIGHTS};
-use crate::sim::SimParams;
+use crate::sim::{MeshColliderParams, SimParams};
 
 /// Everything a parameter file can set.
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
@@ -52,6 +53,8 @@ pub struct Config {
     pub lights: Vec<Light>,
     /// The hair material (`[material]`, `[material.marschner]`).
     pub material: HairMaterial,
+    /// How the mesh collider's field is built (`[mesh_collider]`).
+    pub mesh_collider: MeshColliderParams,
 }
 
 impl Config {
@@ -95,6 +98,7 @@ impl Config {
         self.sim.validate()?;
         self.render.validate()?;
         self.material.validate()?;
+        self.mesh_collider.validate()?;
         if self.lights.len() > MAX_LIGHTS {
             return Err(Error::param("lights", self.lights.len(), format!("at most {MAX_LIGHTS}")));
         }
@@ -110,7 +114,8 @@ impl Config {
             "# vkhair parameters. Uncomment and change the keys you need; every key is\n\
              # optional and keeps the value shown when left out. Units and ranges are\n\
              # documented on the fields of SimParams ([sim]), VolumeParams ([sim.volume]),\n\
-             # RenderParams ([render]), Light ([[lights]]) and HairMaterial ([material]).\n",
+             # RenderParams ([render]), Light ([[lights]]), HairMaterial ([material]) and\n\
+             # MeshColliderParams ([mesh_collider]).\n",
         );
         for line in body.lines() {
             let header = line.starts_with('[') && !line.starts_with("[[");

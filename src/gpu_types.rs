@@ -59,7 +59,7 @@ pub(crate) struct SimStepParams {
     pub layout_info: [u32; 4],
     /// x global shape stiffness per iteration at full strength, y its range
     /// (fraction of the strand from the root), z local shape stiffness per
-    /// iteration, w mesh collider friction.
+    /// sub-step, w mesh collider friction.
     pub shape: [f32; 4],
     /// World-from-head transform at the start of the step, column-major.
     pub previous_head: [[f32; 4]; 4],
@@ -113,7 +113,7 @@ impl SimStepParams {
     pub fn global_shape(&self) -> (f32, f32) {
         (self.shape[0], self.shape[1])
     }
-    /// Local shape stiffness per iteration.
+    /// Local shape stiffness per sub-step (one sweep after the last iteration).
     pub fn local_shape(&self) -> f32 {
         self.shape[2]
     }

@@ -17,7 +17,7 @@ struct SimStepParams {
     uvec4 counts;         // x strands, y points per strand, z iterations, w flags (SIM_*)
     uvec4 layout_info;    // x colliders, y hairs per workgroup, z step index, w sync group size
     vec4 shape;           // x global shape stiffness per iteration, y its range (strand fraction),
-                          // z local shape stiffness per iteration, w mesh collider friction (0..1)
+                          // z local shape stiffness per sub-step, w mesh collider friction (0..1)
     mat4 previous_head;   // world-from-head transform at the start of this step
     vec4 mesh_grid;       // mesh collider: xyz grid point (0, 0, 0) in the head frame, w cell edge
     uvec4 mesh_dims;      // xyz grid points per axis, w 1 when a mesh collider is set

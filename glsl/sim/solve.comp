@@ -8,12 +8,16 @@
 //   1. distance constraints of even segments, 2. of odd segments,
 //   3. bending (distance between points i−1 and i+1, rest from the rest shape,
 //      stiffness from root to tip) centred on i mod 4 ∈ {0,1}, 4. on {2,3},
-//   5. (with SIM_LOCAL_SHAPE) the local shape constraint: each point i ≥ 1 is
-//      pulled toward where its rest offset from its parent puts it, the offset
-//      carried along by the smallest rotation taking the parent segment's rest
-//      direction onto its current one (parallel transport of the rest frame;
-//      the root's frame is the head's); it reads its parent and grandparent
-//      and moves only itself,
+//   5. (with SIM_LOCAL_SHAPE, in the last iteration only, so that its
+//      stiffness is the fraction removed per sub-step whatever the iteration
+//      count) the local shape constraints, swept root to tip by each hair's
+//      root invocation (Gauss-Seidel: a correction reaches the tip within the
+//      sweep): segment (j−1, j) is
+//      pulled toward its rest offset carried along by the smallest rotation
+//      taking the parent segment's rest direction onto its current one
+//      (parallel transport of the rest frame; the first segment's frame is
+//      the head's); both ends move, by their inverse masses, so the constraint
+//      conserves momentum like the distance constraints,
 //   6. the global shape constraint (each point pulled toward its rest position in
 //      the head's frame; it touches only the own point) and body collisions
 //      (spheres, capsules and, with SIM_MESH, the mesh collider's field; each
@@ -50,6 +54,11 @@ layout(std430, set = 0, binding = 10) readonly buffer MeshField { float mesh_fie
 
 shared vec4 s_pos[2][SIM_WORKGROUP];
 shared float s_length[SIM_WORKGROUP];
+// Local shape, per point i ≥ 1 (its segment from i−1): the parent segment's rest
+// direction (world, unit; zero for the first segment and degenerate ones) and
+// the rest offset of i from i−1 (world).
+shared vec3 s_local_dir[SIM_WORKGROUP];
+shared vec3 s_local_offset[SIM_WORKGROUP];
 
 // Ends a constraint set: makes every shared-memory write of the sync group visible.
 // `group` is uniform over the dispatch, so barrier() stays in uniform control flow.
@@ -97,21 +106,44 @@ vec4 project_end(vec4 own, uint lid, int offset, bool first, float rest_d, float
     return own;
 }
 
-// The local shape constraint for point i ≥ 1 (see the header), reading its
-// parent and grandparent from half `src`.
-vec3 local_shape_project(vec3 own, uint lid, uint i, vec3 rest_dir, vec3 offset, uint src) {
-    precise vec3 parent = s_pos[src][lid - 1u].xyz;
-    precise vec3 carried = offset;
-    if (i >= 2u && sim_dot(rest_dir, rest_dir) > 0.0) {
-        precise vec3 d = parent - s_pos[src][lid - 2u].xyz;
-        precise float len = sqrt(sim_dot(d, d));
-        if (len > 0.0) {
-            carried = sim_rotate_between(rest_dir, d / len, offset);
+// Sweeps the local shape constraints of the hair whose root sits at invocation
+// `root`, root to tip, in place in half `src` (see the header). The segments'
+// rest data are in s_local (direction of the parent segment, offset).
+void local_shape_sweep(uint root, uint points, uint src) {
+    for (uint j = 1u; j < points; j++) {
+        vec4 parent = s_pos[src][root + j - 1u];
+        vec4 child = s_pos[src][root + j];
+        precise vec3 carried = s_local_offset[root + j];
+        vec3 dir = s_local_dir[root + j];
+        if (j >= 2u && sim_dot(dir, dir) > 0.0) {
+            precise vec3 d = parent.xyz - s_pos[src][root + j - 2u].xyz;
+            precise float len = sqrt(sim_dot(d, d));
+            if (len > 0.0) {
+                carried = sim_rotate_between(dir, d / len, carried);
+            }
+        }
+        precise float w = parent.w + child.w;
+        if (w > 0.0) {
+            precise vec3 delta = (carried - (child.xyz - parent.xyz)) * params.shape.z;
+            precise vec3 moved_parent = parent.xyz - delta * (parent.w / w);
+            precise vec3 moved_child = child.xyz + delta * (child.w / w);
+            s_pos[src][root + j - 1u] = vec4(moved_parent, parent.w);
+            s_pos[src][root + j] = vec4(moved_child, child.w);
         }
     }
-    precise vec3 target = parent + carried;
-    precise vec3 moved = own + (target - own) * params.shape.z;
-    return moved;
+}
+
+// The rest offset of particle k from its parent, rotated into the world.
+vec3 local_rest_offset(uint k) {
+    return sim_rotate(params.head, rest[k].xyz - rest[k - 1u].xyz);
+}
+
+// The unit rest direction of the segment ending at particle k, in the world
+// (zero for a degenerate segment).
+vec3 local_rest_dir(uint k) {
+    vec3 d = local_rest_offset(k);
+    precise float len = sqrt(sim_dot(d, d));
+    return len > 0.0 ? d / len : vec3(0.0);
 }
 
 // Rest distance and stiffness of the bending constraint centred on point c.
@@ -146,11 +178,6 @@ void main() {
     float shape_k = 0.0;
     bool bending = (flags & SIM_BENDING) != 0u;
     bool local_shape = (flags & SIM_LOCAL_SHAPE) != 0u;
-    // Local shape: the parent segment's rest direction (world, unit; zero for
-    // the first point, whose parent is the root) and the own rest offset from
-    // the parent (world).
-    vec3 local_dir = vec3(0.0);
-    vec3 local_offset = vec3(0.0);
     vec4 own = vec4(0.0);
     float radius = 0.0;
     // Per set: partner offset (0 = none), whether own is the pair's first point,
@@ -172,13 +199,8 @@ void main() {
             shape_target = sim_shape_target(at_rest, k, params.counts.z, flags, params.gravity_dt.xyz, params.gravity_dt.w);
         }
         if (local_shape && i >= 1u) {
-            precise vec3 offset = rest[index].xyz - rest[index - 1u].xyz;
-            local_offset = sim_rotate(params.head, offset);
-            if (i >= 2u) {
-                precise vec3 parent = sim_rotate(params.head, rest[index - 1u].xyz - rest[index - 2u].xyz);
-                precise float len = sqrt(sim_dot(parent, parent));
-                local_dir = len > 0.0 ? parent / len : vec3(0.0);
-            }
+            s_local_offset[lid] = local_rest_offset(index);
+            s_local_dir[lid] = i >= 2u ? local_rest_dir(index - 1u) : vec3(0.0);
         }
         bool has_next = i + 1u < points;
         float len_next = rest_length[index];
@@ -256,13 +278,15 @@ void main() {
         sync(group);
         src = 1u - src;
         own = project_end(own, lid, off_bend_b, first_bend_b, bend_b.x, bend_b.y, src);
-        if (local_shape) {
+        if (local_shape && it + 1u == params.counts.z) {
             if (live) { s_pos[1u - src][lid] = own; }
             sync(group);
             src = 1u - src;
-            if (live && i >= 1u && own.w > 0.0) {
-                own.xyz = local_shape_project(own.xyz, lid, i, local_dir, local_offset, src);
+            if (live && i == 0u) {
+                local_shape_sweep(lid, points, src);
             }
+            sync(group);
+            if (live) { own = s_pos[src][lid]; }
         }
         if (global_shape && live && own.w > 0.0 && shape_k > 0.0) {
             precise vec3 pulled = own.xyz + (shape_target - own.xyz) * shape_k;

@@ -69,12 +69,7 @@ impl MeshSdf {
     /// Where the grid of `mesh`'s field lies: origin, cell edge and points per axis
     /// (see [`MeshSdf::build`] for the arguments).
     pub fn placement(mesh: &TriMesh, resolution: u32, margin: f32) -> Result<(Vec3, f32, [u32; 3])> {
-        if !(8..=MAX_SDF_RESOLUTION).contains(&resolution) {
-            return Err(Error::param("sdf resolution", resolution, format!("8..={MAX_SDF_RESOLUTION}")));
-        }
-        if !(margin.is_finite() && margin >= 0.0) {
-            return Err(Error::param("sdf margin", margin, "finite and ≥ 0"));
-        }
+        Self::check_grid(resolution, margin)?;
         if let Some(bad) = mesh.positions.iter().position(|p| !p.is_finite()) {
             return Err(Error::incompatible("mesh", format!("vertex {bad} is not finite")));
         }
@@ -92,6 +87,17 @@ impl MeshSdf {
         let span = hi + pad - origin;
         let dims = [0, 1, 2].map(|a| ((span[a] / cell).ceil() as u32 + 1).min(MAX_SDF_RESOLUTION));
         Ok((origin, cell, dims))
+    }
+
+    /// Checks a resolution and a margin for [`MeshSdf::build`].
+    pub fn check_grid(resolution: u32, margin: f32) -> Result<()> {
+        if !(8..=MAX_SDF_RESOLUTION).contains(&resolution) {
+            return Err(Error::param("sdf resolution", resolution, format!("8..={MAX_SDF_RESOLUTION}")));
+        }
+        if !(margin.is_finite() && margin >= 0.0) {
+            return Err(Error::param("sdf margin", margin, "finite and ≥ 0"));
+        }
+        Ok(())
     }
 
     /// The jump-flooding steps, largest first: half the grid's longest axis

@@ -39,6 +39,7 @@
 //! and its teardown waits only for its own submissions.
 
 mod async_compute;
+mod control;
 mod mirror;
 mod mode;
 mod options;
@@ -63,7 +64,7 @@ use crate::vk::external::{self, ExternalBuffer};
 use crate::vk::submit::CommandRing;
 use async_compute::{AsyncSim, Pending};
 use mirror::{slot_buffer, Layout, Meta, Mirror, Parts};
-use worker::{SimSide, SimSlots, SimUpdate, Worker};
+use worker::{SimSide, SimSlots, Worker};
 
 use mode::{choose_mode, unavailable};
 pub use options::{FrameSync, HandOff, Pipelining, ScheduleMode, SchedulerOptions, SemaphoreWait};
@@ -380,49 +381,6 @@ impl FrameScheduler {
             Backend::Remote { worker, .. } => worker.report(),
             _ => None,
         }
-    }
-
-    /// Changes simulation parameters from the next step on (validated now). The
-    /// volume stage's mode and resolution are fixed for the scheduler's lifetime.
-    pub fn set_sim_params(&mut self, params: &SimParams) -> Result<()> {
-        params.validate()?;
-        let has_volume = self.mirror.layout().density > 0;
-        let grid = self.mirror.meta().grid.map(|g| g.dims);
-        let same = (params.volume.mode == crate::sim::VolumeMode::Off) != has_volume
-            && grid.is_none_or(|dims| dims == params.volume.resolution);
-        if !same {
-            return Err(Error::incompatible(
-                "volume",
-                "the volume stage's mode and resolution are fixed for a scheduler",
-            ));
-        }
-        match &mut self.backend {
-            Backend::Local { sim, .. } => sim.set_params(params),
-            Backend::Async { sim, .. } => sim.sim.set_params(params),
-            Backend::Remote { worker, .. } => worker.update(SimUpdate::Params(Box::new(params.clone()))),
-            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
-        }
-    }
-
-    /// Replaces the colliders (validated now) from the next step on.
-    pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
-        crate::sim::validate_colliders(colliders)?;
-        match &mut self.backend {
-            Backend::Local { sim, .. } => sim.set_colliders(colliders),
-            Backend::Async { sim, .. } => sim.sim.set_colliders(colliders),
-            Backend::Remote { worker, .. } => worker.update(SimUpdate::Colliders(colliders.to_vec())),
-            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
-        }
-    }
-
-    /// Stops and drops the simulation side now (its thread, its own submissions
-    /// waited for, its buffers; the mirror stays for frames still in flight). Later
-    /// frames get [`Error::SimulationStopped`].
-    pub fn stop_simulation(&mut self) {
-        let old =
-            std::mem::replace(&mut self.backend, Backend::Stopped("the simulation was stopped by the host".into()));
-        drop(old);
-        self.sim_device = None;
     }
 
     #[cfg(test)]

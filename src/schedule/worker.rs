@@ -25,8 +25,9 @@ use ash::vk;
 
 use super::mirror::{record_copy, Layout, Meta, Parts};
 use crate::error::{Error, Result};
+use crate::groom::mesh::TriMesh;
 use crate::profiler::{GpuProfiler, ProfileReport};
-use crate::sim::{Collider, HairSim, RigidTransform, SimParams, SimState};
+use crate::sim::{Collider, HairSim, MeshColliderParams, RigidTransform, SimParams, SimState};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
@@ -40,6 +41,7 @@ const SLICE: Duration = Duration::from_millis(20);
 pub(crate) enum SimUpdate {
     Params(Box<SimParams>),
     Colliders(Vec<Collider>),
+    Mesh(Option<Box<(TriMesh, MeshColliderParams)>>),
 }
 
 enum Request {
@@ -253,6 +255,10 @@ fn run(mut side: SimSide, slots: usize, timeout: Duration, shared: &Shared) {
             Request::Step { job, heads } => step(&mut side, shared, job, &heads, slots, timeout),
             Request::Update(SimUpdate::Params(p)) => side.sim.set_params(&p),
             Request::Update(SimUpdate::Colliders(c)) => side.sim.set_colliders(&c),
+            Request::Update(SimUpdate::Mesh(m)) => match m.as_deref() {
+                Some((mesh, params)) => side.sim.set_mesh(Some(mesh), params),
+                None => side.sim.set_mesh(None, &MeshColliderParams::default()),
+            },
             Request::Read(reply) => {
                 let _ = reply.send(side.sim.read_state());
                 Ok(())

@@ -53,6 +53,13 @@ pub struct MeshColliderParams {
     pub margin: f32,
 }
 
+impl MeshColliderParams {
+    /// Checks both fields' ranges.
+    pub fn validate(&self) -> Result<()> {
+        MeshSdf::check_grid(self.resolution, self.margin)
+    }
+}
+
 impl Default for MeshColliderParams {
     fn default() -> Self {
         MeshColliderParams { resolution: 64, margin: 0.02 }
@@ -92,7 +99,17 @@ impl MeshCollider {
     /// Builds the field of `mesh` (in the head frame, the groom's units) on the GPU.
     /// This submits and waits.
     pub fn new(ctx: &GpuContext, mesh: &TriMesh, params: &MeshColliderParams) -> Result<Self> {
-        Self::build(ctx, mesh, params, None)
+        Self::build(&ctx.device, mesh, params, None)
+    }
+
+    /// Checks `mesh` and `params` as [`MeshCollider::new`] does, without GPU work.
+    pub fn validate(mesh: &TriMesh, params: &MeshColliderParams) -> Result<()> {
+        MeshSdf::placement(mesh, params.resolution, params.margin).map(|_| ())
+    }
+
+    /// As [`MeshCollider::new`], on `device`.
+    pub(crate) fn on_device(device: &Arc<Device>, mesh: &TriMesh, params: &MeshColliderParams) -> Result<Self> {
+        Self::build(device, mesh, params, None)
     }
 
     /// As [`MeshCollider::new`], timing the build with `profiler` (one scope,
@@ -103,7 +120,7 @@ impl MeshCollider {
         params: &MeshColliderParams,
         profiler: &mut GpuProfiler,
     ) -> Result<(Self, Option<ProfileReport>)> {
-        let collider = Self::build(ctx, mesh, params, Some(&mut *profiler))?;
+        let collider = Self::build(&ctx.device, mesh, params, Some(&mut *profiler))?;
         Ok((collider, profiler.drain().pop()))
     }
 
@@ -136,13 +153,13 @@ impl MeshCollider {
     }
 
     fn build(
-        ctx: &GpuContext,
+        device: &Arc<Device>,
         mesh: &TriMesh,
         params: &MeshColliderParams,
         mut profiler: Option<&mut GpuProfiler>,
     ) -> Result<Self> {
         let (origin, cell, dims) = MeshSdf::placement(mesh, params.resolution, params.margin)?;
-        let device = ctx.device.clone();
+        let device = device.clone();
         let triangles = mesh.triangles.len();
         let corners: Vec<[f32; 4]> =
             (0..triangles).flat_map(|t| mesh.corners(t).map(|c| c.extend(0.0).to_array())).collect();

@@ -61,6 +61,7 @@ pub use volume::{Preconditioner, VolumeGrid, VolumeMode, VolumeParams, VolumeSta
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
+use crate::groom::mesh::TriMesh;
 use crate::groom::Groom;
 use crate::profiler::GpuProfiler;
 use crate::profiler::PassScope;
@@ -316,6 +317,17 @@ impl HairSim {
             self.configure_volume(&params)?;
         }
         Ok(previous)
+    }
+
+    /// Builds a mesh collider of `mesh` (head frame, the groom's units) on this
+    /// simulation's device and sets it (see [`HairSim::set_mesh_collider`]); `None`
+    /// removes the current one.
+    pub fn set_mesh(&mut self, mesh: Option<&TriMesh>, params: &MeshColliderParams) -> Result<()> {
+        let collider = match mesh {
+            Some(m) => Some(MeshCollider::on_device(&self.device, m, params)?),
+            None => None,
+        };
+        self.set_mesh_collider(collider).map(drop)
     }
 
     /// Changes the rest length of key hair `strand`; only its tip segments change.

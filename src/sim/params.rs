@@ -81,12 +81,16 @@ pub struct SimParams {
     /// constraint barely holds (under 1 % of their offset removed per sub-step)
     /// are left uncompensated. Default: true.
     pub sag_free: bool,
-    /// Local shape constraint: the fraction of each point's deviation from where
-    /// its rest offset from its parent puts it (the offset carried along with the
-    /// parent segment's rotation, i.e. the rest frames parallel-transported along
-    /// the current strand) removed per sub-step, independent of the iteration
-    /// count (0..=1; 0 switches it off). What keeps curls curled and a mohawk up
-    /// without holding the strand rigidly in place. Default: 0.
+    /// Local shape constraint: the fraction of each segment's deviation from its
+    /// rest offset, carried along with the parent segment's rotation (the rest
+    /// frames parallel-transported along the current strand; the first
+    /// segment's frame is the head's), removed per sub-step by one sweep root to
+    /// tip after the last iteration, so independent of the iteration count
+    /// (0..=1; 0 switches it off). Both ends of a segment move, so it conserves
+    /// momentum: it keeps curls curled and strands' bends where the groom put
+    /// them, while their weight is carried by the root and the global shape
+    /// constraint (pair them, as `presets/curly.toml` does). 1 makes strands
+    /// rigid. Default: 0.
     pub local_shape_stiffness: f32,
     /// Friction against the mesh collider: the fraction of a touching particle's
     /// motion along the surface, relative to the mesh, removed per sub-step
@@ -465,7 +469,7 @@ impl SubstepPlanner {
                         shape: [
                             p.per_iteration(p.global_shape_stiffness),
                             p.global_shape_range,
-                            p.per_iteration(p.local_shape_stiffness),
+                            p.local_shape_stiffness,
                             p.mesh_friction,
                         ],
                         previous_head: previous_head.to_cols_array_2d(),

@@ -281,7 +281,6 @@ fn solve(
     // and rest offset (world), and the positions the set reads.
     let local_shape = flags & flags::LOCAL_SHAPE != 0;
     let mut local = vec![(Vec3::ZERO, Vec3::ZERO); points];
-    let mut before = vec![Vec4::ZERO; points];
     let mut s = vec![Vec4::ZERO; points];
     let mut bend = vec![(0.0f32, 0.0f32); points];
     // Per point of the strand: the global shape constraint's target and stiffness.
@@ -335,19 +334,19 @@ fn solve(
             }
         }
         if local_shape {
+            let offset =
+                |j: usize| rotate(&p.head, state.rest[base + j].truncate() - state.rest[base + j - 1].truncate());
             for (i, slot) in local.iter_mut().enumerate().skip(1) {
-                let rest = |j: usize| state.rest[base + j].truncate();
-                let offset = rotate(&p.head, rest(i) - rest(i - 1));
                 let mut dir = Vec3::ZERO;
                 if i >= 2 {
-                    let parent = rotate(&p.head, rest(i - 1) - rest(i - 2));
-                    let len = dot(parent, parent).sqrt();
-                    dir = if len > 0.0 { parent / len } else { Vec3::ZERO };
+                    let d = offset(i - 1);
+                    let len = dot(d, d).sqrt();
+                    dir = if len > 0.0 { d / len } else { Vec3::ZERO };
                 }
-                *slot = (dir, offset);
+                *slot = (dir, offset(i));
             }
         }
-        for _ in 0..p.iterations() {
+        for iteration in 0..p.iterations() {
             for i in (0..points - 1).step_by(2) {
                 project(&mut s, i, i + 1, lengths[i], 1.0);
             }
@@ -363,23 +362,23 @@ fn solve(
                     }
                 }
             }
-            if local_shape {
-                before.copy_from_slice(&s);
-                for i in 1..points {
-                    if s[i].w > 0.0 {
-                        let (dir, offset) = local[i];
-                        let parent = before[i - 1].truncate();
-                        let mut carried = offset;
-                        if i >= 2 && dot(dir, dir) > 0.0 {
-                            let d = parent - before[i - 2].truncate();
-                            let len = dot(d, d).sqrt();
-                            if len > 0.0 {
-                                carried = rotate_between(dir, d / len, offset);
-                            }
+            if local_shape && iteration + 1 == p.iterations() {
+                // `local_shape_sweep` in glsl/sim/solve.comp.
+                for (j, &(dir, offset)) in local.iter().enumerate().skip(1) {
+                    let (parent, child) = (s[j - 1], s[j]);
+                    let mut carried = offset;
+                    if j >= 2 && dot(dir, dir) > 0.0 {
+                        let d = parent.truncate() - s[j - 2].truncate();
+                        let len = dot(d, d).sqrt();
+                        if len > 0.0 {
+                            carried = rotate_between(dir, d / len, carried);
                         }
-                        let own = s[i].truncate();
-                        let target = parent + carried;
-                        s[i] = (own + (target - own) * p.local_shape()).extend(s[i].w);
+                    }
+                    let w = parent.w + child.w;
+                    if w > 0.0 {
+                        let delta = (carried - (child.truncate() - parent.truncate())) * p.local_shape();
+                        s[j - 1] = (parent.truncate() - delta * (parent.w / w)).extend(parent.w);
+                        s[j] = (child.truncate() + delta * (child.w / w)).extend(child.w);
                     }
                 }
             }

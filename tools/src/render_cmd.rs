@@ -57,9 +57,13 @@ pub struct RenderArgs {
     /// Groom file (.hair or .tfx) instead of the `thesis` scene.
     #[arg(long)]
     input: Option<PathBuf>,
-    /// Head mesh (OBJ) to draw and to place the camera by.
+    /// Head mesh (OBJ) to draw, to place the camera by and (with --input) for the
+    /// strands to collide with through its signed distance field.
     #[arg(long)]
     obj: Option<PathBuf>,
+    /// Draw the --obj mesh but do not collide with it.
+    #[arg(long)]
+    no_mesh_collider: bool,
     /// Multiply input positions (groom and mesh) by this (0.01: Blender units → m).
     #[arg(long, default_value_t = 1.0)]
     scale: f32,
@@ -306,6 +310,14 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let options = schedule_options(a)?;
     let mut sim = FrameScheduler::new(&ctx, &s.groom, &sim_params, &RigidTransform::default(), &s.colliders, &options)?;
     println!("simulation: {} ({})", sim.mode().name(), sim.reason());
+    if a.input.is_some() && a.obj.is_some() && !a.no_mesh_collider {
+        sim.set_mesh_collider(Some(&s.head_mesh), &config.mesh_collider)?;
+        println!(
+            "mesh collider: {} triangles at {} grid points along the longest axis",
+            s.head_mesh.triangles.len(),
+            config.mesh_collider.resolution
+        );
+    }
     let params = config.render.clone();
     let mut renderer = Renderer::new(&ctx, sim.key_hairs(), &params)?;
     renderer.set_lights(&config.lights)?;

@@ -1,0 +1,71 @@
+//! What a host changes on a running scheduler: parameters, colliders, the mesh
+//! collider, and stopping the simulation side.
+
+use super::worker::SimUpdate;
+use super::{Backend, FrameScheduler};
+use crate::error::{Error, Result};
+use crate::groom::mesh::TriMesh;
+use crate::sim::{Collider, MeshCollider, MeshColliderParams, SimParams};
+
+impl FrameScheduler {
+    /// Changes simulation parameters from the next step on (validated now). The
+    /// volume stage's mode and resolution are fixed for the scheduler's lifetime.
+    pub fn set_sim_params(&mut self, params: &SimParams) -> Result<()> {
+        params.validate()?;
+        let has_volume = self.mirror.layout().density > 0;
+        let grid = self.mirror.meta().grid.map(|g| g.dims);
+        let same = (params.volume.mode == crate::sim::VolumeMode::Off) != has_volume
+            && grid.is_none_or(|dims| dims == params.volume.resolution);
+        if !same {
+            return Err(Error::incompatible(
+                "volume",
+                "the volume stage's mode and resolution are fixed for a scheduler",
+            ));
+        }
+        match &mut self.backend {
+            Backend::Local { sim, .. } => sim.set_params(params),
+            Backend::Async { sim, .. } => sim.sim.set_params(params),
+            Backend::Remote { worker, .. } => worker.update(SimUpdate::Params(Box::new(params.clone()))),
+            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
+        }
+    }
+
+    /// Replaces the colliders (validated now) from the next step on.
+    pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
+        crate::sim::validate_colliders(colliders)?;
+        match &mut self.backend {
+            Backend::Local { sim, .. } => sim.set_colliders(colliders),
+            Backend::Async { sim, .. } => sim.sim.set_colliders(colliders),
+            Backend::Remote { worker, .. } => worker.update(SimUpdate::Colliders(colliders.to_vec())),
+            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
+        }
+    }
+
+    /// Sets the mesh collider of `mesh` (head frame, the groom's units; `None`
+    /// removes it), built on the simulation's device (see
+    /// [`crate::sim::HairSim::set_mesh_collider`]). The mesh and parameters are checked now; on
+    /// the SECOND DEVICE the build happens on the worker before its next step.
+    pub fn set_mesh_collider(&mut self, mesh: Option<&TriMesh>, params: &MeshColliderParams) -> Result<()> {
+        if let Some(m) = mesh {
+            MeshCollider::validate(m, params)?;
+        }
+        match &mut self.backend {
+            Backend::Local { sim, .. } => sim.set_mesh(mesh, params),
+            Backend::Async { sim, .. } => sim.sim.set_mesh(mesh, params),
+            Backend::Remote { worker, .. } => {
+                worker.update(SimUpdate::Mesh(mesh.map(|m| Box::new((m.clone(), params.clone())))))
+            }
+            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
+        }
+    }
+
+    /// Stops and drops the simulation side now (its thread, its own submissions
+    /// waited for, its buffers; the mirror stays for frames still in flight). Later
+    /// frames get [`Error::SimulationStopped`].
+    pub fn stop_simulation(&mut self) {
+        let old =
+            std::mem::replace(&mut self.backend, Backend::Stopped("the simulation was stopped by the host".into()));
+        drop(old);
+        self.sim_device = None;
+    }
+}
