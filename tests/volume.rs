@@ -29,6 +29,19 @@ fn assert_finite(state: &SimState) {
     assert!(state.positions.iter().chain(&state.velocities).all(|v| v.is_finite()), "NaN or Inf in the state");
 }
 
+/// Runs 30 steps of the reference motion on both and returns the GPU state and
+/// the largest position difference.
+fn run_side_by_side(sim: &mut HairSim, cpu: &mut CpuHairSim, params: &SimParams) -> (SimState, f32) {
+    sim.run(30, |i| head_at(i, params), None).expect("run");
+    for i in 0..30 {
+        cpu.step(&head_at(i, params)).expect("cpu step");
+    }
+    let g = sim.read_state().expect("readback");
+    assert_finite(&g);
+    let max = g.positions.iter().zip(&cpu.state().positions).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max);
+    (g, max)
+}
+
 #[test]
 fn flip_simulation_follows_the_cpu_reference() {
     let gpu = Gpu::new();
@@ -41,13 +54,7 @@ fn flip_simulation_follows_the_cpu_reference() {
         let mut cpu = CpuHairSim::new(&groom, &params, &head0).expect("cpu sim");
         sim.set_colliders(&motion::thesis_colliders()).expect("colliders");
         cpu.set_colliders(&motion::thesis_colliders()).expect("colliders");
-        sim.run(30, |i| head_at(i, &params), None).expect("run");
-        for i in 0..30 {
-            cpu.step(&head_at(i, &params)).expect("cpu step");
-        }
-        let g = sim.read_state().expect("readback");
-        assert_finite(&g);
-        let max = g.positions.iter().zip(&cpu.state().positions).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max);
+        let (g, max) = run_side_by_side(&mut sim, &mut cpu, &params);
         let stats = sim.volume_stats().expect("stats");
         eprintln!(
             "{:?}: max |gpu − cpu| = {max:e} m; GPU {stats:?}, MIC {:?}",
@@ -251,13 +258,7 @@ fn flip_with_the_mesh_collider_follows_the_cpu_reference() {
     let collider_params = MeshColliderParams { resolution: 32, margin: 0.02 };
     sim.set_mesh_collider(Some(MeshCollider::new(gpu.ctx(), &mesh, &collider_params).expect("mesh"))).expect("set");
     cpu.set_mesh_collider(Some(MeshSdf::build(&mesh, 32, 0.02).expect("field")));
-    sim.run(30, |i| head_at(i, &params), None).expect("run");
-    for i in 0..30 {
-        cpu.step(&head_at(i, &params)).expect("cpu step");
-    }
-    let g = sim.read_state().expect("readback");
-    assert_finite(&g);
-    let max = g.positions.iter().zip(&cpu.state().positions).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max);
+    let (_, max) = run_side_by_side(&mut sim, &mut cpu, &params);
     eprintln!("FLIP with the mesh collider: max |gpu − cpu| = {max:e} m");
     assert!(max < 1e-3, "GPU and CPU differ by {max} m");
 }

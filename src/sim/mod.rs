@@ -12,11 +12,14 @@
 //! 2. **Solve** (`solve.rs`, `glsl/sim/solve.comp`): ONE dispatch, one
 //!    workgroup per group of key hairs, positions in shared memory; for N
 //!    iterations the even then odd distance constraints, two sets of bending
-//!    constraints, the global shape constraint (each particle pulled toward its
-//!    rest position in the head frame, [`SimParams::global_shape_stiffness`]) and
-//!    the body collisions, separated by `barrier()`; one
-//!    global write at the end. DFTL mode replaces this with one
-//!    follow-the-leader sweep and stores correction vectors.
+//!    constraints, in the last iteration the local shape constraints (one sweep
+//!    root to tip, [`SimParams::local_shape_stiffness`]), the global shape
+//!    constraint (each particle pulled toward its rest position in the head
+//!    frame, [`SimParams::global_shape_stiffness`]) and the body collisions
+//!    (spheres, capsules and the [`MeshCollider`]'s field), separated by
+//!    `barrier()`; then friction against the mesh collider and one global write
+//!    at the end. DFTL mode replaces this with one follow-the-leader sweep and
+//!    stores correction vectors.
 //! 3. **Integrate** (`integrate.rs`, `glsl/sim/integrate.comp`): velocity from
 //!    the position change (plus the DFTL correction), damping, and the final
 //!    state into the other half of the double buffer.
@@ -27,7 +30,7 @@
 //!    timestamp scopes: [`SimStage::VolumeSort`], [`SimStage::VolumeTransfer`],
 //!    [`SimStage::VolumePressure`], [`SimStage::VolumeUpdate`].
 //!
-//! Parameters ([`SimParams`]), colliders ([`Collider`]) and the head transform
+//! Parameters ([`SimParams`]), colliders ([`Collider`], [`MeshCollider`]) and the head transform
 //! ([`RigidTransform`]) are validated before any GPU work. [`CpuHairSim`] runs
 //! the same algorithm on the CPU with the same operation order (the test
 //! oracle and benchmark baseline); [`FixedStepDriver`] turns frame times into

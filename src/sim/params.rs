@@ -174,6 +174,21 @@ fn in_range(name: &'static str, v: f32, lo: f32, hi: f32) -> Result<()> {
 }
 
 impl SimParams {
+    /// Parameters for an authored groom: [`SimParams::default`] with the whole
+    /// strand held softly in its authored shape (global shape stiffness 0.15 over
+    /// the whole strand, sag-free) instead of the rest-shape spring, so a still
+    /// head keeps the style and motion still swings it (as `presets/bob.toml`).
+    /// What the `vkhair` tool simulates an `--input` groom with.
+    pub fn styled() -> SimParams {
+        SimParams {
+            global_shape_stiffness: 0.15,
+            global_shape_range: 1.0,
+            sag_free: true,
+            spring_enabled: false,
+            ..SimParams::default()
+        }
+    }
+
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<()> {
         if !(self.dt.is_finite() && self.dt > 0.0 && self.dt <= 0.1) {

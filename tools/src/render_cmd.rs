@@ -13,7 +13,7 @@ use vkhair::groom::Groom;
 use vkhair::headless::{MeshDrawer, Offscreen, Submit};
 use vkhair::render::{Camera, InterpolationMode, Light, Primitive, Renderer, ShadingMode, ShadowCaster, ShadowParams};
 use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, SchedulerOptions};
-use vkhair::sim::{motion, Collider, RigidTransform, VolumeMode, VolumeParams};
+use vkhair::sim::{motion, Collider, RigidTransform, SimParams, VolumeMode, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
 /// `--schedule`: where the simulation runs.
@@ -54,7 +54,8 @@ pub struct RenderArgs {
     /// Output folder for frame PNGs and the contact sheet.
     #[arg(long, default_value = "out")]
     out: PathBuf,
-    /// Groom file (.hair or .tfx) instead of the `thesis` scene.
+    /// Groom file (.hair or .tfx) instead of the `thesis` scene; it is held in its
+    /// authored style unless --config says otherwise (see `SimParams::styled`).
     #[arg(long)]
     input: Option<PathBuf>,
     /// Head mesh (OBJ) to draw, to place the camera by and (with --input) for the
@@ -267,12 +268,15 @@ fn contact_sheet(frames: &[Vec<u8>], width: u32, height: u32) -> (u32, u32, Vec<
     (sw, sh, sheet)
 }
 
-/// The parameters: vkhair's defaults, then the `--config` file, then the flags
-/// given; the tool's lights when the file lists none. Checked before any GPU work.
+/// The parameters: vkhair's defaults (an `--input` groom held in its authored
+/// style, [`SimParams::styled`]), then the `--config` file, then the flags given;
+/// the tool's lights when the file lists none. Checked before any GPU work.
 fn parameters(a: &RenderArgs, center: Vec3) -> Result<Config, vkhair::Error> {
+    let sim = if a.input.is_some() { SimParams::styled() } else { SimParams::default() };
+    let base = Config { sim, ..Config::default() };
     let mut config = match &a.config {
-        Some(path) => Config::default().load_over(path)?,
-        None => Config::default(),
+        Some(path) => base.load_over(path)?,
+        None => base,
     };
     let r = &mut config.render;
     if let Some(level) = a.level {

@@ -21,6 +21,8 @@ use crate::{load, CliResult};
 #[derive(clap::Args)]
 pub struct SimulateArgs {
     /// Groom file (.hair or .tfx); default: the `thesis` scene with its colliders.
+    /// It is held in its authored style unless --config says otherwise (see
+    /// `SimParams::styled`).
     #[arg(long)]
     input: Option<PathBuf>,
     /// Multiply input positions by this (e.g. 0.01 for Blender units to meters).
@@ -65,7 +67,8 @@ pub struct SimulateArgs {
     /// the strands collide with its signed distance field.
     #[arg(long)]
     obj: Option<PathBuf>,
-    /// Do not collide with the --obj mesh.
+    /// Do not collide with the --obj mesh (its field still measures how many
+    /// points end up inside it).
     #[arg(long)]
     no_mesh_collider: bool,
     /// Write the simulated strands after the last step as a .hair file: in the
@@ -89,13 +92,12 @@ enum VolumeArg {
     Friction,
 }
 
-/// The simulation parameters: the tool's defaults (FLIP at 32³), then the
-/// `--config` file, then the flags given. Checked before any GPU work.
+/// The simulation parameters: the tool's defaults (FLIP at 32³; an `--input`
+/// groom held in its authored style, [`SimParams::styled`]), then the `--config`
+/// file, then the flags given. Checked before any GPU work.
 fn simulate_params(a: &SimulateArgs) -> Result<Config, vkhair::Error> {
-    let base = Config {
-        sim: SimParams { volume: VolumeParams::flip([32, 32, 32]), ..SimParams::default() },
-        ..Config::default()
-    };
+    let sim = if a.input.is_some() { SimParams::styled() } else { SimParams::default() };
+    let base = Config { sim: SimParams { volume: VolumeParams::flip([32, 32, 32]), ..sim }, ..Config::default() };
     let config = match &a.config {
         Some(path) => base.load_over(path)?,
         None => base,
@@ -128,14 +130,14 @@ fn simulate_params(a: &SimulateArgs) -> Result<Config, vkhair::Error> {
     Ok(config)
 }
 
-/// The --obj mesh scaled like the groom, when the strands collide with it.
-fn collider_mesh(obj: Option<&Path>, scale: f32, off: bool) -> Result<Option<TriMesh>, vkhair::Error> {
+/// The --obj mesh scaled like the groom.
+fn load_mesh(obj: Option<&Path>, scale: f32) -> Result<Option<TriMesh>, vkhair::Error> {
     match obj {
-        Some(path) if !off => {
+        Some(path) => {
             let m = TriMesh::load_obj(path)?;
             TriMesh::new(m.positions.iter().map(|p| *p * scale).collect(), m.triangles).map(Some)
         }
-        _ => Ok(None),
+        None => Ok(None),
     }
 }
 
@@ -192,7 +194,8 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     };
     let config = simulate_params(a)?;
     let params = config.sim.clone();
-    let mesh = collider_mesh(a.obj.as_deref(), a.scale, a.no_mesh_collider)?;
+    let mesh = load_mesh(a.obj.as_deref(), a.scale)?;
+    let colliding = mesh.is_some() && !a.no_mesh_collider;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let head = |i: usize| {
         let t = (i + 1) as f32 * params.dt;
@@ -209,12 +212,15 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
             let collider = MeshCollider::new(&ctx, m, &config.mesh_collider)?;
             let [nx, ny, nz] = collider.dims();
             println!(
-                "mesh collider: {} triangles, {nx}×{ny}×{nz} field of {:.1} mm cells",
+                "mesh collider{}: {} triangles, {nx}×{ny}×{nz} field of {:.1} mm cells",
+                if colliding { "" } else { " (off: only measuring)" },
                 m.triangles.len(),
                 collider.cell() * 1e3
             );
             let field = collider.read_field()?;
-            sim.set_mesh_collider(Some(collider))?;
+            if colliding {
+                sim.set_mesh_collider(Some(collider))?;
+            }
             Some(field)
         }
         None => None,
@@ -294,7 +300,7 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     if a.check {
         let mut cpu = CpuHairSim::new(&groom, &params, &RigidTransform::default())?;
         cpu.set_colliders(&colliders)?;
-        if let Some(m) = &mesh {
+        if let (Some(m), true) = (&mesh, colliding) {
             let p = &config.mesh_collider;
             cpu.set_mesh_collider(Some(MeshSdf::build(m, p.resolution, p.margin)?));
         }
