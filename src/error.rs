@@ -239,6 +239,15 @@ pub enum Error {
         /// Which attribute.
         what: &'static str,
     },
+    /// The groom's bounding box is so large that its diagonal overflows f32.
+    #[error(
+        "the groom's bounding box spans {extent:e} along its longest axis: its diagonal overflows f32 \
+         (scale the groom down)"
+    )]
+    GroomExtent {
+        /// Largest extent of the bounding box along an axis, in the groom's units.
+        extent: f64,
+    },
     /// Two consecutive points of a strand coincide.
     #[error("strand {strand} segment {segment} has zero length")]
     ZeroLengthSegment {

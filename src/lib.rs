@@ -81,6 +81,7 @@
 pub mod config;
 mod context;
 mod error;
+pub mod files;
 pub(crate) mod gpu_types;
 pub mod groom;
 mod hash;

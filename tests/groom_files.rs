@@ -294,7 +294,65 @@ fn hostile_tfx_files_give_typed_errors() {
     ));
 }
 
+/// A TressFX file like TressFX's own `mohawk.tfx`: one strand (of 4) with a
+/// zero-length first segment, one whose inverse mass is NaN; the strict reader
+/// refuses it, the repairing one drops exactly what is broken and keeps the
+/// per-vertex inverse mass and per-strand thickness of what stays in step.
+#[test]
+fn tfx_with_a_degenerate_strand_is_refused_strictly_and_repaired_otherwise() {
+    let strand = |x: f32, w: f32| [[x, 0.0, 0.0, 0.0], [x, -1.0, 0.0, w], [x, -2.0, 0.0, w]];
+    let mut positions: Vec<[f32; 4]> =
+        [strand(0.0, 1.0), strand(1.0, 0.5), strand(2.0, 1.0), strand(3.0, 0.25)].concat();
+    positions[4] = positions[3]; // strand 1: segment 0 has zero length
+    positions[8][3] = f32::NAN; // strand 2: inverse mass NaN
+    let bytes = tfx_bytes(4, 3, &positions, Some(&[0.1, 0.2, 0.3, 0.4]));
+    assert!(matches!(TfxFile::parse(&bytes), Err(Error::NonFinite { strand: 2, what: "inverse mass", .. })));
+    let mut zero_only = positions.clone();
+    zero_only[8][3] = 1.0;
+    let zero_only = tfx_bytes(4, 3, &zero_only, None);
+    assert!(matches!(TfxFile::parse(&zero_only), Err(Error::ZeroLengthSegment { strand: 1, segment: 0 })));
+    let (f, repairs) = TfxFile::parse_repairing(&bytes).expect("repaired");
+    assert_eq!((repairs.zero_length_segments, repairs.non_finite_strands, repairs.short_strands), (1, 1, 0));
+    assert_eq!(f.groom.strand_count(), 3);
+    assert_eq!(f.groom.strand_len(1), 2, "strand 1 lost its duplicate point");
+    assert_eq!(f.groom.strand(2)[0], Vec3::new(3.0, 0.0, 0.0), "strand 3 became the third");
+    assert_eq!(f.inverse_mass, vec![0.0, 1.0, 1.0, 0.0, 0.5, 0.0, 0.25, 0.25]);
+    let thickness = f.groom.thickness().expect("thickness");
+    assert_eq!(thickness[thickness.len() - 1], 0.4, "per-strand thickness followed its strand");
+    // A clean file: nothing to repair, the same groom as the strict reader's.
+    let clean = tfx_bytes(2, 3, &[strand(0.0, 1.0), strand(1.0, 1.0)].concat(), None);
+    let (f, repairs) = TfxFile::parse_repairing(&clean).expect("clean");
+    assert!(repairs.is_empty());
+    assert_eq!(f, TfxFile::parse(&clean).expect("strict"));
+}
+
+#[test]
+fn hair_with_a_collapsed_strand_is_repaired() {
+    let strands = [
+        vec![Vec3::ZERO, Vec3::new(0.0, -1.0, 0.0), Vec3::new(0.0, -2.0, 0.0)],
+        vec![Vec3::X; 3],
+        vec![Vec3::Z, Vec3::new(0.0, -1.0, 1.0), Vec3::new(0.0, -2.0, 1.0)],
+    ];
+    let counts: Vec<u16> = vec![2, 2, 2];
+    let mut body: Vec<u8> = counts.iter().flat_map(|c| c.to_le_bytes()).collect();
+    body.extend(strands.concat().iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes));
+    let bytes = hair_bytes(3, 9, 0b11, 0, &body);
+    assert!(matches!(HairFile::parse(&bytes), Err(Error::ZeroLengthSegment { strand: 1, .. })));
+    let (f, repairs) = HairFile::parse_repairing(&bytes).expect("repaired");
+    assert_eq!((repairs.zero_length_segments, repairs.short_strands), (2, 1), "{repairs}");
+    assert_eq!(f.groom.strand_count(), 2);
+    assert_eq!(f.groom.strand(1), &strands[2][..]);
+}
+
 // ---- OBJ --------------------------------------------------------------------
+
+#[test]
+fn a_binary_obj_says_it_is_not_text() {
+    let mut bytes = b"v 0 0 0\nv 1 0 0\n".to_vec();
+    bytes.extend_from_slice(&[0xff, 0xfe, 0x00, 0x81]);
+    let err = TriMesh::parse_obj(&bytes).expect_err("binary");
+    assert!(err.to_string().contains("line 3 is not UTF-8"), "{err}");
+}
 
 #[test]
 fn obj_parsing_and_errors() {

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 /// earlier layers (the crate root, `lib.rs`, re-exports from all of them).
 const LAYERS: &[&[&str]] = &[
     &["error", "hash", "limits"],
+    &["files"],
     &["vk", "groom"],
     &["gpu_types", "requirements"],
     &["context"],

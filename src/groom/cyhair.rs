@@ -16,7 +16,8 @@ use std::path::Path;
 use glam::Vec3;
 
 use super::bytes::Reader;
-use super::{Attributes, Groom, MAX_POINTS, MAX_STRANDS};
+use super::repair::Load;
+use super::{Attributes, Groom, Repairs, MAX_POINTS, MAX_STRANDS};
 use crate::error::{Error, FileFormat, Result};
 
 const MAGIC: &[u8; 4] = b"HAIR";
@@ -86,21 +87,43 @@ impl HairFile {
         String::from_utf8_lossy(&self.info[..end]).into_owned()
     }
 
-    /// Reads a `.hair` file from disk.
+    /// Reads a `.hair` file from disk, refusing any defect.
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
         Self::parse(&data).map_err(|e| e.in_asset(path))
     }
 
-    /// Writes a `.hair` file to disk.
-    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+    /// Reads a `.hair` file from disk, repairing what can be repaired (see
+    /// [`Groom::repaired`]).
+    pub fn open_repairing(path: impl AsRef<Path>) -> Result<(Self, Repairs)> {
         let path = path.as_ref();
-        std::fs::write(path, self.to_bytes()).map_err(|source| Error::Io { path: path.into(), source })
+        let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
+        Self::parse_repairing(&data).map_err(|e| e.in_asset(path))
     }
 
-    /// Parses `.hair` bytes. Bytes after the last array are ignored.
+    /// Parses `.hair` bytes, repairing what can be repaired (see
+    /// [`Groom::repaired`]).
+    pub fn parse_repairing(data: &[u8]) -> Result<(Self, Repairs)> {
+        let (file, repairs) = Self::parse_as(data, Load::Repair)?;
+        Ok((file, repairs.unwrap_or_default()))
+    }
+
+    /// Writes a `.hair` file to disk.
+    /// The file appears whole or not at all: the bytes go to a temporary file in
+    /// the same folder, which then replaces `path` (a failed write, a full disk or
+    /// a kill never leaves a truncated file behind).
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+        crate::files::write_atomic(path.as_ref(), &self.to_bytes())
+    }
+
+    /// Parses `.hair` bytes, refusing any defect. Bytes after the last array are
+    /// ignored.
     pub fn parse(data: &[u8]) -> Result<Self> {
+        Self::parse_as(data, Load::Strict).map(|(file, _)| file)
+    }
+
+    fn parse_as(data: &[u8], load: Load) -> Result<(Self, Option<Repairs>)> {
         let r = Reader { data, format: FileFormat::CyHair };
         let magic = r.bytes(0, 4, "signature")?;
         if magic != MAGIC {
@@ -201,8 +224,11 @@ impl HairFile {
         } else {
             None
         };
-        let groom = Groom::with_attributes(positions, &counts, Attributes { thickness, transparency, colors })?;
-        Ok(HairFile { groom, defaults, info, has_segments_array: flags & HAS_SEGMENTS != 0 })
+        let (groom, repairs) = load.build(positions, &counts, Attributes { thickness, transparency, colors })?;
+        // A repaired groom may have lost the uniform point count a file without a
+        // segments array implies.
+        let has_segments_array = flags & HAS_SEGMENTS != 0 || groom.uniform_points_per_strand().is_none();
+        Ok((HairFile { groom, defaults, info, has_segments_array }, repairs))
     }
 
     /// Serialises to `.hair` bytes. The segments array is written when the file had

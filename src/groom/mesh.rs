@@ -47,6 +47,13 @@ impl TriMesh {
 
     /// Parses OBJ text (materials are ignored).
     pub fn parse_obj(data: &[u8]) -> Result<Self> {
+        if let Err(e) = std::str::from_utf8(data) {
+            let line = 1 + data[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count();
+            return Err(Error::Malformed {
+                format: FileFormat::Obj,
+                reason: format!("line {line} is not UTF-8 text (an OBJ file is text; is this a binary file?)"),
+            });
+        }
         let options =
             tobj::LoadOptions { single_index: false, triangulate: true, ignore_points: true, ignore_lines: true };
         let mut reader = std::io::BufReader::new(data);

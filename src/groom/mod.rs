@@ -11,12 +11,15 @@
 //! | at most [`MAX_STRANDS`] strands, [`MAX_POINTS`] points | [`Error::TooManyStrands`], [`Error::TooManyPoints`] |
 //! | 2..=[`MAX_POINTS_PER_STRAND`] points per strand | [`Error::StrandPointCount`] |
 //! | finite positions and attributes | [`Error::NonFinite`] |
+//! | a bounding-box diagonal that f32 can hold | [`Error::GroomExtent`] |
 //! | no segment shorter than [`MIN_SEGMENT_FRACTION`] × the bounding-box diagonal | [`Error::ZeroLengthSegment`] |
 //! | attribute arrays of the right length | [`Error::AttributeLength`] |
 //!
 //! Sources: [`cyhair`] (`.hair` read/write), [`tfx`] (TressFX `.tfx` read),
 //! [`grow`] (procedural growth on a sphere, ellipsoid or OBJ mesh) and
-//! [`scenes`] (the reference scenes of the design). [`Groom::resampled`] gives
+//! [`scenes`] (the reference scenes of the design). [`Groom::repaired`] builds a
+//! groom from real assets, dropping what the checks refuse and counting it in
+//! [`Repairs`]. [`Groom::resampled`] gives
 //! every strand the same point count (the GPU simulation wants it) and
 //! [`Groom::select`] picks key hairs.
 
@@ -28,7 +31,10 @@ pub mod scenes;
 pub mod sdf;
 pub mod tfx;
 
+mod repair;
 mod resample;
+
+pub use repair::Repairs;
 
 use glam::Vec3;
 
@@ -43,6 +49,16 @@ pub const MAX_POINTS_PER_STRAND: usize = 1 << 16;
 /// A segment shorter than this fraction of the groom's bounding-box diagonal counts
 /// as zero-length (scale-free, so it works for meters and for Blender units alike).
 pub const MIN_SEGMENT_FRACTION: f32 = 1e-6;
+
+/// The bounding box `lo..hi` of finite points: its diagonal must be finite for
+/// lengths relative to it (zero-length segments) to mean anything.
+fn check_extent(lo: Vec3, hi: Vec3) -> Result<()> {
+    if lo.cmple(hi).all() && !(hi - lo).length().is_finite() {
+        let extent = (0..3).map(|k| f64::from(hi[k]) - f64::from(lo[k])).fold(0.0, f64::max);
+        return Err(Error::GroomExtent { extent });
+    }
+    Ok(())
+}
 
 /// A set of hair strands (see the module docs for the invariants).
 ///
@@ -183,6 +199,7 @@ impl Groom {
             }
         }
         let (lo, hi) = self.bounds();
+        check_extent(lo, hi)?;
         let min_segment = (hi - lo).length() * MIN_SEGMENT_FRACTION;
         for strand in 0..self.strand_count() {
             let points = self.strand(strand);

@@ -12,7 +12,8 @@ use std::path::Path;
 use glam::{Vec2, Vec3};
 
 use super::bytes::Reader;
-use super::{Attributes, Groom, MAX_POINTS, MAX_POINTS_PER_STRAND, MAX_STRANDS};
+use super::repair::Load;
+use super::{Attributes, Groom, Repairs, MAX_POINTS, MAX_POINTS_PER_STRAND, MAX_STRANDS};
 use crate::error::{Error, FileFormat, Result};
 
 const HEADER_SIZE: u64 = 160;
@@ -32,15 +33,35 @@ pub struct TfxFile {
 }
 
 impl TfxFile {
-    /// Reads a `.tfx` file from disk.
+    /// Reads a `.tfx` file from disk, refusing any defect.
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
         Self::parse(&data).map_err(|e| e.in_asset(path))
     }
 
-    /// Parses `.tfx` bytes.
+    /// Reads a `.tfx` file from disk, repairing what can be repaired (see
+    /// [`Groom::repaired`]; a strand whose inverse mass is NaN, infinite or
+    /// negative counts as non-finite).
+    pub fn open_repairing(path: impl AsRef<Path>) -> Result<(Self, Repairs)> {
+        let path = path.as_ref();
+        let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
+        Self::parse_repairing(&data).map_err(|e| e.in_asset(path))
+    }
+
+    /// Parses `.tfx` bytes, refusing any defect.
     pub fn parse(data: &[u8]) -> Result<Self> {
+        Self::parse_as(data, Load::Strict).map(|(file, _)| file)
+    }
+
+    /// Parses `.tfx` bytes, repairing what can be repaired (see
+    /// [`TfxFile::open_repairing`]).
+    pub fn parse_repairing(data: &[u8]) -> Result<(Self, Repairs)> {
+        let (file, repairs) = Self::parse_as(data, Load::Repair)?;
+        Ok((file, repairs.unwrap_or_default()))
+    }
+
+    fn parse_as(data: &[u8], load: Load) -> Result<(Self, Option<Repairs>)> {
         let r = Reader { data, format: FileFormat::TressFx };
         r.bytes(0, HEADER_SIZE, "header")?;
         let version = r.f32(0, "version")?;
@@ -76,11 +97,15 @@ impl TfxFile {
             });
         }
         let raw = r.f32s(positions_at, 4 * points, "vertex positions")?;
-        let positions: Vec<Vec3> = raw.chunks_exact(4).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
+        let mut positions: Vec<Vec3> = raw.chunks_exact(4).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
         let inverse_mass: Vec<f32> = raw.chunks_exact(4).map(|c| c[3]).collect();
-        if let Some(i) = inverse_mass.iter().position(|w| !w.is_finite() || *w < 0.0) {
-            let (strand, point) = ((i as u64 / per_strand) as usize, (i as u64 % per_strand) as usize);
-            return Err(Error::NonFinite { strand, point, what: "inverse mass" });
+        let per = per_strand as usize;
+        for i in (0..inverse_mass.len()).filter(|&i| !inverse_mass[i].is_finite() || inverse_mass[i] < 0.0) {
+            if load == Load::Strict {
+                return Err(Error::NonFinite { strand: i / per, point: i % per, what: "inverse mass" });
+            }
+            // Repairing: the strand goes as one with a non-finite value.
+            positions[i] = Vec3::NAN;
         }
         let strand_uvs = (strand_uv_at != 0)
             .then(|| r.f32s(strand_uv_at, 2 * strands, "strand UVs"))
@@ -95,7 +120,15 @@ impl TfxFile {
             .transpose()?
             .map(|v| v.chunks_exact(4).map(|c| Vec3::new(c[0], c[1], c[2])).collect());
         let counts = vec![per_strand as u32; strands as usize];
-        let groom = Groom::with_attributes(positions, &counts, Attributes { thickness, transparency: None, colors })?;
-        Ok(TfxFile { version, groom, inverse_mass, strand_uvs })
+        let attributes = Attributes { thickness, transparency: None, colors };
+        let (groom, repairs) = load.build(positions, &counts, attributes)?;
+        let (inverse_mass, strand_uvs) = match &repairs {
+            Some(r) => (
+                r.kept_points().iter().map(|&i| inverse_mass[i]).collect(),
+                strand_uvs.map(|uvs: Vec<Vec2>| r.kept_strands().iter().map(|&s| uvs[s]).collect()),
+            ),
+            None => (inverse_mass, strand_uvs),
+        };
+        Ok((TfxFile { version, groom, inverse_mass, strand_uvs }, repairs))
     }
 }

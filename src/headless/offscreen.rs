@@ -9,6 +9,7 @@ use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::render::RenderTarget;
 use crate::vk::barrier;
+use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc};
 use crate::vk::rendering::{self, Load};
@@ -23,6 +24,8 @@ pub struct Offscreen {
     device: Arc<Device>,
     color: Image,
     depth: Image,
+    /// Host-visible copy target of `color`, kept between reads.
+    readback: Buffer,
 }
 
 impl Offscreen {
@@ -57,7 +60,8 @@ impl Offscreen {
                 aspect: vk::ImageAspectFlags::DEPTH,
             },
         )?;
-        Ok(Offscreen { device, color, depth })
+        let readback = device.readback_staging("offscreen readback", u64::from(width) * u64::from(height) * 4)?;
+        Ok(Offscreen { device, color, depth, readback })
     }
 
     /// The target for [`crate::render::Renderer::record_draw`] and [`super::MeshDrawer::record`].
@@ -108,7 +112,15 @@ impl Offscreen {
     /// Reads the color image back as sRGB-encoded RGBA8 rows, top to bottom
     /// (this submits and waits).
     pub fn read_rgba8(&self) -> Result<Vec<u8>> {
-        self.device.readback_image(&self.color, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, 4)
+        let mut out = Vec::new();
+        self.read_rgba8_into(&mut out)?;
+        Ok(out)
+    }
+
+    /// [`Offscreen::read_rgba8`] into `out`, reusing its memory (and the
+    /// target's own staging buffer): reading every frame allocates nothing.
+    pub fn read_rgba8_into(&self, out: &mut Vec<u8>) -> Result<()> {
+        self.device.readback_image_via(&self.color, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, &self.readback, out)
     }
 
     /// Width and height.

@@ -53,7 +53,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-pub use cpu::CpuHairSim;
+pub use cpu::{CpuHairSim, REFERENCE_STEP_TOLERANCE_M};
 pub use driver::{FixedStepDriver, StepPlan};
 pub use mesh_collider::{MeshCollider, MeshColliderParams, MESH_COLLIDER_BUILD_LABEL};
 pub(crate) use params::validate_colliders;

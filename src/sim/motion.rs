@@ -36,6 +36,16 @@ pub fn violent_motion(time: f32) -> RigidTransform {
     t
 }
 
+/// A violent motion about `pivot` for soak runs: ±1.2 rad at 3 Hz with a nod of
+/// a third of that, and the whole head jolted by up to `jolt` (its units) at 5 Hz
+/// vertically and 2 Hz sideways.
+pub fn violent_about(time: f32, pivot: Vec3, jolt: f32) -> RigidTransform {
+    let mut t = shaking_head_about(time, 1.2, 3.0, pivot);
+    let tau = std::f32::consts::TAU;
+    t.translation += jolt * Vec3::new((tau * 2.0 * time).sin(), (tau * 5.0 * time).sin(), 0.0);
+    t
+}
+
 /// The `thesis` scene's bodies in the head frame: the head sphere, the neck and
 /// the shoulders as capsules.
 pub fn thesis_colliders() -> Vec<Collider> {

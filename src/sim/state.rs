@@ -99,6 +99,20 @@ impl SimState {
         self.rest_lengths[s * self.points..(s + 1) * self.points].iter().sum()
     }
 
+    /// How far apart the particles of two states of the same groom are one step
+    /// of `dt` seconds later, before constraints: the largest |Δx| + dt·|Δv| over
+    /// the particles, meters (∞ when the states differ in size). The measure of
+    /// [`REFERENCE_STEP_TOLERANCE_M`](super::REFERENCE_STEP_TOLERANCE_M). A NaN
+    /// anywhere counts as infinitely far.
+    pub fn step_difference(&self, other: &SimState, dt: f32) -> f32 {
+        if self.positions.len() != other.positions.len() || self.velocities.len() != other.velocities.len() {
+            return f32::INFINITY;
+        }
+        let moved = self.positions.iter().zip(&other.positions).map(|(a, b)| (*a - *b).truncate().length());
+        let sped = self.velocities.iter().zip(&other.velocities).map(|(a, b)| dt * (*a - *b).truncate().length());
+        moved.zip(sped).map(|(x, v)| if (x + v).is_nan() { f32::INFINITY } else { x + v }).fold(0.0, f32::max)
+    }
+
     /// Kinetic energy with unit mass per free particle, J/kg.
     pub fn kinetic_energy(&self) -> f64 {
         self.positions

@@ -222,7 +222,27 @@ impl Device {
         texel_size: u64,
     ) -> Result<Vec<u8>> {
         let len = image.extent.width as u64 * image.extent.height as u64 * texel_size;
-        let staging = self.staging("image readback staging", len, MemoryLocation::GpuToCpu)?;
+        let staging = self.readback_staging("image readback staging", len)?;
+        let mut out = Vec::new();
+        self.readback_image_via(image, layout, &staging, &mut out)?;
+        Ok(out)
+    }
+
+    /// A host-visible buffer of `size` bytes for [`Device::readback_image_via`].
+    pub(crate) fn readback_staging(self: &Arc<Self>, name: &str, size: u64) -> Result<Buffer> {
+        self.staging(name, size, MemoryLocation::GpuToCpu)
+    }
+
+    /// [`Device::readback_image`] through a staging buffer the caller keeps
+    /// (exactly the image's size in bytes), into `out` (its memory reused).
+    pub(crate) fn readback_image_via(
+        self: &Arc<Self>,
+        image: &Image,
+        layout: vk::ImageLayout,
+        staging: &Buffer,
+        out: &mut Vec<u8>,
+    ) -> Result<()> {
+        let len = staging.size();
         let region = whole_image_region(image);
         self.submit_once("readback image", |cmd| {
             // SAFETY: resources of this device; layouts are transitioned around the copy.
@@ -244,7 +264,7 @@ impl Device {
                 self.cmd_barrier(
                     cmd,
                     &[],
-                    &[barrier::buffer(&staging, &[AccessKind::TransferWrite], &[AccessKind::HostRead])],
+                    &[barrier::buffer(staging, &[AccessKind::TransferWrite], &[AccessKind::HostRead])],
                     &[barrier::image(
                         image,
                         &[AccessKind::TransferRead],
@@ -255,10 +275,15 @@ impl Device {
                 );
             }
         })?;
-        staging
+        let bytes = staging
             .mapped()
-            .map(<[u8]>::to_vec)
-            .ok_or_else(|| Error::device("staging memory", "host-visible memory could not be mapped"))
+            .ok_or_else(|| Error::device("staging memory", "host-visible memory could not be mapped"))?;
+        let bytes = bytes
+            .get(..len as usize)
+            .ok_or_else(|| Error::device("staging memory", "the mapped range is smaller than the buffer"))?;
+        out.clear();
+        out.extend_from_slice(bytes);
+        Ok(())
     }
 }
 

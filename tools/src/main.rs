@@ -1,10 +1,16 @@
 //! `vkhair`: the command-line program of the vkhair crate.
 
+mod groom_input;
+mod output;
 mod plot_cmd;
+mod profile;
 mod render_cmd;
+mod sim_check;
 mod simulate_cmd;
 
 use std::path::{Path, PathBuf};
+
+use groom_input::load;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -14,8 +20,7 @@ use vkhair::config::Config;
 use vkhair::groom::cyhair::HairFile;
 use vkhair::groom::grow::{grow, GrowParams, Scalp};
 use vkhair::groom::mesh::TriMesh;
-use vkhair::groom::tfx::TfxFile;
-use vkhair::groom::{scenes, Groom};
+use vkhair::groom::scenes;
 use vkhair::{list_devices, ContextOptions};
 
 #[derive(Parser)]
@@ -33,6 +38,9 @@ enum Command {
     Inspect {
         /// The groom file (.hair or .tfx).
         file: PathBuf,
+        /// Refuse a file with defects instead of repairing it (see `render --strict`).
+        #[arg(long)]
+        strict: bool,
     },
     /// Grow strands on a scalp and write them as a .hair file.
     Grow(GrowArgs),
@@ -58,6 +66,9 @@ enum Command {
         /// Output .hair file.
         #[arg(long)]
         out: PathBuf,
+        /// Refuse a file with defects instead of repairing it (see `render --strict`).
+        #[arg(long)]
+        strict: bool,
     },
 }
 
@@ -117,17 +128,21 @@ struct GrowArgs {
 }
 
 fn main() -> ExitCode {
+    output::restore_sigpipe();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Devices => devices(),
-        Command::Inspect { file } => inspect(&file),
+        Command::Inspect { file, strict } => inspect(&file, strict),
         Command::Grow(args) => grow_cmd(&args),
         Command::Simulate(args) => simulate_cmd::simulate(&args),
         Command::Render(args) => render_cmd::render(&args),
-        Command::Config => Config::default().to_commented_toml().map(|text| print!("{text}")).map_err(Into::into),
+        Command::Config => Config::default()
+            .to_commented_toml()
+            .map(|text| say!("{}", text.trim_end_matches('\n')))
+            .map_err(Into::into),
         Command::Plot(args) => plot_cmd::plot(&args),
-        Command::Convert { input, points, key_hairs, out } => convert(&input, points, key_hairs, &out),
+        Command::Convert { input, points, key_hairs, out, strict } => convert(&input, points, key_hairs, &out, strict),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -138,12 +153,12 @@ fn main() -> ExitCode {
     }
 }
 
-type CliResult = Result<(), Box<dyn std::error::Error>>;
+type CliResult = Result<(), output::Error>;
 
 fn devices() -> CliResult {
     let reports = list_devices(&ContextOptions::default())?;
     if reports.is_empty() {
-        println!("no Vulkan devices (install mesa-vulkan-drivers for lavapipe)");
+        say!("no Vulkan devices (install mesa-vulkan-drivers for lavapipe)");
     }
     for r in &reports {
         let i = &r.info;
@@ -154,7 +169,7 @@ fn devices() -> CliResult {
             vk::PhysicalDeviceType::CPU => "CPU",
             _ => "other",
         };
-        println!(
+        say!(
             "{} {} ({kind}, Vulkan {}.{}.{}, {})",
             if r.chosen { "*" } else { " " },
             i.name,
@@ -164,10 +179,10 @@ fn devices() -> CliResult {
             i.driver
         );
         match &r.usable {
-            Ok(()) => println!("    usable: yes"),
-            Err(why) => println!("    usable: no — {why}"),
+            Ok(()) => say!("    usable: yes"),
+            Err(why) => say!("    usable: no — {why}"),
         }
-        println!(
+        say!(
             "    timestamps: {} valid bits, {} ns/tick; shared memory {} KiB; workgroup ≤ {}; tessellation ≤ {}",
             i.timestamp_valid_bits,
             i.timestamp_period,
@@ -175,47 +190,36 @@ fn devices() -> CliResult {
             i.max_compute_invocations,
             i.max_tessellation_level
         );
-        println!("    async compute queue: {}", if r.async_compute { "yes" } else { "no (single queue path)" });
+        say!("    async compute queue: {}", if r.async_compute { "yes" } else { "no (single queue path)" });
         if !r.optional_extensions.is_empty() {
-            println!("    optional extensions: {}", r.optional_extensions.join(", "));
+            say!("    optional extensions: {}", r.optional_extensions.join(", "));
         }
     }
-    println!("(* = chosen; force a device with {}=<name substring>)", vkhair::DEVICE_ENV);
+    say!("(* = chosen; force a device with {}=<name substring>)", vkhair::DEVICE_ENV);
     Ok(())
 }
 
-fn load(path: &Path) -> Result<(Groom, String), vkhair::Error> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
-    if ext == "tfx" {
-        let f = TfxFile::open(path)?;
-        Ok((f.groom, format!("TressFX {} (.tfx)", f.version)))
-    } else {
-        let f = HairFile::open(path)?;
-        let info = f.info_str();
-        Ok((
-            f.groom,
-            format!("cyHair (.hair){}", if info.is_empty() { String::new() } else { format!(", info \"{info}\"") }),
-        ))
-    }
-}
-
-fn inspect(path: &Path) -> CliResult {
-    let (groom, kind) = load(path)?;
+fn inspect(path: &Path, strict: bool) -> CliResult {
+    let (groom, kind) = load(path, strict)?;
     let s = groom.stats();
-    println!("{}: {kind}", path.display());
-    println!("strands            {}", s.strands);
-    println!("points             {}", s.points);
-    println!(
+    say!("{}: {kind}", path.display());
+    say!("strands            {}", s.strands);
+    say!("points             {}", s.points);
+    say!(
         "points per strand  min {}  mean {:.2}  max {}",
-        s.points_per_strand.0, s.points_per_strand.1, s.points_per_strand.2
+        s.points_per_strand.0,
+        s.points_per_strand.1,
+        s.points_per_strand.2
     );
-    println!(
+    say!(
         "strand length      min {:.4}  mean {:.4}  max {:.4}",
-        s.strand_length.0, s.strand_length.1, s.strand_length.2
+        s.strand_length.0,
+        s.strand_length.1,
+        s.strand_length.2
     );
-    println!("segment length     min {:.5}  max {:.5}", s.segment_length.0, s.segment_length.1);
-    println!("bounds             {:.4} .. {:.4}  (size {:.4})", s.bounds.0, s.bounds.1, s.bounds.1 - s.bounds.0);
-    println!(
+    say!("segment length     min {:.5}  max {:.5}", s.segment_length.0, s.segment_length.1);
+    say!("bounds             {:.4} .. {:.4}  (size {:.4})", s.bounds.0, s.bounds.1, s.bounds.1 - s.bounds.0);
+    say!(
         "attributes         thickness {}  transparency {}  colors {}",
         yes(s.has_thickness),
         yes(s.has_transparency),
@@ -283,18 +287,12 @@ fn grow_cmd(a: &GrowArgs) -> CliResult {
     };
     let s = groom.stats();
     HairFile::new(groom, "grown by vkhair").save(&a.out)?;
-    println!(
-        "wrote {}: {} strands, {} points, mean length {:.4}",
-        a.out.display(),
-        s.strands,
-        s.points,
-        s.strand_length.1
-    );
+    say!("wrote {}: {} strands, {} points, mean length {:.4}", a.out.display(), s.strands, s.points, s.strand_length.1);
     Ok(())
 }
 
-fn convert(input: &Path, points: Option<usize>, key_hairs: Option<usize>, out: &Path) -> CliResult {
-    let (mut groom, _) = load(input)?;
+fn convert(input: &Path, points: Option<usize>, key_hairs: Option<usize>, out: &Path, strict: bool) -> CliResult {
+    let (mut groom, _) = load(input, strict)?;
     if let Some(n) = key_hairs {
         groom = groom.select_evenly(n)?;
     }
@@ -304,6 +302,6 @@ fn convert(input: &Path, points: Option<usize>, key_hairs: Option<usize>, out: &
     let s = groom.stats();
     HairFile::new(groom, &format!("from {}", input.file_name().and_then(|n| n.to_str()).unwrap_or("input")))
         .save(out)?;
-    println!("wrote {}: {} strands, {} points", out.display(), s.strands, s.points);
+    say!("wrote {}: {} strands, {} points", out.display(), s.strands, s.points);
     Ok(())
 }

@@ -24,36 +24,68 @@ pub struct PlotArgs {
     out: Option<PathBuf>,
 }
 
+use crate::output::{write_png, Error};
+use crate::say;
+
 type Lines = BTreeMap<String, Vec<(f64, f64)>>;
-type Error = Box<dyn std::error::Error>;
+
+/// Chart size, pixels.
+const SIZE: (u32, u32) = (1100, 500);
+
+/// Largest magnitude a plotted value may have: beyond it a benchmark figure is
+/// garbage (and would stall the axis layout).
+const LARGEST_VALUE: f64 = 1e12;
 
 /// The CSV's header and rows of numbers (text cells kept as they are).
 struct Table {
+    path: PathBuf,
     header: Vec<String>,
     rows: Vec<Vec<String>>,
 }
 
 impl Table {
     fn read(path: &Path) -> Result<Self, Error> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let mut lines = text.lines();
-        let header = lines.next().ok_or("empty CSV")?.split(',').map(str::to_owned).collect();
+        let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+        let header = lines
+            .next()
+            .ok_or_else(|| format!("{} is empty: a benchmark CSV starts with a header line", path.display()))?
+            .split(',')
+            .map(|h| h.trim().to_owned())
+            .collect();
         let rows: Vec<Vec<String>> = lines.map(|l| l.split(',').map(str::to_owned).collect()).collect();
         if rows.is_empty() {
-            return Err("the CSV has no rows".into());
+            return Err(format!("{} has a header but no rows of figures", path.display()).into());
         }
-        Ok(Table { header, rows })
+        Ok(Table { path: path.to_path_buf(), header, rows })
     }
 
     fn column(&self, name: &str) -> Result<usize, Error> {
-        self.header.iter().position(|h| h == name).ok_or_else(|| format!("CSV has no column {name:?}").into())
+        self.header.iter().position(|h| h == name).ok_or_else(|| {
+            format!(
+                "{} has no column \"{name}\" (its columns: {}); is it a CSV of `cargo bench --bench render` or `--bench volume`?",
+                self.path.display(),
+                self.header.join(", ")
+            )
+            .into()
+        })
     }
 
+    /// The number in `row` (0: the first after the header) and `column`: finite
+    /// and at most [`LARGEST_VALUE`] in magnitude, else an error naming both.
     fn number(&self, row: usize, column: usize) -> Result<f64, Error> {
-        self.rows[row]
-            .get(column)
-            .and_then(|c| c.trim().parse::<f64>().ok())
-            .ok_or_else(|| format!("line {}: bad value in column {column}", row + 2).into())
+        let name = &self.header[column];
+        let at = || format!("line {}, column \"{name}\"", row + 2);
+        let cell = self.rows[row].get(column).map(|c| c.trim()).unwrap_or_default();
+        let value: f64 = cell.parse().map_err(|_| format!("{}: \"{cell}\" is not a number", at()))?;
+        if !value.is_finite() || value.abs() > LARGEST_VALUE {
+            return Err(format!(
+                "{}: {cell} is not a plottable figure (finite, at most {LARGEST_VALUE:e} in magnitude)",
+                at()
+            )
+            .into());
+        }
+        Ok(value)
     }
 }
 
@@ -137,17 +169,28 @@ pub fn plot(a: &PlotArgs) -> Result<(), Error> {
     plotters::style::register_font("sans-serif", FontStyle::Normal, Box::leak(font.into_boxed_slice()))
         .map_err(|_| "the DejaVu font could not be loaded")?;
     let out = a.out.clone().unwrap_or_else(|| a.csv.with_extension("png"));
-    let root = BitMapBackend::new(&out, (1100, 500)).into_drawing_area();
+    // Drawn in memory and written whole: a failed plot leaves no file.
+    let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    draw(&table, &mut rgb).map_err(|e| format!("cannot plot {}: {e}", a.csv.display()))?;
+    let rgba: Vec<u8> = rgb.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
+    write_png(&out, SIZE.0, SIZE.1, &rgba).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    say!("wrote {}", out.display());
+    Ok(())
+}
+
+/// Draws both panels of the chart into an RGB buffer of [`SIZE`].
+fn draw(table: &Table, rgb: &mut [u8]) -> Result<(), Error> {
+    let root = BitMapBackend::with_buffer(rgb, SIZE).into_drawing_area();
     root.fill(&WHITE)?;
     let (left, right) = root.split_horizontally(600);
     if table.column("pcg_iterations").is_ok() {
-        let (time, solves) = volume_lines(&table)?;
+        let (time, solves) = volume_lines(table)?;
         let palette: Vec<String> = time.keys().cloned().collect();
         let caption = "vkhair volume: ms per step (thesis)";
         line_chart(&left, caption, "grid cells per axis", "ms per step", &time, &palette)?;
         line_chart(&right, "PCG iterations per step", "grid cells per axis", "iterations", &solves, &palette)?;
     } else {
-        let (ms, segments) = render_lines(&table)?;
+        let (ms, segments) = render_lines(table)?;
         let palette: Vec<String> = ms.keys().chain(segments.keys()).cloned().collect();
         let caption = "vkhair render: GPU ms per frame (thesis scene)";
         line_chart(&left, caption, "camera distance (m)", "GPU ms (all hair passes)", &ms, &palette)?;
@@ -155,6 +198,5 @@ pub fn plot(a: &PlotArgs) -> Result<(), Error> {
         line_chart(&right, caption, "camera distance (m)", "segments", &segments, &palette)?;
     }
     root.present()?;
-    println!("wrote {}", out.display());
     Ok(())
 }

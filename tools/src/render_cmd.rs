@@ -1,20 +1,24 @@
 //! `vkhair render`: headless frames of a simulated, rendered head of hair.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use vkhair::config::Config;
-use vkhair::groom::cyhair::HairFile;
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::scenes::{self, THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS};
-use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::Groom;
 use vkhair::headless::{MeshDrawer, Offscreen, Submit};
 use vkhair::render::{Camera, InterpolationMode, Light, Primitive, Renderer, ShadingMode, ShadowCaster, ShadowParams};
 use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, SchedulerOptions};
 use vkhair::sim::{motion, Collider, RigidTransform, SimParams, VolumeMode, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
+
+use crate::groom_input::load_scaled;
+use crate::output::{Error, FrameSink, MIN_IMAGE_SIDE};
+use crate::profile::{host_now_ns, Profile};
+use crate::say;
+use crate::simulate_cmd::MotionArg;
 
 /// `--schedule`: where the simulation runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -65,12 +69,18 @@ pub struct RenderArgs {
     /// Draw the --obj mesh but do not collide with it.
     #[arg(long)]
     no_mesh_collider: bool,
-    /// Multiply input positions (groom and mesh) by this (0.01: Blender units → m).
-    #[arg(long, default_value_t = 1.0)]
-    scale: f32,
-    /// Resample input strands to this many points (at most 64).
-    #[arg(long, default_value_t = 16)]
-    points: usize,
+    /// Multiply input positions (groom and mesh) by this (0.01: Blender units → m)
+    /// [default: 1].
+    #[arg(long)]
+    scale: Option<f32>,
+    /// Resample input strands to this many points (2..=64) [default: 16].
+    #[arg(long)]
+    points: Option<usize>,
+    /// Refuse an --input file with defects (zero-length segments, NaN or infinite
+    /// values, strands of fewer than two points) instead of dropping them with a
+    /// warning.
+    #[arg(long)]
+    strict: bool,
     /// Parameter file (TOML, see `vkhair config`): simulation, rendering, lights and
     /// material; the flags below win over it.
     #[arg(long)]
@@ -81,9 +91,10 @@ pub struct RenderArgs {
     /// Smoothed segments per key segment [default: 4].
     #[arg(long)]
     level: Option<u32>,
-    /// Camera distance from the head, meters.
-    #[arg(long, default_value_t = 0.9)]
-    distance: f32,
+    /// Camera distance from the centre of the groom and mesh, in their units
+    /// [default: framed to their bounds].
+    #[arg(long)]
+    distance: Option<f32>,
     /// Supersample 2× and resolve with the 5-tap filter.
     #[arg(long)]
     ssaa: bool,
@@ -110,12 +121,16 @@ pub struct RenderArgs {
     /// opacity maps (turns the simulation's FLIP volume stage on).
     #[arg(long)]
     volume_shadows: bool,
+    /// Head motion about the neck: still, the shake (0.6 rad at 1 Hz) or violent
+    /// (1.2 rad at 3 Hz with a nod and jolts of the whole head).
+    #[arg(long, value_enum, default_value = "shake")]
+    motion: MotionArg,
     /// Where the simulation runs.
     #[arg(long, value_enum, default_value_t = Schedule::Auto)]
     schedule: Schedule,
     /// SECOND DEVICE hand-off.
-    #[arg(long, value_enum, default_value_t = HandOffArg::Auto)]
-    hand_off: HandOffArg,
+    #[arg(long, value_enum)]
+    hand_off: Option<HandOffArg>,
     /// Show each frame's own steps (latency) instead of the previous frame's while
     /// this frame's run (throughput).
     #[arg(long)]
@@ -124,6 +139,13 @@ pub struct RenderArgs {
     /// (default: a second logical device of the rendering GPU).
     #[arg(long)]
     sim_device: Option<String>,
+    /// Write the GPU passes (one track per queue or device) and the CPU frame
+    /// spans as a Chrome trace (opens in Perfetto and chrome://tracing).
+    #[arg(long)]
+    trace: Option<PathBuf>,
+    /// Write the run's summary (device, scene, counts, per-pass statistics) as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
 }
 
 /// The scheduler options the flags ask for (creating the simulation device).
@@ -145,9 +167,9 @@ fn schedule_options(a: &RenderArgs) -> Result<SchedulerOptions, vkhair::Error> {
         mode,
         sim_device,
         hand_off: match a.hand_off {
-            HandOffArg::Auto => None,
-            HandOffArg::External => Some(HandOff::ExternalMemory),
-            HandOffArg::Staging => Some(HandOff::HostStaging),
+            None | Some(HandOffArg::Auto) => None,
+            Some(HandOffArg::External) => Some(HandOff::ExternalMemory),
+            Some(HandOffArg::Staging) => Some(HandOff::HostStaging),
         },
         pipelining: if a.latency { Pipelining::Latency } else { Pipelining::Throughput },
         frames_in_flight: 1,
@@ -160,68 +182,122 @@ struct Scene {
     colliders: Vec<Collider>,
     head_mesh: TriMesh,
     center: Vec3,
+    /// Radius of the sphere around the groom and the mesh (their units).
+    radius: f32,
     pivot: Vec3,
     credit: Option<&'static str>,
 }
 
-fn load_groom(path: &Path, scale: f32, points: usize) -> Result<Groom, vkhair::Error> {
-    let groom = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("tfx")) {
-        TfxFile::open(path)?.groom
-    } else {
-        HairFile::open(path)?.groom
-    };
-    let counts: Vec<u32> = (0..groom.strand_count()).map(|i| groom.strand_len(i) as u32).collect();
-    let scaled = groom.positions().iter().map(|p| *p * scale).collect();
-    Groom::new(scaled, &counts)?.resampled(points)
+/// Options that mean something only with others, and values out of range: an
+/// error saying what the option needs, before any file is read or GPU work done.
+fn check_options(a: &RenderArgs) -> Result<(), String> {
+    if a.width < MIN_IMAGE_SIDE || a.height < MIN_IMAGE_SIDE {
+        return Err(format!(
+            "--width and --height must be at least {MIN_IMAGE_SIDE} pixels (got {}×{})",
+            a.width, a.height
+        ));
+    }
+    if a.frames == 0 {
+        return Err("--frames must be at least 1".into());
+    }
+    if a.input.is_none() {
+        let given = [
+            ("--obj", a.obj.is_some()),
+            ("--scale", a.scale.is_some()),
+            ("--points", a.points.is_some()),
+            ("--strict", a.strict),
+        ];
+        if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
+            return Err(format!("{flag} needs --input (the thesis scene brings its own groom and head)"));
+        }
+        if a.no_mesh_collider {
+            return Err("--no-mesh-collider needs --input and --obj".into());
+        }
+    } else if a.no_mesh_collider && a.obj.is_none() {
+        return Err("--no-mesh-collider needs --obj (there is no mesh to collide with)".into());
+    }
+    if a.schedule != Schedule::SecondDevice {
+        let given = [("--hand-off", a.hand_off.is_some()), ("--sim-device", a.sim_device.is_some())];
+        if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
+            return Err(format!("{flag} needs --schedule second-device"));
+        }
+    }
+    if let Some(scale) = a.scale {
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(format!("--scale must be a finite number above 0 (got {scale})"));
+        }
+    }
+    if let Some(points) = a.points {
+        if !(2..=64).contains(&points) {
+            return Err(format!("--points must be 2..=64 (got {points})"));
+        }
+    }
+    if let Some(d) = a.distance {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(format!("--distance must be a finite number above 0 (got {d})"));
+        }
+    }
+    Ok(())
 }
 
-fn scene(a: &RenderArgs) -> Result<Scene, Box<dyn std::error::Error>> {
+/// The sphere around a set of points: centre of the box and half its diagonal.
+fn bounds_sphere(points: impl Iterator<Item = Vec3>) -> (Vec3, f32) {
+    let (lo, hi) =
+        points.fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    (0.5 * (lo + hi), 0.5 * (hi - lo).length())
+}
+
+fn scene(a: &RenderArgs) -> Result<Scene, Error> {
     let sintel =
         |p: &Option<PathBuf>| p.as_ref().is_some_and(|p| p.to_string_lossy().to_lowercase().contains("sintel"));
-    match &a.input {
-        None => Ok(Scene {
-            groom: scenes::thesis()?,
-            colliders: motion::thesis_colliders(),
-            head_mesh: TriMesh::uv_sphere(THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS * 0.97, 24, 32)?,
-            center: THESIS_HEAD_CENTER,
-            pivot: motion::NECK_PIVOT,
-            credit: None,
-        }),
+    let (groom, colliders, head_mesh, pivot, credit) = match &a.input {
+        None => {
+            let head = TriMesh::uv_sphere(THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS * 0.97, 24, 32)?;
+            (scenes::thesis()?, motion::thesis_colliders(), head, Some(motion::NECK_PIVOT), None)
+        }
         Some(path) => {
-            let groom = load_groom(path, a.scale, a.points)?;
+            let scale = a.scale.unwrap_or(1.0);
+            let groom = load_scaled(path, a.strict, scale, a.points.unwrap_or(16))?;
             let head_mesh = match &a.obj {
                 Some(obj) => {
                     let m = TriMesh::load_obj(obj)?;
-                    TriMesh::new(m.positions.iter().map(|p| *p * a.scale).collect(), m.triangles)?
+                    TriMesh::new(m.positions.iter().map(|p| *p * scale).collect(), m.triangles)?
                 }
                 None => {
+                    // A stand-in head under the roots, sized by the groom's largest
+                    // extent (a flat groom has no extent along one axis).
                     let (lo, hi) = groom.bounds();
-                    TriMesh::uv_sphere(0.5 * (lo + hi), 0.25 * (hi - lo).min_element(), 16, 24)?
+                    let r = 0.25 * (hi - lo).max_element();
+                    TriMesh::uv_sphere(0.5 * (lo + hi), r, 16, 24)?
                 }
             };
-            let (lo, hi) = groom.bounds();
-            let center = 0.5 * (lo + hi);
-            Ok(Scene {
-                groom,
-                colliders: Vec::new(),
-                head_mesh,
-                center,
-                pivot: Vec3::new(center.x, lo.y, center.z),
-                credit: (sintel(&a.input) || sintel(&a.obj))
-                    .then_some("Sintel © Blender Foundation | durian.blender.org (CC BY 3.0)"),
-            })
+            let credit = (sintel(&a.input) || sintel(&a.obj))
+                .then_some("Sintel © Blender Foundation | durian.blender.org (CC BY 3.0)");
+            (groom, Vec::new(), head_mesh, None, credit)
         }
+    };
+    let (center, radius) = bounds_sphere(groom.positions().iter().chain(&head_mesh.positions).copied());
+    if !(center.is_finite() && radius.is_finite() && radius > 0.0) {
+        return Err(format!("the groom and mesh span no finite volume (bounding radius {radius})").into());
     }
+    let (lo, _) = groom.bounds();
+    let pivot = pivot.unwrap_or(Vec3::new(center.x, lo.y, center.z));
+    Ok(Scene { groom, colliders, head_mesh, center, radius, pivot, credit })
 }
 
-/// The thesis scene's three lights: two spots (key and fill) and a rim light.
-fn lights(center: Vec3) -> Vec<Light> {
+/// Lights for a scene of bounding radius `radius` around `center`: two spots
+/// (key and fill) and a rim light, placed as the thesis' setup is for its head.
+fn lights(center: Vec3, radius: f32) -> Vec<Light> {
+    // The thesis' offsets (meters) are for its head and hair.
+    // Spot lights fall off with the squared distance: brighter by k² at k times
+    // the distance, the same light reaches the hair.
+    let k = radius / HEAD_OF_HAIR_RADIUS;
     let spot = |offset: Vec3, color: Vec3| Light::Spot {
-        position: center + offset,
+        position: center + k * offset,
         direction: -offset,
         outer_angle: 0.6,
         inner_angle: 0.4,
-        color,
+        color: color * k * k,
     };
     vec![
         spot(Vec3::new(-0.6, 0.5, 0.8), Vec3::splat(1.1)),
@@ -230,48 +306,40 @@ fn lights(center: Vec3) -> Vec<Light> {
     ]
 }
 
-fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<(), Box<dyn std::error::Error>> {
-    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
-    let mut encoder = png::Encoder::new(file, width, height);
-    encoder.set_color(png::ColorType::Rgba);
-    encoder.set_depth(png::BitDepth::Eight);
-    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-    encoder.write_header()?.write_image_data(rgba)?;
-    Ok(())
-}
+/// Bounding radius of the thesis scene (head sphere and hair), meters: the size
+/// the render parameters' lengths and the tool's lights are set for.
+const HEAD_OF_HAIR_RADIUS: f32 = 0.465;
 
-/// Up to 12 frames, halved, on a 4-column sheet.
-fn contact_sheet(frames: &[Vec<u8>], width: u32, height: u32) -> (u32, u32, Vec<u8>) {
-    let picked: Vec<&Vec<u8>> = if frames.len() <= 12 {
-        frames.iter().collect()
+/// How much wider than given the render's lengths are drawn for a scene of
+/// bounding radius `radius`: 1 for anything a head of hair in meters could be
+/// (5 cm to 1.5 m), else the factor that gives the thesis head's proportions.
+fn drawing_scale(radius: f32) -> f32 {
+    if (0.05..=1.5).contains(&radius) {
+        1.0
     } else {
-        (0..12).map(|i| &frames[i * (frames.len() - 1) / 11]).collect()
-    };
-    let (tw, th) = (width / 2, height / 2);
-    let cols = 4u32.min(picked.len() as u32).max(1);
-    let rows = (picked.len() as u32).div_ceil(cols).max(1);
-    let (sw, sh) = (cols * tw, rows * th);
-    let mut sheet = vec![0u8; (sw * sh * 4) as usize];
-    for (k, frame) in picked.iter().enumerate() {
-        let (ox, oy) = ((k as u32 % cols) * tw, (k as u32 / cols) * th);
-        for y in 0..th {
-            for x in 0..tw {
-                for c in 0..4 {
-                    let at =
-                        |dx: u32, dy: u32| u32::from(frame[(((2 * y + dy) * width + 2 * x + dx) * 4 + c) as usize]);
-                    let v = (at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1) + 2) / 4;
-                    sheet[(((oy + y) * sw + ox + x) * 4 + c) as usize] = v as u8;
-                }
-            }
-        }
+        radius / HEAD_OF_HAIR_RADIUS
     }
-    (sw, sh, sheet)
 }
 
+/// Vertical field of view of the tool's camera, radians.
+const FOV_Y: f32 = 0.698_131_7; // 40°
+
+/// The camera looking at the scene from the front (+Z): at `--distance` when
+/// given, else far enough that the bounding sphere fits the image's shorter side.
+fn framing(s: &Scene, distance: Option<f32>, aspect: f32) -> Result<Camera, vkhair::Error> {
+    let half = 0.5 * FOV_Y;
+    let half_narrow = if aspect >= 1.0 { half } else { (half.tan() * aspect).atan() };
+    let d = distance.unwrap_or(s.radius / half_narrow.sin());
+    let r = s.radius;
+    let eye = s.center + Vec3::new(0.0, 0.1 * r, d);
+    let near = (d - 1.5 * r).max(0.002 * d);
+    let far = d + 1.5 * r;
+    Camera::look_at(eye, s.center, FOV_Y, aspect, near, far)
+}
 /// The parameters: vkhair's defaults (an `--input` groom held in its authored
 /// style, [`SimParams::styled`]), then the `--config` file, then the flags given;
 /// the tool's lights when the file lists none. Checked before any GPU work.
-fn parameters(a: &RenderArgs, center: Vec3) -> Result<Config, vkhair::Error> {
+fn parameters(a: &RenderArgs, center: Vec3, radius: f32) -> Result<Config, vkhair::Error> {
     let sim = if a.input.is_some() { SimParams::styled() } else { SimParams::default() };
     let base = Config { sim, ..Config::default() };
     let mut config = match &a.config {
@@ -300,23 +368,37 @@ fn parameters(a: &RenderArgs, center: Vec3) -> Result<Config, vkhair::Error> {
         config.sim.volume = VolumeParams::flip([32, 32, 32]);
     }
     if config.lights.is_empty() {
-        config.lights = lights(center);
+        config.lights = lights(center, radius);
+    }
+    let k = drawing_scale(radius);
+    if k != 1.0 {
+        eprintln!(
+            "vkhair: warning: the groom and mesh span {:.3} units around their centre, not the size of a \
+             head of hair in meters (vkhair's unit); drawing clumps, hair widths and shadow layers {k:.3}× as wide to match \
+             (give --scale to convert the groom itself: the simulation stays in meters)",
+            radius
+        );
+        config.render.clump_width *= k;
+        config.render.lod.full_detail_distance *= k;
+        config.material.root_width *= k;
+        config.material.tip_width *= k;
     }
     config.validate()?;
     Ok(config)
 }
 
-pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
+pub fn render(a: &RenderArgs) -> Result<(), Error> {
+    check_options(a)?;
     let s = scene(a)?;
-    let config = parameters(a, s.center)?;
+    let config = parameters(a, s.center, s.radius)?;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let sim_params = config.sim.clone();
     let options = schedule_options(a)?;
     let mut sim = FrameScheduler::new(&ctx, &s.groom, &sim_params, &RigidTransform::default(), &s.colliders, &options)?;
-    println!("simulation: {} ({})", sim.mode().name(), sim.reason());
+    say!("simulation: {} ({})", sim.mode().name(), sim.reason());
     if a.input.is_some() && a.obj.is_some() && !a.no_mesh_collider {
         sim.set_mesh_collider(Some(&s.head_mesh), &config.mesh_collider)?;
-        println!(
+        say!(
             "mesh collider: {} triangles at {} grid points along the longest axis",
             s.head_mesh.triangles.len(),
             config.mesh_collider.resolution
@@ -332,7 +414,8 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         } else {
             vec![0.into(), 1.into()]
         };
-        let shadows = ShadowParams { casters, resolution: a.shadow_resolution, ..ShadowParams::default() };
+        let layers = ShadowParams::default().layers.map(|l| l * drawing_scale(s.radius));
+        let shadows = ShadowParams { casters, resolution: a.shadow_resolution, layers, ..ShadowParams::default() };
         renderer.set_shadows(sim.key_hairs(), &shadows)?;
     }
     renderer.set_material(&config.material)?;
@@ -344,20 +427,12 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     } else {
         MeshDrawer::with_hair_shadows(&ctx, &s.head_mesh, &renderer, 0)?
     };
-    let aspect = a.width as f32 / a.height as f32;
-    let camera = Camera::look_at(
-        s.center + Vec3::new(0.0, 0.05, a.distance),
-        s.center - Vec3::new(0.0, 0.08, 0.0),
-        40f32.to_radians(),
-        aspect,
-        0.01,
-        10.0,
-    )?;
+    let camera = framing(&s, a.distance, a.width as f32 / a.height as f32)?;
     let mut profiler = GpuProfiler::new(&ctx, 1, 64)?;
-    std::fs::create_dir_all(&a.out)?;
+    std::fs::create_dir_all(&a.out).map_err(|e| format!("cannot create {}: {e}", a.out.display()))?;
     let (strands, points) = sim.key_hairs().size();
     let (hairs, per_hair) = renderer.hair_counts();
-    println!(
+    say!(
         "{}: {strands} key hairs × {points} points → {hairs} hairs × {} segments ({} segments), {}×{}, {} frames",
         ctx.info().name,
         per_hair - 1,
@@ -368,36 +443,28 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     );
     let bar = ProgressBar::new(a.frames as u64);
     bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed}")
+        ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed} (eta {eta})")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let steps_per_frame = 2; // 1/60 s steps, 30 frames per second
-    let mut totals: Vec<(String, f64, u32)> = Vec::new();
-    let mut add = |report: vkhair::ProfileReport| {
-        for (name, ns) in report.totals_by_name() {
-            match totals.iter_mut().find(|(n, _, _)| *n == name) {
-                Some(entry) => {
-                    entry.1 += ns;
-                    entry.2 += 1;
-                }
-                None => totals.push((name, ns, 1)),
-            }
-        }
-    };
-    let mut frames = Vec::new();
-    let (mut sim_ns, mut overlap_ns, mut sim_reports) = (0.0, 0.0, 0u32);
+    let (lo, hi) = s.groom.bounds();
+    let size = (hi - lo).max_element();
+    let mut profile = Profile::new("frame");
+    let sim_track = format!("simulation, {}", sim.mode().name());
+    let mut last_sim_frame = None;
+    let mut sink = FrameSink::new(&a.out, a.width, a.height, a.frames);
     for frame in 0..a.frames {
         let first_step = frame * steps_per_frame;
         let heads: Vec<RigidTransform> = (0..steps_per_frame)
-            .map(|k| motion::shaking_head_about((first_step + k + 1) as f32 * sim_params.dt, 0.6, 1.0, s.pivot))
+            .map(|k| a.motion.head((first_step + k + 1) as f32 * sim_params.dt, s.pivot, size))
             .collect();
+        let started = host_now_ns();
         ctx.run_frame("vkhair render frame", |cmd| {
             // SAFETY: run_frame hands over a recording command buffer of the
-            // context's device, submits it with the returned waits and waits for it.
+            // context's device, submits it with the returned waits and waits for it;
+            // the profiler's single slot was drained after the previous frame.
             unsafe {
-                if let Some(report) = profiler.begin_frame(cmd, frame as u64) {
-                    add(report);
-                }
+                profiler.begin_frame(cmd, frame as u64);
                 let sync = sim.record_frame(cmd, &heads, Some(&mut profiler))?;
                 renderer.record_prepare(cmd, sim.key_hairs(), Some(&camera), Some(&mut profiler))?;
                 renderer.record_shadows(cmd, sim.key_hairs(), Some(&mut profiler))?;
@@ -418,41 +485,50 @@ pub fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
                 Ok(sync)
             }
         })?;
-        // The simulation's own queue or device (ASYNC COMPUTE, SECOND DEVICE).
-        if let (Some(sim_report), Some(render_report)) = (sim.sim_profile(), profiler.drain().pop()) {
-            sim_ns += sim_report.total_nanoseconds();
-            overlap_ns += render_report.overlap_ns(&sim_report).unwrap_or(0.0);
-            sim_reports += 1;
-            add(render_report);
+        profile.add_cpu_span("frame: record, submit, wait", started, host_now_ns());
+        for report in profiler.drain() {
+            profile.add(&report, "graphics queue", 1);
         }
-        let rgba = offscreen.read_rgba8()?;
-        write_png(&a.out.join(format!("frame_{frame:04}.png")), a.width, a.height, &rgba)?;
-        frames.push(rgba);
+        // The simulation's own queue or device (ASYNC COMPUTE, SECOND DEVICE): its
+        // latest report, once per simulated frame.
+        if let Some(report) = sim.sim_profile().filter(|r| Some(r.frame) != last_sim_frame) {
+            last_sim_frame = Some(report.frame);
+            profile.add(&report, &sim_track, 1);
+        }
+        let read = host_now_ns();
+        let mut rgba = sink.buffer();
+        offscreen.read_rgba8_into(&mut rgba)?;
+        sink.push(frame, rgba)?;
+        profile.add_cpu_span("frame: read back, hand to the PNG writer", read, host_now_ns());
         bar.inc(1);
     }
     bar.finish_and_clear();
-    for report in profiler.drain() {
-        add(report);
+    sink.finish()?;
+    profile.print_table();
+    say!("wrote {} frames and contact_sheet.png to {}", a.frames, a.out.display());
+    if let Some(path) = &a.trace {
+        profile.write_trace(path)?;
+        say!("wrote the GPU trace to {} (open it in Perfetto or chrome://tracing)", path.display());
     }
-    let (sw, sh, sheet) = contact_sheet(&frames, a.width, a.height);
-    write_png(&a.out.join("contact_sheet.png"), sw, sh, &sheet)?;
-    println!("{:<28} {:>10}", "pass (GPU, mean per frame)", "ms");
-    let mut sum = 0.0;
-    for (name, ns, count) in &totals {
-        // Each report sums a pass over the frame (the simulation's two steps too).
-        let per_frame = ns / (*count as f64).max(1.0);
-        sum += per_frame;
-        println!("{name:<28} {:>10.3}", per_frame / 1e6);
+    if let Some(path) = &a.json {
+        let context = serde_json::json!({
+            "command": "render",
+            "device": ctx.info().name,
+            "scene": a.input.as_ref().map_or("thesis".to_owned(), |p| p.display().to_string()),
+            "simulation": sim.mode().name(),
+            "key_hairs": strands,
+            "points_per_key_hair": points,
+            "hairs": hairs,
+            "segments_per_hair": per_hair - 1,
+            "width": a.width,
+            "height": a.height,
+            "frames": a.frames,
+        });
+        profile.write_summary(path, context)?;
+        say!("wrote the run's summary to {}", path.display());
     }
-    println!("{:<28} {:>10.3}", "total", sum / 1e6);
-    if sim_reports > 0 {
-        let n = f64::from(sim_reports);
-        println!("{:<28} {:>10.3}", format!("simulation ({})", sim.mode().name()), sim_ns / n / 1e6);
-        println!("{:<28} {:>10.3}", "overlap with rendering", overlap_ns / n / 1e6);
-    }
-    println!("wrote {} frames and contact_sheet.png to {}", frames.len(), a.out.display());
     if let Some(credit) = s.credit {
-        println!("{credit}");
+        say!("{credit}");
     }
     Ok(())
 }

@@ -5,18 +5,20 @@ use std::path::{Path, PathBuf};
 
 use clap::ValueEnum;
 use glam::Vec3;
+use indicatif::{ProgressBar, ProgressStyle};
 use vkhair::config::Config;
-use vkhair::groom::cyhair::HairFile;
 use vkhair::groom::mesh::TriMesh;
+use vkhair::groom::scenes;
 use vkhair::groom::sdf::MeshSdf;
-use vkhair::groom::{scenes, Groom};
 use vkhair::sim::{
-    motion, CpuHairSim, HairSim, MeshCollider, Preconditioner, RigidTransform, SimParams, SimStage, SimState,
-    SolverMode, VolumeMode, VolumeParams,
+    motion, HairSim, MeshCollider, Preconditioner, RigidTransform, SimParams, SolverMode, VolumeMode, VolumeParams,
 };
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
-use crate::{load, CliResult};
+use crate::groom_input::load_scaled;
+use crate::profile::{host_now_ns, Profile};
+use crate::sim_check::{percentile, share_inside, tip_drift, write_final, Reference, StepCheck};
+use crate::{say, CliResult};
 
 #[derive(clap::Args)]
 pub struct SimulateArgs {
@@ -25,13 +27,18 @@ pub struct SimulateArgs {
     /// `SimParams::styled`).
     #[arg(long)]
     input: Option<PathBuf>,
-    /// Multiply input positions by this (e.g. 0.01 for Blender units to meters).
-    #[arg(long, default_value_t = 1.0)]
-    scale: f32,
-    /// Resample input strands to this many points (at most 64).
-    #[arg(long, default_value_t = 16)]
-    points: usize,
-    /// Simulation steps (1/60 s each).
+    /// Multiply input positions (groom and mesh) by this (0.01: Blender units →
+    /// m) [default: 1].
+    #[arg(long)]
+    scale: Option<f32>,
+    /// Resample input strands to this many points (2..=64) [default: 16].
+    #[arg(long)]
+    points: Option<usize>,
+    /// Refuse an --input file with defects instead of dropping them with a
+    /// warning (see `render --strict`).
+    #[arg(long)]
+    strict: bool,
+    /// Simulation steps (1/60 s each, at least 1).
     #[arg(long, default_value_t = 120)]
     steps: usize,
     /// Parameter file (TOML, see `vkhair config`); the flags below win over it.
@@ -43,7 +50,9 @@ pub struct SimulateArgs {
     /// Use the DFTL solver instead of PBD iterations.
     #[arg(long)]
     dftl: bool,
-    /// Also run the CPU reference and report the largest position difference.
+    /// Also run the CPU reference: every 10 steps it takes one step from the GPU's
+    /// state and must land within a stated tolerance of the GPU's step; without
+    /// FLIP the whole run is compared too. Exits non-zero beyond the tolerance.
     #[arg(long)]
     check: bool,
     /// Volume stage (hair-hair interaction): FLIP on a MAC grid, density friction,
@@ -59,8 +68,8 @@ pub struct SimulateArgs {
     /// Iteration cap of the pressure solve [default: 40].
     #[arg(long)]
     max_iterations: Option<u32>,
-    /// Head motion: still, the shake (0.6 rad at 1 Hz) or a violent shake
-    /// (1 rad at 2 Hz), about the neck.
+    /// Head motion about the neck: still, the shake (0.6 rad at 1 Hz) or violent
+    /// (for soak runs: 1.2 rad at 3 Hz with a nod and jolts of the whole head).
     #[arg(long, value_enum, default_value = "shake")]
     motion: MotionArg,
     /// Character mesh (OBJ, same units and frame as the groom, scaled by --scale):
@@ -76,13 +85,36 @@ pub struct SimulateArgs {
     /// strand per input strand with --points points each.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Write the GPU passes and the CPU spans as a Chrome trace (opens in
+    /// Perfetto and chrome://tracing).
+    #[arg(long)]
+    trace: Option<PathBuf>,
+    /// Write the run's summary (device, groom, counts, per-pass statistics) as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
 }
 
+/// `--motion`: how the head moves (about the neck `pivot`).
 #[derive(Clone, Copy, ValueEnum)]
-enum MotionArg {
+pub enum MotionArg {
+    /// The head stays still (does the groom hold its style?).
     Still,
+    /// 0.6 rad at 1 Hz, with a nod.
     Shake,
+    /// For soak runs: 1.2 rad at 3 Hz with a nod, and the whole head jolted by a
+    /// tenth of the groom's size.
     Violent,
+}
+
+impl MotionArg {
+    /// The head at `time` seconds, for a groom of bounding-box size `size`.
+    pub fn head(self, time: f32, pivot: Vec3, size: f32) -> RigidTransform {
+        match self {
+            MotionArg::Still => RigidTransform::default(),
+            MotionArg::Shake => motion::shaking_head_about(time, 0.6, 1.0, pivot),
+            MotionArg::Violent => motion::violent_about(time, pivot, 0.1 * size),
+        }
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -141,51 +173,49 @@ fn load_mesh(obj: Option<&Path>, scale: f32) -> Result<Option<TriMesh>, vkhair::
     }
 }
 
-/// Share of free particles inside `field` (head frame), with the head at `head`.
-fn share_inside(state: &SimState, field: &MeshSdf, head: &RigidTransform) -> f64 {
-    let back = head.matrix().inverse();
-    let free: Vec<Vec3> = state.positions.iter().filter(|p| p.w > 0.0).map(|p| p.truncate()).collect();
-    let inside = free.iter().filter(|p| field.sample(back.transform_point3(**p)) < 0.0).count();
-    inside as f64 / free.len().max(1) as f64
-}
+/// The profile's track: `simulate` records on the graphics queue.
+const TRACK: &str = "graphics queue";
 
-/// Per strand, the tip's distance from the rest shape carried by `head`, as a
-/// fraction of the strand's rest length, sorted.
-fn tip_drift(state: &SimState, head: &RigidTransform) -> Vec<f32> {
-    let m = head.matrix();
-    let mut drift: Vec<f32> = (0..state.strands)
-        .map(|s| {
-            let tip = s * state.points + state.points - 1;
-            let moved = m.transform_point3(state.rest[tip].truncate());
-            (state.positions[tip].truncate() - moved).length() / state.rest_strand_length(s).max(f32::MIN_POSITIVE)
-        })
-        .collect();
-    drift.sort_by(f32::total_cmp);
-    drift
-}
-
-fn percentile(sorted: &[f32], percent: usize) -> Option<f32> {
-    (!sorted.is_empty()).then(|| sorted[(sorted.len() - 1) * percent / 100])
-}
-
-/// The simulated strands in the input's frame and units, as a .hair file.
-fn write_final(path: &Path, state: &SimState, head: &RigidTransform, scale: f32) -> CliResult {
-    let back = head.matrix().inverse();
-    let positions: Vec<Vec3> = state.positions.iter().map(|p| back.transform_point3(p.truncate()) / scale).collect();
-    let counts = vec![state.points as u32; state.strands];
-    let groom = Groom::new(positions, &counts)?;
-    HairFile::new(groom, "vkhair simulate: strands after the last step").save(path)?;
+/// Options that mean something only with others, and values out of range: an
+/// error saying what the option needs, before any file is read or GPU work done.
+fn check_options(a: &SimulateArgs) -> Result<(), String> {
+    if a.steps == 0 {
+        return Err("--steps must be at least 1".into());
+    }
+    if a.input.is_none() {
+        let given = [
+            ("--obj", a.obj.is_some()),
+            ("--scale", a.scale.is_some()),
+            ("--points", a.points.is_some()),
+            ("--strict", a.strict),
+        ];
+        if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
+            return Err(format!("{flag} needs --input (the thesis scene brings its own groom and colliders)"));
+        }
+    }
+    if a.no_mesh_collider && a.obj.is_none() {
+        return Err("--no-mesh-collider needs --obj (there is no mesh to collide with)".into());
+    }
+    if let Some(scale) = a.scale {
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(format!("--scale must be a finite number above 0 (got {scale})"));
+        }
+    }
+    if let Some(points) = a.points {
+        if !(2..=64).contains(&points) {
+            return Err(format!("--points must be 2..=64 (got {points})"));
+        }
+    }
     Ok(())
 }
 
 pub fn simulate(a: &SimulateArgs) -> CliResult {
+    check_options(a)?;
+    let scale = a.scale.unwrap_or(1.0);
     let (groom, colliders, label, pivot) = match &a.input {
         None => (scenes::thesis()?, motion::thesis_colliders(), "thesis scene".to_owned(), motion::NECK_PIVOT),
         Some(path) => {
-            let (groom, _) = load(path)?;
-            let scaled: Vec<Vec3> = groom.positions().iter().map(|p| *p * a.scale).collect();
-            let counts: Vec<u32> = (0..groom.strand_count()).map(|i| groom.strand_len(i) as u32).collect();
-            let groom = Groom::new(scaled, &counts)?.resampled(a.points)?;
+            let groom = load_scaled(path, a.strict, scale, a.points.unwrap_or(16))?;
             // Turn about the centre of the roots' lowest level: roughly the neck.
             let (lo, hi) = groom.bounds();
             let pivot = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
@@ -194,24 +224,19 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     };
     let config = simulate_params(a)?;
     let params = config.sim.clone();
-    let mesh = load_mesh(a.obj.as_deref(), a.scale)?;
+    let mesh = load_mesh(a.obj.as_deref(), scale)?;
     let colliding = mesh.is_some() && !a.no_mesh_collider;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
-    let head = |i: usize| {
-        let t = (i + 1) as f32 * params.dt;
-        match a.motion {
-            MotionArg::Still => RigidTransform::default(),
-            MotionArg::Shake => motion::shaking_head_about(t, 0.6, 1.0, pivot),
-            MotionArg::Violent => motion::shaking_head_about(t, 1.0, 2.0, pivot),
-        }
-    };
+    let (lo, hi) = groom.bounds();
+    let size = (hi - lo).max_element();
+    let head = |i: usize| a.motion.head((i + 1) as f32 * params.dt, pivot, size);
     let mut sim = HairSim::new(&ctx, &groom, &params, &RigidTransform::default())?;
     sim.set_colliders(&colliders)?;
     let field = match &mesh {
         Some(m) => {
             let collider = MeshCollider::new(&ctx, m, &config.mesh_collider)?;
             let [nx, ny, nz] = collider.dims();
-            println!(
+            say!(
                 "mesh collider{}: {} triangles, {nx}×{ny}×{nz} field of {:.1} mm cells",
                 if colliding { "" } else { " (off: only measuring)" },
                 m.triangles.len(),
@@ -227,13 +252,13 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     };
     let mut profiler = GpuProfiler::new(&ctx, 1, 1024)?;
     let (strands, points) = sim.size();
-    println!(
+    say!(
         "{label}: {strands} key hairs × {points} points on {}, {} steps of {:.4} s",
         ctx.info().name,
         a.steps,
         params.dt
     );
-    println!(
+    say!(
         "parameters: {} iterations, {:?} solver, volume {:?} at {:?}{}",
         params.iterations,
         params.solver,
@@ -241,83 +266,126 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
         params.volume.resolution,
         a.config.as_ref().map(|c| format!(" (from {} and the flags)", c.display())).unwrap_or_default()
     );
-    let mut totals = vec![0.0f64; SimStage::ALL.len()];
-    // With a mesh collider, the share of points inside it is checked every 10 steps.
-    let chunk = if field.is_some() { 10 } else { 100 };
-    let mut done = 0;
-    let mut worst_inside = 0.0f64;
+    let reference = Reference {
+        params: &params,
+        colliders: &colliders,
+        mesh: match (&mesh, colliding) {
+            (Some(m), true) => Some(MeshSdf::build(m, config.mesh_collider.resolution, config.mesh_collider.margin)?),
+            _ => None,
+        },
+    };
+    let mut steps_checked = StepCheck::default();
+    let bar = ProgressBar::new(a.steps as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} steps {elapsed} (eta {eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let mut profile = Profile::new("step");
+    // Every 10 steps: the share of points inside the mesh collider, and with
+    // --check one step of the CPU reference from the GPU's state.
+    let chunk = 10;
+    let (mut done, mut worst_inside) = (0, 0.0f64);
     while done < a.steps {
         let n = chunk.min(a.steps - done);
         let start = done;
-        if let Some(report) = sim.run(n, |i| head(start + i), Some(&mut profiler))? {
-            for (name, ns) in report.totals_by_name() {
-                if let Some(k) = SimStage::ALL.iter().position(|s| s.label() == name) {
-                    totals[k] += ns;
-                }
+        if a.check {
+            // One step of the GPU against the same step of the reference.
+            let state = sim.read_state()?;
+            let started = host_now_ns();
+            if let Some(report) = sim.run(1, |_| head(start), Some(&mut profiler))? {
+                profile.add(&report, TRACK, 1);
             }
+            profile.add_cpu_span(&format!("step {start}: record, submit, wait"), started, host_now_ns());
+            let previous = if start == 0 { RigidTransform::default() } else { head(start - 1) };
+            let cpu = reference.step(state, &previous, &head(start))?;
+            steps_checked.add(sim.read_state()?.step_difference(&cpu, params.dt));
+        }
+        let first = start + usize::from(a.check);
+        if first < start + n {
+            let started = host_now_ns();
+            if let Some(report) = sim.run(start + n - first, |i| head(first + i), Some(&mut profiler))? {
+                profile.add(&report, TRACK, start + n - first);
+            }
+            profile.add_cpu_span(
+                &format!("steps {first}..{}: record, submit, wait", start + n),
+                started,
+                host_now_ns(),
+            );
         }
         done += n;
         if let Some(field) = &field {
             worst_inside = worst_inside.max(share_inside(&sim.read_state()?, field, &head(done - 1)));
         }
+        bar.inc(n as u64);
     }
-    let sum: f64 = totals.iter().sum();
-    println!("{:<28} {:>12} {:>8}", "stage", "ms/step", "share");
-    for (stage, ns) in SimStage::ALL.iter().zip(&totals) {
-        println!("{:<28} {:>12.3} {:>7.1}%", stage.label(), ns / 1e6 / a.steps as f64, 100.0 * ns / sum.max(1.0));
-    }
-    println!("{:<28} {:>12.3}", "total", sum / 1e6 / a.steps as f64);
+    bar.finish_and_clear();
+    profile.print_table();
     let state = sim.read_state()?;
-    println!("kinetic energy {:.4} J/kg per particle", state.kinetic_energy() / state.positions.len() as f64);
-    let last_head = head(a.steps.saturating_sub(1));
+    say!("kinetic energy {:.4} J/kg per particle", state.kinetic_energy() / state.positions.len() as f64);
+    let last_head = head(a.steps - 1);
     let drift = tip_drift(&state, &last_head);
     if let (Some(p50), Some(p95)) = (percentile(&drift, 50), percentile(&drift, 95)) {
-        println!("tip drift from rest: p50 {:.2} % p95 {:.2} % of strand length", 100.0 * p50, 100.0 * p95);
+        say!("tip drift from rest: p50 {:.2} % p95 {:.2} % of strand length", 100.0 * p50, 100.0 * p95);
     }
     if let Some(field) = &field {
-        println!(
+        say!(
             "points inside the mesh collider: {:.3} % after the last step, at most {:.3} % (checked every {chunk} steps)",
             100.0 * share_inside(&state, field, &last_head),
             100.0 * worst_inside
         );
     }
     if let Some(out) = &a.out {
-        write_final(out, &state, &last_head, a.scale)?;
-        println!("wrote {}: {strands} strands × {points} points", out.display());
+        write_final(out, &state, &last_head, scale)?;
+        say!("wrote {}: {strands} strands × {points} points", out.display());
     }
     if let (Some(grid), Some(stats)) = (sim.volume_grid(), sim.volume_stats()?) {
-        println!(
-            "volume grid {}×{}×{} cells of {:.1} mm; last pressure solve: {} iterations, residual {:.1e}{}",
+        let solve = match params.volume.mode {
+            VolumeMode::Flip => format!(
+                "; last pressure solve: {} iterations, residual {:.1e}{}",
+                stats.iterations,
+                stats.relative_residual,
+                if stats.converged { "" } else { " (not converged)" }
+            ),
+            _ => " (density friction: no pressure solve)".to_owned(),
+        };
+        say!(
+            "volume grid {}×{}×{} cells of {:.1} mm{solve}",
             grid.dims[0],
             grid.dims[1],
             grid.dims[2],
             grid.cell_size * 1e3,
-            stats.iterations,
-            stats.relative_residual,
-            if stats.converged { "" } else { " (not converged)" }
         );
     }
+    if let Some(path) = &a.trace {
+        profile.write_trace(path)?;
+        say!("wrote the GPU trace to {} (open it in Perfetto or chrome://tracing)", path.display());
+    }
+    if let Some(path) = &a.json {
+        let context = serde_json::json!({
+            "command": "simulate",
+            "device": ctx.info().name,
+            "groom": label,
+            "key_hairs": strands,
+            "points_per_key_hair": points,
+            "steps": a.steps,
+            "dt_s": params.dt,
+            "iterations": params.iterations,
+            "volume": format!("{:?}", params.volume.mode),
+        });
+        profile.write_summary(path, context)?;
+        say!("wrote the run's summary to {}", path.display());
+    }
     if a.check {
-        let mut cpu = CpuHairSim::new(&groom, &params, &RigidTransform::default())?;
-        cpu.set_colliders(&colliders)?;
-        if let (Some(m), true) = (&mesh, colliding) {
-            let p = &config.mesh_collider;
-            cpu.set_mesh_collider(Some(MeshSdf::build(m, p.resolution, p.margin)?));
-        }
-        for i in 0..a.steps {
-            cpu.step(&head(i))?;
-        }
-        let max =
-            state.positions.iter().zip(&cpu.state().positions).map(|(g, c)| (*g - *c).length()).fold(0.0f32, f32::max);
-        println!("largest GPU − CPU reference position difference: {max:e} m");
-        if params.volume.mode == VolumeMode::Flip {
-            println!(
-                "  (FLIP: the GPU and the reference solve the pressure with different preconditioners, each to a \
-                 relative residual of {:e}; step by step they agree to micrometres, and like any chaotic system the \
-                 trajectories then drift apart — compare with --volume friction or off, which match bit for bit)",
-                params.volume.tolerance
-            );
-        }
+        let whole_run = if params.volume.mode == VolumeMode::Flip {
+            None
+        } else {
+            let mut cpu = reference.start(&groom)?;
+            for i in 0..a.steps {
+                cpu.step(&head(i))?;
+            }
+            Some(state.step_difference(cpu.state(), params.dt))
+        };
+        steps_checked.verdict(whole_run, &ctx.info().name)?;
     }
     Ok(())
 }

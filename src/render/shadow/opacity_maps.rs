@@ -21,9 +21,10 @@ use super::atlas::{ShadowAtlas, DEPTH_FORMAT, Z0_FORMAT};
 use super::{ShadowParams, SHADOW_ATLAS_FORMAT};
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuLight, GpuShadowMap, GpuShadowParams};
-use crate::profiler::GpuProfiler;
+use crate::profiler::{GpuProfiler, PassScope};
 use crate::render::pass::RenderPass;
 use crate::vk::buffer::Buffer;
+use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
 use crate::vk::rendering;
@@ -114,7 +115,12 @@ impl OpacityMaps {
         let depth_rendering = rendering::info(extent, &z0_attachment, Some(&depth_attachment));
         let atlas_attachment = self.atlas.opacity_pass_attachment();
         let opacity_rendering = rendering::info(extent, &atlas_attachment, None);
-        let draw_tiles = |cmd: vk::CommandBuffer, pass: &(GraphicsPipeline, vk::DescriptorSet)| {
+        // Each map is its own nested scope: the profile lists every light's map.
+        let light_of = |map: usize| (0..8).find(|&i| uniforms.light_map[i / 4][i % 4] == map as u32).unwrap_or(map);
+        let draw_tiles = |cmd: vk::CommandBuffer,
+                          pass: &(GraphicsPipeline, vk::DescriptorSet),
+                          stage: RenderPass,
+                          profiler: &mut Option<&mut GpuProfiler>| {
             // SAFETY: inside the rendering instance recorded below.
             unsafe {
                 pass.0.bind(cmd, &[pass.1]);
@@ -122,6 +128,8 @@ impl OpacityMaps {
                     if map.is_density_volume() {
                         continue; // density volume: no map
                     }
+                    let label = format!("{}, light {}", stage.label(), light_of(k));
+                    let scope = PassScope::open(d, cmd, profiler, &label, LabelColor::Graphics);
                     let [x, y, w, h] = map.tile;
                     let viewport = vk::Viewport { x, y, width: w, height: h, min_depth: 0.0, max_depth: 1.0 };
                     let scissor = vk::Rect2D {
@@ -132,6 +140,7 @@ impl OpacityMaps {
                     d.raw.cmd_set_scissor(cmd, 0, &[scissor]);
                     pass.0.push(cmd, &(k as u32));
                     d.raw.cmd_draw(cmd, vertices, 1, 0, 0);
+                    scope.close(d, cmd, profiler);
                 }
             }
         };
@@ -140,13 +149,13 @@ impl OpacityMaps {
             d.cmd_barrier(cmd, &[before], &[], &self.atlas.to_depth_pass());
             let scope = RenderPass::ShadowDepth.open(d, cmd, profiler);
             d.raw.cmd_begin_rendering(cmd, &depth_rendering);
-            draw_tiles(cmd, &self.depth_pass);
+            draw_tiles(cmd, &self.depth_pass, RenderPass::ShadowDepth, profiler);
             d.raw.cmd_end_rendering(cmd);
             d.cmd_barrier(cmd, &[], &[], &self.atlas.to_opacity_pass());
             scope.close(d, cmd, profiler);
             let scope = RenderPass::ShadowOpacity.open(d, cmd, profiler);
             d.raw.cmd_begin_rendering(cmd, &opacity_rendering);
-            draw_tiles(cmd, &self.opacity_pass);
+            draw_tiles(cmd, &self.opacity_pass, RenderPass::ShadowOpacity, profiler);
             d.raw.cmd_end_rendering(cmd);
             d.cmd_barrier(cmd, &[], &[], &[self.atlas.to_sampled()]);
             scope.close(d, cmd, profiler);

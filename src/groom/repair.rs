@@ -1,0 +1,256 @@
+//! Loading real assets: what can be repaired is, and said.
+//!
+//! Exported grooms carry defects that the strict constructor refuses (TressFX's
+//! own `mohawk.tfx` has one zero-length segment among 2,228 strands).
+//! [`Groom::repaired`] drops, in this order: strands with a NaN or infinite value
+//! (position or attribute), then every point that coincides with the strand's
+//! previous kept point (a zero-length segment, as [`Groom::new`] judges it), then
+//! strands left with fewer than two points. [`Repairs`] counts what went.
+
+use glam::Vec3;
+
+use super::{Attributes, Groom, MIN_SEGMENT_FRACTION};
+use crate::error::{Error, Result};
+
+/// What [`Groom::repaired`] dropped (all zero: nothing needed repair).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Repairs {
+    /// Strands dropped for a NaN or infinite position or attribute.
+    pub non_finite_strands: usize,
+    /// Points dropped because they coincided with the previous kept point.
+    pub zero_length_segments: usize,
+    /// Strands dropped for having fewer than two points (left or given).
+    pub short_strands: usize,
+    /// Original index of every kept point, in order.
+    kept_points: Vec<usize>,
+    /// Original index of every kept strand, in order.
+    kept_strands: Vec<usize>,
+}
+
+impl Repairs {
+    /// Whether nothing was dropped.
+    pub fn is_empty(&self) -> bool {
+        self.non_finite_strands == 0 && self.zero_length_segments == 0 && self.short_strands == 0
+    }
+
+    /// Original index of every kept point, in order.
+    pub(crate) fn kept_points(&self) -> &[usize] {
+        &self.kept_points
+    }
+
+    /// Original index of every kept strand, in order.
+    pub(crate) fn kept_strands(&self) -> &[usize] {
+        &self.kept_strands
+    }
+}
+
+impl std::fmt::Display for Repairs {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let plural = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+        let parts: Vec<String> = [
+            (
+                self.non_finite_strands,
+                plural(self.non_finite_strands, "strand", "strands") + " with NaN or infinite values",
+            ),
+            (
+                self.zero_length_segments,
+                plural(self.zero_length_segments, "zero-length segment", "zero-length segments"),
+            ),
+            (self.short_strands, plural(self.short_strands, "strand", "strands") + " with fewer than two points"),
+        ]
+        .into_iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(_, s)| s)
+        .collect();
+        if parts.is_empty() {
+            write!(f, "nothing to repair")
+        } else {
+            write!(f, "dropped {}", parts.join(", "))
+        }
+    }
+}
+
+/// How a file reader turns strands into a groom.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Load {
+    /// Refuse any defect ([`Groom::with_attributes`]).
+    Strict,
+    /// Repair what can be ([`Groom::repaired`]).
+    Repair,
+}
+
+impl Load {
+    /// The groom, with what was repaired (`None` when strict).
+    pub(crate) fn build(
+        self,
+        positions: Vec<Vec3>,
+        points_per_strand: &[u32],
+        attributes: Attributes,
+    ) -> Result<(Groom, Option<Repairs>)> {
+        match self {
+            Load::Strict => Ok((Groom::with_attributes(positions, points_per_strand, attributes)?, None)),
+            Load::Repair => {
+                let (groom, repairs) = Groom::repaired(positions, points_per_strand, attributes)?;
+                Ok((groom, Some(repairs)))
+            }
+        }
+    }
+}
+
+impl Groom {
+    /// A groom from concatenated positions, per-strand point counts and optional
+    /// attributes, repairing what can be repaired (see the module docs of
+    /// `groom::repair`); [`Groom::with_attributes`] refuses instead. Errors: point
+    /// counts that do not add up, attribute arrays of the wrong length, too many
+    /// strands or points, a bounding box too large for f32, nothing left.
+    pub fn repaired(
+        positions: Vec<Vec3>,
+        points_per_strand: &[u32],
+        attributes: Attributes,
+    ) -> Result<(Groom, Repairs)> {
+        let total: u64 = points_per_strand.iter().map(|&n| u64::from(n)).sum();
+        if total != positions.len() as u64 {
+            return Err(Error::AttributeLength {
+                what: "positions",
+                expected: total as usize,
+                actual: positions.len(),
+            });
+        }
+        let check = |what, len: Option<usize>| match len {
+            Some(actual) if actual != positions.len() => {
+                Err(Error::AttributeLength { what, expected: positions.len(), actual })
+            }
+            _ => Ok(()),
+        };
+        check("thickness", attributes.thickness.as_ref().map(Vec::len))?;
+        check("transparency", attributes.transparency.as_ref().map(Vec::len))?;
+        check("colors", attributes.colors.as_ref().map(Vec::len))?;
+        let finite = |i: usize| {
+            positions[i].is_finite()
+                && attributes.thickness.as_ref().is_none_or(|t| t[i].is_finite())
+                && attributes.transparency.as_ref().is_none_or(|t| t[i].is_finite())
+                && attributes.colors.as_ref().is_none_or(|c| c[i].is_finite())
+        };
+        let mut repairs = Repairs::default();
+        let mut strands = Vec::new(); // (strand, first point) of finite strands with 2+ points
+        let mut start = 0usize;
+        for (strand, &n) in points_per_strand.iter().enumerate() {
+            let range = start..start + n as usize;
+            start = range.end;
+            if n < 2 {
+                repairs.short_strands += 1;
+            } else if !range.clone().all(finite) {
+                repairs.non_finite_strands += 1;
+            } else {
+                strands.push((strand, range));
+            }
+        }
+        if strands.is_empty() {
+            return Err(Error::EmptyGroom);
+        }
+        let (lo, hi) = strands
+            .iter()
+            .flat_map(|(_, r)| positions[r.clone()].iter())
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        super::check_extent(lo, hi)?;
+        let min_segment = (hi - lo).length() * MIN_SEGMENT_FRACTION;
+        let mut counts = Vec::with_capacity(strands.len());
+        for (strand, range) in strands {
+            let first = range.start;
+            let mut kept = vec![first];
+            for i in range.skip(1) {
+                let last = positions[*kept.last().unwrap_or(&first)];
+                let length = (positions[i] - last).length();
+                if length <= min_segment || length == 0.0 {
+                    repairs.zero_length_segments += 1;
+                } else {
+                    kept.push(i);
+                }
+            }
+            if kept.len() < 2 {
+                repairs.short_strands += 1;
+                continue;
+            }
+            counts.push(kept.len() as u32);
+            repairs.kept_strands.push(strand);
+            repairs.kept_points.extend(kept);
+        }
+        if counts.is_empty() {
+            return Err(Error::EmptyGroom);
+        }
+        let pick = |v: &Vec<f32>| repairs.kept_points.iter().map(|&i| v[i]).collect();
+        let attributes = Attributes {
+            thickness: attributes.thickness.as_ref().map(pick),
+            transparency: attributes.transparency.as_ref().map(pick),
+            colors: attributes.colors.as_ref().map(|c| repairs.kept_points.iter().map(|&i| c[i]).collect()),
+        };
+        let positions = repairs.kept_points.iter().map(|&i| positions[i]).collect();
+        let groom = Groom::with_attributes(positions, &counts, attributes)?;
+        Ok((groom, repairs))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(n: usize, x: f32) -> Vec<Vec3> {
+        (0..n).map(|i| Vec3::new(x, -0.01 * i as f32, 0.0)).collect()
+    }
+
+    #[test]
+    fn drops_what_the_strict_constructor_refuses_and_counts_it() {
+        let mut doubled = line(4, 0.0);
+        doubled.insert(2, doubled[1]); // one zero-length segment
+        let mut nan = line(3, 0.1);
+        nan[1].y = f32::NAN;
+        let collapsed = vec![Vec3::new(0.2, 0.0, 0.0); 3]; // nothing left but the root
+        let strands = [line(3, 0.3), doubled, nan, collapsed, vec![Vec3::new(0.4, 0.0, 0.0)]];
+        let counts: Vec<u32> = strands.iter().map(|s| s.len() as u32).collect();
+        let positions = strands.concat();
+        let strict = Groom::new(positions.clone(), &counts);
+        assert!(strict.is_err(), "the strict constructor refuses these strands");
+        let (groom, repairs) = Groom::repaired(positions, &counts, Attributes::default()).expect("repaired");
+        assert_eq!(
+            (repairs.non_finite_strands, repairs.zero_length_segments, repairs.short_strands),
+            (1, 3, 2),
+            "{repairs}"
+        );
+        assert_eq!(groom.strand_count(), 2);
+        assert_eq!(groom.strand(1), &line(4, 0.0)[..], "the duplicate point is gone, the rest kept in order");
+        assert_eq!(repairs.kept_strands(), &[0, 1]);
+        assert_eq!(
+            repairs.to_string(),
+            "dropped 1 strand with NaN or infinite values, 3 zero-length segments, 2 strands with fewer than two points"
+        );
+    }
+
+    #[test]
+    fn a_clean_groom_passes_unchanged() {
+        let strands = [line(5, 0.0), line(3, 0.1)];
+        let counts = [5, 3];
+        let (groom, repairs) = Groom::repaired(strands.concat(), &counts, Attributes::default()).expect("clean");
+        assert!(repairs.is_empty());
+        assert_eq!(groom, Groom::new(strands.concat(), &counts).expect("strict"));
+    }
+
+    #[test]
+    fn an_overflowing_bounding_box_is_named_as_such() {
+        let strands = [vec![Vec3::new(-3e38, 0.0, 0.0), Vec3::new(3e38, 0.0, 0.0)]];
+        for result in [
+            Groom::new(strands.concat(), &[2]).map(drop),
+            Groom::repaired(strands.concat(), &[2], Attributes::default()).map(drop),
+        ] {
+            match result {
+                Err(e @ Error::GroomExtent { .. }) => assert!(e.to_string().contains("overflows"), "{e}"),
+                other => panic!("expected GroomExtent, got {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn nothing_left_is_an_empty_groom() {
+        let positions = vec![Vec3::NAN, Vec3::ZERO];
+        assert!(matches!(Groom::repaired(positions, &[2], Attributes::default()), Err(Error::EmptyGroom)));
+    }
+}

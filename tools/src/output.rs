@@ -1,0 +1,171 @@
+//! Where the tool's output goes: standard output that a closed pipe or a full
+//! disk cannot crash, PNG files written whole or not at all, and frames encoded
+//! on a worker thread while the GPU renders the next ones.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::thread::JoinHandle;
+
+use vkhair::files::write_atomic;
+
+pub type Error = Box<dyn std::error::Error + Send + Sync>;
+
+/// `println!` that never panics: a closed pipe ends the program as it does any
+/// Unix tool (SIGPIPE, see [`restore_sigpipe`]); any other failure (a full disk)
+/// is reported on stderr with exit status 1.
+#[macro_export]
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stdout(), $($arg)*) {
+            $crate::output::stdout_failed(e);
+        }
+    }};
+}
+
+/// Ends the program after a failed write to standard output.
+pub fn stdout_failed(e: std::io::Error) -> ! {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(141);
+    }
+    eprintln!("vkhair: standard output: {e}");
+    std::process::exit(1)
+}
+
+/// Lets a write to a closed pipe end the program quietly, as with any Unix
+/// tool (Rust's runtime ignores SIGPIPE and turns it into an error).
+pub fn restore_sigpipe() {
+    // SAFETY: setting a signal's disposition to the default has no preconditions;
+    // it runs before any other thread exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
+/// Smallest image side the tool renders: below it neither the frames nor the
+/// contact sheet (frames halved) would be useful images.
+pub const MIN_IMAGE_SIDE: u32 = 16;
+
+/// An RGBA8 image as PNG bytes.
+pub fn encode_png(width: u32, height: u32, rgba: &[u8]) -> Result<Vec<u8>, Error> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, width, height);
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    encoder.write_header()?.write_image_data(rgba)?;
+    Ok(bytes)
+}
+
+/// Writes an RGBA8 image as a PNG file, whole or not at all.
+pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<(), Error> {
+    write_atomic(path, &encode_png(width, height, rgba)?)?;
+    Ok(())
+}
+
+/// Frames of the contact sheet: all of them up to 12, else 12 spread evenly.
+pub fn sheet_picks(frames: usize) -> Vec<usize> {
+    if frames <= 12 {
+        (0..frames).collect()
+    } else {
+        (0..12).map(|i| i * (frames - 1) / 11).collect()
+    }
+}
+
+/// An image halved in both directions (2 × 2 box filter).
+fn halve(rgba: &[u8], width: u32, height: u32) -> Vec<u8> {
+    let (tw, th) = (width / 2, height / 2);
+    let mut out = vec![0u8; (tw * th * 4) as usize];
+    for y in 0..th {
+        for x in 0..tw {
+            for c in 0..4 {
+                let at = |dx: u32, dy: u32| u32::from(rgba[(((2 * y + dy) * width + 2 * x + dx) * 4 + c) as usize]);
+                let v = (at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1) + 2) / 4;
+                out[((y * tw + x) * 4 + c) as usize] = v as u8;
+            }
+        }
+    }
+    out
+}
+
+/// The halved picks on a sheet of up to 4 columns.
+fn sheet(thumbs: &[Vec<u8>], tw: u32, th: u32) -> (u32, u32, Vec<u8>) {
+    let cols = 4u32.min(thumbs.len() as u32).max(1);
+    let rows = (thumbs.len() as u32).div_ceil(cols).max(1);
+    let (sw, sh) = (cols * tw, rows * th);
+    let mut out = vec![0u8; (sw * sh * 4) as usize];
+    for (k, thumb) in thumbs.iter().enumerate() {
+        let (ox, oy) = ((k as u32 % cols) * tw, (k as u32 / cols) * th);
+        for y in 0..th {
+            let src = &thumb[(y * tw * 4) as usize..((y + 1) * tw * 4) as usize];
+            let at = (((oy + y) * sw + ox) * 4) as usize;
+            out[at..at + src.len()].copy_from_slice(src);
+        }
+    }
+    (sw, sh, out)
+}
+
+/// Writes frames as `frame_NNNN.png` on a worker thread and keeps only the
+/// halved frames the contact sheet needs: memory does not grow with the frame
+/// count. At most two frames wait for the worker; the renderer blocks beyond.
+pub struct FrameSink {
+    sender: Option<mpsc::SyncSender<(usize, Vec<u8>)>>,
+    /// Frames' memory the worker is done with, for the next frames.
+    recycled: mpsc::Receiver<Vec<u8>>,
+    worker: Option<JoinHandle<Result<Vec<Vec<u8>>, Error>>>,
+    width: u32,
+    height: u32,
+    dir: PathBuf,
+}
+
+impl FrameSink {
+    /// A sink for `frames` frames of `width` × `height` into `dir`.
+    pub fn new(dir: &Path, width: u32, height: u32, frames: usize) -> FrameSink {
+        let (sender, receiver) = mpsc::sync_channel::<(usize, Vec<u8>)>(2);
+        let (give_back, recycled) = mpsc::sync_channel::<Vec<u8>>(3);
+        let picks = sheet_picks(frames);
+        let out = dir.to_path_buf();
+        let worker = std::thread::spawn(move || {
+            let mut thumbs = Vec::new();
+            for (index, rgba) in receiver {
+                write_png(&out.join(format!("frame_{index:04}.png")), width, height, &rgba)?;
+                if picks.contains(&index) {
+                    thumbs.push(halve(&rgba, width, height));
+                }
+                let _ = give_back.try_send(rgba); // dropped when nobody takes it
+            }
+            Ok(thumbs)
+        });
+        FrameSink { sender: Some(sender), recycled, worker: Some(worker), width, height, dir: dir.to_path_buf() }
+    }
+
+    /// Memory for the next frame: a written frame's, or new.
+    pub fn buffer(&self) -> Vec<u8> {
+        self.recycled.try_recv().unwrap_or_default()
+    }
+
+    /// Hands frame `index` to the worker. A worker that has failed reports its
+    /// error here or from [`FrameSink::finish`].
+    pub fn push(&mut self, index: usize, rgba: Vec<u8>) -> Result<(), Error> {
+        let sent = self.sender.as_ref().map(|s| s.send((index, rgba)));
+        match sent {
+            Some(Ok(())) => Ok(()),
+            _ => self.join().map(drop),
+        }
+    }
+
+    /// Waits for the worker and writes `contact_sheet.png`.
+    pub fn finish(mut self) -> Result<(), Error> {
+        let thumbs = self.join()?;
+        let (sw, sh, pixels) = sheet(&thumbs, self.width / 2, self.height / 2);
+        write_png(&self.dir.join("contact_sheet.png"), sw, sh, &pixels)
+    }
+
+    fn join(&mut self) -> Result<Vec<Vec<u8>>, Error> {
+        self.sender = None;
+        match self.worker.take() {
+            Some(worker) => worker.join().map_err(|_| Error::from("the frame writer stopped unexpectedly"))?,
+            None => Err("the frame writer already stopped".into()),
+        }
+    }
+}

@@ -1,0 +1,218 @@
+//! What the user gives the tool: grooms of any size framed in the picture,
+//! options that need others, defective real assets, and the messages for each.
+
+mod common;
+
+use std::time::Duration;
+
+use common::run;
+use glam::Vec3;
+
+const LIMIT: Duration = Duration::from_secs(300);
+
+/// Renders frame 0 of `groom` at 160 × 120 and returns the share of the image
+/// that is not background.
+fn coverage_of(dir: &std::path::Path, groom: &std::path::Path) -> f64 {
+    let out = dir.join(format!("{}-frames", groom.file_stem().and_then(|s| s.to_str()).unwrap_or("g")));
+    run(
+        &[
+            "render",
+            "--input",
+            groom.to_str().expect("utf-8"),
+            "--frames",
+            "1",
+            "--width",
+            "160",
+            "--height",
+            "120",
+            "--shadow-resolution",
+            "64",
+            "--out",
+            out.to_str().expect("utf-8"),
+        ],
+        LIMIT,
+    )
+    .assert_ok();
+    let (_, _, rgba) = common::read_png(&out.join("frame_0000.png"));
+    common::coverage(&rgba)
+}
+
+/// The camera frames the groom: a 5-unit groom and a 1-cm groom both cover
+/// between 5 % and 80 % of the image (the thesis camera flooded the first).
+#[test]
+fn grooms_of_any_size_are_framed() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for (name, radius) in [("five_units", 1.6), ("one_cm", 0.003), ("head_size", 0.1)] {
+        let groom = dir.path().join(format!("{name}.hair"));
+        common::write_groom(&groom, &common::cap_groom(150, 8, radius));
+        let covered = coverage_of(dir.path(), &groom);
+        eprintln!("{name}: {:.1} % of the image", 100.0 * covered);
+        assert!((0.05..=0.8).contains(&covered), "{name}: the groom covers {:.1} % of the image", 100.0 * covered);
+    }
+}
+
+/// A flat groom (every root in one plane) gets a stand-in head and renders.
+#[test]
+fn a_flat_groom_renders() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let strands: Vec<Vec<Vec3>> = (0..60)
+        .map(|i| {
+            let x = 0.004 * i as f32;
+            (0..6).map(|k| Vec3::new(x, -0.02 * k as f32, 0.0)).collect()
+        })
+        .collect();
+    let groom = dir.path().join("flat.hair");
+    common::write_groom(&groom, &strands);
+    let covered = coverage_of(dir.path(), &groom);
+    assert!(covered > 0.01, "the flat groom covers {:.2} % of the image", 100.0 * covered);
+}
+
+/// Options that mean something only with others are refused, saying what they
+/// need, before any GPU work.
+#[test]
+fn options_that_need_others_say_so() {
+    let cases: &[(&[&str], &str)] = &[
+        (&["render", "--obj", "head.obj"], "--obj needs --input"),
+        (&["render", "--scale", "0.01"], "--scale needs --input"),
+        (&["render", "--points", "8"], "--points needs --input"),
+        (&["render", "--strict"], "--strict needs --input"),
+        (&["render", "--hand-off", "staging"], "--hand-off needs --schedule second-device"),
+        (&["render", "--sim-device", "llvmpipe"], "--sim-device needs --schedule second-device"),
+        (&["render", "--no-mesh-collider"], "--no-mesh-collider needs --input and --obj"),
+        (&["simulate", "--obj", "head.obj"], "--obj needs --input"),
+        (&["simulate", "--scale", "0.01"], "--scale needs --input"),
+        (&["simulate", "--points", "8"], "--points needs --input"),
+        (&["simulate", "--no-mesh-collider"], "--no-mesh-collider needs --obj"),
+    ];
+    for (args, message) in cases {
+        let out = run(args, LIMIT);
+        out.assert_error(message);
+        assert!(!out.stdout.contains("key hairs"), "{args:?} started GPU work: {}", out.stdout);
+    }
+}
+
+/// Values out of range name their option; library functions are never suggested.
+#[test]
+fn bad_values_name_their_option() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let groom = dir.path().join("g.hair");
+    common::write_groom(&groom, &common::cap_groom(20, 6, 0.1));
+    let g = groom.to_str().expect("utf-8");
+    let cases: &[(&[&str], &str)] = &[
+        (&["render", "--input", g, "--scale", "nan"], "--scale must be a finite number above 0 (got NaN)"),
+        (&["simulate", "--input", g, "--scale=-1"], "--scale must be a finite number above 0 (got -1)"),
+        (&["simulate", "--input", g, "--points", "100"], "--points must be 2..=64 (got 100)"),
+        (&["render", "--input", g, "--points", "1"], "--points must be 2..=64 (got 1)"),
+        (&["render", "--distance", "inf"], "--distance must be a finite number above 0"),
+        (&["render", "--frames", "0"], "--frames must be at least 1"),
+        (&["simulate", "--steps", "0"], "--steps must be at least 1"),
+    ];
+    for (args, message) in cases {
+        let out = run(args, LIMIT);
+        out.assert_error(message);
+        assert!(!out.stderr.contains("Groom::") && !out.stdout.contains("NaN ms"), "{args:?}: {}", out.stderr);
+    }
+}
+
+/// Reading errors name the file and say what is wrong with it.
+#[test]
+fn file_errors_name_the_file_and_the_problem() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let missing = dir.path().join("no-such.hair");
+    run(&["inspect", missing.to_str().expect("utf-8")], LIMIT).assert_error("no-such.hair");
+    let groom = dir.path().join("g.hair");
+    common::write_groom(&groom, &common::cap_groom(20, 6, 0.1));
+    let binary = dir.path().join("head.obj");
+    std::fs::write(&binary, [b'v', b' ', 0xff, 0xfe, 0x00, 0x13]).expect("write");
+    let out =
+        run(&["render", "--input", groom.to_str().expect("utf-8"), "--obj", binary.to_str().expect("utf-8")], LIMIT);
+    out.assert_error("head.obj");
+    out.assert_error("not UTF-8 text");
+    // A groom whose bounding box overflows f32 is reported as such.
+    let huge = dir.path().join("huge.hair");
+    let strands = vec![
+        vec![Vec3::new(-3e38, 0.0, 0.0), Vec3::new(-1e38, 0.0, 0.0)],
+        vec![Vec3::new(3e38, 0.0, 0.0), Vec3::new(2e38, 1e38, 0.0)],
+    ];
+    std::fs::write(&huge, huge_hair_bytes(&strands)).expect("write");
+    run(&["inspect", huge.to_str().expect("utf-8")], LIMIT).assert_error("overflows f32");
+}
+
+/// A `.hair` file written byte by byte (the library refuses to build such grooms).
+fn huge_hair_bytes(strands: &[Vec<Vec3>]) -> Vec<u8> {
+    let points: usize = strands.iter().map(Vec::len).sum();
+    let mut b = b"HAIR".to_vec();
+    for v in [strands.len() as u32, points as u32, 0b11, 0] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    for v in [1.0f32, 0.0, 1.0, 1.0, 1.0] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b.extend_from_slice(&[0u8; 88]);
+    for s in strands {
+        b.extend_from_slice(&(s.len() as u16 - 1).to_le_bytes());
+    }
+    for p in strands.iter().flatten() {
+        for v in p.to_array() {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    b
+}
+
+/// A TressFX file with one zero-length segment (as TressFX's own `mohawk.tfx`):
+/// repaired with a warning that counts what was dropped, refused with --strict.
+#[test]
+fn a_degenerate_strand_is_repaired_with_a_warning_or_refused_when_strict() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let tfx = dir.path().join("mohawk.tfx");
+    let (strands, per) = (40u32, 6u32);
+    let mut positions: Vec<[f32; 4]> = (0..strands)
+        .flat_map(|s| {
+            (0..per).map(move |k| [0.01 * s as f32, 0.1 + 0.02 * k as f32, 0.0, if k == 0 { 0.0 } else { 1.0 }])
+        })
+        .collect();
+    positions[(35 * per + 1) as usize] = positions[(35 * per) as usize]; // strand 35, segment 0
+    let mut bytes = 4.0f32.to_le_bytes().to_vec();
+    for v in [strands, per, 160, 0, 0, 0, 0] {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    bytes.resize(160, 0);
+    for p in &positions {
+        for v in p {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    std::fs::write(&tfx, bytes).expect("write");
+    let path = tfx.to_str().expect("utf-8");
+    let out = run(&["inspect", path], LIMIT);
+    out.assert_ok();
+    assert!(out.stderr.contains("warning") && out.stderr.contains("dropped 1 zero-length segment"), "{}", out.stderr);
+    assert!(out.stderr.contains("40 strands remain"), "{}", out.stderr);
+    assert!(out.stdout.contains("strands            40"), "{}", out.stdout);
+    let out = run(&["inspect", path, "--strict"], LIMIT);
+    out.assert_error("strand 35 segment 0 has zero length");
+    out.assert_error("--strict");
+    let frames = dir.path().join("frames");
+    let out = run(
+        &[
+            "render",
+            "--input",
+            path,
+            "--frames",
+            "1",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--shadow-resolution",
+            "32",
+            "--out",
+            frames.to_str().expect("utf-8"),
+        ],
+        LIMIT,
+    );
+    out.assert_ok();
+    assert!(out.stderr.contains("dropped 1 zero-length segment"), "{}", out.stderr);
+    run(&["simulate", "--input", path, "--strict", "--steps", "1"], LIMIT).assert_error("zero length");
+}

@@ -1,0 +1,167 @@
+//! Where the tool's output goes when things go wrong: a closed pipe, a full
+//! device, a killed run, absurd figures in a CSV, tiny images.
+
+mod common;
+
+use std::os::unix::process::ExitStatusExt;
+use std::path::Path;
+use std::process::Stdio;
+use std::time::{Duration, Instant};
+
+use common::{run, vkhair};
+
+const LIMIT: Duration = Duration::from_secs(300);
+
+/// A closed standard output ends the program quietly, as `head` expects: killed
+/// by SIGPIPE (or exit status 141), no panic, nothing on stderr.
+#[test]
+fn a_closed_pipe_ends_the_program_quietly() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let groom = dir.path().join("g.hair");
+    common::write_groom(&groom, &common::cap_groom(20, 6, 0.1));
+    let out = dir.path().join("frames");
+    let cases: Vec<Vec<String>> = vec![
+        vec!["inspect".into(), groom.display().to_string()],
+        vec!["config".into()],
+        vec!["devices".into()],
+        vec![
+            "render".into(),
+            "--frames".into(),
+            "1".into(),
+            "--width".into(),
+            "32".into(),
+            "--height".into(),
+            "24".into(),
+            "--shadow-resolution".into(),
+            "32".into(),
+            "--out".into(),
+            out.display().to_string(),
+        ],
+    ];
+    for args in cases {
+        // The reading end is closed before the program writes its first line.
+        let mut child =
+            vkhair().args(&args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("start vkhair");
+        drop(child.stdout.take());
+        let output = child.wait_with_output().expect("wait");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        let quiet = output.status.signal() == Some(libc::SIGPIPE) || output.status.code() == Some(141);
+        assert!(quiet, "{args:?}: {:?}\n{stderr}", output.status);
+        assert!(!stderr.contains("panicked") && !stderr.contains("Broken pipe"), "{args:?}: {stderr}");
+    }
+}
+
+/// A full disk: standard output to /dev/full is an error naming standard output;
+/// a file written to /dev/full is an error naming the file (and the device stays
+/// a device).
+#[test]
+fn a_full_device_is_an_error_naming_what_was_written() {
+    let full = Path::new("/dev/full");
+    if !full.exists() {
+        eprintln!("SKIPPED: this system has no /dev/full");
+        return;
+    }
+    let stdout = std::fs::OpenOptions::new().write(true).open(full).expect("open /dev/full");
+    let out = vkhair().arg("config").stdout(stdout).stderr(Stdio::piped()).output().expect("run");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("standard output") && stderr.contains("No space left"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for args in [vec!["grow", "--strands", "10", "--out", "/dev/full"], vec!["convert", "--out", "/dev/full", "GROOM"]]
+    {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let groom = dir.path().join("g.hair");
+        common::write_groom(&groom, &common::cap_groom(10, 6, 0.1));
+        let args: Vec<&str> =
+            args.iter().map(|a| if *a == "GROOM" { groom.to_str().expect("utf-8") } else { a }).collect();
+        run(&args, LIMIT).assert_error("/dev/full");
+        assert!(!std::fs::metadata(full).expect("still there").file_type().is_file(), "/dev/full was replaced");
+    }
+}
+
+/// A killed render leaves every frame it wrote whole: each `frame_*.png` there
+/// decodes completely.
+#[test]
+fn a_killed_render_leaves_only_whole_frames() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("frames");
+    let mut child = vkhair()
+        .args(["render", "--frames", "400", "--width", "320", "--height", "240", "--shadow-resolution", "64", "--out"])
+        .arg(&out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("start vkhair");
+    let start = Instant::now();
+    let frames = |out: &Path| -> Vec<std::path::PathBuf> {
+        let Ok(list) = std::fs::read_dir(out) else { return Vec::new() };
+        let mut v: Vec<_> = list
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("frame_")))
+            .collect();
+        v.sort();
+        v
+    };
+    while frames(&out).len() < 3 && start.elapsed() < LIMIT {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().expect("kill");
+    child.wait().expect("wait");
+    let written = frames(&out);
+    assert!(written.len() >= 3, "the render wrote {} frames before the time limit", written.len());
+    for path in &written {
+        let (w, h, _) = common::read_png(path);
+        assert_eq!((w, h), (320, 240), "{}", path.display());
+    }
+}
+
+/// Sizes too small for an image (or for the half-size contact sheet) are refused
+/// before any GPU work, and no file is written.
+#[test]
+fn tiny_images_are_refused_with_a_clear_message() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("frames");
+    for (w, h) in [("1", "480"), ("640", "15")] {
+        run(&["render", "--width", w, "--height", h, "--out", out.to_str().expect("utf-8")], LIMIT)
+            .assert_error("--width and --height must be at least 16 pixels");
+        assert!(!out.exists(), "a refused render created its output folder");
+    }
+    // The smallest size allowed gives valid images, the contact sheet included.
+    let ok = ["render", "--width", "16", "--height", "16", "--frames", "2", "--shadow-resolution", "16", "--out"];
+    let mut args = ok.to_vec();
+    args.push(out.to_str().expect("utf-8"));
+    run(&args, LIMIT).assert_ok();
+    assert_eq!(common::read_png(&out.join("contact_sheet.png")).0, 16);
+    assert_eq!(common::read_png(&out.join("frame_0001.png")).0, 16);
+}
+
+/// `plot` with infinite or absurd figures is an error naming the row and the
+/// column, within a time limit, and writes no PNG.
+#[test]
+fn plot_refuses_absurd_figures_quickly_and_writes_nothing() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let header = "width,height,distance_m,segments,total_ms,ssaa";
+    for (value, shown) in [("inf", "inf"), ("1e308", "1e308"), ("NaN", "NaN"), ("-1e300", "-1e300")] {
+        let csv = dir.path().join("render.csv");
+        std::fs::write(&csv, format!("{header}\n640,480,0.5,1000,2.5,0\n640,480,1.0,800,{value},0\n")).expect("csv");
+        let started = Instant::now();
+        let out = run(&["plot", csv.to_str().expect("utf-8")], Duration::from_secs(30));
+        out.assert_error(&format!("line 3, column \"total_ms\": {shown} is not a plottable figure"));
+        assert!(started.elapsed() < Duration::from_secs(30));
+        assert!(!csv.with_extension("png").exists(), "a failed plot left a PNG behind");
+    }
+    // Messages are sentences, not Debug dumps.
+    let csv = dir.path().join("other.csv");
+    std::fs::write(&csv, "a,b\n1,2\n").expect("csv");
+    let out = run(&["plot", csv.to_str().expect("utf-8")], Duration::from_secs(30));
+    out.assert_error("has no column \"width\"");
+    assert!(!out.stderr.contains("Err(") && !out.stderr.contains("{ "), "{}", out.stderr);
+    let out = run(&["plot", dir.path().join("missing.csv").to_str().expect("utf-8")], Duration::from_secs(30));
+    out.assert_error("cannot read");
+    assert!(out.stderr.contains("missing.csv") && !out.stderr.contains("Os {"), "{}", out.stderr);
+    // And a good CSV gives a whole PNG.
+    let csv = dir.path().join("good.csv");
+    std::fs::write(&csv, format!("{header}\n640,480,0.5,1000,2.5,0\n640,480,1.0,800,1.5,0\n")).expect("csv");
+    run(&["plot", csv.to_str().expect("utf-8")], Duration::from_secs(60)).assert_ok();
+    assert_eq!(common::read_png(&csv.with_extension("png")).0, 1100);
+}

@@ -1,0 +1,65 @@
+//! `vkhair simulate` as a user meets it: a --check that states its tolerance and
+//! holds the README's promises, progress on long runs, the violent motion.
+
+mod common;
+
+use std::process::Command;
+use std::time::Duration;
+
+use common::run;
+
+const LIMIT: Duration = Duration::from_secs(600);
+
+/// Without FLIP (volume off, density friction) the GPU and the CPU reference
+/// agree bit for bit on lavapipe, as the README says; with FLIP single steps
+/// agree within the stated tolerance. Each run states the tolerance.
+#[test]
+fn check_states_its_tolerance_and_holds_the_readme_promises() {
+    for (volume, whole_run) in [("off", true), ("friction", true), ("flip", false)] {
+        let out = run(&["simulate", "--steps", "20", "--grid", "16", "--volume", volume, "--check"], LIMIT);
+        out.assert_ok();
+        assert!(out.stdout.contains("(tolerance 1e-5 m)"), "{volume}: {}", out.stdout);
+        let lavapipe = out.stdout.contains("llvmpipe");
+        if whole_run {
+            let line = out.stdout.lines().find(|l| l.contains("the whole run")).expect("whole-run line");
+            if lavapipe {
+                assert!(line.contains("0 (bit for bit)"), "{volume}: {line}");
+            } else {
+                eprintln!("not lavapipe: {line}");
+            }
+        } else {
+            assert!(!out.stdout.contains("the whole run"), "{}", out.stdout);
+        }
+        // A friction run has no pressure solve to call unconverged.
+        if volume == "friction" {
+            assert!(
+                out.stdout.contains("no pressure solve") && !out.stdout.contains("not converged"),
+                "{}",
+                out.stdout
+            );
+        }
+    }
+}
+
+/// The violent motion exists for soak runs and stays finite.
+#[test]
+fn violent_motion_runs() {
+    let out = run(&["simulate", "--steps", "30", "--motion", "violent", "--volume", "off"], LIMIT);
+    out.assert_ok();
+    assert!(out.stdout.contains("tip drift from rest") && !out.stdout.contains("NaN"), "{}", out.stdout);
+}
+
+/// On a terminal, a long run shows a progress bar with an ETA (`script` gives
+/// the program a terminal).
+#[test]
+fn long_runs_show_progress_on_a_terminal() {
+    let Ok(status) = Command::new("script").arg("--version").output() else {
+        eprintln!("SKIPPED: no `script` (bsdutils) to give the program a terminal");
+        return;
+    };
+    assert!(status.status.success());
+    let command = format!("{} simulate --steps 120 --volume off", env!("CARGO_BIN_EXE_vkhair"));
+    let out = common::run_command(Command::new("script").args(["-qec", &command, "/dev/null"]), LIMIT);
+    assert!(out.status.success(), "{}{}", out.stdout, out.stderr);
+    assert!(out.stdout.contains("steps") && out.stdout.contains("(eta "), "no progress bar:\n{}", out.stdout);
+}
