@@ -1,7 +1,7 @@
 //! Reading the groom a user gives: `.hair` or `.tfx`, repaired unless `--strict`
 //! (with a warning that counts what was dropped), scaled and resampled.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use vkhair::groom::cyhair::HairFile;
@@ -9,6 +9,84 @@ use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::{Groom, Repairs};
 
 use crate::output::Error;
+
+/// The groom and character mesh a user gives `render` and `simulate`.
+#[derive(clap::Args)]
+pub struct InputArgs {
+    /// Groom file (.hair or .tfx) instead of the `thesis` scene (its groom, head
+    /// and colliders); it holds its authored style (a shape constraint over the
+    /// whole strand and a sag-free rest state) unless --config says otherwise.
+    #[arg(long)]
+    pub input: Option<PathBuf>,
+    /// Character mesh (OBJ, the groom's units and frame): the strands collide with
+    /// its signed distance field; `render` draws it and frames the camera by it.
+    #[arg(long)]
+    pub obj: Option<PathBuf>,
+    /// Do not collide with the --obj mesh (`render` still draws it, `simulate`
+    /// still counts the points inside it).
+    #[arg(long)]
+    pub no_mesh_collider: bool,
+    /// Multiply input positions (groom and mesh) by this (0.01: Blender units →
+    /// m) [default: 1].
+    #[arg(long)]
+    pub scale: Option<f32>,
+    /// Resample input strands to this many points (2..=64) [default: 16].
+    #[arg(long)]
+    pub points: Option<usize>,
+    /// Refuse an --input file with defects (zero-length segments, NaN or infinite
+    /// values, strands of fewer than two points) instead of dropping them with a
+    /// warning.
+    #[arg(long)]
+    pub strict: bool,
+}
+
+impl InputArgs {
+    /// Options that need others and values out of range, as errors that say so.
+    pub fn check(&self) -> Result<(), String> {
+        if self.input.is_none() {
+            let given = [
+                ("--obj", self.obj.is_some()),
+                ("--scale", self.scale.is_some()),
+                ("--points", self.points.is_some()),
+                ("--strict", self.strict),
+            ];
+            if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
+                return Err(format!(
+                    "{flag} needs --input (the thesis scene brings its own groom, head and colliders)"
+                ));
+            }
+        }
+        if self.no_mesh_collider && self.obj.is_none() {
+            return Err("--no-mesh-collider needs --obj (there is no mesh to collide with)".into());
+        }
+        if let Some(scale) = self.scale {
+            if !(scale.is_finite() && scale > 0.0) {
+                return Err(format!("--scale must be a finite number above 0 (got {scale})"));
+            }
+        }
+        if let Some(points) = self.points {
+            if !(2..=64).contains(&points) {
+                return Err(format!("--points must be 2..=64 (got {points})"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The --scale factor.
+    pub fn scale(&self) -> f32 {
+        self.scale.unwrap_or(1.0)
+    }
+
+    /// The --input groom, scaled and resampled (see [`load_scaled`]).
+    pub fn groom(&self, path: &Path) -> Result<Groom, Error> {
+        load_scaled(path, self.strict, self.scale(), self.points.unwrap_or(16))
+    }
+
+    /// Whether the strands collide with the --obj mesh.
+    pub fn colliding(&self) -> bool {
+        self.input.is_some() && self.obj.is_some() && !self.no_mesh_collider
+    }
+}
 
 /// The groom in `path` and a description of its format. Defects that can be
 /// repaired are (with a warning on stderr) unless `strict`; then the file is

@@ -14,7 +14,7 @@ use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, Schedu
 use vkhair::sim::{motion, Collider, RigidTransform, SimParams, VolumeMode, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
-use crate::groom_input::load_scaled;
+use crate::groom_input::InputArgs;
 use crate::output::{Error, FrameSink, MIN_IMAGE_SIDE};
 use crate::profile::{host_now_ns, Profile};
 use crate::say;
@@ -58,29 +58,8 @@ pub struct RenderArgs {
     /// Output folder for frame PNGs and the contact sheet.
     #[arg(long, default_value = "out")]
     out: PathBuf,
-    /// Groom file (.hair or .tfx) instead of the `thesis` scene; it is held in its
-    /// authored style unless --config says otherwise (see `SimParams::styled`).
-    #[arg(long)]
-    input: Option<PathBuf>,
-    /// Head mesh (OBJ) to draw, to place the camera by and (with --input) for the
-    /// strands to collide with through its signed distance field.
-    #[arg(long)]
-    obj: Option<PathBuf>,
-    /// Draw the --obj mesh but do not collide with it.
-    #[arg(long)]
-    no_mesh_collider: bool,
-    /// Multiply input positions (groom and mesh) by this (0.01: Blender units → m)
-    /// [default: 1].
-    #[arg(long)]
-    scale: Option<f32>,
-    /// Resample input strands to this many points (2..=64) [default: 16].
-    #[arg(long)]
-    points: Option<usize>,
-    /// Refuse an --input file with defects (zero-length segments, NaN or infinite
-    /// values, strands of fewer than two points) instead of dropping them with a
-    /// warning.
-    #[arg(long)]
-    strict: bool,
+    #[command(flatten)]
+    input: InputArgs,
     /// Parameter file (TOML, see `vkhair config`): simulation, rendering, lights and
     /// material; the flags below win over it.
     #[arg(long)]
@@ -200,36 +179,11 @@ fn check_options(a: &RenderArgs) -> Result<(), String> {
     if a.frames == 0 {
         return Err("--frames must be at least 1".into());
     }
-    if a.input.is_none() {
-        let given = [
-            ("--obj", a.obj.is_some()),
-            ("--scale", a.scale.is_some()),
-            ("--points", a.points.is_some()),
-            ("--strict", a.strict),
-        ];
-        if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
-            return Err(format!("{flag} needs --input (the thesis scene brings its own groom and head)"));
-        }
-        if a.no_mesh_collider {
-            return Err("--no-mesh-collider needs --input and --obj".into());
-        }
-    } else if a.no_mesh_collider && a.obj.is_none() {
-        return Err("--no-mesh-collider needs --obj (there is no mesh to collide with)".into());
-    }
+    a.input.check()?;
     if a.schedule != Schedule::SecondDevice {
         let given = [("--hand-off", a.hand_off.is_some()), ("--sim-device", a.sim_device.is_some())];
         if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
             return Err(format!("{flag} needs --schedule second-device"));
-        }
-    }
-    if let Some(scale) = a.scale {
-        if !(scale.is_finite() && scale > 0.0) {
-            return Err(format!("--scale must be a finite number above 0 (got {scale})"));
-        }
-    }
-    if let Some(points) = a.points {
-        if !(2..=64).contains(&points) {
-            return Err(format!("--points must be 2..=64 (got {points})"));
         }
     }
     if let Some(d) = a.distance {
@@ -250,15 +204,15 @@ fn bounds_sphere(points: impl Iterator<Item = Vec3>) -> (Vec3, f32) {
 fn scene(a: &RenderArgs) -> Result<Scene, Error> {
     let sintel =
         |p: &Option<PathBuf>| p.as_ref().is_some_and(|p| p.to_string_lossy().to_lowercase().contains("sintel"));
-    let (groom, colliders, head_mesh, pivot, credit) = match &a.input {
+    let (groom, colliders, head_mesh, pivot, credit) = match &a.input.input {
         None => {
             let head = TriMesh::uv_sphere(THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS * 0.97, 24, 32)?;
             (scenes::thesis()?, motion::thesis_colliders(), head, Some(motion::NECK_PIVOT), None)
         }
         Some(path) => {
-            let scale = a.scale.unwrap_or(1.0);
-            let groom = load_scaled(path, a.strict, scale, a.points.unwrap_or(16))?;
-            let head_mesh = match &a.obj {
+            let scale = a.input.scale();
+            let groom = a.input.groom(path)?;
+            let head_mesh = match &a.input.obj {
                 Some(obj) => {
                     let m = TriMesh::load_obj(obj)?;
                     TriMesh::new(m.positions.iter().map(|p| *p * scale).collect(), m.triangles)?
@@ -271,7 +225,7 @@ fn scene(a: &RenderArgs) -> Result<Scene, Error> {
                     TriMesh::uv_sphere(0.5 * (lo + hi), r, 16, 24)?
                 }
             };
-            let credit = (sintel(&a.input) || sintel(&a.obj))
+            let credit = (sintel(&a.input.input) || sintel(&a.input.obj))
                 .then_some("Sintel © Blender Foundation | durian.blender.org (CC BY 3.0)");
             (groom, Vec::new(), head_mesh, None, credit)
         }
@@ -340,7 +294,7 @@ fn framing(s: &Scene, distance: Option<f32>, aspect: f32) -> Result<Camera, vkha
 /// style, [`SimParams::styled`]), then the `--config` file, then the flags given;
 /// the tool's lights when the file lists none. Checked before any GPU work.
 fn parameters(a: &RenderArgs, center: Vec3, radius: f32) -> Result<Config, vkhair::Error> {
-    let sim = if a.input.is_some() { SimParams::styled() } else { SimParams::default() };
+    let sim = if a.input.input.is_some() { SimParams::styled() } else { SimParams::default() };
     let base = Config { sim, ..Config::default() };
     let mut config = match &a.config {
         Some(path) => base.load_over(path)?,
@@ -396,7 +350,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     let options = schedule_options(a)?;
     let mut sim = FrameScheduler::new(&ctx, &s.groom, &sim_params, &RigidTransform::default(), &s.colliders, &options)?;
     say!("simulation: {} ({})", sim.mode().name(), sim.reason());
-    if a.input.is_some() && a.obj.is_some() && !a.no_mesh_collider {
+    if a.input.colliding() {
         sim.set_mesh_collider(Some(&s.head_mesh), &config.mesh_collider)?;
         say!(
             "mesh collider: {} triangles at {} grid points along the longest axis",
@@ -514,7 +468,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
         let context = serde_json::json!({
             "command": "render",
             "device": ctx.info().name,
-            "scene": a.input.as_ref().map_or("thesis".to_owned(), |p| p.display().to_string()),
+            "scene": a.input.input.as_ref().map_or("thesis".to_owned(), |p| p.display().to_string()),
             "simulation": sim.mode().name(),
             "key_hairs": strands,
             "points_per_key_hair": points,

@@ -15,29 +15,15 @@ use vkhair::sim::{
 };
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
-use crate::groom_input::load_scaled;
+use crate::groom_input::InputArgs;
 use crate::profile::{host_now_ns, Profile};
 use crate::sim_check::{percentile, share_inside, tip_drift, write_final, Reference, StepCheck};
 use crate::{say, CliResult};
 
 #[derive(clap::Args)]
 pub struct SimulateArgs {
-    /// Groom file (.hair or .tfx); default: the `thesis` scene with its colliders.
-    /// It is held in its authored style unless --config says otherwise (see
-    /// `SimParams::styled`).
-    #[arg(long)]
-    input: Option<PathBuf>,
-    /// Multiply input positions (groom and mesh) by this (0.01: Blender units →
-    /// m) [default: 1].
-    #[arg(long)]
-    scale: Option<f32>,
-    /// Resample input strands to this many points (2..=64) [default: 16].
-    #[arg(long)]
-    points: Option<usize>,
-    /// Refuse an --input file with defects instead of dropping them with a
-    /// warning (see `render --strict`).
-    #[arg(long)]
-    strict: bool,
+    #[command(flatten)]
+    input: InputArgs,
     /// Simulation steps (1/60 s each, at least 1).
     #[arg(long, default_value_t = 120)]
     steps: usize,
@@ -72,14 +58,6 @@ pub struct SimulateArgs {
     /// (for soak runs: 1.2 rad at 3 Hz with a nod and jolts of the whole head).
     #[arg(long, value_enum, default_value = "shake")]
     motion: MotionArg,
-    /// Character mesh (OBJ, same units and frame as the groom, scaled by --scale):
-    /// the strands collide with its signed distance field.
-    #[arg(long)]
-    obj: Option<PathBuf>,
-    /// Do not collide with the --obj mesh (its field still measures how many
-    /// points end up inside it).
-    #[arg(long)]
-    no_mesh_collider: bool,
     /// Write the simulated strands after the last step as a .hair file: in the
     /// input's frame (the head's motion undone) and units (--scale undone), one
     /// strand per input strand with --points points each.
@@ -128,7 +106,7 @@ enum VolumeArg {
 /// groom held in its authored style, [`SimParams::styled`]), then the `--config`
 /// file, then the flags given. Checked before any GPU work.
 fn simulate_params(a: &SimulateArgs) -> Result<Config, vkhair::Error> {
-    let sim = if a.input.is_some() { SimParams::styled() } else { SimParams::default() };
+    let sim = if a.input.input.is_some() { SimParams::styled() } else { SimParams::default() };
     let base = Config { sim: SimParams { volume: VolumeParams::flip([32, 32, 32]), ..sim }, ..Config::default() };
     let config = match &a.config {
         Some(path) => base.load_over(path)?,
@@ -182,40 +160,17 @@ fn check_options(a: &SimulateArgs) -> Result<(), String> {
     if a.steps == 0 {
         return Err("--steps must be at least 1".into());
     }
-    if a.input.is_none() {
-        let given = [
-            ("--obj", a.obj.is_some()),
-            ("--scale", a.scale.is_some()),
-            ("--points", a.points.is_some()),
-            ("--strict", a.strict),
-        ];
-        if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
-            return Err(format!("{flag} needs --input (the thesis scene brings its own groom and colliders)"));
-        }
-    }
-    if a.no_mesh_collider && a.obj.is_none() {
-        return Err("--no-mesh-collider needs --obj (there is no mesh to collide with)".into());
-    }
-    if let Some(scale) = a.scale {
-        if !(scale.is_finite() && scale > 0.0) {
-            return Err(format!("--scale must be a finite number above 0 (got {scale})"));
-        }
-    }
-    if let Some(points) = a.points {
-        if !(2..=64).contains(&points) {
-            return Err(format!("--points must be 2..=64 (got {points})"));
-        }
-    }
+    a.input.check()?;
     Ok(())
 }
 
 pub fn simulate(a: &SimulateArgs) -> CliResult {
     check_options(a)?;
-    let scale = a.scale.unwrap_or(1.0);
-    let (groom, colliders, label, pivot) = match &a.input {
+    let scale = a.input.scale();
+    let (groom, colliders, label, pivot) = match &a.input.input {
         None => (scenes::thesis()?, motion::thesis_colliders(), "thesis scene".to_owned(), motion::NECK_PIVOT),
         Some(path) => {
-            let groom = load_scaled(path, a.strict, scale, a.points.unwrap_or(16))?;
+            let groom = a.input.groom(path)?;
             // Turn about the centre of the roots' lowest level: roughly the neck.
             let (lo, hi) = groom.bounds();
             let pivot = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
@@ -224,8 +179,8 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     };
     let config = simulate_params(a)?;
     let params = config.sim.clone();
-    let mesh = load_mesh(a.obj.as_deref(), scale)?;
-    let colliding = mesh.is_some() && !a.no_mesh_collider;
+    let mesh = load_mesh(a.input.obj.as_deref(), scale)?;
+    let colliding = a.input.colliding();
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let (lo, hi) = groom.bounds();
     let size = (hi - lo).max_element();

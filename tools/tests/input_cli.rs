@@ -5,7 +5,7 @@ mod common;
 
 use std::time::Duration;
 
-use common::run;
+use common::{run, run_line};
 use glam::Vec3;
 
 const LIMIT: Duration = Duration::from_secs(300);
@@ -14,25 +14,12 @@ const LIMIT: Duration = Duration::from_secs(300);
 /// that is not background.
 fn coverage_of(dir: &std::path::Path, groom: &std::path::Path) -> f64 {
     let out = dir.join(format!("{}-frames", groom.file_stem().and_then(|s| s.to_str()).unwrap_or("g")));
-    run(
-        &[
-            "render",
-            "--input",
-            groom.to_str().expect("utf-8"),
-            "--frames",
-            "1",
-            "--width",
-            "160",
-            "--height",
-            "120",
-            "--shadow-resolution",
-            "64",
-            "--out",
-            out.to_str().expect("utf-8"),
-        ],
-        LIMIT,
-    )
-    .assert_ok();
+    let args = format!(
+        "render --input {} --frames 1 --width 160 --height 120 --shadow-resolution 64 --out {}",
+        groom.display(),
+        out.display()
+    );
+    run_line(&args, LIMIT).assert_ok();
     let (_, _, rgba) = common::read_png(&out.join("frame_0000.png"));
     common::coverage(&rgba)
 }
@@ -78,7 +65,7 @@ fn options_that_need_others_say_so() {
         (&["render", "--strict"], "--strict needs --input"),
         (&["render", "--hand-off", "staging"], "--hand-off needs --schedule second-device"),
         (&["render", "--sim-device", "llvmpipe"], "--sim-device needs --schedule second-device"),
-        (&["render", "--no-mesh-collider"], "--no-mesh-collider needs --input and --obj"),
+        (&["render", "--no-mesh-collider"], "--no-mesh-collider needs --obj"),
         (&["simulate", "--obj", "head.obj"], "--obj needs --input"),
         (&["simulate", "--scale", "0.01"], "--scale needs --input"),
         (&["simulate", "--points", "8"], "--points needs --input"),
@@ -215,4 +202,15 @@ fn a_degenerate_strand_is_repaired_with_a_warning_or_refused_when_strict() {
     out.assert_ok();
     assert!(out.stderr.contains("dropped 1 zero-length segment"), "{}", out.stderr);
     run(&["simulate", "--input", path, "--strict", "--steps", "1"], LIMIT).assert_error("zero length");
+}
+
+/// The help a command-line user reads names options and files, never library
+/// functions.
+#[test]
+fn help_never_points_at_library_functions() {
+    for command in ["devices", "inspect", "grow", "simulate", "render", "config", "plot", "convert"] {
+        let out = run(&[command, "--help"], LIMIT);
+        out.assert_ok();
+        assert!(!out.stdout.contains("::"), "`vkhair {command} --help` names a library item:\n{}", out.stdout);
+    }
 }

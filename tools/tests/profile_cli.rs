@@ -134,31 +134,29 @@ fn check_table_against_summary(out: &Run, summary: &Value) {
     assert!(totals.values().all(|t| *t > 0.0), "a track's total is zero:\n{}", out.stdout);
 }
 
-#[test]
-fn render_lists_every_pass_and_writes_a_trace_and_summary_that_agree() {
+/// Runs `vkhair <args>` (split at spaces) with --trace and --json (and for
+/// `render`, --out) in a temporary folder, checks that the table, the summary
+/// and the trace agree, and returns the run and the summary.
+fn profiled(args: &str) -> (Run, Value) {
     let dir = tempfile::tempdir().expect("temp dir");
     let (trace, summary) = (dir.path().join("trace.json"), dir.path().join("run.json"));
-    let args = [
-        "render",
-        "--frames",
-        "3",
-        "--width",
-        "64",
-        "--height",
-        "48",
-        "--shadow-resolution",
-        "64",
-        "--ssaa",
-        "--schedule",
-        "single",
-        "--out",
-    ];
-    let mut all: Vec<&str> = args.to_vec();
-    let out_dir = dir.path().join("frames");
-    all.extend([out_dir.to_str().expect("utf-8"), "--trace", trace.to_str().expect("utf-8")]);
-    all.extend(["--json", summary.to_str().expect("utf-8")]);
-    let out = run(&all, LIMIT);
+    let mut all: Vec<String> = args.split_whitespace().map(str::to_owned).collect();
+    if all[0] == "render" {
+        all.extend(["--out".into(), dir.path().join("frames").display().to_string()]);
+    }
+    all.extend(["--trace".into(), trace.display().to_string(), "--json".into(), summary.display().to_string()]);
+    let out = run(&all.iter().map(String::as_str).collect::<Vec<_>>(), LIMIT);
     out.assert_ok();
+    let summary = json(&summary);
+    check_table_against_summary(&out, &summary);
+    check_trace_against_summary(&json(&trace), &summary);
+    (out, summary)
+}
+
+#[test]
+fn render_lists_every_pass_and_writes_a_trace_and_summary_that_agree() {
+    let (out, summary) =
+        profiled("render --frames 3 --width 64 --height 48 --shadow-resolution 64 --ssaa --schedule single");
     let (rows, totals) = table(&out.stdout);
     let track = "graphics queue".to_owned();
     for pass in [
@@ -180,42 +178,18 @@ fn render_lists_every_pass_and_writes_a_trace_and_summary_that_agree() {
     }
     assert!(totals[&track] > 0.0, "{}", out.stdout);
     assert!(rows[&(track.clone(), "vkhair render: draw".to_owned())] > 0.0);
-    let summary = json(&summary);
     assert_eq!(summary["run"]["frames"], 3);
     assert_eq!(summary["per"], "frame");
-    check_table_against_summary(&out, &summary);
-    check_trace_against_summary(&json(&trace), &summary);
 }
 
 #[test]
 fn simulate_writes_a_trace_and_summary_that_agree_with_its_table() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let (trace, summary) = (dir.path().join("sim.json"), dir.path().join("sim-run.json"));
-    let out = run(
-        &[
-            "simulate",
-            "--steps",
-            "25",
-            "--volume",
-            "flip",
-            "--grid",
-            "16",
-            "--trace",
-            trace.to_str().expect("utf-8"),
-            "--json",
-            summary.to_str().expect("utf-8"),
-        ],
-        LIMIT,
-    );
-    out.assert_ok();
-    let summary = json(&summary);
+    let (out, summary) = profiled("simulate --steps 25 --volume flip --grid 16");
     assert_eq!(summary["per"], "step");
     let (rows, _) = table(&out.stdout);
     for pass in ["vkhair sim: predict", "vkhair sim: solve", "vkhair sim: integrate", "vkhair sim: volume pressure"] {
         assert!(rows.keys().any(|(_, name)| name == pass), "{pass} missing:\n{}", out.stdout);
     }
-    check_table_against_summary(&out, &summary);
-    check_trace_against_summary(&json(&trace), &summary);
 }
 
 /// Frames stream to disk: the peak resident memory of 40 frames is within 10 %
@@ -225,36 +199,14 @@ fn render_memory_does_not_grow_with_the_frame_count() {
     let dir = tempfile::tempdir().expect("temp dir");
     let groom = dir.path().join("g.hair");
     common::write_groom(&groom, &common::cap_groom(40, 8, 0.1));
-    let peak = |frames: &str| {
-        let summary = dir.path().join(format!("run{frames}.json"));
-        let out_dir = dir.path().join(format!("out{frames}"));
-        let out = run(
-            &[
-                "render",
-                "--input",
-                groom.to_str().expect("utf-8"),
-                "--motion",
-                "still",
-                "--no-shadows",
-                "--hairs-per-key",
-                "1",
-                "--width",
-                "1024",
-                "--height",
-                "768",
-                "--frames",
-                frames,
-                "--out",
-                out_dir.to_str().expect("utf-8"),
-                "--json",
-                summary.to_str().expect("utf-8"),
-            ],
-            LIMIT,
+    let peak = |frames: u32| {
+        let args = format!(
+            "render --input {} --motion still --no-shadows --hairs-per-key 1 --width 1024 --height 768 --frames {frames}",
+            groom.display()
         );
-        out.assert_ok();
-        json(&summary)["peak_resident_bytes"].as_f64().expect("peak")
+        profiled(&args).1["peak_resident_bytes"].as_f64().expect("peak")
     };
-    let (ten, forty) = (peak("10"), peak("40"));
+    let (ten, forty) = (peak(10), peak(40));
     eprintln!("peak resident memory: 10 frames {:.1} MB, 40 frames {:.1} MB", ten / 1e6, forty / 1e6);
     assert!(ten > 0.0);
     assert!(forty <= 1.1 * ten, "40 frames peak at {forty} bytes, 10 frames at {ten}");
@@ -264,38 +216,10 @@ fn render_memory_does_not_grow_with_the_frame_count() {
 /// track per device, and still agree.
 #[test]
 fn a_second_device_gets_its_own_track() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let (trace, summary) = (dir.path().join("trace.json"), dir.path().join("run.json"));
-    let out_dir = dir.path().join("frames");
-    let out = run(
-        &[
-            "render",
-            "--schedule",
-            "second-device",
-            "--frames",
-            "3",
-            "--width",
-            "32",
-            "--height",
-            "32",
-            "--shadow-resolution",
-            "32",
-            "--out",
-            out_dir.to_str().expect("utf-8"),
-            "--trace",
-            trace.to_str().expect("utf-8"),
-            "--json",
-            summary.to_str().expect("utf-8"),
-        ],
-        LIMIT,
-    );
-    out.assert_ok();
+    let (out, _) = profiled("render --schedule second-device --frames 3 --width 32 --height 32 --shadow-resolution 32");
     let (rows, totals) = table(&out.stdout);
     let sim = "simulation, second device".to_owned();
     assert!(rows.contains_key(&(sim.clone(), "vkhair sim: solve".to_owned())), "{}", out.stdout);
     assert!(rows.contains_key(&("graphics queue".to_owned(), "vkhair render: draw".to_owned())), "{}", out.stdout);
     assert_eq!(totals.len(), 2, "{}", out.stdout);
-    let summary = json(&summary);
-    check_table_against_summary(&out, &summary);
-    check_trace_against_summary(&json(&trace), &summary);
 }

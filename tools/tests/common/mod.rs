@@ -52,6 +52,11 @@ pub fn run(args: &[&str], limit: Duration) -> Run {
     run_command(vkhair().args(args), limit)
 }
 
+/// [`run`] with the arguments given as one string, split at spaces.
+pub fn run_line(args: &str, limit: Duration) -> Run {
+    run(&args.split_whitespace().collect::<Vec<_>>(), limit)
+}
+
 /// Runs `command`, killing it and failing the test after `limit`.
 pub fn run_command(command: &mut Command, limit: Duration) -> Run {
     let mut child = command.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("start vkhair");
