@@ -226,6 +226,10 @@ impl GpuLight {
     pub fn kind(&self) -> u32 {
         self.position_kind[3] as u32
     }
+    /// Whether it is a point light (no direction: no single opacity map fits it).
+    pub fn is_point(&self) -> bool {
+        self.kind() == 1
+    }
     /// Position (point and spot lights).
     pub fn position(&self) -> Vec3 {
         Vec3::new(self.position_kind[0], self.position_kind[1], self.position_kind[2])

@@ -12,6 +12,26 @@ use vkhair::ash::{self, vk};
 use vkhair::headless::Submit;
 use vkhair::{requirements, ContextOptions, GpuContext, GpuProfiler, HostDevice, HostQueue, ValidationLog};
 
+mod common;
+
+/// The helper every GPU test uses (`common::Gpu`) checks the validation log
+/// after the context is dropped: a buffer leaked on purpose fails the test.
+#[test]
+fn the_shared_test_helper_catches_a_leaked_buffer() {
+    let caught = std::panic::catch_unwind(|| {
+        let gpu = common::Gpu::new();
+        let info = vk::BufferCreateInfo::default().size(256).usage(vk::BufferUsageFlags::STORAGE_BUFFER);
+        // SAFETY: a valid create info on a live device; the buffer is leaked on
+        // purpose, so the device is destroyed with it still alive.
+        let leaked = unsafe { gpu.ctx().raw_device().create_buffer(&info, None) }.expect("buffer");
+        assert_ne!(leaked, vk::Buffer::null());
+        drop(gpu);
+    });
+    let panic = caught.expect_err("the leaked buffer went unnoticed");
+    let message = panic.downcast_ref::<String>().cloned().unwrap_or_default();
+    assert!(message.contains("VkBuffer"), "the failure does not name the leaked buffer: {message}");
+}
+
 #[test]
 fn headless_context_is_validation_clean() {
     let log = ValidationLog::new();

@@ -120,6 +120,9 @@ fn gpu_matches_cpu_with_the_mesh_collider_and_the_local_shape_constraint() {
         }
         eprintln!("step {target}: max |gpu − cpu| = {worst:e}, {equal}/{} bitwise equal", g.positions.len());
         assert!(worst <= 1e-4, "step {target}: GPU and CPU differ by {worst} m");
+        if common::on_lavapipe(gpu.ctx()) {
+            assert!(common::bits(&g) == common::bits(cpu.state()), "step {target}: not bit for bit on lavapipe");
+        }
     }
 }
 

@@ -12,21 +12,11 @@ use vkhair::headless::{Offscreen, Submit};
 use vkhair::render::{Camera, Light, RenderParams, Renderer, ShadowCaster, ShadowParams};
 use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, SchedulerOptions};
 use vkhair::sim::{motion, FixedStepDriver, RigidTransform, SimParams, VolumeParams};
-use vkhair::{ContextOptions, Error, GpuContext, Groom, ValidationLog};
+use vkhair::{ContextOptions, Error, GpuContext, Groom};
 
 mod common;
 
-/// A validated headless context whose log is checked after everything is dropped.
-struct Device {
-    ctx: GpuContext,
-    log: ValidationLog,
-}
-
-fn device() -> Device {
-    let log = ValidationLog::new();
-    let ctx = GpuContext::headless(&ContextOptions::validated(&log)).expect("headless context with validation");
-    Device { ctx, log }
-}
+use common::Gpu;
 
 fn groom(strands: usize, points: usize) -> Groom {
     common::grown_groom(strands, points, 5)
@@ -66,8 +56,8 @@ struct Shown {
     mode: ScheduleMode,
 }
 
-fn run(render: &Device, options: SchedulerOptions, frames: usize, draw: bool) -> Shown {
-    let ctx = &render.ctx;
+fn run(render: &Gpu, options: SchedulerOptions, frames: usize, draw: bool) -> Shown {
+    let ctx = render.ctx();
     let g = groom(48, 6);
     let mut scheduler =
         FrameScheduler::new(ctx, &g, &params(), &RigidTransform::default(), &motion::thesis_colliders(), &options)
@@ -120,10 +110,14 @@ fn run(render: &Device, options: SchedulerOptions, frames: usize, draw: bool) ->
     shown
 }
 
-fn second_device(sim: &Device, hand_off: HandOff, pipelining: Pipelining) -> SchedulerOptions {
+fn second_device(sim: &Gpu, hand_off: HandOff, pipelining: Pipelining) -> SchedulerOptions {
+    second_device_of(sim.ctx(), hand_off, pipelining)
+}
+
+fn second_device_of(sim: &GpuContext, hand_off: HandOff, pipelining: Pipelining) -> SchedulerOptions {
     SchedulerOptions {
         mode: Some(ScheduleMode::SecondDevice),
-        sim_device: Some(sim.ctx.clone()),
+        sim_device: Some(sim.clone()),
         hand_off: Some(hand_off),
         pipelining,
         ..SchedulerOptions::default()
@@ -145,20 +139,14 @@ fn assert_same(a: &Shown, b: &Shown, what: &str) {
     assert!(a.final_state == b.final_state, "{what}: final simulation state differs");
 }
 
-fn check_clean(devices: &[&Device]) {
-    for d in devices {
-        d.log.assert_clean();
-    }
-}
-
 /// 200 frames in SINGLE QUEUE and in SECOND DEVICE mode with both hand-offs show
 /// the same bits and the same images at every frame, for each pipelining choice;
 /// throughput shows at frame N what latency showed at frame N−1.
 #[test]
 fn single_queue_and_second_device_show_identical_frames() {
     const FRAMES: usize = 200;
-    let render = device();
-    let sim = device();
+    let render = Gpu::new();
+    let sim = Gpu::new();
     let mut latency_positions = None;
     for pipelining in [Pipelining::Latency, Pipelining::Throughput] {
         let reference = run(&render, single(pipelining), FRAMES, true);
@@ -185,7 +173,6 @@ fn single_queue_and_second_device_show_identical_frames() {
             }
         }
     }
-    check_clean(&[&render, &sim]);
 }
 
 /// lavapipe has one queue: the automatic choice is SINGLE QUEUE with the reason
@@ -193,15 +180,15 @@ fn single_queue_and_second_device_show_identical_frames() {
 /// onto the graphics queue shows the same frames as SINGLE QUEUE.
 #[test]
 fn async_compute_falls_back_without_a_second_queue() {
-    let render = device();
+    let render = Gpu::new();
     let g = groom(16, 4);
     let head = RigidTransform::default();
     let auto =
-        FrameScheduler::new(&render.ctx, &g, &params(), &head, &[], &SchedulerOptions::default()).expect("scheduler");
+        FrameScheduler::new(render.ctx(), &g, &params(), &head, &[], &SchedulerOptions::default()).expect("scheduler");
     println!("automatic mode: {} ({})", auto.mode().name(), auto.reason());
     drop(auto);
     let forced = SchedulerOptions { mode: Some(ScheduleMode::AsyncCompute), ..SchedulerOptions::default() };
-    match FrameScheduler::new(&render.ctx, &g, &params(), &head, &[], &forced) {
+    match FrameScheduler::new(render.ctx(), &g, &params(), &head, &[], &forced) {
         Ok(s) => {
             // A device with a second queue: automatic must have chosen it too.
             assert_eq!(s.mode(), ScheduleMode::AsyncCompute);
@@ -224,16 +211,15 @@ fn async_compute_falls_back_without_a_second_queue() {
         assert_eq!(other.mode, ScheduleMode::AsyncCompute);
         assert_same(&reference, &other, &format!("async on the graphics queue, {pipelining:?}"));
     }
-    check_clean(&[&render]);
 }
 
 /// ASYNC COMPUTE on a real second queue, where the device has one.
 #[test]
 fn async_compute_on_a_second_queue_matches_single_queue() {
-    let render = device();
+    let render = Gpu::new();
     let options = SchedulerOptions { mode: Some(ScheduleMode::AsyncCompute), ..SchedulerOptions::default() };
     let g = groom(16, 4);
-    if let Err(e) = FrameScheduler::new(&render.ctx, &g, &params(), &RigidTransform::default(), &[], &options) {
+    if let Err(e) = FrameScheduler::new(render.ctx(), &g, &params(), &RigidTransform::default(), &[], &options) {
         println!("skipped: {e}");
         return;
     }
@@ -242,15 +228,14 @@ fn async_compute_on_a_second_queue_matches_single_queue() {
         let other = run(&render, SchedulerOptions { pipelining, ..options.clone() }, 200, true);
         assert_same(&reference, &other, &format!("async compute, {pipelining:?}"));
     }
-    check_clean(&[&render]);
 }
 
 /// Stopping the simulation side mid-run gives the host typed errors (never a hang),
 /// in every mode, while the renderer can still draw the last shown state.
 #[test]
 fn stopping_the_simulation_side_returns_errors() {
-    let render = device();
-    let sim = device();
+    let render = Gpu::new();
+    let sim = Gpu::new();
     let g = groom(16, 4);
     let heads = frame_heads(12);
     let all = [
@@ -264,16 +249,16 @@ fn stopping_the_simulation_side_returns_errors() {
         second_device(&sim, HandOff::HostStaging, Pipelining::Latency),
     ];
     for options in all {
-        let mut s = FrameScheduler::new(&render.ctx, &g, &params(), &RigidTransform::default(), &[], &options)
+        let mut s = FrameScheduler::new(render.ctx(), &g, &params(), &RigidTransform::default(), &[], &options)
             .expect("scheduler");
-        let renderer = Renderer::new(&render.ctx, s.key_hairs(), &RenderParams::default()).expect("renderer");
+        let renderer = Renderer::new(render.ctx(), s.key_hairs(), &RenderParams::default()).expect("renderer");
         for h in &heads[..6] {
             // SAFETY: recording command buffer of the rendering device, waited for.
-            render.ctx.run_frame("frame", |cmd| unsafe { s.record_frame(cmd, h, None) }).expect("frame");
+            render.ctx().run_frame("frame", |cmd| unsafe { s.record_frame(cmd, h, None) }).expect("frame");
         }
         s.stop_simulation();
         // SAFETY: as above.
-        let err = render.ctx.run_frame("frame", |cmd| unsafe { s.record_frame(cmd, &heads[6], None) });
+        let err = render.ctx().run_frame("frame", |cmd| unsafe { s.record_frame(cmd, &heads[6], None) });
         assert!(matches!(err, Err(Error::SimulationStopped(_))), "{:?}: {err:?}", s.mode());
         assert!(matches!(s.read_state(), Err(Error::SimulationStopped(_))));
         assert!(matches!(s.set_colliders(&[]), Err(Error::SimulationStopped(_))));
@@ -281,17 +266,16 @@ fn stopping_the_simulation_side_returns_errors() {
         assert_eq!(s.read_shown_positions().expect("shown").len(), 16 * 4);
         drop(renderer);
     }
-    check_clean(&[&render, &sim]);
 }
 
 /// Bad input is rejected with typed errors before any work.
 #[test]
 fn bad_input_is_rejected() {
-    let render = device();
-    let sim = device();
+    let render = Gpu::new();
+    let sim = Gpu::new();
     let g = groom(16, 4);
     let head = RigidTransform::default();
-    let bad = |o: SchedulerOptions| FrameScheduler::new(&render.ctx, &g, &params(), &head, &[], &o).err();
+    let bad = |o: SchedulerOptions| FrameScheduler::new(render.ctx(), &g, &params(), &head, &[], &o).err();
     let e = bad(SchedulerOptions { frames_in_flight: 0, ..SchedulerOptions::default() });
     assert!(matches!(e, Some(Error::InvalidParameter { name: "frames_in_flight", .. })), "{e:?}");
     let e = bad(SchedulerOptions { timeout: Duration::ZERO, ..SchedulerOptions::default() });
@@ -299,10 +283,10 @@ fn bad_input_is_rejected() {
     let e = bad(SchedulerOptions { mode: Some(ScheduleMode::SecondDevice), ..SchedulerOptions::default() });
     assert!(matches!(e, Some(Error::ModeUnavailable { .. })), "{e:?}");
     for options in [single(Pipelining::Latency), second_device(&sim, HandOff::HostStaging, Pipelining::Throughput)] {
-        let mut s = FrameScheduler::new(&render.ctx, &g, &params(), &head, &[], &options).expect("scheduler");
+        let mut s = FrameScheduler::new(render.ctx(), &g, &params(), &head, &[], &options).expect("scheduler");
         let nan = RigidTransform { translation: Vec3::NAN, ..RigidTransform::default() };
         // SAFETY: recording command buffer of the rendering device, waited for.
-        let e = render.ctx.run_frame("frame", |cmd| unsafe { s.record_frame(cmd, &[head, nan], None) });
+        let e = render.ctx().run_frame("frame", |cmd| unsafe { s.record_frame(cmd, &[head, nan], None) });
         assert!(matches!(e, Err(Error::InvalidParameter { .. })), "{e:?}");
         let e = s.set_sim_params(&SimParams { volume: VolumeParams::flip([16, 16, 16]), ..SimParams::default() });
         assert!(matches!(e, Err(Error::Incompatible { what: "volume", .. })), "{e:?}");
@@ -310,10 +294,9 @@ fn bad_input_is_rejected() {
         assert!(matches!(e, Err(Error::InvalidParameter { .. })), "{e:?}");
         // Still usable after the rejections.
         // SAFETY: as above.
-        render.ctx.run_frame("frame", |cmd| unsafe { s.record_frame(cmd, &[head], None) }).expect("frame");
+        render.ctx().run_frame("frame", |cmd| unsafe { s.record_frame(cmd, &[head], None) }).expect("frame");
         s.read_state().expect("state");
     }
-    check_clean(&[&render, &sim]);
 }
 
 /// Every drop order of scheduler, renderer and the two contexts leaves no object
@@ -335,25 +318,26 @@ fn any_drop_order_leaks_nothing() {
     for (k, order) in orders.into_iter().enumerate() {
         let hand_off = if k % 2 == 0 { HandOff::ExternalMemory } else { HandOff::HostStaging };
         {
-            let render = device();
-            let sim = device();
-            let logs = [render.log.clone(), sim.log.clone()];
+            // This test drops the contexts itself, in every order, then checks.
+            let (render_ctx, render_log) = Gpu::new().into_parts();
+            let (sim_ctx, sim_log) = Gpu::new().into_parts();
+            let logs = [render_log, sim_log];
             let mut s = FrameScheduler::new(
-                &render.ctx,
+                &render_ctx,
                 &g,
                 &params(),
                 &RigidTransform::default(),
                 &[],
-                &second_device(&sim, hand_off, Pipelining::Throughput),
+                &second_device_of(&sim_ctx, hand_off, Pipelining::Throughput),
             )
             .expect("scheduler");
-            let renderer = Renderer::new(&render.ctx, s.key_hairs(), &RenderParams::default()).expect("renderer");
+            let renderer = Renderer::new(&render_ctx, s.key_hairs(), &RenderParams::default()).expect("renderer");
             for h in &heads {
                 // SAFETY: recording command buffer of the rendering device, waited for.
-                render.ctx.run_frame("frame", |cmd| unsafe { s.record_frame(cmd, h, None) }).expect("frame");
+                render_ctx.run_frame("frame", |cmd| unsafe { s.record_frame(cmd, h, None) }).expect("frame");
             }
             let mut items: [Option<Box<dyn std::any::Any>>; 4] =
-                [Some(Box::new(s)), Some(Box::new(renderer)), Some(Box::new(render.ctx)), Some(Box::new(sim.ctx))];
+                [Some(Box::new(s)), Some(Box::new(renderer)), Some(Box::new(render_ctx)), Some(Box::new(sim_ctx))];
             for i in order {
                 drop(items[i].take());
             }
@@ -371,8 +355,8 @@ fn any_drop_order_leaks_nothing() {
 fn threaded_hand_off_survives_many_short_frames() {
     let (tx, rx) = mpsc::channel();
     let worker = std::thread::spawn(move || {
-        let render = device();
-        let sim = device();
+        let render = Gpu::new();
+        let sim = Gpu::new();
         let g = groom(8, 4);
         let heads = frame_heads(300);
         let mut frames = 0;
@@ -388,17 +372,16 @@ fn threaded_hand_off_survives_many_short_frames() {
             let options =
                 SchedulerOptions { frames_in_flight: 1 + k as u32 % 3, ..second_device(&sim, hand_off, pipelining) };
             let mut s =
-                FrameScheduler::new(&render.ctx, &g, &SimParams::default(), &RigidTransform::default(), &[], &options)
+                FrameScheduler::new(render.ctx(), &g, &SimParams::default(), &RigidTransform::default(), &[], &options)
                     .expect("scheduler");
             for h in &heads {
                 // SAFETY: recording command buffer of the rendering device, waited for.
-                render.ctx.run_frame("frame", |cmd| unsafe { s.record_frame(cmd, h, None) }).expect("frame");
+                render.ctx().run_frame("frame", |cmd| unsafe { s.record_frame(cmd, h, None) }).expect("frame");
                 frames += 1;
             }
             let shown = s.read_shown_positions().expect("shown");
             assert!(shown.iter().all(|p| p.is_finite()));
         }
-        check_clean(&[&render, &sim]);
         let _ = tx.send(frames);
     });
     match rx.recv_timeout(Duration::from_secs(240)) {
@@ -420,19 +403,19 @@ fn threaded_hand_off_survives_many_short_frames() {
 #[test]
 fn profiles_of_both_devices_share_the_host_clock() {
     use vkhair::{Clock, GpuProfiler};
-    let render = device();
-    let sim = device();
+    let render = Gpu::new();
+    let sim = Gpu::new();
     let g = groom(32, 6);
     let heads = frame_heads(24);
     for pipelining in [Pipelining::Latency, Pipelining::Throughput] {
         let options = second_device(&sim, HandOff::ExternalMemory, pipelining);
-        let mut s = FrameScheduler::new(&render.ctx, &g, &params(), &RigidTransform::default(), &[], &options)
+        let mut s = FrameScheduler::new(render.ctx(), &g, &params(), &RigidTransform::default(), &[], &options)
             .expect("scheduler");
-        let mut profiler = GpuProfiler::new(&render.ctx, 1, 16).expect("profiler");
+        let mut profiler = GpuProfiler::new(render.ctx(), 1, 16).expect("profiler");
         let mut checked = 0;
         for (frame, h) in heads.iter().enumerate() {
             render
-                .ctx
+                .ctx()
                 .run_frame("frame", |cmd| {
                     // SAFETY: recording command buffer of the rendering device; every
                     // earlier frame was waited for.
@@ -475,5 +458,4 @@ fn profiles_of_both_devices_share_the_host_clock() {
             assert!(checked >= 10, "{checked} frames checked");
         }
     }
-    check_clean(&[&render, &sim]);
 }

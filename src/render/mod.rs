@@ -255,7 +255,9 @@ impl Renderer {
         if lights.len() > MAX_LIGHTS {
             return Err(Error::param("lights", lights.len(), format!("at most {MAX_LIGHTS}")));
         }
-        self.lights = lights.iter().map(|l| l.to_gpu()).collect::<Result<_>>()?;
+        let gpu: Vec<GpuLight> = lights.iter().map(|l| l.to_gpu()).collect::<Result<_>>()?;
+        shadow::check_casters(&gpu, self.shadows.params())?;
+        self.lights = gpu;
         Ok(())
     }
 
@@ -268,7 +270,13 @@ impl Renderer {
     /// first). A new atlas size (map count or resolution) or a larger density volume
     /// creates new GPU resources and waits for the device to be idle first. Maps are
     /// drawn by [`Renderer::record_shadows`].
+    ///
+    /// A deep-opacity-map caster must be a directional or spot light of the
+    /// current [`Renderer::set_lights`] list: a point light is refused here with
+    /// [`Error::UnsupportedFeature`] (give it a density-volume caster instead),
+    /// as is a later `set_lights` that would turn a map caster into a point light.
     pub fn set_shadows<'a>(&mut self, sim: impl Into<KeyHairs<'a>>, params: &ShadowParams) -> Result<()> {
+        shadow::check_casters(&self.lights, params)?;
         let sim = sim.into();
         let changed = self.shadows.set(&sim, params, self.interpolate.hairs().0);
         if !matches!(changed, Ok(false)) {

@@ -21,6 +21,21 @@ pub fn grown_groom(strands: usize, points: usize, seed: u64) -> Groom {
     grow(&scenes::thesis_scalp(), &p).expect("groom")
 }
 
+/// The raw bits of every component of a state's positions and velocities: equal
+/// bits, not merely equal values (−0 and +0, NaN payloads differ).
+#[allow(dead_code, reason = "not every test file compares states")]
+pub fn bits(state: &SimState) -> Vec<u32> {
+    state.positions.iter().chain(&state.velocities).flat_map(|v| v.to_array().map(f32::to_bits)).collect()
+}
+
+/// Whether `ctx` runs on lavapipe, where the README promises that the GPU
+/// simulation and its CPU reference agree bit for bit (other drivers may round
+/// `sqrt` and division differently).
+#[allow(dead_code, reason = "not every test file compares with the reference")]
+pub fn on_lavapipe(ctx: &GpuContext) -> bool {
+    ctx.info().name.contains("llvmpipe")
+}
+
 /// A headless context with validation and synchronization validation; dropping it
 /// fails the test on any validation message (objects leaked at teardown included).
 #[allow(dead_code, reason = "test files with their own contexts use only the helpers")]
@@ -39,6 +54,13 @@ impl Gpu {
 
     pub fn ctx(&self) -> &GpuContext {
         self.ctx.as_ref().expect("alive")
+    }
+
+    /// The context and its log, for a test that drops the context itself and
+    /// then checks the log (the helper checks only what happened before).
+    pub fn into_parts(mut self) -> (GpuContext, ValidationLog) {
+        let ctx = self.ctx.take().expect("alive");
+        (ctx, self.log.clone())
     }
 }
 

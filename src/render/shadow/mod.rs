@@ -71,6 +71,24 @@ impl From<usize> for ShadowCaster {
     }
 }
 
+/// Refuses deep-opacity-map casters on point lights among `lights` (an
+/// omnidirectional light would need a cube of maps).
+pub(crate) fn check_casters(lights: &[GpuLight], params: &ShadowParams) -> Result<()> {
+    for caster in params.casters.iter().filter(|c| c.method == ShadowMethod::DeepOpacity) {
+        if lights.get(caster.light).is_some_and(GpuLight::is_point) {
+            return Err(Error::unsupported(
+                "deep opacity maps of point lights",
+                format!(
+                    "light {} is a point light; give it a density-volume caster \
+                     (ShadowCaster::density_volume), or use a spot light",
+                    caster.light
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl ShadowCaster {
     /// A light whose shadow comes from the density volume.
     pub fn density_volume(light: usize) -> Self {

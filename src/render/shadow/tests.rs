@@ -330,3 +330,115 @@ fn density_volume_shadows_agree_with_opacity_maps_and_the_light_oriented_map() {
     let front = probe(&s, &[Vec3::new(0.0, s.rows[12], 3.0 * cell)], Probe::March(Vec3::Z));
     assert!(front[0] > 0.999, "{front:?}");
 }
+
+/// Transmittance behind the slab (every sheet in front) at texel row `row`.
+fn behind(s: &Slab, row: usize, how: Probe) -> f32 {
+    let thickness = (SHEETS - 1) as f32 * SPACING;
+    probe(s, &[Vec3::new(0.0, s.rows[row], -(thickness + 0.004))], how)[0]
+}
+
+fn slab_params(casters: Vec<ShadowCaster>, pcf_radius: u32) -> (Spec, ShadowParams) {
+    let spec = Spec { sheets: SHEETS, spacing: SPACING, rows: 8, points: 2, volume: false };
+    let params =
+        ShadowParams { casters, layers: LAYERS, opacity: 0.04, extinction: 1.5, pcf_radius, ..ShadowParams::default() };
+    (spec, params)
+}
+
+/// Exact transmittance through `strands` strands of the slab's opacity.
+fn through(strands: usize) -> f32 {
+    (-1.5f32 * 0.04 * strands as f32).exp()
+}
+
+const ALONG_Z: Light = Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE };
+
+/// A spot light's perspective map: behind the slab the transmittance is that of
+/// its strands (the perspective texel is within 1 % of the orthographic one, so
+/// a texel row holds PER_ROW ± 1 strands of each sheet).
+#[test]
+fn spot_light_opacity_maps_shadow_like_the_strand_count() {
+    let spot = Light::Spot {
+        position: Vec3::new(0.0, 0.0, 1.0),
+        direction: Vec3::NEG_Z,
+        outer_angle: 0.5,
+        inner_angle: 0.4,
+        color: Vec3::ONE,
+    };
+    let (spec, params) = slab_params(vec![0.into()], 0);
+    let s = build(spec, params, &[spot]);
+    let t = behind(&s, 4, Probe::Map(0));
+    let (lo, hi) = (through((PER_ROW + 1) * SHEETS), through((PER_ROW - 1) * SHEETS));
+    eprintln!("spot light, behind the slab: {t} (exact {}, bounds {lo}..{hi})", through(PER_ROW * SHEETS));
+    assert!((lo..=hi).contains(&t), "spot-light transmittance {t} outside {lo}..{hi}");
+    let front = probe(&s, &[Vec3::new(0.0, s.rows[4], 0.01)], Probe::Map(0))[0];
+    assert!(front > 0.999, "in front of the slab: {front}");
+}
+
+/// Percentage-closer filtering: inside the slab a 3 × 3 filter sees the same
+/// count everywhere (exact), at its edge row it blends with empty texels
+/// (softer than without filtering).
+#[test]
+fn pcf_softens_only_the_shadow_edge() {
+    let exact = through(PER_ROW * SHEETS);
+    let edge_row = 7; // the last covered texel row
+    let mut at_edge = Vec::new();
+    for pcf in [0, 1] {
+        let (spec, params) = slab_params(vec![0.into()], pcf);
+        let s = build(spec, params, &[ALONG_Z]);
+        let inside = behind(&s, 4, Probe::Map(0));
+        assert!((inside - exact).abs() < 1e-4, "pcf {pcf}: inside {inside} vs {exact}");
+        at_edge.push(behind(&s, edge_row, Probe::Map(0)));
+    }
+    eprintln!("edge row: pcf 0 {}, pcf 1 {} (exact {exact})", at_edge[0], at_edge[1]);
+    assert!((at_edge[0] - exact).abs() < 1e-4, "unfiltered edge {}", at_edge[0]);
+    assert!(at_edge[1] > exact + 0.05 && at_edge[1] < 1.0 - 0.05, "filtered edge {}", at_edge[1]);
+}
+
+/// The atlas full: four lights (two directional, a spot, a directional) each
+/// cast through their own tile and each map holds the slab; a fifth caster is
+/// refused.
+#[test]
+fn four_shadowed_lights_fill_the_atlas_and_a_fifth_is_refused() {
+    let spot = Light::Spot {
+        position: Vec3::new(0.0, 0.0, 1.0),
+        direction: Vec3::NEG_Z,
+        outer_angle: 0.5,
+        inner_angle: 0.4,
+        color: Vec3::ONE,
+    };
+    let lights = [ALONG_Z, ALONG_Z, spot, ALONG_Z, ALONG_Z];
+    let (spec, params) = slab_params((0..MAX_SHADOW_MAPS).map(ShadowCaster::from).collect(), 0);
+    let mut s = build(spec, params.clone(), &lights);
+    let (lo, hi) = (through((PER_ROW + 1) * SHEETS), through((PER_ROW - 1) * SHEETS));
+    for map in 0..MAX_SHADOW_MAPS as u32 {
+        let t = behind(&s, 4, Probe::Map(map));
+        assert!((lo..=hi).contains(&t), "map {map}: {t} outside {lo}..{hi}");
+    }
+    let five = ShadowParams { casters: (0..=MAX_SHADOW_MAPS).map(ShadowCaster::from).collect(), ..params };
+    match s.renderer.set_shadows(&s.sim, &five) {
+        Err(Error::InvalidParameter { name, .. }) => assert_eq!(name, "shadow casters"),
+        other => panic!("a fifth map caster: {other:?}"),
+    }
+}
+
+/// A point light cannot have one opacity map: `set_shadows` refuses it (and so
+/// does `set_lights` turning a map caster into one); its density-volume shadow
+/// is accepted. At most `MAX_LIGHTS` lights, as the README says.
+#[test]
+fn point_lights_are_refused_as_map_casters() {
+    let (spec, params) = slab_params(vec![0.into()], 0);
+    let mut s = build(spec, params.clone(), &[ALONG_Z]);
+    assert!(s.renderer.set_lights(&[ALONG_Z; MAX_LIGHTS]).is_ok());
+    match s.renderer.set_lights(&[ALONG_Z; MAX_LIGHTS + 1]) {
+        Err(Error::InvalidParameter { name, .. }) => assert_eq!(name, "lights"),
+        other => panic!("{} lights: {other:?}", MAX_LIGHTS + 1),
+    }
+    let point = Light::Point { position: Vec3::new(0.0, 0.0, 1.0), color: Vec3::ONE };
+    match s.renderer.set_lights(&[point]) {
+        Err(Error::UnsupportedFeature { what, .. }) => assert_eq!(what, "deep opacity maps of point lights"),
+        other => panic!("set_lights turned the map caster into a point light: {other:?}"),
+    }
+    s.renderer.set_shadows(&s.sim, &ShadowParams { casters: vec![], ..params.clone() }).expect("no casters");
+    s.renderer.set_lights(&[point]).expect("a point light without a map");
+    let err = s.renderer.set_shadows(&s.sim, &params).expect_err("a map for a point light");
+    assert!(err.to_string().contains("light 0 is a point light"), "{err}");
+}
