@@ -8,6 +8,9 @@
 //! - Any compiler warning fails the build; every module is checked with
 //!   `spirv-val` (from Debian's `spirv-tools`, pulled in by `libshaderc-dev`).
 //! - Files under `glsl/include/` are headers and are not compiled alone.
+//! - A line `// vkhair variant: NAME` in a shader compiles it once more with
+//!   `NAME` defined, as `<IDENT>_<NAME less VKHAIR_>` (e.g. the pressure solve's
+//!   reductions through shared memory, `…_SHARED_REDUCE`).
 //! - Every constant of `src/limits.rs` is defined for every shader as a macro
 //!   (`-DNAME=VALUEu`); a shader or header that declares one of those names
 //!   itself fails the build, so the Rust side and the shaders share one value.
@@ -41,7 +44,7 @@ fn main() {
     sources.sort();
     let mut redeclared = Vec::new();
     for path in sources.iter().chain(headers(&include_dir).iter()) {
-        redeclared.extend(redeclared_constants(path));
+        redeclared.extend(redeclared_in(path));
     }
     if !redeclared.is_empty() {
         panic!("shaders declare constants that build.rs injects from src/limits.rs:\n{}", redeclared.join("\n"));
@@ -60,24 +63,35 @@ fn main() {
         let Some(&(_, kind, stage)) = STAGES.iter().find(|(e, _, _)| *e == ext) else {
             continue;
         };
-        match compile(&compiler, path, &rel_name, kind, &include_dir, &out_dir) {
-            Ok(words) => {
-                let ident = rel_name
-                    .chars()
-                    .map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_uppercase() } else { '_' })
-                    .collect::<String>();
-                let _ = writeln!(
-                    table,
-                    "pub(crate) static {ident}: ShaderSource = ShaderSource {{ name: {rel_name:?}, stage: ShaderStage::{stage}, words: &["
-                );
-                for chunk in words.chunks(8) {
-                    let line = chunk.iter().map(|w| format!("{w:#010x}")).collect::<Vec<_>>().join(", ");
-                    let _ = writeln!(table, "    {line},");
+        // The module as written, then one per `// vkhair variant: NAME` line
+        // (compiled with NAME defined, its identifier suffixed with NAME less
+        // `VKHAIR_`).
+        let text = std::fs::read_to_string(path).unwrap_or_default();
+        let variants = text.lines().filter_map(|l| l.trim().strip_prefix("// vkhair variant:")).map(str::trim);
+        for variant in std::iter::once(None).chain(variants.map(Some)) {
+            let name = match variant {
+                Some(v) => format!("{rel_name}#{}", v.trim_start_matches("VKHAIR_")),
+                None => rel_name.clone(),
+            };
+            match compile(&compiler, path, &name, kind, &include_dir, &out_dir, variant) {
+                Ok(words) => {
+                    let ident = name
+                        .chars()
+                        .map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_uppercase() } else { '_' })
+                        .collect::<String>();
+                    let _ = writeln!(
+                        table,
+                        "pub(crate) static {ident}: ShaderSource = ShaderSource {{ name: {name:?}, stage: ShaderStage::{stage}, words: &["
+                    );
+                    for chunk in words.chunks(8) {
+                        let line = chunk.iter().map(|w| format!("{w:#010x}")).collect::<Vec<_>>().join(", ");
+                        let _ = writeln!(table, "    {line},");
+                    }
+                    let _ = writeln!(table, "] }};\n");
+                    all.push(ident);
                 }
-                let _ = writeln!(table, "] }};\n");
-                all.push(ident);
+                Err(e) => errors.push(e),
             }
-            Err(e) => errors.push(e),
         }
     }
     if !errors.is_empty() {
@@ -114,28 +128,14 @@ fn headers(include_dir: &Path) -> Vec<PathBuf> {
     entries.map(|e| e.expect("directory entry").path()).filter(|p| p.is_file()).collect()
 }
 
-/// Lines of `path` that declare a name of [`SHADER_CONSTANTS`] (`const … NAME`
-/// or `#define NAME`).
-fn redeclared_constants(path: &Path) -> Vec<String> {
+/// Lines of `path` that declare a name of [`SHADER_CONSTANTS`] (see
+/// `redeclared_constants` in src/limits.rs).
+fn redeclared_in(path: &Path) -> Vec<String> {
     let Ok(source) = std::fs::read_to_string(path) else { return Vec::new() };
-    let mut found = Vec::new();
-    for (number, line) in source.lines().enumerate() {
-        let code = line.split("//").next().unwrap_or_default();
-        let words: Vec<&str> = code
-            .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '#'))
-            .filter(|w| !w.is_empty())
-            .collect();
-        let declares = |name: &str| {
-            words.windows(2).any(|w| w[0] == "#define" && w[1] == name)
-                || (words.first() == Some(&"const") && words.iter().skip(1).take(3).any(|w| *w == name))
-        };
-        for (name, _) in SHADER_CONSTANTS {
-            if declares(name) {
-                found.push(format!("{}:{}: declares {name}", path.display(), number + 1));
-            }
-        }
-    }
-    found
+    redeclared_constants(&source)
+        .into_iter()
+        .map(|(line, name)| format!("{}:{line}: declares {name}", path.display()))
+        .collect()
 }
 
 fn compile(
@@ -145,6 +145,7 @@ fn compile(
     kind: shaderc::ShaderKind,
     include_dir: &Path,
     out_dir: &Path,
+    variant: Option<&str>,
 ) -> Result<Vec<u32>, String> {
     let source = std::fs::read_to_string(path).map_err(|e| format!("{rel_name}: {e}"))?;
     let mut options = shaderc::CompileOptions::new().map_err(|e| format!("shaderc options: {e}"))?;
@@ -154,6 +155,9 @@ fn compile(
     options.set_warnings_as_errors();
     for (name, value) in SHADER_CONSTANTS {
         options.add_macro_definition(name, Some(&format!("{value}u")));
+    }
+    if let Some(name) = variant {
+        options.add_macro_definition(name, None);
     }
     // Unoptimised SPIR-V keeps every OpName/OpMemberName (reflection checks
     // struct members by name) and keeps float operation order as written,
@@ -186,7 +190,7 @@ fn compile(
         return Err(format!("{rel_name}: {}", artifact.get_warning_messages()));
     }
     let words = artifact.as_binary().to_vec();
-    let spv_path = out_dir.join(format!("{}.spv", rel_name.replace('/', "__")));
+    let spv_path = out_dir.join(format!("{}.spv", rel_name.replace(['/', '#'], "__")));
     std::fs::write(&spv_path, artifact.as_binary_u8()).map_err(|e| format!("{rel_name}: {e}"))?;
     let status = Command::new("spirv-val")
         .arg("--target-env")

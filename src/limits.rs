@@ -17,8 +17,10 @@ pub const SIM_WORKGROUP: u32 = 64;
 pub const MAX_LIGHTS: u32 = 8;
 /// Most shadow-casting lights.
 pub const MAX_SHADOW_MAPS: u32 = 4;
-/// Invocations of a volume-stage workgroup.
+/// Invocations of a volume-stage workgroup (a power of two: the shared-memory
+/// reduction halves it).
 pub const VOL_GROUP: u32 = 256;
+const _: () = assert!(VOL_GROUP.is_power_of_two());
 /// Keys one radix-sort block ranks, one per invocation.
 pub const VOL_SORT_BLOCK: u32 = 256;
 /// Elements of one prefix-sum tile, four per invocation.
@@ -43,3 +45,28 @@ pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
     ("ITEM_GROUP", ITEM_GROUP),
     ("SDF_MAX_RESOLUTION", SDF_MAX_RESOLUTION),
 ];
+
+/// The lines (1-based) of a shader source that declare a name of
+/// [`SHADER_CONSTANTS`] themselves (`#define NAME` or `const … NAME`), with the
+/// name: build.rs refuses such a shader, so each constant has one definition.
+#[cfg_attr(not(test), allow(dead_code))] // used by build.rs and the tests
+pub fn redeclared_constants(source: &str) -> Vec<(usize, &'static str)> {
+    let mut found = Vec::new();
+    for (number, line) in source.lines().enumerate() {
+        let code = line.split("//").next().unwrap_or_default();
+        let words: Vec<&str> = code
+            .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '#'))
+            .filter(|w| !w.is_empty())
+            .collect();
+        let declares = |name: &str| {
+            words.windows(2).any(|w| w[0] == "#define" && w[1] == name)
+                || (words.first() == Some(&"const") && words.iter().skip(1).take(3).any(|w| *w == name))
+        };
+        for (name, _) in SHADER_CONSTANTS {
+            if declares(name) {
+                found.push((number + 1, *name));
+            }
+        }
+    }
+    found
+}

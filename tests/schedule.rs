@@ -213,16 +213,20 @@ fn async_compute_falls_back_without_a_second_queue() {
     }
 }
 
-/// ASYNC COMPUTE on a real second queue, where the device has one.
+/// ASYNC COMPUTE on a real second queue. lavapipe has none, so this test is
+/// ignored by default (counted as such, never as passed); `tools/test.sh` runs
+/// it with `--ignored` where `vkhair devices` reports a second queue, and there
+/// it fails if the scheduler cannot use it. The same code path runs on every
+/// device through `async_on_graphics_queue` in the test above.
 #[test]
+#[ignore = "needs a device with a second (async compute) queue; tools/test.sh runs it where there is one"]
 fn async_compute_on_a_second_queue_matches_single_queue() {
     let render = Gpu::new();
     let options = SchedulerOptions { mode: Some(ScheduleMode::AsyncCompute), ..SchedulerOptions::default() };
     let g = groom(16, 4);
-    if let Err(e) = FrameScheduler::new(render.ctx(), &g, &params(), &RigidTransform::default(), &[], &options) {
-        println!("skipped: {e}");
-        return;
-    }
+    let probe = FrameScheduler::new(render.ctx(), &g, &params(), &RigidTransform::default(), &[], &options);
+    assert!(probe.is_ok(), "this device has no second queue for ASYNC COMPUTE: {:?}", probe.err());
+    drop(probe);
     for pipelining in [Pipelining::Latency, Pipelining::Throughput] {
         let reference = run(&render, single(pipelining), 200, true);
         let other = run(&render, SchedulerOptions { pipelining, ..options.clone() }, 200, true);

@@ -326,3 +326,54 @@ fn flip_with_the_mesh_collider_follows_the_cpu_reference() {
     eprintln!("FLIP with the mesh collider: one step, max |Δx| + dt·|Δv| = {step:e} m");
     assert!(step <= REFERENCE_STEP_TOLERANCE_M, "one step of GPU and CPU differs by {step} m");
 }
+
+/// The grid follows the hair: lengthening strands at run time refits it on the
+/// GPU and in the reference alike (and `set_params` keeps both fits equal), the
+/// lengthened hair stays inside it through a violent shake, and one step of each
+/// from the same state still agrees.
+#[test]
+fn lengthened_hair_refits_the_grid_the_same_way_on_both_sides() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(120, 6, 9);
+    let params = flip(16);
+    let head0 = RigidTransform::default();
+    let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &head0).expect("gpu sim");
+    let mut cpu = CpuHairSim::new(&groom, &params, &head0).expect("cpu sim");
+    sim.set_colliders(&motion::thesis_colliders()).expect("colliders");
+    let before = sim.volume_grid().expect("grid");
+    assert_eq!(Some(before), cpu.volume_grid());
+    let state = sim.read_state().expect("readback");
+    for s in (0..state.strands).step_by(3) {
+        let longer = 2.0 * state.rest_strand_length(s);
+        sim.set_strand_length(s, longer).expect("gpu length");
+        cpu.set_strand_length(s, longer).expect("cpu length");
+    }
+    let after = sim.volume_grid().expect("grid");
+    assert!(after.cell_size > 1.2 * before.cell_size, "the grid did not grow: {before:?} → {after:?}");
+    assert_eq!(Some(after), cpu.volume_grid(), "GPU and CPU fitted different grids");
+    sim.set_params(&params).expect("gpu params");
+    cpu.set_params(&params).expect("cpu params");
+    assert_eq!(sim.volume_grid(), cpu.volume_grid(), "set_params refitted one side only");
+    let violent = |i: usize| motion::violent_motion((i + 1) as f32 * params.dt);
+    let mut worst_outside = 0.0f32;
+    for chunk in 0..6 {
+        sim.run(10, |i| violent(10 * chunk + i), None).expect("run");
+        let g = sim.read_state().expect("readback");
+        let grid = sim.volume_grid().expect("grid");
+        let to_grid = grid.world_from_grid.inverse();
+        let size = Vec3::new(grid.dims[0] as f32, grid.dims[1] as f32, grid.dims[2] as f32);
+        for p in &g.positions {
+            let q = to_grid.transform_point3(p.truncate());
+            let outside = (Vec3::ZERO - q).max(q - size).max(Vec3::ZERO).max_element();
+            worst_outside = worst_outside.max(outside);
+        }
+    }
+    assert!(worst_outside == 0.0, "lengthened hair left the grid by {worst_outside} cells");
+    let state = sim.read_state().expect("readback");
+    let mut reference = CpuHairSim::from_state(state, &params, &violent(59)).expect("cpu sim");
+    reference.set_colliders(&motion::thesis_colliders()).expect("colliders");
+    reference.step(&violent(60)).expect("cpu step");
+    sim.run(1, |_| violent(60), None).expect("run");
+    let step = sim.read_state().expect("readback").step_difference(reference.state(), params.dt);
+    assert!(step <= REFERENCE_STEP_TOLERANCE_M, "after the refit one step differs by {step} m");
+}

@@ -9,6 +9,25 @@ export VKHAIR_VALIDATION=1
 # Quiet loader noise about XDG_RUNTIME_DIR on headless machines.
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-$(mktemp -d)}
 cargo test --workspace --locked "$@"
+# ASYNC COMPUTE on a real second queue: only where a device has one (lavapipe
+# does not; the same code path runs on its graphics queue in the suite above).
+devices=$(cargo run --quiet --locked -p vkhair-tools -- devices 2>/dev/null || true)
+if grep -q "async compute queue: yes" <<<"$devices"; then
+  cargo test --locked --test schedule "$@" -- --ignored async_compute_on_a_second_queue
+else
+  echo "skipped: async compute on a real second queue (no device here has one)"
+fi
 # The documentation builds without a warning (broken links, missing docs).
 RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked --quiet
 echo "docs: cargo doc has no warnings"
+# The asset readers under libFuzzer for a short while each, where a nightly
+# toolchain and cargo-fuzz are installed (VKHAIR_FUZZ_SECONDS=0 skips).
+seconds=${VKHAIR_FUZZ_SECONDS:-20}
+if [ "$seconds" != 0 ] && cargo +nightly fuzz --version >/dev/null 2>&1; then
+  for target in hair tfx obj; do
+    (cd fuzz && cargo +nightly fuzz run "$target" -- -max_total_time="$seconds" -rss_limit_mb=2048)
+  done
+  echo "fuzz: hair, tfx and obj ran ${seconds} s each without a crash"
+else
+  echo "fuzz: skipped (needs a nightly toolchain and cargo-fuzz: rustup toolchain install nightly; cargo install cargo-fuzz)"
+fi

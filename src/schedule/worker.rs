@@ -53,6 +53,9 @@ enum Request {
     Read(mpsc::Sender<Result<SimState>>),
     #[cfg(test)]
     Panic,
+    /// Test only: the simulation device reports `VK_ERROR_DEVICE_LOST`.
+    #[cfg(test)]
+    DeviceLost,
 }
 
 #[derive(Default)]
@@ -191,6 +194,11 @@ impl Worker {
         self.send(Request::Panic)
     }
 
+    #[cfg(test)]
+    pub(crate) fn inject_device_loss(&self) -> Result<()> {
+        self.send(Request::DeviceLost)
+    }
+
     /// Stops the worker and joins it (its own GPU work is waited for on its thread).
     pub(crate) fn stop(&mut self) {
         {
@@ -265,6 +273,10 @@ fn run(mut side: SimSide, slots: usize, timeout: Duration, shared: &Shared) {
             }
             #[cfg(test)]
             Request::Panic => panic!("injected worker failure"),
+            #[cfg(test)]
+            Request::DeviceLost => {
+                Err(Error::Vulkan { call: "vkQueueSubmit (injected)", result: ash::vk::Result::ERROR_DEVICE_LOST })
+            }
         };
         if let Err(e) = result {
             let mut state = shared.lock();

@@ -76,7 +76,9 @@ impl CpuHairSim {
 
     /// See [`HairSim::set_strand_length`](super::HairSim::set_strand_length).
     pub fn set_strand_length(&mut self, strand: usize, length: f32) -> Result<()> {
-        self.state.set_strand_length(strand, length).map(|_| ())
+        self.state.set_strand_length(strand, length)?;
+        self.volume = cpu_volume_grid(&self.planner.params, &self.state)?;
+        Ok(())
     }
 
     /// Advances one step ending with the head at `head`.

@@ -248,21 +248,24 @@ impl HairSim {
         Ok(sim)
     }
 
-    /// Creates, rebuilds (new resolution) or drops the volume stage for `params`.
+    /// Creates, rebuilds or drops the volume stage for `params`. The grid is fitted
+    /// to the rest state (roots plus the longest rest strand, in the head frame),
+    /// as `CpuHairSim` fits it; a new fit (new resolution, strands lengthened or
+    /// shortened) rebuilds the stage.
     fn configure_volume(&mut self, params: &VolumeParams) -> Result<()> {
         if params.mode == VolumeMode::Off {
             self.volume = None;
             return Ok(());
         }
+        let grid = volume::grid::GridLayout::new(params, &self.shape)?;
         if let Some(stage) = &mut self.volume {
-            if stage.params.resolution == params.resolution {
+            if stage.grid == grid {
                 stage.params = params.clone();
                 return Ok(());
             }
         }
         // The old stage's buffers may still be in use by submitted work.
         self.device.wait_idle()?;
-        let grid = volume::grid::GridLayout::new(params, &self.shape)?;
         let g = &self.gpu;
         let particles = [(&g.positions[0], &g.velocities[0]), (&g.positions[1], &g.velocities[1])];
         let mesh_field = self.mesh.as_ref().map_or(&g.no_mesh, |m| &m.field);
@@ -334,12 +337,16 @@ impl HairSim {
     }
 
     /// Changes the rest length of key hair `strand`; only its tip segments change.
-    /// Takes effect with the next recorded step.
+    /// Takes effect with the next recorded step. With the volume stage on, its grid
+    /// is refitted when the new rest lengths change the fit (as in `CpuHairSim`),
+    /// waiting for the device to be idle first.
     pub fn set_strand_length(&mut self, strand: usize, length: f32) -> Result<()> {
         let first = self.shape.set_strand_length(strand, length)?;
         let end = (strand + 1) * self.shape.points;
         self.pending_rest.push(first..end);
-        Ok(())
+        // The volume grid follows the rest lengths (refitted when they change it).
+        let volume = self.planner.params.volume.clone();
+        self.configure_volume(&volume)
     }
 
     /// Key hairs and points per key hair.

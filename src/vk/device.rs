@@ -45,6 +45,9 @@ pub struct DeviceInfo {
     pub max_storage_buffer_range: u32,
     /// Invocations per subgroup (SPIR-V 1.5 modules always see this size).
     pub subgroup_size: u32,
+    /// Whether compute shaders have subgroup arithmetic on subgroups of at least 4
+    /// lanes: the pressure solve's reductions use it, else shared memory alone.
+    pub subgroup_reductions: bool,
     /// Largest 2D image side, texels.
     pub max_image_dimension_2d: u32,
     /// Whether RGBA32 float color attachments can blend (the opacity-map atlas).
@@ -90,6 +93,9 @@ impl DeviceInfo {
             max_tessellation_level: props.limits.max_tessellation_generation_level,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
             subgroup_size: subgroup.subgroup_size,
+            subgroup_reductions: subgroup.supported_operations.contains(vk::SubgroupFeatureFlags::ARITHMETIC)
+                && subgroup.supported_stages.contains(vk::ShaderStageFlags::COMPUTE)
+                && subgroup.subgroup_size >= 4,
             max_image_dimension_2d: props.limits.max_image_dimension2_d,
             rgba32f_blend: {
                 // SAFETY: as above.
@@ -149,6 +155,9 @@ pub(crate) struct Device {
     /// Serialises the crate's own submissions to `graphics` (queue access must be
     /// externally synchronised).
     pub submit_lock: Mutex<()>,
+    /// Whether kernels with a reduction use their shared-memory variant: where
+    /// [`DeviceInfo::subgroup_reductions`] is false, or forced (tests).
+    pub shared_reductions: std::sync::atomic::AtomicBool,
     owned: Option<Owned>,
 }
 
@@ -171,6 +180,7 @@ impl Device {
     pub(crate) fn new(parts: DeviceParts) -> Result<Arc<Self>> {
         let info = DeviceInfo::query(&parts.instance, parts.physical, parts.graphics.family);
         let debug_utils = parts.debug_utils.then(|| ash::ext::debug_utils::Device::new(&parts.instance, &parts.raw));
+        let shared_reductions = std::sync::atomic::AtomicBool::new(!info.subgroup_reductions);
         let mut record = Device {
             entry: parts.entry,
             instance: parts.instance,
@@ -184,6 +194,7 @@ impl Device {
             extensions: parts.extensions,
             allocator: parts.allocator,
             submit_lock: Mutex::new(()),
+            shared_reductions,
             owned: parts.owned,
         };
         if record.allocator.is_none() {

@@ -503,7 +503,7 @@ fn shaders_are_built_with_the_shared_constants() {
         let item = ["render/shadow_volume.comp", "core/scale_add.comp", "core/shadow_probe.comp"];
         if sim.contains(&name) {
             Some(limits::SIM_WORKGROUP)
-        } else if item.contains(&name) {
+        } else if item.contains(&name) || name.starts_with("sim/sdf/") {
             Some(limits::ITEM_GROUP)
         } else if name.starts_with("sim/volume/") {
             Some(limits::VOL_GROUP)
@@ -518,7 +518,7 @@ fn shaders_are_built_with_the_shared_constants() {
         assert_eq!(reflection.workgroup_size, Some([size, 1, 1]), "{}", shader.name);
         checked += 1;
     }
-    assert_eq!(checked, 26, "3 simulation, 3 per-item and 20 volume kernels");
+    assert_eq!(checked, 34, "3 simulation, 7 per-item and 24 volume kernels (4 shared-memory variants)");
     let glsl = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
     let mut sources = String::new();
     let mut dirs = vec![glsl];
@@ -534,6 +534,30 @@ fn shaders_are_built_with_the_shared_constants() {
     }
     for (name, _) in limits::SHADER_CONSTANTS {
         assert!(sources.contains(name), "{name} is injected but no shader uses it");
+    }
+}
+
+/// build.rs refuses a shader that declares an injected constant itself: the
+/// check finds `#define` and `const` declarations (not uses), and no shader of
+/// the crate has one.
+#[test]
+fn shaders_may_not_redeclare_the_injected_constants() {
+    use crate::limits::redeclared_constants;
+    let bad = "#define VOL_GROUP 128u\nconst uint MAX_LIGHTS = 4u;\nlayout(local_size_x = VOL_GROUP) in;\n\
+               // #define SIM_WORKGROUP 1\nuint n = ITEM_GROUP;\n";
+    assert_eq!(redeclared_constants(bad), vec![(1, "VOL_GROUP"), (2, "MAX_LIGHTS")]);
+    let glsl = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
+    let mut dirs = vec![glsl];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).expect("glsl folder") {
+            let path = entry.expect("entry").path();
+            if path.is_dir() {
+                dirs.push(path);
+            } else {
+                let source = std::fs::read_to_string(&path).expect("shader source");
+                assert!(redeclared_constants(&source).is_empty(), "{} redeclares a constant", path.display());
+            }
+        }
     }
 }
 

@@ -191,6 +191,10 @@ fn devices() -> CliResult {
             i.max_tessellation_level
         );
         say!("    async compute queue: {}", if r.async_compute { "yes" } else { "no (single queue path)" });
+        say!(
+            "    subgroup arithmetic: {}",
+            if i.subgroup_reductions { "yes" } else { "no (reductions through shared memory)" }
+        );
         if !r.optional_extensions.is_empty() {
             say!("    optional extensions: {}", r.optional_extensions.join(", "));
         }

@@ -1,6 +1,7 @@
 #version 460
 // Pressure solve: q = A d, with per-workgroup partials (d·q, 0).
 #include "volume.glsl"
+// vkhair variant: VKHAIR_SHARED_REDUCE
 #include "reduce.glsl"
 
 layout(local_size_x = VOL_GROUP) in;

@@ -1,6 +1,7 @@
 #version 460
 // Pressure solve, after the multigrid preconditioner: per-workgroup partials (r·z, max |r|).
 #include "volume.glsl"
+// vkhair variant: VKHAIR_SHARED_REDUCE
 #include "reduce.glsl"
 
 layout(local_size_x = VOL_GROUP) in;

@@ -3,6 +3,7 @@
 // cell (the divergence times the cell size), r = b, pressure 0; with the
 // Jacobi preconditioner also z = r / diag. Per-workgroup partials (r·z, max |r|).
 #include "volume.glsl"
+// vkhair variant: VKHAIR_SHARED_REDUCE
 #include "reduce.glsl"
 
 layout(local_size_x = VOL_GROUP) in;

@@ -2,6 +2,7 @@
 // Pressure solve: p += α d, r −= α q; with the Jacobi preconditioner also
 // z = r / diag and per-workgroup partials (r·z, max |r|).
 #include "volume.glsl"
+// vkhair variant: VKHAIR_SHARED_REDUCE
 #include "reduce.glsl"
 
 layout(local_size_x = VOL_GROUP) in;

@@ -243,8 +243,17 @@ impl Kernel {
         Kernel::G2p,
     ];
 
-    fn shader(self) -> &'static ShaderSource {
+    /// The kernel's module; `shared` picks the shared-memory reductions of the
+    /// pressure solve's kernels (devices without subgroup arithmetic).
+    fn shader(self, shared: bool) -> &'static ShaderSource {
         use shaders::*;
+        match (self, shared) {
+            (Kernel::PcgInit, true) => return &SIM_VOLUME_PCG_INIT_COMP_SHARED_REDUCE,
+            (Kernel::PcgApply, true) => return &SIM_VOLUME_PCG_APPLY_COMP_SHARED_REDUCE,
+            (Kernel::PcgUpdate, true) => return &SIM_VOLUME_PCG_UPDATE_COMP_SHARED_REDUCE,
+            (Kernel::PcgDot, true) => return &SIM_VOLUME_PCG_DOT_COMP_SHARED_REDUCE,
+            _ => {}
+        }
         match self {
             Kernel::Bin => &SIM_VOLUME_BIN_COMP,
             Kernel::RadixCount => &SIM_VOLUME_RADIX_COUNT_COMP,
@@ -287,7 +296,8 @@ pub(crate) fn kernels(
     Kernel::ALL
         .iter()
         .map(|kernel| {
-            let pipeline = ComputePipeline::new(device, kernel.shader(), particles.len() as u32)?;
+            let shared = device.shared_reductions.load(std::sync::atomic::Ordering::Relaxed);
+            let pipeline = ComputePipeline::new(device, kernel.shader(shared), particles.len() as u32)?;
             let sets = particles
                 .iter()
                 .map(|(pos, vel)| pipeline.declared_buffer_set(0, &buffers.table(colliders, mesh_field, pos, vel)))

@@ -261,8 +261,15 @@ fn projection_is_divergence_free_and_agrees_with_mic_pcg() {
     let grid = unit_grid([16, 16, 16], positions.len());
     let colliders = [GpuCollider { a_radius: [8.0, 8.0, 8.0, 3.0], b_kind: [8.0, 8.0, 8.0, 0.0] }];
     let previous = Mat4::from_translation(Vec3::new(0.0, 0.01, 0.0));
-    let mut iterations = Vec::new();
-    for preconditioner in [Preconditioner::Jacobi, Preconditioner::Multigrid] {
+    let (mut iterations, mut residuals) = (Vec::new(), Vec::new());
+    // Both ways of reducing: subgroup arithmetic where the device has it, and the
+    // shared-memory fallback, forced.
+    let paths = if gpu.device().info.subgroup_reductions { vec![false, true] } else { vec![true] };
+    let runs = paths.into_iter().flat_map(|shared| {
+        [Preconditioner::Jacobi, Preconditioner::Multigrid].map(|preconditioner| (shared, preconditioner))
+    });
+    for (shared, preconditioner) in runs {
+        gpu.device().shared_reductions.store(shared, std::sync::atomic::Ordering::Relaxed);
         let params = VolumeParams { preconditioner, max_iterations: 200, ..VolumeParams::flip([16, 16, 16]) };
         let b = block(&grid, &params, previous, 1);
         let run = run_gpu(&gpu, &grid, &params, &b, &colliders, &positions, &velocities);
@@ -273,7 +280,8 @@ fn projection_is_divergence_free_and_agrees_with_mic_pcg() {
         let after = max_divergence(&grid, &cpu.labels, &run.snapshot.face_vel);
         let cpu_after = max_divergence(&grid, &cpu.labels, &cpu.face_vel);
         eprintln!(
-            "{preconditioner:?}: {} iterations (MIC {}), divergence {before} -> GPU {after}, CPU {cpu_after}; {:?}",
+            "{preconditioner:?}, shared-memory reductions {shared}: {} iterations (MIC {}), divergence {before} -> \
+             GPU {after}, CPU {cpu_after}; {:?}",
             run.stats.iterations, cpu.iterations, run.stats
         );
         assert!(run.stats.converged && run.stats.iterations < params.max_iterations, "{:?}", run.stats);
@@ -287,13 +295,20 @@ fn projection_is_divergence_free_and_agrees_with_mic_pcg() {
         let cpu_v: Vec<f32> = cpu_vel.iter().flat_map(|v| v.to_array()).collect();
         assert_close("FLIP velocities", &gpu_v, &cpu_v, 1e-3);
         iterations.push(run.stats.iterations);
+        residuals.push(run.stats.relative_residual);
     }
-    assert!(
-        iterations[1] * 2 <= iterations[0],
-        "multigrid needs {} iterations, Jacobi {}",
-        iterations[1],
-        iterations[0]
-    );
+    // The two reductions sum the same values in different orders: the solves take
+    // the same iterations to residuals equal but for rounding.
+    if iterations.len() == 4 {
+        assert_eq!(iterations[..2], iterations[2..], "subgroup and shared-memory reductions disagree");
+        for k in 0..2 {
+            let (a, b) = (residuals[k], residuals[k + 2]);
+            assert!((a - b).abs() <= 1e-4 * a, "residuals {a} and {b}");
+        }
+    }
+    for pair in iterations.chunks(2) {
+        assert!(pair[1] * 2 <= pair[0], "multigrid needs {} iterations, Jacobi {}", pair[1], pair[0]);
+    }
 }
 
 #[test]

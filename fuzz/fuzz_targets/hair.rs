@@ -1,0 +1,7 @@
+//! `.hair` bytes through the strict and the repairing reader: no panic.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    let _ = vkhair::groom::cyhair::HairFile::parse(data);
+    let _ = vkhair::groom::cyhair::HairFile::parse_repairing(data);
+});
