@@ -183,22 +183,30 @@ fn async_compute_falls_back_without_a_second_queue() {
     let render = Gpu::new();
     let g = groom(16, 4);
     let head = RigidTransform::default();
-    let auto =
-        FrameScheduler::new(render.ctx(), &g, &params(), &head, &[], &SchedulerOptions::default()).expect("scheduler");
-    println!("automatic mode: {} ({})", auto.mode().name(), auto.reason());
-    drop(auto);
     let forced = SchedulerOptions { mode: Some(ScheduleMode::AsyncCompute), ..SchedulerOptions::default() };
-    match FrameScheduler::new(render.ctx(), &g, &params(), &head, &[], &forced) {
+    let second_queue = match FrameScheduler::new(render.ctx(), &g, &params(), &head, &[], &forced) {
         Ok(s) => {
-            // A device with a second queue: automatic must have chosen it too.
             assert_eq!(s.mode(), ScheduleMode::AsyncCompute);
+            true
         }
         Err(Error::ModeUnavailable { mode, reason }) => {
             assert_eq!(mode, "async compute");
             assert!(reason.contains("no second queue"), "{reason}");
+            false
         }
         Err(e) => panic!("unexpected error {e}"),
+    };
+    // The automatic choice: ASYNC COMPUTE where there is a second queue, else
+    // SINGLE QUEUE, with the reason said.
+    let auto =
+        FrameScheduler::new(render.ctx(), &g, &params(), &head, &[], &SchedulerOptions::default()).expect("scheduler");
+    println!("automatic mode: {} ({})", auto.mode().name(), auto.reason());
+    let expected = if second_queue { ScheduleMode::AsyncCompute } else { ScheduleMode::SingleQueue };
+    assert_eq!(auto.mode(), expected, "{}", auto.reason());
+    if !second_queue {
+        assert!(auto.reason().contains("no second queue"), "{}", auto.reason());
     }
+    drop(auto);
     for pipelining in [Pipelining::Latency, Pipelining::Throughput] {
         let reference = run(&render, single(pipelining), 40, true);
         let options = SchedulerOptions {

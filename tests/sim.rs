@@ -377,8 +377,9 @@ fn gpu_matches_cpu_with_the_global_shape_constraint() {
 
 /// Style parameters a groom holds its shape with: a soft global shape
 /// constraint over the whole strand, with the sag-free rest state (default).
+/// The documented styled configuration, as the tools use it for `--input`.
 fn styled() -> SimParams {
-    SimParams { global_shape_stiffness: 0.15, global_shape_range: 1.0, ..SimParams::default() }
+    SimParams::styled()
 }
 
 /// Tip drift after `steps` steps of `groom` on the head sphere with the head at `head(i)`.

@@ -61,9 +61,12 @@ fn run_with_step_checks(
 fn flip_simulation_follows_the_cpu_reference() {
     let gpu = Gpu::new();
     let groom = common::grown_groom(300, 6, 11);
-    for params in
-        [flip(16), SimParams { volume: VolumeParams { mode: VolumeMode::Friction, ..flip(16).volume }, ..flip(16) }]
-    {
+    // 16³ and the main job's 32³ for FLIP; friction at 16³.
+    for params in [
+        flip(16),
+        flip(32),
+        SimParams { volume: VolumeParams { mode: VolumeMode::Friction, ..flip(16).volume }, ..flip(16) },
+    ] {
         let head0 = RigidTransform::default();
         let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &head0).expect("gpu sim");
         sim.set_colliders(&motion::thesis_colliders()).expect("colliders");

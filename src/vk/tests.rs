@@ -519,19 +519,7 @@ fn shaders_are_built_with_the_shared_constants() {
         checked += 1;
     }
     assert_eq!(checked, 34, "3 simulation, 7 per-item and 24 volume kernels (4 shared-memory variants)");
-    let glsl = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
-    let mut sources = String::new();
-    let mut dirs = vec![glsl];
-    while let Some(dir) = dirs.pop() {
-        for entry in std::fs::read_dir(&dir).expect("glsl folder") {
-            let path = entry.expect("entry").path();
-            if path.is_dir() {
-                dirs.push(path);
-            } else {
-                sources.push_str(&std::fs::read_to_string(&path).expect("shader source"));
-            }
-        }
-    }
+    let sources: String = glsl_sources().into_iter().map(|(_, text)| text).collect();
     for (name, _) in limits::SHADER_CONSTANTS {
         assert!(sources.contains(name), "{name} is injected but no shader uses it");
     }
@@ -546,19 +534,27 @@ fn shaders_may_not_redeclare_the_injected_constants() {
     let bad = "#define VOL_GROUP 128u\nconst uint MAX_LIGHTS = 4u;\nlayout(local_size_x = VOL_GROUP) in;\n\
                // #define SIM_WORKGROUP 1\nuint n = ITEM_GROUP;\n";
     assert_eq!(redeclared_constants(bad), vec![(1, "VOL_GROUP"), (2, "MAX_LIGHTS")]);
-    let glsl = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
-    let mut dirs = vec![glsl];
+    for (path, source) in glsl_sources() {
+        assert!(redeclared_constants(&source).is_empty(), "{} redeclares a constant", path.display());
+    }
+}
+
+/// Every file under `glsl/` with its text.
+fn glsl_sources() -> Vec<(std::path::PathBuf, String)> {
+    let mut out = Vec::new();
+    let mut dirs = vec![std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl")];
     while let Some(dir) = dirs.pop() {
         for entry in std::fs::read_dir(&dir).expect("glsl folder") {
             let path = entry.expect("entry").path();
             if path.is_dir() {
                 dirs.push(path);
             } else {
-                let source = std::fs::read_to_string(&path).expect("shader source");
-                assert!(redeclared_constants(&source).is_empty(), "{} redeclares a constant", path.display());
+                let text = std::fs::read_to_string(&path).expect("shader source");
+                out.push((path, text));
             }
         }
     }
+    out
 }
 
 /// A host including `glsl/include/shadow.glsl` in its own shaders must define

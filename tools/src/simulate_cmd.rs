@@ -221,6 +221,14 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
         params.volume.resolution,
         a.config.as_ref().map(|c| format!(" (from {} and the flags)", c.display())).unwrap_or_default()
     );
+    say!(
+        "style: global shape {:.2} over {:.2} of the strand, local shape {:.2}, rest-shape spring {}, sag-free {}",
+        params.global_shape_stiffness,
+        params.global_shape_range,
+        params.local_shape_stiffness,
+        if params.spring_enabled { "on" } else { "off" },
+        if params.sag_free { "on" } else { "off" }
+    );
     let reference = Reference {
         params: &params,
         colliders: &colliders,

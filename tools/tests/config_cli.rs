@@ -5,8 +5,20 @@
 use std::path::PathBuf;
 use std::process::Command;
 
+/// The binary with validation on: a validation message shows as `vulkan: …`
+/// on stderr, which [`clean`] refuses.
 fn vkhair() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_vkhair"))
+    let mut c = Command::new(env!("CARGO_BIN_EXE_vkhair"));
+    c.env("VKHAIR_VALIDATION", "1");
+    c
+}
+
+/// A successful run without a validation message; its standard output.
+fn clean(out: &std::process::Output) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("vulkan: "), "validation message:\n{stderr}");
+    String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
 fn temp(name: &str, text: &str) -> PathBuf {
@@ -63,8 +75,7 @@ fn flags_win_over_the_file() {
     let path = temp("styled.toml", "[sim]\niterations = 5\nwind = [5.0, 0.0, 0.0]\nwind_enabled = true\n[sim.volume]\nmode = \"friction\"\nresolution = [8, 8, 8]\n");
     let run = |extra: &[&str]| {
         let out = vkhair().args(["simulate", "--steps", "1", "--config"]).arg(&path).args(extra).output().expect("run");
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        String::from_utf8_lossy(&out.stdout).into_owned()
+        clean(&out)
     };
     let from_file = run(&[]);
     assert!(from_file.contains("parameters: 5 iterations, Pbd solver, volume Friction at [8, 8, 8]"), "{from_file}");
@@ -85,8 +96,7 @@ fn simulate_reports_the_drift_and_writes_the_final_strands() {
             .args(extra)
             .output()
             .expect("run");
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        let stdout = clean(&out);
         let line = stdout.lines().find(|l| l.starts_with("tip drift from rest:")).expect("drift line").to_owned();
         let p95: f32 =
             line.split("p95 ").nth(1).and_then(|r| r.split(' ').next()).and_then(|v| v.parse().ok()).expect("p95");
@@ -99,4 +109,39 @@ fn simulate_reports_the_drift_and_writes_the_final_strands() {
     let file = vkhair::groom::cyhair::HairFile::open(&out_path).expect("written file");
     assert_eq!(file.groom.strand_count(), 1750);
     assert_eq!(file.groom.point_count(), 1750 * 6);
+}
+
+/// An `--input` groom is simulated with the styled parameters
+/// (`SimParams::styled`: global shape over the whole strand, sag-free, spring
+/// off) unless a file says otherwise; the thesis scene keeps its spring.
+#[test]
+fn an_input_groom_is_held_in_its_style_by_default() {
+    let groom = temp("g.hair", "");
+    let strands: Vec<Vec<glam::Vec3>> = (0..20)
+        .map(|i| (0..6).map(|k| glam::Vec3::new(0.01 * i as f32, 1.7 - 0.02 * k as f32, 0.0)).collect())
+        .collect();
+    let file = vkhair::groom::cyhair::HairFile::new(vkhair::Groom::from_strands(&strands).expect("groom"), "t");
+    file.save(&groom).expect("save");
+    let styled = clean(
+        &vkhair().args(["simulate", "--steps", "1", "--volume", "off", "--input"]).arg(&groom).output().expect("run"),
+    );
+    let s = vkhair::sim::SimParams::styled();
+    let expected = format!(
+        "style: global shape {:.2} over {:.2} of the strand, local shape {:.2}, rest-shape spring off, sag-free on",
+        s.global_shape_stiffness, s.global_shape_range, s.local_shape_stiffness
+    );
+    assert!(styled.contains(&expected), "{styled}");
+    let thesis = clean(&vkhair().args(["simulate", "--steps", "1", "--volume", "off"]).output().expect("run"));
+    assert!(thesis.contains("rest-shape spring on"), "{thesis}");
+    let path = temp("unstyled.toml", "[sim]\nglobal_shape_stiffness = 0.0\n");
+    let from_file = clean(
+        &vkhair()
+            .args(["simulate", "--steps", "1", "--volume", "off", "--config"])
+            .arg(&path)
+            .arg("--input")
+            .arg(&groom)
+            .output()
+            .expect("run"),
+    );
+    assert!(from_file.contains("style: global shape 0.00"), "{from_file}");
 }

@@ -3,6 +3,7 @@
 
 mod common;
 
+use std::os::fd::{FromRawFd, OwnedFd};
 use std::os::unix::process::ExitStatusExt;
 use std::path::Path;
 use std::process::Stdio;
@@ -39,10 +40,16 @@ fn a_closed_pipe_ends_the_program_quietly() {
         ],
     ];
     for args in cases {
-        // The reading end is closed before the program writes its first line.
-        let mut child =
-            vkhair().args(&args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("start vkhair");
-        drop(child.stdout.take());
+        // A pipe whose reading end is closed before the program even starts (so
+        // no other test's process, forked meanwhile, can hold it open).
+        let mut fds = [0; 2];
+        // SAFETY: `fds` has room for the two descriptors pipe2 writes.
+        assert_eq!(unsafe { libc::pipe2(fds.as_mut_ptr(), libc::O_CLOEXEC) }, 0, "pipe");
+        // SAFETY: both descriptors were just created and are owned here.
+        let (read_end, write_end) = unsafe { (OwnedFd::from_raw_fd(fds[0]), OwnedFd::from_raw_fd(fds[1])) };
+        drop(read_end);
+        let child =
+            vkhair().args(&args).stdout(Stdio::from(write_end)).stderr(Stdio::piped()).spawn().expect("start vkhair");
         let output = child.wait_with_output().expect("wait");
         let stderr = String::from_utf8_lossy(&output.stderr);
         let quiet = output.status.signal() == Some(libc::SIGPIPE) || output.status.code() == Some(141);

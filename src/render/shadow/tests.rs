@@ -351,20 +351,22 @@ fn through(strands: usize) -> f32 {
 
 const ALONG_Z: Light = Light::Directional { direction: Vec3::NEG_Z, color: Vec3::ONE };
 
+/// A spot light 1 m in front of the slab, pointing through it.
+const SPOT: Light = Light::Spot {
+    position: Vec3::new(0.0, 0.0, 1.0),
+    direction: Vec3::NEG_Z,
+    outer_angle: 0.5,
+    inner_angle: 0.4,
+    color: Vec3::ONE,
+};
+
 /// A spot light's perspective map: behind the slab the transmittance is that of
 /// its strands (the perspective texel is within 1 % of the orthographic one, so
 /// a texel row holds PER_ROW ± 1 strands of each sheet).
 #[test]
 fn spot_light_opacity_maps_shadow_like_the_strand_count() {
-    let spot = Light::Spot {
-        position: Vec3::new(0.0, 0.0, 1.0),
-        direction: Vec3::NEG_Z,
-        outer_angle: 0.5,
-        inner_angle: 0.4,
-        color: Vec3::ONE,
-    };
     let (spec, params) = slab_params(vec![0.into()], 0);
-    let s = build(spec, params, &[spot]);
+    let s = build(spec, params, &[SPOT]);
     let t = behind(&s, 4, Probe::Map(0));
     let (lo, hi) = (through((PER_ROW + 1) * SHEETS), through((PER_ROW - 1) * SHEETS));
     eprintln!("spot light, behind the slab: {t} (exact {}, bounds {lo}..{hi})", through(PER_ROW * SHEETS));
@@ -398,14 +400,7 @@ fn pcf_softens_only_the_shadow_edge() {
 /// refused.
 #[test]
 fn four_shadowed_lights_fill_the_atlas_and_a_fifth_is_refused() {
-    let spot = Light::Spot {
-        position: Vec3::new(0.0, 0.0, 1.0),
-        direction: Vec3::NEG_Z,
-        outer_angle: 0.5,
-        inner_angle: 0.4,
-        color: Vec3::ONE,
-    };
-    let lights = [ALONG_Z, ALONG_Z, spot, ALONG_Z, ALONG_Z];
+    let lights = [ALONG_Z, ALONG_Z, SPOT, ALONG_Z, ALONG_Z];
     let (spec, params) = slab_params((0..MAX_SHADOW_MAPS).map(ShadowCaster::from).collect(), 0);
     let mut s = build(spec, params.clone(), &lights);
     let (lo, hi) = (through((PER_ROW + 1) * SHEETS), through((PER_ROW - 1) * SHEETS));
