@@ -684,3 +684,27 @@ fn hair_shadows_fall_on_the_hosts_mesh() {
     assert!(darker > 100, "the hair shadows part of the floor ({darker} pixels)");
     assert!(same > floor_pixels.len() / 4, "the floor away from the hair is untouched");
 }
+
+/// Key hairs of another device are refused with `Incompatible`, as the README
+/// says: at construction and when a frame is prepared.
+#[test]
+fn key_hairs_of_another_device_are_refused() {
+    let gpu = Gpu::new();
+    let other = Gpu::new();
+    let mine = thesis_sim(&gpu);
+    let theirs = thesis_sim(&other);
+    match Renderer::new(gpu.ctx(), &theirs, &RenderParams::default()) {
+        Err(Error::Incompatible { what, .. }) => assert_eq!(what, "key hairs"),
+        Err(e) => panic!("wrong error {e}"),
+        Ok(_) => panic!("a renderer accepted another device's key hairs"),
+    }
+    let mut renderer = Renderer::new(gpu.ctx(), &mine, &RenderParams::default()).expect("renderer");
+    let mut result = Ok(());
+    gpu.ctx()
+        .run_commands("foreign key hairs", |cmd| {
+            // SAFETY: a recording command buffer of the renderer's device.
+            result = unsafe { renderer.record_prepare(cmd, &theirs, None, None) };
+        })
+        .expect("submit");
+    assert!(matches!(result, Err(Error::Incompatible { what: "key hairs", .. })), "{result:?}");
+}

@@ -392,6 +392,14 @@ impl FrameScheduler {
     }
 
     #[cfg(test)]
+    fn inject_worker_stall(&self, how_long: std::time::Duration) -> Result<()> {
+        match &self.backend {
+            Backend::Remote { worker, .. } => worker.inject_stall(how_long),
+            _ => Ok(()),
+        }
+    }
+
+    #[cfg(test)]
     fn inject_sim_device_loss(&self) -> Result<()> {
         match &self.backend {
             Backend::Remote { worker, .. } => worker.inject_device_loss(),
@@ -505,63 +513,4 @@ fn make_slots(
 }
 
 #[cfg(test)]
-mod tests {
-    use std::time::Duration;
-
-    use super::*;
-    use crate::headless::Submit;
-    use crate::vk::tests::TestGpu;
-
-    /// A worker that dies mid-run (it panics, or its device reports
-    /// `VK_ERROR_DEVICE_LOST`) turns into typed errors for the host from the next
-    /// frame calls, in bounded time, for each pipelining choice; dropping the
-    /// scheduler afterwards joins the dead worker without hanging.
-    #[test]
-    fn a_dying_worker_gives_errors_not_hangs() {
-        let render = TestGpu::new();
-        let sim = TestGpu::new();
-        let strands: Vec<Vec<glam::Vec3>> = (0..8)
-            .map(|k| (0..4).map(|i| glam::Vec3::new(k as f32 * 0.02, 1.7 - 0.05 * i as f32, 0.0)).collect())
-            .collect();
-        let groom = Groom::from_strands(&strands).expect("groom");
-        let failures = [Pipelining::Latency, Pipelining::Throughput].into_iter().flat_map(|p| [(p, true), (p, false)]);
-        for (pipelining, panic) in failures {
-            let options = SchedulerOptions {
-                mode: Some(ScheduleMode::SecondDevice),
-                sim_device: Some(sim.ctx().clone()),
-                pipelining,
-                timeout: Duration::from_secs(20),
-                ..SchedulerOptions::default()
-            };
-            let head = RigidTransform::default();
-            let mut s = FrameScheduler::new(render.ctx(), &groom, &SimParams::default(), &head, &[], &options)
-                .expect("scheduler");
-            let frame = |s: &mut FrameScheduler| {
-                // SAFETY: recording command buffer of the rendering device, waited for.
-                render.ctx().run_frame("frame", |cmd| unsafe { s.record_frame(cmd, &[head], None) })
-            };
-            frame(&mut s).expect("first frame");
-            let expected = if panic {
-                s.inject_worker_panic().expect("worker alive");
-                "panicked"
-            } else {
-                s.inject_sim_device_loss().expect("worker alive");
-                "device has been lost"
-            };
-            let started = std::time::Instant::now();
-            // Throughput may still take one finished job; within two frames the error comes.
-            let errors: Vec<_> = (0..2).map(|_| frame(&mut s)).collect();
-            assert!(
-                errors.iter().any(|e| matches!(e, Err(Error::SimulationStopped(m)) if m.contains(expected))),
-                "{errors:?}"
-            );
-            // And it stays an error, not a hang or a panic.
-            assert!(matches!(frame(&mut s), Err(Error::SimulationStopped(_))));
-            assert!(matches!(s.read_state(), Err(Error::SimulationStopped(_))));
-            assert!(started.elapsed() < Duration::from_secs(15));
-            drop(s);
-        }
-        assert!(render.finish_with_messages().is_empty());
-        assert!(sim.finish_with_messages().is_empty());
-    }
-}
+mod tests;

@@ -56,6 +56,9 @@ enum Request {
     /// Test only: the simulation device reports `VK_ERROR_DEVICE_LOST`.
     #[cfg(test)]
     DeviceLost,
+    /// Test only: the worker is alive but stuck this long.
+    #[cfg(test)]
+    Stall(Duration),
 }
 
 #[derive(Default)]
@@ -199,6 +202,11 @@ impl Worker {
         self.send(Request::DeviceLost)
     }
 
+    #[cfg(test)]
+    pub(crate) fn inject_stall(&self, how_long: Duration) -> Result<()> {
+        self.send(Request::Stall(how_long))
+    }
+
     /// Stops the worker and joins it (its own GPU work is waited for on its thread).
     pub(crate) fn stop(&mut self) {
         {
@@ -273,6 +281,11 @@ fn run(mut side: SimSide, slots: usize, timeout: Duration, shared: &Shared) {
             }
             #[cfg(test)]
             Request::Panic => panic!("injected worker failure"),
+            #[cfg(test)]
+            Request::Stall(how_long) => {
+                std::thread::sleep(how_long);
+                Ok(())
+            }
             #[cfg(test)]
             Request::DeviceLost => {
                 Err(Error::Vulkan { call: "vkQueueSubmit (injected)", result: ash::vk::Result::ERROR_DEVICE_LOST })

@@ -1,0 +1,97 @@
+//! The scheduler's own tests: dying, lost and stuck simulation sides.
+
+use std::time::Duration;
+
+use super::*;
+use crate::headless::Submit;
+use crate::vk::tests::TestGpu;
+
+/// A worker that dies mid-run (it panics, or its device reports
+/// `VK_ERROR_DEVICE_LOST`) turns into typed errors for the host from the next
+/// frame calls, in bounded time, for each pipelining choice; dropping the
+/// scheduler afterwards joins the dead worker without hanging.
+#[test]
+fn a_dying_worker_gives_errors_not_hangs() {
+    let render = TestGpu::new();
+    let sim = TestGpu::new();
+    let strands: Vec<Vec<glam::Vec3>> = (0..8)
+        .map(|k| (0..4).map(|i| glam::Vec3::new(k as f32 * 0.02, 1.7 - 0.05 * i as f32, 0.0)).collect())
+        .collect();
+    let groom = Groom::from_strands(&strands).expect("groom");
+    let failures = [Pipelining::Latency, Pipelining::Throughput].into_iter().flat_map(|p| [(p, true), (p, false)]);
+    for (pipelining, panic) in failures {
+        let options = SchedulerOptions {
+            mode: Some(ScheduleMode::SecondDevice),
+            sim_device: Some(sim.ctx().clone()),
+            pipelining,
+            timeout: Duration::from_secs(20),
+            ..SchedulerOptions::default()
+        };
+        let head = RigidTransform::default();
+        let mut s =
+            FrameScheduler::new(render.ctx(), &groom, &SimParams::default(), &head, &[], &options).expect("scheduler");
+        let frame = |s: &mut FrameScheduler| {
+            // SAFETY: recording command buffer of the rendering device, waited for.
+            render.ctx().run_frame("frame", |cmd| unsafe { s.record_frame(cmd, &[head], None) })
+        };
+        frame(&mut s).expect("first frame");
+        let expected = if panic {
+            s.inject_worker_panic().expect("worker alive");
+            "panicked"
+        } else {
+            s.inject_sim_device_loss().expect("worker alive");
+            "device has been lost"
+        };
+        let started = std::time::Instant::now();
+        // Throughput may still take one finished job; within two frames the error comes.
+        let errors: Vec<_> = (0..2).map(|_| frame(&mut s)).collect();
+        assert!(
+            errors.iter().any(|e| matches!(e, Err(Error::SimulationStopped(m)) if m.contains(expected))),
+            "{errors:?}"
+        );
+        // And it stays an error, not a hang or a panic.
+        assert!(matches!(frame(&mut s), Err(Error::SimulationStopped(_))));
+        assert!(matches!(s.read_state(), Err(Error::SimulationStopped(_))));
+        assert!(started.elapsed() < Duration::from_secs(15));
+        drop(s);
+    }
+    assert!(render.finish_with_messages().is_empty());
+    assert!(sim.finish_with_messages().is_empty());
+}
+
+/// A worker that is alive but stuck: the next frame calls give a hand-off
+/// error at the scheduler's timeout, not a hang.
+#[test]
+fn a_stuck_worker_meets_the_deadline() {
+    let render = TestGpu::new();
+    let sim = TestGpu::new();
+    let strands: Vec<Vec<glam::Vec3>> = (0..8)
+        .map(|k| (0..4).map(|i| glam::Vec3::new(k as f32 * 0.02, 1.7 - 0.05 * i as f32, 0.0)).collect())
+        .collect();
+    let groom = Groom::from_strands(&strands).expect("groom");
+    let timeout = Duration::from_millis(500);
+    let options = SchedulerOptions {
+        mode: Some(ScheduleMode::SecondDevice),
+        sim_device: Some(sim.ctx().clone()),
+        pipelining: Pipelining::Latency,
+        timeout,
+        ..SchedulerOptions::default()
+    };
+    let head = RigidTransform::default();
+    let mut s =
+        FrameScheduler::new(render.ctx(), &groom, &SimParams::default(), &head, &[], &options).expect("scheduler");
+    let frame = |s: &mut FrameScheduler| {
+        // SAFETY: recording command buffer of the rendering device, waited for.
+        render.ctx().run_frame("frame", |cmd| unsafe { s.record_frame(cmd, &[head], None) })
+    };
+    frame(&mut s).expect("first frame");
+    s.inject_worker_stall(Duration::from_secs(3)).expect("worker alive");
+    let started = std::time::Instant::now();
+    let result = frame(&mut s);
+    let waited = started.elapsed();
+    assert!(matches!(result, Err(Error::HandOff(_))), "{result:?}");
+    assert!(waited >= timeout && waited < 4 * timeout, "the frame call waited {waited:?} for a {timeout:?} deadline");
+    drop(s);
+    assert!(render.finish_with_messages().is_empty());
+    assert!(sim.finish_with_messages().is_empty());
+}
