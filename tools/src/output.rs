@@ -42,6 +42,17 @@ pub fn restore_sigpipe() {
     }
 }
 
+/// A progress bar over `len` `units` ("frames", "steps") with elapsed time and
+/// ETA, on stderr (hidden when stderr is not a terminal).
+pub fn progress(len: usize, units: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(len as u64);
+    let template = format!("{{bar:40}} {{pos}}/{{len}} {units} {{elapsed}} (eta {{eta}})");
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(&template).unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}
+
 /// Smallest image side the tool renders: below it neither the frames nor the
 /// contact sheet (frames halved) would be useful images.
 pub const MIN_IMAGE_SIDE: u32 = 16;

@@ -2,7 +2,7 @@
 //! share), a Chrome trace (Perfetto, `chrome://tracing`) and a JSON summary,
 //! all three from the same reports.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde_json::{json, Value};
 use vkhair::files::write_atomic;
@@ -57,10 +57,38 @@ pub fn host_now_ns() -> f64 {
 }
 
 /// The nearest-rank percentile of sorted samples (the smallest sample that at
-/// least `percent` % of them do not exceed).
-fn percentile(sorted: &[f64], percent: usize) -> f64 {
+/// least `percent` % of them do not exceed); `None` when there are none.
+pub fn percentile<T: Copy>(sorted: &[T], percent: usize) -> Option<T> {
     let rank = (sorted.len() * percent).div_ceil(100).max(1);
-    sorted.get(rank - 1).copied().unwrap_or(0.0)
+    sorted.get(rank - 1).copied()
+}
+
+/// `--trace` and `--json`, the same for `render` and `simulate`.
+#[derive(clap::Args)]
+pub struct ProfileArgs {
+    /// Write the GPU passes (one track per queue or device) and the CPU spans as
+    /// a Chrome trace (opens in Perfetto and chrome://tracing).
+    #[arg(long)]
+    trace: Option<PathBuf>,
+    /// Write the run's summary (device, scene, counts, per-pass statistics) as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+}
+
+impl ProfileArgs {
+    /// Writes the files asked for from `profile`, the summary with `context`
+    /// (made only when it is asked for), saying where each went.
+    pub fn write(&self, profile: &Profile, context: impl FnOnce() -> Value) -> Result<(), Error> {
+        if let Some(path) = &self.trace {
+            profile.write_trace(path)?;
+            say!("wrote the GPU trace to {} (open it in Perfetto or chrome://tracing)", path.display());
+        }
+        if let Some(path) = &self.json {
+            profile.write_summary(path, context())?;
+            say!("wrote the run's summary to {}", path.display());
+        }
+        Ok(())
+    }
 }
 
 impl Profile {
@@ -125,7 +153,7 @@ impl Profile {
                 Row {
                     pass: p,
                     mean_ns,
-                    p95_ns: percentile(&sorted, 95),
+                    p95_ns: percentile(&sorted, 95).unwrap_or(0.0),
                     share: if t > 0.0 { mean_ns / t } else { 0.0 },
                 }
             })

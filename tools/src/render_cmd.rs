@@ -3,7 +3,6 @@
 use std::path::PathBuf;
 
 use glam::Vec3;
-use indicatif::{ProgressBar, ProgressStyle};
 use vkhair::config::Config;
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::scenes::{self, THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS};
@@ -15,8 +14,8 @@ use vkhair::sim::{motion, Collider, RigidTransform, SimParams, VolumeMode, Volum
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
 use crate::groom_input::InputArgs;
-use crate::output::{Error, FrameSink, MIN_IMAGE_SIDE};
-use crate::profile::{host_now_ns, Profile};
+use crate::output::{progress, Error, FrameSink, MIN_IMAGE_SIDE};
+use crate::profile::{host_now_ns, Profile, ProfileArgs};
 use crate::say;
 use crate::simulate_cmd::MotionArg;
 
@@ -118,13 +117,8 @@ pub struct RenderArgs {
     /// (default: a second logical device of the rendering GPU).
     #[arg(long)]
     sim_device: Option<String>,
-    /// Write the GPU passes (one track per queue or device) and the CPU frame
-    /// spans as a Chrome trace (opens in Perfetto and chrome://tracing).
-    #[arg(long)]
-    trace: Option<PathBuf>,
-    /// Write the run's summary (device, scene, counts, per-pass statistics) as JSON.
-    #[arg(long)]
-    json: Option<PathBuf>,
+    #[command(flatten)]
+    profile_out: ProfileArgs,
 }
 
 /// The scheduler options the flags ask for (creating the simulation device).
@@ -395,11 +389,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
         a.height,
         a.frames
     );
-    let bar = ProgressBar::new(a.frames as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed} (eta {eta})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = progress(a.frames, "frames");
     let steps_per_frame = 2; // 1/60 s steps, 30 frames per second
     let (lo, hi) = s.groom.bounds();
     let size = (hi - lo).max_element();
@@ -460,12 +450,8 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     sink.finish()?;
     profile.print_table();
     say!("wrote {} frames and contact_sheet.png to {}", a.frames, a.out.display());
-    if let Some(path) = &a.trace {
-        profile.write_trace(path)?;
-        say!("wrote the GPU trace to {} (open it in Perfetto or chrome://tracing)", path.display());
-    }
-    if let Some(path) = &a.json {
-        let context = serde_json::json!({
+    a.profile_out.write(&profile, || {
+        serde_json::json!({
             "command": "render",
             "device": ctx.info().name,
             "scene": a.input.input.as_ref().map_or("thesis".to_owned(), |p| p.display().to_string()),
@@ -477,10 +463,8 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
             "width": a.width,
             "height": a.height,
             "frames": a.frames,
-        });
-        profile.write_summary(path, context)?;
-        say!("wrote the run's summary to {}", path.display());
-    }
+        })
+    })?;
     if let Some(credit) = s.credit {
         say!("{credit}");
     }

@@ -34,12 +34,6 @@ pub fn tip_drift(state: &SimState, head: &RigidTransform) -> Vec<f32> {
     drift
 }
 
-/// The nearest-rank percentile of sorted values.
-pub fn percentile(sorted: &[f32], percent: usize) -> Option<f32> {
-    let rank = (sorted.len() * percent).div_ceil(100).max(1);
-    sorted.get(rank - 1).copied()
-}
-
 /// The simulated strands in the input's frame and units, as a .hair file.
 pub fn write_final(path: &Path, state: &SimState, head: &RigidTransform, scale: f32) -> CliResult {
     let back = head.matrix().inverse();

@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 
 use clap::ValueEnum;
 use glam::Vec3;
-use indicatif::{ProgressBar, ProgressStyle};
 use vkhair::config::Config;
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::scenes;
@@ -16,8 +15,9 @@ use vkhair::sim::{
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
 use crate::groom_input::InputArgs;
-use crate::profile::{host_now_ns, Profile};
-use crate::sim_check::{percentile, share_inside, tip_drift, write_final, Reference, StepCheck};
+use crate::output::progress;
+use crate::profile::{host_now_ns, percentile, Profile, ProfileArgs};
+use crate::sim_check::{share_inside, tip_drift, write_final, Reference, StepCheck};
 use crate::{say, CliResult};
 
 #[derive(clap::Args)]
@@ -63,13 +63,8 @@ pub struct SimulateArgs {
     /// strand per input strand with --points points each.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Write the GPU passes and the CPU spans as a Chrome trace (opens in
-    /// Perfetto and chrome://tracing).
-    #[arg(long)]
-    trace: Option<PathBuf>,
-    /// Write the run's summary (device, groom, counts, per-pass statistics) as JSON.
-    #[arg(long)]
-    json: Option<PathBuf>,
+    #[command(flatten)]
+    profile_out: ProfileArgs,
 }
 
 /// `--motion`: how the head moves (about the neck `pivot`).
@@ -238,11 +233,7 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
         },
     };
     let mut steps_checked = StepCheck::default();
-    let bar = ProgressBar::new(a.steps as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} steps {elapsed} (eta {eta})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = progress(a.steps, "steps");
     let mut profile = Profile::new("step");
     // Every 10 steps: the share of points inside the mesh collider, and with
     // --check one step of the CPU reference from the GPU's state.
@@ -319,12 +310,8 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
             grid.cell_size * 1e3,
         );
     }
-    if let Some(path) = &a.trace {
-        profile.write_trace(path)?;
-        say!("wrote the GPU trace to {} (open it in Perfetto or chrome://tracing)", path.display());
-    }
-    if let Some(path) = &a.json {
-        let context = serde_json::json!({
+    a.profile_out.write(&profile, || {
+        serde_json::json!({
             "command": "simulate",
             "device": ctx.info().name,
             "groom": label,
@@ -334,10 +321,8 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
             "dt_s": params.dt,
             "iterations": params.iterations,
             "volume": format!("{:?}", params.volume.mode),
-        });
-        profile.write_summary(path, context)?;
-        say!("wrote the run's summary to {}", path.display());
-    }
+        })
+    })?;
     if a.check {
         let whole_run = if params.volume.mode == VolumeMode::Flip {
             None

@@ -39,6 +39,18 @@ fn json(path: &Path) -> Value {
     serde_json::from_slice(&std::fs::read(path).expect("read")).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
+/// The summary's `field` of every pass, by (track, name).
+fn summary_passes(summary: &Value, field: &str) -> BTreeMap<(String, String), Value> {
+    let passes = summary["passes"].as_array().expect("passes");
+    passes
+        .iter()
+        .map(|p| {
+            let key = (p["track"].as_str().expect("track").to_owned(), p["name"].as_str().expect("name").to_owned());
+            (key, p[field].clone())
+        })
+        .collect()
+}
+
 /// Checks that the trace is what Perfetto loads (complete events with numeric
 /// times, properly nested per thread, named threads) and agrees with the
 /// summary: the same passes, each as many times as the summary counts.
@@ -75,15 +87,8 @@ fn check_trace_against_summary(trace: &Value, summary: &Value) {
             }
         }
     }
-    let summarised: BTreeMap<(String, String), u64> = summary["passes"]
-        .as_array()
-        .expect("passes")
-        .iter()
-        .map(|p| {
-            let key = (p["track"].as_str().expect("track").to_owned(), p["name"].as_str().expect("name").to_owned());
-            (key, p["events"].as_u64().expect("events"))
-        })
-        .collect();
+    let summarised: BTreeMap<(String, String), u64> =
+        summary_passes(summary, "events").into_iter().map(|(k, v)| (k, v.as_u64().expect("events"))).collect();
     assert_eq!(counts, summarised, "the trace's GPU events and the summary's passes differ");
     // Calibrated timestamps put the GPU on the CPU's clock: GPU events lie
     // within the CPU frame spans.
@@ -114,15 +119,8 @@ fn check_trace_against_summary(trace: &Value, summary: &Value) {
 
 fn check_table_against_summary(out: &Run, summary: &Value) {
     let (rows, totals) = table(&out.stdout);
-    let summarised: BTreeMap<(String, String), f64> = summary["passes"]
-        .as_array()
-        .expect("passes")
-        .iter()
-        .map(|p| {
-            let key = (p["track"].as_str().expect("track").to_owned(), p["name"].as_str().expect("name").to_owned());
-            (key, p["mean_ms"].as_f64().expect("mean"))
-        })
-        .collect();
+    let summarised: BTreeMap<(String, String), f64> =
+        summary_passes(summary, "mean_ms").into_iter().map(|(k, v)| (k, v.as_f64().expect("mean"))).collect();
     assert_eq!(rows.keys().collect::<Vec<_>>(), summarised.keys().collect::<Vec<_>>(), "{}", out.stdout);
     for (key, mean) in &rows {
         assert!(
