@@ -109,12 +109,10 @@ fn summary() {
     let ctx = GpuContext::headless(&ContextOptions::default()).expect("context");
     let mut profiler = GpuProfiler::new(&ctx, 1, 1024).expect("profiler");
     let steps = 10;
-    let mut csv = String::from(
-        "scene,config,ms_per_step,particle_steps_per_s,ratio_to_cpu,predict_share,solve_share,integrate_share\n",
-    );
+    let mut csv = String::from("scene,config,ms_per_step,particle_steps_per_s,ratio_to_cpu,step_share\n");
     println!("\n{} — simulation step, GPU time from timestamps, CPU reference in the same run", ctx.info().name);
     println!(
-        "{:<26} {:<28} {:>10} {:>14} {:>9}  stage shares (predict/solve/integrate)",
+        "{:<26} {:<28} {:>10} {:>14} {:>9}  share of the step kernel",
         "scene", "config", "ms/step", "particle-st/s", "vs CPU"
     );
     for scene in scenes() {
@@ -127,30 +125,20 @@ fn summary() {
             cpu.step(&head(i + 1)).expect("step");
         }
         let cpu_ms = t0.elapsed().as_secs_f64() * 1e3 / steps as f64;
-        let row = |config: &str, ms: f64, shares: [f64; 3], csv: &mut String| {
+        let row = |config: &str, ms: f64, shares: [f64; 1], csv: &mut String| {
             let rate = particles / (ms / 1e3);
             println!(
-                "{:<26} {:<28} {:>10.3} {:>14.3e} {:>8.2}x  {:.0}/{:.0}/{:.0} %",
+                "{:<26} {:<28} {:>10.3} {:>14.3e} {:>8.2}x  {:.0} %",
                 scene.name,
                 config,
                 ms,
                 rate,
                 cpu_ms / ms,
-                shares[0],
-                shares[1],
-                shares[2]
+                shares[0]
             );
-            let _ = writeln!(
-                csv,
-                "{},{config},{ms:.4},{rate:.1},{:.3},{:.1},{:.1},{:.1}",
-                scene.name,
-                cpu_ms / ms,
-                shares[0],
-                shares[1],
-                shares[2]
-            );
+            let _ = writeln!(csv, "{},{config},{ms:.4},{rate:.1},{:.3},{:.1}", scene.name, cpu_ms / ms, shares[0]);
         };
-        row("cpu reference (baseline)", cpu_ms, [0.0; 3], &mut csv);
+        row("cpu reference (baseline)", cpu_ms, [0.0; 1], &mut csv);
         for (name, params) in variants(&scene.params) {
             let mut sim = make_sim(&ctx, &scene, &params);
             gpu_time(&mut sim, &mut profiler, 0, 2);
@@ -159,7 +147,7 @@ fn summary() {
             let share = |stage: SimStage| {
                 100.0 * totals.iter().find(|(n, _)| n == stage.label()).map_or(0.0, |(_, v)| *v) / total
             };
-            let shares = [share(SimStage::Predict), share(SimStage::Solve), share(SimStage::Integrate)];
+            let shares = [share(SimStage::Step)];
             row(name, t.as_secs_f64() * 1e3 / steps as f64, shares, &mut csv);
         }
     }

@@ -204,6 +204,12 @@ impl GpuContext {
         Ok(GpuContext { device })
     }
 
+    /// What vkhair has recorded on this context's device so far (dispatches,
+    /// barriers, bytes bound): subtract two readings to count a step or a frame.
+    pub fn recorded_work(&self) -> crate::RecordedWork {
+        self.device.counters.read()
+    }
+
     /// The device's name, type, driver and limits.
     pub fn info(&self) -> &DeviceInfo {
         &self.device.info

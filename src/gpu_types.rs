@@ -72,6 +72,15 @@ gpu_struct!(SimStepParams => "SimStepParams" {
     head, gravity_dt, wind, wind_noise, bending, counts, layout_info, shape, previous_head, mesh_grid, mesh_dims
 });
 
+/// Push constants of the simulation step kernel (`SimPush` in `glsl/include/sim.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct SimPush {
+    /// x first sub-step of the dispatch (index into the per-sub-step arrays), y how many.
+    pub range: [u32; 4],
+}
+gpu_struct!(SimPush => "SimPush" { range });
+
 impl SimStepParams {
     /// Gravity, m/s².
     pub fn gravity(&self) -> Vec3 {
@@ -104,10 +113,6 @@ impl SimStepParams {
     /// `SIM_*` flags.
     pub fn flags(&self) -> u32 {
         self.counts[3]
-    }
-    /// Hairs per solver workgroup.
-    pub fn hairs_per_group(&self) -> u32 {
-        self.layout_info[1]
     }
     /// Global shape stiffness per iteration at full strength, and its range.
     pub fn global_shape(&self) -> (f32, f32) {
@@ -457,6 +462,7 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<ScaleAddPush>(reflection, &mut problems);
     check::<LayoutProbe>(reflection, &mut problems);
     check::<SimStepParams>(reflection, &mut problems);
+    check::<SimPush>(reflection, &mut problems);
     check::<GpuCollider>(reflection, &mut problems);
     check::<SdfPush>(reflection, &mut problems);
     check::<SmoothPush>(reflection, &mut problems);

@@ -101,6 +101,7 @@ pub use error::{Error, FileFormat, Result};
 pub use groom::Groom;
 pub use profiler::{Clock, GpuProfiler, PassTiming, ProfileReport, ScopeId};
 pub use requirements::{requirements, RequiredFeatures, Requirements, API_VERSION};
+pub use vk::counters::RecordedWork;
 pub use vk::debug::{Severity, ValidationLog, ValidationMessage};
 pub use vk::device::DeviceInfo;
 

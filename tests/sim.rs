@@ -84,6 +84,56 @@ fn gpu_matches_cpu_with_substeps() {
     compare(gpu.ctx(), &groom, &params, &[1, 30]);
 }
 
+/// Sub-steps run inside one dispatch keep the DFTL correction vectors and the
+/// local shape's rest frames per sub-step, as the reference does.
+#[test]
+fn gpu_matches_cpu_with_substeps_in_dftl_mode_and_with_local_shape() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(120, 6, 7);
+    let dftl = SimParams { substeps: 3, solver: SolverMode::Dftl, ..SimParams::default() };
+    compare(gpu.ctx(), &groom, &dftl, &[1, 20]);
+    let local = SimParams { substeps: 3, iterations: 6, local_shape_stiffness: 0.5, ..SimParams::styled() };
+    compare(gpu.ctx(), &groom, &local, &[1, 20]);
+}
+
+/// The step is one dispatch however many sub-steps it has (with the volume stage
+/// off), between two barriers (uploads, then the kernel), and it writes each
+/// particle's position and velocity once; with the volume stage on, one step
+/// dispatch per sub-step.
+#[test]
+fn a_step_is_one_dispatch_without_the_volume_stage() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(100, 16, 3);
+    let particles = groom.point_count() as u64;
+    for substeps in [1, 4] {
+        let params = SimParams { substeps, ..SimParams::default() };
+        let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
+        // What one submission adds besides its steps cancels out: 4 steps less 1.
+        let mut run = |steps| {
+            let before = gpu.ctx().recorded_work();
+            sim.run(steps, |i| head_at(i, &params), None).expect("run");
+            gpu.ctx().recorded_work() - before
+        };
+        let (one, four) = (run(1), run(4));
+        let work = four - one;
+        assert_eq!(work.dispatches, 3, "{substeps} sub-steps: {work:?}");
+        assert_eq!(work.barriers, 6, "{substeps} sub-steps: {work:?}");
+        assert_eq!(work.bytes_written, 3 * particles * 32, "positions and velocities, once per step: {work:?}");
+        // Positions, velocities and rest positions (16 bytes each), rest lengths (4).
+        assert!(work.bytes_read >= 3 * particles * 52, "{work:?}");
+    }
+    let params = SimParams {
+        substeps: 2,
+        volume: vkhair::sim::VolumeParams { mode: vkhair::sim::VolumeMode::Friction, ..Default::default() },
+        ..SimParams::default()
+    };
+    let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
+    let mut profiler = vkhair::GpuProfiler::new(gpu.ctx(), 1, 64).expect("profiler");
+    let report = sim.run(1, |i| head_at(i, &params), Some(&mut profiler)).expect("run").expect("timestamps");
+    let steps = report.passes.iter().filter(|p| p.name == vkhair::sim::SimStage::Step.label()).count();
+    assert_eq!(steps, 2, "one step dispatch per sub-step with the volume stage: {report}");
+}
+
 #[test]
 fn gpu_matches_cpu_in_dftl_mode() {
     let gpu = Gpu::new();

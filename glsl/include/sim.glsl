@@ -1,4 +1,4 @@
-// Declarations shared by the simulation stages (glsl/sim/*.comp).
+// Declarations shared by the simulation kernels (glsl/sim/step.comp and the volume stage).
 // The CPU reference (src/sim/reference.rs) mirrors every function here with
 // the same operation order; `precise` keeps the compiler from fusing or
 // reordering float operations so both sides round the same way.
@@ -7,7 +7,7 @@
 
 #include "hash.glsl"
 
-// Per-step parameters (uniform block, binding 0). Twin: gpu_types::SimStepParams.
+// Per-sub-step parameters (one array entry per sub-step, binding 0). Twin: gpu_types::SimStepParams.
 struct SimStepParams {
     mat4 head;            // world-from-head transform at the end of this step
     vec4 gravity_dt;      // xyz gravity (m/s²), w time step (s)
@@ -21,6 +21,11 @@ struct SimStepParams {
     mat4 previous_head;   // world-from-head transform at the start of this step
     vec4 mesh_grid;       // mesh collider: xyz grid point (0, 0, 0) in the head frame, w cell edge
     uvec4 mesh_dims;      // xyz grid points per axis, w 1 when a mesh collider is set
+};
+
+// Push constants of the step kernel. Twin: gpu_types::SimPush.
+struct SimPush {
+    uvec4 range;          // x first sub-step (index into the per-sub-step arrays), y sub-steps, zw unused
 };
 
 // One collider in world space. Twin: gpu_types::GpuCollider.

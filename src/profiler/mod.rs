@@ -80,7 +80,7 @@ struct Slot {
 ///     })?;
 ///     result?;
 ///     let report = profiler.drain().pop().expect("frame 0 has completed");
-///     assert!(report.pass(SimStage::Solve.label()).is_some());
+///     assert!(report.pass(SimStage::Step.label()).is_some());
 ///     println!("{report}");
 /// }
 /// log.assert_clean();

@@ -5,25 +5,31 @@
 //! A step is `substeps` sub-steps, each running these stages in order (the
 //! [`SimStage`] enum names their debug labels and timestamp scopes):
 //!
-//! 1. **Predict** (`predict.rs`, `glsl/sim/predict.comp`): external forces —
-//!    gravity, wind with deterministic gust noise, a spring toward the rest
-//!    shape in the head frame, each switchable — then v* = v + dt·a,
-//!    x* = x + dt·v*. Pinned particles (roots) follow the head transform.
-//! 2. **Solve** (`solve.rs`, `glsl/sim/solve.comp`): ONE dispatch, one
-//!    workgroup per group of key hairs, positions in shared memory; for N
-//!    iterations the even then odd distance constraints, two sets of bending
-//!    constraints, in the last iteration the local shape constraints (one sweep
-//!    root to tip, [`SimParams::local_shape_stiffness`]), the global shape
-//!    constraint (each particle pulled toward its rest position in the head
-//!    frame, [`SimParams::global_shape_stiffness`]) and the body collisions
-//!    (spheres, capsules and the [`MeshCollider`]'s field), separated by
-//!    `barrier()`; then friction against the mesh collider and one global write
-//!    at the end. DFTL mode replaces this with one follow-the-leader sweep and
-//!    stores correction vectors.
-//! 3. **Integrate** (`integrate.rs`, `glsl/sim/integrate.comp`): velocity from
-//!    the position change (plus the DFTL correction), damping, and the final
-//!    state into the other half of the double buffer.
-//! 4. **Volume** ([`volume`], `glsl/sim/volume/`), when
+//! 1. **Step** (`step.rs`, `glsl/sim/step.comp`): ONE dispatch, one
+//!    workgroup per group of key hairs, each point's state loaded once into
+//!    registers and shared memory; per sub-step
+//!    1. external forces — gravity, wind with deterministic gust noise, a
+//!       spring toward the rest shape in the head frame, each switchable —
+//!       then v* = v + dt·a, x* = x + dt·v*; pinned particles (roots) follow
+//!       the head transform;
+//!    2. the constraint solve: for N iterations the even then odd distance
+//!       constraints, two sets of bending constraints, in the last iteration
+//!       the local shape constraints (one sweep root to tip,
+//!       [`SimParams::local_shape_stiffness`]), the global shape constraint
+//!       (each particle pulled toward its rest position in the head frame,
+//!       [`SimParams::global_shape_stiffness`]) and the body collisions
+//!       (spheres, capsules and the [`MeshCollider`]'s field), separated by
+//!       barriers; then friction against the mesh collider. DFTL mode replaces
+//!       the iterations with one follow-the-leader sweep and keeps the
+//!       correction vectors in shared memory;
+//!    3. velocity from the position change (plus the DFTL correction) and
+//!       damping;
+//!
+//!    and one store of the final state into the other half of the double
+//!    buffer. With the volume stage off, the one dispatch runs every sub-step
+//!    of the step; with it on, one dispatch per sub-step, since the volume
+//!    stage exchanges velocities between all hairs after each.
+//! 2. **Volume** ([`volume`], `glsl/sim/volume/`), when
 //!    [`SimParams::volume`] switches it on: particles sorted into a MAC grid,
 //!    then either FLIP (pressure projection with a GPU conjugate-gradient solve)
 //!    or density friction/repulsion corrects the new velocities. Four
@@ -38,14 +44,12 @@
 
 mod cpu;
 mod driver;
-mod integrate;
 mod mesh_collider;
 pub mod motion;
 mod params;
-mod predict;
 pub(crate) mod reference;
-mod solve;
 mod state;
+mod step;
 mod view;
 pub mod volume;
 
@@ -57,13 +61,14 @@ pub use cpu::{CpuHairSim, REFERENCE_STEP_TOLERANCE_M};
 pub use driver::{FixedStepDriver, StepPlan};
 pub use mesh_collider::{MeshCollider, MeshColliderParams, MESH_COLLIDER_BUILD_LABEL};
 pub(crate) use params::validate_colliders;
-pub use params::{Collider, RigidTransform, SimParams, SolverMode, MAX_COLLIDERS, MAX_SIM_POINTS};
+pub use params::{Collider, RigidTransform, SimParams, SolverMode, MAX_COLLIDERS, MAX_SIM_POINTS, MAX_SUBSTEPS};
 pub use state::SimState;
 pub use view::KeyHairs;
 pub use volume::{Preconditioner, VolumeGrid, VolumeMode, VolumeParams, VolumeStats};
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
+use crate::gpu_types::SimPush;
 use crate::groom::mesh::TriMesh;
 use crate::groom::Groom;
 use crate::profiler::GpuProfiler;
@@ -72,42 +77,35 @@ use crate::vk::barrier::{self, AccessKind};
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 use crate::vk::pipeline::ComputePipeline;
-use params::SubstepPlanner;
+use params::{SubstepInputs, SubstepPlanner};
 use state::GpuState;
 
-/// The stages of a simulation sub-step, in order.
+/// The stages of a simulation step, in order (the timestamp scopes of
+/// [`HairSim::record_step`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum SimStage {
-    /// Stage 1: forces and prediction.
-    Predict,
-    /// Stage 2: constraint solve.
-    Solve,
-    /// Stage 3: velocity update, damping, final state.
-    Integrate,
-    /// Stage 4a: binning and counting sort of particles by grid cell.
+    /// Stage 1: prediction, constraint solve and velocity update of the sub-steps
+    /// (all of a step's with the volume stage off, else one), one dispatch.
+    Step,
+    /// Stage 2a: binning and counting sort of particles by grid cell.
     VolumeSort,
-    /// Stage 4b: cell densities and labels, particle velocities to the MAC faces.
+    /// Stage 2b: cell densities and labels, particle velocities to the MAC faces.
     VolumeTransfer,
-    /// Stage 4c: pressure solve and projection (FLIP mode only).
+    /// Stage 2c: pressure solve and projection (FLIP mode only).
     VolumePressure,
-    /// Stage 4d: grid velocities back to the particles.
+    /// Stage 2d: grid velocities back to the particles.
     VolumeUpdate,
 }
 
 impl SimStage {
     /// Every stage in execution order.
-    pub const ALL: [SimStage; 7] = [
-        SimStage::Predict,
-        SimStage::Solve,
-        SimStage::Integrate,
+    pub const ALL: [SimStage; 5] = [
+        SimStage::Step,
         SimStage::VolumeSort,
         SimStage::VolumeTransfer,
         SimStage::VolumePressure,
         SimStage::VolumeUpdate,
     ];
-
-    /// The position-based dynamics stages, which always run.
-    const PBD: [SimStage; 3] = [SimStage::Predict, SimStage::Solve, SimStage::Integrate];
 
     /// The scopes of the volume stage.
     const VOLUME: [SimStage; 4] =
@@ -116,9 +114,7 @@ impl SimStage {
     /// The debug label and timestamp scope name of the stage.
     pub fn label(self) -> &'static str {
         match self {
-            SimStage::Predict => "vkhair sim: predict",
-            SimStage::Solve => "vkhair sim: solve",
-            SimStage::Integrate => "vkhair sim: integrate",
+            SimStage::Step => "vkhair sim: step",
             SimStage::VolumeSort => "vkhair sim: volume sort",
             SimStage::VolumeTransfer => "vkhair sim: volume transfer",
             SimStage::VolumePressure => "vkhair sim: volume pressure",
@@ -126,7 +122,7 @@ impl SimStage {
         }
     }
 
-    /// Position of the stage in a sub-step (its timestamp slot).
+    /// Position of the stage in a step (its timestamp slot).
     pub fn index(self) -> usize {
         self as usize
     }
@@ -135,29 +131,6 @@ impl SimStage {
     pub fn is_volume(self) -> bool {
         Self::VOLUME.contains(&self)
     }
-
-    fn shader(self) -> &'static crate::vk::shaders::ShaderSource {
-        match self {
-            SimStage::Predict => predict::SHADER,
-            SimStage::Solve => solve::SHADER,
-            _ => integrate::SHADER,
-        }
-    }
-
-    fn threads(self, strands: u32, points: u32, hairs_per_group: u32) -> u32 {
-        match self {
-            SimStage::Predict => predict::threads(strands, points, hairs_per_group),
-            SimStage::Solve => solve::threads(strands, points, hairs_per_group),
-            _ => integrate::threads(strands, points, hairs_per_group),
-        }
-    }
-}
-
-struct StagePipeline {
-    stage: SimStage,
-    pipeline: ComputePipeline,
-    /// Descriptor sets reading half 0 and half 1 of the double buffer.
-    sets: [vk::DescriptorSet; 2],
 }
 
 /// The GPU hair simulation (see the module docs for the stage list).
@@ -193,7 +166,10 @@ struct StagePipeline {
 pub struct HairSim {
     device: Arc<Device>,
     gpu: GpuState,
-    stages: Vec<StagePipeline>,
+    /// The step kernel.
+    pipeline: ComputePipeline,
+    /// Its descriptor sets reading half 0 and half 1 of the double buffer.
+    sets: [vk::DescriptorSet; 2],
     planner: SubstepPlanner,
     /// Rest shape and lengths as last uploaded (positions unused).
     shape: SimState,
@@ -223,20 +199,16 @@ impl HairSim {
         let subgroup = if device.full_subgroups { device.info.subgroup_size } else { 0 };
         let planner = SubstepPlanner::new(params, head, state.strands, state.points, subgroup)?;
         let gpu = GpuState::new(&device, state)?;
-        let mut stages = Vec::new();
-        for stage in SimStage::PBD {
-            let full = stage == SimStage::Solve && device.full_subgroups;
-            let pipeline = ComputePipeline::with_full_subgroups(&device, stage.shader(), 2, full)?;
-            let sets = [
-                pipeline.declared_buffer_set(0, &gpu.bindings(0, None))?,
-                pipeline.declared_buffer_set(0, &gpu.bindings(1, None))?,
-            ];
-            stages.push(StagePipeline { stage, pipeline, sets });
-        }
+        let pipeline = ComputePipeline::with_full_subgroups(&device, step::SHADER, 2, device.full_subgroups)?;
+        let sets = [
+            pipeline.declared_buffer_set(0, &gpu.bindings(0, None))?,
+            pipeline.declared_buffer_set(0, &gpu.bindings(1, None))?,
+        ];
         let mut sim = HairSim {
             device,
             gpu,
-            stages,
+            pipeline,
+            sets,
             planner,
             shape: state.clone(),
             pending_rest: Vec::new(),
@@ -269,7 +241,8 @@ impl HairSim {
         let g = &self.gpu;
         let particles = [(&g.positions[0], &g.velocities[0]), (&g.positions[1], &g.velocities[1])];
         let mesh_field = self.mesh.as_ref().map_or(&g.no_mesh, |m| &m.field);
-        self.volume = Some(volume::VolumeStage::new(&self.device, grid, params, &g.colliders, mesh_field, &particles)?);
+        self.volume =
+            Some(volume::VolumeStage::new(&self.device, grid, params, &g.volume_colliders, mesh_field, &particles)?);
         Ok(())
     }
 
@@ -308,12 +281,10 @@ impl HairSim {
         }
         self.device.wait_idle()?;
         let field = mesh.as_ref().map(|m| &m.field);
-        for stage in &self.stages {
-            for (parity, &set) in stage.sets.iter().enumerate() {
-                // SAFETY: the set was allocated by this pipeline for set 0, and the
-                // device is idle; recording happens only through `&mut self`.
-                unsafe { stage.pipeline.rewrite_declared(set, 0, &self.gpu.bindings(parity, field))? };
-            }
+        for (parity, &set) in self.sets.iter().enumerate() {
+            // SAFETY: the set was allocated by this pipeline for set 0, and the
+            // device is idle; recording happens only through `&mut self`.
+            unsafe { self.pipeline.rewrite_declared(set, 0, &self.gpu.bindings(parity, field))? };
         }
         self.planner.mesh = mesh.as_ref().map(MeshCollider::grid);
         let previous = std::mem::replace(&mut self.mesh, mesh);
@@ -423,7 +394,11 @@ impl HairSim {
     }
 
     /// Records one step that ends with the head at `head` into `cmd`, with a debug
-    /// label and (when a profiler is given) a timestamp scope per stage.
+    /// label and (when a profiler is given) a timestamp scope per stage: with the
+    /// volume stage off one dispatch and two barriers (uploads of the sub-steps'
+    /// parameters, then the dispatch); with it on, per sub-step the step dispatch
+    /// followed by the volume stage's kernels. Leaves the step pipeline or the
+    /// volume stage's last kernel bound.
     ///
     /// # Safety
     /// `cmd` is a command buffer of the context's device in the recording state,
@@ -439,71 +414,108 @@ impl HairSim {
         mut profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
         let inputs = self.planner.next(head)?;
-        let (strands, points) = (self.planner.strands, self.planner.points);
-        let d = &self.device;
-        let entry = barrier::memory(
-            &[AccessKind::AnyWrite],
-            &[
-                AccessKind::TransferWrite,
-                AccessKind::ComputeRead,
-                AccessKind::ComputeWrite,
-                AccessKind::ComputeUniformRead,
-            ],
-        );
-        let uploaded = barrier::memory(
-            &[AccessKind::TransferWrite],
-            &[
-                AccessKind::ComputeUniformRead,
-                AccessKind::ComputeRead,
-                AccessKind::ComputeWrite,
-                AccessKind::IndirectRead,
-            ],
-        );
-        let between = barrier::memory(&[AccessKind::ComputeWrite], barrier::COMPUTE_READ_WRITE);
-        for sub in &inputs {
-            // SAFETY: guaranteed by the caller; all buffers belong to this device, and
-            // update sizes are multiples of 4 below 64 KiB (checked by construction).
-            unsafe {
-                d.cmd_barrier(cmd, &[entry], &[], &[]);
-                d.raw.cmd_update_buffer(cmd, self.gpu.params.raw(), 0, bytemuck::bytes_of(&sub.params));
-                if !sub.colliders.is_empty() {
-                    d.raw.cmd_update_buffer(cmd, self.gpu.colliders.raw(), 0, bytemuck::cast_slice(&sub.colliders));
-                }
-                for range in self.pending_rest.drain(..) {
-                    let rest = bytemuck::cast_slice(&self.shape.rest[range.clone()]);
-                    let lengths = bytemuck::cast_slice(&self.shape.rest_lengths[range.clone()]);
-                    update_chunked(d, cmd, self.gpu.rest.raw(), range.start as u64 * 16, rest);
-                    update_chunked(d, cmd, self.gpu.rest_lengths.raw(), range.start as u64 * 4, lengths);
-                }
+        let Some(first) = inputs.first() else { return Ok(()) };
+        let substeps = inputs.len() as u32;
+        // SAFETY (whole body): guaranteed by the caller; all buffers belong to this
+        // device, and update sizes are multiples of 4 below 64 KiB (by construction).
+        unsafe {
+            self.record_uploads(cmd, &inputs, |cmd| {
                 if let Some(volume) = &self.volume {
-                    let colliders = self.planner.colliders.len() as u32;
-                    volume.record_uploads(cmd, &sub.volume_params(&volume.grid, &volume.params, colliders));
+                    self.record_volume_uploads(cmd, volume, first);
                 }
-                d.cmd_barrier(cmd, &[uploaded], &[], &[]);
+            });
+            self.pending_rest.clear();
+            if self.volume.is_none() {
+                self.record_dispatch(cmd, [0, substeps], &mut profiler);
+                self.current = 1 - self.current;
+                return Ok(());
             }
-            let hairs_per_group = sub.params.hairs_per_group();
-            for (k, stage) in self.stages.iter().enumerate() {
-                let threads = stage.stage.threads(strands, points, hairs_per_group);
-                // SAFETY: as above; the profiler contract is the caller's.
-                unsafe {
-                    let last = k + 1 == self.stages.len() && self.volume.is_none();
-                    PassScope::record(d, cmd, &mut profiler, stage.stage.label(), LabelColor::Compute, || {
-                        stage.pipeline.bind(cmd, &[stage.sets[self.current]]);
-                        stage.pipeline.dispatch_threads(cmd, [threads, 1, 1]);
-                        if !last {
-                            d.cmd_barrier(cmd, &[between], &[], &[]);
-                        }
-                    });
+            let between = barrier::memory(&[AccessKind::ComputeWrite], barrier::COMPUTE_READ_WRITE);
+            for (k, sub) in inputs.iter().enumerate() {
+                let Some(volume) = &self.volume else { break };
+                if k > 0 {
+                    self.device.cmd_barrier(cmd, &[entry_barrier()], &[], &[]);
+                    self.record_volume_uploads(cmd, volume, sub);
+                    self.device.cmd_barrier(cmd, &[uploaded_barrier()], &[], &[]);
                 }
-            }
-            if let Some(volume) = &self.volume {
+                self.record_dispatch(cmd, [k as u32, 1], &mut profiler);
+                self.device.cmd_barrier(cmd, &[between], &[], &[]);
                 let labels = SimStage::VOLUME.map(SimStage::label);
-                // SAFETY: as above; the barrier after integrate made its writes visible.
-                unsafe { volume.record(cmd, 1 - self.current, labels, profiler.as_deref_mut()) };
+                // The barrier above made the step's writes visible.
+                volume.record(cmd, 1 - self.current, labels, profiler.as_deref_mut());
+                self.current = 1 - self.current;
             }
-            self.current = 1 - self.current;
         }
         Ok(())
+    }
+
+    /// Records the uploads of a step between the entry and the uploaded barrier:
+    /// the sub-steps' parameters and colliders, pending rest data, and `extra`.
+    ///
+    /// # Safety
+    /// As [`HairSim::record_step`].
+    unsafe fn record_uploads(
+        &self,
+        cmd: vk::CommandBuffer,
+        inputs: &[SubstepInputs],
+        extra: impl FnOnce(vk::CommandBuffer),
+    ) {
+        let d = &self.device;
+        let params: Vec<_> = inputs.iter().map(|sub| sub.params).collect();
+        // SAFETY: guaranteed by the caller; sizes are multiples of 4, each update
+        // below 64 KiB (at most MAX_SUBSTEPS parameter blocks of 256 bytes, at
+        // most MAX_COLLIDERS colliders of 32 bytes).
+        unsafe {
+            d.cmd_barrier(cmd, &[entry_barrier()], &[], &[]);
+            d.raw.cmd_update_buffer(cmd, self.gpu.params.raw(), 0, bytemuck::cast_slice(&params));
+            for (k, sub) in inputs.iter().enumerate().filter(|(_, sub)| !sub.colliders.is_empty()) {
+                let offset = state::collider_offset(k);
+                d.raw.cmd_update_buffer(cmd, self.gpu.colliders.raw(), offset, bytemuck::cast_slice(&sub.colliders));
+            }
+            for range in &self.pending_rest {
+                let rest = bytemuck::cast_slice(&self.shape.rest[range.clone()]);
+                let lengths = bytemuck::cast_slice(&self.shape.rest_lengths[range.clone()]);
+                update_chunked(d, cmd, self.gpu.rest.raw(), range.start as u64 * 16, rest);
+                update_chunked(d, cmd, self.gpu.rest_lengths.raw(), range.start as u64 * 4, lengths);
+            }
+            extra(cmd);
+            d.cmd_barrier(cmd, &[uploaded_barrier()], &[], &[]);
+        }
+    }
+
+    /// The volume stage's uploads for sub-step `sub`: its parameters and the
+    /// colliders it sees.
+    ///
+    /// # Safety
+    /// As [`HairSim::record_step`], between an entry and an uploaded barrier.
+    unsafe fn record_volume_uploads(&self, cmd: vk::CommandBuffer, volume: &volume::VolumeStage, sub: &SubstepInputs) {
+        let colliders = self.planner.colliders.len() as u32;
+        // SAFETY: guaranteed by the caller; at most MAX_COLLIDERS colliders of 32 bytes.
+        unsafe {
+            if !sub.colliders.is_empty() {
+                let bytes = bytemuck::cast_slice(&sub.colliders);
+                self.device.raw.cmd_update_buffer(cmd, self.gpu.volume_colliders.raw(), 0, bytes);
+            }
+            volume.record_uploads(cmd, &sub.volume_params(&volume.grid, &volume.params, colliders));
+        }
+    }
+
+    /// Records the step kernel for sub-steps `range` = [first, count] in a
+    /// timestamp scope.
+    ///
+    /// # Safety
+    /// As [`HairSim::record_step`], after the uploads' barrier.
+    unsafe fn record_dispatch(&self, cmd: vk::CommandBuffer, range: [u32; 2], profiler: &mut Option<&mut GpuProfiler>) {
+        let (strands, groups) = (self.planner.strands, self.planner.packing().hairs_per_group);
+        let push = SimPush { range: [range[0], range[1], 0, 0] };
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            PassScope::record(&self.device, cmd, profiler, SimStage::Step.label(), LabelColor::Compute, || {
+                self.pipeline.bind(cmd, &[self.sets[self.current]]);
+                self.pipeline.push(cmd, &push);
+                self.pipeline.dispatch_threads(cmd, [step::threads(strands, groups), 1, 1]);
+            });
+        }
     }
 
     /// Reads the latest state back (this submits and waits for the queue).
@@ -529,7 +541,7 @@ impl HairSim {
     /// Runs `steps` steps with the head at `head(i)` for step i, in one submission
     /// (headless use: tests, tools, benchmarks; this submits and waits). With a
     /// profiler, returns the per-stage GPU timings of the whole run (the profiler
-    /// needs 3 × steps × substeps scopes).
+    /// needs one scope per step, or 5 per sub-step with the volume stage).
     pub fn run(
         &mut self,
         steps: usize,
@@ -557,6 +569,22 @@ impl HairSim {
         result?;
         Ok(profiler.and_then(|p| p.drain().pop()))
     }
+}
+
+/// Earlier work (a previous step's reads and writes) before a step's uploads.
+fn entry_barrier() -> vk::MemoryBarrier2<'static> {
+    barrier::memory(
+        &[AccessKind::AnyWrite],
+        &[AccessKind::TransferWrite, AccessKind::ComputeRead, AccessKind::ComputeWrite, AccessKind::ComputeUniformRead],
+    )
+}
+
+/// A step's uploads before the kernels that read them.
+fn uploaded_barrier() -> vk::MemoryBarrier2<'static> {
+    barrier::memory(
+        &[AccessKind::TransferWrite],
+        &[AccessKind::ComputeUniformRead, AccessKind::ComputeRead, AccessKind::ComputeWrite, AccessKind::IndirectRead],
+    )
 }
 
 /// `vkCmdUpdateBuffer` in chunks of at most 64 KiB.

@@ -13,6 +13,8 @@ use crate::gpu_types::{GpuCollider, SimStepParams};
 pub const MAX_COLLIDERS: usize = crate::limits::SIM_MAX_COLLIDERS as usize;
 /// Most points per key hair the GPU solver handles (one 64-invocation workgroup).
 pub const MAX_SIM_POINTS: usize = crate::limits::SIM_WORKGROUP as usize;
+/// Most sub-steps per step ([`SimParams::substeps`]).
+pub const MAX_SUBSTEPS: u32 = 64;
 
 /// How the constraints are solved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
@@ -194,7 +196,7 @@ impl SimParams {
         if !(self.dt.is_finite() && self.dt > 0.0 && self.dt <= 0.1) {
             return Err(Error::param("dt", self.dt, "(0, 0.1] seconds"));
         }
-        if !(1..=64).contains(&self.substeps) {
+        if !(1..=MAX_SUBSTEPS).contains(&self.substeps) {
             return Err(Error::param("substeps", self.substeps, "1..=64"));
         }
         if !(1..=1000).contains(&self.iterations) {
@@ -440,8 +442,8 @@ impl SubstepPlanner {
     }
 
     /// How the solver packs hairs for the current parameters.
-    pub(crate) fn packing(&self) -> super::solve::Packing {
-        super::solve::packing(
+    pub(crate) fn packing(&self) -> super::step::Packing {
+        super::step::packing(
             self.points,
             self.subgroup_size,
             self.params.hairs_per_workgroup,

@@ -363,7 +363,7 @@ fn solve(
                 }
             }
             if local_shape && iteration + 1 == p.iterations() {
-                // `local_shape_sweep` in glsl/sim/solve.comp.
+                // `local_shape_sweep` in glsl/sim/step.comp.
                 for (j, &(dir, offset)) in local.iter().enumerate().skip(1) {
                     let (parent, child) = (s[j - 1], s[j]);
                     let mut carried = offset;

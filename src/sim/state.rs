@@ -7,8 +7,6 @@
 //! | --- | --- | --- |
 //! | positions ×2 | vec4 | world position, w inverse mass (0 = pinned to the head) |
 //! | velocities ×2 | vec4 | world velocity (m/s) |
-//! | predicted | vec4 | scratch: predicted, then solved positions |
-//! | correction | vec4 | scratch: DFTL correction vectors |
 //! | rest | vec4 | rest position in the head frame, w collision radius |
 //! | rest lengths | f32 | rest length of the segment to the next point |
 //!
@@ -20,7 +18,7 @@ use std::sync::Arc;
 
 use glam::{Vec3, Vec4};
 
-use super::params::{RigidTransform, SimParams, MAX_COLLIDERS, MAX_SIM_POINTS};
+use super::params::{RigidTransform, SimParams, MAX_COLLIDERS, MAX_SIM_POINTS, MAX_SUBSTEPS};
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuCollider, SimStepParams};
 use crate::groom::Groom;
@@ -159,23 +157,29 @@ impl SimState {
 pub(crate) struct GpuState {
     pub positions: [Buffer; 2],
     pub velocities: [Buffer; 2],
-    pub predicted: Buffer,
-    pub correction: Buffer,
     pub rest: Buffer,
     pub rest_lengths: Buffer,
+    /// The colliders of every sub-step of a step, [`MAX_COLLIDERS`] entries each
+    /// (see [`collider_offset`]).
     pub colliders: Buffer,
+    /// The colliders of the current sub-step, as the volume stage reads them.
+    pub volume_colliders: Buffer,
+    /// The parameters of every sub-step of a step.
     pub params: Buffer,
     /// Bound as the mesh collider's field while none is set (never read then).
     pub no_mesh: Buffer,
 }
 
-/// Binding numbers shared by the stage shaders (see `glsl/sim/*.comp`).
+/// Byte offset of sub-step `k`'s colliders in [`GpuState::colliders`].
+pub(crate) fn collider_offset(k: usize) -> u64 {
+    (k * MAX_COLLIDERS * std::mem::size_of::<GpuCollider>()) as u64
+}
+
+/// Binding numbers of the step kernel (see `glsl/sim/step.comp`).
 pub(crate) mod binding {
     pub const PARAMS: u32 = 0;
     pub const POS_IN: u32 = 1;
     pub const VEL_IN: u32 = 2;
-    pub const PREDICTED: u32 = 3;
-    pub const CORRECTION: u32 = 4;
     pub const REST: u32 = 5;
     pub const REST_LENGTH: u32 = 6;
     pub const COLLIDERS: u32 = 7;
@@ -205,23 +209,19 @@ impl GpuState {
                 storage("vkhair sim velocities 0", vec4_bytes)?,
                 storage("vkhair sim velocities 1", vec4_bytes)?,
             ],
-            predicted: storage("vkhair sim predicted", vec4_bytes)?,
-            correction: storage("vkhair sim correction", vec4_bytes)?,
             rest: storage("vkhair sim rest", vec4_bytes)?,
             rest_lengths: storage("vkhair sim rest lengths", n * 4)?,
-            colliders: Buffer::uniform(
-                device,
-                "vkhair sim colliders",
-                (MAX_COLLIDERS * std::mem::size_of::<GpuCollider>()) as u64,
+            colliders: storage("vkhair sim colliders", collider_offset(MAX_SUBSTEPS as usize))?,
+            volume_colliders: Buffer::uniform(device, "vkhair sim volume colliders", collider_offset(1))?,
+            params: storage(
+                "vkhair sim params",
+                u64::from(MAX_SUBSTEPS) * std::mem::size_of::<SimStepParams>() as u64,
             )?,
-            params: Buffer::uniform(device, "vkhair sim params", std::mem::size_of::<SimStepParams>() as u64)?,
             no_mesh: storage("vkhair sim no mesh collider", 16)?,
         };
         gpu.upload(device, state, 0)?;
         device.upload_pod(&gpu.rest, &state.rest)?;
         device.upload_pod(&gpu.rest_lengths, &state.rest_lengths)?;
-        device.upload_pod(&gpu.correction, &vec![Vec4::ZERO; n as usize])?;
-        device.upload_pod(&gpu.predicted, &state.positions)?;
         Ok(gpu)
     }
 
@@ -233,14 +233,12 @@ impl GpuState {
 
     /// Buffers by binding number for half `parity` (reads `parity`, writes the other),
     /// with `mesh` as the mesh collider's field (none: the placeholder).
-    pub(crate) fn bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 11] {
+    pub(crate) fn bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 9] {
         use binding::*;
         [
             (PARAMS, &self.params),
             (POS_IN, &self.positions[parity]),
             (VEL_IN, &self.velocities[parity]),
-            (PREDICTED, &self.predicted),
-            (CORRECTION, &self.correction),
             (REST, &self.rest),
             (REST_LENGTH, &self.rest_lengths),
             (COLLIDERS, &self.colliders),

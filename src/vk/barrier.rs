@@ -219,6 +219,7 @@ impl Device {
             .memory_barriers(memory)
             .buffer_memory_barriers(buffers)
             .image_memory_barriers(images);
+        self.counters.barrier();
         // SAFETY: guaranteed by the caller.
         unsafe { self.raw.cmd_pipeline_barrier2(cmd, &info) };
     }

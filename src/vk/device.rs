@@ -158,6 +158,8 @@ pub(crate) struct Device {
     /// Whether kernels with a reduction use their shared-memory variant: where
     /// [`DeviceInfo::subgroup_reductions`] is false, or forced (tests).
     pub shared_reductions: std::sync::atomic::AtomicBool,
+    /// What has been recorded on this device.
+    pub counters: super::counters::Counters,
     owned: Option<Owned>,
 }
 
@@ -195,6 +197,7 @@ impl Device {
             allocator: parts.allocator,
             submit_lock: Mutex::new(()),
             shared_reductions,
+            counters: Default::default(),
             owned: parts.owned,
         };
         if record.allocator.is_none() {

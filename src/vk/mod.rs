@@ -3,6 +3,7 @@
 
 pub(crate) mod barrier;
 pub(crate) mod buffer;
+pub(crate) mod counters;
 pub(crate) mod debug;
 pub(crate) mod device;
 pub(crate) mod external;

@@ -44,6 +44,10 @@ pub(crate) struct Binding {
     pub ty: vk::DescriptorType,
     pub count: u32,
     pub name: String,
+    /// Whether the shader may read the binding (not `NonReadable`).
+    pub reads: bool,
+    /// Whether the shader may write it (a storage buffer or image not `NonWritable`).
+    pub writes: bool,
 }
 
 /// What a shader module declares.
@@ -100,6 +104,20 @@ impl Module {
 
     fn member_decoration(&self, target: u32, member: u32, which: Decoration) -> Option<&[Operand]> {
         self.member_decorations.get(&(target, member))?.iter().find(|(d, _)| *d == which).map(|(_, o)| o.as_slice())
+    }
+
+    /// Whether variable `var` of block (or image) type `element` is read and
+    /// written: `NonReadable`/`NonWritable` on the variable or on every member of
+    /// its block; only storage buffers and images are written.
+    fn access(&self, var: u32, element: u32, ty: vk::DescriptorType) -> (bool, bool) {
+        let members =
+            self.defs.get(&element).filter(|d| d.class.opcode == Op::TypeStruct).map_or(0, |d| d.operands.len());
+        let has = |which: Decoration| {
+            self.decoration(var, which).is_some()
+                || (members > 0 && (0..members as u32).all(|i| self.member_decoration(element, i, which).is_some()))
+        };
+        let writable = matches!(ty, vk::DescriptorType::STORAGE_BUFFER | vk::DescriptorType::STORAGE_IMAGE);
+        (!has(Decoration::NonReadable), writable && !has(Decoration::NonWritable))
     }
 
     fn constant(&self, id: u32) -> Option<u32> {
@@ -316,7 +334,8 @@ pub(crate) fn reflect(shader: &ShaderSource) -> Result<Reflection> {
         };
         let name =
             m.names.get(var).filter(|n| !n.is_empty()).or_else(|| m.names.get(&element)).cloned().unwrap_or_default();
-        bindings.push(Binding { set, binding, ty, count, name });
+        let (reads, writes) = m.access(*var, element, ty);
+        bindings.push(Binding { set, binding, ty, count, name, reads, writes });
     }
     bindings.sort_by_key(|b| (b.set, b.binding));
 

@@ -499,7 +499,7 @@ fn profiler_rejects_bad_parameters() {
 fn shaders_are_built_with_the_shared_constants() {
     use crate::limits;
     let expected = |name: &str| -> Option<u32> {
-        let sim = ["sim/predict.comp", "sim/solve.comp", "sim/integrate.comp"];
+        let sim = ["sim/step.comp"];
         let item = ["render/shadow_volume.comp", "core/scale_add.comp", "core/shadow_probe.comp"];
         if sim.contains(&name) {
             Some(limits::SIM_WORKGROUP)
@@ -518,7 +518,7 @@ fn shaders_are_built_with_the_shared_constants() {
         assert_eq!(reflection.workgroup_size, Some([size, 1, 1]), "{}", shader.name);
         checked += 1;
     }
-    assert_eq!(checked, 34, "3 simulation, 7 per-item and 24 volume kernels (4 shared-memory variants)");
+    assert_eq!(checked, 32, "1 simulation, 7 per-item and 24 volume kernels (4 shared-memory variants)");
     let sources: String = glsl_sources().into_iter().map(|(_, text)| text).collect();
     for (name, _) in limits::SHADER_CONSTANTS {
         assert!(sources.contains(name), "{name} is injected but no shader uses it");
@@ -582,4 +582,22 @@ fn shadow_header_needs_the_documented_macro() {
     let error = compile(false).err().expect("fails without the macro").to_string();
     assert!(error.contains("MAX_SHADOW_MAPS"), "{error}");
     compile(true).expect("compiles with the macro");
+}
+
+/// Reflection tells read-only, write-only and read-write bindings apart (the
+/// traffic counters rely on it): the step kernel reads its input half and writes
+/// the other; a volume kernel both reads and writes its labels.
+#[test]
+fn reflection_reads_the_access_of_each_binding() {
+    let step = reflect(&shaders::SIM_STEP_COMP).expect("reflect");
+    let access = |r: &crate::vk::reflect::Reflection, binding: u32| {
+        let b = r.bindings.iter().find(|b| b.binding == binding).expect("binding");
+        (b.reads, b.writes)
+    };
+    assert_eq!(access(&step, 0), (true, false), "parameters");
+    assert_eq!(access(&step, 1), (true, false), "positions in");
+    assert_eq!(access(&step, 8), (false, true), "positions out");
+    let mark = reflect(&shaders::SIM_VOLUME_MARK_COMP).expect("reflect");
+    assert_eq!(access(&mark, 16), (true, true), "labels");
+    assert_eq!(access(&mark, 0), (true, false), "uniform block");
 }

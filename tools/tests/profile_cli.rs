@@ -158,9 +158,7 @@ fn render_lists_every_pass_and_writes_a_trace_and_summary_that_agree() {
     let (rows, totals) = table(&out.stdout);
     let track = "graphics queue".to_owned();
     for pass in [
-        "vkhair sim: predict",
-        "vkhair sim: solve",
-        "vkhair sim: integrate",
+        "vkhair sim: step",
         "vkhair render: smooth",
         "vkhair render: interpolate",
         "vkhair render: shadow depth",
@@ -185,7 +183,7 @@ fn simulate_writes_a_trace_and_summary_that_agree_with_its_table() {
     let (out, summary) = profiled("simulate --steps 25 --volume flip --grid 16");
     assert_eq!(summary["per"], "step");
     let (rows, _) = table(&out.stdout);
-    for pass in ["vkhair sim: predict", "vkhair sim: solve", "vkhair sim: integrate", "vkhair sim: volume pressure"] {
+    for pass in ["vkhair sim: step", "vkhair sim: volume sort", "vkhair sim: volume pressure"] {
         assert!(rows.keys().any(|(_, name)| name == pass), "{pass} missing:\n{}", out.stdout);
     }
 }
@@ -217,7 +215,7 @@ fn a_second_device_gets_its_own_track() {
     let (out, _) = profiled("render --schedule second-device --frames 3 --width 32 --height 32 --shadow-resolution 32");
     let (rows, totals) = table(&out.stdout);
     let sim = "simulation, second device".to_owned();
-    assert!(rows.contains_key(&(sim.clone(), "vkhair sim: solve".to_owned())), "{}", out.stdout);
+    assert!(rows.contains_key(&(sim.clone(), "vkhair sim: step".to_owned())), "{}", out.stdout);
     assert!(rows.contains_key(&("graphics queue".to_owned(), "vkhair render: draw".to_owned())), "{}", out.stdout);
     assert_eq!(totals.len(), 2, "{}", out.stdout);
 }

@@ -1,6 +1,7 @@
 //! Compute pipelines: workgroup size from reflection, dispatches in threads.
 
-use std::sync::Arc;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
 
 use ash::vk;
 
@@ -17,6 +18,10 @@ pub(crate) struct ComputePipeline {
     raw: vk::Pipeline,
     workgroup_size: [u32; 3],
     name: String,
+    /// Bytes read and written through each buffer descriptor set (for the counters).
+    traffic: Mutex<HashMap<vk::DescriptorSet, (u64, u64)>>,
+    /// The traffic of the sets bound last.
+    bound: Mutex<(u64, u64)>,
 }
 
 impl ComputePipeline {
@@ -59,7 +64,14 @@ impl ComputePipeline {
         unsafe { device.raw.destroy_shader_module(module, None) };
         let raw = result.map_err(|(_, r)| Error::Vulkan { call: "vkCreateComputePipelines", result: r })?[0];
         device.set_name(raw, shader.name);
-        Ok(ComputePipeline { layout, raw, workgroup_size, name: shader.name.to_owned() })
+        Ok(ComputePipeline {
+            layout,
+            raw,
+            workgroup_size,
+            name: shader.name.to_owned(),
+            traffic: Mutex::default(),
+            bound: Mutex::default(),
+        })
     }
 
     #[cfg(test)]
@@ -85,13 +97,24 @@ impl ComputePipeline {
         set: u32,
         buffers: &[(u32, &Buffer)],
     ) -> Result<()> {
-        self.layout.write_buffers(target, set, &self.layout.declared(set, buffers))
+        let declared = self.layout.declared(set, buffers);
+        self.layout.write_buffers(target, set, &declared)?;
+        self.note_traffic(target, set, &declared);
+        Ok(())
+    }
+
+    fn note_traffic(&self, target: vk::DescriptorSet, set: u32, buffers: &[(u32, &Buffer)]) {
+        let traffic = self.layout.traffic(set, buffers);
+        if let Ok(mut map) = self.traffic.lock() {
+            map.insert(target, traffic);
+        }
     }
 
     /// Allocates descriptor set `set` and points its buffer bindings at `buffers`.
     pub(crate) fn buffer_set(&self, set: u32, buffers: &[(u32, &Buffer)]) -> Result<vk::DescriptorSet> {
         let target = self.layout.allocate_set(set, &format!("{} set {set}", self.name))?;
         self.layout.write_buffers(target, set, buffers)?;
+        self.note_traffic(target, set, buffers);
         Ok(target)
     }
 
@@ -119,6 +142,9 @@ impl ComputePipeline {
     /// # Safety
     /// `cmd` is a recording command buffer of this device.
     pub(crate) unsafe fn bind(&self, cmd: vk::CommandBuffer, sets: &[vk::DescriptorSet]) {
+        if let (Ok(map), Ok(mut bound)) = (self.traffic.lock(), self.bound.lock()) {
+            *bound = sets.iter().filter_map(|s| map.get(s)).fold((0, 0), |a, t| (a.0 + t.0, a.1 + t.1));
+        }
         // SAFETY: guaranteed by the caller.
         unsafe { self.layout.bind(cmd, vk::PipelineBindPoint::COMPUTE, self.raw, sets) };
     }
@@ -138,6 +164,7 @@ impl ComputePipeline {
     /// `cmd` is recording with this pipeline bound.
     pub(crate) unsafe fn dispatch_threads(&self, cmd: vk::CommandBuffer, threads: [u32; 3]) {
         let groups = [0, 1, 2].map(|i| threads[i].div_ceil(self.workgroup_size[i]));
+        self.count_dispatch();
         // SAFETY: guaranteed by the caller.
         unsafe { self.layout.device.raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
     }
@@ -150,8 +177,16 @@ impl ComputePipeline {
     /// holds a command at `offset` (a multiple of 4) whose counts stay within the
     /// device limits, and writes to it are made visible to DRAW_INDIRECT reads.
     pub(crate) unsafe fn dispatch_indirect(&self, cmd: vk::CommandBuffer, buffer: vk::Buffer, offset: u64) {
+        self.count_dispatch();
         // SAFETY: guaranteed by the caller.
         unsafe { self.layout.device.raw.cmd_dispatch_indirect(cmd, buffer, offset) };
+    }
+}
+
+impl ComputePipeline {
+    fn count_dispatch(&self) {
+        let traffic = self.bound.lock().map_or((0, 0), |b| *b);
+        self.layout.device.counters.dispatch(traffic);
     }
 }
 

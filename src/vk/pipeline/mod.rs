@@ -41,6 +41,8 @@ impl Layout {
         for r in reflections {
             for b in &r.bindings {
                 let entry = merged.entry((b.set, b.binding)).or_insert((b.clone(), vk::ShaderStageFlags::empty()));
+                entry.0.reads |= b.reads;
+                entry.0.writes |= b.writes;
                 if entry.0.ty != b.ty || entry.0.count != b.count {
                     return Err(Error::Shader {
                         shader: name.to_owned(),
@@ -207,6 +209,19 @@ impl Layout {
         self.write_buffers(target, set, buffers)?;
         self.write_images(target, set, images)?;
         Ok(target)
+    }
+
+    /// Bytes a dispatch reads and writes through `buffers` bound to `set`, each
+    /// counted whole (see [`crate::RecordedWork`]).
+    fn traffic(&self, set: u32, buffers: &[(u32, &Buffer)]) -> (u64, u64) {
+        let mut traffic = (0, 0);
+        for (binding, buffer) in buffers {
+            if let Some((b, _)) = self.bindings.iter().find(|(b, _)| b.set == set && b.binding == *binding) {
+                traffic.0 += if b.reads { buffer.size() } else { 0 };
+                traffic.1 += if b.writes { buffer.size() } else { 0 };
+            }
+        }
+        traffic
     }
 
     /// Points storage/uniform buffer bindings of `set` at whole buffers.

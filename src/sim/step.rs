@@ -1,13 +1,15 @@
-//! Stage 2 — constraint solve (`glsl/sim/solve.comp`): one 64-invocation
-//! workgroup per `hairs_per_group` key hairs, positions in shared memory.
+//! The simulation step kernel (`glsl/sim/step.comp`): prediction, the
+//! constraint solve and the velocity update of one or more sub-steps in one
+//! dispatch, one 64-invocation workgroup per `hairs_per_group` key hairs,
+//! positions in shared memory.
 
 use super::params::MAX_SIM_POINTS;
-use crate::vk::shaders::{ShaderSource, SIM_SOLVE_COMP};
+use crate::vk::shaders::{ShaderSource, SIM_STEP_COMP};
 
-pub(super) const SHADER: &ShaderSource = &SIM_SOLVE_COMP;
+pub(super) const SHADER: &ShaderSource = &SIM_STEP_COMP;
 
 /// Invocations: a whole workgroup for each group of hairs.
-pub(super) fn threads(strands: u32, _points: u32, hairs_per_group: u32) -> u32 {
+pub(super) fn threads(strands: u32, hairs_per_group: u32) -> u32 {
     strands.div_ceil(hairs_per_group) * MAX_SIM_POINTS as u32
 }
 

@@ -1,0 +1,388 @@
+#version 460
+// The simulation step, one dispatch for every key hair and (with the volume
+// stage off) every sub-step of a step: each workgroup holds `hairs per
+// workgroup` whole hairs, one invocation per point, loads each point's
+// position and velocity once, runs the sub-steps steps[first .. first+count)
+// in registers and shared memory, and stores once. Per sub-step:
+//
+//   1. forces and prediction (own point only):
+//        a  = gravity + wind·(1 + turbulence·noise) + spring·(rest_world − x)
+//        v* = v + dt·a,  x* = x + dt·v*
+//      pinned particles (inverse mass 0) follow the head: x* = head · rest;
+//   2. the constraint solve: N iterations with a barrier between the sets.
+//      The barrier's scope is the "sync group": the subgroup when every hair
+//      fits into one (hairs are packed so none straddles two), else the whole
+//      workgroup (barrier()). The sets are:
+//        a. distance constraints of even segments, b. of odd segments,
+//        c. bending (distance between points i−1 and i+1, rest from the rest
+//           shape, stiffness from root to tip) centred on i mod 4 ∈ {0,1},
+//           d. on {2,3},
+//        e. (with SIM_LOCAL_SHAPE, in the last iteration only, so that its
+//           stiffness is the fraction removed per sub-step whatever the
+//           iteration count) the local shape constraints, swept root to tip by
+//           each hair's root invocation (Gauss-Seidel: a correction reaches
+//           the tip within the sweep): segment (j−1, j) is pulled toward its
+//           rest offset carried along by the smallest rotation taking the
+//           parent segment's rest direction onto its current one (parallel
+//           transport of the rest frame; the first segment's frame is the
+//           head's); both ends move, by their inverse masses, so the
+//           constraint conserves momentum like the distance constraints,
+//        f. the global shape constraint (each point pulled toward its rest
+//           position in the head's frame; it touches only the own point) and
+//           body collisions (spheres, capsules and, with SIM_MESH, the mesh
+//           collider's field; each particle has its own radius),
+//      then, with the mesh collider, friction against it (once per sub-step);
+//   3. velocity from the position change, damping:
+//        v = (x_solved − x_old) / dt  [− s·d_{i+1} / dt in DFTL mode],  v *= 1 − damping.
+//
+// The final state goes to the other half of the double buffer.
+//
+// Both ends of a constraint compute the same correction from the same two
+// positions, and each keeps its own result: every invocation holds its point
+// in a register and, per set, reads its partner from one half of a
+// double-buffered shared array and writes its own point to the other half, so
+// one barrier per set suffices (collisions, which touch only the own point,
+// share the last set's barrier). The arithmetic is exactly that of projecting
+// the pair in one place, which the CPU reference does.
+//
+// DFTL mode instead places each point at its rest distance from its parent,
+// root to tip, in one sweep (with collisions) and keeps the correction
+// vectors in shared memory for the velocity update.
+#extension GL_KHR_shader_subgroup_basic : require
+#include "sim.glsl"
+
+layout(local_size_x = SIM_WORKGROUP) in;
+
+// x: the first sub-step of this dispatch (index into `steps`), y: how many.
+layout(push_constant) uniform Push { SimPush push; };
+layout(std430, set = 0, binding = 0) readonly buffer Steps { SimStepParams steps[]; };
+layout(std430, set = 0, binding = 1) readonly buffer PosIn { vec4 pos_in[]; };
+layout(std430, set = 0, binding = 2) readonly buffer VelIn { vec4 vel_in[]; };
+layout(std430, set = 0, binding = 5) readonly buffer Rest { vec4 rest[]; };
+layout(std430, set = 0, binding = 6) readonly buffer RestLength { float rest_length[]; };
+// SIM_MAX_COLLIDERS entries per sub-step, in the world at that sub-step.
+layout(std430, set = 0, binding = 7) readonly buffer Colliders { Collider colliders[]; };
+layout(std430, set = 0, binding = 8) writeonly buffer PosOut { vec4 pos_out[]; };
+layout(std430, set = 0, binding = 9) writeonly buffer VelOut { vec4 vel_out[]; };
+layout(std430, set = 0, binding = 10) readonly buffer MeshField { float mesh_field[]; };
+#include "mesh_sdf.glsl"
+
+shared vec4 s_pos[2][SIM_WORKGROUP];
+shared float s_length[SIM_WORKGROUP];
+// Local shape, per point i ≥ 1 (its segment from i−1): the parent segment's rest
+// direction (world, unit; zero for the first segment and degenerate ones) and
+// the rest offset of i from i−1 (world).
+shared vec3 s_local_dir[SIM_WORKGROUP];
+// In DFTL mode s_local_offset holds each point's correction vector instead.
+shared vec3 s_local_offset[SIM_WORKGROUP];
+
+// The parameters of the sub-step being run, and where its colliders start.
+SimStepParams params;
+uint collider_base;
+
+// Ends a constraint set: makes every shared-memory write of the sync group visible.
+// `group` is uniform over the dispatch, so barrier() stays in uniform control flow.
+void sync(uint group) {
+    if (group == SIM_WORKGROUP) {
+        barrier();
+    } else {
+        subgroupBarrier();
+    }
+}
+
+vec3 collide_all(vec3 p, float radius) {
+    for (uint c = 0u; c < params.layout_info.x; c++) {
+        p = sim_collide(colliders[collider_base + c], p, radius);
+    }
+    if ((params.counts.w & SIM_MESH) != 0u) {
+        p = mesh_collide(params.head, params.mesh_grid, params.mesh_dims, p, radius);
+    }
+    return p;
+}
+
+// One end of a constraint between this invocation's point `own` and the point
+// `offset` invocations away, read from half `src`. `first`: own is the lower
+// index (a) of the pair. Returns own's projected position.
+vec4 project_end(vec4 own, uint lid, int offset, bool first, float rest_d, float k, uint src) {
+    if (offset == 0) {
+        return own;
+    }
+    vec4 other = s_pos[src][uint(int(lid) + offset)];
+    vec4 a = first ? own : other;
+    vec4 b = first ? other : own;
+    precise float w = a.w + b.w;
+    precise vec3 d = b.xyz - a.xyz;
+    precise float len = sqrt(dot(d, d));
+    if (w > 0.0 && len > 0.0) {
+        precise float c = ((len - rest_d) / (len * w)) * k;
+        if (first) {
+            precise vec3 pa = a.xyz + d * (a.w * c);
+            own.xyz = pa;
+        } else {
+            precise vec3 pb = b.xyz - d * (b.w * c);
+            own.xyz = pb;
+        }
+    }
+    return own;
+}
+
+// Sweeps the local shape constraints of the hair whose root sits at invocation
+// `root`, root to tip, in place in half `src` (see the header). The segments'
+// rest data are in s_local (direction of the parent segment, offset).
+void local_shape_sweep(uint root, uint points, uint src) {
+    for (uint j = 1u; j < points; j++) {
+        vec4 parent = s_pos[src][root + j - 1u];
+        vec4 child = s_pos[src][root + j];
+        precise vec3 carried = s_local_offset[root + j];
+        vec3 dir = s_local_dir[root + j];
+        if (j >= 2u && sim_dot(dir, dir) > 0.0) {
+            precise vec3 d = parent.xyz - s_pos[src][root + j - 2u].xyz;
+            precise float len = sqrt(sim_dot(d, d));
+            if (len > 0.0) {
+                carried = sim_rotate_between(dir, d / len, carried);
+            }
+        }
+        precise float w = parent.w + child.w;
+        if (w > 0.0) {
+            precise vec3 delta = (carried - (child.xyz - parent.xyz)) * params.shape.z;
+            precise vec3 moved_parent = parent.xyz - delta * (parent.w / w);
+            precise vec3 moved_child = child.xyz + delta * (child.w / w);
+            s_pos[src][root + j - 1u] = vec4(moved_parent, parent.w);
+            s_pos[src][root + j] = vec4(moved_child, child.w);
+        }
+    }
+}
+
+// The rest offset of particle k from its parent, rotated into the world.
+vec3 local_rest_offset(uint k) {
+    return sim_rotate(params.head, rest[k].xyz - rest[k - 1u].xyz);
+}
+
+// The unit rest direction of the segment ending at particle k, in the world
+// (zero for a degenerate segment).
+vec3 local_rest_dir(uint k) {
+    vec3 d = local_rest_offset(k);
+    precise float len = sqrt(sim_dot(d, d));
+    return len > 0.0 ? d / len : vec3(0.0);
+}
+
+// Rest distance and stiffness of the bending constraint centred on point c.
+vec2 bend_at(uint strand_base, uint c, uint points) {
+    precise vec3 r = rest[strand_base + c + 1u].xyz - rest[strand_base + c - 1u].xyz;
+    precise float t = float(c) / float(points - 1u);
+    precise float k = params.bending.x + (params.bending.y - params.bending.x) * t;
+    return vec2(sqrt(dot(r, r)), k);
+}
+
+// Stage 1 for the own point: its predicted position (w: inverse mass) from the
+// position `x` and velocity `v` at the start of the sub-step.
+vec4 predict(vec4 x, vec3 v, vec3 rest_head, uint strand) {
+    uint flags = params.counts.w;
+    float dt = params.gravity_dt.w;
+    vec3 rest_world = sim_transform_point(params.head, rest_head);
+    if (x.w == 0.0) {
+        return vec4(rest_world, 0.0);
+    }
+    precise vec3 a = vec3(0.0);
+    if ((flags & SIM_GRAVITY) != 0u) {
+        a = a + params.gravity_dt.xyz;
+    }
+    if ((flags & SIM_WIND) != 0u) {
+        precise float gust = 1.0 + params.wind.w * sim_noise(params.wind_noise.y * params.wind_noise.x, strand);
+        a = a + params.wind.xyz * gust;
+    }
+    if ((flags & SIM_SPRING) != 0u) {
+        a = a + (rest_world - x.xyz) * params.wind_noise.z;
+    }
+    precise vec3 moved = v + a * dt;
+    precise vec3 p = x.xyz + moved * dt;
+    return vec4(p, x.w);
+}
+
+void main() {
+    params = steps[push.range.x];
+    uint points = params.counts.y;
+    uint per_group = params.layout_info.y;
+    uint group = params.layout_info.w;
+    uint per_sync = group / points;
+    // With subgroup sync (always full subgroups) hairs are laid out by subgroup.
+    uint lid = group == SIM_WORKGROUP ? gl_LocalInvocationID.x : gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID;
+    uint sync_index = lid / group;
+    uint lane = lid - sync_index * group;
+    uint in_sync = lane / points;
+    uint i = lane - in_sync * points;
+    uint hair = sync_index * per_sync + in_sync;
+    uint strand = gl_WorkGroupID.x * per_group + hair;
+    bool live = in_sync < per_sync && hair < per_group && strand < params.counts.x;
+    uint index = strand * points + i;
+    uint base = strand * points;
+
+    // What stays the same over the step: the state (in registers from here to the
+    // store), the rest data and each constraint set's partner, rest distance and
+    // stiffness.
+    bool bending = (params.counts.w & SIM_BENDING) != 0u;
+    vec4 x = vec4(0.0);
+    vec3 v = vec3(0.0);
+    vec3 rest_head = vec3(0.0);
+    float radius = 0.0;
+    // Per set: partner offset (0 = none), whether own is the pair's first point,
+    // rest distance and stiffness.
+    int off_even = 0, off_odd = 0, off_bend_a = 0, off_bend_b = 0;
+    bool first_even = false, first_odd = false, first_bend_a = false, first_bend_b = false;
+    float rest_even = 0.0, rest_odd = 0.0;
+    vec2 bend_a = vec2(0.0), bend_b = vec2(0.0);
+    if (live) {
+        x = pos_in[index];
+        v = vel_in[index].xyz;
+        vec4 r = rest[index];
+        rest_head = r.xyz;
+        radius = r.w;
+        s_length[lid] = rest_length[index];
+        bool has_next = i + 1u < points;
+        float len_next = rest_length[index];
+        float len_prev = i > 0u ? rest_length[index - 1u] : 0.0;
+        // Distance sets: segment (j, j+1) is even when j is even.
+        if ((i & 1u) == 0u) {
+            if (has_next) { off_even = 1; first_even = true; rest_even = len_next; }
+            if (i > 0u) { off_odd = -1; rest_odd = len_prev; }
+        } else {
+            off_even = -1; rest_even = len_prev;
+            if (has_next) { off_odd = 1; first_odd = true; rest_odd = len_next; }
+        }
+        // Bending sets: centre c joins c−1 and c+1; set A has c mod 4 ∈ {0,1}.
+        if (bending) {
+            if (i + 2u < points) {
+                uint c = i + 1u;
+                vec2 bk = bend_at(base, c, points);
+                if (bk.y > 0.0) {
+                    if ((c & 3u) < 2u) { off_bend_a = 2; first_bend_a = true; bend_a = bk; }
+                    else { off_bend_b = 2; first_bend_b = true; bend_b = bk; }
+                }
+            }
+            if (i >= 2u) {
+                uint c = i - 1u;
+                vec2 bk = bend_at(base, c, points);
+                if (bk.y > 0.0) {
+                    if ((c & 3u) < 2u) { off_bend_a = -2; bend_a = bk; }
+                    else { off_bend_b = -2; bend_b = bk; }
+                }
+            }
+        }
+    }
+
+    for (uint sub = 0u; sub < push.range.y; sub++) {
+        params = steps[push.range.x + sub];
+        collider_base = (push.range.x + sub) * SIM_MAX_COLLIDERS;
+        uint flags = params.counts.w;
+        bool collisions = (flags & SIM_COLLISIONS) != 0u;
+        bool global_shape = (flags & SIM_GLOBAL_SHAPE) != 0u;
+        bool local_shape = (flags & SIM_LOCAL_SHAPE) != 0u;
+        vec3 shape_target = vec3(0.0);
+        float shape_k = 0.0;
+
+        // 1. Prediction, and what the shape constraints need of this sub-step's head.
+        vec4 own = vec4(0.0);
+        if (live) {
+            own = predict(x, v, rest_head, strand);
+            s_pos[0][lid] = own;
+            if (global_shape) {
+                precise float t = float(i) / float(points - 1u);
+                precise float k = params.shape.x * sim_shape_weight(t, params.shape.y);
+                shape_k = k;
+                vec3 at_rest = sim_transform_point(params.head, rest_head);
+                shape_target = sim_shape_target(at_rest, k, params.counts.z, flags, params.gravity_dt.xyz, params.gravity_dt.w);
+            }
+            if (local_shape && i >= 1u) {
+                s_local_offset[lid] = local_rest_offset(index);
+                s_local_dir[lid] = i >= 2u ? local_rest_dir(index - 1u) : vec3(0.0);
+            }
+        }
+        sync(group);
+        vec4 predicted = own;
+
+        // 2. The constraint solve.
+        if ((flags & SIM_DFTL) != 0u) {
+            // Follow the leader: sequential down each hair, by its root's invocation.
+            if (live && i == 0u) {
+                for (uint k = 1u; k < points; k++) {
+                    vec4 parent = s_pos[0][lid + k - 1u];
+                    vec4 q = s_pos[0][lid + k];
+                    if (q.w > 0.0) {
+                        precise vec3 d = q.xyz - parent.xyz;
+                        precise float len = sqrt(dot(d, d));
+                        precise vec3 placed = len > 0.0 ? parent.xyz + d * (s_length[lid + k - 1u] / len) : q.xyz;
+                        if (collisions) {
+                            placed = collide_all(placed, rest[index + k].w);
+                        }
+                        s_pos[0][lid + k] = vec4(placed, q.w);
+                    }
+                }
+            }
+            sync(group);
+            if (live) {
+                own = s_pos[0][lid];
+                precise vec3 d = own.xyz - predicted.xyz;
+                s_local_offset[lid] = d;
+            }
+            sync(group);
+        } else {
+            // Halves alternate: each set reads `src` and writes the other one.
+            uint src = 0u;
+            for (uint it = 0u; it < params.counts.z; it++) {
+                own = project_end(own, lid, off_even, first_even, rest_even, 1.0, src);
+                if (live) { s_pos[1u - src][lid] = own; }
+                sync(group);
+                src = 1u - src;
+                own = project_end(own, lid, off_odd, first_odd, rest_odd, 1.0, src);
+                if (live) { s_pos[1u - src][lid] = own; }
+                sync(group);
+                src = 1u - src;
+                own = project_end(own, lid, off_bend_a, first_bend_a, bend_a.x, bend_a.y, src);
+                if (live) { s_pos[1u - src][lid] = own; }
+                sync(group);
+                src = 1u - src;
+                own = project_end(own, lid, off_bend_b, first_bend_b, bend_b.x, bend_b.y, src);
+                if (local_shape && it + 1u == params.counts.z) {
+                    if (live) { s_pos[1u - src][lid] = own; }
+                    sync(group);
+                    src = 1u - src;
+                    if (live && i == 0u) {
+                        local_shape_sweep(lid, points, src);
+                    }
+                    sync(group);
+                    if (live) { own = s_pos[src][lid]; }
+                }
+                if (global_shape && live && own.w > 0.0 && shape_k > 0.0) {
+                    precise vec3 pulled = own.xyz + (shape_target - own.xyz) * shape_k;
+                    own.xyz = pulled;
+                }
+                if (collisions && live && own.w > 0.0) {
+                    own.xyz = collide_all(own.xyz, radius);
+                }
+                if (live) { s_pos[1u - src][lid] = own; }
+                sync(group);
+                src = 1u - src;
+            }
+            if ((flags & SIM_MESH) != 0u && collisions && live && own.w > 0.0) {
+                own.xyz = mesh_friction(params.head, params.previous_head, params.mesh_grid, params.mesh_dims, own.xyz,
+                                        x.xyz, radius, params.shape.w);
+            }
+        }
+
+        // 3. Velocity from the position change, damping.
+        if (live) {
+            float dt = params.gravity_dt.w;
+            precise vec3 vel = (own.xyz - x.xyz) / dt;
+            if ((flags & SIM_DFTL) != 0u && i + 1u < points) {
+                vel = vel - s_local_offset[lid + 1u] * (params.bending.z / dt);
+            }
+            vel = vel * (1.0 - params.wind_noise.w);
+            x = own;
+            v = vel;
+        }
+    }
+    if (live) {
+        pos_out[index] = x;
+        vel_out[index] = vec4(v, 0.0);
+    }
+}
