@@ -206,7 +206,7 @@ impl GpuContext {
 
     /// What vkhair has recorded on this context's device so far (dispatches,
     /// barriers, bytes bound): subtract two readings to count a step or a frame.
-    pub fn recorded_work(&self) -> crate::RecordedWork {
+    pub fn recorded_work(&self) -> crate::vk::counters::RecordedWork {
         self.device.counters.read()
     }
 

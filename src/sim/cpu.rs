@@ -38,6 +38,8 @@ pub struct CpuHairSim {
     last_volume: Option<volume::reference::VolumeSnapshot>,
     /// The mesh collider's field, when set.
     mesh: Option<MeshSdf>,
+    /// Wall time of the volume stage in the latest step.
+    volume_time: std::time::Duration,
 }
 
 impl CpuHairSim {
@@ -52,7 +54,7 @@ impl CpuHairSim {
         // The CPU runs the same constraint sets in the same order whatever the packing.
         let planner = SubstepPlanner::new(params, head, state.strands, state.points, MAX_SIM_POINTS as u32)?;
         let volume = cpu_volume_grid(params, &state)?;
-        Ok(CpuHairSim { planner, state, volume, last_volume: None, mesh: None })
+        Ok(CpuHairSim { planner, state, volume, last_volume: None, mesh: None, volume_time: Default::default() })
     }
 
     /// See [`HairSim::set_params`](super::HairSim::set_params).
@@ -84,10 +86,12 @@ impl CpuHairSim {
     /// Advances one step ending with the head at `head`.
     pub fn step(&mut self, head: &RigidTransform) -> Result<()> {
         let inputs = self.planner.next(head)?;
+        self.volume_time = std::time::Duration::ZERO;
         for sub in &inputs {
             let mesh = self.mesh.as_ref().map(reference::MeshField::new);
             reference::step(&mut self.state, std::slice::from_ref(sub), mesh);
             if let Some(grid) = &self.volume {
+                let started = std::time::Instant::now();
                 let vp = &self.planner.params.volume;
                 let gpu = sub.volume_params(grid, vp, self.planner.colliders.len() as u32);
                 let snapshot = volume::reference::step(
@@ -99,6 +103,7 @@ impl CpuHairSim {
                     &mut self.state.velocities,
                 );
                 self.last_volume = Some(snapshot);
+                self.volume_time += started.elapsed();
             }
         }
         Ok(())
@@ -112,6 +117,12 @@ impl CpuHairSim {
     /// MIC(0)-PCG iterations of the latest volume step (FLIP mode).
     pub fn volume_iterations(&self) -> Option<u32> {
         self.last_volume.as_ref().map(|s| s.iterations)
+    }
+
+    /// Wall time the volume stage took in the latest step (zero when it is off):
+    /// the benchmark's CPU-reference figure for the volume step alone.
+    pub fn last_volume_time(&self) -> std::time::Duration {
+        self.volume_time
     }
 
     /// The current state.

@@ -1,5 +1,7 @@
 //! `vkhair`: the command-line program of the vkhair crate.
 
+mod bench_cmd;
+mod bench_measure;
 mod groom_input;
 mod output;
 mod plot_cmd;
@@ -49,6 +51,9 @@ enum Command {
     /// Simulate and render a head of hair headless: PNG frames, a contact sheet and a
     /// per-pass GPU timing table.
     Render(render_cmd::RenderArgs),
+    /// Measure every stage on the GPU beside its CPU reference (thesis, Sintel, a
+    /// large groom), with recorded work, bandwidth bounds and scaling curves.
+    Bench(bench_cmd::BenchArgs),
     /// Print the default parameters as commented TOML, a starting point for --config.
     Config,
     /// Chart the render benchmark's CSV (cargo bench --bench render) as a PNG.
@@ -142,6 +147,7 @@ fn main() -> ExitCode {
             .map(|text| say!("{}", text.trim_end_matches('\n')))
             .map_err(Into::into),
         Command::Plot(args) => plot_cmd::plot(&args),
+        Command::Bench(args) => bench_cmd::bench(&args),
         Command::Convert { input, points, key_hairs, out, strict } => convert(&input, points, key_hairs, &out, strict),
     };
     match result {

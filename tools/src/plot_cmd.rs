@@ -4,6 +4,8 @@
 //!   one line per resolution, and the drawn segment count.
 //! - `volume.csv` (benches/volume.rs): GPU ms per simulation step against the
 //!   grid resolution, one line per solver, and PCG iterations per step.
+//! - `scaling.csv` (`vkhair bench`): GPU and CPU-reference ms against the work
+//!   (particles, cells, pixels), one panel per scaling axis.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -16,7 +18,8 @@ const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
 #[derive(clap::Args)]
 pub struct PlotArgs {
-    /// CSV written by `cargo bench --bench render` or `--bench volume`.
+    /// CSV written by `cargo bench --bench render` or `--bench volume`, or the
+    /// scaling.csv of `vkhair bench`.
     #[arg(default_value = "target/vkhair-bench/render.csv")]
     csv: PathBuf,
     /// Output PNG (default: the CSV's path with a .png extension).
@@ -164,24 +167,64 @@ fn volume_lines(t: &Table) -> Result<(Lines, Lines), Error> {
 }
 
 pub fn plot(a: &PlotArgs) -> Result<(), Error> {
-    let table = Table::read(&a.csv)?;
+    let out = a.out.clone().unwrap_or_else(|| a.csv.with_extension("png"));
+    plot_file(&a.csv, &out)
+}
+
+/// Charts the benchmark CSV `csv` into the PNG `out`.
+pub fn plot_file(csv: &Path, out: &Path) -> Result<(), Error> {
+    let table = Table::read(csv)?;
     let font = std::fs::read(FONT).map_err(|e| format!("{FONT}: {e} (install fonts-dejavu-core)"))?;
     plotters::style::register_font("sans-serif", FontStyle::Normal, Box::leak(font.into_boxed_slice()))
         .map_err(|_| "the DejaVu font could not be loaded")?;
-    let out = a.out.clone().unwrap_or_else(|| a.csv.with_extension("png"));
+    let size = if table.column("axis").is_ok() { SCALING_SIZE } else { SIZE };
     // Drawn in memory and written whole: a failed plot leaves no file.
-    let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
-    draw(&table, &mut rgb).map_err(|e| format!("cannot plot {}: {e}", a.csv.display()))?;
+    let mut rgb = vec![0u8; (size.0 * size.1 * 3) as usize];
+    draw(&table, &mut rgb, size).map_err(|e| format!("cannot plot {}: {e}", csv.display()))?;
     let rgba: Vec<u8> = rgb.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
-    write_png(&out, SIZE.0, SIZE.1, &rgba).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    write_png(out, size.0, size.1, &rgba).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
     say!("wrote {}", out.display());
     Ok(())
 }
 
-/// Draws both panels of the chart into an RGB buffer of [`SIZE`].
-fn draw(table: &Table, rgb: &mut [u8]) -> Result<(), Error> {
-    let root = BitMapBackend::with_buffer(rgb, SIZE).into_drawing_area();
+/// One panel per scaling axis: GPU and CPU-reference ms against the work.
+fn scaling_panels(table: &Table, root: &DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), Error> {
+    let (axis, unit, work) = (table.column("axis")?, table.column("unit")?, table.column("work")?);
+    let (gpu, cpu) = (table.column("gpu_ms")?, table.column("cpu_ms")?);
+    let mut axes: Vec<(String, String, Lines)> = Vec::new();
+    for r in 0..table.rows.len() {
+        let name = table.rows[r].get(axis).cloned().unwrap_or_default();
+        if axes.last().is_none_or(|a| a.0 != name) {
+            axes.push((name.clone(), table.rows[r].get(unit).cloned().unwrap_or_default(), Lines::new()));
+        }
+        let lines = &mut axes.last_mut().ok_or("no axis")?.2;
+        let w = table.number(r, work)?;
+        lines.entry("GPU".into()).or_default().push((w, table.number(r, gpu)?));
+        // The render has no CPU reference: its cells are NaN.
+        if let Ok(c) = table.number(r, cpu) {
+            lines.entry("CPU reference".into()).or_default().push((w, c));
+        }
+    }
+    let palette = vec!["GPU".to_owned(), "CPU reference".to_owned()];
+    let panels = root.split_evenly((2, 2));
+    for ((name, unit, lines), area) in axes.iter().zip(panels.iter()) {
+        line_chart(area, name, unit, "ms", lines, &palette)?;
+    }
+    Ok(())
+}
+
+/// Chart size of the scaling curves (four panels), pixels.
+const SCALING_SIZE: (u32, u32) = (1100, 900);
+
+/// Draws the chart's panels into an RGB buffer of `size`.
+fn draw(table: &Table, rgb: &mut [u8], size: (u32, u32)) -> Result<(), Error> {
+    let root = BitMapBackend::with_buffer(rgb, size).into_drawing_area();
     root.fill(&WHITE)?;
+    if table.column("axis").is_ok() {
+        scaling_panels(table, &root)?;
+        root.present()?;
+        return Ok(());
+    }
     let (left, right) = root.split_horizontally(600);
     if table.column("pcg_iterations").is_ok() {
         let (time, solves) = volume_lines(table)?;

@@ -121,6 +121,112 @@ pub struct RenderArgs {
     profile_out: ProfileArgs,
 }
 
+/// The renderer `render` draws with: parameters, lights, the two spot lights'
+/// shadows and the material of `config`.
+fn make_renderer(
+    a: &RenderArgs,
+    ctx: &GpuContext,
+    config: &Config,
+    key_hairs: vkhair::sim::KeyHairs<'_>,
+    radius: f32,
+) -> Result<Renderer, vkhair::Error> {
+    let mut renderer = Renderer::new(ctx, key_hairs, &config.render)?;
+    renderer.set_lights(&config.lights)?;
+    if !a.no_shadows {
+        // The thesis' setup: both spot lights cast shadows through their own maps.
+        let casters = if a.volume_shadows {
+            vec![ShadowCaster::density_volume(0), ShadowCaster::density_volume(1)]
+        } else {
+            vec![0.into(), 1.into()]
+        };
+        let layers = ShadowParams::default().layers.map(|l| l * drawing_scale(radius));
+        let shadows = ShadowParams { casters, resolution: a.shadow_resolution, layers, ..ShadowParams::default() };
+        renderer.set_shadows(key_hairs, &shadows)?;
+    }
+    renderer.set_material(&config.material)?;
+    Ok(renderer)
+}
+
+/// What `vkhair bench` measures of a frame: the render passes' GPU time (from
+/// their timestamp scopes), the wall time of the submission holding them (the
+/// simulation's steps go in a submission of their own before it), and what
+/// the render passes record.
+pub struct FrameFigures {
+    pub gpu: crate::bench_measure::Samples,
+    pub wall: crate::bench_measure::Samples,
+    pub work: vkhair::RecordedWork,
+    pub hairs: u64,
+    pub segments: u64,
+    pub pixels: u64,
+}
+
+/// Renders `samples` frames (after two warm-up frames) of the scene `render`
+/// would draw with `args` (its flags, e.g. `["--width", "1280"]`), the
+/// simulation on the same queue, and measures the render passes.
+pub fn bench_frames(ctx: &GpuContext, args: &[&str], samples: usize) -> Result<FrameFigures, Error> {
+    #[derive(clap::Parser)]
+    struct Wrapper {
+        #[command(flatten)]
+        render: RenderArgs,
+    }
+    let a = <Wrapper as clap::Parser>::try_parse_from(std::iter::once("render").chain(args.iter().copied()))
+        .map_err(|e| format!("bench render arguments: {e}"))?
+        .render;
+    check_options(&a)?;
+    let s = scene(&a)?;
+    let config = parameters(&a, s.center, s.radius)?;
+    let mut sim = vkhair::sim::HairSim::new(ctx, &s.groom, &config.sim, &RigidTransform::default())?;
+    sim.set_colliders(&s.colliders)?;
+    let mut renderer = make_renderer(&a, ctx, &config, sim.key_hairs(), s.radius)?;
+    let offscreen = Offscreen::new(ctx, a.width, a.height)?;
+    let camera = framing(&s, a.distance, a.width as f32 / a.height as f32)?;
+    let mut profiler = GpuProfiler::new(ctx, 1, 64)?;
+    let (lo, hi) = s.groom.bounds();
+    let size = (hi - lo).max_element();
+    let (hairs, per_hair) = renderer.hair_counts();
+    let mut figures = FrameFigures {
+        gpu: Default::default(),
+        wall: Default::default(),
+        work: Default::default(),
+        hairs: u64::from(hairs),
+        segments: u64::from(hairs) * u64::from(per_hair.saturating_sub(1)),
+        pixels: u64::from(a.width) * u64::from(a.height),
+    };
+    for frame in 0..samples + 2 {
+        let heads: Vec<RigidTransform> =
+            (0..2).map(|k| a.motion.head((frame * 2 + k + 1) as f32 * config.sim.dt, s.pivot, size)).collect();
+        sim.run(heads.len(), |k| heads[k], None)?;
+        let started = std::time::Instant::now();
+        let mut render_work = vkhair::RecordedWork::default();
+        let mut result = Ok(());
+        ctx.run_commands("vkhair bench frame", |cmd| {
+            // SAFETY: a recording command buffer of the context's device; the
+            // previous frame completed (run_commands waits) and was drained.
+            result = unsafe {
+                (|| -> Result<(), vkhair::Error> {
+                    profiler.begin_frame(cmd, frame as u64);
+                    let before = ctx.recorded_work();
+                    renderer.record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler))?;
+                    renderer.record_shadows(cmd, &sim, Some(&mut profiler))?;
+                    offscreen.record_clear(cmd, Vec3::splat(0.02));
+                    renderer.record_draw(cmd, frame as u64, &offscreen.target(), &camera, Some(&mut profiler))?;
+                    render_work = ctx.recorded_work() - before;
+                    Ok(())
+                })()
+            };
+        })?;
+        result?;
+        let wall = started.elapsed().as_secs_f64() * 1e3;
+        let report = profiler.drain().pop().ok_or("the device wrote no timestamps")?;
+        if frame >= 2 {
+            figures.gpu.0.push(report.total_nanoseconds() / 1e6);
+            figures.wall.0.push(wall);
+            figures.work = render_work;
+        }
+    }
+    Ok(figures)
+}
+
 /// The scheduler options the flags ask for (creating the simulation device).
 fn schedule_options(a: &RenderArgs) -> Result<SchedulerOptions, vkhair::Error> {
     let mode = match a.schedule {
@@ -352,21 +458,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
             config.mesh_collider.resolution
         );
     }
-    let params = config.render.clone();
-    let mut renderer = Renderer::new(&ctx, sim.key_hairs(), &params)?;
-    renderer.set_lights(&config.lights)?;
-    if !a.no_shadows {
-        // The thesis' setup: both spot lights cast shadows through their own maps.
-        let casters = if a.volume_shadows {
-            vec![ShadowCaster::density_volume(0), ShadowCaster::density_volume(1)]
-        } else {
-            vec![0.into(), 1.into()]
-        };
-        let layers = ShadowParams::default().layers.map(|l| l * drawing_scale(s.radius));
-        let shadows = ShadowParams { casters, resolution: a.shadow_resolution, layers, ..ShadowParams::default() };
-        renderer.set_shadows(sim.key_hairs(), &shadows)?;
-    }
-    renderer.set_material(&config.material)?;
+    let renderer = make_renderer(a, &ctx, &config, sim.key_hairs(), s.radius)?;
     let offscreen = Offscreen::new(&ctx, a.width, a.height)?;
     // The head mesh (lit along the key spot light's direction) takes that light's hair
     // shadow the way a host would, through glsl/include/shadow.glsl.
@@ -376,6 +468,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
         MeshDrawer::with_hair_shadows(&ctx, &s.head_mesh, &renderer, 0)?
     };
     let camera = framing(&s, a.distance, a.width as f32 / a.height as f32)?;
+    let mut renderer = renderer;
     let mut profiler = GpuProfiler::new(&ctx, 1, 64)?;
     std::fs::create_dir_all(&a.out).map_err(|e| format!("cannot create {}: {e}", a.out.display()))?;
     let (strands, points) = sim.key_hairs().size();

@@ -1,0 +1,466 @@
+//! `vkhair bench`: every GPU figure beside its CPU reference, its recorded work
+//! and the time the bytes it moves would take at the memory bandwidth of real
+//! GPUs, on the thesis scene, Sintel and a large generated groom; then scaling
+//! curves with their fitted exponents (`scaling.csv`, `scaling.png`).
+//!
+//! Each figure is the median and p95 of `--samples` samples; GPU and CPU
+//! reference samples alternate step by step in one process. Two GPU figures
+//! are taken of every sample: the sum of the stage's timestamp scopes, and the
+//! wall time of a submission holding just that step or frame (record, submit,
+//! wait) less the median wall time of an empty submission. On a GPU the
+//! timestamps are the figure. On a CPU device (lavapipe) they are not: the
+//! driver writes a timestamp when it reaches the command, not when the work
+//! before it has finished (a 32-point step read 0.05 ms in timestamps against
+//! 9.7 ms of wall time), so there the wall-clock figure is the one reported,
+//! and a stage measured alone is the difference of two steps' wall times.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde_json::{json, Value};
+use vkhair::groom::grow::{grow, GrowParams};
+use vkhair::groom::{scenes, Groom};
+use vkhair::sim::{motion, Collider, SimParams, VolumeMode, VolumeParams};
+use vkhair::{ContextOptions, GpuContext, RecordedWork};
+
+use crate::bench_measure::{fitted_exponent, measure_sim, Samples, SimCase, SimFigures};
+use crate::output::Error;
+use crate::render_cmd::bench_frames;
+use crate::say;
+
+/// Peak memory bandwidth of a few GPUs, bytes per second (vendors' figures): the
+/// physical bound of a stage that moves its bytes once.
+pub const PEAK_BANDWIDTH: &[(&str, f64)] = &[
+    ("H100 SXM", 3.35e12),
+    ("H200", 4.8e12),
+    ("A100 80GB SXM", 2.039e12),
+    ("RTX 4090", 1.008e12),
+    ("RX 7900 XTX", 0.96e12),
+];
+
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    /// Samples per figure (the report gives their median and p95).
+    #[arg(long, default_value_t = 20)]
+    samples: usize,
+    /// Samples per point of the scaling curves.
+    #[arg(long, default_value_t = 5)]
+    scaling_samples: usize,
+    /// Folder holding Sintel's sintel_hair.tfx and sintel_bust.obj (its rows are
+    /// skipped, with the reason printed, when absent).
+    #[arg(long, default_value = "../shared/data/sintel")]
+    sintel: PathBuf,
+    /// Key hairs of the large generated groom (32 points each).
+    #[arg(long, default_value_t = 20_000)]
+    large: usize,
+    /// Small scenes and short scaling ranges (a smoke run).
+    #[arg(long)]
+    quick: bool,
+    /// Folder for scaling.csv and scaling.png.
+    #[arg(long, default_value = "out/bench")]
+    out: PathBuf,
+    /// Write every figure as JSON to this file.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Refuse to run on a CPU implementation of Vulkan (lavapipe): for
+    /// tools/gpu-bench.sh on a machine with a GPU.
+    #[arg(long)]
+    require_gpu: bool,
+}
+
+/// One stage's figures on one scene.
+struct Row {
+    scene: String,
+    stage: String,
+    /// "step" or "frame".
+    per: &'static str,
+    /// The GPU figure (see the module docs), ms.
+    gpu: Samples,
+    /// The sum of the timestamp scopes, ms.
+    timestamps: Samples,
+    cpu: Option<Samples>,
+    work: RecordedWork,
+}
+
+impl Row {
+    fn ratio(&self) -> f64 {
+        self.cpu.as_ref().map_or(f64::NAN, |c| self.gpu.median() / c.median())
+    }
+
+    fn new(scene: &str, stage: &str, per: &'static str, gpu: Samples, timestamps: Samples, work: RecordedWork) -> Row {
+        Row { scene: scene.into(), stage: stage.into(), per, gpu, timestamps, cpu: None, work }
+    }
+
+    fn bytes(&self) -> u64 {
+        self.work.bytes_read + self.work.bytes_written
+    }
+
+    fn json(&self) -> Value {
+        let bound: serde_json::Map<String, Value> = PEAK_BANDWIDTH
+            .iter()
+            .map(|(name, bw)| (name.to_string(), json!(finite(self.bytes() as f64 / bw * 1e3))))
+            .collect();
+        let per = self.per;
+        let mut v = json!({
+            "scene": self.scene,
+            "stage": self.stage,
+            "per": per,
+            format!("gpu_ms_per_{per}"): finite(self.gpu.median()),
+            format!("gpu_ms_per_{per}_p95"): finite(self.gpu.p95()),
+            format!("gpu_timestamp_ms_per_{per}"): finite(self.timestamps.median()),
+            format!("dispatches_per_{per}"): self.work.dispatches,
+            format!("barriers_per_{per}"): self.work.barriers,
+            format!("bytes_read_per_{per}"): self.work.bytes_read,
+            format!("bytes_written_per_{per}"): self.work.bytes_written,
+            "bandwidth_bound_ms": bound,
+            "samples": self.gpu.0.len(),
+        });
+        if let Some(cpu) = &self.cpu {
+            v[format!("cpu_ms_per_{per}")] = finite(cpu.median());
+            v[format!("cpu_ms_per_{per}_p95")] = finite(cpu.p95());
+            v["ratio_gpu_to_cpu"] = finite(self.ratio());
+        }
+        v
+    }
+}
+
+/// A JSON number, or null for NaN/Inf (JSON has no such numbers).
+fn finite(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else {
+        Value::Null
+    }
+}
+
+/// How the GPU figures are taken on this device (see the module docs).
+#[derive(Clone, Copy)]
+struct Clocking {
+    /// Whether the wall clock stands for the GPU (a CPU device).
+    wall: bool,
+    /// Median wall time of an empty submission, ms.
+    empty_ms: f64,
+}
+
+impl Clocking {
+    fn new(ctx: &GpuContext) -> Result<Clocking, Error> {
+        use vkhair::headless::Submit;
+        let mut empty = Samples::default();
+        for _ in 0..20 {
+            let started = std::time::Instant::now();
+            ctx.run_commands("vkhair bench empty submission", |_| {})?;
+            empty.0.push(started.elapsed().as_secs_f64() * 1e3);
+        }
+        let wall = ctx.info().device_type == vkhair::ash::vk::PhysicalDeviceType::CPU;
+        Ok(Clocking { wall, empty_ms: empty.median() })
+    }
+
+    /// The GPU figure of samples with these timestamps and wall times.
+    fn figure(&self, timestamps: &Samples, wall: &Samples) -> Samples {
+        match self.wall {
+            true => Samples(wall.0.iter().map(|w| (w - self.empty_ms).max(0.0)).collect()),
+            false => timestamps.clone(),
+        }
+    }
+
+    fn describe(&self) -> String {
+        match self.wall {
+            true => format!(
+                "a CPU device: GPU figures are wall time less an empty submission ({:.3} ms), timestamps shown beside",
+                self.empty_ms
+            ),
+            false => "GPU figures from timestamp queries".to_owned(),
+        }
+    }
+}
+
+/// The row of a simulation configuration and, with the volume stage, the row of
+/// the volume stage alone: its own scopes on a GPU; on a CPU device, the step
+/// less the step without the volume stage (`without`).
+fn sim_rows(scene: &str, stage: &str, f: &SimFigures, clock: Clocking, without: Option<&SimFigures>) -> Vec<Row> {
+    let gpu = clock.figure(&f.gpu, &f.gpu_wall);
+    let mut row = Row::new(scene, stage, "step", gpu.clone(), f.gpu.clone(), f.work);
+    row.cpu = (!f.cpu.0.is_empty()).then(|| f.cpu.clone());
+    let mut rows = vec![row];
+    if let Some(off) = without {
+        let alone = volume_alone(f, off, clock);
+        let stage = format!("{stage}: volume stage alone");
+        let mut row = Row::new(scene, &stage, "step", alone, f.volume_gpu.clone(), f.work - off.work);
+        row.cpu = (!f.volume_cpu.0.is_empty()).then(|| f.volume_cpu.clone());
+        rows.push(row);
+    }
+    rows
+}
+
+/// The GPU figure of the volume stage alone: its scopes on a GPU, on a CPU
+/// device the step less the median step without it (`off`).
+fn volume_alone(f: &SimFigures, off: &SimFigures, clock: Clocking) -> Samples {
+    match clock.wall {
+        true => {
+            let base = clock.figure(&off.gpu, &off.gpu_wall).median();
+            Samples(clock.figure(&f.gpu, &f.gpu_wall).0.iter().map(|g| (g - base).max(0.0)).collect())
+        }
+        false => f.volume_gpu.clone(),
+    }
+}
+
+/// A scene of the bench: its groom, colliders and how `render` draws it.
+struct Scene {
+    name: String,
+    groom: Groom,
+    colliders: Vec<Collider>,
+    render_args: Option<Vec<String>>,
+}
+
+fn grown(strands: usize, points: usize) -> Result<Groom, Error> {
+    let p = GrowParams { strands, points_per_strand: points, length: 0.35, seed: 3, ..GrowParams::default() };
+    Ok(grow(&scenes::thesis_scalp(), &p)?)
+}
+
+fn bench_scenes(a: &BenchArgs) -> Result<(Vec<Scene>, Vec<String>), Error> {
+    let size = |w: u32, h: u32| vec!["--width".to_owned(), w.to_string(), "--height".into(), h.to_string()];
+    let (w, h) = if a.quick { (160, 120) } else { (1280, 720) };
+    let mut skipped = Vec::new();
+    let mut list = vec![Scene {
+        name: "thesis 1750×6".into(),
+        groom: scenes::thesis()?,
+        colliders: motion::thesis_colliders(),
+        render_args: Some(size(w, h)),
+    }];
+    let (hair, bust) = (a.sintel.join("sintel_hair.tfx"), a.sintel.join("sintel_bust.obj"));
+    if hair.is_file() && bust.is_file() {
+        let groom = crate::groom_input::load_scaled(&hair, false, 0.01, 32)?;
+        let mut args = size(w, h);
+        for s in ["--input", &hair.display().to_string(), "--obj", &bust.display().to_string(), "--scale", "0.01"] {
+            args.push(s.to_owned());
+        }
+        let name = format!("Sintel {}×32", groom.strand_count());
+        list.push(Scene { name, groom, colliders: Vec::new(), render_args: Some(args) });
+    } else {
+        let why = format!("Sintel: {} or {} is missing", hair.display(), bust.display());
+        say!("skipped {why}");
+        skipped.push(why);
+    }
+    let large = if a.quick { a.large.min(500) } else { a.large };
+    list.push(Scene {
+        name: format!("generated {large}×32"),
+        groom: grown(large, 32)?,
+        colliders: motion::thesis_colliders(),
+        render_args: None,
+    });
+    Ok((list, skipped))
+}
+
+fn volume(mode: VolumeMode, grid: u32) -> SimParams {
+    SimParams {
+        volume: VolumeParams { mode, resolution: [grid; 3], ..VolumeParams::default() },
+        ..SimParams::default()
+    }
+}
+
+/// One scaling curve: (work, GPU ms, CPU ms) per point.
+struct Curve {
+    axis: &'static str,
+    unit: &'static str,
+    points: Vec<(f64, f64, f64)>,
+}
+
+impl Curve {
+    fn exponents(&self) -> (f64, f64) {
+        let gpu: Vec<(f64, f64)> = self.points.iter().map(|p| (p.0, p.1)).collect();
+        let cpu: Vec<(f64, f64)> = self.points.iter().map(|p| (p.0, p.2)).collect();
+        (fitted_exponent(&gpu), fitted_exponent(&cpu))
+    }
+}
+
+fn scaling(ctx: &GpuContext, a: &BenchArgs, clock: Clocking) -> Result<Vec<Curve>, Error> {
+    let n = a.scaling_samples.max(1);
+    let colliders = motion::thesis_colliders();
+    let off = volume(VolumeMode::Off, 32);
+    let sim = |groom: &Groom, params: &SimParams| {
+        let case = SimCase { groom, colliders: &colliders, params: params.clone(), cpu: true };
+        measure_sim(ctx, &case, n)
+    };
+    let sim_point = |groom: &Groom, params: &SimParams| {
+        sim(groom, params).map(|f| (clock.figure(&f.gpu, &f.gpu_wall).median(), f.cpu.median()))
+    };
+    let quick = a.quick;
+    let hairs: &[usize] = if quick { &[200, 400] } else { &[1000, 4000, 16_000, 64_000] };
+    let points: &[usize] = if quick { &[8, 16] } else { &[8, 16, 32, 64] };
+    let grids: &[u32] = if quick { &[8, 16] } else { &[16, 32, 64] };
+    let sizes: &[(u32, u32)] = if quick { &[(160, 120), (320, 240)] } else { &[(854, 480), (1280, 720), (1920, 1080)] };
+    let mut curves = Vec::new();
+    let mut curve = Curve { axis: "key hairs (16 points; volume off)", unit: "particles", points: Vec::new() };
+    for &h in hairs {
+        let groom = grown(h, 16)?;
+        let (g, c) = sim_point(&groom, &off)?;
+        curve.points.push((groom.point_count() as f64, g, c));
+    }
+    curves.push(curve);
+    let keys = if a.quick { 200 } else { 4000 };
+    let mut curve = Curve { axis: "points per key hair (volume off)", unit: "particles", points: Vec::new() };
+    for &p in points {
+        let groom = grown(keys, p)?;
+        let (g, c) = sim_point(&groom, &off)?;
+        curve.points.push((groom.point_count() as f64, g, c));
+    }
+    curves.push(curve);
+    let thesis = scenes::thesis()?;
+    let mut curve = Curve { axis: "grid (FLIP volume stage alone; thesis)", unit: "cells", points: Vec::new() };
+    let without = sim(&thesis, &off)?;
+    for &g in grids {
+        let f = sim(&thesis, &volume(VolumeMode::Flip, g))?;
+        let gpu = volume_alone(&f, &without, clock).median();
+        curve.points.push((f64::from(g).powi(3), gpu, f.volume_cpu.median()));
+    }
+    curves.push(curve);
+    let mut curve = Curve { axis: "resolution (render frame; thesis)", unit: "pixels", points: Vec::new() };
+    for &(w, h) in sizes {
+        let (w, h) = (w.to_string(), h.to_string());
+        let f = bench_frames(ctx, &["--width", &w, "--height", &h], n)?;
+        curve.points.push((f.pixels as f64, clock.figure(&f.gpu, &f.wall).median(), f64::NAN));
+    }
+    curves.push(curve);
+    Ok(curves)
+}
+
+fn print_rows(rows: &[Row]) {
+    say!(
+        "{:<22} {:<36} {:>9} {:>9} {:>9} {:>9} {:>7} {:>5} {:>5} {:>9} {:>9}",
+        "scene",
+        "stage (ms per step or frame)",
+        "GPU med",
+        "GPU p95",
+        "stamps",
+        "CPU ref",
+        "GPU/CPU",
+        "disp",
+        "barr",
+        "MB moved",
+        "H100 ms"
+    );
+    for r in rows {
+        let cpu = r.cpu.as_ref().map_or(f64::NAN, Samples::median);
+        say!(
+            "{:<22} {:<36} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>7.2} {:>5} {:>5} {:>9.2} {:>9.4}",
+            r.scene,
+            r.stage,
+            r.gpu.median(),
+            r.gpu.p95(),
+            r.timestamps.median(),
+            cpu,
+            r.ratio(),
+            r.work.dispatches,
+            r.work.barriers,
+            r.bytes() as f64 / 1e6,
+            r.bytes() as f64 / PEAK_BANDWIDTH[0].1 * 1e3
+        );
+    }
+}
+
+fn write_scaling(out: &Path, curves: &[Curve]) -> Result<PathBuf, Error> {
+    let mut csv = String::from("axis,unit,work,gpu_ms,cpu_ms\n");
+    for c in curves {
+        for p in &c.points {
+            let _ = writeln!(csv, "{},{},{},{:.4},{:.4}", c.axis, c.unit, p.0, p.1, p.2);
+        }
+    }
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let path = out.join("scaling.csv");
+    vkhair::files::write_atomic(&path, csv.as_bytes())?;
+    Ok(path)
+}
+
+pub fn bench(a: &BenchArgs) -> Result<(), Error> {
+    if a.samples == 0 {
+        return Err("--samples must be at least 1 (the report's figures are medians of 20 by default)".into());
+    }
+    let ctx = GpuContext::headless(&ContextOptions::default())?;
+    let info = ctx.info();
+    if a.require_gpu && info.device_type == vkhair::ash::vk::PhysicalDeviceType::CPU {
+        return Err(format!(
+            "--require-gpu: the device chosen is {}, a CPU implementation; no GPU was found (see `vkhair devices`; VKHAIR_DEVICE picks one)",
+            info.name
+        )
+        .into());
+    }
+    say!("{} ({}): {} samples per figure, GPU and CPU reference interleaved", info.name, info.driver, a.samples);
+    let clock = Clocking::new(&ctx)?;
+    say!("{}", clock.describe());
+    let (scenes, skipped) = bench_scenes(a)?;
+    let mut rows = Vec::new();
+    for s in &scenes {
+        say!(
+            "{}: {} key hairs × {} points",
+            s.name,
+            s.groom.strand_count(),
+            s.groom.point_count() / s.groom.strand_count().max(1)
+        );
+        let case = |params: SimParams| SimCase { groom: &s.groom, colliders: &s.colliders, params, cpu: true };
+        let off = measure_sim(&ctx, &case(volume(VolumeMode::Off, 32)), a.samples)?;
+        rows.extend(sim_rows(&s.name, "sim, volume off", &off, clock, None));
+        let f = measure_sim(&ctx, &case(volume(VolumeMode::Friction, 32)), a.samples)?;
+        rows.extend(sim_rows(&s.name, "sim, density friction 32³", &f, clock, Some(&off)));
+        let f = measure_sim(&ctx, &case(volume(VolumeMode::Flip, 32)), a.samples)?;
+        rows.extend(sim_rows(&s.name, "sim, FLIP 32³", &f, clock, Some(&off)));
+        if let Some(args) = &s.render_args {
+            let args: Vec<&str> = args.iter().map(String::as_str).collect();
+            let f = bench_frames(&ctx, &args, a.samples)?;
+            let stage = format!("render frame, {} hairs, {} segments", f.hairs, f.segments);
+            rows.push(Row::new(&s.name, &stage, "frame", clock.figure(&f.gpu, &f.wall), f.gpu, f.work));
+        }
+    }
+    print_rows(&rows);
+    say!("no CPU reference renders a whole frame (render::reference checks small scenes in the tests)");
+    let curves = scaling(&ctx, a, clock)?;
+    for c in &curves {
+        let (g, cpu) = c.exponents();
+        say!("scaling, {}: time ∝ {}^{g:.2} on the GPU, ^{cpu:.2} on the CPU reference", c.axis, c.unit);
+    }
+    let csv = write_scaling(&a.out, &curves)?;
+    crate::plot_cmd::plot_file(&csv, &csv.with_extension("png"))?;
+    if let Some(path) = &a.json {
+        let find = |stage: &str| rows.iter().find(|r| r.scene == scenes[0].name && r.stage == stage);
+        let (off, flip) = (find("sim, volume off"), find("sim, FLIP 32³: volume stage alone"));
+        let median = |r: Option<&Row>, cpu: bool| {
+            finite(r.map_or(f64::NAN, |r| {
+                if cpu {
+                    r.cpu.as_ref().map_or(f64::NAN, Samples::median)
+                } else {
+                    r.gpu.median()
+                }
+            }))
+        };
+        let summary = json!({
+            "command": "bench",
+            "device": info.name,
+            "driver": info.driver,
+            "samples": a.samples,
+            "gpu_figures": clock.describe(),
+            "scene": scenes[0].name,
+            "gpu_ms_per_step": median(off, false),
+            "cpu_ms_per_step": median(off, true),
+            "dispatches_per_step": off.map(|r| r.work.dispatches),
+            "barriers_per_step": off.map(|r| r.work.barriers),
+            "volume_gpu_ms_per_step": median(flip, false),
+            "volume_cpu_ms_per_step": median(flip, true),
+            "bandwidth_bytes_per_s": PEAK_BANDWIDTH.iter().map(|(n, b)| json!({"device": n, "bytes_per_s": b})).collect::<Vec<_>>(),
+            "stages": rows.iter().map(Row::json).collect::<Vec<_>>(),
+            "scaling": curves.iter().map(|c| {
+                let (g, cpu) = c.exponents();
+                json!({
+                    "axis": c.axis,
+                    "unit": c.unit,
+                    "gpu_exponent": finite(g),
+                    "cpu_exponent": finite(cpu),
+                    "points": c.points.iter().map(|p| json!({"work": p.0, "gpu_ms": finite(p.1), "cpu_ms": finite(p.2)})).collect::<Vec<_>>(),
+                })
+            }).collect::<Vec<_>>(),
+            "skipped": skipped,
+        });
+        let text = serde_json::to_string_pretty(&summary).map_err(|e| format!("cannot encode the report: {e}"))?;
+        vkhair::files::write_atomic(path, text.as_bytes())?;
+        say!("wrote {}", path.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,80 @@
+//! `vkhair bench` as a user meets it: a quick run reports every stage beside its
+//! CPU reference with the keys the JSON promises, the one-dispatch step, and a
+//! scaling chart.
+
+mod common;
+
+use std::time::Duration;
+
+use common::run;
+
+const LIMIT: Duration = Duration::from_secs(600);
+
+#[test]
+fn a_quick_bench_reports_every_stage_with_its_reference_and_writes_json_and_a_chart() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let json = dir.path().join("bench.json");
+    let out = dir.path().join("charts");
+    let (json_arg, out_arg) = (json.display().to_string(), out.display().to_string());
+    // No Sintel here: its rows are skipped with the reason printed.
+    let missing = dir.path().join("no-sintel").display().to_string();
+    let args = [
+        "bench",
+        "--quick",
+        "--samples",
+        "3",
+        "--scaling-samples",
+        "1",
+        "--json",
+        &json_arg,
+        "--out",
+        &out_arg,
+        "--sintel",
+        &missing,
+    ];
+    let r = run(&args, LIMIT);
+    r.assert_ok();
+    assert!(r.stdout.contains("skipped Sintel"), "{}", r.stdout);
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("parse");
+    for key in [
+        "gpu_ms_per_step",
+        "cpu_ms_per_step",
+        "dispatches_per_step",
+        "barriers_per_step",
+        "volume_gpu_ms_per_step",
+        "volume_cpu_ms_per_step",
+    ] {
+        assert!(v[key].is_number(), "{key} missing or not a number: {}", v[key]);
+    }
+    assert_eq!(v["dispatches_per_step"], 1, "the step is one dispatch with the volume stage off");
+    assert_eq!(v["barriers_per_step"], 2);
+    let stages = v["stages"].as_array().expect("stages");
+    for stage in ["sim, volume off", "sim, density friction 32³", "sim, FLIP 32³", "sim, FLIP 32³: volume stage alone"]
+    {
+        let rows: Vec<_> = stages.iter().filter(|s| s["stage"] == stage).collect();
+        assert_eq!(rows.len(), 2, "{stage}: the thesis scene and the generated groom");
+        for row in rows {
+            assert!(row["gpu_ms_per_step"].as_f64().is_some_and(|x| x > 0.0), "{row}");
+            assert!(row["cpu_ms_per_step"].as_f64().is_some_and(|x| x > 0.0), "{row}");
+            assert!(row["bandwidth_bound_ms"]["H100 SXM"].is_number(), "{row}");
+        }
+    }
+    let frame = stages.iter().find(|s| s["per"] == "frame").expect("a render frame row");
+    assert!(frame["gpu_ms_per_frame"].as_f64().is_some_and(|x| x > 0.0), "{frame}");
+    let scaling = v["scaling"].as_array().expect("scaling");
+    assert_eq!(scaling.len(), 4, "hairs, points, grid, resolution");
+    assert!(scaling[0]["gpu_exponent"].is_number() && scaling[0]["cpu_exponent"].is_number(), "{}", scaling[0]);
+    let png = out.join("scaling.png");
+    let (w, h, _) = common::read_png(&png);
+    assert_eq!((w, h), (1100, 900));
+}
+
+#[test]
+fn require_gpu_refuses_a_cpu_device() {
+    let r = run(&["bench", "--require-gpu", "--quick"], LIMIT);
+    if r.stdout.contains("llvmpipe") || r.stderr.contains("CPU implementation") {
+        r.assert_error("--require-gpu");
+    } else {
+        eprintln!("a GPU is present: --require-gpu accepted it (nothing to refuse here)");
+    }
+}
