@@ -109,7 +109,7 @@ fn line_chart(
         .x_label_area_size(40)
         .y_label_area_size(70)
         .build_cartesian_2d(0.0..max_x.max(1e-9), 0.0..max_y.max(1e-9))?;
-    chart.configure_mesh().x_desc(x_desc).y_desc(y_desc).draw()?;
+    chart.configure_mesh().x_labels(6).x_label_formatter(&|x| short(*x)).x_desc(x_desc).y_desc(y_desc).draw()?;
     for (name, points) in lines {
         // The same name gets the same color in every panel.
         let color = Palette99::pick(palette.iter().position(|p| p == name).unwrap_or(0)).to_rgba();
@@ -124,6 +124,15 @@ fn line_chart(
         chart.configure_series_labels().border_style(BLACK).background_style(WHITE.mix(0.8)).draw()?;
     }
     Ok(())
+}
+
+/// An axis label that stays short: 250k, 1.5M; small values with one decimal.
+fn short(x: f64) -> String {
+    match x.abs() {
+        a if a >= 1e6 => format!("{:.1}M", x / 1e6),
+        a if a >= 1e4 => format!("{:.0}k", x / 1e3),
+        _ => format!("{x:.1}"),
+    }
 }
 
 fn render_lines(t: &Table) -> Result<(Lines, Lines), Error> {

@@ -208,7 +208,7 @@ fn a_degenerate_strand_is_repaired_with_a_warning_or_refused_when_strict() {
 /// functions.
 #[test]
 fn help_never_points_at_library_functions() {
-    for command in ["devices", "inspect", "grow", "simulate", "render", "config", "plot", "convert"] {
+    for command in ["devices", "inspect", "grow", "simulate", "render", "config", "plot", "convert", "bench"] {
         let out = run(&[command, "--help"], LIMIT);
         out.assert_ok();
         assert!(!out.stdout.contains("::"), "`vkhair {command} --help` names a library item:\n{}", out.stdout);
