@@ -414,52 +414,43 @@ impl HairSim {
         mut profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
         let inputs = self.planner.next(head)?;
-        let Some(first) = inputs.first() else { return Ok(()) };
-        let substeps = inputs.len() as u32;
         // SAFETY (whole body): guaranteed by the caller; all buffers belong to this
         // device, and update sizes are multiples of 4 below 64 KiB (by construction).
         unsafe {
-            self.record_uploads(cmd, &inputs, |cmd| {
-                if let Some(volume) = &self.volume {
-                    self.record_volume_uploads(cmd, volume, first);
-                }
-            });
+            self.record_uploads(cmd, &inputs);
             self.pending_rest.clear();
-            if self.volume.is_none() {
-                self.record_dispatch(cmd, [0, substeps], &mut profiler);
+            let Some(volume) = &self.volume else {
+                self.record_dispatch(cmd, self.current, [0, inputs.len() as u32], &mut profiler);
                 self.current = 1 - self.current;
                 return Ok(());
-            }
+            };
             let between = barrier::memory(&[AccessKind::ComputeWrite], barrier::COMPUTE_READ_WRITE);
+            let mut current = self.current;
             for (k, sub) in inputs.iter().enumerate() {
-                let Some(volume) = &self.volume else { break };
                 if k > 0 {
                     self.device.cmd_barrier(cmd, &[entry_barrier()], &[], &[]);
                     self.record_volume_uploads(cmd, volume, sub);
                     self.device.cmd_barrier(cmd, &[uploaded_barrier()], &[], &[]);
                 }
-                self.record_dispatch(cmd, [k as u32, 1], &mut profiler);
+                self.record_dispatch(cmd, current, [k as u32, 1], &mut profiler);
                 self.device.cmd_barrier(cmd, &[between], &[], &[]);
                 let labels = SimStage::VOLUME.map(SimStage::label);
                 // The barrier above made the step's writes visible.
-                volume.record(cmd, 1 - self.current, labels, profiler.as_deref_mut());
-                self.current = 1 - self.current;
+                volume.record(cmd, 1 - current, labels, profiler.as_deref_mut());
+                current = 1 - current;
             }
+            self.current = current;
         }
         Ok(())
     }
 
     /// Records the uploads of a step between the entry and the uploaded barrier:
-    /// the sub-steps' parameters and colliders, pending rest data, and `extra`.
+    /// the sub-steps' parameters and colliders, pending rest data, and with the
+    /// volume stage its uploads for the first sub-step.
     ///
     /// # Safety
     /// As [`HairSim::record_step`].
-    unsafe fn record_uploads(
-        &self,
-        cmd: vk::CommandBuffer,
-        inputs: &[SubstepInputs],
-        extra: impl FnOnce(vk::CommandBuffer),
-    ) {
+    unsafe fn record_uploads(&self, cmd: vk::CommandBuffer, inputs: &[SubstepInputs]) {
         let d = &self.device;
         let params: Vec<_> = inputs.iter().map(|sub| sub.params).collect();
         // SAFETY: guaranteed by the caller; sizes are multiples of 4, each update
@@ -478,7 +469,9 @@ impl HairSim {
                 update_chunked(d, cmd, self.gpu.rest.raw(), range.start as u64 * 16, rest);
                 update_chunked(d, cmd, self.gpu.rest_lengths.raw(), range.start as u64 * 4, lengths);
             }
-            extra(cmd);
+            if let (Some(volume), Some(first)) = (&self.volume, inputs.first()) {
+                self.record_volume_uploads(cmd, volume, first);
+            }
             d.cmd_barrier(cmd, &[uploaded_barrier()], &[], &[]);
         }
     }
@@ -500,18 +493,24 @@ impl HairSim {
         }
     }
 
-    /// Records the step kernel for sub-steps `range` = [first, count] in a
-    /// timestamp scope.
+    /// Records the step kernel for sub-steps `range` = [first, count], reading
+    /// half `parity` of the double buffer, in a timestamp scope.
     ///
     /// # Safety
     /// As [`HairSim::record_step`], after the uploads' barrier.
-    unsafe fn record_dispatch(&self, cmd: vk::CommandBuffer, range: [u32; 2], profiler: &mut Option<&mut GpuProfiler>) {
+    unsafe fn record_dispatch(
+        &self,
+        cmd: vk::CommandBuffer,
+        parity: usize,
+        range: [u32; 2],
+        profiler: &mut Option<&mut GpuProfiler>,
+    ) {
         let (strands, groups) = (self.planner.strands, self.planner.packing().hairs_per_group);
         let push = SimPush { range: [range[0], range[1], 0, 0] };
         // SAFETY: guaranteed by the caller.
         unsafe {
             PassScope::record(&self.device, cmd, profiler, SimStage::Step.label(), LabelColor::Compute, || {
-                self.pipeline.bind(cmd, &[self.sets[self.current]]);
+                self.pipeline.bind(cmd, &[self.sets[parity]]);
                 self.pipeline.push(cmd, &push);
                 self.pipeline.dispatch_threads(cmd, [step::threads(strands, groups), 1, 1]);
             });
