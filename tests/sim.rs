@@ -135,6 +135,29 @@ fn a_step_is_one_dispatch_without_the_volume_stage() {
 }
 
 #[test]
+fn a_pressure_iteration_is_four_passes_per_multigrid_level_and_six_more() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(100, 16, 3);
+    // Levels of a 32³ grid: 32³, 16³, 8³ and the coarsest, 4³ (at most 256 cells).
+    let levels_above_coarsest = 3;
+    // Matrix product, reduction, update, reduction, new direction; per level:
+    // pre-smoothing, restriction and two post-smoothing passes; the coarsest
+    // level's solve. (Before the passes were fused: 25 in all.)
+    let per_iteration = 5 + 4 * levels_above_coarsest + 1;
+    let run = |max_iterations| {
+        let volume = vkhair::sim::VolumeParams { max_iterations, ..vkhair::sim::VolumeParams::flip([32, 32, 32]) };
+        let params = SimParams { volume, ..SimParams::default() };
+        let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
+        let before = gpu.ctx().recorded_work();
+        sim.run(1, |i| head_at(i, &params), None).expect("run");
+        gpu.ctx().recorded_work() - before
+    };
+    let work = run(3) - run(1);
+    assert_eq!(work.dispatches, 2 * per_iteration, "{work:?}");
+    assert_eq!(work.barriers, 2 * per_iteration, "{work:?}");
+}
+
+#[test]
 fn gpu_matches_cpu_in_dftl_mode() {
     let gpu = Gpu::new();
     let groom = scenes::thesis().expect("thesis");

@@ -44,6 +44,10 @@ const uint VOL_SOLID = 2u;
 const uint VOL_MODE_FLIP = 1u;
 const uint VOL_MODE_FRICTION = 2u;
 
+// Stencil words of the pressure matrix (volume_ops.glsl).
+const uint VOL_STENCIL_FLUID = 1u << 16u;
+const uint VOL_STENCIL_COUNT_SHIFT = 8u;
+
 const uint VOL_PRECOND_JACOBI = 0u;
 const uint VOL_PRECOND_MULTIGRID = 1u;
 

@@ -1,24 +1,36 @@
-// The pressure matrix A of a grid level, for kernels that declare
-//   layout(... binding = 16) buffer Labels { uint labels[]; };
+// The pressure matrix A of a grid level, as stencil words written once per
+// solve by mg_stencil.comp, for kernels that declare
+//   layout(... binding = 30) buffer Stencil { uint stencil[]; };
 // before including this file. Row of a fluid cell: the number of non-solid
 // neighbours on the diagonal (outside the grid counts as air, p = 0), −1 for
 // each fluid neighbour; solid neighbours drop out (Neumann boundary).
+//
+// Word of a cell: bit n (0..5: −x, +x, −y, +y, −z, +z) set when neighbour n is
+// fluid, the diagonal in bits 8..10, VOL_STENCIL_FLUID when the cell itself is
+// fluid; 0 for air and solid cells.
 #ifndef VKHAIR_VOLUME_OPS_GLSL
 #define VKHAIR_VOLUME_OPS_GLSL
 
 #include "volume.glsl"
 
-// Diagonal of cell `ijk` of the level at `offset` with `dims` cells; `fluid[n]`
-// gets the level-array index of neighbour n when it is fluid, else −1.
-float vol_stencil(uvec3 ijk, uvec3 dims, uint offset, out int fluid[6]) {
-    float diagonal = 0.0;
-    for (uint n = 0u; n < 6u; ++n) {
-        int nb = vol_neighbor(ijk, dims, n);
-        uint label = nb < 0 ? VOL_AIR : labels[offset + uint(nb)];
-        fluid[n] = label == VOL_FLUID ? int(offset) + nb : -1;
-        diagonal += label == VOL_SOLID ? 0.0 : 1.0;
-    }
-    return diagonal;
+bool vol_is_fluid(uint word) {
+    return (word & VOL_STENCIL_FLUID) != 0u;
+}
+
+bool vol_has_fluid_neighbor(uint word, uint n) {
+    return (word & (1u << n)) != 0u;
+}
+
+// Diagonal of the row (an integer, exactly as a sum of ones).
+float vol_diagonal(uint word) {
+    return float((word >> VOL_STENCIL_COUNT_SHIFT) & 7u);
+}
+
+// Level-array index of neighbour n of the cell at level-array index i, on a
+// level of `dims` cells; meaningful only where the neighbour exists.
+uint vol_neighbor_index(uint i, uvec3 dims, uint n) {
+    uint stride = n < 2u ? 1u : (n < 4u ? dims.x : dims.x * dims.y);
+    return (n & 1u) == 0u ? i - stride : i + stride;
 }
 
 #endif

@@ -1,16 +1,21 @@
 #version 460
 // Multigrid preconditioner, coarsest level (at most 256 cells), one workgroup:
-// op.z damped Jacobi sweeps (an even number) from x = 0 in shared memory.
+// op.z damped Jacobi sweeps (an even number) from x = 0 in shared memory;
+// with op.y = 1 (a grid of one level) also the partials (r·z, max |r|) of the
+// conjugate gradients, as the finest level's last sweep gives them otherwise.
 //   dims: the level (w its first cell).
 #include "volume.glsl"
+// vkhair variant: VKHAIR_SHARED_REDUCE
+#include "reduce.glsl"
 
 layout(local_size_x = VOL_GROUP) in;
 
 layout(push_constant) uniform Push { VolumePush pc; };
-layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };
+layout(std430, set = 0, binding = 30) readonly buffer Stencil { uint stencil[]; };
 #include "volume_ops.glsl"
 layout(std430, set = 0, binding = 23) writeonly buffer X { float x[]; };
 layout(std430, set = 0, binding = 25) readonly buffer Rhs { float rhs[]; };
+layout(std430, set = 0, binding = 27) writeonly buffer Partials { vec2 partials[]; };
 
 shared float values[2][VOL_GROUP];
 
@@ -21,14 +26,10 @@ void main() {
     uvec3 dims = pc.dims.xyz;
     bool live = c < dims.x * dims.y * dims.z;
     uint i = pc.dims.w + c;
-    bool fluid_cell = live && labels[i] == VOL_FLUID;
-    int fluid[6];
-    float diagonal = 0.0;
-    float b = 0.0;
-    if (fluid_cell) {
-        diagonal = vol_stencil(vol_cell_coords(c, dims), dims, pc.dims.w, fluid);
-        b = rhs[i];
-    }
+    uint w = live ? stencil[i] : 0u;
+    bool fluid_cell = vol_is_fluid(w);
+    float diagonal = vol_diagonal(w);
+    float b = fluid_cell ? rhs[i] : 0.0;
     values[0][c] = 0.0;
     barrier();
     for (uint sweep = 0u; sweep < pc.op.z; ++sweep) {
@@ -37,8 +38,8 @@ void main() {
         if (fluid_cell && diagonal > 0.0) {
             precise float ax = diagonal * values[from][c];
             for (uint n = 0u; n < 6u; ++n) {
-                if (fluid[n] >= 0) {
-                    ax -= values[from][uint(fluid[n]) - pc.dims.w];
+                if (vol_has_fluid_neighbor(w, n)) {
+                    ax -= values[from][vol_neighbor_index(c, dims, n)];
                 }
             }
             value = values[from][c] + OMEGA * (b - ax) / diagonal;
@@ -46,7 +47,14 @@ void main() {
         values[1u - from][c] = value;
         barrier();
     }
+    float result = values[pc.op.z & 1u][c];
     if (live) {
-        x[i] = values[pc.op.z & 1u][c];
+        x[i] = result;
+    }
+    if (pc.op.y == 1u) {
+        vec2 total = reduce_sum_max(live ? vec2(rhs[i] * result, abs(rhs[i])) : vec2(0.0));
+        if (gl_LocalInvocationIndex == 0u) {
+            partials[0] = total;
+        }
     }
 }

@@ -8,7 +8,7 @@
 layout(local_size_x = VOL_GROUP) in;
 
 layout(push_constant) uniform Push { VolumePush pc; };
-layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };
+layout(std430, set = 0, binding = 30) readonly buffer Stencil { uint stencil[]; };
 #include "volume_ops.glsl"
 layout(std430, set = 0, binding = 23) readonly buffer X { float x[]; };
 layout(std430, set = 0, binding = 25) buffer Rhs { float rhs[]; };
@@ -21,22 +21,21 @@ void main() {
     }
     uvec3 ijk = vol_cell_coords(c, cd);
     precise float sum = 0.0;
-    if (labels[pc.coarse.w + c] == VOL_FLUID) {
+    if (vol_is_fluid(stencil[pc.coarse.w + c])) {
         for (uint k = 0u; k < 8u; ++k) {
             uvec3 child = ijk * 2u + uvec3(k & 1u, (k >> 1u) & 1u, k >> 2u);
             if (any(greaterThanEqual(child, pc.dims.xyz))) {
                 continue;
             }
             uint i = pc.dims.w + vol_cell_index(child, pc.dims.xyz);
-            if (labels[i] != VOL_FLUID) {
+            uint w = stencil[i];
+            if (!vol_is_fluid(w)) {
                 continue;
             }
-            int fluid[6];
-            float diagonal = vol_stencil(child, pc.dims.xyz, pc.dims.w, fluid);
-            precise float residual = rhs[i] - diagonal * x[i];
+            precise float residual = rhs[i] - vol_diagonal(w) * x[i];
             for (uint n = 0u; n < 6u; ++n) {
-                if (fluid[n] >= 0) {
-                    residual += x[uint(fluid[n])];
+                if (vol_has_fluid_neighbor(w, n)) {
+                    residual += x[vol_neighbor_index(i, pc.dims.xyz, n)];
                 }
             }
             sum += residual;

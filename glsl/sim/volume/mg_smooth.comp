@@ -1,48 +1,101 @@
 #version 460
-// Multigrid preconditioner: one damped Jacobi sweep (ω = 2/3) on one level,
-// x ← x + ω (rhs − A x) / diag, non-fluid cells 0.
-//   dims: the level (w its first cell);
-//   op.x = 0: from x = 0 into tmp;  1: tmp → x;  2: x → tmp.
+// Multigrid preconditioner: damped Jacobi sweeps (ω = 2/3) on one level,
+// x ← x + ω (rhs − A x) / diag, non-fluid cells 0. Three forms, so that the
+// V-cycle needs no pass of its own for the first sweep or the prolongation:
+//   op.x = 0 (pre):   two sweeps from x = 0 into x; the first sweep's values of
+//                     the cell and its neighbours are recomputed where needed;
+//   op.x = 1 (post):  one sweep from x plus the coarse parent's correction
+//                     (piecewise-constant prolongation, the transpose of the
+//                     restriction up to its factor) into tmp;
+//   op.x = 2 (post):  one sweep tmp → x; with op.y = 1 (finest level, in
+//                     conjugate gradients) also the per-workgroup partials
+//                     (r·z, max |r|) of z = x and r = rhs.
+//   dims: the level (w its first cell);  coarse: the next coarser level.
 #include "volume.glsl"
+// vkhair variant: VKHAIR_SHARED_REDUCE
+#include "reduce.glsl"
 
 layout(local_size_x = VOL_GROUP) in;
 
 layout(push_constant) uniform Push { VolumePush pc; };
-layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };
+layout(std430, set = 0, binding = 30) readonly buffer Stencil { uint stencil[]; };
 #include "volume_ops.glsl"
 layout(std430, set = 0, binding = 23) buffer X { float x[]; };
 layout(std430, set = 0, binding = 24) buffer Tmp { float tmp[]; };
 layout(std430, set = 0, binding = 25) readonly buffer Rhs { float rhs[]; };
+layout(std430, set = 0, binding = 27) writeonly buffer Partials { vec2 partials[]; };
 
 const float OMEGA = 2.0 / 3.0;
 
-float read_source(uint i) {
-    return pc.op.x == 0u ? 0.0 : (pc.op.x == 1u ? tmp[i] : x[i]);
+// One sweep's value at cell i with word w, from its own value and the sum of
+// its fluid neighbours' values subtracted in order n = 0..5 (done by the caller).
+float sweep(uint i, uint w, float own, float ax) {
+    float diagonal = vol_diagonal(w);
+    precise float value = diagonal > 0.0 ? own + OMEGA * (rhs[i] - ax) / diagonal : 0.0;
+    return value;
+}
+
+// The first sweep from x = 0 at cell j.
+float first_sweep(uint j) {
+    uint w = stencil[j];
+    if (!vol_is_fluid(w)) {
+        return 0.0;
+    }
+    precise float ax = vol_diagonal(w) * 0.0;
+    for (uint n = 0u; n < 6u; ++n) {
+        if (vol_has_fluid_neighbor(w, n)) {
+            ax -= 0.0;
+        }
+    }
+    return sweep(j, w, 0.0, ax);
+}
+
+// x at fluid cell `ijk` (level-array index j) with its coarse parent's correction added.
+float prolonged(uint j, uvec3 ijk) {
+    uint parent = pc.coarse.w + vol_cell_index(ijk / 2u, pc.coarse.xyz);
+    precise float value = x[j] + x[parent];
+    return value;
+}
+
+float source(uint j, uvec3 ijk) {
+    if (pc.op.x == 0u) {
+        return first_sweep(j);
+    }
+    return pc.op.x == 1u ? prolonged(j, ijk) : tmp[j];
 }
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
     uvec3 dims = pc.dims.xyz;
-    if (c >= dims.x * dims.y * dims.z) {
-        return;
-    }
+    bool live = c < dims.x * dims.y * dims.z;
     uint i = pc.dims.w + c;
     precise float value = 0.0;
-    if (labels[i] == VOL_FLUID) {
-        int fluid[6];
-        float diagonal = vol_stencil(vol_cell_coords(c, dims), dims, pc.dims.w, fluid);
-        float own = read_source(i);
-        precise float ax = diagonal * own;
+    uint w = live ? stencil[i] : 0u;
+    if (vol_is_fluid(w)) {
+        uvec3 ijk = pc.op.x == 1u ? vol_cell_coords(c, dims) : uvec3(0u);
+        float own = source(i, ijk);
+        precise float ax = vol_diagonal(w) * own;
         for (uint n = 0u; n < 6u; ++n) {
-            if (fluid[n] >= 0) {
-                ax -= read_source(uint(fluid[n]));
+            if (vol_has_fluid_neighbor(w, n)) {
+                uvec3 nb = ijk;
+                nb[n >> 1u] = (n & 1u) == 0u ? nb[n >> 1u] - 1u : nb[n >> 1u] + 1u;
+                ax -= source(vol_neighbor_index(i, dims, n), nb);
             }
         }
-        value = diagonal > 0.0 ? own + OMEGA * (rhs[i] - ax) / diagonal : 0.0;
+        value = sweep(i, w, own, ax);
     }
-    if (pc.op.x == 1u) {
-        x[i] = value;
-    } else {
-        tmp[i] = value;
+    if (live) {
+        if (pc.op.x == 1u) {
+            tmp[i] = value;
+        } else {
+            x[i] = value;
+        }
+    }
+    if (pc.op.y == 1u) {
+        vec2 local = live ? vec2(rhs[i] * value, abs(rhs[i])) : vec2(0.0);
+        vec2 total = reduce_sum_max(local);
+        if (gl_LocalInvocationIndex == 0u) {
+            partials[gl_WorkGroupID.x] = total;
+        }
     }
 }

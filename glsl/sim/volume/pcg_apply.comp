@@ -7,7 +7,7 @@
 layout(local_size_x = VOL_GROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
-layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };
+layout(std430, set = 0, binding = 30) readonly buffer Stencil { uint stencil[]; };
 #include "volume_ops.glsl"
 layout(std430, set = 0, binding = 21) readonly buffer D { float d[]; };
 layout(std430, set = 0, binding = 22) writeonly buffer Q { float q[]; };
@@ -19,13 +19,12 @@ void main() {
     vec2 local = vec2(0.0);
     if (c < vp.dims.w) {
         precise float qc = 0.0;
-        if (labels[c] == VOL_FLUID) {
-            int fluid[6];
-            float diagonal = vol_stencil(vol_cell_coords(c, dims), dims, 0u, fluid);
-            qc = diagonal * d[c];
+        uint w = stencil[c];
+        if (vol_is_fluid(w)) {
+            qc = vol_diagonal(w) * d[c];
             for (uint n = 0u; n < 6u; ++n) {
-                if (fluid[n] >= 0) {
-                    qc -= d[fluid[n]];
+                if (vol_has_fluid_neighbor(w, n)) {
+                    qc -= d[vol_neighbor_index(c, dims, n)];
                 }
             }
         }

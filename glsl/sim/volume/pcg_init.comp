@@ -10,6 +10,7 @@ layout(local_size_x = VOL_GROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
 layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };
+layout(std430, set = 0, binding = 30) readonly buffer Stencil { uint stencil[]; };
 #include "volume_ops.glsl"
 layout(std430, set = 0, binding = 17) readonly buffer FaceVel { float face_vel[]; };
 layout(std430, set = 0, binding = 20) writeonly buffer Pressure { float pressure[]; };
@@ -34,8 +35,7 @@ void main() {
                     - face_vel[vol_face_index(ijk, axis, dims, vp.counts)];
             }
             b = -outflow;
-            int fluid[6];
-            float diagonal = vol_stencil(ijk, dims, 0u, fluid);
+            float diagonal = vol_diagonal(stencil[c]);
             if (vp.config.y == VOL_PRECOND_JACOBI && diagonal > 0.0) {
                 zc = b / diagonal;
             }

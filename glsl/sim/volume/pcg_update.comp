@@ -8,7 +8,7 @@
 layout(local_size_x = VOL_GROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
-layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };
+layout(std430, set = 0, binding = 30) readonly buffer Stencil { uint stencil[]; };
 #include "volume_ops.glsl"
 layout(std430, set = 0, binding = 20) buffer Pressure { float pressure[]; };
 layout(std430, set = 0, binding = 21) readonly buffer D { float d[]; };
@@ -20,7 +20,6 @@ layout(std430, set = 0, binding = 27) writeonly buffer Partials { vec2 partials[
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
-    uvec3 dims = vp.dims.xyz;
     vec2 local = vec2(0.0);
     if (c < vp.dims.w) {
         float alpha = scalars.alpha;
@@ -30,9 +29,9 @@ void main() {
         r[c] = rc;
         if (vp.config.y == VOL_PRECOND_JACOBI) {
             precise float zc = 0.0;
-            if (labels[c] == VOL_FLUID) {
-                int fluid[6];
-                float diagonal = vol_stencil(vol_cell_coords(c, dims), dims, 0u, fluid);
+            uint w = stencil[c];
+            float diagonal = vol_diagonal(w);
+            if (vol_is_fluid(w)) {
                 zc = diagonal > 0.0 ? rc / diagonal : 0.0;
             }
             z[c] = zc;

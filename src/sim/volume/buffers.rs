@@ -45,6 +45,7 @@ pub(crate) mod binding {
     pub const PARTIALS: u32 = 27;
     pub const INDIRECT: u32 = 28;
     pub const MESH_FIELD: u32 = 29;
+    pub const STENCIL: u32 = 30;
 }
 
 /// Keys per sort block (one workgroup of `radix_count`/`radix_scatter`).
@@ -72,6 +73,7 @@ pub(crate) struct VolumeBuffers {
     pub start: Buffer,
     pub cells: Buffer,
     pub labels: Buffer,
+    pub stencil: Buffer,
     pub face_vel: Buffer,
     pub face_star: Buffer,
     pub face_weight: Buffer,
@@ -124,6 +126,7 @@ impl VolumeBuffers {
             start: storage("vkhair volume cell start", (cells + 1) * 4)?,
             cells: density,
             labels: storage("vkhair volume labels", levels * 4)?,
+            stencil: storage("vkhair volume stencil words", levels * 4)?,
             face_vel: storage("vkhair volume face velocities", faces * 4)?,
             face_star: storage("vkhair volume transferred face velocities", faces * 4)?,
             face_weight: storage("vkhair volume face weights", faces * 4)?,
@@ -157,7 +160,7 @@ impl VolumeBuffers {
         mesh_field: &'a Buffer,
         positions: &'a Buffer,
         velocities: &'a Buffer,
-    ) -> [(u32, &'a Buffer); 30] {
+    ) -> [(u32, &'a Buffer); 31] {
         use binding::*;
         [
             (PARAMS, &self.params),
@@ -178,6 +181,7 @@ impl VolumeBuffers {
             (START, &self.start),
             (CELLS, &self.cells),
             (LABELS, &self.labels),
+            (STENCIL, &self.stencil),
             (FACE_VEL, &self.face_vel),
             (FACE_STAR, &self.face_star),
             (FACE_WEIGHT, &self.face_weight),
@@ -207,20 +211,19 @@ pub(crate) enum Kernel {
     PcgInit,
     PcgApply,
     PcgUpdate,
-    PcgDot,
     PcgDirection,
     PcgReduce,
     Gradient,
     MgCoarsen,
+    MgStencil,
     MgSmooth,
     MgRestrict,
-    MgProlong,
     MgCoarsest,
     G2p,
 }
 
 impl Kernel {
-    pub(crate) const ALL: [Kernel; 20] = [
+    pub(crate) const ALL: [Kernel; 19] = [
         Kernel::Bin,
         Kernel::RadixCount,
         Kernel::RadixScatter,
@@ -231,14 +234,13 @@ impl Kernel {
         Kernel::PcgInit,
         Kernel::PcgApply,
         Kernel::PcgUpdate,
-        Kernel::PcgDot,
         Kernel::PcgDirection,
         Kernel::PcgReduce,
         Kernel::Gradient,
         Kernel::MgCoarsen,
+        Kernel::MgStencil,
         Kernel::MgSmooth,
         Kernel::MgRestrict,
-        Kernel::MgProlong,
         Kernel::MgCoarsest,
         Kernel::G2p,
     ];
@@ -251,7 +253,8 @@ impl Kernel {
             (Kernel::PcgInit, true) => return &SIM_VOLUME_PCG_INIT_COMP_SHARED_REDUCE,
             (Kernel::PcgApply, true) => return &SIM_VOLUME_PCG_APPLY_COMP_SHARED_REDUCE,
             (Kernel::PcgUpdate, true) => return &SIM_VOLUME_PCG_UPDATE_COMP_SHARED_REDUCE,
-            (Kernel::PcgDot, true) => return &SIM_VOLUME_PCG_DOT_COMP_SHARED_REDUCE,
+            (Kernel::MgSmooth, true) => return &SIM_VOLUME_MG_SMOOTH_COMP_SHARED_REDUCE,
+            (Kernel::MgCoarsest, true) => return &SIM_VOLUME_MG_COARSEST_COMP_SHARED_REDUCE,
             _ => {}
         }
         match self {
@@ -265,14 +268,13 @@ impl Kernel {
             Kernel::PcgInit => &SIM_VOLUME_PCG_INIT_COMP,
             Kernel::PcgApply => &SIM_VOLUME_PCG_APPLY_COMP,
             Kernel::PcgUpdate => &SIM_VOLUME_PCG_UPDATE_COMP,
-            Kernel::PcgDot => &SIM_VOLUME_PCG_DOT_COMP,
             Kernel::PcgDirection => &SIM_VOLUME_PCG_DIRECTION_COMP,
             Kernel::PcgReduce => &SIM_VOLUME_PCG_REDUCE_COMP,
             Kernel::Gradient => &SIM_VOLUME_GRADIENT_COMP,
             Kernel::MgCoarsen => &SIM_VOLUME_MG_COARSEN_COMP,
+            Kernel::MgStencil => &SIM_VOLUME_MG_STENCIL_COMP,
             Kernel::MgSmooth => &SIM_VOLUME_MG_SMOOTH_COMP,
             Kernel::MgRestrict => &SIM_VOLUME_MG_RESTRICT_COMP,
-            Kernel::MgProlong => &SIM_VOLUME_MG_PROLONG_COMP,
             Kernel::MgCoarsest => &SIM_VOLUME_MG_COARSEST_COMP,
             Kernel::G2p => &SIM_VOLUME_G2P_COMP,
         }

@@ -34,7 +34,11 @@
 //!    in a fixed order; the iteration cap is recorded and a reduction kernel
 //!    sets the indirect dispatches of the remaining iterations to zero once
 //!    max |r| ≤ tolerance · max |b|. The preconditioner is Jacobi or one
-//!    multigrid V-cycle. Then the pressure difference is subtracted on faces
+//!    multigrid V-cycle. The matrix is read as one stencil word per cell and
+//!    level (`mg_stencil.comp`, once per solve); a V-cycle is four passes per
+//!    level (the two pre-sweeps in one, the prolongation folded into the first
+//!    post-sweep, the next dot product into the last) and an iteration 4 passes
+//!    per level above the coarsest plus 6. Then the pressure difference is subtracted on faces
 //!    between a fluid cell and a non-solid one (`gradient.comp`).
 //! 7. **Update** (`g2p.comp`): FLIP/PIC blend ṽ = α(v + Lerp(x, v − v*)) +
 //!    (1 − α)Lerp(x, v), or friction and repulsion from the cells.

@@ -206,10 +206,11 @@ impl VolumeStage {
                     self.run(cmd, Kernel::MgCoarsen, variant, push, Launch::Indirect(level + 1));
                 }
             }
+            let words = if multigrid { self.grid.level_cells() } else { self.grid.cells() };
+            self.run(cmd, Kernel::MgStencil, variant, none, Launch::Threads(words));
             self.run(cmd, Kernel::PcgInit, variant, none, cells);
             if multigrid {
                 self.record_vcycle(cmd, variant);
-                self.run(cmd, Kernel::PcgDot, variant, none, cells);
             }
             self.run(cmd, Kernel::PcgReduce, variant, reduce(0), single);
             self.run(cmd, Kernel::PcgDirection, variant, none, cells);
@@ -219,7 +220,6 @@ impl VolumeStage {
                 self.run(cmd, Kernel::PcgUpdate, variant, none, cells);
                 if multigrid {
                     self.record_vcycle(cmd, variant);
-                    self.run(cmd, Kernel::PcgDot, variant, none, cells);
                 }
                 self.run(cmd, Kernel::PcgReduce, variant, reduce(2), single);
                 self.run(cmd, Kernel::PcgDirection, variant, none, cells);
@@ -228,9 +228,12 @@ impl VolumeStage {
         }
     }
 
-    /// z = V-cycle(r): damped Jacobi pre- and post-smoothing (2 sweeps each), half the
-    /// summed residual restricted, piecewise-constant prolongation, Jacobi sweeps on
-    /// the coarsest level. Symmetric, so conjugate gradients may use it.
+    /// z = V-cycle(r), then the partials of r·z and max |r|: damped Jacobi pre- and
+    /// post-smoothing (2 sweeps each), half the summed residual restricted,
+    /// piecewise-constant prolongation, Jacobi sweeps on the coarsest level.
+    /// Symmetric, so conjugate gradients may use it. Four passes per level: the
+    /// two pre-sweeps are one pass, the prolongation is folded into the first
+    /// post-sweep and the partials into the last (see `mg_smooth.comp`).
     unsafe fn record_vcycle(&self, cmd: vk::CommandBuffer, variant: usize) {
         let levels = self.grid.levels.len();
         // SAFETY: guaranteed by the caller.
@@ -238,16 +241,15 @@ impl VolumeStage {
             for level in 0..levels - 1 {
                 let at = Launch::Indirect(level);
                 self.run(cmd, Kernel::MgSmooth, variant, self.level_push(level, [0; 4]), at);
-                self.run(cmd, Kernel::MgSmooth, variant, self.level_push(level, [1, 0, 0, 0]), at);
                 self.run(cmd, Kernel::MgRestrict, variant, self.level_push(level, [0; 4]), Launch::Indirect(level + 1));
             }
-            let coarsest = self.level_push(levels - 1, [0, 0, COARSEST_SWEEPS, 0]);
+            let coarsest = self.level_push(levels - 1, [0, u32::from(levels == 1), COARSEST_SWEEPS, 0]);
             self.run(cmd, Kernel::MgCoarsest, variant, coarsest, Launch::Indirect(levels));
             for level in (0..levels - 1).rev() {
                 let at = Launch::Indirect(level);
-                self.run(cmd, Kernel::MgProlong, variant, self.level_push(level, [0; 4]), at);
-                self.run(cmd, Kernel::MgSmooth, variant, self.level_push(level, [2, 0, 0, 0]), at);
+                let partials = u32::from(level == 0);
                 self.run(cmd, Kernel::MgSmooth, variant, self.level_push(level, [1, 0, 0, 0]), at);
+                self.run(cmd, Kernel::MgSmooth, variant, self.level_push(level, [2, partials, 0, 0]), at);
             }
         }
     }

@@ -335,3 +335,29 @@ fn flip_ratio_zero_is_pic_and_one_is_flip() {
         assert!(changed > positions.len() / 2, "the projection changed most velocities");
     }
 }
+
+#[test]
+fn a_grid_of_one_multigrid_level_is_solved_by_its_coarsest_pass() {
+    let gpu = TestGpu::new();
+    let mut rng = Pcg32::seed_from_u64(11);
+    let (positions, velocities) = random_particles(&mut rng, 800, Vec3::splat(0.5), Vec3::splat(5.5), 1.0);
+    let grid = unit_grid([6, 6, 6], positions.len());
+    assert_eq!(grid.levels.len(), 1, "216 cells are the coarsest level already");
+    let params = VolumeParams { max_iterations: 100, ..VolumeParams::flip([6, 6, 6]) };
+    let b = block(&grid, &params, Mat4::IDENTITY, 0);
+    let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
+    let mut cpu_vel = velocities.clone();
+    let cpu = reference::step(&grid, &b, &[], None, &positions, &mut cpu_vel);
+    let before = max_divergence(&grid, &cpu.labels, &cpu.face_star);
+    let after = max_divergence(&grid, &cpu.labels, &run.snapshot.face_vel);
+    eprintln!(
+        "one level: {} iterations (MIC {}), divergence {before} -> {after}",
+        run.stats.iterations, cpu.iterations
+    );
+    assert!(run.stats.converged && !run.stats.non_finite && run.stats.iterations < 100, "{:?}", run.stats);
+    assert!(before > 0.5 && after <= 4e-5 * before, "divergence {before} -> {after}");
+    let pmax = cpu.pressure.iter().fold(0.0f32, |m, p| m.max(p.abs()));
+    for (c, (g, r)) in run.snapshot.pressure.iter().zip(&cpu.pressure).enumerate() {
+        assert!((g - r).abs() <= 1e-3 * pmax, "pressure of cell {c}: GPU {g} vs MIC {r} (max {pmax})");
+    }
+}
