@@ -12,6 +12,11 @@ layout(location = 1) in vec3 v_tan[];
 layout(location = 2) in float v_t[];
 layout(location = 3) flat in uint v_hair[];
 
+// The depth pre-pass and the shading draw must rasterize the same depths: the
+// same modules in both pipelines, and no fused multiply-adds that a compiler
+// could choose differently in each.
+precise gl_Position;
+
 layout(location = 0) out vec3 g_pos;
 layout(location = 1) out vec3 g_tan;
 layout(location = 2) out float g_t;

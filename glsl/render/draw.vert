@@ -7,6 +7,11 @@ layout(std140, set = 0, binding = 0) uniform Draw { DrawParams dp; };
 layout(std430, set = 0, binding = 1) readonly buffer HairPos { vec4 hair_pos[]; };
 layout(std430, set = 0, binding = 2) readonly buffer HairTan { vec4 hair_tan[]; };
 
+// The depth pre-pass and the shading draw must rasterize the same depths: the
+// same modules in both pipelines, and no fused multiply-adds that a compiler
+// could choose differently in each.
+precise gl_Position;
+
 layout(location = 0) out vec3 v_pos;
 layout(location = 1) out vec3 v_tan;
 layout(location = 2) out float v_t;

@@ -2,10 +2,13 @@
 //! camera-facing ribbons expanded in the geometry stage, shaded with
 //! Kajiya-Kay diffuse and two shifted highlights for every light, into the
 //! host's color and depth images (dynamic rendering, depth-tested against what
-//! the host drew). Pipelines are made on first use for each combination of
-//! color format, depth format, sample count and primitive. The pass owns the
-//! Marschner lookup tables it samples and rebuilds them when the material's
-//! parameters change.
+//! the host drew). With a depth image the ribbons are drawn twice in one
+//! rendering instance: first depth only (no fragment stage), then shaded with
+//! depth writes off and the depth test passing only fragments at the nearest
+//! depth, so that hidden layers of hair are not shaded. Pipelines are made on
+//! first use for each combination of color format, depth format, sample count
+//! and primitive. The pass owns the Marschner lookup tables it samples and
+//! rebuilds them when the material's parameters change.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -40,13 +43,20 @@ pub(super) struct TargetKey {
 /// noise texture and the Marschner tables.
 pub(super) struct DrawPass {
     device: Arc<Device>,
-    pipelines: HashMap<TargetKey, (GraphicsPipeline, vk::DescriptorSet)>,
+    pipelines: HashMap<TargetKey, DrawPipelines>,
     noise: Image,
     sampler: Sampler,
     /// The frame's [`DrawParams`], written by a transfer before the draw.
     params: Buffer,
     /// Marschner lookup tables, rebuilt when their parameters change.
     marschner: MarschnerTables,
+}
+
+/// The pipelines of one target: the depth pre-pass (targets with a depth image)
+/// and the shading draw, each with its descriptor set.
+struct DrawPipelines {
+    depth: Option<(GraphicsPipeline, vk::DescriptorSet)>,
+    shade: (GraphicsPipeline, vk::DescriptorSet),
 }
 
 /// What the draw reads besides its own resources.
@@ -96,36 +106,53 @@ impl DrawPass {
         key: TargetKey,
         buffers: &[(u32, &Buffer)],
         images: &[(u32, vk::ImageView, vk::Sampler)],
-    ) -> Result<&(GraphicsPipeline, vk::DescriptorSet)> {
+    ) -> Result<&DrawPipelines> {
         if !self.pipelines.contains_key(&key) {
             let color_formats = [key.color];
+            let has_depth = key.depth != vk::Format::UNDEFINED;
             // Lines skip the geometry stage: the fragment stage reads the vertex
             // stage's outputs at the same locations.
-            let ribbons: &[&ShaderSource] = &[&RENDER_DRAW_VERT, &RENDER_DRAW_GEOM, &RENDER_DRAW_FRAG];
-            let lines: &[&ShaderSource] = &[&RENDER_DRAW_VERT, &RENDER_DRAW_FRAG];
-            let pipeline = GraphicsPipeline::new(
-                &self.device,
-                &GraphicsDesc {
-                    name: "vkhair hair draw",
-                    stages: if key.primitive == Primitive::Lines { lines } else { ribbons },
-                    topology: vk::PrimitiveTopology::LINE_LIST,
-                    patch_control_points: 0,
-                    color_formats: &color_formats,
-                    depth_format: key.depth,
-                    samples: key.samples,
-                    depth_test: key.depth != vk::Format::UNDEFINED,
-                    depth_write: key.depth != vk::Format::UNDEFINED,
-                    blend: Blend::None,
-                    rasterizer_discard: false,
-                },
-                1,
-            )?;
+            let lines = key.primitive == Primitive::Lines;
+            let shading: &[&ShaderSource] = if lines {
+                &[&RENDER_DRAW_VERT, &RENDER_DRAW_FRAG]
+            } else {
+                &[&RENDER_DRAW_VERT, &RENDER_DRAW_GEOM, &RENDER_DRAW_FRAG]
+            };
+            let desc = |name, stages, depth_write, blend| GraphicsDesc {
+                name,
+                stages,
+                topology: vk::PrimitiveTopology::LINE_LIST,
+                patch_control_points: 0,
+                color_formats: &color_formats,
+                depth_format: key.depth,
+                samples: key.samples,
+                depth_test: has_depth,
+                depth_write,
+                blend,
+                rasterizer_discard: false,
+            };
+            // The geometry is the same in both: only the hair positions (bindings 1
+            // and 2) and the uniform block.
+            let depth = if has_depth {
+                let stages = &shading[..shading.len() - 1];
+                let pipeline =
+                    GraphicsPipeline::new(&self.device, &desc("vkhair hair depth", stages, true, Blend::NoColor), 1)?;
+                let geometry: Vec<_> = std::iter::once((0, &self.params))
+                    .chain(buffers.iter().copied().filter(|(b, _)| *b <= 2))
+                    .collect();
+                let set = pipeline.resource_set(0, &geometry, &[])?;
+                Some((pipeline, set))
+            } else {
+                None
+            };
+            let pipeline =
+                GraphicsPipeline::new(&self.device, &desc("vkhair hair draw", shading, false, Blend::None), 1)?;
             let mut all_buffers = vec![(0, &self.params)];
             all_buffers.extend_from_slice(buffers);
             let mut all_images = vec![(3, self.noise.view(), self.sampler.raw)];
             all_images.extend_from_slice(images);
             let set = pipeline.resource_set(0, &all_buffers, &all_images)?;
-            self.pipelines.insert(key, (pipeline, set));
+            self.pipelines.insert(key, DrawPipelines { depth, shade: (pipeline, set) });
         }
         Ok(&self.pipelines[&key])
     }
@@ -179,14 +206,18 @@ impl DrawPass {
             d.cmd_barrier(cmd, before.0, &[], before.1);
             // The draw pipeline may sample the Marschner tables: build them first.
             self.marschner.record_update(d, cmd, marschner);
-            let (pipeline, set) = &self.pipelines[&target.key];
+            let pipelines = &self.pipelines[&target.key];
             d.cmd_barrier(cmd, &[before_update], &[], &[]);
             d.raw.cmd_update_buffer(cmd, params_buffer, 0, bytemuck::bytes_of(params));
             d.cmd_barrier(cmd, &[updated], &[], &[]);
             d.raw.cmd_begin_rendering(cmd, target.rendering);
             d.cmd_set_full_viewport(cmd, target.extent);
-            pipeline.bind(cmd, &[*set]);
-            d.raw.cmd_draw(cmd, vertices, 1, 0, 0);
+            // Within one rendering instance, rasterization order puts the depth
+            // pre-pass's writes before the shading draw's tests.
+            for (pipeline, set) in pipelines.depth.iter().chain([&pipelines.shade]) {
+                pipeline.bind(cmd, &[*set]);
+                d.raw.cmd_draw(cmd, vertices, 1, 0, 0);
+            }
             d.raw.cmd_end_rendering(cmd);
             scope.close(d, cmd, profiler);
         }

@@ -42,6 +42,8 @@ pub(crate) enum Blend {
     Premultiplied,
     /// Add the color, keep the larger alpha (opacity layers with z0 in alpha).
     AddColorMaxAlpha,
+    /// Write no color at all (depth pre-passes).
+    NoColor,
 }
 
 /// A graphics pipeline.
@@ -90,6 +92,9 @@ impl GraphicsPipeline {
         let attachment = match desc.blend {
             Blend::None => {
                 vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)
+            }
+            Blend::NoColor => {
+                vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::empty())
             }
             Blend::Additive | Blend::Premultiplied => {
                 let dst = if desc.blend == Blend::Additive {
