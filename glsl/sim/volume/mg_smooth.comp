@@ -35,19 +35,10 @@ float sweep(uint i, uint w, float own, float ax) {
     return value;
 }
 
-// The first sweep from x = 0 at cell j.
+// The first sweep from x = 0 at cell j (A x is then exactly +0).
 float first_sweep(uint j) {
     uint w = stencil[j];
-    if (!vol_is_fluid(w)) {
-        return 0.0;
-    }
-    precise float ax = vol_diagonal(w) * 0.0;
-    for (uint n = 0u; n < 6u; ++n) {
-        if (vol_has_fluid_neighbor(w, n)) {
-            ax -= 0.0;
-        }
-    }
-    return sweep(j, w, 0.0, ax);
+    return vol_is_fluid(w) ? sweep(j, w, 0.0, 0.0) : 0.0;
 }
 
 // x at fluid cell `ijk` (level-array index j) with its coarse parent's correction added.

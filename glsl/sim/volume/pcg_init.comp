@@ -9,7 +9,6 @@
 layout(local_size_x = VOL_GROUP) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { VolumeParams vp; };
-layout(std430, set = 0, binding = 16) readonly buffer Labels { uint labels[]; };
 layout(std430, set = 0, binding = 30) readonly buffer Stencil { uint stencil[]; };
 #include "volume_ops.glsl"
 layout(std430, set = 0, binding = 17) readonly buffer FaceVel { float face_vel[]; };
@@ -26,7 +25,8 @@ void main() {
         uvec3 ijk = vol_cell_coords(c, dims);
         precise float b = 0.0;
         precise float zc = 0.0;
-        if (labels[c] == VOL_FLUID) {
+        uint w = stencil[c];
+        if (vol_is_fluid(w)) {
             precise float outflow = 0.0;
             for (uint axis = 0u; axis < 3u; ++axis) {
                 uvec3 up = ijk;
@@ -35,7 +35,7 @@ void main() {
                     - face_vel[vol_face_index(ijk, axis, dims, vp.counts)];
             }
             b = -outflow;
-            float diagonal = vol_diagonal(stencil[c]);
+            float diagonal = vol_diagonal(w);
             if (vp.config.y == VOL_PRECOND_JACOBI && diagonal > 0.0) {
                 zc = b / diagonal;
             }
