@@ -269,14 +269,32 @@ pub(crate) struct DrawParams {
     pub shifts: [f32; 4],
     /// Root width, tip width (m), least width (pixels).
     pub widths: [f32; 4],
+    /// 1 for transparent strands (coverage, no least width), opacity, hairs a
+    /// strand stands for.
+    pub coverage: [f32; 4],
     /// Hairs, vertices per hair, lights.
     pub counts: [u32; 4],
     /// The lights.
     pub lights: [GpuLight; limits::MAX_LIGHTS as usize],
 }
 gpu_struct!(DrawParams => "DrawParams" {
-    view_proj, camera, root_color, tip_color, primary, secondary, shifts, widths, counts, lights
+    view_proj, camera, root_color, tip_color, primary, secondary, shifts, widths, coverage, counts, lights
 });
+
+/// The transparency passes' per-frame words (`OitCounters` in `glsl/include/oit.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct OitCounters {
+    /// Fragments offered this frame (stored: the smaller of this and `capacity`).
+    pub used: u32,
+    /// Nodes in the pool.
+    pub capacity: u32,
+    /// Pixels per row of the lists' image.
+    pub width: u32,
+    /// Fragments sorted exactly per pixel (K).
+    pub sorted: u32,
+}
+gpu_struct!(OitCounters => "OitCounters" { used, capacity, width, sorted });
 
 /// Push constants of the Marschner table builder (`MarschnerPush` in `glsl/include/marschner.glsl`).
 #[repr(C)]
@@ -469,6 +487,7 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<InterpolatePush>(reflection, &mut problems);
     check::<GpuLight>(reflection, &mut problems);
     check::<DrawParams>(reflection, &mut problems);
+    check::<OitCounters>(reflection, &mut problems);
     check::<MarschnerPush>(reflection, &mut problems);
     check::<GpuVolumeParams>(reflection, &mut problems);
     check::<VolumePush>(reflection, &mut problems);

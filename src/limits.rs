@@ -32,6 +32,9 @@ pub const ITEM_GROUP: u32 = 64;
 /// Most grid points per axis of a mesh collider's distance field.
 pub const SDF_MAX_RESOLUTION: u32 = 256;
 
+/// Most fragments per pixel the exact transparency mode sorts (its K).
+pub const OIT_MAX_SORTED: u32 = 32;
+
 /// Every constant above with the name the shaders see it by.
 #[cfg_attr(not(test), allow(dead_code))] // used by build.rs and the tests
 pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
@@ -44,6 +47,7 @@ pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
     ("VOL_SCAN_TILE", VOL_SCAN_TILE),
     ("ITEM_GROUP", ITEM_GROUP),
     ("SDF_MAX_RESOLUTION", SDF_MAX_RESOLUTION),
+    ("OIT_MAX_SORTED", OIT_MAX_SORTED),
 ];
 
 /// The lines (1-based) of a shader source that declare a name of

@@ -88,6 +88,7 @@ struct DrawParams {
     vec4 secondary;       // rgb secondary highlight color, w exponent
     vec4 shifts;          // x primary shift, y secondary shift, z shift jitter, w highlight breakup
     vec4 widths;          // x root width (m), y tip width (m), z least width (pixels), w unused
+    vec4 coverage;        // x 1 for transparent strands (coverage, no least width), y opacity, z hairs a strand stands for
     uvec4 counts;         // x hairs, y vertices per hair, z lights, w shading mode (0 Kajiya-Kay, 1 Marschner)
     Light lights[MAX_LIGHTS];
 };

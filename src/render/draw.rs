@@ -59,6 +59,9 @@ struct DrawPipelines {
     shade: (GraphicsPipeline, vk::DescriptorSet),
 }
 
+/// The shading stages' buffers and (view, sampler) images, by binding.
+pub(super) type ShadingBindings<'a> = ([(u32, &'a Buffer); 5], [(u32, vk::ImageView, vk::Sampler); 4]);
+
 /// What the draw reads besides its own resources.
 pub(super) struct DrawInputs<'a> {
     /// Interpolated hair positions and (tangent, t).
@@ -98,63 +101,51 @@ impl DrawPass {
         Ok(DrawPass { device: device.clone(), pipelines: HashMap::new(), noise, sampler, params, marschner })
     }
 
-    /// The pipeline and descriptor set for `key`, made on first use with the
-    /// pass's uniform block (binding 0), `buffers` and `images` (by binding) and the
-    /// noise texture (binding 3).
-    fn pipeline(
-        &mut self,
-        key: TargetKey,
-        buffers: &[(u32, &Buffer)],
-        images: &[(u32, vk::ImageView, vk::Sampler)],
-    ) -> Result<&DrawPipelines> {
-        if !self.pipelines.contains_key(&key) {
-            let color_formats = [key.color];
-            let has_depth = key.depth != vk::Format::UNDEFINED;
-            // Lines skip the geometry stage: the fragment stage reads the vertex
-            // stage's outputs at the same locations.
-            let lines = key.primitive == Primitive::Lines;
-            let shading: &[&ShaderSource] = if lines {
-                &[&RENDER_DRAW_VERT, &RENDER_DRAW_FRAG]
-            } else {
-                &[&RENDER_DRAW_VERT, &RENDER_DRAW_GEOM, &RENDER_DRAW_FRAG]
-            };
-            let desc = |name, stages, depth_write, blend| GraphicsDesc {
-                name,
-                stages,
-                topology: vk::PrimitiveTopology::LINE_LIST,
-                patch_control_points: 0,
-                color_formats: &color_formats,
-                depth_format: key.depth,
-                samples: key.samples,
-                depth_test: has_depth,
-                depth_write,
-                blend,
-                rasterizer_discard: false,
-            };
-            // The geometry is the same in both: only the hair positions (bindings 1
-            // and 2) and the uniform block.
-            let depth = if has_depth {
-                let stages = &shading[..shading.len() - 1];
-                let pipeline =
-                    GraphicsPipeline::new(&self.device, &desc("vkhair hair depth", stages, true, Blend::NoColor), 1)?;
-                let geometry: Vec<_> = std::iter::once((0, &self.params))
-                    .chain(buffers.iter().copied().filter(|(b, _)| *b <= 2))
-                    .collect();
-                let set = pipeline.resource_set(0, &geometry, &[])?;
-                Some((pipeline, set))
-            } else {
-                None
-            };
-            let pipeline =
-                GraphicsPipeline::new(&self.device, &desc("vkhair hair draw", shading, false, Blend::None), 1)?;
-            let mut all_buffers = vec![(0, &self.params)];
-            all_buffers.extend_from_slice(buffers);
-            let mut all_images = vec![(3, self.noise.view(), self.sampler.raw)];
-            all_images.extend_from_slice(images);
-            let set = pipeline.resource_set(0, &all_buffers, &all_images)?;
-            self.pipelines.insert(key, DrawPipelines { depth, shade: (pipeline, set) });
+    /// Makes the pipelines and descriptor sets for `key` on first use, bound to
+    /// [`DrawPass::shading_bindings`] of `inputs`.
+    fn make_pipelines(&mut self, key: TargetKey, inputs: &DrawInputs<'_>) -> Result<()> {
+        if self.pipelines.contains_key(&key) {
+            return Ok(());
         }
-        Ok(&self.pipelines[&key])
+        let (buffers, images) = self.shading_bindings(inputs);
+        let color_formats = [key.color];
+        let has_depth = key.depth != vk::Format::UNDEFINED;
+        // Lines skip the geometry stage: the fragment stage reads the vertex
+        // stage's outputs at the same locations.
+        let lines = key.primitive == Primitive::Lines;
+        let shading: &[&ShaderSource] = if lines {
+            &[&RENDER_DRAW_VERT, &RENDER_DRAW_FRAG]
+        } else {
+            &[&RENDER_DRAW_VERT, &RENDER_DRAW_GEOM, &RENDER_DRAW_FRAG]
+        };
+        let desc = |name, stages, depth_write, blend| GraphicsDesc {
+            name,
+            stages,
+            topology: vk::PrimitiveTopology::LINE_LIST,
+            patch_control_points: 0,
+            color_formats: &color_formats,
+            depth_format: key.depth,
+            samples: key.samples,
+            depth_test: has_depth,
+            depth_write,
+            blend,
+            rasterizer_discard: false,
+        };
+        // The geometry is the same in both: only the hair positions (bindings 1
+        // and 2) and the uniform block.
+        let depth = if has_depth {
+            let stages = &shading[..shading.len() - 1];
+            let pipeline =
+                GraphicsPipeline::new(&self.device, &desc("vkhair hair depth", stages, true, Blend::NoColor), 1)?;
+            let set = pipeline.resource_set(0, &buffers[..3], &[])?;
+            Some((pipeline, set))
+        } else {
+            None
+        };
+        let pipeline = GraphicsPipeline::new(&self.device, &desc("vkhair hair draw", shading, false, Blend::None), 1)?;
+        let set = pipeline.resource_set(0, &buffers, &images)?;
+        self.pipelines.insert(key, DrawPipelines { depth, shade: (pipeline, set) });
+        Ok(())
     }
 
     /// Drops every pipeline and set (their resources changed); the caller made sure
@@ -185,31 +176,15 @@ impl DrawPass {
         vertices: u32,
         profiler: &mut Option<&mut GpuProfiler>,
     ) -> Result<()> {
+        // Made (or found) before anything is recorded: a failure leaves `cmd` as it was.
+        self.make_pipelines(target.key, inputs)?;
         let device = self.device.clone();
         let d = &device;
-        let sampler = self.marschner.sampler.raw;
-        let images = [
-            (4, self.marschner.m.view(), sampler),
-            (5, self.marschner.n.view(), sampler),
-            (7, inputs.atlas.0, inputs.atlas.1),
-        ];
-        let params_buffer = self.params.raw();
-        let buffers =
-            [(1, inputs.hairs.0), (2, inputs.hairs.1), (6, inputs.shadow_uniforms), (8, inputs.transmittance)];
-        let before_update = barrier::memory(&[AccessKind::AnyWrite], &[AccessKind::TransferWrite]);
-        let updated = barrier::memory(&[AccessKind::TransferWrite], UNIFORM_READERS);
-        // Made (or found) before anything is recorded: a failure leaves `cmd` as it was.
-        self.pipeline(target.key, &buffers, &images)?;
         // SAFETY: guaranteed by the caller; all objects belong to this device.
         unsafe {
             let scope = RenderPass::Draw.open(d, cmd, profiler);
-            d.cmd_barrier(cmd, before.0, &[], before.1);
-            // The draw pipeline may sample the Marschner tables: build them first.
-            self.marschner.record_update(d, cmd, marschner);
+            self.record_updates(cmd, before, params, marschner);
             let pipelines = &self.pipelines[&target.key];
-            d.cmd_barrier(cmd, &[before_update], &[], &[]);
-            d.raw.cmd_update_buffer(cmd, params_buffer, 0, bytemuck::bytes_of(params));
-            d.cmd_barrier(cmd, &[updated], &[], &[]);
             d.raw.cmd_begin_rendering(cmd, target.rendering);
             d.cmd_set_full_viewport(cmd, target.extent);
             // Within one rendering instance, rasterization order puts the depth
@@ -224,6 +199,57 @@ impl DrawPass {
         Ok(())
     }
 
+    /// The shading stages' buffers and images by binding: this pass's uniform
+    /// block (binding 0, first), noise (binding 3, first image) and Marschner
+    /// tables, and `inputs`.
+    pub(super) fn shading_bindings<'a>(&'a self, inputs: &DrawInputs<'a>) -> ShadingBindings<'a> {
+        let sampler = self.marschner.sampler.raw;
+        (
+            [
+                (0, &self.params),
+                (1, inputs.hairs.0),
+                (2, inputs.hairs.1),
+                (6, inputs.shadow_uniforms),
+                (8, inputs.transmittance),
+            ],
+            [
+                (3, self.noise.view(), self.sampler.raw),
+                (4, self.marschner.m.view(), sampler),
+                (5, self.marschner.n.view(), sampler),
+                (7, inputs.atlas.0, inputs.atlas.1),
+            ],
+        )
+    }
+
+    /// Records `before` (the barriers that make the target ready), the Marschner
+    /// tables' rebuild if `marschner` changed and the update of the uniform block
+    /// to `params`, with the barriers that make both visible to the draw's stages.
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of this device outside a render pass;
+    /// draws recorded earlier that read the uniform block are ordered before by the
+    /// recorded barrier.
+    pub(super) unsafe fn record_updates(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        before: (&[vk::MemoryBarrier2<'_>], &[vk::ImageMemoryBarrier2<'_>]),
+        params: &DrawParams,
+        marschner: &MarschnerParams,
+    ) {
+        let d = &self.device;
+        let before_update = barrier::memory(&[AccessKind::AnyWrite], &[AccessKind::TransferWrite]);
+        let updated = barrier::memory(&[AccessKind::TransferWrite], UNIFORM_READERS);
+        // SAFETY: guaranteed by the caller; all objects belong to this device.
+        unsafe {
+            d.cmd_barrier(cmd, before.0, &[], before.1);
+            // The draw pipeline may sample the Marschner tables: build them first.
+            self.marschner.record_update(d, cmd, marschner);
+            d.cmd_barrier(cmd, &[before_update], &[], &[]);
+            d.raw.cmd_update_buffer(cmd, self.params.raw(), 0, bytemuck::bytes_of(params));
+            d.cmd_barrier(cmd, &[updated], &[], &[]);
+        }
+    }
+
     /// Builds the Marschner tables for `params` and reads them back (M, then N;
     /// submits and waits).
     pub(super) fn read_marschner_tables(&mut self, params: &MarschnerParams) -> Result<(Vec<Vec4>, Vec<Vec4>)> {
@@ -236,14 +262,23 @@ impl DrawPass {
     }
 }
 
+/// Fraction of a band of `n` hair widths that `n` hairs placed at random across
+/// it cover: 1 − (1 − 1/n)^n (1 for one hair, toward 1 − 1/e for many).
+pub(super) fn band_density(n: f32) -> f32 {
+    let n = n.max(1.0);
+    1.0 - (1.0 - 1.0 / n).powf(n)
+}
+
 /// Stages that read the draw's uniform block.
 const UNIFORM_READERS: &[AccessKind] =
     &[AccessKind::VertexUniformRead, AccessKind::GeometryUniformRead, AccessKind::FragmentUniformRead];
 
 /// The draw's uniform block for `hairs` hairs of `per_hair` vertices with
 /// `material`, `lights` and the width factor of the frame's detail, seen by
-/// `camera` into a target of `extent`.
+/// `camera` into a target of `extent`; `transparent` strands are drawn with
+/// their coverage (no least width).
 pub(super) fn draw_params(
+    transparent: bool,
     material: &HairMaterial,
     lights: &[GpuLight],
     width_scale: f32,
@@ -265,6 +300,12 @@ pub(super) fn draw_params(
         secondary: m.secondary_color.extend(m.secondary_exponent).to_array(),
         shifts: [m.primary_shift, m.secondary_shift, m.shift_jitter, m.highlight_breakup],
         widths: [m.root_width * width_scale, m.tip_width * width_scale, m.least_pixel_width, 0.0],
+        coverage: [
+            if transparent { 1.0 } else { 0.0 },
+            m.opacity,
+            m.represented_hairs,
+            band_density(m.represented_hairs),
+        ],
         counts: [hairs, per_hair, lights.len() as u32, m.shading as u32],
         lights: gpu_lights,
     }

@@ -28,6 +28,8 @@
 mod draw;
 mod interpolate;
 pub mod marschner;
+mod oit;
+mod output;
 mod params;
 pub(crate) mod pass;
 mod readback;
@@ -40,8 +42,10 @@ mod smooth;
 mod target;
 
 pub use marschner::MarschnerParams;
+pub use oit::OitStats;
 pub use params::{
-    Detail, InterpolationMode, LodParams, Primitive, RenderParams, MAX_HAIRS_PER_KEY, MAX_SMOOTHING_LEVEL,
+    Detail, InterpolationMode, LodParams, OitParams, Primitive, RenderParams, Transparency, MAX_HAIRS_PER_KEY,
+    MAX_SMOOTHING_LEVEL,
 };
 pub use pass::RenderPass;
 pub use shading::{Camera, HairMaterial, Light, ShadingMode, MAX_LIGHTS};
@@ -61,10 +65,10 @@ use crate::sim::KeyHairs;
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
-use crate::vk::rendering::{self, Load};
-use draw::{DrawInputs, DrawPass, DrawTarget, TargetKey};
+use draw::DrawPass;
 use interpolate::InterpolatePass;
-use resolve::{ResolvePass, SUPERSAMPLED_COLOR, SUPERSAMPLED_DEPTH};
+use oit::OitPass;
+use resolve::ResolvePass;
 use shadow::{Bounds, Shadows};
 use smooth::SmoothPass;
 use target::Placement;
@@ -127,6 +131,7 @@ pub struct Renderer {
     interpolate: InterpolatePass,
     shadows: Shadows,
     draw: DrawPass,
+    oit: OitPass,
     resolve: ResolvePass,
     material: HairMaterial,
     lights: Vec<GpuLight>,
@@ -198,6 +203,7 @@ impl Renderer {
             interpolate,
             shadows,
             draw,
+            oit: OitPass::new(&device)?,
             resolve: ResolvePass::new(&device),
             material: HairMaterial::default(),
             lights: Vec::new(),
@@ -283,6 +289,7 @@ impl Renderer {
             // The draw's descriptor sets name images and buffers that were (or, after
             // a failure half way, may have been) replaced.
             self.draw.forget();
+            self.oit.forget();
         }
         changed.map(|_| ())
     }
@@ -466,131 +473,3 @@ impl Renderer {
         self.shadows.uniforms()
     }
 }
-
-/// Passes 4–5: the draw and the resolve.
-impl Renderer {
-    /// Records the draw pass for the host's frame `frame`: the hairs prepared by
-    /// [`Renderer::record_prepare`] into the host's `target`, seen by `camera`. The
-    /// color (and depth) image is loaded, drawn into with depth test and write
-    /// against what the host drew, and stored. With [`RenderParams::supersampling`],
-    /// the hair is drawn at twice the size into the renderer's own images and
-    /// resolved into `target` (depth tested, not written). When the target's size
-    /// changes, the images of the old size are kept until `frame` is
-    /// [`RenderParams::frames_in_flight`] frames later. Viewport and scissor are
-    /// left set to the full target; the host binds its own pipeline and state
-    /// again afterwards.
-    ///
-    /// # Safety
-    /// As for [`Renderer::record_prepare`], which must have been recorded before in
-    /// submission order. `target`'s views belong to the context's device, are in the
-    /// layouts [`RenderTarget`] names, and are not used by other pending work in a
-    /// conflicting way; writes to them recorded earlier on the same queue are ordered
-    /// before the draw by the recorded barrier. Frame indices increase by one per host
-    /// frame, and the command buffers of frame `frame − frames_in_flight` and earlier
-    /// have completed (the usual frames-in-flight wait).
-    pub unsafe fn record_draw(
-        &mut self,
-        cmd: vk::CommandBuffer,
-        frame: u64,
-        target: &RenderTarget,
-        camera: &Camera,
-        mut profiler: Option<&mut GpuProfiler>,
-    ) -> Result<()> {
-        if target.extent.width == 0 || target.extent.height == 0 {
-            return Err(Error::param(
-                "render target extent",
-                format!("{:?}", target.extent),
-                "non-zero width and height",
-            ));
-        }
-        if self.last_frame.is_some_and(|last| frame < last) {
-            return Err(Error::incompatible(
-                "frame",
-                format!("{frame} is before the previous frame {:?}", self.last_frame),
-            ));
-        }
-        self.last_frame = Some(frame);
-        self.resolve.collect_retired(frame, self.params.frames_in_flight);
-        let finite = camera.view.is_finite() && camera.projection.is_finite() && camera.fov_y.is_finite();
-        if !finite {
-            return Err(Error::param(
-                "camera",
-                "a non-finite matrix or field of view",
-                "finite view, projection and field of view",
-            ));
-        }
-        let host_key = TargetKey {
-            color: target.color_format,
-            depth: target.depth_format,
-            samples: target.samples,
-            primitive: self.params.primitive,
-        };
-        // The host's earlier attachment writes (its head, its clear) before ours.
-        let attachments = barrier::memory(HOST_ATTACHMENT_WRITES, barrier::ATTACHMENTS);
-        let host_color = [rendering::color(target.color, Load::Keep)];
-        let host_depth = rendering::depth(target.depth, Load::Keep);
-        let has_depth = target.depth_format != vk::Format::UNDEFINED;
-        let host_rendering = rendering::info(target.extent, &host_color, has_depth.then_some(&host_depth));
-        let host = DrawTarget { key: host_key, rendering: &host_rendering, extent: target.extent };
-        let counts = self.hair_counts();
-        let vertices = self.line_vertices();
-        let inputs = DrawInputs {
-            hairs: self.interpolate.hairs(),
-            shadow_uniforms: self.shadows.uniforms(),
-            atlas: self.shadows.atlas(),
-            transmittance: self.shadows.transmittance(),
-        };
-        let marschner = self.material.marschner;
-        let draw_params =
-            |extent| draw::draw_params(&self.material, &self.lights, self.detail.width_scale, counts, camera, extent);
-
-        if !self.params.supersampling {
-            let params = draw_params(target.extent);
-            // SAFETY: guaranteed by the caller.
-            return unsafe {
-                self.draw.record(
-                    cmd,
-                    (&[attachments], &[]),
-                    &host,
-                    &inputs,
-                    &params,
-                    &marschner,
-                    vertices,
-                    &mut profiler,
-                )
-            };
-        }
-
-        let mut images = self.resolve.take(frame, target.extent)?;
-        let big = images.extent();
-        let params = draw_params(big);
-        let ss_key = TargetKey {
-            color: SUPERSAMPLED_COLOR,
-            depth: SUPERSAMPLED_DEPTH,
-            samples: vk::SampleCountFlags::TYPE_1,
-            primitive: self.params.primitive,
-        };
-        let (ss_color, ss_depth) = images.attachments();
-        let ss_rendering = rendering::info(big, &ss_color, Some(&ss_depth));
-        let ss = DrawTarget { key: ss_key, rendering: &ss_rendering, extent: big };
-        let to_attachments = images.to_attachments();
-        // SAFETY: guaranteed by the caller; the supersampling images are this
-        // renderer's and earlier resolves that sampled them are ordered by the barriers.
-        let result = unsafe {
-            self.draw
-                .record(cmd, (&[], &to_attachments), &ss, &inputs, &params, &marschner, vertices, &mut profiler)
-                .and_then(|_| self.resolve.record(cmd, &mut images, &host, attachments, &mut profiler))
-        };
-        self.resolve.restore(images);
-        result
-    }
-
-    /// Sets of size-dependent images waiting for their frames to complete.
-    pub fn retired_image_sets(&self) -> usize {
-        self.resolve.retired_count()
-    }
-}
-
-/// Writes a host may have made to its attachments before the draw.
-const HOST_ATTACHMENT_WRITES: &[AccessKind] =
-    &[AccessKind::ColorAttachmentWrite, AccessKind::DepthAttachmentWrite, AccessKind::AnyTransferWrite];

@@ -34,6 +34,10 @@ pub struct RenderParams {
     pub interpolation: InterpolationMode,
     /// What each hair segment is drawn as. Default: [`Primitive::Ribbons`].
     pub primitive: Primitive,
+    /// How hair is blended. Default: [`Transparency::Off`] (opaque ribbons).
+    pub transparency: Transparency,
+    /// The transparent modes' sizes.
+    pub oit: OitParams,
     /// Frames the host has in flight (1..=16): images a new target size makes
     /// obsolete are freed this many frames after their last use. Default: 2.
     pub frames_in_flight: u32,
@@ -74,8 +78,46 @@ impl Default for RenderParams {
             supersampling: false,
             interpolation: InterpolationMode::SingleStrand,
             primitive: Primitive::Ribbons,
+            transparency: Transparency::Off,
+            oit: OitParams::default(),
             frames_in_flight: 2,
         }
+    }
+}
+
+/// How the draw pass blends hair into the target.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Transparency {
+    /// Opaque ribbons at least [`super::HairMaterial::least_pixel_width`] wide,
+    /// nearest layer only (a depth pre-pass, then one shaded layer).
+    #[default]
+    Off,
+    /// Weighted blended order-independent transparency (one pass, two
+    /// accumulation images, no lists): every fragment shaded once, the colours
+    /// averaged with weights falling with depth, the total opacity exact.
+    Fast,
+    /// Per-pixel linked lists of every fragment (shaded once when stored), the
+    /// [`OitParams::sorted_fragments`] nearest sorted exactly per pixel and the rest
+    /// blended as an order-independent tail.
+    Exact,
+}
+
+/// Sizes of the transparent modes ([`Transparency::Fast`], [`Transparency::Exact`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OitParams {
+    /// Fragments sorted exactly per pixel in the exact mode, K (1..=32). Default: 8.
+    pub sorted_fragments: u32,
+    /// Fragment pool of the exact mode, in fragments per pixel of the drawn extent
+    /// (0.01..=256; 16 bytes each): fragments beyond it are counted and dropped.
+    /// Default: 8.
+    pub fragments_per_pixel: f32,
+}
+
+impl Default for OitParams {
+    fn default() -> Self {
+        OitParams { sorted_fragments: 8, fragments_per_pixel: 8.0 }
     }
 }
 
@@ -150,6 +192,21 @@ impl RenderParams {
             if !(v.is_finite() && (0.0..=1e3).contains(&v)) {
                 return Err(Error::param(name, v, "0..=1000"));
             }
+        }
+        let k = self.oit.sorted_fragments;
+        if !(1..=crate::limits::OIT_MAX_SORTED).contains(&k) {
+            return Err(Error::param("oit.sorted_fragments", k, format!("1..={}", crate::limits::OIT_MAX_SORTED)));
+        }
+        let f = self.oit.fragments_per_pixel;
+        if !(f.is_finite() && (0.01..=256.0).contains(&f)) {
+            return Err(Error::param("oit.fragments_per_pixel", f, "0.01..=256"));
+        }
+        if self.transparency != Transparency::Off && self.primitive == Primitive::Lines {
+            return Err(Error::param(
+                "transparency",
+                format!("{:?} with lines", self.transparency),
+                "off with lines (transparent strands need ribbons for their coverage)",
+            ));
         }
         Ok(())
     }

@@ -4,7 +4,7 @@
 //! ## The pass convention
 //!
 //! Every pass is a plain struct in its own file ([`super::smooth`],
-//! [`super::interpolate`], [`super::shadow`], [`super::draw`], [`super::resolve`])
+//! [`super::interpolate`], [`super::shadow`], [`super::draw`], [`super::oit`], [`super::resolve`])
 //! that
 //!
 //! - makes its pipelines, descriptor sets and the buffers and images it writes
@@ -46,21 +46,25 @@ pub enum RenderPass {
     ShadowOpacity,
     /// Pass 3c: density-volume shadows, transmittance toward the light at every cell.
     ShadowVolume,
-    /// Pass 4: drawing and shading.
+    /// Pass 4: drawing and shading (with transparency: storing the shaded fragments).
     Draw,
+    /// Pass 4b (with transparency): sorting and blending each pixel's fragments
+    /// into the target.
+    Composite,
     /// Pass 5: supersampling resolve.
     Resolve,
 }
 
 impl RenderPass {
     /// Every pass, in recording order.
-    pub const ALL: [RenderPass; 7] = [
+    pub const ALL: [RenderPass; 8] = [
         RenderPass::Smooth,
         RenderPass::Interpolate,
         RenderPass::ShadowDepth,
         RenderPass::ShadowOpacity,
         RenderPass::ShadowVolume,
         RenderPass::Draw,
+        RenderPass::Composite,
         RenderPass::Resolve,
     ];
 
@@ -73,6 +77,7 @@ impl RenderPass {
             RenderPass::ShadowOpacity => "vkhair render: shadow opacity",
             RenderPass::ShadowVolume => "vkhair render: shadow volume",
             RenderPass::Draw => "vkhair render: draw",
+            RenderPass::Composite => "vkhair render: composite",
             RenderPass::Resolve => "vkhair render: resolve",
         }
     }

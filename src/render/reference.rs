@@ -112,6 +112,124 @@ pub fn light_oriented_transmittance(
         .collect()
 }
 
+/// What [`composite_strands`] draws: hairs as the draw pass's ribbons (true
+/// width, no least width), coloured by `color(t)` along each hair, in one
+/// uniform opacity, over a background.
+pub struct CompositeScene<'a> {
+    /// Each hair's vertices, root to tip: xyz position (m), w the parameter t
+    /// along the hair (0 at the root, 1 at the tip).
+    pub hairs: &'a [Vec<glam::Vec4>],
+    /// World → clip.
+    pub view_proj: glam::Mat4,
+    /// Camera position (the ribbons face it).
+    pub camera: Vec3,
+    /// Image width and height, pixels.
+    pub extent: (u32, u32),
+    /// Hair width at the root and at the tip, meters.
+    pub widths: (f32, f32),
+    /// Real hairs each drawn strand stands for (as
+    /// [`super::HairMaterial::represented_hairs`]).
+    pub represented_hairs: f32,
+    /// Opacity of a strand where it covers a sample.
+    pub opacity: f32,
+    /// Linear colour of the hair at t.
+    pub color: &'a dyn Fn(f32) -> Vec3,
+    /// Linear background colour.
+    pub background: Vec3,
+}
+
+/// Sub-samples per pixel side of [`composite_strands`] (16 per pixel).
+pub const COMPOSITE_SAMPLES: u32 = 4;
+
+/// The exact transparent image of `scene` (the ground truth of the transparency
+/// modes): every segment of every hair becomes the draw pass's camera-facing
+/// quad of its true width (a band `represented_hairs` widths wide, of opacity
+/// `opacity` times the band's density), every quad is point-sampled at 4×4
+/// samples per pixel with perspective-correct t, each sample's fragments are
+/// sorted by depth and composited front to back over the background, and the
+/// samples of a pixel are averaged. Linear RGB and hair alpha, rows from the top.
+pub fn composite_strands(scene: &CompositeScene<'_>) -> Vec<glam::Vec4> {
+    let (w, h) = scene.extent;
+    let n = COMPOSITE_SAMPLES;
+    let n_hairs = scene.represented_hairs.max(1.0);
+    let alpha = scene.opacity * (1.0 - (1.0 - 1.0 / n_hairs).powf(n_hairs));
+    let mut samples: Vec<Vec<(f32, Vec3)>> = vec![Vec::new(); (w * h * n * n) as usize];
+    let project = |p: Vec3| {
+        let c = scene.view_proj * p.extend(1.0);
+        let ndc = c.truncate() / c.w;
+        (glam::Vec2::new((ndc.x * 0.5 + 0.5) * w as f32, (ndc.y * 0.5 + 0.5) * h as f32), ndc.z, c.w)
+    };
+    for hair in scene.hairs {
+        for seg in hair.windows(2) {
+            let (p0, p1) = (seg[0].truncate(), seg[1].truncate());
+            let Some(dir) = (p1 - p0).try_normalize() else { continue };
+            let mut corners = Vec::with_capacity(4);
+            for v in [seg[0], seg[1]] {
+                let p = v.truncate();
+                let side = dir.cross(scene.camera - p).try_normalize().unwrap_or(Vec3::X);
+                let half = 0.5 * n_hairs * (scene.widths.0 + (scene.widths.1 - scene.widths.0) * v.w);
+                for s in [-1.0, 1.0] {
+                    let (xy, z, cw) = project(p + side * half * s);
+                    corners.push((xy, z, cw, v.w));
+                }
+            }
+            if corners.iter().any(|c| c.2.is_nan() || c.2 <= 0.0) {
+                continue;
+            }
+            for tri in [[0, 1, 2], [1, 2, 3]] {
+                let t = tri.map(|i| corners[i]);
+                let lo = t.iter().fold(glam::Vec2::splat(f32::MAX), |a, c| a.min(c.0));
+                let hi = t.iter().fold(glam::Vec2::splat(f32::MIN), |a, c| a.max(c.0));
+                let area = (t[1].0 - t[0].0).perp_dot(t[2].0 - t[0].0);
+                if area.abs() < 1e-12 {
+                    continue;
+                }
+                let sx0 = ((lo.x * n as f32 - 0.5).ceil().max(0.0)) as u32;
+                let sy0 = ((lo.y * n as f32 - 0.5).ceil().max(0.0)) as u32;
+                let sx1 = ((hi.x * n as f32 - 0.5).floor().min((w * n) as f32 - 1.0)) as i64;
+                let sy1 = ((hi.y * n as f32 - 0.5).floor().min((h * n) as f32 - 1.0)) as i64;
+                for sy in sy0 as i64..=sy1 {
+                    for sx in sx0 as i64..=sx1 {
+                        let q = glam::Vec2::new((sx as f32 + 0.5) / n as f32, (sy as f32 + 0.5) / n as f32);
+                        let b = [
+                            (t[2].0 - t[1].0).perp_dot(q - t[1].0) / area,
+                            (t[0].0 - t[2].0).perp_dot(q - t[2].0) / area,
+                            (t[1].0 - t[0].0).perp_dot(q - t[0].0) / area,
+                        ];
+                        // Half-open on the shared diagonal (corners 1–2): a sample on it
+                        // belongs to the first triangle only.
+                        let inside = b.iter().all(|&x| x >= 0.0) && !(tri[0] == 1 && b[0] == 0.0);
+                        if !inside {
+                            continue;
+                        }
+                        let depth = b[0] * t[0].1 + b[1] * t[1].1 + b[2] * t[2].1;
+                        let inv_w = b[0] / t[0].2 + b[1] / t[1].2 + b[2] / t[2].2;
+                        let along = (b[0] * t[0].3 / t[0].2 + b[1] * t[1].3 / t[1].2 + b[2] * t[2].3 / t[2].2) / inv_w;
+                        if !(0.0..=1.0).contains(&depth) {
+                            continue;
+                        }
+                        samples[(sy as u32 * w * n + sx as u32) as usize].push((depth, (scene.color)(along)));
+                    }
+                }
+            }
+        }
+    }
+    let mut image = vec![glam::Vec4::ZERO; (w * h) as usize];
+    for (index, fragments) in samples.iter_mut().enumerate() {
+        fragments.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut sum = Vec3::ZERO;
+        let mut transmittance = 1.0;
+        for (_, c) in fragments.iter() {
+            sum += transmittance * alpha * *c;
+            transmittance *= 1.0 - alpha;
+        }
+        let (sx, sy) = (index as u32 % (w * n), index as u32 / (w * n));
+        let pixel = &mut image[((sy / n) * w + sx / n) as usize];
+        *pixel += (sum + transmittance * scene.background).extend(1.0 - transmittance) / (n * n) as f32;
+    }
+    image
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -115,6 +115,11 @@ impl Supersampling {
         self.color.extent
     }
 
+    /// The colour and depth views.
+    pub(super) fn views(&self) -> (vk::ImageView, vk::ImageView) {
+        (self.color.view(), self.depth.view())
+    }
+
     /// The draw's attachments: colour cleared to transparent, depth to 1.
     pub(super) fn attachments(
         &self,

@@ -174,8 +174,18 @@ pub struct HairMaterial {
     pub root_width: f32,
     /// Ribbon width at the tip, meters (≥ 0). Default: 0.00005.
     pub tip_width: f32,
-    /// Least ribbon width on screen, pixels (0 = none). Default: 1.
+    /// Least ribbon width on screen, pixels (0 = none), for opaque hair only
+    /// ([`super::Transparency::Off`]); transparent strands keep their true width
+    /// and are drawn with their coverage instead. Default: 1.
     pub least_pixel_width: f32,
+    /// Opacity of one strand where it covers a whole pixel, for transparent hair
+    /// (0..=1). Default: 0.8.
+    pub opacity: f32,
+    /// Real hairs each drawn strand stands for (1..=10,000), for transparent hair:
+    /// the strand is drawn as a band n hair widths wide, whose alpha where it
+    /// covers fraction c of a pixel is `opacity · c · (1 − (1 − 1/n)^n)` (the
+    /// part of the band n hairs placed at random cover). Default: 1.
+    pub represented_hairs: f32,
     /// Shading model. Default: [`ShadingMode::KajiyaKay`].
     pub shading: ShadingMode,
     /// Marschner parameters (used in [`ShadingMode::Marschner`]; the lookup tables
@@ -201,6 +211,8 @@ impl Default for HairMaterial {
             root_width: 0.00012,
             tip_width: 0.00005,
             least_pixel_width: 1.0,
+            opacity: 0.8,
+            represented_hairs: 1.0,
             shading: ShadingMode::KajiyaKay,
             marschner: super::MarschnerParams::default(),
         }
@@ -233,6 +245,8 @@ impl HairMaterial {
             ("root_width", self.root_width, 0.0, 1.0),
             ("tip_width", self.tip_width, 0.0, 1.0),
             ("least_pixel_width", self.least_pixel_width, 0.0, 64.0),
+            ("opacity", self.opacity, 0.0, 1.0),
+            ("represented_hairs", self.represented_hairs, 1.0, 10_000.0),
         ];
         for (name, v, lo, hi) in ranges {
             if !(v.is_finite() && v >= lo && v <= hi) {

@@ -408,6 +408,19 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
             let f = bench_frames(&ctx, &args, a.samples)?;
             let stage = format!("render frame, {} hairs, {} segments", f.hairs, f.segments);
             rows.push(Row::new(&s.name, &stage, "frame", clock.figure(&f.gpu, &f.wall), f.gpu, f.work));
+            // The same frame in each transparency mode (the default above is exact, K = 8).
+            for (mode, k) in [("off", 8), ("fast", 8), ("exact", 4), ("exact", 16)] {
+                let k = k.to_string();
+                let mut with_mode = args.clone();
+                with_mode.extend(["--transparency", mode, "--sorted-fragments", &k]);
+                let f = bench_frames(&ctx, &with_mode, a.samples)?;
+                let mib = f.transparency_bytes as f64 / (1024.0 * 1024.0);
+                let stage = match mode {
+                    "exact" => format!("render frame, transparency exact K = {k}, {mib:.1} MiB"),
+                    _ => format!("render frame, transparency {mode}, {mib:.1} MiB"),
+                };
+                rows.push(Row::new(&s.name, &stage, "frame", clock.figure(&f.gpu, &f.wall), f.gpu, f.work));
+            }
         }
     }
     print_rows(&rows);

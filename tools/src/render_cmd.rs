@@ -8,7 +8,9 @@ use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::scenes::{self, THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS};
 use vkhair::groom::Groom;
 use vkhair::headless::{MeshDrawer, Offscreen, Submit};
-use vkhair::render::{Camera, InterpolationMode, Light, Primitive, Renderer, ShadingMode, ShadowCaster, ShadowParams};
+use vkhair::render::{
+    Camera, InterpolationMode, Light, Primitive, Renderer, ShadingMode, ShadowCaster, ShadowParams, Transparency,
+};
 use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, SchedulerOptions};
 use vkhair::sim::{motion, Collider, RigidTransform, SimParams, VolumeMode, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
@@ -18,6 +20,9 @@ use crate::output::{progress, Error, FrameSink, MIN_IMAGE_SIDE};
 use crate::profile::{host_now_ns, Profile, ProfileArgs};
 use crate::say;
 use crate::simulate_cmd::MotionArg;
+
+mod bench;
+pub use bench::bench_frames;
 
 /// `--schedule`: where the simulation runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -41,6 +46,17 @@ pub enum HandOffArg {
     External,
     /// Host-visible staging buffers.
     Staging,
+}
+
+/// `--transparency`: how hair is blended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TransparencyArg {
+    /// Opaque ribbons at least a pixel wide, nearest layer only.
+    Off,
+    /// Weighted blended transparency: one pass, no lists.
+    Fast,
+    /// Per-pixel lists, the nearest fragments sorted exactly.
+    Exact,
 }
 
 #[derive(clap::Args)]
@@ -86,9 +102,17 @@ pub struct RenderArgs {
     /// Shade with Marschner lookup tables instead of Kajiya-Kay.
     #[arg(long)]
     marschner: bool,
-    /// Draw one-pixel lines instead of ribbons.
+    /// Draw one-pixel lines instead of ribbons (opaque: turns transparency off
+    /// unless --transparency is given).
     #[arg(long)]
     lines: bool,
+    /// How hair is blended: opaque ribbons, weighted blended transparency or
+    /// per-pixel sorted lists [default: the --config file's, else exact].
+    #[arg(long, value_enum)]
+    transparency: Option<TransparencyArg>,
+    /// Fragments sorted exactly per pixel by --transparency exact (1..=32) [default: 8].
+    #[arg(long)]
+    sorted_fragments: Option<u32>,
     /// No self-shadowing (by default the two spot lights cast deep opacity maps).
     #[arg(long)]
     no_shadows: bool,
@@ -143,88 +167,23 @@ fn make_renderer(
         let shadows = ShadowParams { casters, resolution: a.shadow_resolution, layers, ..ShadowParams::default() };
         renderer.set_shadows(key_hairs, &shadows)?;
     }
-    renderer.set_material(&config.material)?;
+    let mut material = config.material.clone();
+    if material.represented_hairs == 1.0 {
+        material.represented_hairs = represented_hairs(renderer.hair_counts().0);
+    }
+    renderer.set_material(&material)?;
     Ok(renderer)
 }
 
-/// What `vkhair bench` measures of a frame: the render passes' GPU time (from
-/// their timestamp scopes), the wall time of the submission holding them (the
-/// simulation's steps go in a submission of their own before it), and what
-/// the render passes record.
-pub struct FrameFigures {
-    pub gpu: crate::bench_measure::Samples,
-    pub wall: crate::bench_measure::Samples,
-    pub work: vkhair::RecordedWork,
-    pub hairs: u64,
-    pub segments: u64,
-    pub pixels: u64,
-}
+/// Hairs on a full head of real hair, for the tool's default of
+/// [`vkhair::render::HairMaterial::represented_hairs`].
+pub const FULL_HEAD_HAIRS: f32 = 100_000.0;
 
-/// Renders `samples` frames (after two warm-up frames) of the scene `render`
-/// would draw with `args` (its flags, e.g. `["--width", "1280"]`), the
-/// simulation on the same queue, and measures the render passes.
-pub fn bench_frames(ctx: &GpuContext, args: &[&str], samples: usize) -> Result<FrameFigures, Error> {
-    #[derive(clap::Parser)]
-    struct Wrapper {
-        #[command(flatten)]
-        render: RenderArgs,
-    }
-    let a = <Wrapper as clap::Parser>::try_parse_from(std::iter::once("render").chain(args.iter().copied()))
-        .map_err(|e| format!("bench render arguments: {e}"))?
-        .render;
-    check_options(&a)?;
-    let s = scene(&a)?;
-    let config = parameters(&a, s.center, s.radius)?;
-    let mut sim = vkhair::sim::HairSim::new(ctx, &s.groom, &config.sim, &RigidTransform::default())?;
-    sim.set_colliders(&s.colliders)?;
-    let mut renderer = make_renderer(&a, ctx, &config, sim.key_hairs(), s.radius)?;
-    let offscreen = Offscreen::new(ctx, a.width, a.height)?;
-    let camera = framing(&s, a.distance, a.width as f32 / a.height as f32)?;
-    let mut profiler = GpuProfiler::new(ctx, 1, 64)?;
-    let (lo, hi) = s.groom.bounds();
-    let size = (hi - lo).max_element();
-    let (hairs, per_hair) = renderer.hair_counts();
-    let mut figures = FrameFigures {
-        gpu: Default::default(),
-        wall: Default::default(),
-        work: Default::default(),
-        hairs: u64::from(hairs),
-        segments: u64::from(hairs) * u64::from(per_hair.saturating_sub(1)),
-        pixels: u64::from(a.width) * u64::from(a.height),
-    };
-    for frame in 0..samples + 2 {
-        let heads: Vec<RigidTransform> =
-            (0..2).map(|k| a.motion.head((frame * 2 + k + 1) as f32 * config.sim.dt, s.pivot, size)).collect();
-        sim.run(heads.len(), |k| heads[k], None)?;
-        let started = std::time::Instant::now();
-        let mut render_work = vkhair::RecordedWork::default();
-        let mut result = Ok(());
-        ctx.run_commands("vkhair bench frame", |cmd| {
-            // SAFETY: a recording command buffer of the context's device; the
-            // previous frame completed (run_commands waits) and was drained.
-            result = unsafe {
-                (|| -> Result<(), vkhair::Error> {
-                    profiler.begin_frame(cmd, frame as u64);
-                    let before = ctx.recorded_work();
-                    renderer.record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler))?;
-                    renderer.record_shadows(cmd, &sim, Some(&mut profiler))?;
-                    offscreen.record_clear(cmd, Vec3::splat(0.02));
-                    renderer.record_draw(cmd, frame as u64, &offscreen.target(), &camera, Some(&mut profiler))?;
-                    render_work = ctx.recorded_work() - before;
-                    Ok(())
-                })()
-            };
-        })?;
-        result?;
-        let wall = started.elapsed().as_secs_f64() * 1e3;
-        let report = profiler.drain().pop().ok_or("the device wrote no timestamps")?;
-        if frame >= 2 {
-            figures.gpu.0.push(report.total_nanoseconds() / 1e6);
-            figures.wall.0.push(wall);
-            figures.work = render_work;
-        }
-    }
-    Ok(figures)
+/// The tool's default hairs per drawn strand for `drawn` strands: a full head
+/// ([`FULL_HEAD_HAIRS`]) over the strands drawn at full detail, at least 1
+/// (`material.represented_hairs` in a `--config` file other than 1 wins).
+pub fn represented_hairs(drawn: u32) -> f32 {
+    (FULL_HEAD_HAIRS / drawn.max(1) as f32).clamp(1.0, 10_000.0)
 }
 
 /// The scheduler options the flags ask for (creating the simulation device).
@@ -395,7 +354,9 @@ fn framing(s: &Scene, distance: Option<f32>, aspect: f32) -> Result<Camera, vkha
 /// the tool's lights when the file lists none. Checked before any GPU work.
 fn parameters(a: &RenderArgs, center: Vec3, radius: f32) -> Result<Config, vkhair::Error> {
     let sim = if a.input.input.is_some() { SimParams::styled() } else { SimParams::default() };
-    let base = Config { sim, ..Config::default() };
+    let mut base = Config { sim, ..Config::default() };
+    // The tool draws soft hair unless told otherwise (the library's default is opaque).
+    base.render.transparency = Transparency::Exact;
     let mut config = match &a.config {
         Some(path) => base.load_over(path)?,
         None => base,
@@ -414,6 +375,17 @@ fn parameters(a: &RenderArgs, center: Vec3, radius: f32) -> Result<Config, vkhai
     }
     if a.lines {
         r.primitive = Primitive::Lines;
+        r.transparency = Transparency::Off;
+    }
+    if let Some(k) = a.sorted_fragments {
+        r.oit.sorted_fragments = k;
+    }
+    if let Some(t) = a.transparency {
+        r.transparency = match t {
+            TransparencyArg::Off => Transparency::Off,
+            TransparencyArg::Fast => Transparency::Fast,
+            TransparencyArg::Exact => Transparency::Exact,
+        };
     }
     if a.marschner {
         config.material.shading = ShadingMode::Marschner;
@@ -542,6 +514,21 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     bar.finish_and_clear();
     sink.finish()?;
     profile.print_table();
+    let mode = renderer.params().transparency;
+    if mode != Transparency::Off {
+        let extent = vkhair::ash::vk::Extent2D { width: a.width, height: a.height };
+        let mib = renderer.transparency_memory(extent) as f64 / (1024.0 * 1024.0);
+        say!("transparency: {mode:?}, {mib:.1} MiB of lists or accumulation images");
+    }
+    if let Some(stats) = renderer.transparency_stats() {
+        say!(
+            "last frame: {} hair fragments, {} stored, {} dropped (pool of {}; raise oit.fragments_per_pixel if any are dropped)",
+            stats.fragments,
+            stats.stored,
+            stats.dropped,
+            stats.capacity
+        );
+    }
     say!("wrote {} frames and contact_sheet.png to {}", a.frames, a.out.display());
     a.profile_out.write(&profile, || {
         serde_json::json!({

@@ -163,6 +163,18 @@ impl GraphicsPipeline {
         self.buffer_set(set, &self.layout.declared(set, buffers))
     }
 
+    /// As [`GraphicsPipeline::resource_set`] with only the entries of `buffers` and
+    /// `images` whose binding the pipeline declares in `set`.
+    pub(crate) fn declared_resource_set(
+        &self,
+        set: u32,
+        buffers: &[(u32, &Buffer)],
+        images: &[(u32, vk::ImageView, vk::Sampler)],
+    ) -> Result<vk::DescriptorSet> {
+        let images: Vec<_> = images.iter().copied().filter(|(b, _, _)| self.layout.declares(set, *b)).collect();
+        self.resource_set(set, &self.layout.declared(set, buffers), &images)
+    }
+
     /// Allocates descriptor set `set` with buffer and combined image-sampler bindings.
     pub(crate) fn resource_set(
         &self,

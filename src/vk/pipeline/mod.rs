@@ -131,13 +131,14 @@ impl Layout {
         Ok(set)
     }
 
+    /// Whether the pipeline declares `binding` in `set`.
+    fn declares(&self, set: u32, binding: u32) -> bool {
+        self.bindings.iter().any(|(b, _)| b.set == set && b.binding == binding)
+    }
+
     /// The entries of `buffers` whose binding the pipeline declares in `set`.
     fn declared<'a>(&self, set: u32, buffers: &[(u32, &'a Buffer)]) -> Vec<(u32, &'a Buffer)> {
-        buffers
-            .iter()
-            .filter(|(binding, _)| self.bindings.iter().any(|(b, _)| b.set == set && b.binding == *binding))
-            .copied()
-            .collect()
+        buffers.iter().filter(|(binding, _)| self.declares(set, *binding)).copied().collect()
     }
 
     /// Points storage-image bindings of `set` at views in GENERAL layout.

@@ -1,0 +1,34 @@
+#version 460
+// Exact transparency, build: every hair fragment that passes the depth test is
+// shaded once and pushed onto its pixel's list (a node from the pool; when the
+// pool is full it is counted and dropped). Early tests: the depth test runs
+// before the stores.
+#include "hair_shading.glsl"
+#include "oit.glsl"
+
+layout(early_fragment_tests) in;
+
+layout(location = 0) in vec3 g_pos;
+layout(location = 1) in vec3 g_tan;
+layout(location = 2) in float g_t;
+layout(location = 3) flat in uint g_hair;
+layout(location = 4) in vec2 g_cover;
+
+void main() {
+    float alpha = strand_alpha(g_cover);
+    if (alpha < OIT_LEAST_ALPHA) {
+        return;
+    }
+    vec3 color = shade_hair(g_pos, g_tan, g_t, g_hair);
+    uint pixel = oit_pixel(gl_FragCoord);
+    if (alpha >= OIT_OPAQUE_ALPHA) {
+        atomicMin(oit_opaque[pixel], floatBitsToUint(gl_FragCoord.z));
+    }
+    uint node = atomicAdd(oit.used, 1u);
+    if (node >= oit.capacity) {
+        return;
+    }
+    uint next = atomicExchange(oit_heads[pixel], node);
+    oit_nodes[node] = uvec4(packHalf2x16(color.rg), packHalf2x16(vec2(color.b, alpha)),
+                            floatBitsToUint(gl_FragCoord.z), next);
+}

@@ -1,0 +1,66 @@
+#version 460
+// Exact transparency, resolve (one full-screen triangle): walks the pixel's
+// list, keeps its K nearest fragments sorted by depth (insertion), folds every
+// farther one into an order-independent tail (sum of premultiplied colour, sum
+// of alpha, product of transmittance), composites the K front to back and the
+// tail behind them, and blends the result over the target as premultiplied
+// colour. Pixels without hair are discarded.
+#include "oit.glsl"
+
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    uint node = oit_heads[oit_pixel(gl_FragCoord)];
+    if (node == OIT_END) {
+        discard;
+    }
+    float depth[OIT_MAX_SORTED];
+    vec4 color[OIT_MAX_SORTED];
+    uint k = min(oit.sorted, uint(OIT_MAX_SORTED));
+    uint n = 0u;
+    vec3 tail_sum = vec3(0.0);
+    float tail_alpha = 0.0;
+    float tail_transmittance = 1.0;
+    // Each stored node is on exactly one list: at most min(used, capacity) steps.
+    uint steps = min(oit.used, oit.capacity);
+    for (uint step = 0u; node != OIT_END && step < steps; step++) {
+        uvec4 record = oit_nodes[node];
+        node = record.w;
+        vec4 c = vec4(unpackHalf2x16(record.x), unpackHalf2x16(record.y));
+        float z = uintBitsToFloat(record.z);
+        if (n == k) {
+            // Full: the farther of this fragment and the farthest kept one goes to the tail.
+            if (k == 0u || z >= depth[n - 1u]) {
+                tail_sum += c.rgb * c.a;
+                tail_alpha += c.a;
+                tail_transmittance *= 1.0 - c.a;
+                continue;
+            }
+            vec4 out_c = color[n - 1u];
+            tail_sum += out_c.rgb * out_c.a;
+            tail_alpha += out_c.a;
+            tail_transmittance *= 1.0 - out_c.a;
+            n -= 1u;
+        }
+        uint i = n;
+        while (i > 0u && depth[i - 1u] > z) {
+            depth[i] = depth[i - 1u];
+            color[i] = color[i - 1u];
+            i -= 1u;
+        }
+        depth[i] = z;
+        color[i] = c;
+        n += 1u;
+    }
+    vec3 sum = vec3(0.0);
+    float transmittance = 1.0;
+    for (uint i = 0u; i < n; i++) {
+        sum += transmittance * color[i].a * color[i].rgb;
+        transmittance *= 1.0 - color[i].a;
+    }
+    if (tail_alpha > 0.0) {
+        sum += transmittance * (1.0 - tail_transmittance) * (tail_sum / tail_alpha);
+        transmittance *= tail_transmittance;
+    }
+    out_color = vec4(sum, 1.0 - transmittance);
+}

@@ -1,0 +1,352 @@
+//! Transparent hair (`RenderParams::transparency`) against the exact CPU
+//! reference `render::reference::composite_strands`, under validation.
+//!
+//! The scenes are unlit (no lights, ambient 1), so a fragment's colour is the
+//! albedo at its t along the hair and the reference needs no shading model: what
+//! is compared is coverage and compositing.
+
+use glam::{Vec3, Vec4};
+use vkhair::groom::scenes;
+use vkhair::headless::{Offscreen, Submit};
+use vkhair::render::reference::{composite_strands, CompositeScene};
+use vkhair::render::{Camera, HairMaterial, LodParams, RenderParams, Renderer, Transparency};
+use vkhair::sim::{HairSim, RigidTransform, SimParams};
+use vkhair::Groom;
+mod common;
+
+use common::Gpu;
+
+const W: u32 = 160;
+const H: u32 = 120;
+const ROOT: Vec3 = Vec3::new(0.9, 0.2, 0.05);
+const TIP: Vec3 = Vec3::new(0.1, 0.5, 0.9);
+const BACKGROUND: Vec3 = Vec3::new(0.02, 0.02, 0.02);
+
+/// A frame index per drawn frame (every test frame is waited for).
+fn next_frame() -> u64 {
+    static FRAME: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    FRAME.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+/// The unlit material: albedo from ROOT to TIP, ambient 1, `width` metres wide.
+fn material(width: f32, opacity: f32) -> HairMaterial {
+    HairMaterial {
+        root_color: ROOT,
+        tip_color: TIP,
+        ambient: 1.0,
+        root_width: width,
+        tip_width: width,
+        opacity,
+        ..HairMaterial::default()
+    }
+}
+
+/// One hair per key hair, on the key hair itself (no clump offset), two smoothed
+/// segments per key segment, no level of detail.
+fn params(transparency: Transparency) -> RenderParams {
+    RenderParams {
+        hairs_per_key: 1,
+        smoothing_level: 2,
+        clump_width: 0.0,
+        lod: LodParams { enabled: false, ..LodParams::default() },
+        transparency,
+        ..RenderParams::default()
+    }
+}
+
+/// The camera of the small scenes: the thesis head from the front, 0.9 m away.
+fn camera() -> Camera {
+    let center = scenes::THESIS_HEAD_CENTER;
+    Camera::look_at(
+        center + Vec3::new(0.0, -0.05, 0.9),
+        center - Vec3::new(0.0, 0.1, 0.0),
+        0.7,
+        W as f32 / H as f32,
+        0.05,
+        10.0,
+    )
+    .expect("camera")
+}
+
+struct Scene {
+    sim: HairSim,
+    renderer: Renderer,
+    offscreen: Offscreen,
+    camera: Camera,
+}
+
+fn scene(gpu: &Gpu, groom: &Groom, params: &RenderParams, material: &HairMaterial) -> Scene {
+    let sim = HairSim::new(gpu.ctx(), groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    let mut renderer = Renderer::new(gpu.ctx(), &sim, params).expect("renderer");
+    renderer.set_material(material).expect("material");
+    Scene { sim, renderer, offscreen: Offscreen::new(gpu.ctx(), W, H).expect("offscreen"), camera: camera() }
+}
+
+/// Draws the hair over BACKGROUND; returns linear RGB per pixel.
+fn draw(gpu: &Gpu, s: &mut Scene) -> Vec<Vec3> {
+    let mut result = Ok(());
+    gpu.ctx()
+        .run_commands("transparency test frame", |cmd| {
+            // SAFETY: a recording command buffer of the context's device.
+            result = unsafe {
+                s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
+                    s.renderer.record_shadows(cmd, &s.sim, None)?;
+                    s.offscreen.record_clear(cmd, BACKGROUND);
+                    s.renderer.record_draw(cmd, next_frame(), &s.offscreen.target(), &s.camera, None)
+                })
+            };
+        })
+        .expect("submit");
+    result.expect("record");
+    let rgba = s.offscreen.read_rgba8().expect("readback");
+    rgba.chunks_exact(4).map(|p| Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))).collect()
+}
+
+fn linear(v: u8) -> f32 {
+    let c = f32::from(v) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The exact image of the hairs the renderer drew (read back), by the CPU reference.
+fn reference(s: &Scene, width: f32, opacity: f32) -> Vec<Vec3> {
+    let (positions, tangents) = s.renderer.read_hairs().expect("hairs");
+    let (hairs, per_hair) = s.renderer.hair_counts();
+    let per_hair = per_hair as usize;
+    let strands: Vec<Vec<Vec4>> = (0..hairs as usize)
+        .map(|h| {
+            (0..per_hair).map(|k| positions[h * per_hair + k].truncate().extend(tangents[h * per_hair + k].w)).collect()
+        })
+        .collect();
+    let color = |t: f32| ROOT.lerp(TIP, t);
+    let image = composite_strands(&CompositeScene {
+        hairs: &strands,
+        view_proj: s.camera.projection * s.camera.view,
+        camera: s.camera.position(),
+        extent: (W, H),
+        widths: (width, width),
+        represented_hairs: 1.0,
+        opacity,
+        color: &color,
+        background: BACKGROUND,
+    });
+    image.iter().map(|p| p.truncate()).collect()
+}
+
+/// Mean absolute error in 8-bit sRGB steps over the pixels where either image has hair.
+fn mae(image: &[Vec3], reference: &[Vec3]) -> f64 {
+    let srgb = |c: f32| if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 } * 255.0;
+    let background = BACKGROUND.to_array().map(srgb);
+    let mut sum = 0.0;
+    let mut count = 0usize;
+    for (a, b) in image.iter().zip(reference) {
+        let (a, b) = (a.to_array().map(srgb), b.to_array().map(srgb));
+        let hair = (0..3).any(|i| (a[i] - background[i]).abs() > 1.0 || (b[i] - background[i]).abs() > 1.0);
+        if hair {
+            sum += (0..3).map(|i| f64::from((a[i] - b[i]).abs())).sum::<f64>() / 3.0;
+            count += 1;
+        }
+    }
+    assert!(count > 100, "only {count} hair pixels: the scene shows no hair");
+    sum / count as f64
+}
+
+/// A pixel-wide scene: 300 key hairs grown on the thesis scalp, 0.8 mm wide
+/// (about a third of a pixel at this distance), opacity 0.8.
+const WIDTH: f32 = 0.0008;
+const OPACITY: f32 = 0.8;
+
+#[test]
+fn each_mode_against_the_exact_reference() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(300, 8, 5);
+    let m = material(WIDTH, OPACITY);
+    let mut errors = Vec::new();
+    for mode in [Transparency::Off, Transparency::Fast, Transparency::Exact] {
+        let mut s = scene(&gpu, &groom, &params(mode), &m);
+        let image = draw(&gpu, &mut s);
+        let truth = reference(&s, WIDTH, OPACITY);
+        let e = mae(&image, &truth);
+        let ink = |img: &[Vec3]| img.iter().map(|c| (*c - BACKGROUND).element_sum()).sum::<f32>();
+        println!("{mode:?}: ink {:.1}, reference ink {:.1}", ink(&image), ink(&truth));
+        println!("{mode:?}: mean absolute error against the reference {e:.2} (8-bit sRGB steps)");
+        errors.push(e);
+    }
+    let [off, fast, exact] = [errors[0], errors[1], errors[2]];
+    assert!(exact <= 0.5 * off, "exact's error {exact:.2} is not at most half of off's {off:.2}");
+    assert!(fast < off, "fast's error {fast:.2} is not below off's {off:.2}");
+}
+
+#[test]
+fn the_exact_image_does_not_depend_on_strand_order() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(200, 8, 9);
+    // Every strand, in another order: the last first, odd before even.
+    let order: Vec<usize> = (0..groom.strand_count())
+        .rev()
+        .filter(|i| i % 2 == 1)
+        .chain((0..groom.strand_count()).filter(|i| i % 2 == 0))
+        .collect();
+    let shuffled = groom.select(&order).expect("shuffle");
+    // K large enough to cover the depth complexity of this sparse scene.
+    let mut p = params(Transparency::Exact);
+    p.oit.sorted_fragments = 32;
+    let m = material(WIDTH, OPACITY);
+    let mut a = scene(&gpu, &groom, &p, &m);
+    let mut b = scene(&gpu, &shuffled, &p, &m);
+    let (first, second) = (draw(&gpu, &mut a), draw(&gpu, &mut b));
+    let differing = first.iter().zip(&second).filter(|(x, y)| (**x - **y).abs().max_element() > 0.0).count();
+    let worst = first
+        .iter()
+        .zip(&second)
+        .map(|(x, y)| {
+            let to8 = |c: Vec3| c.to_array().map(|v| (v.powf(1.0 / 2.2) * 255.0).round());
+            let (x, y) = (to8(*x), to8(*y));
+            (0..3).map(|i| (x[i] - y[i]).abs()).fold(0.0f32, f32::max)
+        })
+        .fold(0.0f32, f32::max);
+    println!("shuffled strands: {differing} pixels differ, by at most {worst} steps");
+    assert!(worst <= 1.0, "shuffling the strands changed a pixel by {worst} steps of 255");
+    assert!(first.iter().filter(|c| (**c - BACKGROUND).abs().max_element() > 0.01).count() > 100, "no hair drawn");
+}
+
+#[test]
+fn an_overflowing_pool_drops_fragments_and_says_so() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(300, 8, 5);
+    let m = material(WIDTH, OPACITY);
+    let mut s = scene(&gpu, &groom, &params(Transparency::Exact), &m);
+    let full = draw(&gpu, &mut s);
+    let needed = s.renderer.transparency_stats().expect("stats of an exact frame");
+    assert_eq!(needed.dropped, 0, "the default pool overflowed: {needed:?}");
+    assert!(needed.fragments > 1000, "too few fragments to test with: {needed:?}");
+    // A pool of 1 % of the fragments the scene needs.
+    let mut p = params(Transparency::Exact);
+    p.oit.fragments_per_pixel = 0.01 * needed.fragments as f32 / (W * H) as f32;
+    s.renderer.set_params(&p).expect("params");
+    let starved = draw(&gpu, &mut s);
+    let stats = s.renderer.transparency_stats().expect("stats");
+    println!("pool of {} for {} fragments: {stats:?}", stats.capacity, needed.fragments);
+    assert_eq!(stats.fragments, needed.fragments, "the same fragments are offered");
+    assert_eq!(stats.stored, stats.capacity, "the pool is filled");
+    assert_eq!(stats.dropped, needed.fragments - stats.capacity, "the rest is counted as dropped");
+    let hair = |img: &[Vec3]| img.iter().filter(|c| (**c - BACKGROUND).abs().max_element() > 0.01).count();
+    let (full_hair, starved_hair) = (hair(&full), hair(&starved));
+    println!("hair pixels: {full_hair} with the full pool, {starved_hair} with 1 %");
+    assert!(starved_hair > 0 && starved_hair < full_hair, "the starved image is not a part of the full one");
+    assert!(starved.iter().all(|c| c.is_finite() && c.max_element() <= 1.0), "garbage in the starved image");
+}
+
+/// Darkening (sum over the image of background − pixel, linear) of one straight
+/// black strand across a white background, `pixels` wide.
+fn darkening(gpu: &Gpu, pixels: f32) -> f32 {
+    let center = scenes::THESIS_HEAD_CENTER;
+    let distance = 0.9;
+    // A horizontal strand through the view's centre, at the camera's distance.
+    let strand: Vec<Vec3> = (0..8).map(|i| center + Vec3::new(-0.15 + 0.3 * i as f32 / 7.0, 0.0, 0.0)).collect();
+    let groom = Groom::from_strands(&[strand]).expect("strand");
+    let camera = Camera::look_at(center + Vec3::new(0.0, 0.0, distance), center, 0.7, W as f32 / H as f32, 0.05, 10.0)
+        .expect("camera");
+    let pixel = 2.0 * (0.35f32).tan() * distance / H as f32;
+    let m =
+        HairMaterial { root_color: Vec3::ZERO, tip_color: Vec3::ZERO, opacity: 1.0, ..material(pixels * pixel, 1.0) };
+    let mut s = scene(gpu, &groom, &params(Transparency::Exact), &m);
+    s.camera = camera;
+    let mut result = Ok(());
+    gpu.ctx()
+        .run_commands("coverage frame", |cmd| {
+            // SAFETY: a recording command buffer of the context's device.
+            result = unsafe {
+                s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
+                    s.renderer.record_shadows(cmd, &s.sim, None)?;
+                    s.offscreen.record_clear(cmd, Vec3::ONE);
+                    s.renderer.record_draw(cmd, next_frame(), &s.offscreen.target(), &s.camera, None)
+                })
+            };
+        })
+        .expect("submit");
+    result.expect("record");
+    let rgba = s.offscreen.read_rgba8().expect("readback");
+    rgba.chunks_exact(4).map(|p| 1.0 - linear(p[1])).sum()
+}
+
+#[test]
+fn a_quarter_pixel_strand_darkens_a_quarter_of_a_one_pixel_strand() {
+    let gpu = Gpu::new();
+    let (quarter, one) = (darkening(&gpu, 0.25), darkening(&gpu, 1.0));
+    let ratio = quarter / one;
+    println!("darkening: 0.25 px {quarter:.2}, 1 px {one:.2}, ratio {ratio:.3}");
+    assert!(one > 40.0, "the 1-px strand darkens only {one}");
+    assert!((ratio - 0.25).abs() <= 0.025, "a 0.25-px strand darkens {ratio:.3} of a 1-px one, not 0.25 ± 10 %");
+}
+
+/// Fraction of the crown's pixels (within half the head's radius of its centre,
+/// seen from above) where the reference image of `groom`'s hairs, drawn as
+/// strands standing for `represented_hairs` hairs each, is at least half opaque.
+fn crown_coverage(gpu: &Gpu, groom: &Groom, hairs_per_key: u32, represented_hairs: f32) -> f32 {
+    let center = scenes::THESIS_HEAD_CENTER;
+    let radius = scenes::THESIS_HEAD_RADIUS;
+    let p = RenderParams { hairs_per_key, clump_width: 0.02, ..params(Transparency::Exact) };
+    let m = HairMaterial::default();
+    let mut s = scene(gpu, groom, &p, &m);
+    // From above (a little in front, so +Y can stay the camera's up).
+    s.camera = Camera::look_at(center + Vec3::new(0.0, 0.6, 0.06), center, 0.7, W as f32 / H as f32, 0.05, 10.0)
+        .expect("camera");
+    // Prepares the interpolated hairs for this camera.
+    draw(gpu, &mut s);
+    let (positions, tangents) = s.renderer.read_hairs().expect("hairs");
+    let (hairs, per_hair) = s.renderer.hair_counts();
+    let per_hair = per_hair as usize;
+    let strands: Vec<Vec<Vec4>> = (0..hairs as usize)
+        .map(|h| {
+            (0..per_hair).map(|k| positions[h * per_hair + k].truncate().extend(tangents[h * per_hair + k].w)).collect()
+        })
+        .collect();
+    let image = composite_strands(&CompositeScene {
+        hairs: &strands,
+        view_proj: s.camera.projection * s.camera.view,
+        camera: s.camera.position(),
+        extent: (W, H),
+        widths: (m.root_width, m.tip_width),
+        represented_hairs,
+        opacity: m.opacity,
+        color: &|_| Vec3::ONE,
+        background: Vec3::ZERO,
+    });
+    let project = |q: Vec3| {
+        let c = s.camera.projection * s.camera.view * q.extend(1.0);
+        ((c.truncate().truncate() / c.w) * 0.5 + 0.5) * glam::Vec2::new(W as f32, H as f32)
+    };
+    let (mid, edge) = (project(center), project(center + Vec3::new(0.5 * radius, 0.0, 0.0)));
+    let crown = (edge - mid).length();
+    let mut inside = 0usize;
+    let mut covered = 0usize;
+    for (i, px) in image.iter().enumerate() {
+        let xy = glam::Vec2::new((i as u32 % W) as f32 + 0.5, (i as u32 / W) as f32 + 0.5);
+        if (xy - mid).length() <= crown {
+            inside += 1;
+            covered += usize::from(px.w >= 0.5);
+        }
+    }
+    assert!(inside > 50, "the crown covers only {inside} pixels");
+    covered as f32 / inside as f32
+}
+
+#[test]
+fn strands_standing_for_a_full_head_cover_the_scalp() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(400, 8, 3);
+    let hairs_per_key = 4;
+    // A full head of 100,000 hairs over the 1,600 strands drawn (the tool's default).
+    let full = crown_coverage(&gpu, &groom, hairs_per_key, 100_000.0 / (400.0 * hairs_per_key as f32));
+    let single = crown_coverage(&gpu, &groom, hairs_per_key, 1.0);
+    println!(
+        "crown pixels at least half covered: {:.1} % standing for a full head, {:.1} % one hair each",
+        100.0 * full,
+        100.0 * single
+    );
+    assert!(full >= 0.75, "strands standing for a full head cover only {:.1} % of the crown", 100.0 * full);
+}
