@@ -84,22 +84,7 @@ fn scene(gpu: &Gpu, groom: &Groom, params: &RenderParams, material: &HairMateria
 
 /// Draws the hair over BACKGROUND; returns linear RGB per pixel.
 fn draw(gpu: &Gpu, s: &mut Scene) -> Vec<Vec3> {
-    let mut result = Ok(());
-    gpu.ctx()
-        .run_commands("transparency test frame", |cmd| {
-            // SAFETY: a recording command buffer of the context's device.
-            result = unsafe {
-                s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
-                    s.renderer.record_shadows(cmd, &s.sim, None)?;
-                    s.offscreen.record_clear(cmd, BACKGROUND);
-                    s.renderer.record_draw(cmd, next_frame(), &s.offscreen.target(), &s.camera, None)
-                })
-            };
-        })
-        .expect("submit");
-    result.expect("record");
-    let rgba = s.offscreen.read_rgba8().expect("readback");
-    rgba.chunks_exact(4).map(|p| Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))).collect()
+    draw_then(gpu, s, BACKGROUND, None)
 }
 
 fn linear(v: u8) -> f32 {
@@ -111,16 +96,21 @@ fn linear(v: u8) -> f32 {
     }
 }
 
-/// The exact image of the hairs the renderer drew (read back), by the CPU reference.
-fn reference(s: &Scene, width: f32, opacity: f32) -> Vec<Vec3> {
+/// The hairs the renderer drew (read back): position and t along the hair.
+fn drawn_hairs(s: &Scene) -> Vec<Vec<Vec4>> {
     let (positions, tangents) = s.renderer.read_hairs().expect("hairs");
     let (hairs, per_hair) = s.renderer.hair_counts();
     let per_hair = per_hair as usize;
-    let strands: Vec<Vec<Vec4>> = (0..hairs as usize)
+    (0..hairs as usize)
         .map(|h| {
             (0..per_hair).map(|k| positions[h * per_hair + k].truncate().extend(tangents[h * per_hair + k].w)).collect()
         })
-        .collect();
+        .collect()
+}
+
+/// The exact image of the hairs the renderer drew (read back), by the CPU reference.
+fn reference(s: &Scene, width: f32, opacity: f32) -> Vec<Vec3> {
+    let strands = drawn_hairs(s);
     let color = |t: f32| ROOT.lerp(TIP, t);
     let image = composite_strands(&CompositeScene {
         hairs: &strands,
@@ -255,22 +245,7 @@ fn darkening(gpu: &Gpu, pixels: f32) -> f32 {
         HairMaterial { root_color: Vec3::ZERO, tip_color: Vec3::ZERO, opacity: 1.0, ..material(pixels * pixel, 1.0) };
     let mut s = scene(gpu, &groom, &params(Transparency::Exact), &m);
     s.camera = camera;
-    let mut result = Ok(());
-    gpu.ctx()
-        .run_commands("coverage frame", |cmd| {
-            // SAFETY: a recording command buffer of the context's device.
-            result = unsafe {
-                s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
-                    s.renderer.record_shadows(cmd, &s.sim, None)?;
-                    s.offscreen.record_clear(cmd, Vec3::ONE);
-                    s.renderer.record_draw(cmd, next_frame(), &s.offscreen.target(), &s.camera, None)
-                })
-            };
-        })
-        .expect("submit");
-    result.expect("record");
-    let rgba = s.offscreen.read_rgba8().expect("readback");
-    rgba.chunks_exact(4).map(|p| 1.0 - linear(p[1])).sum()
+    draw_then(gpu, &mut s, Vec3::ONE, None).iter().map(|c| 1.0 - c.y).sum()
 }
 
 #[test]
@@ -297,14 +272,7 @@ fn crown_coverage(gpu: &Gpu, groom: &Groom, hairs_per_key: u32, represented_hair
         .expect("camera");
     // Prepares the interpolated hairs for this camera.
     draw(gpu, &mut s);
-    let (positions, tangents) = s.renderer.read_hairs().expect("hairs");
-    let (hairs, per_hair) = s.renderer.hair_counts();
-    let per_hair = per_hair as usize;
-    let strands: Vec<Vec<Vec4>> = (0..hairs as usize)
-        .map(|h| {
-            (0..per_hair).map(|k| positions[h * per_hair + k].truncate().extend(tangents[h * per_hair + k].w)).collect()
-        })
-        .collect();
+    let strands = drawn_hairs(&s);
     let image = composite_strands(&CompositeScene {
         hairs: &strands,
         view_proj: s.camera.projection * s.camera.view,
@@ -349,4 +317,87 @@ fn strands_standing_for_a_full_head_cover_the_scalp() {
         100.0 * single
     );
     assert!(full >= 0.75, "strands standing for a full head cover only {:.1} % of the crown", 100.0 * full);
+}
+
+/// Draws the hair over `background`, then (if given) a green mesh the host draws
+/// after it; returns linear RGB per pixel.
+fn draw_then(gpu: &Gpu, s: &mut Scene, background: Vec3, after: Option<&vkhair::headless::MeshDrawer>) -> Vec<Vec3> {
+    let mut result = Ok(());
+    gpu.ctx()
+        .run_commands("hair, then the host", |cmd| {
+            // SAFETY: a recording command buffer of the context's device.
+            result = unsafe {
+                s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
+                    s.renderer.record_shadows(cmd, &s.sim, None)?;
+                    s.offscreen.record_clear(cmd, background);
+                    s.renderer.record_draw(cmd, next_frame(), &s.offscreen.target(), &s.camera, None)?;
+                    if let Some(mesh) = after {
+                        let vp = s.camera.projection * s.camera.view;
+                        mesh.record(
+                            cmd,
+                            &s.offscreen.target(),
+                            vp,
+                            (glam::Quat::IDENTITY, Vec3::ZERO),
+                            Vec3::Y,
+                            Vec3::NEG_Z,
+                        );
+                    }
+                    Ok(())
+                })
+            };
+        })
+        .expect("submit");
+    result.expect("record");
+    let rgba = s.offscreen.read_rgba8().expect("readback");
+    rgba.chunks_exact(4).map(|p| Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))).collect()
+}
+
+/// Transparent hair writes the depth of its nearest half-opaque layer: a sphere
+/// the host draws afterwards behind the hair is hidden where the hair is dense
+/// and shows through elsewhere. Through the supersampling images the hair is
+/// drawn too, and (as for opaque hair) the host's depth is left unwritten.
+#[test]
+fn later_host_geometry_behind_transparent_hair_is_hidden_where_the_hair_is_dense() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(300, 8, 5);
+    // Dense strands (a band of 30 hairs) so that many pixels are more than half covered.
+    let m = HairMaterial { represented_hairs: 30.0, ..material(WIDTH, 1.0) };
+    let behind = scenes::THESIS_HEAD_CENTER - Vec3::new(0.0, 0.0, 1.0);
+    let sphere = vkhair::groom::mesh::TriMesh::uv_sphere(behind, 0.8, 16, 24).expect("sphere");
+    let mesh = vkhair::headless::MeshDrawer::new(gpu.ctx(), &sphere).expect("mesh");
+    for supersampling in [false, true] {
+        let p = RenderParams { supersampling, ..params(Transparency::Exact) };
+        let mut s = scene(&gpu, &groom, &p, &m);
+        let hair = draw_then(&gpu, &mut s, BACKGROUND, None);
+        let with_sphere = draw_then(&gpu, &mut s, BACKGROUND, Some(&mesh));
+        let green = |c: &Vec3| c.y > 0.05 && c.y > 4.0 * c.x;
+        // Pixels well inside the sphere's outline (it spans about 75 px around its centre).
+        let c = s.camera.projection * s.camera.view * behind.extend(1.0);
+        let centre = ((c.truncate().truncate() / c.w) * 0.5 + 0.5) * glam::Vec2::new(W as f32, H as f32);
+        let inside = |i: usize| {
+            let xy = glam::Vec2::new((i as u32 % W) as f32 + 0.5, (i as u32 / W) as f32 + 0.5);
+            (xy - centre).length() < 50.0
+        };
+        // Pixels the hair covers well (alpha ≳ 2/3: colours reach about 0.9), and hairless ones.
+        let dense: Vec<usize> =
+            (0..hair.len()).filter(|&i| inside(i) && (hair[i] - BACKGROUND).max_element() > 0.6).collect();
+        let bare: Vec<usize> =
+            (0..hair.len()).filter(|&i| inside(i) && (hair[i] - BACKGROUND).max_element() < 0.001).collect();
+        let hidden = dense.iter().filter(|&&i| !green(&with_sphere[i])).count();
+        let shown = bare.iter().filter(|&&i| green(&with_sphere[i])).count();
+        println!(
+            "supersampling {supersampling}: {hidden} of {} dense hair pixels hide the sphere; it shows in {shown} of {} hairless pixels",
+            dense.len(),
+            bare.len()
+        );
+        assert!(dense.len() > 100, "too few dense hair pixels: {}", dense.len());
+        if supersampling {
+            // The supersampling resolve tests the host's depth but does not write it
+            // (as for opaque hair): the sphere drawn afterwards covers the hair.
+            assert_eq!(hidden, 0, "the supersampled hair wrote the host's depth");
+            continue;
+        }
+        assert!(hidden * 10 >= dense.len() * 9, "the sphere shows through dense hair: {hidden} of {}", dense.len());
+        assert!(shown == bare.len() && bare.len() > 100, "the sphere is hidden where there is no hair");
+    }
 }

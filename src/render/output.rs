@@ -18,18 +18,20 @@ impl Renderer {
     /// Records the draw pass for the host's frame `frame`: the hairs prepared by
     /// [`Renderer::record_prepare`] into the host's `target`, seen by `camera`. The
     /// color (and depth) image is loaded, drawn into with depth test and write
-    /// against what the host drew, and stored. With [`RenderParams::supersampling`],
+    /// against what the host drew, and stored. With [`super::RenderParams::supersampling`],
     /// the hair is drawn at twice the size into the renderer's own images and
     /// resolved into `target` (depth tested, not written). When the target's size
     /// changes, the images of the old size are kept until `frame` is
-    /// [`RenderParams::frames_in_flight`] frames later. Viewport and scissor are
+    /// [`super::RenderParams::frames_in_flight`] frames later. Viewport and scissor are
     /// left set to the full target; the host binds its own pipeline and state
     /// again afterwards.
     ///
     /// With [`super::RenderParams::transparency`] on, the hair is composited over
     /// the target's colour instead (see `render/oit.rs`): each fragment depth-tested
     /// against the target's depth, and the depth of the nearest fragment at least
-    /// half opaque written where it is nearer; the target must then be single-sample.
+    /// half opaque written where it is nearer (not with supersampling, whose
+    /// resolve leaves the host's depth as it was); the target must then be
+    /// single-sample.
     ///
     /// # Safety
     /// As for [`Renderer::record_prepare`], which must have been recorded before in
@@ -106,83 +108,61 @@ impl Renderer {
             )
         };
 
-        if !self.params.supersampling {
-            let params = draw_params(target.extent);
-            if mode != Transparency::Off {
-                let oit_target = OitTarget {
-                    key: host_key,
-                    extent: target.extent,
-                    color: (target.color, Load::Keep),
-                    depth: has_depth.then_some((target.depth, Load::Keep)),
-                    before: (&[attachments], &[]),
-                };
-                // SAFETY: guaranteed by the caller.
-                return unsafe {
-                    self.oit.record(
-                        cmd,
-                        frame,
-                        (mode, &self.params.oit),
-                        &mut self.draw,
-                        &oit_target,
-                        &inputs,
-                        (&params, &marschner),
-                        vertices,
-                        &mut profiler,
-                    )
-                };
-            }
-            // SAFETY: guaranteed by the caller.
-            return unsafe {
-                self.draw.record(
-                    cmd,
-                    (&[attachments], &[]),
-                    &host,
-                    &inputs,
-                    &params,
-                    &marschner,
-                    vertices,
-                    &mut profiler,
-                )
-            };
-        }
-
-        let mut images = self.resolve.take(frame, target.extent)?;
-        let big = images.extent();
-        let params = draw_params(big);
+        // With supersampling, the hair goes into the renderer's own images first.
+        let mut images = match self.params.supersampling {
+            true => Some(self.resolve.take(frame, target.extent)?),
+            false => None,
+        };
         let ss_key = TargetKey {
             color: SUPERSAMPLED_COLOR,
             depth: SUPERSAMPLED_DEPTH,
             samples: vk::SampleCountFlags::TYPE_1,
             primitive: self.params.primitive,
         };
-        let (ss_color, ss_depth) = images.attachments();
-        let ss_rendering = rendering::info(big, &ss_color, Some(&ss_depth));
-        let ss = DrawTarget { key: ss_key, rendering: &ss_rendering, extent: big };
-        let to_attachments = images.to_attachments();
-        let (color_view, depth_view) = images.views();
-        let oit_target = OitTarget {
-            key: ss_key,
-            extent: big,
-            color: (color_view, Load::color([0.0; 4])),
-            depth: Some((depth_view, Load::depth(1.0))),
-            before: (&[], &to_attachments),
+        let ss_attachments = images.as_ref().map(|i| i.attachments());
+        let ss_rendering = images
+            .as_ref()
+            .zip(ss_attachments.as_ref())
+            .map(|(i, (color, depth))| rendering::info(i.extent(), color, Some(depth)));
+        let to_attachments = images.as_ref().map(|i| i.to_attachments());
+        let host_barrier = [attachments];
+        let (drawn, before, oit_target) = match (&images, &ss_rendering, &to_attachments) {
+            (Some(images), Some(ss_rendering), Some(to_attachments)) => {
+                let (color, depth) = images.views();
+                let big = images.extent();
+                (
+                    DrawTarget { key: ss_key, rendering: ss_rendering, extent: big },
+                    (&[][..], &to_attachments[..]),
+                    OitTarget {
+                        key: ss_key,
+                        extent: big,
+                        color: (color, Load::color([0.0; 4])),
+                        depth: Some((depth, Load::depth(1.0))),
+                        before: (&[], to_attachments),
+                    },
+                )
+            }
+            _ => (
+                DrawTarget { key: host_key, rendering: &host_rendering, extent: target.extent },
+                (&host_barrier[..], &[][..]),
+                OitTarget {
+                    key: host_key,
+                    extent: target.extent,
+                    color: (target.color, Load::Keep),
+                    depth: has_depth.then_some((target.depth, Load::Keep)),
+                    before: (&host_barrier, &[]),
+                },
+            ),
         };
+        let params = draw_params(drawn.extent);
         // SAFETY: guaranteed by the caller; the supersampling images are this
         // renderer's and earlier resolves that sampled them are ordered by the barriers.
         let result = unsafe {
-            let drawn = if mode == Transparency::Off {
-                self.draw.record(
-                    cmd,
-                    (&[], &to_attachments),
-                    &ss,
-                    &inputs,
-                    &params,
-                    &marschner,
-                    vertices,
-                    &mut profiler,
-                )
-            } else {
-                self.oit.record(
+            let result = match mode {
+                Transparency::Off => {
+                    self.draw.record(cmd, before, &drawn, &inputs, &params, &marschner, vertices, &mut profiler)
+                }
+                _ => self.oit.record(
                     cmd,
                     frame,
                     (mode, &self.params.oit),
@@ -192,11 +172,18 @@ impl Renderer {
                     (&params, &marschner),
                     vertices,
                     &mut profiler,
-                )
+                ),
             };
-            drawn.and_then(|_| self.resolve.record(cmd, &mut images, &host, attachments, &mut profiler))
+            match &mut images {
+                Some(images) => {
+                    result.and_then(|_| self.resolve.record(cmd, images, &host, attachments, &mut profiler))
+                }
+                None => result,
+            }
         };
-        self.resolve.restore(images);
+        if let Some(images) = images {
+            self.resolve.restore(images);
+        }
         result
     }
 
