@@ -147,12 +147,6 @@ fn interpolation_grows_stable_clumps() {
 use vkhair::groom::mesh::TriMesh;
 use vkhair::render::{Camera, HairMaterial, Light};
 
-/// Frame indices for record_draw: every test frame is submitted and waited for.
-fn next_frame() -> u64 {
-    static FRAME: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    FRAME.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
-}
-
 const W: u32 = 160;
 const H: u32 = 120;
 const BACKGROUND: [u8; 3] = [0, 0, 0];
@@ -204,33 +198,8 @@ fn rgb_at(img: &[u8], i: usize) -> [u8; 3] {
 
 /// Renders the hair (and `blocker`, drawn first, if given) and returns RGBA8 rows.
 fn draw(gpu: &Gpu, s: &mut Scene, blocker: Option<&MeshDrawer>) -> Vec<u8> {
-    let mut result = Ok(());
-    gpu.ctx()
-        .run_commands("test frame", |cmd| {
-            // SAFETY: a recording command buffer of the context's device.
-            result = unsafe {
-                s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
-                    // Without casters this only marks every light unshadowed.
-                    s.renderer.record_shadows(cmd, &s.sim, None)?;
-                    s.offscreen.record_clear(cmd, Vec3::ZERO);
-                    if let Some(mesh) = blocker {
-                        let vp = s.camera.projection * s.camera.view;
-                        mesh.record(
-                            cmd,
-                            &s.offscreen.target(),
-                            vp,
-                            (glam::Quat::IDENTITY, Vec3::ZERO),
-                            Vec3::new(0.0, 1.0, 0.0),
-                            Vec3::NEG_Z,
-                        );
-                    }
-                    s.renderer.record_draw(cmd, next_frame(), &s.offscreen.target(), &s.camera, None)
-                })
-            };
-        })
-        .expect("submit");
-    result.expect("record");
-    s.offscreen.read_rgba8().expect("readback")
+    let host = common::HostFrame { clear: Vec3::ZERO, before: blocker, after: None };
+    common::draw_frame(gpu, (&s.sim, &mut s.renderer), &s.offscreen, &s.camera, &host)
 }
 
 fn hair_pixels(rgba: &[u8]) -> Vec<(u32, u32, f32)> {
@@ -361,7 +330,8 @@ fn detail_falls_with_distance() {
                     s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
                         s.offscreen.record_clear(cmd, Vec3::ZERO);
                         device.cmd_begin_query(cmd, pool, 0, vk::QueryControlFlags::empty());
-                        let r = s.renderer.record_draw(cmd, next_frame(), &s.offscreen.target(), &s.camera, None);
+                        let r =
+                            s.renderer.record_draw(cmd, common::next_frame(), &s.offscreen.target(), &s.camera, None);
                         device.cmd_end_query(cmd, pool, 0);
                         r
                     })
@@ -549,7 +519,7 @@ fn lines_mode_draws_and_a_bad_camera_is_rejected() {
     gpu.ctx()
         .run_commands("bad camera", |cmd| {
             // SAFETY: a recording command buffer of the context's device.
-            result = unsafe { s.renderer.record_draw(cmd, next_frame(), &s.offscreen.target(), &bad, None) };
+            result = unsafe { s.renderer.record_draw(cmd, common::next_frame(), &s.offscreen.target(), &bad, None) };
         })
         .expect("submit");
     assert!(matches!(result, Err(Error::InvalidParameter { name: "camera", .. })), "{result:?}");

@@ -22,12 +22,6 @@ const ROOT: Vec3 = Vec3::new(0.9, 0.2, 0.05);
 const TIP: Vec3 = Vec3::new(0.1, 0.5, 0.9);
 const BACKGROUND: Vec3 = Vec3::new(0.02, 0.02, 0.02);
 
-/// A frame index per drawn frame (every test frame is waited for).
-fn next_frame() -> u64 {
-    static FRAME: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    FRAME.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
-}
-
 /// The unlit material: albedo from ROOT to TIP, ambient 1, `width` metres wide.
 fn material(width: f32, opacity: f32) -> HairMaterial {
     HairMaterial {
@@ -209,6 +203,7 @@ fn an_overflowing_pool_drops_fragments_and_says_so() {
     let groom = common::grown_groom(300, 8, 5);
     let m = material(WIDTH, OPACITY);
     let mut s = scene(&gpu, &groom, &params(Transparency::Exact), &m);
+    assert_eq!(s.renderer.transparency_stats(), None, "stats before any frame");
     let full = draw(&gpu, &mut s);
     let needed = s.renderer.transparency_stats().expect("stats of an exact frame");
     assert_eq!(needed.dropped, 0, "the default pool overflowed: {needed:?}");
@@ -228,6 +223,10 @@ fn an_overflowing_pool_drops_fragments_and_says_so() {
     println!("hair pixels: {full_hair} with the full pool, {starved_hair} with 1 %");
     assert!(starved_hair > 0 && starved_hair < full_hair, "the starved image is not a part of the full one");
     assert!(starved.iter().all(|c| c.is_finite() && c.max_element() <= 1.0), "garbage in the starved image");
+    // A fast-mode frame keeps no lists: nothing to report.
+    s.renderer.set_params(&params(Transparency::Fast)).expect("params");
+    draw(&gpu, &mut s);
+    assert_eq!(s.renderer.transparency_stats(), None, "stats after a fast-mode frame");
 }
 
 /// Darkening (sum over the image of background − pixel, linear) of one straight
@@ -322,33 +321,8 @@ fn strands_standing_for_a_full_head_cover_the_scalp() {
 /// Draws the hair over `background`, then (if given) a green mesh the host draws
 /// after it; returns linear RGB per pixel.
 fn draw_then(gpu: &Gpu, s: &mut Scene, background: Vec3, after: Option<&vkhair::headless::MeshDrawer>) -> Vec<Vec3> {
-    let mut result = Ok(());
-    gpu.ctx()
-        .run_commands("hair, then the host", |cmd| {
-            // SAFETY: a recording command buffer of the context's device.
-            result = unsafe {
-                s.renderer.record_prepare(cmd, &s.sim, Some(&s.camera), None).and_then(|_| {
-                    s.renderer.record_shadows(cmd, &s.sim, None)?;
-                    s.offscreen.record_clear(cmd, background);
-                    s.renderer.record_draw(cmd, next_frame(), &s.offscreen.target(), &s.camera, None)?;
-                    if let Some(mesh) = after {
-                        let vp = s.camera.projection * s.camera.view;
-                        mesh.record(
-                            cmd,
-                            &s.offscreen.target(),
-                            vp,
-                            (glam::Quat::IDENTITY, Vec3::ZERO),
-                            Vec3::Y,
-                            Vec3::NEG_Z,
-                        );
-                    }
-                    Ok(())
-                })
-            };
-        })
-        .expect("submit");
-    result.expect("record");
-    let rgba = s.offscreen.read_rgba8().expect("readback");
+    let host = common::HostFrame { clear: background, before: None, after };
+    let rgba = common::draw_frame(gpu, (&s.sim, &mut s.renderer), &s.offscreen, &s.camera, &host);
     rgba.chunks_exact(4).map(|p| Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))).collect()
 }
 
@@ -400,4 +374,56 @@ fn later_host_geometry_behind_transparent_hair_is_hidden_where_the_hair_is_dense
         assert!(hidden * 10 >= dense.len() * 9, "the sphere shows through dense hair: {hidden} of {}", dense.len());
         assert!(shown == bare.len() && bare.len() > 100, "the sphere is hidden where there is no hair");
     }
+}
+
+/// Out-of-range transparency parameters are refused, naming the field; a
+/// multisampled target is refused by the transparent draw before it records.
+#[test]
+fn bad_transparency_parameters_and_targets_are_refused() {
+    let field = |r: vkhair::Result<()>| match r {
+        Err(vkhair::Error::InvalidParameter { name, .. }) => name,
+        other => panic!("not refused as a parameter: {other:?}"),
+    };
+    let mut p = params(Transparency::Exact);
+    for (k, f) in [(0, 8.0), (33, 8.0), (8, 0.0), (8, f32::NAN), (8, 300.0)] {
+        p.oit.sorted_fragments = k;
+        p.oit.fragments_per_pixel = f;
+        let name = field(p.validate());
+        assert!(name.starts_with("oit."), "K {k}, fragments {f}: refused as {name}");
+    }
+    let lines = RenderParams { primitive: vkhair::render::Primitive::Lines, ..params(Transparency::Fast) };
+    assert_eq!(field(lines.validate()), "transparency");
+    assert!(RenderParams { primitive: vkhair::render::Primitive::Lines, ..params(Transparency::Off) }
+        .validate()
+        .is_ok());
+    for (m, expected) in [
+        (HairMaterial { opacity: 1.5, ..HairMaterial::default() }, "opacity"),
+        (HairMaterial { opacity: f32::NAN, ..HairMaterial::default() }, "opacity"),
+        (HairMaterial { represented_hairs: 0.5, ..HairMaterial::default() }, "represented_hairs"),
+        (HairMaterial { represented_hairs: f32::INFINITY, ..HairMaterial::default() }, "represented_hairs"),
+    ] {
+        assert_eq!(field(m.validate()), expected);
+    }
+
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(20, 8, 1);
+    let mut s = scene(&gpu, &groom, &params(Transparency::Exact), &material(WIDTH, OPACITY));
+    let mut target = s.offscreen.target();
+    target.samples = vkhair::ash::vk::SampleCountFlags::TYPE_4;
+    let mut result = Ok(());
+    gpu.ctx()
+        .run_commands("multisampled target", |cmd| {
+            // SAFETY: a recording command buffer of the context's device; the call
+            // refuses the target before recording anything with it.
+            result = unsafe {
+                s.renderer
+                    .record_prepare(cmd, &s.sim, Some(&s.camera), None)
+                    .and_then(|_| s.renderer.record_draw(cmd, common::next_frame(), &target, &s.camera, None))
+            };
+        })
+        .expect("submit");
+    assert!(
+        matches!(result, Err(vkhair::Error::Incompatible { what: "render target", .. })),
+        "a multisampled target was not refused: {result:?}"
+    );
 }

@@ -79,12 +79,10 @@ struct OitResources {
     extent: vk::Extent2D,
     mode: Transparency,
     capacity: u32,
-    /// Per pixel: the newest node of its list.
-    heads: Buffer,
     /// Per pixel: the nearest half-opaque depth.
     opaque: Buffer,
-    /// The node pool (exact mode).
-    nodes: Option<Buffer>,
+    /// Exact mode: per pixel the newest node of its list, and the node pool.
+    lists: Option<(Buffer, Buffer)>,
     /// Weighted sums and absorbance (fast mode).
     weighted: Option<(Image, Image)>,
     pipelines: HashMap<TargetKey, OitPipelines>,
@@ -110,8 +108,6 @@ pub(super) struct OitPass {
     nearest: Sampler,
     current: Option<OitResources>,
     retired: Vec<(u64, OitResources)>,
-    /// Whether the latest recorded frame was an exact-mode frame.
-    counted: bool,
 }
 
 impl OitPass {
@@ -131,18 +127,20 @@ impl OitPass {
             nearest: Sampler::nearest(device, "vkhair transparency sums")?,
             current: None,
             retired: Vec::new(),
-            counted: false,
         })
     }
 
     /// Bytes of GPU memory the exact or fast mode needs at `extent`.
     pub(super) fn memory_bytes(mode: Transparency, params: &OitParams, extent: vk::Extent2D) -> u64 {
         let pixels = u64::from(extent.width) * u64::from(extent.height);
-        let per_frame = std::mem::size_of::<OitCounters>() as u64 + 2 * 4 * pixels;
+        // Both: the counters and a depth word per pixel.
+        let shared = std::mem::size_of::<OitCounters>() as u64 + 4 * pixels;
         match mode {
             Transparency::Off => 0,
-            Transparency::Exact => per_frame + NODE_BYTES * pool_capacity(params, extent),
-            Transparency::Fast => per_frame + (16 + 4) * pixels,
+            // A head word per pixel and the node pool.
+            Transparency::Exact => shared + 4 * pixels + NODE_BYTES * pool_capacity(params, extent),
+            // The RGBA32F sums and the R32F absorbance.
+            Transparency::Fast => shared + (16 + 4) * pixels,
         }
     }
 
@@ -168,7 +166,8 @@ impl OitPass {
     /// What the latest exact-mode frame stored, read from host-visible memory:
     /// valid once that frame completed and before the next one is submitted.
     pub(super) fn stats(&self) -> Option<OitStats> {
-        if !self.counted {
+        // The current resources are those of the latest transparent frame.
+        if self.current.as_ref()?.mode != Transparency::Exact {
             return None;
         }
         let bytes = self.counters.mapped()?;
@@ -215,10 +214,15 @@ impl OitPass {
             ));
         }
         let pixels = u64::from(extent.width) * u64::from(extent.height);
-        let heads = Buffer::storage(d, "vkhair transparency heads", 4 * pixels)?;
         let opaque = Buffer::storage(d, "vkhair transparency opaque depth", 4 * pixels)?;
-        let (nodes, weighted) = match mode {
-            Transparency::Exact => (Some(Buffer::storage(d, "vkhair transparency nodes", node_bytes)?), None),
+        let (lists, weighted) = match mode {
+            Transparency::Exact => (
+                Some((
+                    Buffer::storage(d, "vkhair transparency heads", 4 * pixels)?,
+                    Buffer::storage(d, "vkhair transparency nodes", node_bytes)?,
+                )),
+                None,
+            ),
             _ => {
                 let image = |name, format| {
                     Image::new(
@@ -241,9 +245,8 @@ impl OitPass {
             extent,
             mode,
             capacity: capacity as u32,
-            heads,
             opaque,
-            nodes,
+            lists,
             weighted,
             pipelines: HashMap::new(),
         });
@@ -277,9 +280,9 @@ impl OitPass {
             blend,
             rasterizer_discard: false,
         };
-        let mut ours = vec![(9, &self.counters), (10, &res.heads), (12, &res.opaque)];
-        if let Some(nodes) = &res.nodes {
-            ours.push((11, nodes));
+        let mut ours = vec![(9, &self.counters), (12, &res.opaque)];
+        if let Some((heads, nodes)) = &res.lists {
+            ours.extend([(10, heads), (11, nodes)]);
         }
         let (shading_buffers, shading_images) = draw.shading_bindings(inputs);
         let mut buffers = shading_buffers.to_vec();
@@ -375,7 +378,6 @@ impl OitPass {
         // Made (or found) before anything is recorded: a failure leaves `cmd` as it was.
         self.prepare(frame, mode, params, target.extent)?;
         self.make_pipelines(target.key, draw, inputs)?;
-        self.counted = mode == Transparency::Exact;
         let Some(res) = self.current.as_ref() else {
             return Err(Error::incompatible("transparency", "no resources after preparing them"));
         };
@@ -434,7 +436,9 @@ impl OitPass {
             let scope = RenderPass::Draw.open(d, cmd, profiler);
             draw.record_updates(cmd, target.before, draw_params, marschner);
             d.cmd_barrier(cmd, &[to_clear], &[], &to_sums);
-            d.raw.cmd_fill_buffer(cmd, res.heads.raw(), 0, vk::WHOLE_SIZE, END);
+            if let Some((heads, _)) = &res.lists {
+                d.raw.cmd_fill_buffer(cmd, heads.raw(), 0, vk::WHOLE_SIZE, END);
+            }
             d.raw.cmd_fill_buffer(cmd, res.opaque.raw(), 0, vk::WHOLE_SIZE, END);
             d.raw.cmd_update_buffer(cmd, self.counters.raw(), 0, bytemuck::bytes_of(&counters));
             d.cmd_barrier(cmd, &[cleared], &[], &[]);

@@ -96,18 +96,6 @@ impl Renderer {
         };
         let marschner = self.material.marschner;
         let mode = self.params.transparency;
-        let draw_params = |extent| {
-            draw::draw_params(
-                mode != Transparency::Off,
-                &self.material,
-                &self.lights,
-                self.detail.width_scale,
-                counts,
-                camera,
-                extent,
-            )
-        };
-
         // With supersampling, the hair goes into the renderer's own images first.
         let mut images = match self.params.supersampling {
             true => Some(self.resolve.take(frame, target.extent)?),
@@ -119,29 +107,23 @@ impl Renderer {
             samples: vk::SampleCountFlags::TYPE_1,
             primitive: self.params.primitive,
         };
-        let ss_attachments = images.as_ref().map(|i| i.attachments());
-        let ss_rendering = images
-            .as_ref()
-            .zip(ss_attachments.as_ref())
-            .map(|(i, (color, depth))| rendering::info(i.extent(), color, Some(depth)));
-        let to_attachments = images.as_ref().map(|i| i.to_attachments());
+        // Their attachments, the barriers that make them ready, views and extent,
+        // then the rendering instance over the attachments.
+        let ss = images.as_ref().map(|i| (i.attachments(), i.to_attachments(), i.views(), i.extent()));
+        let ss_rendering = ss.as_ref().map(|((color, depth), _, _, big)| rendering::info(*big, color, Some(depth)));
         let host_barrier = [attachments];
-        let (drawn, before, oit_target) = match (&images, &ss_rendering, &to_attachments) {
-            (Some(images), Some(ss_rendering), Some(to_attachments)) => {
-                let (color, depth) = images.views();
-                let big = images.extent();
-                (
-                    DrawTarget { key: ss_key, rendering: ss_rendering, extent: big },
-                    (&[][..], &to_attachments[..]),
-                    OitTarget {
-                        key: ss_key,
-                        extent: big,
-                        color: (color, Load::color([0.0; 4])),
-                        depth: Some((depth, Load::depth(1.0))),
-                        before: (&[], to_attachments),
-                    },
-                )
-            }
+        let (drawn, before, oit_target) = match (&ss, &ss_rendering) {
+            (Some((_, to_attachments, (color, depth), big)), Some(ss_rendering)) => (
+                DrawTarget { key: ss_key, rendering: ss_rendering, extent: *big },
+                (&[][..], &to_attachments[..]),
+                OitTarget {
+                    key: ss_key,
+                    extent: *big,
+                    color: (*color, Load::color([0.0; 4])),
+                    depth: Some((*depth, Load::depth(1.0))),
+                    before: (&[], to_attachments),
+                },
+            ),
             _ => (
                 DrawTarget { key: host_key, rendering: &host_rendering, extent: target.extent },
                 (&host_barrier[..], &[][..]),
@@ -154,7 +136,15 @@ impl Renderer {
                 },
             ),
         };
-        let params = draw_params(drawn.extent);
+        let params = draw::draw_params(
+            mode != Transparency::Off,
+            &self.material,
+            &self.lights,
+            self.detail.width_scale,
+            counts,
+            camera,
+            drawn.extent,
+        );
         // SAFETY: guaranteed by the caller; the supersampling images are this
         // renderer's and earlier resolves that sampled them are ordered by the barriers.
         let result = unsafe {
@@ -196,7 +186,8 @@ impl Renderer {
     /// What the latest frame drawn with [`Transparency::Exact`] stored: fragments
     /// offered, stored and dropped because the pool was full. Read from
     /// host-visible memory: valid once that frame's commands completed and before
-    /// the next frame's are submitted. `None` before any exact-mode frame.
+    /// the next frame's are submitted. `None` unless the latest frame drawn with
+    /// transparency was an exact-mode frame.
     pub fn transparency_stats(&self) -> Option<OitStats> {
         self.oit.stats()
     }

@@ -135,3 +135,62 @@ pub fn tip_drift_of(state: &SimState, head: &RigidTransform) -> Vec<f32> {
 pub fn p(drift: &[f32], percent: usize) -> f32 {
     drift[(drift.len() - 1) * percent / 100]
 }
+
+/// Frame indices for `Renderer::record_draw`: one per drawn test frame (every
+/// test frame is submitted and waited for).
+#[allow(dead_code, reason = "not every test file draws")]
+pub fn next_frame() -> u64 {
+    static FRAME: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    FRAME.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+/// What the host draws in a test frame around the hair: its clear colour, and
+/// green meshes (lit from the camera's side) before and after the hair.
+#[allow(dead_code, reason = "not every test file draws")]
+pub struct HostFrame<'a> {
+    pub clear: Vec3,
+    pub before: Option<&'a vkhair::headless::MeshDrawer>,
+    pub after: Option<&'a vkhair::headless::MeshDrawer>,
+}
+
+/// Records, submits and waits for one frame — the hairs prepared for `camera`,
+/// their shadows, the host's clear and `host`'s meshes around the hair's draw
+/// into `offscreen` — and returns its RGBA8 rows.
+#[allow(dead_code, reason = "not every test file draws")]
+pub fn draw_frame(
+    gpu: &Gpu,
+    (sim, renderer): (&vkhair::sim::HairSim, &mut vkhair::render::Renderer),
+    offscreen: &vkhair::headless::Offscreen,
+    camera: &vkhair::render::Camera,
+    host: &HostFrame<'_>,
+) -> Vec<u8> {
+    use vkhair::headless::Submit;
+    let view_proj = camera.projection * camera.view;
+    let mesh = |cmd, m: Option<&vkhair::headless::MeshDrawer>| {
+        if let Some(m) = m {
+            // SAFETY: a recording command buffer of the context's device.
+            unsafe {
+                m.record(cmd, &offscreen.target(), view_proj, (glam::Quat::IDENTITY, Vec3::ZERO), Vec3::Y, Vec3::NEG_Z)
+            };
+        }
+    };
+    let mut result = Ok(());
+    gpu.ctx()
+        .run_commands("test frame", |cmd| {
+            // SAFETY: a recording command buffer of the context's device.
+            result = unsafe {
+                renderer.record_prepare(cmd, sim, Some(camera), None).and_then(|_| {
+                    // Without casters this only marks every light unshadowed.
+                    renderer.record_shadows(cmd, sim, None)?;
+                    offscreen.record_clear(cmd, host.clear);
+                    mesh(cmd, host.before);
+                    renderer.record_draw(cmd, next_frame(), &offscreen.target(), camera, None)?;
+                    mesh(cmd, host.after);
+                    Ok(())
+                })
+            };
+        })
+        .expect("submit");
+    result.expect("record");
+    offscreen.read_rgba8().expect("readback")
+}

@@ -160,7 +160,7 @@ impl GraphicsPipeline {
 
     /// As [`ComputePipeline::declared_buffer_set`].
     pub(crate) fn declared_buffer_set(&self, set: u32, buffers: &[(u32, &Buffer)]) -> Result<vk::DescriptorSet> {
-        self.buffer_set(set, &self.layout.declared(set, buffers))
+        self.declared_resource_set(set, buffers, &[])
     }
 
     /// As [`GraphicsPipeline::resource_set`] with only the entries of `buffers` and
