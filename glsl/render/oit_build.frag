@@ -1,8 +1,10 @@
 #version 460
 // Exact transparency, build: every hair fragment that passes the depth test is
-// shaded once and pushed onto its pixel's list (a node from the pool; when the
-// pool is full it is counted and dropped). Early tests: the depth test runs
-// before the stores.
+// shaded once and pushed onto its pixel's list (a node from the pool). When the
+// pool is full it is counted and added to the overflow sums instead (colour
+// premultiplied, alpha, absorbance −ln(1 − alpha); additive blending), which the
+// resolve folds into the order-independent tail: nothing is lost. Early tests:
+// the depth test runs before the stores.
 #include "hair_shading.glsl"
 #include "oit.glsl"
 
@@ -14,10 +16,13 @@ layout(location = 2) in float g_t;
 layout(location = 3) flat in uint g_hair;
 layout(location = 4) in vec2 g_cover;
 
+layout(location = 0) out vec4 out_overflow;
+layout(location = 1) out vec4 out_absorbance;
+
 void main() {
     float alpha = strand_alpha(g_cover);
     if (alpha < OIT_LEAST_ALPHA) {
-        return;
+        discard;
     }
     vec3 color = shade_hair(g_pos, g_tan, g_t, g_hair);
     uint pixel = oit_pixel(gl_FragCoord);
@@ -26,8 +31,12 @@ void main() {
     }
     uint node = atomicAdd(oit.used, 1u);
     if (node >= oit.capacity) {
+        out_overflow = vec4(color * alpha, alpha);
+        out_absorbance = vec4(-log(max(1.0 - alpha, 1e-4)), 0.0, 0.0, 0.0);
         return;
     }
+    out_overflow = vec4(0.0);
+    out_absorbance = vec4(0.0);
     uint next = atomicExchange(oit_heads[pixel], node);
     oit_nodes[node] = uvec4(packHalf2x16(color.rg), packHalf2x16(vec2(color.b, alpha)),
                             floatBitsToUint(gl_FragCoord.z), next);

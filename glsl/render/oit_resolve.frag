@@ -2,25 +2,32 @@
 // Exact transparency, resolve (one full-screen triangle): walks the pixel's
 // list, keeps its K nearest fragments sorted by depth (insertion), folds every
 // farther one into an order-independent tail (sum of premultiplied colour, sum
-// of alpha, product of transmittance), composites the K front to back and the
-// tail behind them, and blends the result over the target as premultiplied
-// colour. Pixels without hair are discarded.
+// of alpha, product of transmittance) together with the fragments the full
+// pool could not store (the build's overflow sums), composites the K front to
+// back and the tail behind them, and blends the result over the target as
+// premultiplied colour. Pixels without hair are discarded.
 #include "oit.glsl"
+
+// The build's sums of the fragments beyond the pool: Σ premultiplied colour and
+// Σ alpha; Σ absorbance −ln(1 − alpha).
+layout(set = 0, binding = 0) uniform sampler2D overflow_sum;
+layout(set = 0, binding = 1) uniform sampler2D overflow_absorbance;
 
 layout(location = 0) out vec4 out_color;
 
 void main() {
     uint node = oit_heads[oit_pixel(gl_FragCoord)];
-    if (node == OIT_END) {
+    vec4 overflow = texelFetch(overflow_sum, ivec2(gl_FragCoord.xy), 0);
+    if (node == OIT_END && overflow.a <= 0.0) {
         discard;
     }
     float depth[OIT_MAX_SORTED];
     vec4 color[OIT_MAX_SORTED];
     uint k = min(oit.sorted, uint(OIT_MAX_SORTED));
     uint n = 0u;
-    vec3 tail_sum = vec3(0.0);
-    float tail_alpha = 0.0;
-    float tail_transmittance = 1.0;
+    vec3 tail_sum = overflow.rgb;
+    float tail_alpha = overflow.a;
+    float tail_transmittance = exp(-texelFetch(overflow_absorbance, ivec2(gl_FragCoord.xy), 0).r);
     // Each stored node is on exactly one list: at most min(used, capacity) steps.
     uint steps = min(oit.used, oit.capacity);
     for (uint step = 0u; node != OIT_END && step < steps; step++) {

@@ -6,13 +6,13 @@
 //!    per fragment, depth-tested against the target's depth (not written). Every
 //!    surviving fragment is shaded once and either pushed onto its pixel's list
 //!    (exact: a node from a pool of [`OitParams::fragments_per_pixel`] per pixel;
-//!    beyond it, counted and dropped) or added to two accumulation images
-//!    (fast: weighted blended). Both keep the nearest depth of a fragment at
-//!    least half opaque.
+//!    beyond it, counted and added to two accumulation images instead) or added
+//!    to two accumulation images (fast: weighted blended). Both keep the nearest
+//!    depth of a fragment at least half opaque.
 //! 2. **Composite** ([`RenderPass::Composite`]): one full-screen triangle blends
 //!    each pixel's hair over the target as premultiplied colour (exact: the
-//!    [`OitParams::sorted_fragments`] nearest sorted, the rest an
-//!    order-independent tail), then a second one writes that nearest
+//!    [`OitParams::sorted_fragments`] nearest sorted, the rest and the pool's
+//!    overflow an order-independent tail behind them), then a second one writes that nearest
 //!    half-opaque depth into the target's depth where it is nearer, so later
 //!    host passes see the hair.
 //!
@@ -44,9 +44,10 @@ use crate::vk::shaders::{
     RENDER_OIT_RESOLVE_FRAG, RENDER_OIT_WEIGHTED_FRAG, RENDER_OIT_WEIGHTED_RESOLVE_FRAG, RENDER_RESOLVE_VERT,
 };
 
-/// Format of the fast mode's weighted colour and weight sums.
+/// Format of the weighted colour and weight sums (fast mode; the exact mode's
+/// overflow: weight 1).
 const WEIGHTED_SUM: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
-/// Format of the fast mode's absorbance sum.
+/// Format of the absorbance sum (fast mode; the exact mode's overflow).
 const ABSORBANCE: vk::Format = vk::Format::R32_SFLOAT;
 /// Bytes of one stored fragment (colour and alpha as half floats, depth, next).
 const NODE_BYTES: u64 = 16;
@@ -61,8 +62,9 @@ pub struct OitStats {
     pub fragments: u64,
     /// Of those, the ones stored in the pool.
     pub stored: u64,
-    /// The ones dropped because the pool was full.
-    pub dropped: u64,
+    /// The ones the full pool could not store: composited unsorted, in the
+    /// order-independent tail behind the sorted ones (not dropped).
+    pub overflowed: u64,
     /// Fragments the pool holds.
     pub capacity: u64,
 }
@@ -83,8 +85,8 @@ struct OitResources {
     opaque: Buffer,
     /// Exact mode: per pixel the newest node of its list, and the node pool.
     lists: Option<(Buffer, Buffer)>,
-    /// Weighted sums and absorbance (fast mode).
-    weighted: Option<(Image, Image)>,
+    /// Weighted sums and absorbance (fast mode; the exact mode's overflow).
+    sums: (Image, Image),
     pipelines: HashMap<TargetKey, OitPipelines>,
 }
 
@@ -133,14 +135,14 @@ impl OitPass {
     /// Bytes of GPU memory the exact or fast mode needs at `extent`.
     pub(super) fn memory_bytes(mode: Transparency, params: &OitParams, extent: vk::Extent2D) -> u64 {
         let pixels = u64::from(extent.width) * u64::from(extent.height);
-        // Both: the counters and a depth word per pixel.
-        let shared = std::mem::size_of::<OitCounters>() as u64 + 4 * pixels;
+        // Both: the counters, a depth word per pixel, the RGBA32F sums and the
+        // R32F absorbance.
+        let shared = std::mem::size_of::<OitCounters>() as u64 + (4 + 16 + 4) * pixels;
         match mode {
             Transparency::Off => 0,
             // A head word per pixel and the node pool.
             Transparency::Exact => shared + 4 * pixels + NODE_BYTES * pool_capacity(params, extent),
-            // The RGBA32F sums and the R32F absorbance.
-            Transparency::Fast => shared + (16 + 4) * pixels,
+            Transparency::Fast => shared,
         }
     }
 
@@ -176,7 +178,7 @@ impl OitPass {
         Some(OitStats {
             fragments: u64::from(counters.used),
             stored: u64::from(stored),
-            dropped: u64::from(counters.used - stored),
+            overflowed: u64::from(counters.used - stored),
             capacity: u64::from(counters.capacity),
         })
     }
@@ -215,39 +217,37 @@ impl OitPass {
         }
         let pixels = u64::from(extent.width) * u64::from(extent.height);
         let opaque = Buffer::storage(d, "vkhair transparency opaque depth", 4 * pixels)?;
-        let (lists, weighted) = match mode {
-            Transparency::Exact => (
-                Some((
-                    Buffer::storage(d, "vkhair transparency heads", 4 * pixels)?,
-                    Buffer::storage(d, "vkhair transparency nodes", node_bytes)?,
-                )),
-                None,
-            ),
-            _ => {
-                let image = |name, format| {
-                    Image::new(
-                        d,
-                        &ImageDesc {
-                            name,
-                            extent,
-                            format,
-                            usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
-                            samples: vk::SampleCountFlags::TYPE_1,
-                            aspect: vk::ImageAspectFlags::COLOR,
-                        },
-                    )
-                };
-                let sums = image("vkhair transparency weighted sums", WEIGHTED_SUM)?;
-                (None, Some((sums, image("vkhair transparency absorbance", ABSORBANCE)?)))
-            }
+        let lists = match mode {
+            Transparency::Exact => Some((
+                Buffer::storage(d, "vkhair transparency heads", 4 * pixels)?,
+                Buffer::storage(d, "vkhair transparency nodes", node_bytes)?,
+            )),
+            _ => None,
         };
+        let image = |name, format| {
+            Image::new(
+                d,
+                &ImageDesc {
+                    name,
+                    extent,
+                    format,
+                    usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+                    samples: vk::SampleCountFlags::TYPE_1,
+                    aspect: vk::ImageAspectFlags::COLOR,
+                },
+            )
+        };
+        let sums = (
+            image("vkhair transparency weighted sums", WEIGHTED_SUM)?,
+            image("vkhair transparency absorbance", ABSORBANCE)?,
+        );
         self.current = Some(OitResources {
             extent,
             mode,
             capacity: capacity as u32,
             opaque,
             lists,
-            weighted,
+            sums,
             pipelines: HashMap::new(),
         });
         Ok(())
@@ -290,13 +290,18 @@ impl OitPass {
 
         let build_frag: &ShaderSource = if exact { &RENDER_OIT_BUILD_FRAG } else { &RENDER_OIT_WEIGHTED_FRAG };
         let build_stages = [&RENDER_DRAW_VERT, &RENDER_OIT_GEOM, build_frag];
-        let (colors, blend): (&[vk::Format], _) =
-            if exact { (&[], Blend::NoColor) } else { (&weighted_formats, Blend::Additive) };
         let build = GraphicsPipeline::new(
             d,
             &GraphicsDesc {
                 topology: vk::PrimitiveTopology::LINE_LIST,
-                ..desc("vkhair hair transparency build", &build_stages, colors, has_depth, false, blend)
+                ..desc(
+                    "vkhair hair transparency build",
+                    &build_stages,
+                    &weighted_formats,
+                    has_depth,
+                    false,
+                    Blend::Additive,
+                )
             },
             1,
         )?;
@@ -317,11 +322,8 @@ impl OitPass {
             ),
             1,
         )?;
-        let sums: Vec<_> = res
-            .weighted
-            .iter()
-            .flat_map(|(s, a)| [(0, s.view(), self.nearest.raw), (1, a.view(), self.nearest.raw)])
-            .collect();
+        let (sum, absorbance) = &res.sums;
+        let sums = [(0, sum.view(), self.nearest.raw), (1, absorbance.view(), self.nearest.raw)];
         let composite_set = composite.declared_resource_set(0, &ours, &sums)?;
 
         let depth = if has_depth {
@@ -397,10 +399,8 @@ impl OitPass {
         let depth_order = barrier::memory(barrier::ATTACHMENTS, barrier::ATTACHMENTS);
         let to_host = barrier::memory(&[AccessKind::FragmentWrite], &[AccessKind::HostRead]);
         let sampled = &[AccessKind::FragmentSampledRead];
-        let (to_sums, from_sums): (Vec<_>, Vec<_>) = res
-            .weighted
-            .iter()
-            .flat_map(|(s, a)| [s, a])
+        let (to_sums, from_sums): (Vec<_>, Vec<_>) = [&res.sums.0, &res.sums.1]
+            .into_iter()
             .map(|image| {
                 (
                     barrier::image(
@@ -420,12 +420,7 @@ impl OitPass {
                 )
             })
             .unzip();
-        let sums: Vec<_> = res
-            .weighted
-            .iter()
-            .flat_map(|(s, a)| [s, a])
-            .map(|i| rendering::color(i.view(), Load::color([0.0; 4])))
-            .collect();
+        let sums = [&res.sums.0, &res.sums.1].map(|i| rendering::color(i.view(), Load::color([0.0; 4])));
         let depth_first = target.depth.map(|(view, load)| rendering::depth(view, load));
         let depth_again = target.depth.map(|(view, _)| rendering::depth(view, Load::Keep));
         let build_rendering = rendering::info(target.extent, &sums, depth_first.as_ref());

@@ -184,7 +184,8 @@ impl Renderer {
     }
 
     /// What the latest frame drawn with [`Transparency::Exact`] stored: fragments
-    /// offered, stored and dropped because the pool was full. Read from
+    /// offered, stored, and overflowed because the pool was full (those are
+    /// composited unsorted behind the stored ones). Read from
     /// host-visible memory: valid once that frame's commands completed and before
     /// the next frame's are submitted. `None` unless the latest frame drawn with
     /// transparency was an exact-mode frame.

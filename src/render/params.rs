@@ -110,8 +110,9 @@ pub struct OitParams {
     /// Fragments sorted exactly per pixel in the exact mode, K (1..=32). Default: 8.
     pub sorted_fragments: u32,
     /// Fragment pool of the exact mode, in fragments per pixel of the drawn extent
-    /// (0.01..=256; 16 bytes each): fragments beyond it are counted and dropped.
-    /// Default: 8.
+    /// (0.01..=256; 16 bytes each): fragments beyond it are counted and
+    /// composited unsorted, in the order-independent tail behind the sorted
+    /// ones (none is lost; the order of those is approximate). Default: 8.
     pub fragments_per_pixel: f32,
 }
 

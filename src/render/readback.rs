@@ -20,6 +20,19 @@ impl Renderer {
         self.interpolate.read(hairs as usize * per_hair as usize)
     }
 
+    /// Reads the interpolated hairs back as [`super::reference::CompositeScene::hairs`]
+    /// takes them: per hair its vertices root to tip, xyz the position and w the
+    /// t along the hair (this submits and waits).
+    pub fn read_strands(&self) -> Result<Vec<Vec<Vec4>>> {
+        let (positions, tangents) = self.read_hairs()?;
+        let per_hair = self.hair_counts().1.max(1) as usize;
+        Ok(positions
+            .chunks_exact(per_hair)
+            .zip(tangents.chunks_exact(per_hair))
+            .map(|(p, t)| p.iter().zip(t).map(|(p, t)| p.truncate().extend(t.w)).collect())
+            .collect())
+    }
+
     /// The key hairs' reference vectors (rest-plane normals, head frame).
     pub fn reference_vectors(&self) -> Result<Vec<Vec4>> {
         self.interpolate.read_reference(self.strands as usize)

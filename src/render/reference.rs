@@ -133,13 +133,87 @@ pub struct CompositeScene<'a> {
     /// Opacity of a strand where it covers a sample.
     pub opacity: f32,
     /// Linear colour of the hair at t.
-    pub color: &'a dyn Fn(f32) -> Vec3,
+    pub color: &'a (dyn Fn(f32) -> Vec3 + Sync),
     /// Linear background colour.
     pub background: Vec3,
 }
 
 /// Sub-samples per pixel side of [`composite_strands`] (16 per pixel).
 pub const COMPOSITE_SAMPLES: u32 = 4;
+
+/// Pixel rows of one band of [`composite_strands`]: its memory holds one band's
+/// sample fragments per thread, not the whole image's.
+const BAND_ROWS: u32 = 8;
+
+/// One triangle of a ribbon quad in screen space: per corner the pixel
+/// position, depth, clip w and t along the hair.
+#[derive(Clone, Copy)]
+struct ScreenTriangle {
+    corners: [(glam::Vec2, f32, f32, f32); 3],
+    /// Twice the signed area.
+    area: f32,
+    /// The quad's second triangle (half-open on the shared diagonal).
+    second: bool,
+    /// Sample rows covered, inclusive.
+    rows: (u32, u32),
+    /// Sample columns covered, inclusive.
+    columns: (u32, u32),
+}
+
+/// The ribbon triangles of `scene` (the draw pass's camera-facing quads).
+fn screen_triangles(scene: &CompositeScene<'_>) -> Vec<ScreenTriangle> {
+    let (w, h) = scene.extent;
+    let n = COMPOSITE_SAMPLES as f32;
+    let n_hairs = scene.represented_hairs.max(1.0);
+    let project = |p: Vec3| {
+        let c = scene.view_proj * p.extend(1.0);
+        let ndc = c.truncate() / c.w;
+        (glam::Vec2::new((ndc.x * 0.5 + 0.5) * w as f32, (ndc.y * 0.5 + 0.5) * h as f32), ndc.z, c.w)
+    };
+    let mut triangles = Vec::new();
+    for hair in scene.hairs {
+        for seg in hair.windows(2) {
+            let (p0, p1) = (seg[0].truncate(), seg[1].truncate());
+            let Some(dir) = (p1 - p0).try_normalize() else { continue };
+            let mut corners = [(glam::Vec2::ZERO, 0.0, 0.0, 0.0); 4];
+            for (i, v) in [seg[0], seg[1]].into_iter().enumerate() {
+                let p = v.truncate();
+                let side = dir.cross(scene.camera - p).try_normalize().unwrap_or(Vec3::X);
+                let half = 0.5 * n_hairs * (scene.widths.0 + (scene.widths.1 - scene.widths.0) * v.w);
+                for (k, s) in [-1.0, 1.0].into_iter().enumerate() {
+                    let (xy, z, cw) = project(p + side * half * s);
+                    corners[2 * i + k] = (xy, z, cw, v.w);
+                }
+            }
+            if corners.iter().any(|c| c.2.is_nan() || c.2 <= 0.0) {
+                continue;
+            }
+            for (second, tri) in [(false, [0, 1, 2]), (true, [1, 2, 3])] {
+                let t = tri.map(|i| corners[i]);
+                let lo = t.iter().fold(glam::Vec2::splat(f32::MAX), |a, c| a.min(c.0));
+                let hi = t.iter().fold(glam::Vec2::splat(f32::MIN), |a, c| a.max(c.0));
+                let area = (t[1].0 - t[0].0).perp_dot(t[2].0 - t[0].0);
+                if area.abs() < 1e-12 || !(lo.is_finite() && hi.is_finite()) {
+                    continue;
+                }
+                let first = |v: f32| (v * n - 0.5).ceil().max(0.0);
+                let last = |v: f32, size: u32| (v * n - 0.5).floor().min(size as f32 * n - 1.0);
+                let (x0, y0, x1, y1) = (first(lo.x), first(lo.y), last(hi.x, w), last(hi.y, h));
+                if x1 < x0 || y1 < y0 {
+                    continue;
+                }
+                triangles.push(ScreenTriangle {
+                    corners: t,
+                    area,
+                    second,
+                    rows: (y0 as u32, y1 as u32),
+                    columns: (x0 as u32, x1 as u32),
+                });
+            }
+        }
+    }
+    triangles
+}
 
 /// The exact transparent image of `scene` (the ground truth of the transparency
 /// modes): every segment of every hair becomes the draw pass's camera-facing
@@ -148,74 +222,96 @@ pub const COMPOSITE_SAMPLES: u32 = 4;
 /// samples per pixel with perspective-correct t, each sample's fragments are
 /// sorted by depth and composited front to back over the background, and the
 /// samples of a pixel are averaged. Linear RGB and hair alpha, rows from the top.
+///
+/// The image is built in bands of pixel rows on every core; the result does not
+/// depend on the number of threads (each sample's fragments keep the order of
+/// the hairs, so equal depths resolve the same way).
 pub fn composite_strands(scene: &CompositeScene<'_>) -> Vec<glam::Vec4> {
+    composite_on(scene, std::thread::available_parallelism().map_or(1, |t| t.get()))
+}
+
+/// [`composite_strands`] on at most `threads` threads.
+fn composite_on(scene: &CompositeScene<'_>, threads: usize) -> Vec<glam::Vec4> {
     let (w, h) = scene.extent;
     let n = COMPOSITE_SAMPLES;
     let n_hairs = scene.represented_hairs.max(1.0);
     let alpha = scene.opacity * (1.0 - (1.0 - 1.0 / n_hairs).powf(n_hairs));
-    let mut samples: Vec<Vec<(f32, Vec3)>> = vec![Vec::new(); (w * h * n * n) as usize];
-    let project = |p: Vec3| {
-        let c = scene.view_proj * p.extend(1.0);
-        let ndc = c.truncate() / c.w;
-        (glam::Vec2::new((ndc.x * 0.5 + 0.5) * w as f32, (ndc.y * 0.5 + 0.5) * h as f32), ndc.z, c.w)
-    };
-    for hair in scene.hairs {
-        for seg in hair.windows(2) {
-            let (p0, p1) = (seg[0].truncate(), seg[1].truncate());
-            let Some(dir) = (p1 - p0).try_normalize() else { continue };
-            let mut corners = Vec::with_capacity(4);
-            for v in [seg[0], seg[1]] {
-                let p = v.truncate();
-                let side = dir.cross(scene.camera - p).try_normalize().unwrap_or(Vec3::X);
-                let half = 0.5 * n_hairs * (scene.widths.0 + (scene.widths.1 - scene.widths.0) * v.w);
-                for s in [-1.0, 1.0] {
-                    let (xy, z, cw) = project(p + side * half * s);
-                    corners.push((xy, z, cw, v.w));
-                }
-            }
-            if corners.iter().any(|c| c.2.is_nan() || c.2 <= 0.0) {
-                continue;
-            }
-            for tri in [[0, 1, 2], [1, 2, 3]] {
-                let t = tri.map(|i| corners[i]);
-                let lo = t.iter().fold(glam::Vec2::splat(f32::MAX), |a, c| a.min(c.0));
-                let hi = t.iter().fold(glam::Vec2::splat(f32::MIN), |a, c| a.max(c.0));
-                let area = (t[1].0 - t[0].0).perp_dot(t[2].0 - t[0].0);
-                if area.abs() < 1e-12 {
-                    continue;
-                }
-                let sx0 = ((lo.x * n as f32 - 0.5).ceil().max(0.0)) as u32;
-                let sy0 = ((lo.y * n as f32 - 0.5).ceil().max(0.0)) as u32;
-                let sx1 = ((hi.x * n as f32 - 0.5).floor().min((w * n) as f32 - 1.0)) as i64;
-                let sy1 = ((hi.y * n as f32 - 0.5).floor().min((h * n) as f32 - 1.0)) as i64;
-                for sy in sy0 as i64..=sy1 {
-                    for sx in sx0 as i64..=sx1 {
-                        let q = glam::Vec2::new((sx as f32 + 0.5) / n as f32, (sy as f32 + 0.5) / n as f32);
-                        let b = [
-                            (t[2].0 - t[1].0).perp_dot(q - t[1].0) / area,
-                            (t[0].0 - t[2].0).perp_dot(q - t[2].0) / area,
-                            (t[1].0 - t[0].0).perp_dot(q - t[0].0) / area,
-                        ];
-                        // Half-open on the shared diagonal (corners 1–2): a sample on it
-                        // belongs to the first triangle only.
-                        let inside = b.iter().all(|&x| x >= 0.0) && !(tri[0] == 1 && b[0] == 0.0);
-                        if !inside {
-                            continue;
-                        }
-                        let depth = b[0] * t[0].1 + b[1] * t[1].1 + b[2] * t[2].1;
-                        let inv_w = b[0] / t[0].2 + b[1] / t[1].2 + b[2] / t[2].2;
-                        let along = (b[0] * t[0].3 / t[0].2 + b[1] * t[1].3 / t[1].2 + b[2] * t[2].3 / t[2].2) / inv_w;
-                        if !(0.0..=1.0).contains(&depth) {
-                            continue;
-                        }
-                        samples[(sy as u32 * w * n + sx as u32) as usize].push((depth, (scene.color)(along)));
-                    }
-                }
-            }
+    let triangles = screen_triangles(scene);
+    let band_samples = BAND_ROWS * n;
+    let bands = h.div_ceil(BAND_ROWS).max(1);
+    let mut in_band: Vec<Vec<u32>> = vec![Vec::new(); bands as usize];
+    for (i, t) in triangles.iter().enumerate() {
+        for band in t.rows.0 / band_samples..=t.rows.1 / band_samples {
+            in_band[band as usize].push(i as u32);
         }
     }
     let mut image = vec![glam::Vec4::ZERO; (w * h) as usize];
-    for (index, fragments) in samples.iter_mut().enumerate() {
+    let work = std::sync::Mutex::new(image.chunks_mut((w * BAND_ROWS) as usize).zip(in_band.iter()).enumerate());
+    let threads = threads.clamp(1, bands as usize);
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| {
+                let mut samples: Vec<Vec<(f32, Vec3)>> = vec![Vec::new(); (w * n * band_samples) as usize];
+                // The lock is released as soon as a band is taken (the guard is
+                // consumed by the closure). A poisoned lock means another band
+                // panicked; that panic is re-raised by the scope.
+                let next_band = || work.lock().ok().and_then(|mut w| w.next());
+                while let Some((band, (pixels, list))) = next_band() {
+                    let top = band as u32 * band_samples;
+                    for &i in list {
+                        rasterize(&triangles[i as usize], top, top + band_samples - 1, w * n, scene, &mut samples);
+                    }
+                    resolve_band(&mut samples, pixels, w, alpha, scene.background);
+                }
+            });
+        }
+    });
+    image
+}
+
+/// Adds the fragments of `t` in sample rows `top..=bottom` to `samples` (rows
+/// from `top`, `row_len` samples each).
+fn rasterize(
+    t: &ScreenTriangle,
+    top: u32,
+    bottom: u32,
+    row_len: u32,
+    scene: &CompositeScene<'_>,
+    samples: &mut [Vec<(f32, Vec3)>],
+) {
+    let n = COMPOSITE_SAMPLES as f32;
+    let c = &t.corners;
+    for sy in t.rows.0.max(top)..=t.rows.1.min(bottom) {
+        for sx in t.columns.0..=t.columns.1 {
+            let q = glam::Vec2::new((sx as f32 + 0.5) / n, (sy as f32 + 0.5) / n);
+            let b = [
+                (c[2].0 - c[1].0).perp_dot(q - c[1].0) / t.area,
+                (c[0].0 - c[2].0).perp_dot(q - c[2].0) / t.area,
+                (c[1].0 - c[0].0).perp_dot(q - c[0].0) / t.area,
+            ];
+            // Half-open on the shared diagonal (corners 1–2): a sample on it
+            // belongs to the first triangle only.
+            let inside = b.iter().all(|&x| x >= 0.0) && !(t.second && b[0] == 0.0);
+            if !inside {
+                continue;
+            }
+            let depth = b[0] * c[0].1 + b[1] * c[1].1 + b[2] * c[2].1;
+            let inv_w = b[0] / c[0].2 + b[1] / c[1].2 + b[2] / c[2].2;
+            let along = (b[0] * c[0].3 / c[0].2 + b[1] * c[1].3 / c[1].2 + b[2] * c[2].3 / c[2].2) / inv_w;
+            if !(0.0..=1.0).contains(&depth) {
+                continue;
+            }
+            samples[((sy - top) * row_len + sx) as usize].push((depth, (scene.color)(along)));
+        }
+    }
+}
+
+/// Sorts and composites each sample of a band and averages them into `pixels`
+/// (the band's rows of the image), leaving `samples` empty for the next band.
+fn resolve_band(samples: &mut [Vec<(f32, Vec3)>], pixels: &mut [glam::Vec4], w: u32, alpha: f32, background: Vec3) {
+    let n = COMPOSITE_SAMPLES;
+    let rows = pixels.len() as u32 / w;
+    for (index, fragments) in samples.iter_mut().enumerate().take((rows * n * w * n) as usize) {
         fragments.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut sum = Vec3::ZERO;
         let mut transmittance = 1.0;
@@ -223,16 +319,95 @@ pub fn composite_strands(scene: &CompositeScene<'_>) -> Vec<glam::Vec4> {
             sum += transmittance * alpha * *c;
             transmittance *= 1.0 - alpha;
         }
+        fragments.clear();
         let (sx, sy) = (index as u32 % (w * n), index as u32 / (w * n));
-        let pixel = &mut image[((sy / n) * w + sx / n) as usize];
-        *pixel += (sum + transmittance * scene.background).extend(1.0 - transmittance) / (n * n) as f32;
+        let pixel = &mut pixels[((sy / n) * w + sx / n) as usize];
+        *pixel += (sum + transmittance * background).extend(1.0 - transmittance) / (n * n) as f32;
     }
-    image
+}
+
+/// An sRGB-encoded RGBA8 image (as [`crate::headless::Offscreen::read_rgba8`]
+/// reads it) as linear RGB per pixel.
+pub fn linear_rgb(rgba8: &[u8]) -> Vec<Vec3> {
+    let linear = |v: u8| {
+        let c = f32::from(v) / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    rgba8.chunks_exact(4).map(|p| Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))).collect()
+}
+
+/// Mean absolute difference of two linear RGB images in 8-bit sRGB steps, over
+/// the pixels where either differs from `background` by more than one step
+/// (the hair); and how many pixels that is. `None` when no pixel has hair or
+/// the sizes differ.
+pub fn srgb_error(image: &[Vec3], reference: &[Vec3], background: Vec3) -> Option<(f64, usize)> {
+    if image.len() != reference.len() {
+        return None;
+    }
+    let srgb = |c: f32| if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 } * 255.0;
+    let background = background.to_array().map(srgb);
+    let mut sum = 0.0;
+    let mut count = 0usize;
+    for (a, b) in image.iter().zip(reference) {
+        let (a, b) = (a.to_array().map(srgb), b.to_array().map(srgb));
+        let hair = (0..3).any(|i| (a[i] - background[i]).abs() > 1.0 || (b[i] - background[i]).abs() > 1.0);
+        if hair {
+            sum += (0..3).map(|i| f64::from((a[i] - b[i]).abs())).sum::<f64>() / 3.0;
+            count += 1;
+        }
+    }
+    (count > 0).then(|| (sum / count as f64, count))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Crossing hairs over several bands: one thread and three give the same
+    /// image to the bit, and every band has hair in it.
+    #[test]
+    fn the_composite_does_not_depend_on_the_thread_count() {
+        let hairs: Vec<Vec<glam::Vec4>> = (0..12)
+            .map(|i| {
+                let x = -0.5 + i as f32 / 11.0;
+                (0..9)
+                    .map(|k| {
+                        glam::Vec4::new(
+                            x + 0.05 * k as f32 * (i % 3) as f32,
+                            0.6 - 0.15 * k as f32,
+                            0.01 * i as f32,
+                            k as f32 / 8.0,
+                        )
+                    })
+                    .collect()
+            })
+            .collect();
+        let camera = crate::render::Camera::look_at(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, 0.8, 4.0 / 3.0, 0.1, 10.0)
+            .expect("camera");
+        let view_proj = camera.projection * camera.view;
+        let color = |t: f32| Vec3::new(1.0 - t, 0.5, t);
+        let scene = CompositeScene {
+            hairs: &hairs,
+            view_proj,
+            camera: Vec3::new(0.0, 0.0, 2.0),
+            extent: (40, 30),
+            widths: (0.01, 0.004),
+            represented_hairs: 3.0,
+            opacity: 0.7,
+            color: &color,
+            background: Vec3::splat(0.1),
+        };
+        let one = composite_on(&scene, 1);
+        let three = composite_on(&scene, 3);
+        assert!(one.iter().zip(&three).all(|(a, b)| a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits)));
+        for band in one.chunks(40 * BAND_ROWS as usize) {
+            assert!(band.iter().any(|p| p.w > 0.0), "a band without hair: the scene does not test the bands");
+        }
+    }
 
     #[test]
     fn curve_passes_through_root_and_tip_with_end_tangents() {

@@ -24,6 +24,9 @@ use vkhair::sim::{motion, Collider, SimParams, VolumeMode, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, RecordedWork};
 
 use crate::bench_measure::{fitted_exponent, measure_sim, Samples, SimCase, SimFigures};
+use modes::{render_rows, write_modes};
+
+mod modes;
 use crate::output::Error;
 use crate::render_cmd::bench_frames;
 use crate::say;
@@ -80,6 +83,8 @@ struct Row {
     timestamps: Samples,
     cpu: Option<Samples>,
     work: RecordedWork,
+    /// A render frame's error against the exact reference, 8-bit sRGB steps.
+    error: Option<f64>,
 }
 
 impl Row {
@@ -88,7 +93,7 @@ impl Row {
     }
 
     fn new(scene: &str, stage: &str, per: &'static str, gpu: Samples, timestamps: Samples, work: RecordedWork) -> Row {
-        Row { scene: scene.into(), stage: stage.into(), per, gpu, timestamps, cpu: None, work }
+        Row { scene: scene.into(), stage: stage.into(), per, gpu, timestamps, cpu: None, work, error: None }
     }
 
     fn bytes(&self) -> u64 {
@@ -119,6 +124,9 @@ impl Row {
             v[format!("cpu_ms_per_{per}")] = finite(cpu.median());
             v[format!("cpu_ms_per_{per}_p95")] = finite(cpu.p95());
             v["ratio_gpu_to_cpu"] = finite(self.ratio());
+        }
+        if let Some(e) = self.error {
+            v["error_vs_reference_srgb_steps"] = finite(e);
         }
         v
     }
@@ -218,19 +226,21 @@ fn grown(strands: usize, points: usize) -> Result<Groom, Error> {
 }
 
 fn bench_scenes(a: &BenchArgs) -> Result<(Vec<Scene>, Vec<String>), Error> {
-    let size = |w: u32, h: u32| vec!["--width".to_owned(), w.to_string(), "--height".into(), h.to_string()];
-    let (w, h) = if a.quick { (160, 120) } else { (1280, 720) };
+    let size = |full: (u32, u32)| {
+        let (w, h) = if a.quick { (160, 120) } else { full };
+        vec!["--width".to_owned(), w.to_string(), "--height".into(), h.to_string()]
+    };
     let mut skipped = Vec::new();
     let mut list = vec![Scene {
         name: "thesis 1750×6".into(),
         groom: scenes::thesis()?,
         colliders: motion::thesis_colliders(),
-        render_args: Some(size(w, h)),
+        render_args: Some(size((800, 600))),
     }];
     let (hair, bust) = (a.sintel.join("sintel_hair.tfx"), a.sintel.join("sintel_bust.obj"));
     if hair.is_file() && bust.is_file() {
         let groom = crate::groom_input::load_scaled(&hair, false, 0.01, 32)?;
-        let mut args = size(w, h);
+        let mut args = size((1280, 720));
         for s in ["--input", &hair.display().to_string(), "--obj", &bust.display().to_string(), "--scale", "0.01"] {
             args.push(s.to_owned());
         }
@@ -317,7 +327,7 @@ fn scaling(ctx: &GpuContext, a: &BenchArgs, clock: Clocking) -> Result<Vec<Curve
     let mut curve = Curve { axis: "resolution (render frame; thesis)", unit: "pixels", points: Vec::new() };
     for &(w, h) in sizes {
         let (w, h) = (w.to_string(), h.to_string());
-        let f = bench_frames(ctx, &["--width", &w, "--height", &h], n)?;
+        let f = bench_frames(ctx, &["--width", &w, "--height", &h], n, false)?;
         curve.points.push((f.pixels as f64, clock.figure(&f.gpu, &f.wall).median(), f64::NAN));
     }
     curves.push(curve);
@@ -326,7 +336,7 @@ fn scaling(ctx: &GpuContext, a: &BenchArgs, clock: Clocking) -> Result<Vec<Curve
 
 fn print_rows(rows: &[Row]) {
     say!(
-        "{:<22} {:<36} {:>9} {:>9} {:>9} {:>9} {:>7} {:>5} {:>5} {:>9} {:>9}",
+        "{:<22} {:<36} {:>9} {:>9} {:>9} {:>9} {:>7} {:>5} {:>5} {:>9} {:>9} {:>6}",
         "scene",
         "stage (ms per step or frame)",
         "GPU med",
@@ -337,12 +347,13 @@ fn print_rows(rows: &[Row]) {
         "disp",
         "barr",
         "MB moved",
-        "H100 ms"
+        "H100 ms",
+        "err"
     );
     for r in rows {
         let cpu = r.cpu.as_ref().map_or(f64::NAN, Samples::median);
         say!(
-            "{:<22} {:<36} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>7.2} {:>5} {:>5} {:>9.2} {:>9.4}",
+            "{:<22} {:<36} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>7.2} {:>5} {:>5} {:>9.2} {:>9.4} {:>6}",
             r.scene,
             r.stage,
             r.gpu.median(),
@@ -353,7 +364,8 @@ fn print_rows(rows: &[Row]) {
             r.work.dispatches,
             r.work.barriers,
             r.bytes() as f64 / 1e6,
-            r.bytes() as f64 / PEAK_BANDWIDTH[0].1 * 1e3
+            r.bytes() as f64 / PEAK_BANDWIDTH[0].1 * 1e3,
+            r.error.map_or(String::new(), |e| format!("{e:.1}"))
         );
     }
 }
@@ -389,6 +401,7 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     say!("{}", clock.describe());
     let (scenes, skipped) = bench_scenes(a)?;
     let mut rows = Vec::new();
+    let mut modes = Vec::new();
     for s in &scenes {
         say!(
             "{}: {} key hairs × {} points",
@@ -404,27 +417,15 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
         let f = measure_sim(&ctx, &case(volume(VolumeMode::Flip, 32)), a.samples)?;
         rows.extend(sim_rows(&s.name, "sim, FLIP 32³", &f, clock, Some(&off)));
         if let Some(args) = &s.render_args {
-            let args: Vec<&str> = args.iter().map(String::as_str).collect();
-            let f = bench_frames(&ctx, &args, a.samples)?;
-            let stage = format!("render frame, {} hairs, {} segments", f.hairs, f.segments);
-            rows.push(Row::new(&s.name, &stage, "frame", clock.figure(&f.gpu, &f.wall), f.gpu, f.work));
-            // The same frame in each transparency mode (the default above is exact, K = 8).
-            for (mode, k) in [("off", 8), ("fast", 8), ("exact", 4), ("exact", 16)] {
-                let k = k.to_string();
-                let mut with_mode = args.clone();
-                with_mode.extend(["--transparency", mode, "--sorted-fragments", &k]);
-                let f = bench_frames(&ctx, &with_mode, a.samples)?;
-                let mib = f.transparency_bytes as f64 / (1024.0 * 1024.0);
-                let stage = match mode {
-                    "exact" => format!("render frame, transparency exact K = {k}, {mib:.1} MiB"),
-                    _ => format!("render frame, transparency {mode}, {mib:.1} MiB"),
-                };
-                rows.push(Row::new(&s.name, &stage, "frame", clock.figure(&f.gpu, &f.wall), f.gpu, f.work));
-            }
+            render_rows(&ctx, &s.name, args, a.samples, clock, &mut rows, &mut modes)?;
         }
     }
     print_rows(&rows);
-    say!("no CPU reference renders a whole frame (render::reference checks small scenes in the tests)");
+    say!("err: a frame drawn once more unlit against render::reference::composite_strands, mean absolute error over hair pixels in 8-bit sRGB steps");
+    if !modes.is_empty() {
+        let csv = write_modes(&a.out, &modes)?;
+        crate::plot_cmd::plot_file(&csv, &csv.with_extension("png"))?;
+    }
     let curves = scaling(&ctx, a, clock)?;
     for c in &curves {
         let (g, cpu) = c.exponents();

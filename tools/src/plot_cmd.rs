@@ -6,6 +6,9 @@
 //!   grid resolution, one line per solver, and PCG iterations per step.
 //! - `scaling.csv` (`vkhair bench`): GPU and CPU-reference ms against the work
 //!   (particles, cells, pixels), one panel per scaling axis.
+//! - `transparency.csv` (`vkhair bench`): each transparency mode's GPU ms per
+//!   frame and memory against its error from the exact reference, one series
+//!   per scene, each point labelled with its mode.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -19,7 +22,7 @@ const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 #[derive(clap::Args)]
 pub struct PlotArgs {
     /// CSV written by `cargo bench --bench render` or `--bench volume`, or the
-    /// scaling.csv of `vkhair bench`.
+    /// scaling.csv or transparency.csv of `vkhair bench`.
     #[arg(default_value = "target/vkhair-bench/render.csv")]
     csv: PathBuf,
     /// Output PNG (default: the CSV's path with a .png extension).
@@ -222,6 +225,80 @@ fn scaling_panels(table: &Table, root: &DrawingArea<BitMapBackend<'_>, Shift>) -
     Ok(())
 }
 
+/// Points with a label each, per series.
+type Labelled = BTreeMap<String, Vec<(f64, f64, String)>>;
+
+/// Each transparency mode's GPU ms and memory against its error (rows whose
+/// error is not a number, a frame without hair, are left out and said).
+fn mode_panels(table: &Table, root: &DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), Error> {
+    let (scene, mode) = (table.column("scene")?, table.column("mode")?);
+    let (ms, mib, error) = (table.column("gpu_ms")?, table.column("memory_mib")?, table.column("error_srgb_steps")?);
+    let (mut time, mut memory) = (Labelled::new(), Labelled::new());
+    for r in 0..table.rows.len() {
+        let name = table.rows[r].get(scene).cloned().unwrap_or_default();
+        let label = table.rows[r].get(mode).cloned().unwrap_or_default();
+        let Ok(e) = table.number(r, error) else {
+            say!("{name}, {label}: no error figure (line {}), left out of the chart", r + 2);
+            continue;
+        };
+        time.entry(name.clone()).or_default().push((e, table.number(r, ms)?, label.clone()));
+        memory.entry(name).or_default().push((e, table.number(r, mib)?, label));
+    }
+    let palette: Vec<String> = time.keys().cloned().collect();
+    let (left, right) = root.split_horizontally(SIZE.0 / 2);
+    let x = "error against the exact reference (8-bit sRGB steps)";
+    let caption = "GPU ms per frame (Kn: exact, n sorted; *: default)";
+    scatter_chart(&left, caption, x, "GPU ms per frame", &time, &palette)?;
+    scatter_chart(&right, "transparency memory", x, "MiB", &memory, &palette)?;
+    Ok(())
+}
+
+/// A scatter chart of labelled points, one colour per series.
+fn scatter_chart(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    caption: &str,
+    x_desc: &str,
+    y_desc: &str,
+    series: &Labelled,
+    palette: &[String],
+) -> Result<(), Error> {
+    let all = series.values().flatten();
+    let max_x = all.clone().map(|p| p.0).fold(0.0, f64::max) * 1.25;
+    let max_y = all.map(|p| p.1).fold(0.0, f64::max) * 1.15;
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..max_x.max(1e-9), 0.0..max_y.max(1e-9))?;
+    chart.configure_mesh().x_labels(6).x_desc(x_desc).y_desc(y_desc).draw()?;
+    for (name, points) in series {
+        let color = Palette99::pick(palette.iter().position(|p| p == name).unwrap_or(0)).to_rgba();
+        chart
+            .draw_series(points.iter().map(|p| Circle::new((p.0, p.1), 4, color.filled())))?
+            .label(name.clone())
+            .legend(move |(x, y)| Circle::new((x + 9, y), 4, color.filled()));
+        let font = ("sans-serif", 13).into_font().color(&color);
+        // Labels staggered in three rows so that close points stay readable.
+        chart.draw_series(points.iter().enumerate().map(|(i, p)| {
+            EmptyElement::at((p.0, p.1)) + Text::new(short_mode(&p.2), (6, -16 + 12 * (i % 3) as i32), font.clone())
+        }))?;
+    }
+    chart.configure_series_labels().border_style(BLACK).background_style(WHITE.mix(0.8)).draw()?;
+    Ok(())
+}
+
+/// A mode's chart label: "exact K = 8 (default)" → "K8*", others as they are.
+fn short_mode(mode: &str) -> String {
+    match mode.strip_prefix("exact K = ") {
+        Some(rest) => {
+            let default = rest.contains("default");
+            format!("K{}{}", rest.split_whitespace().next().unwrap_or(rest), if default { "*" } else { "" })
+        }
+        None => mode.to_owned(),
+    }
+}
+
 /// Chart size of the scaling curves (four panels), pixels.
 const SCALING_SIZE: (u32, u32) = (1100, 900);
 
@@ -231,6 +308,11 @@ fn draw(table: &Table, rgb: &mut [u8], size: (u32, u32)) -> Result<(), Error> {
     root.fill(&WHITE)?;
     if table.column("axis").is_ok() {
         scaling_panels(table, &root)?;
+        root.present()?;
+        return Ok(());
+    }
+    if table.column("mode").is_ok() {
+        mode_panels(table, &root)?;
         root.present()?;
         return Ok(());
     }

@@ -522,10 +522,10 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     }
     if let Some(stats) = renderer.transparency_stats() {
         say!(
-            "last frame: {} hair fragments, {} stored, {} dropped (pool of {}; raise oit.fragments_per_pixel if any are dropped)",
+            "last frame: {} hair fragments, {} stored, {} beyond the pool blended unsorted (pool of {}; raise oit.fragments_per_pixel if many are)",
             stats.fragments,
             stats.stored,
-            stats.dropped,
+            stats.overflowed,
             stats.capacity
         );
     }

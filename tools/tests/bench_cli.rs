@@ -59,8 +59,22 @@ fn a_quick_bench_reports_every_stage_with_its_reference_and_writes_json_and_a_ch
             assert!(row["bandwidth_bound_ms"]["H100 SXM"].is_number(), "{row}");
         }
     }
-    let frame = stages.iter().find(|s| s["per"] == "frame").expect("a render frame row");
-    assert!(frame["gpu_ms_per_frame"].as_f64().is_some_and(|x| x > 0.0), "{frame}");
+    let frames: Vec<_> = stages.iter().filter(|s| s["per"] == "frame").collect();
+    assert_eq!(frames.len(), 5, "the thesis frame in the default mode, off, fast, exact K = 4 and 16");
+    for frame in &frames {
+        assert!(frame["gpu_ms_per_frame"].as_f64().is_some_and(|x| x > 0.0), "{frame}");
+        assert!(frame["error_vs_reference_srgb_steps"].as_f64().is_some_and(|x| x > 0.0), "{frame}");
+    }
+    let error = |stage: &str| {
+        let row = frames.iter().find(|f| f["stage"].as_str().is_some_and(|s| s.contains(stage))).expect(stage);
+        row["error_vs_reference_srgb_steps"].as_f64().unwrap_or(f64::NAN)
+    };
+    let (default, off) = (error("segments"), error("transparency off"));
+    assert!(default < 0.5 * off, "the default (exact) frame's error {default} is not below half of off's {off}");
+    let csv = std::fs::read_to_string(out.join("transparency.csv")).expect("transparency.csv");
+    assert_eq!(csv.lines().count(), 6, "a header and a row per mode: {csv}");
+    let (w, h, _) = common::read_png(&out.join("transparency.png"));
+    assert_eq!((w, h), (1100, 500));
     let scaling = v["scaling"].as_array().expect("scaling");
     assert_eq!(scaling.len(), 4, "hairs, points, grid, resolution");
     assert!(scaling[0]["gpu_exponent"].is_number() && scaling[0]["cpu_exponent"].is_number(), "{}", scaling[0]);

@@ -1,9 +1,11 @@
 //! What `vkhair bench` measures of a render frame: `render`'s scene, parameters
 //! and renderer, timed per frame.
 
-use glam::Vec3;
+use glam::{Mat4, Vec3, Vec4};
 use vkhair::headless::{Offscreen, Submit};
-use vkhair::sim::RigidTransform;
+use vkhair::render::reference::{composite_strands, linear_rgb, srgb_error, CompositeScene};
+use vkhair::render::{Camera, HairMaterial, LodParams, Renderer};
+use vkhair::sim::{HairSim, RigidTransform};
 use vkhair::{GpuContext, GpuProfiler};
 
 use super::{check_options, framing, make_renderer, parameters, scene, RenderArgs};
@@ -22,12 +24,114 @@ pub struct FrameFigures {
     pub pixels: u64,
     /// GPU memory of the transparency mode (lists or accumulation images), bytes.
     pub transparency_bytes: u64,
+    /// The last frame drawn once more unlit, when asked for.
+    pub unlit: Option<UnlitFrame>,
+}
+
+/// Albedo at the root and the tip of the unlit frame.
+const UNLIT_ROOT: Vec3 = Vec3::new(0.9, 0.2, 0.05);
+const UNLIT_TIP: Vec3 = Vec3::new(0.1, 0.5, 0.9);
+/// Background of the unlit frame (linear).
+const UNLIT_BACKGROUND: Vec3 = Vec3::splat(0.02);
+
+/// A frame drawn unlit (no lights, ambient 1, albedo from [`UNLIT_ROOT`] to
+/// [`UNLIT_TIP`] along each hair, level of detail off; the frame's widths,
+/// opacity, hairs per strand and transparency mode): what
+/// `render::reference::composite_strands` can draw exactly, to measure a
+/// transparency mode's error.
+pub struct UnlitFrame {
+    /// Linear RGB per pixel, rows from the top.
+    pub image: Vec<Vec3>,
+    /// The hairs drawn (position, t along the hair).
+    pub strands: Vec<Vec<Vec4>>,
+    view_proj: Mat4,
+    camera: Vec3,
+    extent: (u32, u32),
+    material: HairMaterial,
+}
+
+impl UnlitFrame {
+    /// The exact image of this frame's hairs (the CPU reference; slow at full
+    /// size: every core, seconds).
+    pub fn reference(&self) -> Vec<Vec3> {
+        let color = |t: f32| UNLIT_ROOT.lerp(UNLIT_TIP, t);
+        let image = composite_strands(&CompositeScene {
+            hairs: &self.strands,
+            view_proj: self.view_proj,
+            camera: self.camera,
+            extent: self.extent,
+            widths: (self.material.root_width, self.material.tip_width),
+            represented_hairs: self.material.represented_hairs,
+            opacity: self.material.opacity,
+            color: &color,
+            background: UNLIT_BACKGROUND,
+        });
+        image.iter().map(|p| p.truncate()).collect()
+    }
+
+    /// Mean absolute error against `reference` in 8-bit sRGB steps over the hair
+    /// pixels (NaN when there is no hair).
+    pub fn error(&self, reference: &[Vec3]) -> f64 {
+        srgb_error(&self.image, reference, UNLIT_BACKGROUND).map_or(f64::NAN, |e| e.0)
+    }
+}
+
+/// Draws the current state of `sim` once more, unlit (see [`UnlitFrame`]).
+fn draw_unlit(
+    ctx: &GpuContext,
+    sim: &HairSim,
+    renderer: &mut Renderer,
+    offscreen: &Offscreen,
+    camera: &Camera,
+    frame: u64,
+) -> Result<UnlitFrame, Error> {
+    let lit = renderer.material().clone();
+    let material = HairMaterial {
+        root_color: UNLIT_ROOT,
+        tip_color: UNLIT_TIP,
+        ambient: 1.0,
+        root_width: lit.root_width,
+        tip_width: lit.tip_width,
+        opacity: lit.opacity,
+        represented_hairs: lit.represented_hairs,
+        ..HairMaterial::default()
+    };
+    renderer.set_material(&material)?;
+    renderer.set_lights(&[])?;
+    let params = vkhair::render::RenderParams {
+        lod: LodParams { enabled: false, ..renderer.params().lod },
+        ..renderer.params().clone()
+    };
+    renderer.set_params(&params)?;
+    let mut result = Ok(());
+    ctx.run_commands("vkhair bench unlit frame", |cmd| {
+        // SAFETY: a recording command buffer of the context's device; the
+        // previous frame completed (run_commands waits).
+        result = unsafe {
+            (|| -> Result<(), vkhair::Error> {
+                renderer.record_prepare(cmd, sim, Some(camera), None)?;
+                offscreen.record_clear(cmd, UNLIT_BACKGROUND);
+                renderer.record_draw(cmd, frame, &offscreen.target(), camera, None)
+            })()
+        };
+    })?;
+    result?;
+    let (w, h) = offscreen.size();
+    Ok(UnlitFrame {
+        image: linear_rgb(&offscreen.read_rgba8()?),
+        strands: renderer.read_strands()?,
+        view_proj: camera.projection * camera.view,
+        camera: camera.position(),
+        extent: (w, h),
+        material,
+    })
 }
 
 /// Renders `samples` frames (after two warm-up frames) of the scene `render`
 /// would draw with `args` (its flags, e.g. `["--width", "1280"]`), the
-/// simulation on the same queue, and measures the render passes.
-pub fn bench_frames(ctx: &GpuContext, args: &[&str], samples: usize) -> Result<FrameFigures, Error> {
+/// simulation on the same queue, and measures the render passes; with `unlit`,
+/// then draws the last state once more unlit ([`FrameFigures::unlit`]).
+pub fn bench_frames(ctx: &GpuContext, args: &[&str], samples: usize, unlit: bool) -> Result<FrameFigures, Error> {
     #[derive(clap::Parser)]
     struct Wrapper {
         #[command(flatten)]
@@ -39,7 +143,7 @@ pub fn bench_frames(ctx: &GpuContext, args: &[&str], samples: usize) -> Result<F
     check_options(&a)?;
     let s = scene(&a)?;
     let config = parameters(&a, s.center, s.radius)?;
-    let mut sim = vkhair::sim::HairSim::new(ctx, &s.groom, &config.sim, &RigidTransform::default())?;
+    let mut sim = HairSim::new(ctx, &s.groom, &config.sim, &RigidTransform::default())?;
     sim.set_colliders(&s.colliders)?;
     let mut renderer = make_renderer(&a, ctx, &config, sim.key_hairs(), s.radius)?;
     let offscreen = Offscreen::new(ctx, a.width, a.height)?;
@@ -57,6 +161,7 @@ pub fn bench_frames(ctx: &GpuContext, args: &[&str], samples: usize) -> Result<F
         pixels: u64::from(a.width) * u64::from(a.height),
         transparency_bytes: renderer
             .transparency_memory(vkhair::ash::vk::Extent2D { width: a.width, height: a.height }),
+        unlit: None,
     };
     for frame in 0..samples + 2 {
         let heads: Vec<RigidTransform> =
@@ -89,6 +194,9 @@ pub fn bench_frames(ctx: &GpuContext, args: &[&str], samples: usize) -> Result<F
             figures.wall.0.push(wall);
             figures.work = render_work;
         }
+    }
+    if unlit {
+        figures.unlit = Some(draw_unlit(ctx, &sim, &mut renderer, &offscreen, &camera, samples as u64 + 2)?);
     }
     Ok(figures)
 }
