@@ -183,8 +183,11 @@ pub(crate) struct SmoothPush {
     pub level: u32,
     /// Smoothed vertices per key hair.
     pub stride: u32,
+    /// Where between the state before the latest step (0) and the latest (1)
+    /// the key hairs are drawn.
+    pub alpha: f32,
 }
-gpu_struct!(SmoothPush => "SmoothPush" { strands, points, level, stride });
+gpu_struct!(SmoothPush => "SmoothPush" { strands, points, level, stride, alpha });
 
 /// Push constants of the interpolation pass (`InterpolatePush` in `glsl/include/render.glsl`).
 #[repr(C)]

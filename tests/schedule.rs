@@ -1,7 +1,9 @@
 //! The frame scheduler: SINGLE QUEUE, SECOND DEVICE (two logical devices on one
 //! physical device, external memory and host staging) and ASYNC COMPUTE must show
-//! bitwise-identical key-hair state and identical images frame by frame, under
-//! validation with synchronization validation on every device.
+//! bitwise-identical key-hair state and identical images frame by frame (drawn
+//! halfway between the last two states, so the state before the latest step
+//! travels with each hand-off too), under validation with synchronization
+//! validation on every device.
 
 use std::sync::mpsc;
 use std::time::Duration;
@@ -89,7 +91,8 @@ fn run(render: &Gpu, options: SchedulerOptions, frames: usize, draw: bool) -> Sh
             unsafe {
                 let sync = scheduler.record_frame(cmd, heads, None)?;
                 if draw {
-                    renderer.record_prepare(cmd, scheduler.key_hairs(), Some(&camera), None)?;
+                    // Halfway between the last two states: both travel with every hand-off.
+                    renderer.record_prepare(cmd, scheduler.key_hairs().blended(0.5)?, Some(&camera), None)?;
                     renderer.record_shadows(cmd, scheduler.key_hairs(), None)?;
                     offscreen.record_clear(cmd, Vec3::ZERO);
                     renderer.record_draw(cmd, frame as u64, &offscreen.target(), &camera, None)?;

@@ -118,7 +118,8 @@ fn a_step_is_one_dispatch_without_the_volume_stage() {
         let work = four - one;
         assert_eq!(work.dispatches, 3, "{substeps} sub-steps: {work:?}");
         assert_eq!(work.barriers, 6, "{substeps} sub-steps: {work:?}");
-        assert_eq!(work.bytes_written, 3 * particles * 32, "positions and velocities, once per step: {work:?}");
+        // Positions, velocities and the positions before the step (for drawing between states).
+        assert_eq!(work.bytes_written, 3 * particles * 48, "three vec4 per particle, once per step: {work:?}");
         // Positions, velocities and rest positions (16 bytes each), rest lengths (4).
         assert!(work.bytes_read >= 3 * particles * 52, "{work:?}");
     }

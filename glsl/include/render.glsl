@@ -10,6 +10,7 @@ struct SmoothPush {
     uint points;          // points per key hair
     uint level;           // smoothed segments per key segment
     uint stride;          // smoothed vertices per key hair: (points − 1)·level + 1
+    float alpha;          // 0: the state before the latest step, 1: the latest
 };
 
 // Push constants of the interpolation pass. Twin: gpu_types::InterpolatePush.

@@ -65,6 +65,9 @@ layout(std430, set = 0, binding = 7) readonly buffer Colliders { Collider collid
 layout(std430, set = 0, binding = 8) writeonly buffer PosOut { vec4 pos_out[]; };
 layout(std430, set = 0, binding = 9) writeonly buffer VelOut { vec4 vel_out[]; };
 layout(std430, set = 0, binding = 10) readonly buffer MeshField { float mesh_field[]; };
+// The positions before the step: written by its first sub-step, for drawing
+// between the last two states (render's blend by the fixed-step driver's alpha).
+layout(std430, set = 0, binding = 11) writeonly buffer PosBefore { vec4 pos_before[]; };
 #include "mesh_sdf.glsl"
 
 shared vec4 s_pos[2][SIM_WORKGROUP];
@@ -233,6 +236,9 @@ void main() {
     vec2 bend_a = vec2(0.0), bend_b = vec2(0.0);
     if (live) {
         x = pos_in[index];
+        if (push.range.x == 0u) {
+            pos_before[index] = x;
+        }
         v = vel_in[index].xyz;
         vec4 r = rest[index];
         rest_head = r.xyz;

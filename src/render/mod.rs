@@ -140,7 +140,7 @@ pub struct Renderer {
     /// The detail of the latest prepared frame.
     detail: Detail,
     /// The key-hair buffers the smoothing pass is bound to.
-    source: [vk::Buffer; 2],
+    source: [vk::Buffer; 4],
     /// The last frame index `record_draw` was given.
     last_frame: Option<u64>,
 }
@@ -187,7 +187,7 @@ impl Renderer {
                 ),
             ));
         }
-        let smooth = SmoothPass::new(&device, sim.halves, strands as u64 * stride)?;
+        let smooth = SmoothPass::new(&device, sim.halves, sim.before, strands as u64 * stride)?;
         let interpolate = InterpolatePass::new(&device, sim.rest, &triangles, &smooth, hair_vertices)?;
         interpolate.check_mode(params.interpolation)?;
         let draw = DrawPass::new(&device)?;
@@ -343,6 +343,7 @@ impl Renderer {
             points: self.points,
             level: self.detail.smoothing_level,
             stride: self.smoothed_vertices_per_strand(),
+            alpha: 1.0,
         }
     }
 
@@ -395,7 +396,8 @@ impl Renderer {
             &[AccessKind::AnyWrite],
             &[AccessKind::VertexRead, AccessKind::TessellationRead, AccessKind::TessellationWrite],
         );
-        let (smooth_push, interpolate_push) = (self.smooth_push(), self.interpolate_push());
+        let smooth_push = SmoothPush { alpha: sim.alpha, ..self.smooth_push() };
+        let interpolate_push = self.interpolate_push();
         // SAFETY: guaranteed by the caller.
         unsafe {
             self.device.cmd_barrier(cmd, &[entry], &[], &[]);

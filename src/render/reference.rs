@@ -15,6 +15,21 @@ fn control_point(points: &[Vec3], idx: isize) -> Vec3 {
     }
 }
 
+/// The key points drawn at `alpha` between the state before the latest step and
+/// the latest one ([`crate::sim::KeyHairs::blended`]): `before + (latest −
+/// before)·alpha` per point, exactly `before` at 0 and `latest` at 1.
+pub fn blend_key_points(before: &[glam::Vec4], latest: &[glam::Vec4], alpha: f32) -> Vec<Vec3> {
+    before
+        .iter()
+        .zip(latest)
+        .map(|(b, l)| match alpha {
+            a if a >= 1.0 => l.truncate(),
+            a if a <= 0.0 => b.truncate(),
+            a => b.truncate() + (l.truncate() - b.truncate()) * a,
+        })
+        .collect()
+}
+
 /// Smoothed vertices (position, unit tangent) of one key hair with `level`
 /// segments per key segment: (points − 1)·level + 1 of them, root to tip.
 pub fn smooth_strand(points: &[Vec3], level: u32) -> Vec<(Vec3, Vec3)> {

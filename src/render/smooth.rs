@@ -28,7 +28,8 @@ use crate::vk::shaders::{RENDER_SMOOTH_TESC, RENDER_SMOOTH_TESE, RENDER_SMOOTH_V
 pub(super) struct SmoothPass {
     device: Arc<Device>,
     pipeline: GraphicsPipeline,
-    /// One set per half of the simulation's double-buffered positions.
+    /// One set per half of the simulation's double-buffered positions (each with
+    /// the positions before the step that produced it).
     sets: [vk::DescriptorSet; 2],
     /// Smoothed positions, strand after strand.
     positions: Buffer,
@@ -37,9 +38,10 @@ pub(super) struct SmoothPass {
 }
 
 impl SmoothPass {
-    /// The pass reading the simulation's two position buffers `keys`, with room
-    /// for `vertices` smoothed vertices.
-    pub(super) fn new(device: &Arc<Device>, keys: [&Buffer; 2], vertices: u64) -> Result<Self> {
+    /// The pass reading the simulation's two position buffers `keys` and the
+    /// positions before the step of each (`before`), with room for `vertices`
+    /// smoothed vertices.
+    pub(super) fn new(device: &Arc<Device>, keys: [&Buffer; 2], before: [&Buffer; 2], vertices: u64) -> Result<Self> {
         let positions = Buffer::storage(device, "vkhair smoothed positions", vertices * 16)?;
         let tangents = Buffer::storage(device, "vkhair smoothed tangents", vertices * 16)?;
         let pipeline = pass::capture_pipeline(
@@ -50,8 +52,8 @@ impl SmoothPass {
             2,
         )?;
         let sets = [
-            pipeline.buffer_set(0, &[(0, keys[0]), (1, &positions), (2, &tangents)])?,
-            pipeline.buffer_set(0, &[(0, keys[1]), (1, &positions), (2, &tangents)])?,
+            pipeline.buffer_set(0, &[(0, keys[0]), (1, &positions), (2, &tangents), (3, before[0])])?,
+            pipeline.buffer_set(0, &[(0, keys[1]), (1, &positions), (2, &tangents), (3, before[1])])?,
         ];
         Ok(SmoothPass { device: device.clone(), pipeline, sets, positions, tangents })
     }

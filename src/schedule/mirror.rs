@@ -1,8 +1,9 @@
 //! The rendering side's copy of the key-hair state, and the copies that pack a
 //! simulation's latest state into a hand-off buffer and unpack it again.
 //!
-//! A hand-off buffer holds the positions (vec4 per particle) followed, when the
-//! volume stage is on, by the density cells (vec4 per cell).
+//! A hand-off buffer holds the positions (vec4 per particle), the positions
+//! before the latest step (the same size) and, when the volume stage is on, the
+//! density cells (vec4 per cell).
 
 use std::sync::Arc;
 
@@ -29,7 +30,8 @@ impl Meta {
     }
 }
 
-/// Byte sizes of the two parts of a hand-off.
+/// Byte sizes of the parts of a hand-off (the positions before the latest step
+/// are as large as the positions).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Layout {
     pub positions: u64,
@@ -43,7 +45,7 @@ impl Layout {
     }
 
     pub(crate) fn total(&self) -> u64 {
-        self.positions + self.density
+        2 * self.positions + self.density
     }
 }
 
@@ -64,11 +66,13 @@ fn before_copy() -> vk::MemoryBarrier2<'static> {
     barrier::memory(&[AccessKind::AnyWrite], &[AccessKind::TransferRead, AccessKind::TransferWrite])
 }
 
-/// Where the two parts of a state are: (buffer, byte offset) of the positions
-/// and, with the volume stage, of the density cells.
+/// Where the parts of a state are: (buffer, byte offset) of the positions, of
+/// the positions before the latest step and, with the volume stage, of the
+/// density cells.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Parts {
     positions: (vk::Buffer, u64),
+    before: (vk::Buffer, u64),
     density: Option<(vk::Buffer, u64)>,
 }
 
@@ -76,12 +80,17 @@ impl Parts {
     /// A simulation's latest state.
     pub(crate) fn of_sim(sim: &HairSim) -> Parts {
         let (positions, density) = sim.latest_buffers();
-        Parts { positions: (positions.raw(), 0), density: density.map(|d| (d.raw(), 0)) }
+        let before = (sim.previous_positions_buffer(), 0);
+        Parts { positions: (positions.raw(), 0), before, density: density.map(|d| (d.raw(), 0)) }
     }
 
     /// A hand-off buffer laid out as `layout`.
     pub(crate) fn packed(buffer: vk::Buffer, layout: Layout) -> Parts {
-        Parts { positions: (buffer, 0), density: (layout.density > 0).then_some((buffer, layout.positions)) }
+        Parts {
+            positions: (buffer, 0),
+            before: (buffer, layout.positions),
+            density: (layout.density > 0).then_some((buffer, 2 * layout.positions)),
+        }
     }
 }
 
@@ -100,18 +109,20 @@ pub(crate) unsafe fn record_copy(device: &Device, cmd: vk::CommandBuffer, src: P
     // SAFETY: guaranteed by the caller.
     unsafe { device.cmd_barrier(cmd, &[before_copy()], &[], &[]) };
     copy(src.positions, dst.positions, layout.positions);
+    copy(src.before, dst.before, layout.positions);
     if let (Some(from), Some(to)) = (src.density, dst.density) {
         copy(from, to, layout.density);
     }
 }
 
-/// The rendering device's copy of the latest handed-off state: positions double
-/// buffered (a hand-off writes the half the previous frame did not read) and the
-/// density cells.
+/// The rendering device's copy of the latest handed-off state: positions and the
+/// positions before the latest step double buffered (a hand-off writes the half
+/// the previous frame did not read) and the density cells.
 pub(crate) struct Mirror {
     device: Arc<Device>,
     rest: SimState,
     halves: [Buffer; 2],
+    before: [Buffer; 2],
     density: Option<Buffer>,
     current: usize,
     meta: Meta,
@@ -123,7 +134,10 @@ impl Mirror {
     pub(crate) fn new(device: &Arc<Device>, initial: &SimState, meta: Meta, layout: Layout) -> Result<Self> {
         let half = |i: usize| Buffer::storage(device, &format!("vkhair hand-off positions {i}"), layout.positions);
         let halves = [half(0)?, half(1)?];
-        for h in &halves {
+        let half =
+            |i: usize| Buffer::storage(device, &format!("vkhair hand-off positions before {i}"), layout.positions);
+        let before = [half(0)?, half(1)?];
+        for h in halves.iter().chain(&before) {
             device.upload_pod(h, &initial.positions)?;
         }
         let density = match layout.density {
@@ -134,7 +148,7 @@ impl Mirror {
                 Some(b)
             }
         };
-        Ok(Mirror { device: device.clone(), rest: initial.clone(), halves, density, current: 0, meta, layout })
+        Ok(Mirror { device: device.clone(), rest: initial.clone(), halves, before, density, current: 0, meta, layout })
     }
 
     pub(crate) fn device(&self) -> &Arc<Device> {
@@ -156,6 +170,8 @@ impl Mirror {
             rest: &self.rest,
             halves: [&self.halves[0], &self.halves[1]],
             current: self.current,
+            before: [&self.before[0], &self.before[1]],
+            alpha: 1.0,
             head: self.meta.head,
             volume: self.meta.grid.zip(self.density.as_ref()),
         }
@@ -171,8 +187,11 @@ impl Mirror {
     /// semaphores or acquire barriers).
     pub(crate) unsafe fn record_update(&mut self, cmd: vk::CommandBuffer, src: Parts, meta: Meta) {
         let next = 1 - self.current;
-        let dst =
-            Parts { positions: (self.halves[next].raw(), 0), density: self.density.as_ref().map(|d| (d.raw(), 0)) };
+        let dst = Parts {
+            positions: (self.halves[next].raw(), 0),
+            before: (self.before[next].raw(), 0),
+            density: self.density.as_ref().map(|d| (d.raw(), 0)),
+        };
         let d = &self.device;
         // SAFETY: guaranteed by the caller.
         unsafe {

@@ -11,7 +11,8 @@ pub struct StepPlan {
     /// Fixed steps to run now.
     pub steps: u32,
     /// Fraction of a step accumulated beyond them (0..1): blend factor between
-    /// the previous and the latest state for drawing.
+    /// the state before the latest step and the latest state for drawing
+    /// ([`crate::sim::KeyHairs::blended`]).
     pub alpha: f32,
     /// Time dropped because the cap was reached, seconds.
     pub dropped: f64,

@@ -343,6 +343,8 @@ impl HairSim {
             rest: &self.shape,
             halves: [&self.gpu.positions[0], &self.gpu.positions[1]],
             current: self.current,
+            before: [&self.gpu.before, &self.gpu.before],
+            alpha: 1.0,
             head: self.planner.head,
             volume: self.volume.as_ref().map(|v| (v.grid.describe(&self.planner.head.matrix()), &v.buffers.cells)),
         }
@@ -359,11 +361,10 @@ impl HairSim {
         self.planner.head
     }
 
-    /// The positions buffer holding the state before the latest step (for drawing
-    /// between the last two states with [`StepPlan::alpha`]); same layout and barrier
-    /// rule as [`HairSim::positions_buffer`].
+    /// The positions before the latest step (for [`KeyHairs::blended`]); same
+    /// layout and barrier rule as [`HairSim::positions_buffer`].
     pub fn previous_positions_buffer(&self) -> vk::Buffer {
-        self.gpu.positions[1 - self.current].raw()
+        self.gpu.before.raw()
     }
 
     /// The volume grid as placed for the latest step, when the volume stage is on.

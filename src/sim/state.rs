@@ -156,6 +156,9 @@ impl SimState {
 /// The GPU buffers of the simulation.
 pub(crate) struct GpuState {
     pub positions: [Buffer; 2],
+    /// The positions before the latest step (written by its first sub-step), for
+    /// drawing between the last two states.
+    pub before: Buffer,
     pub velocities: [Buffer; 2],
     pub rest: Buffer,
     pub rest_lengths: Buffer,
@@ -186,6 +189,7 @@ pub(crate) mod binding {
     pub const POS_OUT: u32 = 8;
     pub const VEL_OUT: u32 = 9;
     pub const MESH_FIELD: u32 = 10;
+    pub const POS_BEFORE: u32 = 11;
 }
 
 impl GpuState {
@@ -205,6 +209,7 @@ impl GpuState {
         let storage = |name: &str, size: u64| Buffer::storage(device, name, size);
         let gpu = GpuState {
             positions: [storage("vkhair sim positions 0", vec4_bytes)?, storage("vkhair sim positions 1", vec4_bytes)?],
+            before: storage("vkhair sim positions before the step", vec4_bytes)?,
             velocities: [
                 storage("vkhair sim velocities 0", vec4_bytes)?,
                 storage("vkhair sim velocities 1", vec4_bytes)?,
@@ -225,15 +230,18 @@ impl GpuState {
         Ok(gpu)
     }
 
-    /// Uploads positions and velocities into half `parity` (submits and waits).
+    /// Uploads positions and velocities into half `parity`, and the positions as
+    /// the state before the latest step too (a state set has no motion to draw
+    /// between; submits and waits).
     pub(crate) fn upload(&self, device: &Arc<Device>, state: &SimState, parity: usize) -> Result<()> {
         device.upload_pod(&self.positions[parity], &state.positions)?;
+        device.upload_pod(&self.before, &state.positions)?;
         device.upload_pod(&self.velocities[parity], &state.velocities)
     }
 
     /// Buffers by binding number for half `parity` (reads `parity`, writes the other),
     /// with `mesh` as the mesh collider's field (none: the placeholder).
-    pub(crate) fn bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 9] {
+    pub(crate) fn bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 10] {
         use binding::*;
         [
             (PARAMS, &self.params),
@@ -245,6 +253,7 @@ impl GpuState {
             (POS_OUT, &self.positions[1 - parity]),
             (VEL_OUT, &self.velocities[1 - parity]),
             (MESH_FIELD, mesh.unwrap_or(&self.no_mesh)),
+            (POS_BEFORE, &self.before),
         ]
     }
 }
