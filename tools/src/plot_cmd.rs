@@ -13,6 +13,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -95,6 +96,21 @@ impl Table {
     }
 }
 
+/// The chart of a panel: its caption and axes from 0 to `max_x` and `max_y`.
+fn axes<'a, 'b>(
+    area: &'a DrawingArea<BitMapBackend<'b>, Shift>,
+    caption: &str,
+    max_x: f64,
+    max_y: f64,
+) -> Result<ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>, Error> {
+    Ok(ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..max_x.max(1e-9), 0.0..max_y.max(1e-9))?)
+}
+
 fn line_chart(
     area: &DrawingArea<BitMapBackend<'_>, Shift>,
     caption: &str,
@@ -106,12 +122,7 @@ fn line_chart(
     let all = lines.values().flatten();
     let max_x = all.clone().map(|p| p.0).fold(0.0, f64::max) * 1.05;
     let max_y = all.map(|p| p.1).filter(|v| v.is_finite()).fold(0.0, f64::max) * 1.1;
-    let mut chart = ChartBuilder::on(area)
-        .caption(caption, ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(0.0..max_x.max(1e-9), 0.0..max_y.max(1e-9))?;
+    let mut chart = axes(area, caption, max_x, max_y)?;
     chart.configure_mesh().x_labels(6).x_label_formatter(&|x| short(*x)).x_desc(x_desc).y_desc(y_desc).draw()?;
     for (name, points) in lines {
         // The same name gets the same color in every panel.
@@ -265,12 +276,7 @@ fn scatter_chart(
     let all = series.values().flatten();
     let max_x = all.clone().map(|p| p.0).fold(0.0, f64::max) * 1.25;
     let max_y = all.map(|p| p.1).fold(0.0, f64::max) * 1.15;
-    let mut chart = ChartBuilder::on(area)
-        .caption(caption, ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(0.0..max_x.max(1e-9), 0.0..max_y.max(1e-9))?;
+    let mut chart = axes(area, caption, max_x, max_y)?;
     chart.configure_mesh().x_labels(6).x_desc(x_desc).y_desc(y_desc).draw()?;
     for (name, points) in series {
         let color = Palette99::pick(palette.iter().position(|p| p == name).unwrap_or(0)).to_rgba();
