@@ -248,6 +248,9 @@ pub fn composite_strands(scene: &CompositeScene<'_>) -> Vec<glam::Vec4> {
 /// [`composite_strands`] on at most `threads` threads.
 fn composite_on(scene: &CompositeScene<'_>, threads: usize) -> Vec<glam::Vec4> {
     let (w, h) = scene.extent;
+    if w == 0 || h == 0 {
+        return Vec::new();
+    }
     let n = COMPOSITE_SAMPLES;
     let n_hairs = scene.represented_hairs.max(1.0);
     let alpha = scene.opacity * (1.0 - (1.0 - 1.0 / n_hairs).powf(n_hairs));
@@ -421,6 +424,10 @@ mod tests {
         assert!(one.iter().zip(&three).all(|(a, b)| a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits)));
         for band in one.chunks(40 * BAND_ROWS as usize) {
             assert!(band.iter().any(|p| p.w > 0.0), "a band without hair: the scene does not test the bands");
+        }
+        // An empty extent is an empty image, not a panic.
+        for extent in [(0, 30), (40, 0)] {
+            assert!(composite_on(&CompositeScene { extent, ..scene }, 2).is_empty(), "{extent:?}");
         }
     }
 
