@@ -162,16 +162,7 @@ fn scene(gpu: &Gpu) -> Scene {
     let sim = thesis_sim(gpu);
     let renderer = Renderer::new(gpu.ctx(), &sim, &RenderParams::default()).expect("renderer");
     let offscreen = Offscreen::new(gpu.ctx(), W, H).expect("offscreen");
-    let center = scenes::THESIS_HEAD_CENTER;
-    let camera = Camera::look_at(
-        center + Vec3::new(0.0, -0.05, 1.0),
-        center - Vec3::new(0.0, 0.1, 0.0),
-        0.7,
-        W as f32 / H as f32,
-        0.05,
-        10.0,
-    )
-    .expect("camera");
+    let camera = common::front_camera(1.0, (W, H));
     Scene { sim, renderer, offscreen, camera }
 }
 

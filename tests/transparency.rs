@@ -50,16 +50,7 @@ fn params(transparency: Transparency) -> RenderParams {
 
 /// The camera of the small scenes: the thesis head from the front, 0.9 m away.
 fn camera() -> Camera {
-    let center = scenes::THESIS_HEAD_CENTER;
-    Camera::look_at(
-        center + Vec3::new(0.0, -0.05, 0.9),
-        center - Vec3::new(0.0, 0.1, 0.0),
-        0.7,
-        W as f32 / H as f32,
-        0.05,
-        10.0,
-    )
-    .expect("camera")
+    common::front_camera(0.9, (W, H))
 }
 
 struct Scene {

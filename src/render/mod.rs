@@ -337,13 +337,13 @@ impl Renderer {
         self.placement.bound_radius
     }
 
-    fn smooth_push(&self) -> SmoothPush {
+    fn smooth_push(&self, alpha: f32) -> SmoothPush {
         SmoothPush {
             strands: self.strands,
             points: self.points,
             level: self.detail.smoothing_level,
             stride: self.smoothed_vertices_per_strand(),
-            alpha: 1.0,
+            alpha,
         }
     }
 
@@ -396,8 +396,7 @@ impl Renderer {
             &[AccessKind::AnyWrite],
             &[AccessKind::VertexRead, AccessKind::TessellationRead, AccessKind::TessellationWrite],
         );
-        let smooth_push = SmoothPush { alpha: sim.alpha, ..self.smooth_push() };
-        let interpolate_push = self.interpolate_push();
+        let (smooth_push, interpolate_push) = (self.smooth_push(sim.alpha), self.interpolate_push());
         // SAFETY: guaranteed by the caller.
         unsafe {
             self.device.cmd_barrier(cmd, &[entry], &[], &[]);

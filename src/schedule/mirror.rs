@@ -132,11 +132,11 @@ pub(crate) struct Mirror {
 impl Mirror {
     /// A mirror on `device` holding `initial` (uploaded now; this submits and waits).
     pub(crate) fn new(device: &Arc<Device>, initial: &SimState, meta: Meta, layout: Layout) -> Result<Self> {
-        let half = |i: usize| Buffer::storage(device, &format!("vkhair hand-off positions {i}"), layout.positions);
-        let halves = [half(0)?, half(1)?];
-        let half =
-            |i: usize| Buffer::storage(device, &format!("vkhair hand-off positions before {i}"), layout.positions);
-        let before = [half(0)?, half(1)?];
+        let halves = |what: &str| -> Result<[Buffer; 2]> {
+            let half = |i: usize| Buffer::storage(device, &format!("vkhair hand-off {what} {i}"), layout.positions);
+            Ok([half(0)?, half(1)?])
+        };
+        let (halves, before) = (halves("positions")?, halves("positions before")?);
         for h in halves.iter().chain(&before) {
             device.upload_pod(h, &initial.positions)?;
         }

@@ -6,6 +6,22 @@ use vkhair::groom::scenes;
 use vkhair::sim::{RigidTransform, SimState};
 use vkhair::{ContextOptions, GpuContext, Groom, ValidationLog};
 
+/// The camera of the small scenes: the thesis head from the front, `distance`
+/// metres away, slightly above and looking a little down, for a `w` × `h` image.
+#[allow(dead_code, reason = "not every test file draws the thesis head")]
+pub fn front_camera(distance: f32, (w, h): (u32, u32)) -> vkhair::render::Camera {
+    let center = scenes::THESIS_HEAD_CENTER;
+    vkhair::render::Camera::look_at(
+        center + Vec3::new(0.0, -0.05, distance),
+        center - Vec3::new(0.0, 0.1, 0.0),
+        0.7,
+        w as f32 / h as f32,
+        0.05,
+        10.0,
+    )
+    .expect("camera")
+}
+
 /// Key hairs grown on the `thesis` scalp: `strands` × `points`, 0.35 m long with
 /// segments 1.5× longer toward the tip, from `seed`.
 #[allow(dead_code, reason = "not every test file grows its own groom")]

@@ -24,12 +24,12 @@ use vkhair::sim::{motion, Collider, SimParams, VolumeMode, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, RecordedWork};
 
 use crate::bench_measure::{fitted_exponent, measure_sim, Samples, SimCase, SimFigures};
-use modes::{render_rows, write_modes};
-
-mod modes;
 use crate::output::Error;
 use crate::render_cmd::bench_frames;
 use crate::say;
+use modes::{render_rows, write_modes};
+
+mod modes;
 
 /// Peak memory bandwidth of a few GPUs, bytes per second (vendors' figures): the
 /// physical bound of a stage that moves its bytes once.
@@ -377,8 +377,13 @@ fn write_scaling(out: &Path, curves: &[Curve]) -> Result<PathBuf, Error> {
             let _ = writeln!(csv, "{},{},{},{:.4},{:.4}", c.axis, c.unit, p.0, p.1, p.2);
         }
     }
+    write_csv(out, "scaling.csv", &csv)
+}
+
+/// Writes `csv` whole as `out/name` (creating `out`); returns its path.
+fn write_csv(out: &Path, name: &str, csv: &str) -> Result<PathBuf, Error> {
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
-    let path = out.join("scaling.csv");
+    let path = out.join(name);
     vkhair::files::write_atomic(&path, csv.as_bytes())?;
     Ok(path)
 }

@@ -86,8 +86,5 @@ pub(super) fn write_modes(out: &Path, modes: &[ModeRow]) -> Result<PathBuf, Erro
     for m in modes {
         let _ = writeln!(csv, "{},{},{:.4},{:.3},{:.3}", m.scene, m.mode, m.gpu_ms, m.mib, m.error);
     }
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
-    let path = out.join("transparency.csv");
-    vkhair::files::write_atomic(&path, csv.as_bytes())?;
-    Ok(path)
+    super::write_csv(out, "transparency.csv", &csv)
 }
