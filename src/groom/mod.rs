@@ -33,6 +33,7 @@ pub mod tfx;
 
 mod repair;
 mod resample;
+mod transform;
 
 pub use repair::Repairs;
 

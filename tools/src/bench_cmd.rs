@@ -239,7 +239,7 @@ fn bench_scenes(a: &BenchArgs) -> Result<(Vec<Scene>, Vec<String>), Error> {
     }];
     let (hair, bust) = (a.sintel.join("sintel_hair.tfx"), a.sintel.join("sintel_bust.obj"));
     if hair.is_file() && bust.is_file() {
-        let groom = crate::groom_input::load_scaled(&hair, false, 0.01, 32)?;
+        let groom = crate::groom_input::load_scaled(&hair, false, 0.01, 32)?.groom;
         let mut args = size((1280, 720));
         for s in ["--input", &hair.display().to_string(), "--obj", &bust.display().to_string(), "--scale", "0.01"] {
             args.push(s.to_owned());

@@ -3,7 +3,6 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
 use vkhair::groom::cyhair::HairFile;
 use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::{Groom, Repairs};
@@ -77,8 +76,9 @@ impl InputArgs {
         self.scale.unwrap_or(1.0)
     }
 
-    /// The --input groom, scaled and resampled (see [`load_scaled`]).
-    pub fn groom(&self, path: &Path) -> Result<Groom, Error> {
+    /// The --input groom, scaled and resampled, with the thickness it gives its
+    /// strands (see [`load_scaled`]).
+    pub fn groom(&self, path: &Path) -> Result<Scaled, Error> {
         load_scaled(path, self.strict, self.scale(), self.points.unwrap_or(16))
     }
 
@@ -92,6 +92,17 @@ impl InputArgs {
 /// repaired are (with a warning on stderr) unless `strict`; then the file is
 /// refused with the defect named.
 pub fn load(path: &Path, strict: bool) -> Result<(Groom, String), Error> {
+    load_with_defaults(path, strict).map(|(g, kind, _)| (g, kind))
+}
+
+/// The cyHair format's default thickness: a file that leaves it unchanged and has
+/// no thickness array says nothing about its strands' thickness.
+const CYHAIR_DEFAULT_THICKNESS: f32 = 1.0;
+
+/// [`load`], and the thickness a cyHair file gives every point in its header when
+/// it has no thickness array and the header says something other than the
+/// format's default.
+fn load_with_defaults(path: &Path, strict: bool) -> Result<(Groom, String, Option<f32>), Error> {
     let tfx = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("tfx"));
     let refused = |e: vkhair::Error| -> Error {
         match e {
@@ -101,14 +112,14 @@ pub fn load(path: &Path, strict: bool) -> Result<(Groom, String), Error> {
             e => e.into(),
         }
     };
-    let (groom, kind, repairs) = if tfx {
+    let (groom, kind, repairs, header_thickness) = if tfx {
         let (f, repairs) = if strict {
             (TfxFile::open(path).map_err(refused)?, Repairs::default())
         } else {
             TfxFile::open_repairing(path)?
         };
         let kind = format!("TressFX {} (.tfx)", f.version);
-        (f.groom, kind, repairs)
+        (f.groom, kind, repairs, None)
     } else {
         let (f, repairs) = if strict {
             (HairFile::open(path).map_err(refused)?, Repairs::default())
@@ -118,7 +129,9 @@ pub fn load(path: &Path, strict: bool) -> Result<(Groom, String), Error> {
         let info = f.info_str();
         let kind =
             format!("cyHair (.hair){}", if info.is_empty() { String::new() } else { format!(", info \"{info}\"") });
-        (f.groom, kind, repairs)
+        let header = f.defaults.thickness;
+        let header_thickness = (f.groom.thickness().is_none() && header != CYHAIR_DEFAULT_THICKNESS).then_some(header);
+        (f.groom, kind, repairs, header_thickness)
     };
     if !repairs.is_empty() {
         eprintln!(
@@ -127,14 +140,51 @@ pub fn load(path: &Path, strict: bool) -> Result<(Groom, String), Error> {
             groom.strand_count()
         );
     }
-    Ok((groom, kind))
+    Ok((groom, kind, header_thickness))
 }
 
-/// The groom in `path` (see [`load`]) with its positions multiplied by `scale`
-/// and every strand resampled to `points` points.
-pub fn load_scaled(path: &Path, strict: bool, scale: f32, points: usize) -> Result<Groom, Error> {
-    let (groom, _) = load(path, strict)?;
-    let counts: Vec<u32> = (0..groom.strand_count()).map(|i| groom.strand_len(i) as u32).collect();
-    let scaled: Vec<Vec3> = groom.positions().iter().map(|p| *p * scale).collect();
-    Ok(Groom::new(scaled, &counts)?.resampled(points)?)
+/// A groom read, scaled and resampled, with what it says about its strands' width.
+pub struct Scaled {
+    /// The groom (scaled, resampled; attributes kept).
+    pub groom: Groom,
+    /// Root and tip thickness (diameters, after scaling) when the file gives it:
+    /// the medians over the strands of a per-point thickness array, else a cyHair
+    /// header's default thickness when it is not the format's default of 1.
+    pub thickness: Option<(f32, f32)>,
+}
+
+/// The groom in `path` (see [`load`]) with its lengths (positions and thickness)
+/// multiplied by `scale` and every strand resampled to `points` points.
+pub fn load_scaled(path: &Path, strict: bool, scale: f32, points: usize) -> Result<Scaled, Error> {
+    let (groom, _, header_thickness) = load_with_defaults(path, strict)?;
+    let groom = groom.scaled(scale)?;
+    let thickness = groom.end_thickness().or(header_thickness.map(|t| (t * scale, t * scale)));
+    Ok(Scaled { groom: groom.resampled(points)?, thickness })
+}
+
+/// Plausible strand diameters, meters: from a fine human hair's 5 µm to a 2 mm
+/// strand standing for a clump. A groom's thickness outside is not used.
+const PLAUSIBLE_WIDTH: std::ops::RangeInclusive<f32> = 5e-6..=2e-3;
+
+/// The root and tip width to draw strands at, in the scene's units, from the
+/// `thickness` the groom file gives (see [`Scaled::thickness`]) for a scene
+/// drawn `k` times as wide as a head in meters: `None` (with a warning saying
+/// why when there was a thickness) when it has none or an implausible one,
+/// checked as meters after dividing by `k`. A tip thinner than the plausible
+/// least (tapered to a point) is kept.
+pub fn strand_widths(thickness: Option<(f32, f32)>, k: f32) -> Option<(f32, f32)> {
+    let (root, tip) = thickness?;
+    let (root_m, tip_m) = (root / k, tip / k);
+    let fits = PLAUSIBLE_WIDTH.contains(&root_m) && (0.0..=*PLAUSIBLE_WIDTH.end()).contains(&tip_m);
+    if !fits {
+        eprintln!(
+            "vkhair: warning: the groom's thickness ({root_m:e} m at the root, {tip_m:e} m at the tip after --scale) \
+             is not a hair's ({:e}..={:e} m); drawing vkhair's default widths instead (set material.root_width \
+             and tip_width in --config, or fix --scale)",
+            PLAUSIBLE_WIDTH.start(),
+            PLAUSIBLE_WIDTH.end()
+        );
+        return None;
+    }
+    Some((root, tip))
 }

@@ -15,7 +15,7 @@ use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, Schedu
 use vkhair::sim::{motion, Collider, RigidTransform, SimParams, VolumeMode, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
-use crate::groom_input::InputArgs;
+use crate::groom_input::{self, InputArgs};
 use crate::output::{progress, Error, FrameSink, MIN_IMAGE_SIDE};
 use crate::profile::{host_now_ns, Profile, ProfileArgs};
 use crate::say;
@@ -222,6 +222,8 @@ struct Scene {
     center: Vec3,
     /// Radius of the sphere around the groom and the mesh (their units).
     radius: f32,
+    /// Root and tip thickness the groom file gives (its units after --scale).
+    thickness: Option<(f32, f32)>,
     pivot: Vec3,
     credit: Option<&'static str>,
 }
@@ -263,14 +265,14 @@ fn bounds_sphere(points: impl Iterator<Item = Vec3>) -> (Vec3, f32) {
 fn scene(a: &RenderArgs) -> Result<Scene, Error> {
     let sintel =
         |p: &Option<PathBuf>| p.as_ref().is_some_and(|p| p.to_string_lossy().to_lowercase().contains("sintel"));
-    let (groom, colliders, head_mesh, pivot, credit) = match &a.input.input {
+    let (groom, thickness, colliders, head_mesh, pivot, credit) = match &a.input.input {
         None => {
             let head = TriMesh::uv_sphere(THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS * 0.97, 24, 32)?;
-            (scenes::thesis()?, motion::thesis_colliders(), head, Some(motion::NECK_PIVOT), None)
+            (scenes::thesis()?, None, motion::thesis_colliders(), head, Some(motion::NECK_PIVOT), None)
         }
         Some(path) => {
             let scale = a.input.scale();
-            let groom = a.input.groom(path)?;
+            let groom_input::Scaled { groom, thickness } = a.input.groom(path)?;
             let head_mesh = match &a.input.obj {
                 Some(obj) => {
                     let m = TriMesh::load_obj(obj)?;
@@ -286,7 +288,7 @@ fn scene(a: &RenderArgs) -> Result<Scene, Error> {
             };
             let credit = (sintel(&a.input.input) || sintel(&a.input.obj))
                 .then_some("Sintel © Blender Foundation | durian.blender.org (CC BY 3.0)");
-            (groom, Vec::new(), head_mesh, None, credit)
+            (groom, thickness, Vec::new(), head_mesh, None, credit)
         }
     };
     let (center, radius) = bounds_sphere(groom.positions().iter().chain(&head_mesh.positions).copied());
@@ -295,7 +297,7 @@ fn scene(a: &RenderArgs) -> Result<Scene, Error> {
     }
     let (lo, _) = groom.bounds();
     let pivot = pivot.unwrap_or(Vec3::new(center.x, lo.y, center.z));
-    Ok(Scene { groom, colliders, head_mesh, center, radius, pivot, credit })
+    Ok(Scene { groom, colliders, head_mesh, center, radius, thickness, pivot, credit })
 }
 
 /// Lights for a scene of bounding radius `radius` around `center`: two spots
@@ -350,13 +352,22 @@ fn framing(s: &Scene, distance: Option<f32>, aspect: f32) -> Result<Camera, vkha
     Camera::look_at(eye, s.center, FOV_Y, aspect, near, far)
 }
 /// The parameters: vkhair's defaults (an `--input` groom held in its authored
-/// style, [`SimParams::styled`]), then the `--config` file, then the flags given;
+/// style, [`SimParams::styled`]; strands as wide as the groom file says when it
+/// says something plausible), then the `--config` file, then the flags given;
 /// the tool's lights when the file lists none. Checked before any GPU work.
-fn parameters(a: &RenderArgs, center: Vec3, radius: f32) -> Result<Config, vkhair::Error> {
+fn parameters(a: &RenderArgs, s: &Scene) -> Result<Config, vkhair::Error> {
+    let (center, radius) = (s.center, s.radius);
     let sim = if a.input.input.is_some() { SimParams::styled() } else { SimParams::default() };
     let mut base = Config { sim, ..Config::default() };
     // The tool draws soft hair unless told otherwise (the library's default is opaque).
     base.render.transparency = Transparency::Exact;
+    let k = drawing_scale(radius);
+    let from_groom = groom_input::strand_widths(s.thickness, k);
+    if let Some((root, tip)) = from_groom {
+        // In the units the scale below converts from, so that they come out as given.
+        (base.material.root_width, base.material.tip_width) = (root / k, tip / k);
+    }
+    let base_widths = (base.material.root_width, base.material.tip_width);
     let mut config = match &a.config {
         Some(path) => base.load_over(path)?,
         None => base,
@@ -396,7 +407,13 @@ fn parameters(a: &RenderArgs, center: Vec3, radius: f32) -> Result<Config, vkhai
     if config.lights.is_empty() {
         config.lights = lights(center, radius);
     }
-    let k = drawing_scale(radius);
+    let m = &config.material;
+    let source = match from_groom {
+        _ if a.config.is_some() && (m.root_width, m.tip_width) != base_widths => "--config",
+        Some(_) => "the groom's thickness",
+        None => "vkhair's default",
+    };
+    say!("strand width: {:.1} µm at the root, {:.1} µm at the tip ({source})", m.root_width * 1e6, m.tip_width * 1e6);
     if k != 1.0 {
         eprintln!(
             "vkhair: warning: the groom and mesh span {:.3} units around their centre, not the size of a \
@@ -416,7 +433,7 @@ fn parameters(a: &RenderArgs, center: Vec3, radius: f32) -> Result<Config, vkhai
 pub fn render(a: &RenderArgs) -> Result<(), Error> {
     check_options(a)?;
     let s = scene(a)?;
-    let config = parameters(a, s.center, s.radius)?;
+    let config = parameters(a, &s)?;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let sim_params = config.sim.clone();
     let options = schedule_options(a)?;

@@ -165,7 +165,7 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     let (groom, colliders, label, pivot) = match &a.input.input {
         None => (scenes::thesis()?, motion::thesis_colliders(), "thesis scene".to_owned(), motion::NECK_PIVOT),
         Some(path) => {
-            let groom = a.input.groom(path)?;
+            let groom = a.input.groom(path)?.groom;
             // Turn about the centre of the roots' lowest level: roughly the neck.
             let (lo, hi) = groom.bounds();
             let pivot = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));

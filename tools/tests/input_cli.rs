@@ -54,6 +54,65 @@ fn a_flat_groom_renders() {
     assert!(covered > 0.01, "the flat groom covers {:.2} % of the image", 100.0 * covered);
 }
 
+/// Strands are drawn as wide as the groom file says (a cyHair thickness array,
+/// scaled with the groom), vkhair's default when it says nothing or something no
+/// hair could be (with a warning), and `--config` overrides both.
+#[test]
+fn strand_width_comes_from_the_groom_thickness() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let strands = common::cap_groom(150, 8, 10.0);
+    let counts: Vec<u32> = strands.iter().map(|s| s.len() as u32).collect();
+    let positions: Vec<Vec3> = strands.concat();
+    let write = |name: &str, thickness: Option<f32>| {
+        let path = dir.path().join(name);
+        let attributes =
+            vkhair::groom::Attributes { thickness: thickness.map(|t| vec![t; positions.len()]), ..Default::default() };
+        let groom = vkhair::Groom::with_attributes(positions.clone(), &counts, attributes).expect("groom");
+        vkhair::groom::cyhair::HairFile::new(groom, "t").save(&path).expect("save");
+        path
+    };
+    // In centimetres, as a groom from a DCC is: --scale 0.01 gives meters.
+    let thick = write("thick.hair", Some(0.03)); // 300 µm
+    let none = write("none.hair", None);
+    let absurd = write("absurd.hair", Some(5.0)); // 5 cm
+    let config = dir.path().join("widths.toml");
+    std::fs::write(&config, "[material]\nroot_width = 0.0002\ntip_width = 0.0001\n").expect("write config");
+    let render = |name: &str, groom: &std::path::Path, extra: &str| {
+        let out = dir.path().join(name);
+        let args = format!(
+            "render --input {} --scale 0.01 --frames 1 --width 160 --height 120 --shadow-resolution 64 --out {} {extra}",
+            groom.display(),
+            out.display()
+        );
+        let run = run_line(&args, LIMIT);
+        run.assert_ok();
+        let (_, _, rgba) = common::read_png(&out.join("frame_0000.png"));
+        (run, rgba)
+    };
+    let (thick_run, thick_image) = render("thick", &thick, "");
+    let (none_run, none_image) = render("none", &none, "");
+    let (absurd_run, absurd_image) = render("absurd", &absurd, "");
+    let (config_run, config_image) = render("config", &thick, &format!("--config {}", config.display()));
+    let (config_none_run, config_none_image) = render("config_none", &none, &format!("--config {}", config.display()));
+    let line = |r: &common::Run| {
+        r.stdout.lines().find(|l| l.starts_with("strand width:")).map(str::to_owned).unwrap_or_default()
+    };
+    assert_eq!(line(&thick_run), "strand width: 300.0 µm at the root, 300.0 µm at the tip (the groom's thickness)");
+    assert_eq!(line(&none_run), "strand width: 120.0 µm at the root, 50.0 µm at the tip (vkhair's default)");
+    assert_eq!(line(&absurd_run), line(&none_run));
+    assert!(absurd_run.stderr.contains("is not a hair's"), "{}", absurd_run.stderr);
+    assert!(!thick_run.stderr.contains("warning"), "{}", thick_run.stderr);
+    assert_eq!(line(&config_run), "strand width: 200.0 µm at the root, 100.0 µm at the tip (--config)");
+    assert_eq!(line(&config_none_run), line(&config_run));
+    // The picture follows: an implausible thickness draws exactly the default,
+    // the config draws the same whatever the groom says, thick hair covers more.
+    assert!(absurd_image == none_image, "an implausible thickness changed the picture");
+    assert!(config_image == config_none_image, "--config widths did not override the groom's");
+    let (thick_cover, none_cover) = (common::coverage(&thick_image), common::coverage(&none_image));
+    eprintln!("coverage: 300 µm {:.2} %, default {:.2} %", 100.0 * thick_cover, 100.0 * none_cover);
+    assert!(thick_cover > none_cover * 1.05, "300 µm strands cover {thick_cover}, the default's {none_cover}");
+}
+
 /// Options that mean something only with others are refused, saying what they
 /// need, before any GPU work.
 #[test]

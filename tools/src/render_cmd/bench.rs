@@ -142,7 +142,7 @@ pub fn bench_frames(ctx: &GpuContext, args: &[&str], samples: usize, unlit: bool
         .render;
     check_options(&a)?;
     let s = scene(&a)?;
-    let config = parameters(&a, s.center, s.radius)?;
+    let config = parameters(&a, &s)?;
     let mut sim = HairSim::new(ctx, &s.groom, &config.sim, &RigidTransform::default())?;
     sim.set_colliders(&s.colliders)?;
     let mut renderer = make_renderer(&a, ctx, &config, sim.key_hairs(), s.radius)?;
