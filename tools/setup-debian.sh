@@ -3,10 +3,12 @@
 # lavapipe (mesa-vulkan-drivers), the Vulkan loader, the validation layers,
 # Debian's static shaderc/glslang/SPIRV-Tools libraries (libshaderc-dev;
 # build.rs links them instead of building shaderc from source), spirv-val, and
-# the DejaVu font `vkhair plot` labels its charts with.
+# the DejaVu font `vkhair plot` labels its charts with, and for the windowed
+# viewer (examples/viewer, tests/viewer.rs) a virtual X server and the X11
+# libraries winit loads at run time.
 set -euo pipefail
 
-packages=(mesa-vulkan-drivers libvulkan1 vulkan-validationlayers libshaderc-dev glslc spirv-tools fonts-dejavu-core)
+packages=(mesa-vulkan-drivers libvulkan1 vulkan-validationlayers libshaderc-dev glslc spirv-tools fonts-dejavu-core xvfb libx11-xcb1 libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6)
 missing=()
 for p in "${packages[@]}"; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

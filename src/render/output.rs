@@ -23,8 +23,10 @@ impl Renderer {
     /// resolved into `target` (depth tested, not written). When the target's size
     /// changes, the images of the old size are kept until `frame` is
     /// [`super::RenderParams::frames_in_flight`] frames later. Viewport and scissor are
-    /// left set to the full target; the host binds its own pipeline and state
-    /// again afterwards.
+    /// left set to the full target and one of vkhair's pipelines bound; vkhair
+    /// binds no vertex or index buffers, so the host's stay bound, and the host
+    /// binds its own pipeline and pushes its constants again afterwards
+    /// (`tests/viewer.rs` draws after the hair relying on exactly this).
     ///
     /// With [`super::RenderParams::transparency`] on, the hair is composited over
     /// the target's colour instead (see `render/oit.rs`): each fragment depth-tested

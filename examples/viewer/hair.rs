@@ -1,0 +1,300 @@
+//! vkhair's part of the viewer: the scene the command line names, the
+//! simulation at a fixed 60 Hz through `FixedStepDriver`, the renderer drawing
+//! between the last two states by the driver's alpha, the GPU profiler, and the
+//! run-time controls the keys and the overlay change.
+
+use std::path::Path;
+
+use ash::vk;
+use glam::Vec3;
+use vkhair::config::Config;
+use vkhair::groom::cyhair::HairFile;
+use vkhair::groom::mesh::TriMesh;
+use vkhair::groom::scenes;
+use vkhair::groom::tfx::TfxFile;
+use vkhair::groom::Groom;
+use vkhair::render::{Camera, Light, RenderTarget, Renderer, ShadingMode, ShadowParams, Transparency};
+use vkhair::sim::{motion, Collider, FixedStepDriver, HairSim, RigidTransform, SimState};
+use vkhair::{ash, GpuContext, GpuProfiler, ProfileReport};
+
+use crate::host::BoxError;
+use crate::Args;
+
+/// Frames the host keeps in flight (vkhair's `RenderParams::frames_in_flight`
+/// is set to match).
+pub const FRAMES_IN_FLIGHT: u32 = 2;
+
+/// The groom, what it collides with and the head the host draws.
+pub struct Scene {
+    pub groom: Groom,
+    pub head: TriMesh,
+    /// Whether the strands collide with `head` (an --obj mesh).
+    pub mesh_collider: bool,
+    /// Sphere and capsule colliders (the thesis scene's).
+    pub colliders: Vec<Collider>,
+    pub center: Vec3,
+    pub radius: f32,
+}
+
+impl Scene {
+    /// The thesis scene, or `--input` (`.hair` or `.tfx`, repaired when it has
+    /// defects) with `--obj` scaled by `--scale`.
+    pub fn load(args: &Args) -> Result<Scene, BoxError> {
+        let (groom, head, mesh_collider, colliders) = match &args.input {
+            None => {
+                let head = TriMesh::uv_sphere(scenes::THESIS_HEAD_CENTER, scenes::THESIS_HEAD_RADIUS * 0.97, 24, 32)?;
+                (scenes::thesis()?, head, false, motion::thesis_colliders())
+            }
+            Some(path) => {
+                let groom = read_groom(path)?.scaled(args.scale)?.resampled(16)?;
+                let head = match &args.obj {
+                    Some(obj) => {
+                        let m = TriMesh::load_obj(obj)?;
+                        TriMesh::new(m.positions.iter().map(|p| *p * args.scale).collect(), m.triangles)?
+                    }
+                    None => {
+                        let (lo, hi) = groom.bounds();
+                        TriMesh::uv_sphere(0.5 * (lo + hi), 0.25 * (hi - lo).max_element(), 16, 24)?
+                    }
+                };
+                (groom, head, args.obj.is_some(), Vec::new())
+            }
+        };
+        let (lo, hi) = groom
+            .positions()
+            .iter()
+            .chain(&head.positions)
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let (center, radius) = (0.5 * (lo + hi), 0.5 * (hi - lo).length());
+        if !(center.is_finite() && radius.is_finite() && radius > 0.0) {
+            return Err(format!("the groom and mesh span no finite volume (radius {radius})").into());
+        }
+        Ok(Scene { groom, head, mesh_collider, colliders, center, radius })
+    }
+}
+
+fn read_groom(path: &Path) -> Result<Groom, BoxError> {
+    let tfx = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("tfx"));
+    let (groom, repairs) = if tfx {
+        let (f, r) = TfxFile::open_repairing(path)?;
+        (f.groom, r)
+    } else {
+        let (f, r) = HairFile::open_repairing(path)?;
+        (f.groom, r)
+    };
+    if !repairs.is_empty() {
+        eprintln!("viewer: warning: {}: {repairs}", path.display());
+    }
+    Ok(groom)
+}
+
+/// Key and fill spots and a rim light around `center`, for a scene of `radius`.
+fn lights(center: Vec3, radius: f32) -> Vec<Light> {
+    let k = radius / 0.465; // the thesis head of hair's radius, meters
+    let spot = |offset: Vec3, color: Vec3| Light::Spot {
+        position: center + k * offset,
+        direction: -offset,
+        outer_angle: 0.6,
+        inner_angle: 0.4,
+        color: color * k * k,
+    };
+    vec![
+        spot(Vec3::new(-0.6, 0.5, 0.8), Vec3::splat(1.1)),
+        spot(Vec3::new(0.9, 0.1, 0.4), Vec3::new(0.25, 0.27, 0.33)),
+        Light::Directional { direction: Vec3::new(0.2, -0.3, 1.0), color: Vec3::new(0.25, 0.22, 0.2) },
+    ]
+}
+
+/// The simulation, the renderer and the controls.
+pub struct Hair {
+    pub sim: HairSim,
+    pub renderer: Renderer,
+    pub profiler: GpuProfiler,
+    pub config: Config,
+    pub shadows: ShadowParams,
+    pub shadows_on: bool,
+    /// Latest per-pass GPU timings.
+    pub report: Option<ProfileReport>,
+    pub paused: bool,
+    /// Steps still to run while paused (the single-step key).
+    pub pending_steps: u32,
+    /// Whether the head follows the reference motion (else it stays still).
+    pub moving: bool,
+    pub steps_done: u64,
+    driver: FixedStepDriver,
+    initial: SimState,
+    alpha: f32,
+}
+
+impl Hair {
+    pub fn new(ctx: &GpuContext, scene: &Scene, config: Config) -> Result<Hair, BoxError> {
+        let mut config = config;
+        config.render.frames_in_flight = FRAMES_IN_FLIGHT;
+        if config.lights.is_empty() {
+            config.lights = lights(scene.center, scene.radius);
+        }
+        let head = RigidTransform::default();
+        let mut sim = HairSim::new(ctx, &scene.groom, &config.sim, &head)?;
+        sim.set_colliders(&scene.colliders)?;
+        if scene.mesh_collider {
+            sim.set_mesh(Some(&scene.head), &config.mesh_collider)?;
+        }
+        let initial = sim.read_state()?;
+        let mut renderer = Renderer::new(ctx, &sim, &config.render)?;
+        renderer.set_lights(&config.lights)?;
+        renderer.set_material(&config.material)?;
+        let k = scene.radius / 0.465;
+        let layers = ShadowParams::default().layers.map(|l| l * k);
+        let shadows = ShadowParams { casters: vec![0.into(), 1.into()], layers, ..ShadowParams::default() };
+        renderer.set_shadows(&sim, &shadows)?;
+        let profiler = GpuProfiler::new(ctx, FRAMES_IN_FLIGHT, 64)?;
+        let driver = FixedStepDriver::new(f64::from(config.sim.dt), 2)?;
+        Ok(Hair {
+            sim,
+            renderer,
+            profiler,
+            config,
+            shadows,
+            shadows_on: true,
+            report: None,
+            paused: false,
+            pending_steps: 0,
+            moving: false,
+            steps_done: 0,
+            driver,
+            initial,
+            alpha: 1.0,
+        })
+    }
+
+    /// Records frame `frame`: the steps due after `frame_time` seconds, the
+    /// geometry between the last two states, the shadow maps.
+    ///
+    /// # Safety
+    /// `cmd` records for the context's queue, outside rendering; the frame
+    /// `frame − FRAMES_IN_FLIGHT` has completed.
+    pub unsafe fn record_simulation(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: u64,
+        frame_time: f64,
+        camera: &Camera,
+    ) -> Result<(), BoxError> {
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            if let Some(report) = self.profiler.begin_frame(cmd, frame) {
+                self.report = Some(report);
+            }
+            let steps = if self.paused {
+                self.alpha = 1.0;
+                std::mem::take(&mut self.pending_steps)
+            } else {
+                let plan = self.driver.advance(frame_time);
+                self.alpha = plan.alpha;
+                plan.steps
+            };
+            for _ in 0..steps {
+                self.steps_done += 1;
+                let t = self.steps_done as f32 * self.config.sim.dt;
+                let head = if self.moving { motion::reference_motion(t) } else { RigidTransform::default() };
+                self.sim.record_step(cmd, &head, Some(&mut self.profiler))?;
+            }
+            let key_hairs = self.sim.key_hairs().blended(self.alpha)?;
+            self.renderer.record_prepare(cmd, key_hairs, Some(camera), Some(&mut self.profiler))?;
+            self.renderer.record_shadows(cmd, &self.sim, Some(&mut self.profiler))?;
+        }
+        Ok(())
+    }
+
+    /// Records the hair into the host's `target`.
+    ///
+    /// # Safety
+    /// As for [`Hair::record_simulation`], recorded after it.
+    pub unsafe fn record_draw(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: u64,
+        target: &RenderTarget,
+        camera: &Camera,
+    ) -> Result<(), BoxError> {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.renderer.record_draw(cmd, frame, target, camera, Some(&mut self.profiler)) }?;
+        Ok(())
+    }
+
+    /// Back to the first state (the device must be idle: the state is uploaded).
+    pub fn reset(&mut self) -> Result<(), BoxError> {
+        self.sim.write_state(&self.initial)?;
+        self.driver = FixedStepDriver::new(f64::from(self.config.sim.dt), 2)?;
+        self.steps_done = 0;
+        Ok(())
+    }
+
+    /// Applies `config.sim`, `config.render` and `config.material` after a change.
+    pub fn apply(&mut self) -> Result<(), BoxError> {
+        self.sim.set_params(&self.config.sim)?;
+        self.renderer.set_params(&self.config.render)?;
+        self.renderer.set_material(&self.config.material)?;
+        Ok(())
+    }
+
+    /// Shadows on or off, or a new map resolution (the device must be idle).
+    pub fn apply_shadows(&mut self) -> Result<(), BoxError> {
+        let params = if self.shadows_on {
+            self.shadows.clone()
+        } else {
+            ShadowParams { casters: Vec::new(), ..self.shadows.clone() }
+        };
+        self.renderer.set_shadows(&self.sim, &params)?;
+        Ok(())
+    }
+
+    pub fn toggle_lod(&mut self) -> Result<(), BoxError> {
+        self.config.render.lod.enabled = !self.config.render.lod.enabled;
+        self.apply()
+    }
+
+    pub fn toggle_supersampling(&mut self) -> Result<(), BoxError> {
+        self.config.render.supersampling = !self.config.render.supersampling;
+        self.apply()
+    }
+
+    pub fn next_shading(&mut self) -> Result<(), BoxError> {
+        self.config.material.shading = match self.config.material.shading {
+            ShadingMode::KajiyaKay => ShadingMode::Marschner,
+            _ => ShadingMode::KajiyaKay,
+        };
+        self.apply()
+    }
+
+    pub fn next_transparency(&mut self) -> Result<(), BoxError> {
+        self.config.render.transparency = match self.config.render.transparency {
+            Transparency::Off => Transparency::Fast,
+            Transparency::Fast => Transparency::Exact,
+            Transparency::Exact => Transparency::Off,
+        };
+        self.apply()
+    }
+
+    /// A line saying what is on, for the overlay and the log.
+    pub fn status(&self) -> String {
+        let r = &self.config.render;
+        format!(
+            "LOD {} · shadows {} · SSAA {} · {:?} · transparency {:?}{}",
+            on(r.lod.enabled),
+            on(self.shadows_on),
+            on(r.supersampling),
+            self.config.material.shading,
+            r.transparency,
+            if self.paused { " · paused" } else { "" }
+        )
+    }
+}
+
+fn on(b: bool) -> &'static str {
+    if b {
+        "on"
+    } else {
+        "off"
+    }
+}

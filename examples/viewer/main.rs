@@ -1,0 +1,261 @@
+//! A windowed host embedding vkhair the way an engine does.
+//!
+//! The viewer owns everything Vulkan: a `winit` window, an `ash-window`
+//! surface, its own instance, device, queue and `gpu-allocator` allocator, a
+//! swapchain with two frames in flight (recreated on resize), the head mesh and
+//! floor it draws itself, and an egui overlay drawn by `egui-ash-renderer`.
+//! vkhair borrows the device through `GpuContext::from_host` and records into
+//! the viewer's command buffer every frame: the simulation at a fixed 60 Hz
+//! (`FixedStepDriver`), the key hairs drawn between the last two states by the
+//! driver's alpha, shadow maps and hair, all timed by `GpuProfiler`.
+//!
+//! ```text
+//! cargo run --release --example viewer
+//! cargo run --release --example viewer -- --input sintel_hair.tfx --obj sintel_bust.obj --scale 0.01
+//! ```
+//!
+//! Mouse: drag to orbit, scroll to zoom. Keys: L level of detail, S shadows,
+//! A supersampling, K shading model, T transparency, M head motion, Space
+//! pause, N one step while paused, R reset, Esc quit. `--frames N
+//! --screenshot FILE.png` renders N frames through the swapchain, saves the last
+//! presented image and exits; `--validation` turns on the Khronos layer with
+//! synchronization validation and makes any message an error.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Parser;
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{Key, NamedKey};
+use winit::window::{Window, WindowId};
+
+#[path = "../embed_minimal/host.rs"]
+#[allow(dead_code)]
+mod host;
+
+mod device;
+mod frame;
+mod hair;
+mod overlay;
+mod record;
+mod scene;
+mod swapchain;
+
+use frame::Running;
+use host::BoxError;
+
+/// Command line.
+#[derive(Parser, Debug, Clone)]
+#[command(name = "viewer", about = "vkhair in a window: a host with a swapchain, an egui overlay and vkhair beside it")]
+pub struct Args {
+    /// Groom file (.hair or .tfx) instead of the thesis scene.
+    #[arg(long)]
+    pub input: Option<PathBuf>,
+    /// Character mesh (OBJ, the groom's units) the strands collide with and the viewer draws.
+    #[arg(long)]
+    pub obj: Option<PathBuf>,
+    /// Multiply groom and mesh positions by this (0.01: centimetres to meters).
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f32,
+    /// TOML parameters over vkhair's defaults (see presets/).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Window width, pixels.
+    #[arg(long, default_value_t = 1280)]
+    pub width: u32,
+    /// Window height, pixels.
+    #[arg(long, default_value_t = 720)]
+    pub height: u32,
+    /// Render this many frames, then exit.
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// Save the last presented image here (PNG), with --frames.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    /// Ask the window system for a new size (WIDTHxHEIGHT) at frame --resize-frame.
+    #[arg(long, value_parser = parse_size)]
+    pub resize: Option<(u32, u32)>,
+    /// The frame at which --resize is asked for.
+    #[arg(long, default_value_t = 30)]
+    pub resize_frame: u64,
+    /// No egui overlay.
+    #[arg(long)]
+    pub no_overlay: bool,
+    /// Simulate but draw no hair: the host's scene alone, for comparison.
+    #[arg(long)]
+    pub no_hair: bool,
+    /// The Khronos validation layer with synchronization validation; any message
+    /// fails the run (exit status 2).
+    #[arg(long)]
+    pub validation: bool,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once('x').ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
+    let parse = |v: &str| v.parse::<u32>().ok().filter(|v| (16..=8192).contains(v));
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!("each side must be 16..=8192 pixels (got {s:?})")),
+    }
+}
+
+/// The application: the window, then everything drawn into it.
+struct App {
+    args: Args,
+    window: Option<Window>,
+    running: Option<Running>,
+    /// The first error, which ends the run.
+    error: Option<BoxError>,
+    /// Validation messages of the finished run.
+    messages: Vec<String>,
+    last_frame: Instant,
+    cursor: (f64, f64),
+    dragging: bool,
+}
+
+impl App {
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: BoxError) {
+        self.error.get_or_insert(e);
+        event_loop.exit();
+    }
+
+    fn shut_down(&mut self) {
+        if let Some(running) = self.running.take() {
+            self.messages = running.shut_down();
+        }
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.window.is_some() {
+            return;
+        }
+        let attributes = Window::default_attributes()
+            .with_title("vkhair viewer")
+            .with_inner_size(winit::dpi::PhysicalSize::new(self.args.width, self.args.height));
+        let made = event_loop
+            .create_window(attributes)
+            .map_err(BoxError::from)
+            .and_then(|window| Running::new(&self.args, &window).map(|r| (window, r)));
+        match made {
+            Ok((window, running)) => {
+                self.window = Some(window);
+                self.running = Some(running);
+                self.last_frame = Instant::now();
+            }
+            Err(e) => self.fail(event_loop, e),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let (Some(window), Some(running)) = (self.window.as_ref(), self.running.as_mut()) else {
+            return;
+        };
+        if running.overlay_event(window, &event) {
+            return;
+        }
+        let result = match event {
+            WindowEvent::CloseRequested => {
+                event_loop.exit();
+                Ok(())
+            }
+            WindowEvent::Resized(_) => {
+                running.resized = true;
+                Ok(())
+            }
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed && !event.repeat => {
+                match event.logical_key.as_ref() {
+                    Key::Named(NamedKey::Escape) => {
+                        event_loop.exit();
+                        Ok(())
+                    }
+                    Key::Named(NamedKey::Space) => running.key(" "),
+                    Key::Character(c) => running.key(&c.to_lowercase()),
+                    _ => Ok(()),
+                }
+            }
+            WindowEvent::MouseInput { state, button: MouseButton::Left, .. } => {
+                self.dragging = state == ElementState::Pressed && !running.overlay_wants_pointer();
+                Ok(())
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                if self.dragging {
+                    running.orbit.drag((position.x - self.cursor.0) as f32, (position.y - self.cursor.1) as f32);
+                }
+                self.cursor = (position.x, position.y);
+                Ok(())
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                running.orbit.zoom(lines);
+                Ok(())
+            }
+            WindowEvent::RedrawRequested => {
+                let now = Instant::now();
+                let dt = now.duration_since(self.last_frame).as_secs_f64();
+                self.last_frame = now;
+                running.draw(window, dt, &self.args).map(|done| {
+                    if done {
+                        event_loop.exit();
+                    }
+                })
+            }
+            _ => Ok(()),
+        };
+        if let Err(e) = result {
+            self.fail(event_loop, e);
+        }
+    }
+
+    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
+        if let Some(window) = &self.window {
+            window.request_redraw();
+        }
+    }
+
+    fn exiting(&mut self, _: &ActiveEventLoop) {
+        self.shut_down();
+    }
+}
+
+fn main() -> std::process::ExitCode {
+    let mut args = Args::parse();
+    args.validation |= std::env::var("VKHAIR_VALIDATION").is_ok_and(|v| v == "1");
+    if args.screenshot.is_some() && args.frames.is_none() {
+        eprintln!("viewer: --screenshot needs --frames (the frame whose image is saved)");
+        return std::process::ExitCode::from(1);
+    }
+    let mut app = App {
+        args,
+        window: None,
+        running: None,
+        error: None,
+        messages: Vec::new(),
+        last_frame: Instant::now(),
+        cursor: (0.0, 0.0),
+        dragging: false,
+    };
+    let result = EventLoop::new().map_err(BoxError::from).and_then(|event_loop| {
+        event_loop.set_control_flow(ControlFlow::Poll);
+        event_loop.run_app(&mut app).map_err(BoxError::from)
+    });
+    app.shut_down();
+    for m in &app.messages {
+        eprintln!("validation: {m}");
+    }
+    if let Some(e) = app.error.or(result.err()) {
+        eprintln!("viewer: {e}");
+        return std::process::ExitCode::from(1);
+    }
+    if !app.messages.is_empty() {
+        eprintln!("viewer: {} validation messages", app.messages.len());
+        return std::process::ExitCode::from(2);
+    }
+    std::process::ExitCode::SUCCESS
+}

@@ -1,0 +1,244 @@
+//! What the viewer draws itself: the head mesh before the hair and a floor
+//! after it (as a host's later passes would be), lit by one fixed light, with
+//! its own pipeline (dynamic viewport and scissor) and vertex buffer.
+
+use std::sync::Mutex;
+
+use ash::vk;
+use glam::{Mat4, Vec3};
+use gpu_allocator::vulkan::{Allocation, Allocator};
+use gpu_allocator::MemoryLocation;
+use vkhair::groom::mesh::TriMesh;
+use vkhair::{ash, gpu_allocator};
+
+use crate::host::{allocate, compile, BoxError, Memory};
+use crate::swapchain::DEPTH;
+
+const VERT: &str = r#"#version 460
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(push_constant) uniform Push { mat4 view_projection; vec4 color; } pc;
+layout(location = 0) out vec3 v_normal;
+void main() {
+    v_normal = normal;
+    gl_Position = pc.view_projection * vec4(position, 1.0);
+}
+"#;
+
+const FRAG: &str = r#"#version 460
+layout(location = 0) in vec3 v_normal;
+layout(push_constant) uniform Push { mat4 view_projection; vec4 color; } pc;
+layout(location = 0) out vec4 color;
+void main() {
+    float l = max(dot(normalize(v_normal), normalize(vec3(-0.4, 0.6, 0.7))), 0.0);
+    color = vec4(pc.color.rgb * (0.3 + 0.7 * l), 1.0);
+}
+"#;
+
+/// The head's and the floor's colours (linear).
+const HEAD_COLOR: [f32; 4] = [0.45, 0.30, 0.24, 1.0];
+const FLOOR_COLOR: [f32; 4] = [0.12, 0.12, 0.13, 1.0];
+
+/// The viewer's own geometry and the pipeline that draws it.
+pub struct HostScene {
+    device: ash::Device,
+    pipeline: vk::Pipeline,
+    layout: vk::PipelineLayout,
+    buffer: vk::Buffer,
+    memory: Memory,
+    /// Vertex ranges (first, count) of the head and the floor.
+    head: (u32, u32),
+    floor: (u32, u32),
+}
+
+impl HostScene {
+    /// The head `mesh` and a floor square of half side `floor_half` at height
+    /// `floor_y` under `center`, drawn into `color_format` with [`DEPTH`].
+    pub fn new(
+        device: &ash::Device,
+        allocator: &Mutex<Allocator>,
+        color_format: vk::Format,
+        mesh: &TriMesh,
+        (center, floor_y, floor_half): (Vec3, f32, f32),
+    ) -> Result<HostScene, BoxError> {
+        let mut vertices: Vec<f32> = Vec::new();
+        for t in 0..mesh.triangles.len() {
+            let n = mesh.scaled_normal(t).normalize_or_zero();
+            for p in mesh.corners(t) {
+                vertices.extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z]);
+            }
+        }
+        let head = (0, (vertices.len() / 6) as u32);
+        let (x0, x1, z0, z1) =
+            (center.x - floor_half, center.x + floor_half, center.z - floor_half, center.z + floor_half);
+        for [x, z] in [[x0, z0], [x0, z1], [x1, z1], [x0, z0], [x1, z1], [x1, z0]] {
+            vertices.extend_from_slice(&[x, floor_y, z, 0.0, 1.0, 0.0]);
+        }
+        let floor = (head.1, 6);
+        let size = (vertices.len() * 4) as u64;
+        let info = vk::BufferCreateInfo::default().size(size).usage(vk::BufferUsageFlags::VERTEX_BUFFER);
+        // SAFETY: valid create info; destroyed in `destroy`.
+        let buffer = unsafe { device.create_buffer(&info, None) }?;
+        // SAFETY: the buffer is alive.
+        let requirements = unsafe { device.get_buffer_memory_requirements(buffer) };
+        let mut memory: Allocation =
+            allocate(allocator, "viewer scene vertices", requirements, MemoryLocation::CpuToGpu, true)?;
+        // SAFETY: memory allocated for this buffer.
+        unsafe { device.bind_buffer_memory(buffer, memory.memory(), memory.offset()) }?;
+        memory.mapped_slice_mut().ok_or("vertex memory is not mapped")?[..size as usize]
+            .copy_from_slice(bytemuck::cast_slice(&vertices));
+        let (pipeline, layout) = pipeline(device, color_format)?;
+        Ok(HostScene { device: device.clone(), pipeline, layout, buffer, memory: Memory(Some(memory)), head, floor })
+    }
+
+    /// Records the head inside the caller's rendering (color attachment of the
+    /// format given at creation, depth [`DEPTH`]): binds the pipeline and the
+    /// vertex buffer, sets viewport and scissor to `extent`.
+    ///
+    /// # Safety
+    /// `cmd` is recording inside such a rendering.
+    pub unsafe fn record_head(&self, cmd: vk::CommandBuffer, extent: vk::Extent2D, view_projection: Mat4) {
+        let d = &self.device;
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: extent.width as f32,
+            height: extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        // SAFETY: guaranteed by the caller; every object here is alive.
+        unsafe {
+            d.cmd_set_viewport(cmd, 0, &[viewport]);
+            d.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
+            d.cmd_bind_vertex_buffers(cmd, 0, &[self.buffer], &[0]);
+            self.draw(cmd, self.head, HEAD_COLOR, view_projection);
+        }
+    }
+
+    /// Records the floor after vkhair's hair, inside the caller's rendering of
+    /// the same attachments, relying on what vkhair documents about the state it
+    /// leaves: the vertex buffer bound by [`HostScene::record_head`] is still
+    /// bound (vkhair binds none), and the viewport and scissor are the full
+    /// target (`Renderer::record_draw` leaves them so). Only the pipeline and
+    /// the push constants are the host's to set again.
+    ///
+    /// # Safety
+    /// As for [`HostScene::record_head`], after it and after `record_draw` in the
+    /// same command buffer.
+    pub unsafe fn record_floor(&self, cmd: vk::CommandBuffer, view_projection: Mat4) {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.draw(cmd, self.floor, FLOOR_COLOR, view_projection) }
+    }
+
+    /// Binds the pipeline, pushes the constants and draws `(first, count)`.
+    unsafe fn draw(&self, cmd: vk::CommandBuffer, (first, count): (u32, u32), color: [f32; 4], view_projection: Mat4) {
+        let d = &self.device;
+        let mut push = [0f32; 20];
+        push[..16].copy_from_slice(&view_projection.to_cols_array());
+        push[16..].copy_from_slice(&color);
+        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+        // SAFETY: guaranteed by the callers.
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_push_constants(cmd, self.layout, stages, 0, bytemuck::cast_slice(&push));
+            d.cmd_draw(cmd, count, 1, first, 0);
+        }
+    }
+
+    /// Destroys everything (no pending work uses it).
+    pub fn destroy(&mut self, allocator: &Mutex<Allocator>) {
+        // SAFETY: the caller waited for the device.
+        unsafe {
+            self.device.destroy_pipeline(self.pipeline, None);
+            self.device.destroy_pipeline_layout(self.layout, None);
+            self.device.destroy_buffer(self.buffer, None);
+        }
+        self.memory.free(allocator);
+    }
+}
+
+/// The mesh pipeline for `color_format` and [`DEPTH`].
+fn pipeline(device: &ash::Device, color_format: vk::Format) -> Result<(vk::Pipeline, vk::PipelineLayout), BoxError> {
+    let vert = compile(VERT, shaderc::ShaderKind::Vertex, "scene.vert")?;
+    let frag = compile(FRAG, shaderc::ShaderKind::Fragment, "scene.frag")?;
+    // SAFETY: SPIR-V from shaderc; destroyed below once the pipeline exists.
+    let modules = unsafe {
+        [
+            device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&vert), None)?,
+            device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&frag), None)?,
+        ]
+    };
+    let stages_flags = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+    let push = [vk::PushConstantRange { stage_flags: stages_flags, offset: 0, size: 80 }];
+    // SAFETY: valid create info; destroyed by `HostScene::destroy`.
+    let layout = unsafe {
+        device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&push), None)
+    }?;
+    let stages = [
+        vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::VERTEX)
+            .module(modules[0])
+            .name(c"main"),
+        vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::FRAGMENT)
+            .module(modules[1])
+            .name(c"main"),
+    ];
+    let bindings =
+        [vk::VertexInputBindingDescription { binding: 0, stride: 24, input_rate: vk::VertexInputRate::VERTEX }];
+    let attributes = [
+        vk::VertexInputAttributeDescription {
+            location: 0,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: 0,
+        },
+        vk::VertexInputAttributeDescription {
+            location: 1,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: 12,
+        },
+    ];
+    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+        .vertex_binding_descriptions(&bindings)
+        .vertex_attribute_descriptions(&attributes);
+    let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+    let viewport_state = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+    let raster = vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(vk::PolygonMode::FILL)
+        .cull_mode(vk::CullModeFlags::NONE)
+        .line_width(1.0);
+    let multisample =
+        vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let depth_state = vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(true)
+        .depth_write_enable(true)
+        .depth_compare_op(vk::CompareOp::LESS);
+    let blend_attachments =
+        [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
+    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+    let dynamic = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+    let dynamic_state = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
+    let formats = [color_format];
+    let mut rendering =
+        vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats).depth_attachment_format(DEPTH);
+    let info = vk::GraphicsPipelineCreateInfo::default()
+        .stages(&stages)
+        .vertex_input_state(&vertex_input)
+        .input_assembly_state(&assembly)
+        .viewport_state(&viewport_state)
+        .rasterization_state(&raster)
+        .multisample_state(&multisample)
+        .depth_stencil_state(&depth_state)
+        .color_blend_state(&blend)
+        .dynamic_state(&dynamic_state)
+        .layout(layout)
+        .push_next(&mut rendering);
+    // SAFETY: every pointer refers to locals alive for the call.
+    let created = unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
+    // SAFETY: the modules are no longer needed once the pipeline exists (or failed).
+    unsafe { modules.iter().for_each(|m| device.destroy_shader_module(*m, None)) };
+    Ok((created.map_err(|(_, e)| e)?[0], layout))
+}

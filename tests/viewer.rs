@@ -1,0 +1,176 @@
+//! The windowed viewer example (`examples/viewer`) under a virtual X server:
+//! 120 frames through a real swapchain with validation and synchronization
+//! validation on and a resize half way, the screenshot showing hair, the
+//! overlay present, and the floor the host draws after vkhair's hair relying on
+//! the state vkhair documents it leaves (opaque, exact transparency and
+//! supersampled hair). Run it through `cargo test`, which builds the example
+//! (`cargo test --test viewer` alone does not rebuild it). Skipped, saying why, where no X server
+//! can be started (Debian: `apt install xvfb`, which tools/setup-debian.sh does).
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// A virtual X server for the test, stopped on drop.
+struct Xvfb(Child);
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// An X display: a new Xvfb when the binary is there, else `$DISPLAY`.
+fn display() -> Result<(String, Option<Xvfb>), String> {
+    let xvfb = std::env::var_os("PATH")
+        .and_then(|paths| std::env::split_paths(&paths).map(|p| p.join("Xvfb")).find(|p| p.is_file()));
+    if let Some(xvfb) = xvfb {
+        let free = (90..190).find(|n| {
+            !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && !Path::new(&format!("/tmp/.X{n}-lock")).exists()
+        });
+        let n = free.ok_or("no free X display number in :90..:190")?;
+        let child = Command::new(xvfb)
+            .args([
+                format!(":{n}"),
+                "-screen".into(),
+                "0".into(),
+                "1024x768x24".into(),
+                "-nolisten".into(),
+                "tcp".into(),
+            ])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .map_err(|e| format!("Xvfb did not start: {e}"))?;
+        let server = Xvfb(child);
+        let start = Instant::now();
+        while !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
+            if start.elapsed() > Duration::from_secs(20) {
+                return Err("Xvfb did not open its socket in 20 s".into());
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        return Ok((format!(":{n}"), Some(server)));
+    }
+    match std::env::var("DISPLAY") {
+        Ok(d) if !d.is_empty() => Ok((d, None)),
+        _ => Err("no Xvfb on PATH and no $DISPLAY (install Debian's xvfb)".into()),
+    }
+}
+
+/// The example's binary, which `cargo test` builds beside the tests.
+fn viewer() -> PathBuf {
+    let exe = std::env::current_exe().expect("test binary path");
+    let dir = exe.parent().and_then(Path::parent).expect("target directory");
+    let path = dir.join("examples").join(format!("viewer{}", std::env::consts::EXE_SUFFIX));
+    assert!(path.is_file(), "{} is missing: cargo test builds the examples", path.display());
+    path
+}
+
+/// Runs the viewer on `display` and returns its screenshot's size and RGBA pixels.
+fn run(display: &str, out: &Path, args: &[&str]) -> (u32, u32, Vec<u8>) {
+    let output = Command::new(viewer())
+        .env("DISPLAY", display)
+        .args(["--validation", "--screenshot"])
+        .arg(out)
+        .args(args)
+        .output()
+        .expect("run the viewer");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "viewer {args:?}: {:?}\n{stdout}\n{stderr}", output.status);
+    assert!(!stderr.contains("validation"), "viewer {args:?} had validation messages:\n{stderr}");
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(out).expect("screenshot")));
+    let mut reader = decoder.read_info().expect("png header");
+    let mut pixels = vec![0; reader.output_buffer_size().expect("size")];
+    let info = reader.next_frame(&mut pixels).expect("png data");
+    pixels.truncate(info.buffer_size());
+    (info.width, info.height, pixels)
+}
+
+/// Mean RGB over the rectangle `(x0, y0)..(x1, y1)` of an image `width` wide.
+fn mean(pixels: &[u8], width: u32, (x0, y0, x1, y1): (u32, u32, u32, u32)) -> [f64; 3] {
+    let mut sum = [0.0; 3];
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let i = ((y * width + x) * 4) as usize;
+            (0..3).for_each(|c| sum[c] += f64::from(pixels[i + c]));
+        }
+    }
+    sum.map(|s| s / f64::from((x1 - x0) * (y1 - y0)))
+}
+
+/// The floor's colour in the screenshot: the viewer's floor albedo (0.12, 0.12,
+/// 0.13) lit as `examples/viewer/scene.rs` lights it (0.3 + 0.7 · n·l with n up
+/// and l = normalize(−0.4, 0.6, 0.7)), in sRGB.
+fn floor_srgb() -> [f64; 3] {
+    let l = 0.6 / (0.16f64 + 0.36 + 0.49).sqrt();
+    let srgb = |v: f64| 255.0 * (1.055 * v.powf(1.0 / 2.4) - 0.055);
+    [0.12, 0.12, 0.13].map(|a| srgb(a * (0.3 + 0.7 * l)))
+}
+
+#[test]
+fn the_viewer_runs_clean_in_a_window_and_shows_hair_overlay_and_floor() {
+    let (display, _server) = match display() {
+        Ok(d) => d,
+        Err(why) => {
+            println!("SKIPPED the viewer test: {why}");
+            eprintln!("SKIPPED the viewer test: {why}");
+            return;
+        }
+    };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let shot = |name: &str| dir.path().join(name);
+    // 120 frames with validation, the window resized at frame 40: the screenshot
+    // has the new size, so the swapchain was recreated.
+    let (w, h, full) = run(
+        &display,
+        &shot("full.png"),
+        &["--frames", "120", "--width", "320", "--height", "240", "--resize", "400x300", "--resize-frame", "40"],
+    );
+    assert_eq!((w, h), (400, 300), "the resize did not reach the swapchain");
+    let size = ["--width", "400", "--height", "300"];
+    let (_, _, plain) = run(&display, &shot("plain.png"), &[&["--frames", "10", "--no-overlay"][..], &size].concat());
+    let (_, _, bare) =
+        run(&display, &shot("bare.png"), &[&["--frames", "10", "--no-overlay", "--no-hair"][..], &size].concat());
+    // Hair: pixels that differ from the host's scene alone.
+    let differs = plain
+        .chunks_exact(4)
+        .zip(bare.chunks_exact(4))
+        .filter(|(a, b)| a.iter().zip(b.iter()).take(3).any(|(x, y)| x.abs_diff(*y) > 24));
+    let hair = differs.count() as f64 / f64::from(400 * 300);
+    println!("hair covers {:.1} % of the window", 100.0 * hair);
+    assert!(hair > 0.05, "the screenshot shows hair on {:.2} % of the window", 100.0 * hair);
+    // The overlay: its corner differs from the same corner without it.
+    let corner = (0, 0, 200, 100);
+    let (with, without) = (mean(&full, 400, corner), mean(&plain, 400, corner));
+    let diff: f64 = with.iter().zip(without).map(|(a, b)| (a - b).abs()).sum();
+    println!("overlay corner: {with:?} against {without:?} without it");
+    assert!(diff > 20.0, "the overlay is not in the top-left corner ({with:?} vs {without:?})");
+    // The floor, drawn after vkhair's hair with only the host's pipeline and push
+    // constants set again, is where it should be, in its colour, with and without hair.
+    // The same after the exact transparency's composite and the supersampling's
+    // resolve, the last passes of those modes.
+    let mut modes = Vec::new();
+    for (name, toml) in
+        [("exact", "[render]\ntransparency = \"exact\"\n"), ("ssaa", "[render]\nsupersampling = true\n")]
+    {
+        let config = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&config, toml).expect("write config");
+        let config = config.to_string_lossy().into_owned();
+        let args = [&["--frames", "4", "--no-overlay", "--config", &config][..], &size].concat();
+        modes.push((name, run(&display, &shot(&format!("{name}.png")), &args).2));
+    }
+    let patch = (60, 285, 120, 299);
+    let expected = floor_srgb();
+    let images = [("with hair", &plain), ("without hair", &bare)].into_iter().chain(modes.iter().map(|(n, i)| (*n, i)));
+    for (name, image) in images {
+        let got = mean(image, 400, patch);
+        println!("floor {name}: {got:?}, expected {expected:?}");
+        assert!(
+            got.iter().zip(expected).all(|(g, e)| (g - e).abs() <= 6.0),
+            "the floor {name} is {got:?}, expected {expected:?}"
+        );
+    }
+}
