@@ -174,3 +174,23 @@ fn the_viewer_runs_clean_in_a_window_and_shows_hair_overlay_and_floor() {
         );
     }
 }
+
+/// Values out of range are refused before any window opens, naming the option.
+#[test]
+fn the_viewer_refuses_bad_options_by_name() {
+    for (args, named) in [
+        (&["--width", "0"][..], "--width"),
+        (&["--scale", "nan"][..], "--scale"),
+        (&["--frames", "0"][..], "--frames"),
+        (&["--resize", "10x5000"][..], "--resize"),
+    ] {
+        let output = Command::new(viewer()).args(args).env_remove("DISPLAY").output().expect("run the viewer");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(named) && !stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+    let output = Command::new(viewer()).args(["--screenshot", "x.png"]).output().expect("run the viewer");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("--screenshot needs --frames"), "{stderr}");
+}

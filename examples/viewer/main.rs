@@ -56,20 +56,20 @@ pub struct Args {
     /// Character mesh (OBJ, the groom's units) the strands collide with and the viewer draws.
     #[arg(long)]
     pub obj: Option<PathBuf>,
-    /// Multiply groom and mesh positions by this (0.01: centimetres to meters).
-    #[arg(long, default_value_t = 1.0)]
+    /// Multiply groom and mesh positions by this (0.01: centimetres to meters; > 0).
+    #[arg(long, default_value_t = 1.0, value_parser = positive)]
     pub scale: f32,
     /// TOML parameters over vkhair's defaults (see presets/).
     #[arg(long)]
     pub config: Option<PathBuf>,
-    /// Window width, pixels.
-    #[arg(long, default_value_t = 1280)]
+    /// Window width, pixels (16..=8192).
+    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub width: u32,
-    /// Window height, pixels.
-    #[arg(long, default_value_t = 720)]
+    /// Window height, pixels (16..=8192).
+    #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub height: u32,
-    /// Render this many frames, then exit.
-    #[arg(long)]
+    /// Render this many frames (at least 1), then exit.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub frames: Option<u64>,
     /// Save the last presented image here (PNG), with --frames.
     #[arg(long)]
@@ -90,6 +90,13 @@ pub struct Args {
     /// fails the run (exit status 2).
     #[arg(long)]
     pub validation: bool,
+}
+
+fn positive(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("expected a finite number above 0, got {s:?}")),
+    }
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
