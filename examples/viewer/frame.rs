@@ -110,7 +110,7 @@ impl Running {
         }?;
         let hair = Hair::new(&ctx, &scene_data, config)?;
         let size = window.inner_size();
-        let swapchain = Swapchain::new(&gpu, (size.width.max(1), size.height.max(1)), None)?;
+        let swapchain = Swapchain::new(&gpu, (size.width.max(1), size.height.max(1)))?;
         let floor_y =
             scene_data.head.positions.iter().chain(scene_data.groom.positions()).map(|p| p.y).fold(f32::MAX, f32::min)
                 - 0.2 * scene_data.radius;
@@ -220,8 +220,7 @@ impl Running {
         }
         // SAFETY: waiting for the device before its swapchain is replaced.
         unsafe { self.gpu.device.device_wait_idle() }?;
-        let old = std::mem::replace(&mut self.swapchain, Swapchain::new(&self.gpu, (size.width, size.height), None)?);
-        let mut old = old;
+        let mut old = std::mem::replace(&mut self.swapchain, Swapchain::new(&self.gpu, (size.width, size.height))?);
         old.destroy(self.gpu.device.clone(), self.gpu.allocator());
         self.resized = false;
         Ok(true)

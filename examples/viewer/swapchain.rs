@@ -41,8 +41,8 @@ pub struct Swapchain {
 
 impl Swapchain {
     /// A swapchain for `gpu`'s surface at `size` (clamped to what the surface
-    /// allows), replacing `old` (destroyed here once the new one exists).
-    pub fn new(gpu: &HostGpu, size: (u32, u32), old: Option<Swapchain>) -> Result<Swapchain, BoxError> {
+    /// allows).
+    pub fn new(gpu: &HostGpu, size: (u32, u32)) -> Result<Swapchain, BoxError> {
         let s = &gpu.surface_fn;
         // SAFETY: live physical device and surface.
         let caps = unsafe { s.get_physical_device_surface_capabilities(gpu.physical, gpu.surface) }?;
@@ -80,13 +80,9 @@ impl Swapchain {
             .pre_transform(caps.current_transform)
             .composite_alpha(vk::CompositeAlphaFlagsKHR::OPAQUE)
             .present_mode(vk::PresentModeKHR::FIFO)
-            .clipped(true)
-            .old_swapchain(old.as_ref().map_or(vk::SwapchainKHR::null(), |o| o.handle));
+            .clipped(true);
         // SAFETY: valid create info; destroyed in `destroy`.
         let handle = unsafe { loader.create_swapchain(&info, None) }?;
-        if let Some(mut old) = old {
-            old.destroy(gpu.device.clone(), gpu.allocator());
-        }
         // SAFETY: the swapchain is alive.
         let images = unsafe { loader.get_swapchain_images(handle) }?;
         let device = &gpu.device;
