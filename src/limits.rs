@@ -50,11 +50,12 @@ pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
     ("OIT_MAX_SORTED", OIT_MAX_SORTED),
 ];
 
-/// The lines (1-based) of a shader source that declare a name of
-/// [`SHADER_CONSTANTS`] themselves (`#define NAME` or `const … NAME`), with the
-/// name: build.rs refuses such a shader, so each constant has one definition.
+/// The lines (1-based) of a shader source that declare a name of `table`
+/// ([`SHADER_CONSTANTS`], or the shared codes of src/codes.rs) themselves
+/// (`#define NAME` or `const … NAME`), with the name: build.rs refuses such a
+/// shader, so each constant has one definition.
 #[cfg_attr(not(test), allow(dead_code))] // used by build.rs and the tests
-pub fn redeclared_constants(source: &str) -> Vec<(usize, &'static str)> {
+pub fn redeclared_constants(source: &str, table: &[(&'static str, u32)]) -> Vec<(usize, &'static str)> {
     let mut found = Vec::new();
     for (number, line) in source.lines().enumerate() {
         let code = line.split("//").next().unwrap_or_default();
@@ -66,7 +67,7 @@ pub fn redeclared_constants(source: &str) -> Vec<(usize, &'static str)> {
             words.windows(2).any(|w| w[0] == "#define" && w[1] == name)
                 || (words.first() == Some(&"const") && words.iter().skip(1).take(3).any(|w| *w == name))
         };
-        for (name, _) in SHADER_CONSTANTS {
+        for (name, _) in table {
             if declares(name) {
                 found.push((number + 1, *name));
             }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 /// Top-level modules from the bottom up; a module may use only those in
 /// earlier layers (the crate root, `lib.rs`, re-exports from all of them).
 const LAYERS: &[&[&str]] = &[
-    &["error", "hash", "limits"],
+    &["error", "hash", "limits", "codes"],
     &["files"],
     &["vk", "groom"],
     &["gpu_types", "requirements"],
@@ -144,4 +144,74 @@ fn no_source_file_outside_the_tests_exceeds_600_lines() {
         })
         .collect();
     assert!(long.is_empty(), "split these files:\n{}", long.join("\n"));
+}
+
+// The view list (src/gpu_types/views.rs) as a table: which members of which
+// GLSL blocks are packed.
+include!("../src/gpu_types/views_table.rs");
+include!("../src/gpu_types/views.rs");
+
+/// The simulation's shaders and the headers they share.
+fn simulation_shaders() -> Vec<PathBuf> {
+    let glsl = Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
+    let mut files = Vec::new();
+    let mut dirs = vec![glsl.join("sim")];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).expect("shader folder") {
+            let path = entry.expect("entry").path();
+            if path.is_dir() {
+                dirs.push(path);
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    for header in ["sim.glsl", "volume.glsl", "volume_ops.glsl", "mesh_sdf.glsl", "sdf.glsl", "reduce.glsl"] {
+        files.push(glsl.join("include").join(header));
+    }
+    files
+}
+
+/// `source`'s reads of a packed member (`.member` of a block with a view),
+/// outside comments, as "line: .member".
+fn packed_member_reads(source: &str) -> Vec<String> {
+    let packed: BTreeSet<&str> = SHADER_VIEWS.iter().map(|f| f.member).collect();
+    let mut found = Vec::new();
+    for (number, line) in source.lines().enumerate() {
+        let code = line.split("//").next().unwrap_or_default();
+        for (i, _) in code.match_indices('.') {
+            let name: String = code[i + 1..].chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+            let before = code[..i].chars().next_back();
+            let after_ident = before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_' || c == ')' || c == ']');
+            if after_ident && packed.contains(name.as_str()) {
+                found.push(format!("{}: .{name}", number + 1));
+            }
+        }
+    }
+    found
+}
+
+/// The step kernel, the volume stage and the mesh collider build read their
+/// parameter blocks only through the generated accessors (`views.glsl`): a
+/// raw `params.counts.w` would bypass the one definition of the packing.
+#[test]
+fn simulation_shaders_read_packed_blocks_only_through_their_views() {
+    let files = simulation_shaders();
+    assert!(files.len() > 25, "found only {} simulation shaders", files.len());
+    let mut violations = Vec::new();
+    for file in &files {
+        let source = std::fs::read_to_string(file).expect("shader source");
+        for read in packed_member_reads(&source) {
+            violations.push(format!("{}:{read}", file.display()));
+        }
+    }
+    assert!(violations.is_empty(), "read these through their views' accessors:\n{}", violations.join("\n"));
+}
+
+#[test]
+fn the_packed_member_check_sees_a_raw_read() {
+    let source = "uint f = params.counts.w; // params.shape.x in a comment\nvec3 g = steps[i].gravity_dt.xyz;\n\
+                  float ok = sim_dt(params);\nvec4 counts = vec4(1.0);\n";
+    assert_eq!(packed_member_reads(source), vec!["1: .counts", "2: .gravity_dt"]);
+    assert!(SHADER_VIEWS.len() > 80, "the view table has only {} fields", SHADER_VIEWS.len());
 }

@@ -77,7 +77,7 @@ vec3 shade_hair(vec3 pos, vec3 tangent, float t_along, uint hair) {
             }
         }
         vec3 radiance = light.color_range.rgb * falloff * shadow(pos, i);
-        if (dp.counts.w == 1u) {
+        if (dp.counts.w == SHADING_MARSCHNER) {
             // Marschner: S = M_R N_R + (M_TT N_TT + M_TRT N_TRT), the transmitted
             // paths tinted by the hair's albedo, times cos θi.
             float sin_i = dot(l, t);

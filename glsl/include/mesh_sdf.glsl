@@ -5,12 +5,22 @@
 #ifndef VKHAIR_MESH_SDF_GLSL
 #define VKHAIR_MESH_SDF_GLSL
 
+// Where the field's samples are: grid point (0, 0, 0) in the head frame, the
+// edge of one cell and the grid points per axis (a stage builds it from its
+// parameter block's accessors, e.g. `sim_mesh_origin(p)`).
+struct MeshGrid {
+    vec3 origin;
+    float cell;
+    uvec3 points;
+};
+
 // Trilinear field value (w) and the gradient of the same interpolant (xyz,
 // per cell, unnormalised) at q in the head frame. Outside the grid (which
 // reaches at least two cells past the mesh) w is +1e30: no contact.
-vec4 mesh_sample(vec4 grid, uvec4 dims, vec3 q) {
-    precise vec3 g = (q - grid.xyz) / grid.w;
-    vec3 top = vec3(dims.xyz) - 1.0;
+vec4 mesh_sample(MeshGrid m, vec3 q) {
+    uvec3 dims = m.points;
+    precise vec3 g = (q - m.origin) / m.cell;
+    vec3 top = vec3(dims) - 1.0;
     if (any(lessThan(g, vec3(0.0))) || any(greaterThan(g, top))) {
         return vec4(0.0, 0.0, 0.0, 1e30);
     }
@@ -46,9 +56,9 @@ vec4 mesh_sample(vec4 grid, uvec4 dims, vec3 q) {
 
 // Projects world point p out of the mesh (moved by `head`) along the field's
 // gradient, keeping a gap of `radius`.
-vec3 mesh_collide(mat4 head, vec4 grid, uvec4 dims, vec3 p, float radius) {
+vec3 mesh_collide(mat4 head, MeshGrid m, vec3 p, float radius) {
     precise vec3 q = sim_to_head(head, p);
-    vec4 s = mesh_sample(grid, dims, q);
+    vec4 s = mesh_sample(m, q);
     if (s.w < radius) {
         precise float len = sqrt(sim_dot(s.xyz, s.xyz));
         if (len > 0.0) {
@@ -63,10 +73,10 @@ vec3 mesh_collide(mat4 head, vec4 grid, uvec4 dims, vec3 p, float radius) {
 // the surface loses the fraction `friction` of its motion along the surface
 // relative to the mesh during the step (`from` is where it was, the mesh then
 // placed by `previous_head`).
-vec3 mesh_friction(mat4 head, mat4 previous_head, vec4 grid, uvec4 dims, vec3 p, vec3 from, float radius, float friction) {
+vec3 mesh_friction(mat4 head, mat4 previous_head, MeshGrid m, vec3 p, vec3 from, float radius, float friction) {
     precise vec3 q = sim_to_head(head, p);
-    vec4 s = mesh_sample(grid, dims, q);
-    precise float contact = radius + 0.1 * grid.w;
+    vec4 s = mesh_sample(m, q);
+    precise float contact = radius + 0.1 * m.cell;
     precise float len = sqrt(sim_dot(s.xyz, s.xyz));
     if (!(s.w < contact) || !(len > 0.0) || friction <= 0.0) {
         return p;

@@ -3,8 +3,8 @@
 #ifndef VKHAIR_OIT_GLSL
 #define VKHAIR_OIT_GLSL
 
-// End of a pixel's list; also the "no opaque layer" depth word.
-const uint OIT_END = 0xffffffffu;
+// OIT_END, the end of a pixel's list and the "no opaque layer" depth word, is
+// injected by build.rs from src/codes.rs.
 // A fragment at least this opaque counts as the pixel's opaque layer: the
 // nearest such depth is written to the target's depth image.
 const float OIT_OPAQUE_ALPHA = 0.5;

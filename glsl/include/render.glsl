@@ -67,10 +67,8 @@ void key_frame(vec3 t, vec3 reference, out vec3 b1, out vec3 b2) {
     b2 = cross(t, b1);
 }
 
-// MAX_LIGHTS (render::MAX_LIGHTS) is injected by build.rs from src/limits.rs.
-const uint LIGHT_DIRECTIONAL = 0u;
-const uint LIGHT_POINT = 1u;
-const uint LIGHT_SPOT = 2u;
+// MAX_LIGHTS (render::MAX_LIGHTS) is injected by build.rs from src/limits.rs,
+// the LIGHT_* kinds and SHADING_* models from src/codes.rs.
 
 // One light. Twin: gpu_types::GpuLight.
 struct Light {

@@ -4,14 +4,17 @@
 #ifndef VKHAIR_SDF_GLSL
 #define VKHAIR_SDF_GLSL
 
-// Push constants of every build kernel. Twin: gpu_types::SdfPush.
-struct SdfPush {
-    vec4 origin_cell;     // xyz grid point (0, 0, 0) in the mesh frame, w cell edge
-    uvec4 dims;           // xyz grid points per axis, w triangles
-    uvec4 pass_info;      // x seed mode (0 distance, 1 triangle) or flood step, y ray axis
-};
+#include "views.glsl"
 
-const uint SDF_NONE = 0xffffffffu;
+// Push constants of every build kernel, read through the accessors of their
+// view, `sdf_pass_*(pc)` (views.glsl). Twin: gpu_types::SdfPush, view
+// gpu_types::SdfPass. SDF_NONE, the "no triangle yet" word, is injected by
+// build.rs from src/codes.rs.
+struct SdfPush {
+    vec4 origin_cell;
+    uvec4 dims;
+    uvec4 pass_info;
+};
 
 uvec3 sdf_grid_point(uint k, uvec3 dims) {
     return uvec3(k % dims.x, (k / dims.x) % dims.y, k / (dims.x * dims.y));
@@ -21,8 +24,8 @@ uint sdf_index(uvec3 g, uvec3 dims) {
     return (g.z * dims.y + g.y) * dims.x + g.x;
 }
 
-vec3 sdf_point(uvec3 g, vec4 origin_cell) {
-    precise vec3 p = origin_cell.xyz + vec3(g) * origin_cell.w;
+vec3 sdf_point(uvec3 g, vec3 origin, float cell) {
+    precise vec3 p = origin + vec3(g) * cell;
     return p;
 }
 

@@ -27,8 +27,7 @@ struct ShadowMap {
     vec4 params;      // x opacity per strand fragment, y PCF radius (texels), z method (SHADOW_*), w unused
 };
 
-const uint SHADOW_DEEP_OPACITY = 0u;
-const uint SHADOW_DENSITY_VOLUME = 1u;
+// The SHADOW_* methods are injected by build.rs from src/codes.rs.
 
 // The maps of a frame. Twin: gpu_types::ShadowParams.
 struct ShadowParams {

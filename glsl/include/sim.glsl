@@ -6,47 +6,40 @@
 #define VKHAIR_SIM_GLSL
 
 #include "hash.glsl"
+#include "views.glsl"
 
-// Per-sub-step parameters (one array entry per sub-step, binding 0). Twin: gpu_types::SimStepParams.
+// The packed blocks below are read only through the accessors of their views
+// (views.glsl, generated from src/gpu_types/views.rs, which names every lane):
+// `sim_*(p)` for SimStepParams, `step_range_*(p)` for SimPush, `collider_*(c)`
+// for Collider. The SIM_* switches (src/codes.rs) and SIM_MAX_COLLIDERS and
+// SIM_WORKGROUP (src/limits.rs) are injected by build.rs.
+
+// Per-sub-step parameters (one array entry per sub-step, binding 0). Twin:
+// gpu_types::SimStepParams, view gpu_types::SimStep.
 struct SimStepParams {
-    mat4 head;            // world-from-head transform at the end of this step
-    vec4 gravity_dt;      // xyz gravity (m/s²), w time step (s)
-    vec4 wind;            // xyz wind acceleration (m/s²), w turbulence (0..1)
-    vec4 wind_noise;      // x noise frequency (1/s), y time (s), z spring stiffness (1/s²), w damping per step (0..1)
-    vec4 bending;         // x stiffness per iteration at the root, y at the tip, z DFTL velocity damping, w unused
-    uvec4 counts;         // x strands, y points per strand, z iterations, w flags (SIM_*)
-    uvec4 layout_info;    // x colliders, y hairs per workgroup, z step index, w sync group size
-    vec4 shape;           // x global shape stiffness per iteration, y its range (strand fraction),
-                          // z local shape stiffness per sub-step, w mesh collider friction (0..1)
-    mat4 previous_head;   // world-from-head transform at the start of this step
-    vec4 mesh_grid;       // mesh collider: xyz grid point (0, 0, 0) in the head frame, w cell edge
-    uvec4 mesh_dims;      // xyz grid points per axis, w 1 when a mesh collider is set
+    mat4 head;
+    vec4 gravity_dt;
+    vec4 wind;
+    vec4 wind_noise;
+    vec4 bending;
+    uvec4 counts;
+    uvec4 layout_info;
+    vec4 shape;
+    mat4 previous_head;
+    vec4 mesh_grid;
+    uvec4 mesh_dims;
 };
 
-// Push constants of the step kernel. Twin: gpu_types::SimPush.
+// Push constants of the step kernel. Twin: gpu_types::SimPush, view gpu_types::StepRange.
 struct SimPush {
-    uvec4 range;          // x first sub-step (index into the per-sub-step arrays), y sub-steps, zw unused
+    uvec4 range;
 };
 
-// One collider in world space. Twin: gpu_types::GpuCollider.
+// One collider in world space. Twin: gpu_types::GpuCollider, view gpu_types::ColliderShape.
 struct Collider {
-    vec4 a_radius;        // xyz centre (sphere) or first end (capsule), w radius (m)
-    vec4 b_kind;          // xyz second end (capsule), w 0 = sphere, 1 = capsule
+    vec4 a_radius;
+    vec4 b_kind;
 };
-
-const uint SIM_GRAVITY = 1u;
-const uint SIM_WIND = 2u;
-const uint SIM_SPRING = 4u;
-const uint SIM_BENDING = 8u;
-const uint SIM_COLLISIONS = 16u;
-const uint SIM_DFTL = 32u;
-const uint SIM_GLOBAL_SHAPE = 64u;
-const uint SIM_SAG_FREE = 128u;
-const uint SIM_LOCAL_SHAPE = 256u;
-const uint SIM_MESH = 512u;
-
-// SIM_MAX_COLLIDERS (sim::MAX_COLLIDERS) and SIM_WORKGROUP are injected by
-// build.rs from src/limits.rs.
 
 
 // head * vec4(p, 1), written out so that the CPU reference can match it.
@@ -74,16 +67,16 @@ float sim_noise(float t, uint strand) {
 
 // Projects p out of one collider, keeping a gap of `radius` (the particle's pearl).
 vec3 sim_collide(Collider c, vec3 p, float radius) {
-    precise vec3 closest = c.a_radius.xyz;
-    if (c.b_kind.w > 0.5) {
-        precise vec3 ab = c.b_kind.xyz - c.a_radius.xyz;
+    precise vec3 closest = collider_a(c);
+    if (collider_kind(c) == float(COLLIDER_CAPSULE)) {
+        precise vec3 ab = collider_b(c) - collider_a(c);
         precise float len2 = dot(ab, ab);
-        precise float t = len2 > 0.0 ? clamp(dot(p - c.a_radius.xyz, ab) / len2, 0.0, 1.0) : 0.0;
-        closest = c.a_radius.xyz + ab * t;
+        precise float t = len2 > 0.0 ? clamp(dot(p - collider_a(c), ab) / len2, 0.0, 1.0) : 0.0;
+        closest = collider_a(c) + ab * t;
     }
     precise vec3 d = p - closest;
     precise float dist = sqrt(dot(d, d));
-    precise float reach = c.a_radius.w + radius;
+    precise float reach = collider_radius(c) + radius;
     if (dist < reach && dist > 0.0) {
         precise vec3 out_p = closest + d * (reach / dist);
         return out_p;

@@ -13,52 +13,39 @@
 #define VKHAIR_VOLUME_GLSL
 
 #include "sim.glsl"
+#include "views.glsl"
 
-// Per-sub-step parameters (uniform block, binding 0). Twin: gpu_types::VolumeParams.
+// The packed blocks below are read only through the accessors of their views
+// (views.glsl, generated from src/gpu_types/views.rs): `vol_*(p)` for
+// VolumeParams; for VolumePush, which means something else to each kernel
+// family, `radix_*`, `scan_*`, `reduce_*`, `level_*`, `mg_smooth_*` and
+// `mg_coarsest_*`. The VOL_* codes (cell labels, modes, preconditioners,
+// statuses, stencil bits: src/codes.rs) and the workgroup sizes VOL_GROUP,
+// VOL_SORT_BLOCK and VOL_SCAN_TILE (src/limits.rs) are injected by build.rs.
+
+// Per-sub-step parameters (uniform block, binding 0). Twin:
+// gpu_types::GpuVolumeParams, view gpu_types::VolumeStep.
 struct VolumeParams {
-    mat4 grid_from_world;  // world position → grid coordinates (cells)
-    mat4 world_from_grid;  // grid coordinates → world position
-    mat4 axes;             // upper 3×3: world vector → grid axes (a rotation)
-    mat4 solid_velocity;   // grid coordinates → velocity of the colliders' rigid motion, grid axes (affine)
-    uvec4 dims;            // xyz cells per axis, w cell count
-    uvec4 counts;          // x particles, y first v face, z first w face, w face count
-    vec4 transfer;         // x FLIP ratio α, y friction (0..1), z repulsion (m/s²), w repulsion threshold density
-    vec4 solve;            // x tolerance (relative max-norm residual), y cell size (m), z time step (s), w mode (VOL_MODE_*)
-    uvec4 config;          // x iteration cap, y preconditioner (VOL_PRECOND_*), z multigrid levels, w colliders
-    mat4 mesh_from_grid;   // grid coordinates → the mesh collider's frame (the head frame)
-    vec4 mesh_grid;        // mesh collider: xyz grid point (0, 0, 0), w cell edge
-    uvec4 mesh_dims;       // xyz grid points per axis, w 1 when its cells count as solid
+    mat4 grid_from_world;
+    mat4 world_from_grid;
+    mat4 axes;
+    mat4 solid_velocity;
+    uvec4 dims;
+    uvec4 counts;
+    vec4 transfer;
+    vec4 solve;
+    uvec4 config;
+    mat4 mesh_from_grid;
+    vec4 mesh_grid;
+    uvec4 mesh_dims;
 };
 
 // Push constants shared by the volume kernels. Twin: gpu_types::VolumePush.
 struct VolumePush {
-    uvec4 dims;    // xyz cells of the level worked on, w its first cell in the level arrays
-    uvec4 coarse;  // xyz cells of the next coarser level, w its first cell
-    uvec4 op;      // kernel-specific: see each kernel
+    uvec4 dims;
+    uvec4 coarse;
+    uvec4 op;
 };
-
-const uint VOL_AIR = 0u;
-const uint VOL_FLUID = 1u;
-const uint VOL_SOLID = 2u;
-
-const uint VOL_MODE_FLIP = 1u;
-const uint VOL_MODE_FRICTION = 2u;
-
-// Stencil words of the pressure matrix (volume_ops.glsl).
-const uint VOL_STENCIL_FLUID = 1u << 16u;
-const uint VOL_STENCIL_COUNT_SHIFT = 8u;
-
-const uint VOL_PRECOND_JACOBI = 0u;
-const uint VOL_PRECOND_MULTIGRID = 1u;
-
-// Status of the pressure solve (PcgScalars::status).
-const uint VOL_STATUS_OK = 0u;
-const uint VOL_STATUS_BREAKDOWN = 1u;
-const uint VOL_STATUS_NONFINITE = 2u;
-
-// Workgroup size of every per-cell, per-face and per-particle kernel.
-// VOL_GROUP, VOL_SORT_BLOCK and VOL_SCAN_TILE are injected by build.rs from
-// src/limits.rs.
 
 // Scalars of the conjugate-gradient solve, kept on the GPU between kernels.
 struct PcgScalars {
@@ -108,9 +95,9 @@ float vol_weight(vec3 d) {
     return w;
 }
 
-// Axis of face f and its coordinates on that axis' face grid.
-uint vol_face_axis(uint f, uvec4 counts) {
-    return f < counts.y ? 0u : (f < counts.z ? 1u : 2u);
+// Axis of face f, given the first v and w faces (the u faces come first).
+uint vol_face_axis(uint f, uint first_v, uint first_w) {
+    return f < first_v ? 0u : (f < first_w ? 1u : 2u);
 }
 
 uvec3 vol_face_dims(uvec3 dims, uint axis) {
@@ -119,8 +106,9 @@ uvec3 vol_face_dims(uvec3 dims, uint axis) {
     return d;
 }
 
-uint vol_face_index(uvec3 ijk, uint axis, uvec3 dims, uvec4 counts) {
-    uint base = axis == 0u ? 0u : (axis == 1u ? counts.y : counts.z);
+// Index of face ijk of `axis`, given the first v and w faces.
+uint vol_face_index(uvec3 ijk, uint axis, uvec3 dims, uint first_v, uint first_w) {
+    uint base = axis == 0u ? 0u : (axis == 1u ? first_v : first_w);
     uvec3 fd = vol_face_dims(dims, axis);
     return base + ijk.x + fd.x * (ijk.y + fd.y * ijk.z);
 }

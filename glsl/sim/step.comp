@@ -93,12 +93,17 @@ void sync(uint group) {
     }
 }
 
+// The mesh collider's grid of the sub-step being run.
+MeshGrid mesh_grid() {
+    return MeshGrid(sim_mesh_origin(params), sim_mesh_cell(params), sim_mesh_dims(params));
+}
+
 vec3 collide_all(vec3 p, float radius) {
-    for (uint c = 0u; c < params.layout_info.x; c++) {
+    for (uint c = 0u; c < sim_colliders(params); c++) {
         p = sim_collide(colliders[collider_base + c], p, radius);
     }
-    if ((params.counts.w & SIM_MESH) != 0u) {
-        p = mesh_collide(params.head, params.mesh_grid, params.mesh_dims, p, radius);
+    if ((sim_flags(params) & SIM_MESH) != 0u) {
+        p = mesh_collide(sim_head(params), mesh_grid(), p, radius);
     }
     return p;
 }
@@ -147,7 +152,7 @@ void local_shape_sweep(uint root, uint points, uint src) {
         }
         precise float w = parent.w + child.w;
         if (w > 0.0) {
-            precise vec3 delta = (carried - (child.xyz - parent.xyz)) * params.shape.z;
+            precise vec3 delta = (carried - (child.xyz - parent.xyz)) * sim_local_shape(params);
             precise vec3 moved_parent = parent.xyz - delta * (parent.w / w);
             precise vec3 moved_child = child.xyz + delta * (child.w / w);
             s_pos[src][root + j - 1u] = vec4(moved_parent, parent.w);
@@ -158,7 +163,7 @@ void local_shape_sweep(uint root, uint points, uint src) {
 
 // The rest offset of particle k from its parent, rotated into the world.
 vec3 local_rest_offset(uint k) {
-    return sim_rotate(params.head, rest[k].xyz - rest[k - 1u].xyz);
+    return sim_rotate(sim_head(params), rest[k].xyz - rest[k - 1u].xyz);
 }
 
 // The unit rest direction of the segment ending at particle k, in the world
@@ -173,29 +178,29 @@ vec3 local_rest_dir(uint k) {
 vec2 bend_at(uint strand_base, uint c, uint points) {
     precise vec3 r = rest[strand_base + c + 1u].xyz - rest[strand_base + c - 1u].xyz;
     precise float t = float(c) / float(points - 1u);
-    precise float k = params.bending.x + (params.bending.y - params.bending.x) * t;
+    precise float k = sim_bending_root(params) + (sim_bending_tip(params) - sim_bending_root(params)) * t;
     return vec2(sqrt(dot(r, r)), k);
 }
 
 // Stage 1 for the own point: its predicted position (w: inverse mass) from the
 // position `x` and velocity `v` at the start of the sub-step.
 vec4 predict(vec4 x, vec3 v, vec3 rest_head, uint strand) {
-    uint flags = params.counts.w;
-    float dt = params.gravity_dt.w;
-    vec3 rest_world = sim_transform_point(params.head, rest_head);
+    uint flags = sim_flags(params);
+    float dt = sim_dt(params);
+    vec3 rest_world = sim_transform_point(sim_head(params), rest_head);
     if (x.w == 0.0) {
         return vec4(rest_world, 0.0);
     }
     precise vec3 a = vec3(0.0);
     if ((flags & SIM_GRAVITY) != 0u) {
-        a = a + params.gravity_dt.xyz;
+        a = a + sim_gravity(params);
     }
     if ((flags & SIM_WIND) != 0u) {
-        precise float gust = 1.0 + params.wind.w * sim_noise(params.wind_noise.y * params.wind_noise.x, strand);
-        a = a + params.wind.xyz * gust;
+        precise float gust = 1.0 + sim_wind_turbulence(params) * sim_noise(sim_time(params) * sim_wind_frequency(params), strand);
+        a = a + sim_wind(params) * gust;
     }
     if ((flags & SIM_SPRING) != 0u) {
-        a = a + (rest_world - x.xyz) * params.wind_noise.z;
+        a = a + (rest_world - x.xyz) * sim_spring_stiffness(params);
     }
     precise vec3 moved = v + a * dt;
     precise vec3 p = x.xyz + moved * dt;
@@ -203,10 +208,10 @@ vec4 predict(vec4 x, vec3 v, vec3 rest_head, uint strand) {
 }
 
 void main() {
-    params = steps[push.range.x];
-    uint points = params.counts.y;
-    uint per_group = params.layout_info.y;
-    uint group = params.layout_info.w;
+    params = steps[step_range_first(push)];
+    uint points = sim_points(params);
+    uint per_group = sim_hairs_per_group(params);
+    uint group = sim_sync_group(params);
     uint per_sync = group / points;
     // With subgroup sync (always full subgroups) hairs are laid out by subgroup.
     uint lid = group == SIM_WORKGROUP ? gl_LocalInvocationID.x : gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID;
@@ -216,14 +221,14 @@ void main() {
     uint i = lane - in_sync * points;
     uint hair = sync_index * per_sync + in_sync;
     uint strand = gl_WorkGroupID.x * per_group + hair;
-    bool live = in_sync < per_sync && hair < per_group && strand < params.counts.x;
+    bool live = in_sync < per_sync && hair < per_group && strand < sim_strands(params);
     uint index = strand * points + i;
     uint base = strand * points;
 
     // What stays the same over the step: the state (in registers from here to the
     // store), the rest data and each constraint set's partner, rest distance and
     // stiffness.
-    bool bending = (params.counts.w & SIM_BENDING) != 0u;
+    bool bending = (sim_flags(params) & SIM_BENDING) != 0u;
     vec4 x = vec4(0.0);
     vec3 v = vec3(0.0);
     vec3 rest_head = vec3(0.0);
@@ -236,7 +241,7 @@ void main() {
     vec2 bend_a = vec2(0.0), bend_b = vec2(0.0);
     if (live) {
         x = pos_in[index];
-        if (push.range.x == 0u) {
+        if (step_range_first(push) == 0u) {
             pos_before[index] = x;
         }
         v = vel_in[index].xyz;
@@ -276,10 +281,10 @@ void main() {
         }
     }
 
-    for (uint sub = 0u; sub < push.range.y; sub++) {
-        params = steps[push.range.x + sub];
-        collider_base = (push.range.x + sub) * SIM_MAX_COLLIDERS;
-        uint flags = params.counts.w;
+    for (uint sub = 0u; sub < step_range_count(push); sub++) {
+        params = steps[step_range_first(push) + sub];
+        collider_base = (step_range_first(push) + sub) * SIM_MAX_COLLIDERS;
+        uint flags = sim_flags(params);
         bool collisions = (flags & SIM_COLLISIONS) != 0u;
         bool global_shape = (flags & SIM_GLOBAL_SHAPE) != 0u;
         bool local_shape = (flags & SIM_LOCAL_SHAPE) != 0u;
@@ -293,10 +298,10 @@ void main() {
             s_pos[0][lid] = own;
             if (global_shape) {
                 precise float t = float(i) / float(points - 1u);
-                precise float k = params.shape.x * sim_shape_weight(t, params.shape.y);
+                precise float k = sim_global_shape(params) * sim_shape_weight(t, sim_global_shape_range(params));
                 shape_k = k;
-                vec3 at_rest = sim_transform_point(params.head, rest_head);
-                shape_target = sim_shape_target(at_rest, k, params.counts.z, flags, params.gravity_dt.xyz, params.gravity_dt.w);
+                vec3 at_rest = sim_transform_point(sim_head(params), rest_head);
+                shape_target = sim_shape_target(at_rest, k, sim_iterations(params), flags, sim_gravity(params), sim_dt(params));
             }
             if (local_shape && i >= 1u) {
                 s_local_offset[lid] = local_rest_offset(index);
@@ -334,7 +339,7 @@ void main() {
         } else {
             // Halves alternate: each set reads `src` and writes the other one.
             uint src = 0u;
-            for (uint it = 0u; it < params.counts.z; it++) {
+            for (uint it = 0u; it < sim_iterations(params); it++) {
                 own = project_end(own, lid, off_even, first_even, rest_even, 1.0, src);
                 if (live) { s_pos[1u - src][lid] = own; }
                 sync(group);
@@ -348,7 +353,7 @@ void main() {
                 sync(group);
                 src = 1u - src;
                 own = project_end(own, lid, off_bend_b, first_bend_b, bend_b.x, bend_b.y, src);
-                if (local_shape && it + 1u == params.counts.z) {
+                if (local_shape && it + 1u == sim_iterations(params)) {
                     if (live) { s_pos[1u - src][lid] = own; }
                     sync(group);
                     src = 1u - src;
@@ -370,19 +375,19 @@ void main() {
                 src = 1u - src;
             }
             if ((flags & SIM_MESH) != 0u && collisions && live && own.w > 0.0) {
-                own.xyz = mesh_friction(params.head, params.previous_head, params.mesh_grid, params.mesh_dims, own.xyz,
-                                        x.xyz, radius, params.shape.w);
+                own.xyz = mesh_friction(sim_head(params), sim_previous_head(params), mesh_grid(), own.xyz,
+                                        x.xyz, radius, sim_mesh_friction(params));
             }
         }
 
         // 3. Velocity from the position change, damping.
         if (live) {
-            float dt = params.gravity_dt.w;
+            float dt = sim_dt(params);
             precise vec3 vel = (own.xyz - x.xyz) / dt;
             if ((flags & SIM_DFTL) != 0u && i + 1u < points) {
-                vel = vel - s_local_offset[lid + 1u] * (params.bending.z / dt);
+                vel = vel - s_local_offset[lid + 1u] * (sim_dftl_damping(params) / dt);
             }
-            vel = vel * (1.0 - params.wind_noise.w);
+            vel = vel * (1.0 - sim_damping(params));
             x = own;
             v = vel;
         }

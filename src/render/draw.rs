@@ -306,7 +306,7 @@ pub(super) fn draw_params(
             m.represented_hairs,
             band_density(m.represented_hairs),
         ],
-        counts: [hairs, per_hair, lights.len() as u32, m.shading as u32],
+        counts: [hairs, per_hair, lights.len() as u32, m.shading.code()],
         lights: gpu_lights,
     }
 }

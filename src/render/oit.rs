@@ -52,7 +52,7 @@ const ABSORBANCE: vk::Format = vk::Format::R32_SFLOAT;
 /// Bytes of one stored fragment (colour and alpha as half floats, depth, next).
 const NODE_BYTES: u64 = 16;
 /// The "no node" / "no depth" word the lists and the opaque depths are cleared to.
-const END: u32 = u32::MAX;
+const END: u32 = crate::codes::sentinel::OIT_END;
 
 /// What the last exact-mode frame stored, read by
 /// [`super::Renderer::transparency_stats`].

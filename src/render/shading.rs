@@ -5,6 +5,7 @@ use glam::{Mat4, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
+use crate::codes::{light_kind, shading};
 use crate::error::{Error, Result};
 use crate::gpu_types::GpuLight;
 
@@ -94,7 +95,7 @@ impl Light {
                     return Err(bad());
                 }
                 GpuLight {
-                    position_kind: [0.0, 0.0, 0.0, 0.0],
+                    position_kind: [0.0, 0.0, 0.0, light_kind::DIRECTIONAL as f32],
                     direction_cone: [d.x, d.y, d.z, 0.0],
                     color_range: color.extend(0.0).to_array(),
                 }
@@ -104,7 +105,7 @@ impl Light {
                     return Err(bad());
                 }
                 GpuLight {
-                    position_kind: position.extend(1.0).to_array(),
+                    position_kind: position.extend(light_kind::POINT as f32).to_array(),
                     direction_cone: [0.0, -1.0, 0.0, 0.0],
                     color_range: color.extend(0.0).to_array(),
                 }
@@ -120,7 +121,7 @@ impl Light {
                     return Err(bad());
                 }
                 GpuLight {
-                    position_kind: position.extend(2.0).to_array(),
+                    position_kind: position.extend(light_kind::SPOT as f32).to_array(),
                     direction_cone: [d.x, d.y, d.z, outer_angle.cos()],
                     color_range: color.extend(inner_angle.cos()).to_array(),
                 }
@@ -135,10 +136,20 @@ impl Light {
 pub enum ShadingMode {
     /// Kajiya-Kay diffuse and two shifted highlights (Scheuermann; the thesis).
     #[default]
-    KajiyaKay = 0,
+    KajiyaKay,
     /// Marschner R, TT and TRT through lookup tables (Nalu), with
     /// [`HairMaterial::marschner`] parameters.
-    Marschner = 1,
+    Marschner,
+}
+
+impl ShadingMode {
+    /// The `SHADING_*` code the draw pass's shaders test.
+    pub(crate) fn code(self) -> u32 {
+        match self {
+            ShadingMode::KajiyaKay => shading::KAJIYA_KAY,
+            ShadingMode::Marschner => shading::MARSCHNER,
+        }
+    }
 }
 
 /// Hair material (Kajiya-Kay diffuse and two shifted specular highlights).

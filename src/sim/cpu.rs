@@ -1,6 +1,6 @@
 //! The CPU reference simulation.
 
-use super::params::SubstepPlanner;
+use super::planner::SubstepPlanner;
 use super::{reference, volume, Collider, RigidTransform, SimParams, SimState, VolumeGrid, VolumeMode, MAX_SIM_POINTS};
 use crate::error::Result;
 use crate::groom::sdf::MeshSdf;
@@ -72,7 +72,8 @@ impl CpuHairSim {
     /// See [`HairSim::set_mesh_collider`](super::HairSim::set_mesh_collider); the
     /// field is the CPU reference's ([`MeshSdf::build`]) with the same grid.
     pub fn set_mesh_collider(&mut self, mesh: Option<MeshSdf>) -> Option<MeshSdf> {
-        self.planner.mesh = mesh.as_ref().map(|m| super::mesh_collider::grid_of(m.origin, m.cell, m.dims));
+        self.planner.mesh =
+            mesh.as_ref().map(|m| super::mesh_collider::MeshGrid { origin: m.origin, cell: m.cell, dims: m.dims });
         std::mem::replace(&mut self.mesh, mesh)
     }
 

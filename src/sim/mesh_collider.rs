@@ -28,9 +28,10 @@ use ash::vk;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use crate::codes::sentinel;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
-use crate::gpu_types::SdfPush;
+use crate::gpu_types::{SdfPass, SdfPush};
 use crate::groom::mesh::TriMesh;
 use crate::groom::sdf::MeshSdf;
 use crate::profiler::{GpuProfiler, PassScope, ProfileReport};
@@ -66,10 +67,16 @@ impl Default for MeshColliderParams {
     }
 }
 
-/// A field's grid as the simulation's parameters carry it (see `mesh_sample` in
-/// `glsl/include/mesh_sdf.glsl`).
-pub(crate) fn grid_of(origin: Vec3, cell: f32, dims: [u32; 3]) -> ([f32; 4], [u32; 4]) {
-    (origin.extend(cell).to_array(), [dims[0], dims[1], dims[2], 1])
+/// Where a field's samples are, as the simulation's parameters carry it
+/// (`MeshGrid` of `glsl/include/mesh_sdf.glsl`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct MeshGrid {
+    /// Grid point (0, 0, 0) in the head frame.
+    pub origin: Vec3,
+    /// Edge of one cell.
+    pub cell: f32,
+    /// Grid points per axis.
+    pub dims: [u32; 3],
 }
 
 /// Label and timestamp scope of the build.
@@ -146,10 +153,9 @@ impl MeshCollider {
         Ok(MeshSdf { origin: self.origin, cell: self.cell, dims: self.dims, values })
     }
 
-    /// The grid as the simulation's parameters carry it: origin and cell edge, and
-    /// points per axis.
-    pub(crate) fn grid(&self) -> ([f32; 4], [u32; 4]) {
-        grid_of(self.origin, self.cell, self.dims)
+    /// The grid as the simulation's parameters carry it.
+    pub(crate) fn grid(&self) -> MeshGrid {
+        MeshGrid { origin: self.origin, cell: self.cell, dims: self.dims }
     }
 
     fn build(
@@ -197,12 +203,8 @@ impl MeshCollider {
         let result = steps.len() % 2;
         let finalize_set = finalize.declared_buffer_set(0, &table(result))?;
 
-        let base = SdfPush {
-            origin_cell: origin.extend(cell).to_array(),
-            dims: [dims[0], dims[1], dims[2], triangles as u32],
-            pass_info: [0; 4],
-        };
-        let with = |x: u32, y: u32| SdfPush { pass_info: [x, y, 0, 0], ..base };
+        let base = SdfPass { origin, cell, dims, triangles: triangles as u32, ..SdfPass::default() };
+        let with = |pass: SdfPass| SdfPush::from(&pass);
         let filled = barrier::memory(&[AccessKind::TransferWrite], barrier::COMPUTE_READ_WRITE);
         let between = barrier::memory(&[AccessKind::ComputeWrite], barrier::COMPUTE_READ_WRITE);
         let points = points as u32;
@@ -217,31 +219,31 @@ impl MeshCollider {
                     let _ = p.begin_frame(cmd, frame);
                 }
                 PassScope::record(d, cmd, &mut profiler, MESH_COLLIDER_BUILD_LABEL, LabelColor::Compute, || {
-                    d.raw.cmd_fill_buffer(cmd, distance.raw(), 0, vk::WHOLE_SIZE, u32::MAX);
-                    d.raw.cmd_fill_buffer(cmd, ids[0].raw(), 0, vk::WHOLE_SIZE, u32::MAX);
+                    d.raw.cmd_fill_buffer(cmd, distance.raw(), 0, vk::WHOLE_SIZE, sentinel::SDF_NONE);
+                    d.raw.cmd_fill_buffer(cmd, ids[0].raw(), 0, vk::WHOLE_SIZE, sentinel::SDF_NONE);
                     d.raw.cmd_fill_buffer(cmd, votes.raw(), 0, vk::WHOLE_SIZE, 0);
                     d.cmd_barrier(cmd, &[filled], &[], &[]);
                     seed.bind(cmd, &[seed_set]);
                     for mode in 0..2 {
-                        seed.push(cmd, &with(mode, 0));
+                        seed.push(cmd, &with(SdfPass { seed_mode: mode, ..base }));
                         seed.dispatch_threads(cmd, [triangles as u32, 1, 1]);
                         d.cmd_barrier(cmd, &[between], &[], &[]);
                     }
                     for (k, &step) in steps.iter().enumerate() {
                         flood.bind(cmd, &[flood_sets[k % 2]]);
-                        flood.push(cmd, &with(step, 0));
+                        flood.push(cmd, &with(SdfPass { jump: step, ..base }));
                         flood.dispatch_threads(cmd, [points, 1, 1]);
                         d.cmd_barrier(cmd, &[between], &[], &[]);
                     }
                     sign.bind(cmd, &[sign_set]);
                     for axis in 0..3usize {
                         let lines = dims[(axis + 1) % 3] * dims[(axis + 2) % 3];
-                        sign.push(cmd, &with(0, axis as u32));
+                        sign.push(cmd, &with(SdfPass { ray_axis: axis as u32, ..base }));
                         sign.dispatch_threads(cmd, [lines, 1, 1]);
                         d.cmd_barrier(cmd, &[between], &[], &[]);
                     }
                     finalize.bind(cmd, &[finalize_set]);
-                    finalize.push(cmd, &base);
+                    finalize.push(cmd, &with(base));
                     finalize.dispatch_threads(cmd, [points, 1, 1]);
                 });
             }

@@ -3,7 +3,7 @@
 
 use glam::{Quat, Vec3};
 
-use super::params::{Collider, RigidTransform};
+use super::body::{Collider, RigidTransform};
 use crate::groom::scenes::{THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS};
 
 /// The neck pivot the head turns about, meters (world = head frame at rest).

@@ -6,32 +6,34 @@
 //! are applied in the same sequence as the GPU's barrier-separated phases, so
 //! the result matches the GPU up to how a driver rounds `sqrt` and division.
 
-use glam::{Vec3, Vec4};
+use glam::{Mat4, Vec3, Vec4};
 
-use super::params::{flags, SubstepInputs};
+use super::mesh_collider::MeshGrid;
+use super::planner::SubstepInputs;
 use super::state::SimState;
-use crate::gpu_types::{GpuCollider, SimStepParams};
+use crate::codes::sim_flags as flags;
+use crate::gpu_types::{ColliderShape, SimStep};
 use crate::groom::sdf::MeshSdf;
 
 fn dot(a: Vec3, b: Vec3) -> f32 {
     (a.x * b.x + a.y * b.y) + a.z * b.z
 }
 
-fn transform_point(m: &[[f32; 4]; 4], p: Vec3) -> Vec3 {
-    let c = |i: usize| Vec3::new(m[i][0], m[i][1], m[i][2]);
+fn transform_point(m: &Mat4, p: Vec3) -> Vec3 {
+    let c = |i: usize| m.col(i).truncate();
     ((c(0) * p.x + c(1) * p.y) + c(2) * p.z) + c(3)
 }
 
 /// `sim_to_head`: Rᵀ(p − t) for a rigid `m`.
-fn to_head(m: &[[f32; 4]; 4], p: Vec3) -> Vec3 {
-    let d = p - Vec3::new(m[3][0], m[3][1], m[3][2]);
-    let row = |i: usize| (m[i][0] * d.x + m[i][1] * d.y) + m[i][2] * d.z;
+fn to_head(m: &Mat4, p: Vec3) -> Vec3 {
+    let d = p - m.col(3).truncate();
+    let row = |i: usize| (m.col(i).x * d.x + m.col(i).y * d.y) + m.col(i).z * d.z;
     Vec3::new(row(0), row(1), row(2))
 }
 
 /// `sim_rotate`: R · v.
-fn rotate(m: &[[f32; 4]; 4], v: Vec3) -> Vec3 {
-    let c = |i: usize| Vec3::new(m[i][0], m[i][1], m[i][2]);
+fn rotate(m: &Mat4, v: Vec3) -> Vec3 {
+    let c = |i: usize| m.col(i).truncate();
     (c(0) * v.x + c(1) * v.y) + c(2) * v.z
 }
 
@@ -52,28 +54,27 @@ fn rotate_between(a: Vec3, b: Vec3, v: Vec3) -> Vec3 {
 /// The mesh collider's field as the solver sees it.
 #[derive(Clone, Copy)]
 pub(crate) struct MeshField<'a> {
-    pub grid: [f32; 4],
-    pub dims: [u32; 4],
+    pub grid: MeshGrid,
     pub values: &'a [f32],
 }
 
 impl<'a> MeshField<'a> {
     pub(crate) fn new(sdf: &'a MeshSdf) -> Self {
-        let (grid, dims) = super::mesh_collider::grid_of(sdf.origin, sdf.cell, sdf.dims);
-        MeshField { grid, dims, values: &sdf.values }
+        MeshField { grid: MeshGrid { origin: sdf.origin, cell: sdf.cell, dims: sdf.dims }, values: &sdf.values }
     }
 
     /// `mesh_sample`: trilinear value and its gradient (per cell) at q, head frame.
     pub(crate) fn sample(&self, q: Vec3) -> (Vec3, f32) {
-        let g = (q - Vec3::new(self.grid[0], self.grid[1], self.grid[2])) / self.grid[3];
-        let top = Vec3::new(self.dims[0] as f32, self.dims[1] as f32, self.dims[2] as f32) - 1.0;
+        let dims = self.grid.dims;
+        let g = (q - self.grid.origin) / self.grid.cell;
+        let top = Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32) - 1.0;
         if g.cmplt(Vec3::ZERO).any() || g.cmpgt(top).any() {
             return (Vec3::ZERO, 1e30);
         }
         let base = g.floor().min(top - 1.0);
         let f = g - base;
-        let (sx, sy, sz) = (1usize, self.dims[0] as usize, (self.dims[0] * self.dims[1]) as usize);
-        let k = ((base.z as usize * self.dims[1] as usize) + base.y as usize) * self.dims[0] as usize + base.x as usize;
+        let (sx, sy, sz) = (1usize, dims[0] as usize, (dims[0] * dims[1]) as usize);
+        let k = ((base.z as usize * dims[1] as usize) + base.y as usize) * dims[0] as usize + base.x as usize;
         let v = |o: usize| self.values[k + o];
         let (c000, c100, c010, c110) = (v(0), v(sx), v(sy), v(sx + sy));
         let (c001, c101, c011, c111) = (v(sz), v(sx + sz), v(sy + sz), v(sx + sy + sz));
@@ -93,7 +94,7 @@ impl<'a> MeshField<'a> {
     }
 
     /// `mesh_collide`.
-    fn collide(&self, head: &[[f32; 4]; 4], p: Vec3, radius: f32) -> Vec3 {
+    fn collide(&self, head: &Mat4, p: Vec3, radius: f32) -> Vec3 {
         let q = to_head(head, p);
         let (gradient, value) = self.sample(q);
         if value < radius {
@@ -107,18 +108,10 @@ impl<'a> MeshField<'a> {
 
     /// `mesh_friction`.
     #[allow(clippy::too_many_arguments, reason = "mirrors the shader function")]
-    fn friction(
-        &self,
-        head: &[[f32; 4]; 4],
-        previous_head: &[[f32; 4]; 4],
-        p: Vec3,
-        from: Vec3,
-        radius: f32,
-        friction: f32,
-    ) -> Vec3 {
+    fn friction(&self, head: &Mat4, previous_head: &Mat4, p: Vec3, from: Vec3, radius: f32, friction: f32) -> Vec3 {
         let q = to_head(head, p);
         let (gradient, value) = self.sample(q);
-        let contact = radius + 0.1 * self.grid[3];
+        let contact = radius + 0.1 * self.grid.cell;
         let len = dot(gradient, gradient).sqrt();
         // Written to treat NaN as the shader does: no contact.
         let touching = value < contact && len > 0.0;
@@ -147,18 +140,18 @@ pub(crate) fn noise(t: f32, strand: u32) -> f32 {
     a + (b - a) * s
 }
 
-fn collide(c: &GpuCollider, p: Vec3, radius: f32) -> Vec3 {
-    let a = c.a();
+fn collide(c: &ColliderShape, p: Vec3, radius: f32) -> Vec3 {
+    let a = c.a;
     let mut closest = a;
     if c.is_capsule() {
-        let ab = c.b() - a;
+        let ab = c.b - a;
         let len2 = dot(ab, ab);
         let t = if len2 > 0.0 { (dot(p - a, ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
         closest = a + ab * t;
     }
     let d = p - closest;
     let dist = dot(d, d).sqrt();
-    let reach = c.radius() + radius;
+    let reach = c.radius + radius;
     if dist < reach && dist > 0.0 {
         closest + d * (reach / dist)
     } else {
@@ -170,9 +163,9 @@ fn collide(c: &GpuCollider, p: Vec3, radius: f32) -> Vec3 {
 /// collider when `SIM_MESH` is set.
 #[derive(Clone, Copy)]
 struct Bodies<'a> {
-    colliders: &'a [GpuCollider],
+    colliders: &'a [ColliderShape],
     mesh: Option<MeshField<'a>>,
-    head: &'a [[f32; 4]; 4],
+    head: &'a Mat4,
 }
 
 impl Bodies<'_> {
@@ -233,12 +226,9 @@ fn project(s: &mut [Vec4], i: usize, j: usize, rest_d: f32, k: f32) {
 }
 
 /// Stage 1: forces and prediction.
-fn predict(p: &SimStepParams, state: &SimState, predicted: &mut [Vec4]) {
-    let points = p.points() as usize;
-    let dt = p.dt();
-    let flags = p.flags();
-    let gravity = p.gravity();
-    let wind = Vec3::new(p.wind[0], p.wind[1], p.wind[2]);
+fn predict(p: &SimStep, state: &SimState, predicted: &mut [Vec4]) {
+    let points = p.points as usize;
+    let (dt, flags, gravity, wind) = (p.dt, p.flags, p.gravity, p.wind);
     for (index, out) in predicted.iter_mut().enumerate() {
         let strand = (index / points) as u32;
         let x = state.positions[index];
@@ -252,11 +242,11 @@ fn predict(p: &SimStepParams, state: &SimState, predicted: &mut [Vec4]) {
             a += gravity;
         }
         if flags & flags::WIND != 0 {
-            let gust = 1.0 + p.wind[3] * noise(p.wind_noise[1] * p.wind_noise[0], strand);
+            let gust = 1.0 + p.wind_turbulence * noise(p.time * p.wind_frequency, strand);
             a += wind * gust;
         }
         if flags & flags::SPRING != 0 {
-            a += (rest_world - x.truncate()) * p.wind_noise[2];
+            a += (rest_world - x.truncate()) * p.spring_stiffness;
         }
         let v = state.velocities[index].truncate() + a * dt;
         *out = (x.truncate() + v * dt).extend(x.w);
@@ -265,15 +255,15 @@ fn predict(p: &SimStepParams, state: &SimState, predicted: &mut [Vec4]) {
 
 /// Stage 2: constraint solve, hair by hair.
 fn solve(
-    p: &SimStepParams,
-    colliders: &[GpuCollider],
+    p: &SimStep,
+    colliders: &[ColliderShape],
     mesh: Option<MeshField<'_>>,
     state: &SimState,
     predicted: &mut [Vec4],
     correction: &mut [Vec4],
 ) {
-    let points = p.points() as usize;
-    let flags = p.flags();
+    let points = p.points as usize;
+    let flags = p.flags;
     let collisions = flags & flags::COLLISIONS != 0;
     let mesh = mesh.filter(|_| flags & flags::MESH != 0);
     let bodies = Bodies { colliders, mesh, head: &p.head };
@@ -285,9 +275,9 @@ fn solve(
     let mut bend = vec![(0.0f32, 0.0f32); points];
     // Per point of the strand: the global shape constraint's target and stiffness.
     let global_shape = flags & flags::GLOBAL_SHAPE != 0;
-    let (shape_stiffness, shape_range) = p.global_shape();
+    let (shape_stiffness, shape_range) = (p.global_shape, p.global_shape_range);
     let mut shape = vec![(Vec3::ZERO, 0.0f32); points];
-    for strand in 0..p.strands() as usize {
+    for strand in 0..p.strands as usize {
         let base = strand * points;
         s.copy_from_slice(&predicted[base..base + points]);
         let lengths = &state.rest_lengths[base..base + points];
@@ -318,10 +308,7 @@ fn solve(
             if i > 0 && i + 1 < points {
                 let r = state.rest[base + i + 1].truncate() - state.rest[base + i - 1].truncate();
                 let t = i as f32 / (points - 1) as f32;
-                *b = (dot(r, r).sqrt(), {
-                    let (root, tip) = p.bending_root_tip();
-                    root + (tip - root) * t
-                });
+                *b = (dot(r, r).sqrt(), p.bending_root + (p.bending_tip - p.bending_root) * t);
             }
         }
         let bending = flags & flags::BENDING != 0;
@@ -330,7 +317,7 @@ fn solve(
                 let t = i as f32 / (points - 1) as f32;
                 let k = shape_stiffness * shape_weight(t, shape_range);
                 let at_rest = transform_point(&p.head, state.rest[base + i].truncate());
-                *slot = (shape_target(at_rest, k, p.iterations(), flags, p.gravity(), p.dt()), k);
+                *slot = (shape_target(at_rest, k, p.iterations, flags, p.gravity, p.dt), k);
             }
         }
         if local_shape {
@@ -346,7 +333,7 @@ fn solve(
                 *slot = (dir, offset(i));
             }
         }
-        for iteration in 0..p.iterations() {
+        for iteration in 0..p.iterations {
             for i in (0..points - 1).step_by(2) {
                 project(&mut s, i, i + 1, lengths[i], 1.0);
             }
@@ -362,7 +349,7 @@ fn solve(
                     }
                 }
             }
-            if local_shape && iteration + 1 == p.iterations() {
+            if local_shape && iteration + 1 == p.iterations {
                 // `local_shape_sweep` in glsl/sim/step.comp.
                 for (j, &(dir, offset)) in local.iter().enumerate().skip(1) {
                     let (parent, child) = (s[j - 1], s[j]);
@@ -376,7 +363,7 @@ fn solve(
                     }
                     let w = parent.w + child.w;
                     if w > 0.0 {
-                        let delta = (carried - (child.truncate() - parent.truncate())) * p.local_shape();
+                        let delta = (carried - (child.truncate() - parent.truncate())) * p.local_shape;
                         s[j - 1] = (parent.truncate() - delta * (parent.w / w)).extend(parent.w);
                         s[j] = (child.truncate() + delta * (child.w / w)).extend(child.w);
                     }
@@ -401,8 +388,7 @@ fn solve(
             for (i, q) in s.iter_mut().enumerate() {
                 if q.w > 0.0 {
                     let from = state.positions[base + i].truncate();
-                    let held =
-                        mesh.friction(&p.head, &p.previous_head, q.truncate(), from, radius(i), p.mesh_friction());
+                    let held = mesh.friction(&p.head, &p.previous_head, q.truncate(), from, radius(i), p.mesh_friction);
                     *q = held.extend(q.w);
                 }
             }
@@ -412,18 +398,18 @@ fn solve(
 }
 
 /// Stage 3: velocity update, damping, final state.
-fn integrate(p: &SimStepParams, state: &mut SimState, predicted: &[Vec4], correction: &[Vec4]) {
-    let points = p.points() as usize;
-    let dt = p.dt();
-    let dftl = p.flags() & flags::DFTL != 0;
+fn integrate(p: &SimStep, state: &mut SimState, predicted: &[Vec4], correction: &[Vec4]) {
+    let points = p.points as usize;
+    let dt = p.dt;
+    let dftl = p.flags & flags::DFTL != 0;
     for index in 0..predicted.len() {
         let i = index % points;
         let solved = predicted[index];
         let mut v = (solved.truncate() - state.positions[index].truncate()) / dt;
         if dftl && i + 1 < points {
-            v -= correction[index + 1].truncate() * (p.dftl_damping() / dt);
+            v -= correction[index + 1].truncate() * (p.dftl_damping / dt);
         }
-        v *= 1.0 - p.wind_noise[3];
+        v *= 1.0 - p.damping;
         state.positions[index] = solved;
         state.velocities[index] = v.extend(0.0);
     }

@@ -18,7 +18,8 @@ use std::sync::Arc;
 
 use glam::{Vec3, Vec4};
 
-use super::params::{RigidTransform, SimParams, MAX_COLLIDERS, MAX_SIM_POINTS, MAX_SUBSTEPS};
+use super::body::{RigidTransform, MAX_COLLIDERS};
+use super::params::{SimParams, MAX_SIM_POINTS, MAX_SUBSTEPS};
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuCollider, SimStepParams};
 use crate::groom::Groom;

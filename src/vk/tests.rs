@@ -531,12 +531,16 @@ fn shaders_are_built_with_the_shared_constants() {
 /// the crate has one.
 #[test]
 fn shaders_may_not_redeclare_the_injected_constants() {
-    use crate::limits::redeclared_constants;
+    use crate::codes::SHADER_CODES;
+    use crate::limits::{redeclared_constants, SHADER_CONSTANTS};
     let bad = "#define VOL_GROUP 128u\nconst uint MAX_LIGHTS = 4u;\nlayout(local_size_x = VOL_GROUP) in;\n\
-               // #define SIM_WORKGROUP 1\nuint n = ITEM_GROUP;\n";
-    assert_eq!(redeclared_constants(bad), vec![(1, "VOL_GROUP"), (2, "MAX_LIGHTS")]);
+               // #define SIM_WORKGROUP 1\nuint n = ITEM_GROUP;\nconst uint SIM_GRAVITY = 1u;\n";
+    assert_eq!(redeclared_constants(bad, SHADER_CONSTANTS), vec![(1, "VOL_GROUP"), (2, "MAX_LIGHTS")]);
+    assert_eq!(redeclared_constants(bad, SHADER_CODES), vec![(6, "SIM_GRAVITY")]);
     for (path, source) in glsl_sources() {
-        assert!(redeclared_constants(&source).is_empty(), "{} redeclares a constant", path.display());
+        for table in [SHADER_CONSTANTS, SHADER_CODES] {
+            assert!(redeclared_constants(&source, table).is_empty(), "{} redeclares a constant", path.display());
+        }
     }
 }
 

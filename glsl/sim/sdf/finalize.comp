@@ -14,7 +14,7 @@ layout(push_constant) uniform Push { SdfPush pc; };
 
 void main() {
     uint k = gl_GlobalInvocationID.x;
-    uvec3 dims = pc.dims.xyz;
+    uvec3 dims = sdf_pass_dims(pc);
     if (k >= dims.x * dims.y * dims.z) {
         return;
     }
@@ -22,7 +22,7 @@ void main() {
     // Unreachable: the seeds cover the mesh and the floods reach every point.
     float d = 3.40282347e38;
     if (t != SDF_NONE) {
-        vec3 p = sdf_point(sdf_grid_point(k, dims), pc.origin_cell);
+        vec3 p = sdf_point(sdf_grid_point(k, dims), sdf_pass_origin(pc), sdf_pass_cell(pc));
         d = sdf_triangle_distance(p, corners[3u * t].xyz, corners[3u * t + 1u].xyz, corners[3u * t + 2u].xyz);
     }
     field[k] = votes[k] >= 2u ? -d : d;

@@ -18,15 +18,15 @@ float distance_to(uint t, vec3 p) {
 
 void main() {
     uint k = gl_GlobalInvocationID.x;
-    uvec3 dims = pc.dims.xyz;
+    uvec3 dims = sdf_pass_dims(pc);
     if (k >= dims.x * dims.y * dims.z) {
         return;
     }
     uvec3 g = sdf_grid_point(k, dims);
-    vec3 p = sdf_point(g, pc.origin_cell);
+    vec3 p = sdf_point(g, sdf_pass_origin(pc), sdf_pass_cell(pc));
     uint best = ids_in[k];
     float best_d = best == SDF_NONE ? uintBitsToFloat(0x7f800000u) : distance_to(best, p);
-    int step = int(pc.pass_info.x);
+    int step = int(sdf_pass_jump(pc));
     for (int dz = -1; dz <= 1; dz++) {
         for (int dy = -1; dy <= 1; dy++) {
             for (int dx = -1; dx <= 1; dx++) {

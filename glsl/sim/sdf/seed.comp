@@ -16,27 +16,27 @@ layout(push_constant) uniform Push { SdfPush pc; };
 
 void main() {
     uint t = gl_GlobalInvocationID.x;
-    if (t >= pc.dims.w) {
+    if (t >= sdf_pass_triangles(pc)) {
         return;
     }
     vec3 a = corners[3u * t].xyz;
     vec3 b = corners[3u * t + 1u].xyz;
     vec3 c = corners[3u * t + 2u].xyz;
-    float cell = pc.origin_cell.w;
+    float cell = sdf_pass_cell(pc);
     precise vec3 lo = min(min(a, b), c) - vec3(1.5 * cell);
     precise vec3 hi = max(max(a, b), c) + vec3(1.5 * cell);
-    precise vec3 first_f = max(ceil((lo - pc.origin_cell.xyz) / cell), vec3(0.0));
-    precise vec3 last_f = floor((hi - pc.origin_cell.xyz) / cell);
+    precise vec3 first_f = max(ceil((lo - sdf_pass_origin(pc)) / cell), vec3(0.0));
+    precise vec3 last_f = floor((hi - sdf_pass_origin(pc)) / cell);
     uvec3 first = uvec3(first_f);
     // Negative ends saturate to 0, as `as u32` does on the CPU.
-    uvec3 last = min(uvec3(max(last_f, vec3(0.0))), pc.dims.xyz - 1u);
+    uvec3 last = min(uvec3(max(last_f, vec3(0.0))), sdf_pass_dims(pc) - 1u);
     for (uint z = first.z; z <= last.z; z++) {
         for (uint y = first.y; y <= last.y; y++) {
             for (uint x = first.x; x <= last.x; x++) {
                 uvec3 g = uvec3(x, y, z);
-                uint k = sdf_index(g, pc.dims.xyz);
-                float d = sdf_triangle_distance(sdf_point(g, pc.origin_cell), a, b, c);
-                if (pc.pass_info.x == 0u) {
+                uint k = sdf_index(g, sdf_pass_dims(pc));
+                float d = sdf_triangle_distance(sdf_point(g, sdf_pass_origin(pc), sdf_pass_cell(pc)), a, b, c);
+                if (sdf_pass_seed_mode(pc) == 0u) {
                     atomicMin(distance_bits[k], floatBitsToUint(d));
                 } else if (floatBitsToUint(d) == distance_bits[k]) {
                     atomicMin(ids[k], t);

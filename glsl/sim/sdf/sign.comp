@@ -17,25 +17,25 @@ layout(push_constant) uniform Push { SdfPush pc; };
 uint parity[SDF_MAX_RESOLUTION / 32u];
 
 void main() {
-    uint axis = pc.pass_info.y;
+    uint axis = sdf_pass_ray_axis(pc);
     uint u = (axis + 1u) % 3u;
     uint v = (axis + 2u) % 3u;
-    uvec3 dims = pc.dims.xyz;
+    uvec3 dims = sdf_pass_dims(pc);
     uint line = gl_GlobalInvocationID.x;
     if (line >= dims[u] * dims[v]) {
         return;
     }
     uint i = line % dims[u];
     uint j = line / dims[u];
-    float cell = pc.origin_cell.w;
-    precise float ou = pc.origin_cell[u] + (float(i) + 1e-3) * cell;
-    precise float ov = pc.origin_cell[v] + (float(j) + 2e-3) * cell;
-    float ow = pc.origin_cell[axis];
+    float cell = sdf_pass_cell(pc);
+    precise float ou = sdf_pass_origin(pc)[u] + (float(i) + 1e-3) * cell;
+    precise float ov = sdf_pass_origin(pc)[v] + (float(j) + 2e-3) * cell;
+    float ow = sdf_pass_origin(pc)[axis];
     uint nw = dims[axis];
     for (uint b = 0u; b < SDF_MAX_RESOLUTION / 32u; b++) {
         parity[b] = 0u;
     }
-    for (uint t = 0u; t < pc.dims.w; t++) {
+    for (uint t = 0u; t < sdf_pass_triangles(pc); t++) {
         vec3 a = corners[3u * t].xyz;
         vec3 b = corners[3u * t + 1u].xyz;
         vec3 c = corners[3u * t + 2u].xyz;

@@ -17,13 +17,13 @@ layout(std430, set = 0, binding = 11) writeonly buffer GridVel { vec4 grid_vel[]
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
-    if (i >= vp.counts.x) {
+    if (i >= vol_particles(vp)) {
         return;
     }
     vec4 p = pos[i];
-    vec3 g = vol_affine(vp.grid_from_world, p.xyz);
-    vec3 v = vol_linear(vp.axes, vel[i].xyz);
-    keys_a[i] = vol_cell_of(g, vp.dims.xyz, vp.dims.w);
+    vec3 g = vol_affine(vol_grid_from_world(vp), p.xyz);
+    vec3 v = vol_linear(vol_axes(vp), vel[i].xyz);
+    keys_a[i] = vol_cell_of(g, vol_dims(vp), vol_cells(vp));
     vals_a[i] = i;
     grid_pos[i] = vec4(g, p.w);
     grid_vel[i] = vec4(v, 0.0);

@@ -19,7 +19,7 @@ layout(std430, set = 0, binding = 18) readonly buffer FaceStar { float face_star
 
 // Trilinear samples of component `axis` at g: x = Lerp(v_grid), y = Lerp(v_grid − v*_grid).
 vec2 sample_faces(vec3 g, uint axis) {
-    uvec3 fd = vol_face_dims(vp.dims.xyz, axis);
+    uvec3 fd = vol_face_dims(vol_dims(vp), axis);
     vec3 q = g - 0.5;
     q[axis] += 0.5;
     vec3 base = floor(q);
@@ -30,7 +30,7 @@ vec2 sample_faces(vec3 g, uint axis) {
         ivec3 at = clamp(ivec3(base) + ivec3(corner), ivec3(0), ivec3(fd) - 1);
         precise vec3 w3 = mix(vec3(1.0) - t, t, vec3(corner));
         precise float w = (w3.x * w3.y) * w3.z;
-        uint f = vol_face_index(uvec3(at), axis, vp.dims.xyz, vp.counts);
+        uint f = vol_face_index(uvec3(at), axis, vol_dims(vp), vol_first_v_face(vp), vol_first_w_face(vp));
         float v = face_vel[f];
         result += vec2(v, v - face_star[f]) * w;
     }
@@ -40,7 +40,7 @@ vec2 sample_faces(vec3 g, uint axis) {
 // Trilinear sample of the cell-centred (momentum, density) at g: the mean velocity
 // weighted by density, so that empty cells do not pull velocities toward zero.
 vec4 sample_cells(vec3 g) {
-    uvec3 dims = vp.dims.xyz;
+    uvec3 dims = vol_dims(vp);
     vec3 q = g - 0.5;
     vec3 base = floor(q);
     precise vec3 t = q - base;
@@ -58,17 +58,17 @@ vec4 sample_cells(vec3 g) {
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
-    if (i >= vp.counts.x) {
+    if (i >= vol_particles(vp)) {
         return;
     }
     vec4 gp = grid_pos[i];
-    if (gp.w == 0.0 || vol_cell_of(gp.xyz, vp.dims.xyz, vp.dims.w) == vp.dims.w) {
+    if (gp.w == 0.0 || vol_cell_of(gp.xyz, vol_dims(vp), vol_cells(vp)) == vol_cells(vp)) {
         return;
     }
     vec3 g = gp.xyz;
     precise vec3 v = grid_vel[i].xyz;
-    if (vp.solve.w == float(VOL_MODE_FLIP)) {
-        float alpha = vp.transfer.x;
+    if (vol_mode(vp) == float(VOL_MODE_FLIP)) {
+        float alpha = vol_flip_ratio(vp);
         vec2 su = sample_faces(g, 0u);
         vec2 sv = sample_faces(g, 1u);
         vec2 sw = sample_faces(g, 2u);
@@ -77,14 +77,14 @@ void main() {
         v = flip * alpha + pic * (1.0 - alpha);
     } else {
         vec4 cell = sample_cells(g);
-        float s = vp.transfer.y;
+        float s = vol_friction(vp);
         if (cell.w > 0.0) {
             precise vec3 mean = cell.xyz / cell.w;
             v = v * (1.0 - s) + mean * s;
         }
-        float threshold = vp.transfer.w;
-        if (vp.transfer.z > 0.0 && cell.w > threshold) {
-            uvec3 dims = vp.dims.xyz;
+        float threshold = vol_repulsion_threshold(vp);
+        if (vol_repulsion(vp) > 0.0 && cell.w > threshold) {
+            uvec3 dims = vol_dims(vp);
             uvec3 c = min(uvec3(g), dims - 1u);
             vec3 gradient = vec3(0.0);
             for (uint axis = 0u; axis < 3u; ++axis) {
@@ -97,11 +97,11 @@ void main() {
             float len = length(gradient);
             if (len > 0.0) {
                 float excess = min((cell.w - threshold) / max(threshold, 1e-6), 1.0);
-                v = v - gradient * (vp.transfer.z * vp.solve.z * excess / len);
+                v = v - gradient * (vol_repulsion(vp) * vol_dt(vp) * excess / len);
             }
         }
     }
     // Back to world axes: the transpose of the rotation.
-    mat3 to_grid = mat3(vp.axes);
+    mat3 to_grid = mat3(vol_axes(vp));
     vel[i] = vec4(transpose(to_grid) * v, 0.0);
 }

@@ -31,17 +31,17 @@ layout(std430, set = 0, binding = 29) readonly buffer MeshField { float mesh_fie
 #include "mesh_sdf.glsl"
 
 bool inside_collider(vec3 p) {
-    for (uint k = 0u; k < vp.config.w; ++k) {
+    for (uint k = 0u; k < vol_colliders(vp); ++k) {
         Collider c = colliders[k];
-        vec3 closest = c.a_radius.xyz;
-        if (c.b_kind.w > 0.5) {
-            vec3 ab = c.b_kind.xyz - c.a_radius.xyz;
+        vec3 closest = collider_a(c);
+        if (collider_kind(c) == float(COLLIDER_CAPSULE)) {
+            vec3 ab = collider_b(c) - collider_a(c);
             float len2 = dot(ab, ab);
-            float t = len2 > 0.0 ? clamp(dot(p - c.a_radius.xyz, ab) / len2, 0.0, 1.0) : 0.0;
-            closest = c.a_radius.xyz + ab * t;
+            float t = len2 > 0.0 ? clamp(dot(p - collider_a(c), ab) / len2, 0.0, 1.0) : 0.0;
+            closest = collider_a(c) + ab * t;
         }
         vec3 d = p - closest;
-        if (dot(d, d) < c.a_radius.w * c.a_radius.w) {
+        if (dot(d, d) < collider_radius(c) * collider_radius(c)) {
             return true;
         }
     }
@@ -50,24 +50,24 @@ bool inside_collider(vec3 p) {
 
 // Whether cell q (possibly outside the grid, which is never solid) is solid.
 bool solid_cell(ivec3 q) {
-    if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, ivec3(vp.dims.xyz)))) {
+    if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, ivec3(vol_dims(vp))))) {
         return false;
     }
     vec3 centre = vec3(q) + 0.5;
-    if (vp.mesh_dims.w == 1u && mesh_sample(vp.mesh_grid, vp.mesh_dims, vol_affine(vp.mesh_from_grid, centre)).w < 0.0) {
+    if (vol_mesh_solid(vp) == 1u && mesh_sample(MeshGrid(vol_mesh_origin(vp), vol_mesh_cell(vp), vol_mesh_dims(vp)), vol_affine(vol_mesh_from_grid(vp), centre)).w < 0.0) {
         return true;
     }
-    return inside_collider(vol_affine(vp.world_from_grid, centre));
+    return inside_collider(vol_affine(vol_world_from_grid(vp), centre));
 }
 
 void main() {
-    uvec3 dims = vp.dims.xyz;
+    uvec3 dims = vol_dims(vp);
     uvec3 ext = dims + 1u;
     uint t = gl_GlobalInvocationID.x;
     if (t >= ext.x * ext.y * ext.z) {
         return;
     }
-    uint n = vp.counts.x;
+    uint n = vol_particles(vp);
     ivec3 ijk = ivec3(vol_cell_coords(t, ext));
     bool has_cell = all(lessThan(ijk, ivec3(dims)));
     // Face a exists when the other two coordinates are inside the grid.
@@ -129,9 +129,9 @@ void main() {
         x[a] -= 0.5;
         precise float u = weights[a] > 0.0 ? sums[a] / weights[a] : 0.0;
         if (solid_here || solid_cell(below)) {
-            u = vol_affine(vp.solid_velocity, x)[a];
+            u = vol_affine(vol_solid_velocity(vp), x)[a];
         }
-        uint f = vol_face_index(uvec3(ijk), a, dims, vp.counts);
+        uint f = vol_face_index(uvec3(ijk), a, dims, vol_first_v_face(vp), vol_first_w_face(vp));
         face_vel[f] = u;
         face_star[f] = u;
         face_weight[f] = weights[a];

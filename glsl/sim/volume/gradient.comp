@@ -15,12 +15,12 @@ layout(std430, set = 0, binding = 26) readonly buffer Scalars { PcgScalars scala
 
 void main() {
     uint f = gl_GlobalInvocationID.x;
-    if (f >= vp.counts.w || scalars.status == VOL_STATUS_NONFINITE) {
+    if (f >= vol_faces(vp) || scalars.status == VOL_STATUS_NONFINITE) {
         return;
     }
-    uvec3 dims = vp.dims.xyz;
-    uint axis = vol_face_axis(f, vp.counts);
-    uint base = axis == 0u ? 0u : (axis == 1u ? vp.counts.y : vp.counts.z);
+    uvec3 dims = vol_dims(vp);
+    uint axis = vol_face_axis(f, vol_first_v_face(vp), vol_first_w_face(vp));
+    uint base = axis == 0u ? 0u : (axis == 1u ? vol_first_v_face(vp) : vol_first_w_face(vp));
     uvec3 ijk = vol_cell_coords(f - base, vol_face_dims(dims, axis));
     uint below_label = VOL_AIR;
     uint above_label = VOL_AIR;

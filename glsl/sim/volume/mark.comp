@@ -14,17 +14,17 @@ layout(std430, set = 0, binding = 19) readonly buffer FaceWeight { float face_we
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
-    if (c >= vp.dims.w || labels[c] != VOL_AIR) {
+    if (c >= vol_cells(vp) || labels[c] != VOL_AIR) {
         return;
     }
-    uvec3 dims = vp.dims.xyz;
+    uvec3 dims = vol_dims(vp);
     uvec3 ijk = vol_cell_coords(c, dims);
     bool covered = true;
     for (uint axis = 0u; axis < 3u; ++axis) {
         uvec3 up = ijk;
         up[axis] += 1u;
-        covered = covered && face_weight[vol_face_index(ijk, axis, dims, vp.counts)] > 0.0
-            && face_weight[vol_face_index(up, axis, dims, vp.counts)] > 0.0;
+        covered = covered && face_weight[vol_face_index(ijk, axis, dims, vol_first_v_face(vp), vol_first_w_face(vp))] > 0.0
+            && face_weight[vol_face_index(up, axis, dims, vol_first_v_face(vp), vol_first_w_face(vp))] > 0.0;
     }
     if (covered) {
         labels[c] = VOL_FLUID;

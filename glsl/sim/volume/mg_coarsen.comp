@@ -12,7 +12,7 @@ layout(std430, set = 0, binding = 16) buffer Labels { uint labels[]; };
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
-    uvec3 cd = pc.coarse.xyz;
+    uvec3 cd = level_coarse_dims(pc);
     if (c >= cd.x * cd.y * cd.z) {
         return;
     }
@@ -21,12 +21,12 @@ void main() {
     bool air = false;
     for (uint k = 0u; k < 8u; ++k) {
         uvec3 child = ijk * 2u + uvec3(k & 1u, (k >> 1u) & 1u, k >> 2u);
-        if (any(greaterThanEqual(child, pc.dims.xyz))) {
+        if (any(greaterThanEqual(child, level_dims(pc)))) {
             continue;
         }
-        uint label = labels[pc.dims.w + vol_cell_index(child, pc.dims.xyz)];
+        uint label = labels[level_first(pc) + vol_cell_index(child, level_dims(pc))];
         fluid = fluid || label == VOL_FLUID;
         air = air || label == VOL_AIR;
     }
-    labels[pc.coarse.w + c] = fluid ? VOL_FLUID : (air ? VOL_AIR : VOL_SOLID);
+    labels[level_coarse_first(pc) + c] = fluid ? VOL_FLUID : (air ? VOL_AIR : VOL_SOLID);
 }

@@ -1,9 +1,9 @@
 #version 460
 // Multigrid preconditioner, coarsest level (at most 256 cells), one workgroup:
-// op.z damped Jacobi sweeps (an even number) from x = 0 in shared memory;
-// with op.y = 1 (a grid of one level) also the partials (r·z, max |r|) of the
+// mg_coarsest_sweeps damped Jacobi sweeps (an even number) from x = 0 in shared memory;
+// with mg_coarsest_partials = 1 (a grid of one level) also the partials (r·z, max |r|) of the
 // conjugate gradients, as the finest level's last sweep gives them otherwise.
-//   dims: the level (w its first cell).
+//   mg_coarsest_dims/first: the level.
 #include "volume.glsl"
 // vkhair variant: VKHAIR_SHARED_REDUCE
 #include "reduce.glsl"
@@ -23,16 +23,16 @@ const float OMEGA = 2.0 / 3.0;
 
 void main() {
     uint c = gl_LocalInvocationID.x;
-    uvec3 dims = pc.dims.xyz;
+    uvec3 dims = mg_coarsest_dims(pc);
     bool live = c < dims.x * dims.y * dims.z;
-    uint i = pc.dims.w + c;
+    uint i = mg_coarsest_first(pc) + c;
     uint w = live ? stencil[i] : 0u;
     bool fluid_cell = vol_is_fluid(w);
     float diagonal = vol_diagonal(w);
     float b = fluid_cell ? rhs[i] : 0.0;
     values[0][c] = 0.0;
     barrier();
-    for (uint sweep = 0u; sweep < pc.op.z; ++sweep) {
+    for (uint sweep = 0u; sweep < mg_coarsest_sweeps(pc); ++sweep) {
         uint from = sweep & 1u;
         precise float value = 0.0;
         if (fluid_cell && diagonal > 0.0) {
@@ -47,11 +47,11 @@ void main() {
         values[1u - from][c] = value;
         barrier();
     }
-    float result = values[pc.op.z & 1u][c];
+    float result = values[mg_coarsest_sweeps(pc) & 1u][c];
     if (live) {
         x[i] = result;
     }
-    if (pc.op.y == 1u) {
+    if (mg_coarsest_partials(pc) == 1u) {
         vec2 total = reduce_sum_max(live ? vec2(rhs[i] * result, abs(rhs[i])) : vec2(0.0));
         if (gl_LocalInvocationIndex == 0u) {
             partials[0] = total;

@@ -2,15 +2,15 @@
 // Multigrid preconditioner: damped Jacobi sweeps (ω = 2/3) on one level,
 // x ← x + ω (rhs − A x) / diag, non-fluid cells 0. Three forms, so that the
 // V-cycle needs no pass of its own for the first sweep or the prolongation:
-//   op.x = 0 (pre):   two sweeps from x = 0 into x; the first sweep's values of
+//   mg_smooth_mode = 0 (pre):   two sweeps from x = 0 into x; the first sweep's values of
 //                     the cell and its neighbours are recomputed where needed;
-//   op.x = 1 (post):  one sweep from x plus the coarse parent's correction
+//   mg_smooth_mode = 1 (post):  one sweep from x plus the coarse parent's correction
 //                     (piecewise-constant prolongation, the transpose of the
 //                     restriction up to its factor) into tmp;
-//   op.x = 2 (post):  one sweep tmp → x; with op.y = 1 (finest level, in
+//   mg_smooth_mode = 2 (post):  one sweep tmp → x; with mg_smooth_partials = 1 (finest level, in
 //                     conjugate gradients) also the per-workgroup partials
 //                     (r·z, max |r|) of z = x and r = rhs.
-//   dims: the level (w its first cell);  coarse: the next coarser level.
+//   mg_smooth_dims/first: the level;  mg_smooth_coarse_dims/first: the next coarser level.
 #include "volume.glsl"
 // vkhair variant: VKHAIR_SHARED_REDUCE
 #include "reduce.glsl"
@@ -43,27 +43,27 @@ float first_sweep(uint j) {
 
 // x at fluid cell `ijk` (level-array index j) with its coarse parent's correction added.
 float prolonged(uint j, uvec3 ijk) {
-    uint parent = pc.coarse.w + vol_cell_index(ijk / 2u, pc.coarse.xyz);
+    uint parent = mg_smooth_coarse_first(pc) + vol_cell_index(ijk / 2u, mg_smooth_coarse_dims(pc));
     precise float value = x[j] + x[parent];
     return value;
 }
 
 float source(uint j, uvec3 ijk) {
-    if (pc.op.x == 0u) {
+    if (mg_smooth_mode(pc) == 0u) {
         return first_sweep(j);
     }
-    return pc.op.x == 1u ? prolonged(j, ijk) : tmp[j];
+    return mg_smooth_mode(pc) == 1u ? prolonged(j, ijk) : tmp[j];
 }
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
-    uvec3 dims = pc.dims.xyz;
+    uvec3 dims = mg_smooth_dims(pc);
     bool live = c < dims.x * dims.y * dims.z;
-    uint i = pc.dims.w + c;
+    uint i = mg_smooth_first(pc) + c;
     precise float value = 0.0;
     uint w = live ? stencil[i] : 0u;
     if (vol_is_fluid(w)) {
-        uvec3 ijk = pc.op.x == 1u ? vol_cell_coords(c, dims) : uvec3(0u);
+        uvec3 ijk = mg_smooth_mode(pc) == 1u ? vol_cell_coords(c, dims) : uvec3(0u);
         float own = source(i, ijk);
         precise float ax = vol_diagonal(w) * own;
         for (uint n = 0u; n < 6u; ++n) {
@@ -76,13 +76,13 @@ void main() {
         value = sweep(i, w, own, ax);
     }
     if (live) {
-        if (pc.op.x == 1u) {
+        if (mg_smooth_mode(pc) == 1u) {
             tmp[i] = value;
         } else {
             x[i] = value;
         }
     }
-    if (pc.op.y == 1u) {
+    if (mg_smooth_partials(pc) == 1u) {
         vec2 local = live ? vec2(rhs[i] * value, abs(rhs[i])) : vec2(0.0);
         vec2 total = reduce_sum_max(local);
         if (gl_LocalInvocationIndex == 0u) {

@@ -15,10 +15,10 @@ layout(std430, set = 0, binding = 30) writeonly buffer Stencil { uint stencil[];
 
 void main() {
     uint g = gl_GlobalInvocationID.x;
-    uvec3 dims = vp.dims.xyz;
+    uvec3 dims = vol_dims(vp);
     uint offset = 0u;
     uint level = 0u;
-    for (; level < vp.config.z; ++level) {
+    for (; level < vol_levels(vp); ++level) {
         uint cells = dims.x * dims.y * dims.z;
         if (g < offset + cells) {
             break;
@@ -26,7 +26,7 @@ void main() {
         offset += cells;
         dims = (dims + 1u) / 2u;
     }
-    if (level == vp.config.z) {
+    if (level == vol_levels(vp)) {
         return;
     }
     uint word = 0u;

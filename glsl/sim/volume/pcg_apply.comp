@@ -15,9 +15,9 @@ layout(std430, set = 0, binding = 27) writeonly buffer Partials { vec2 partials[
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
-    uvec3 dims = vp.dims.xyz;
+    uvec3 dims = vol_dims(vp);
     vec2 local = vec2(0.0);
-    if (c < vp.dims.w) {
+    if (c < vol_cells(vp)) {
         precise float qc = 0.0;
         uint w = stencil[c];
         if (vol_is_fluid(w)) {

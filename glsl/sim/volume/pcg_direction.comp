@@ -11,7 +11,7 @@ layout(std430, set = 0, binding = 26) readonly buffer Scalars { PcgScalars scala
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
-    if (c >= vp.dims.w) {
+    if (c >= vol_cells(vp)) {
         return;
     }
     precise float dc = z[c] + scalars.beta * d[c];

@@ -19,9 +19,9 @@ layout(std430, set = 0, binding = 27) writeonly buffer Partials { vec2 partials[
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
-    uvec3 dims = vp.dims.xyz;
+    uvec3 dims = vol_dims(vp);
     vec2 local = vec2(0.0);
-    if (c < vp.dims.w) {
+    if (c < vol_cells(vp)) {
         uvec3 ijk = vol_cell_coords(c, dims);
         precise float b = 0.0;
         precise float zc = 0.0;
@@ -31,12 +31,12 @@ void main() {
             for (uint axis = 0u; axis < 3u; ++axis) {
                 uvec3 up = ijk;
                 up[axis] += 1u;
-                outflow += face_vel[vol_face_index(up, axis, dims, vp.counts)]
-                    - face_vel[vol_face_index(ijk, axis, dims, vp.counts)];
+                outflow += face_vel[vol_face_index(up, axis, dims, vol_first_v_face(vp), vol_first_w_face(vp))]
+                    - face_vel[vol_face_index(ijk, axis, dims, vol_first_v_face(vp), vol_first_w_face(vp))];
             }
             b = -outflow;
             float diagonal = vol_diagonal(w);
-            if (vp.config.y == VOL_PRECOND_JACOBI && diagonal > 0.0) {
+            if (vol_preconditioner(vp) == VOL_PRECOND_JACOBI && diagonal > 0.0) {
                 zc = b / diagonal;
             }
         }

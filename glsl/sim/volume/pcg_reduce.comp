@@ -1,11 +1,11 @@
 #version 460
 // Pressure solve, one workgroup: sums the per-workgroup partials in a fixed
 // order and advances the conjugate-gradient scalars.
-//   op.x = 0 (start):  σ = Σ r·z, bmax = max |b|; nothing to do when b = 0.
-//   op.x = 1 (step):   α = σ / Σ d·q.
-//   op.x = 2 (check):  one more iteration; converged when max |r| ≤ tol · bmax,
+//   reduce_mode = 0 (start):  σ = Σ r·z, bmax = max |b|; nothing to do when b = 0.
+//   reduce_mode = 1 (step):   α = σ / Σ d·q.
+//   reduce_mode = 2 (check):  one more iteration; converged when max |r| ≤ tol · bmax,
 //                      else β = Σ r·z / σ, σ = Σ r·z.
-//   op.z: partials;  op.w: indirect dispatch entries.
+//   reduce_partials: partials;  reduce_dispatches: indirect dispatch entries.
 // Once converged (or broken down, or not finite) every indirect dispatch of the
 // remaining recorded iterations is set to zero workgroups.
 #include "volume.glsl"
@@ -23,7 +23,7 @@ shared vec2 sums[VOL_GROUP];
 void main() {
     uint t = gl_LocalInvocationID.x;
     vec2 own = vec2(0.0);
-    for (uint k = t; k < pc.op.z; k += VOL_GROUP) {
+    for (uint k = t; k < reduce_partials(pc); k += VOL_GROUP) {
         own.x += partials[k].x;
         own.y = max(own.y, partials[k].y);
     }
@@ -40,7 +40,7 @@ void main() {
     }
     vec2 total = sums[0];
     bool stop = false;
-    if (pc.op.x == 0u) {
+    if (reduce_mode(pc) == 0u) {
         scalars.sigma = total.x;
         scalars.alpha = 0.0;
         scalars.beta = 0.0;
@@ -55,7 +55,7 @@ void main() {
         } else if (total.y <= 0.0 || total.x <= 0.0) {
             stop = true;
         }
-    } else if (pc.op.x == 1u) {
+    } else if (reduce_mode(pc) == 1u) {
         if (total.x > 0.0 && !isinf(total.x)) {
             scalars.alpha = scalars.sigma / total.x;
         } else {
@@ -69,7 +69,7 @@ void main() {
         if (isnan(total.x) || isinf(total.x) || isnan(total.y) || isinf(total.y)) {
             scalars.status = VOL_STATUS_NONFINITE;
             stop = true;
-        } else if (total.y <= vp.solve.x * scalars.bmax) {
+        } else if (total.y <= vol_tolerance(vp) * scalars.bmax) {
             stop = true;
         } else if (total.x > 0.0 && scalars.sigma > 0.0) {
             scalars.beta = total.x / scalars.sigma;
@@ -81,7 +81,7 @@ void main() {
     }
     if (stop) {
         scalars.converged = 1u;
-        for (uint k = 0u; k < pc.op.w; ++k) {
+        for (uint k = 0u; k < reduce_dispatches(pc); ++k) {
             indirect[k].x = 0u;
         }
     }

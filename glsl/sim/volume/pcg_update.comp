@@ -21,13 +21,13 @@ layout(std430, set = 0, binding = 27) writeonly buffer Partials { vec2 partials[
 void main() {
     uint c = gl_GlobalInvocationID.x;
     vec2 local = vec2(0.0);
-    if (c < vp.dims.w) {
+    if (c < vol_cells(vp)) {
         float alpha = scalars.alpha;
         precise float pc = pressure[c] + alpha * d[c];
         precise float rc = r[c] - alpha * q[c];
         pressure[c] = pc;
         r[c] = rc;
-        if (vp.config.y == VOL_PRECOND_JACOBI) {
+        if (vol_preconditioner(vp) == VOL_PRECOND_JACOBI) {
             precise float zc = 0.0;
             uint w = stencil[c];
             float diagonal = vol_diagonal(w);

@@ -3,8 +3,8 @@
 // workgroup counts the digits of its 256 keys and stores the counts digit-major
 // (table[digit · blocks + block]) so that one exclusive scan of the table gives
 // every (digit, block) its first output slot.
-//   op.x: 0 = keys in A, 1 = keys in B;  op.y: digit shift;  op.z: key count;
-//   op.w: blocks.  coarse.x: digit bits.
+//   radix_source: 0 = keys in A, 1 = keys in B;  radix_shift: digit shift;
+//   radix_keys: key count;  radix_blocks: blocks;  radix_digit_bits: digit bits.
 #include "volume.glsl"
 
 layout(local_size_x = VOL_GROUP) in;
@@ -19,16 +19,16 @@ shared uint histogram[256];
 void main() {
     uint t = gl_LocalInvocationID.x;
     uint block = gl_WorkGroupID.x;
-    uint digits = 1u << pc.coarse.x;
+    uint digits = 1u << radix_digit_bits(pc);
     histogram[t] = 0u;
     barrier();
     uint i = block * VOL_SORT_BLOCK + t;
-    if (i < pc.op.z) {
-        uint key = pc.op.x == 0u ? keys_a[i] : keys_b[i];
-        atomicAdd(histogram[(key >> pc.op.y) & (digits - 1u)], 1u);
+    if (i < radix_keys(pc)) {
+        uint key = radix_source(pc) == 0u ? keys_a[i] : keys_b[i];
+        atomicAdd(histogram[(key >> radix_shift(pc)) & (digits - 1u)], 1u);
     }
     barrier();
     if (t < digits) {
-        table[t * pc.op.w + block] = histogram[t];
+        table[t * radix_blocks(pc) + block] = histogram[t];
     }
 }

@@ -2,7 +2,7 @@
 // Counting sort pass — stable scatter: a key goes to its (digit, block) slot
 // from the scanned table plus the number of keys before it in the block with
 // the same digit, so equal keys keep their order and the result is the same on
-// every run. Push constants as in radix_count.comp; A → B when op.x = 0.
+// every run. Push constants as in radix_count.comp; A → B when radix_source = 0.
 #include "volume.glsl"
 
 layout(local_size_x = VOL_GROUP) in;
@@ -20,14 +20,14 @@ void main() {
     uint t = gl_LocalInvocationID.x;
     uint block = gl_WorkGroupID.x;
     uint i = block * VOL_SORT_BLOCK + t;
-    bool live = i < pc.op.z;
+    bool live = i < radix_keys(pc);
     uint key = 0u;
     uint value = 0u;
     uint digit = 0xffffffffu;
     if (live) {
-        key = pc.op.x == 0u ? keys_a[i] : keys_b[i];
-        value = pc.op.x == 0u ? vals_a[i] : vals_b[i];
-        digit = (key >> pc.op.y) & ((1u << pc.coarse.x) - 1u);
+        key = radix_source(pc) == 0u ? keys_a[i] : keys_b[i];
+        value = radix_source(pc) == 0u ? vals_a[i] : vals_b[i];
+        digit = (key >> radix_shift(pc)) & ((1u << radix_digit_bits(pc)) - 1u);
     }
     block_digits[t] = digit;
     barrier();
@@ -38,8 +38,8 @@ void main() {
     for (uint s = 0u; s < t; ++s) {
         rank += block_digits[s] == digit ? 1u : 0u;
     }
-    uint dst = table[digit * pc.op.w + block] + rank;
-    if (pc.op.x == 0u) {
+    uint dst = table[digit * radix_blocks(pc) + block] + rank;
+    if (radix_source(pc) == 0u) {
         keys_b[dst] = key;
         vals_b[dst] = value;
     } else {

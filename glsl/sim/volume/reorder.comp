@@ -18,7 +18,7 @@ layout(std430, set = 0, binding = 14) writeonly buffer Start { uint start[]; };
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
-    if (i >= vp.counts.x) {
+    if (i >= vol_particles(vp)) {
         return;
     }
     uint key = keys_a[i];

@@ -1,9 +1,9 @@
 #version 460
 // Exclusive prefix sum of a uint array in tiles of 1024 (4 per invocation):
-//   op.x = 0: each workgroup stores the sum of its tile in tile_sums;
-//   op.x = 1: one workgroup scans tile_sums (op.w of them) in place;
-//   op.x = 2: each workgroup scans its tile and adds its tile's offset.
-//   op.z: element count.
+//   scan_mode = 0: each workgroup stores the sum of its tile in tile_sums;
+//   scan_mode = 1: one workgroup scans tile_sums (scan_tiles of them) in place;
+//   scan_mode = 2: each workgroup scans its tile and adds its tile's offset.
+//   scan_len: element count.
 #include "volume.glsl"
 
 layout(local_size_x = VOL_GROUP) in;
@@ -64,8 +64,8 @@ uint scan_tile(uint base, uint array_len, uint offset, bool tiles) {
 void main() {
     uint t = gl_LocalInvocationID.x;
     uint tile = gl_WorkGroupID.x;
-    uint n = pc.op.z;
-    if (pc.op.x == 0u) {
+    uint n = scan_len(pc);
+    if (scan_mode(pc) == 0u) {
         uint own = 0u;
         for (uint e = 0u; e < 4u; ++e) {
             uint i = tile * VOL_SCAN_TILE + t * 4u + e;
@@ -76,10 +76,10 @@ void main() {
         if (t == 0u) {
             tile_sums[tile] = total;
         }
-    } else if (pc.op.x == 1u) {
+    } else if (scan_mode(pc) == 1u) {
         uint carry = 0u;
-        for (uint base = 0u; base < pc.op.w; base += VOL_SCAN_TILE) {
-            carry += scan_tile(base, pc.op.w, carry, true);
+        for (uint base = 0u; base < scan_tiles(pc); base += VOL_SCAN_TILE) {
+            carry += scan_tile(base, scan_tiles(pc), carry, true);
         }
     } else {
         scan_tile(tile * VOL_SCAN_TILE, n, tile_sums[tile], false);

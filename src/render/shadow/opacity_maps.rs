@@ -19,6 +19,7 @@ use glam::{Vec3, Vec4};
 
 use super::atlas::{ShadowAtlas, DEPTH_FORMAT, Z0_FORMAT};
 use super::{ShadowParams, SHADOW_ATLAS_FORMAT};
+use crate::codes::shadow_kind;
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuLight, GpuShadowMap, GpuShadowParams};
 use crate::profiler::{GpuProfiler, PassScope};
@@ -219,7 +220,7 @@ pub(crate) fn light_map(
         view_z: (-row).to_array(),
         layers: Vec4::new(params.layers[0], params.layers[1], params.layers[2], params.extinction).to_array(),
         tile: params.tile(index),
-        params: [params.opacity, params.pcf_radius as f32, 0.0, 0.0],
+        params: [params.opacity, params.pcf_radius as f32, shadow_kind::DEEP_OPACITY as f32, 0.0],
     })
 }
 

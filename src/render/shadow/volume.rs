@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
+use crate::codes::shadow_kind;
 use crate::error::Result;
 use crate::gpu_types::{GpuLight, GpuShadowMap};
 use crate::profiler::GpuProfiler;
@@ -29,7 +30,7 @@ pub(super) fn volume_map(light: &GpuLight, slot: usize, cells: u32) -> GpuShadow
     GpuShadowMap {
         view_z,
         tile: [(slot as u32 * cells) as f32, 0.0, 0.0, 0.0],
-        params: [0.0, 0.0, 1.0, 0.0],
+        params: [0.0, 0.0, shadow_kind::DENSITY_VOLUME as f32, 0.0],
         ..GpuShadowMap::default()
     }
 }

@@ -11,8 +11,10 @@
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
 use super::params::{Preconditioner, VolumeMode, VolumeParams};
+use crate::codes::{vol_mode, vol_precond};
 use crate::error::{Error, Result};
-use crate::gpu_types::GpuVolumeParams;
+use crate::gpu_types::VolumeStep;
+use crate::sim::mesh_collider::MeshGrid;
 use crate::sim::SimState;
 
 /// Most cells of the coarsest multigrid level (solved by one workgroup).
@@ -134,18 +136,18 @@ impl GridLayout {
         VolumeGrid { dims: self.dims, cell_size: self.cell_size, world_from_grid: self.world_from_grid(head) }
     }
 
-    /// The uniform block of one sub-step that moves the head from `previous` to `head`
-    /// in `dt` seconds, with `colliders` colliders marking solid cells.
-    pub(crate) fn gpu_params(
+    /// The volume stage's parameters of one sub-step that moves the head from
+    /// `previous` to `head` in `dt` seconds, with `colliders` colliders marking
+    /// solid cells and the mesh collider's grid when its cells count as solid.
+    pub(crate) fn step_params(
         &self,
         params: &VolumeParams,
         previous: &Mat4,
         head: &Mat4,
         dt: f32,
         colliders: u32,
-        mesh: Option<([f32; 4], [u32; 4])>,
-    ) -> GpuVolumeParams {
-        let (mesh_grid, mesh_dims) = mesh.unwrap_or(([0.0, 0.0, 0.0, 1.0], [0; 4]));
+        mesh: Option<&MeshGrid>,
+    ) -> VolumeStep {
         let world_from_grid = self.world_from_grid(head);
         let grid_from_world = world_from_grid.inverse();
         // Head rotation only (the head transform is rigid).
@@ -156,27 +158,44 @@ impl GridLayout {
         let motion = (*head - *previous) * self.head_from_grid() * (1.0 / dt);
         let solid_velocity = axes * motion;
         let mode = match params.mode {
-            VolumeMode::Off => 0.0,
-            VolumeMode::Flip => 1.0,
-            VolumeMode::Friction => 2.0,
+            VolumeMode::Off => vol_mode::OFF,
+            VolumeMode::Flip => vol_mode::FLIP,
+            VolumeMode::Friction => vol_mode::FRICTION,
         };
         let preconditioner = match params.preconditioner {
-            Preconditioner::Jacobi => 0,
-            Preconditioner::Multigrid => 1,
+            Preconditioner::Jacobi => vol_precond::JACOBI,
+            Preconditioner::Multigrid => vol_precond::MULTIGRID,
         };
-        GpuVolumeParams {
-            grid_from_world: grid_from_world.to_cols_array_2d(),
-            world_from_grid: world_from_grid.to_cols_array_2d(),
-            axes: axes.to_cols_array_2d(),
-            solid_velocity: solid_velocity.to_cols_array_2d(),
-            dims: [self.dims[0], self.dims[1], self.dims[2], self.cells()],
-            counts: [self.particles, self.faces[0], self.faces[1], self.faces[2]],
-            transfer: [params.flip_ratio, params.friction, params.repulsion, params.repulsion_threshold],
-            solve: [params.tolerance, self.cell_size, dt, mode],
-            config: [params.max_iterations, preconditioner, self.levels.len() as u32, colliders],
-            mesh_from_grid: self.head_from_grid().to_cols_array_2d(),
-            mesh_grid,
-            mesh_dims,
+        let unset = MeshGrid { origin: Vec3::ZERO, cell: 1.0, dims: [0; 3] };
+        let grid = mesh.unwrap_or(&unset);
+        VolumeStep {
+            grid_from_world,
+            world_from_grid,
+            axes,
+            solid_velocity,
+            dims: self.dims,
+            cells: self.cells(),
+            particles: self.particles,
+            first_v_face: self.faces[0],
+            first_w_face: self.faces[1],
+            faces: self.faces[2],
+            flip_ratio: params.flip_ratio,
+            friction: params.friction,
+            repulsion: params.repulsion,
+            repulsion_threshold: params.repulsion_threshold,
+            tolerance: params.tolerance,
+            cell_size: self.cell_size,
+            dt,
+            mode: mode as f32,
+            max_iterations: params.max_iterations,
+            preconditioner,
+            levels: self.levels.len() as u32,
+            colliders,
+            mesh_from_grid: self.head_from_grid(),
+            mesh_origin: grid.origin,
+            mesh_cell: grid.cell,
+            mesh_dims: grid.dims,
+            mesh_solid: u32::from(mesh.is_some()),
         }
     }
 }

@@ -8,8 +8,11 @@ use super::buffers::{self, Kernel, KernelPipeline, VolumeBuffers, GROUP, INDIREC
 use super::grid::GridLayout;
 use super::params::{Preconditioner, VolumeMode, VolumeParams};
 use super::VolumeStats;
+use crate::codes::vol_status;
 use crate::error::Result;
-use crate::gpu_types::{GpuVolumeParams, PcgScalars, VolumePush};
+use crate::gpu_types::{
+    CoarsestPass, GpuVolumeParams, LevelPass, PcgScalars, RadixPass, ReducePass, ScanPass, SmoothingPass, VolumePush,
+};
 use crate::profiler::GpuProfiler;
 use crate::profiler::PassScope;
 use crate::vk::barrier::{self, AccessKind};
@@ -153,11 +156,13 @@ impl VolumeStage {
         let key_bits = 32 - self.grid.cells().leading_zeros();
         let (digit_bits, passes) = if key_bits <= 16 { (8, 2) } else { (6, 4) };
         for pass in 0..passes {
-            let push = VolumePush {
-                dims: [0; 4],
-                coarse: [digit_bits, 0, 0, 0],
-                op: [pass % 2, pass * digit_bits, n, blocks],
-            };
+            let push = VolumePush::from(&RadixPass {
+                source: pass % 2,
+                shift: pass * digit_bits,
+                keys: n,
+                blocks,
+                digit_bits,
+            });
             // SAFETY: guaranteed by the caller.
             unsafe {
                 self.run(cmd, Kernel::RadixCount, variant, push, Launch::Threads(blocks * SORT_BLOCK));
@@ -173,7 +178,7 @@ impl VolumeStage {
     /// Exclusive scan of the first `len` entries of the digit table.
     unsafe fn record_scan(&self, cmd: vk::CommandBuffer, variant: usize, len: u32) {
         let tiles = len.div_ceil(SCAN_TILE);
-        let push = |mode: u32| VolumePush { dims: [0; 4], coarse: [0; 4], op: [mode, 0, len, tiles] };
+        let push = |mode: u32| VolumePush::from(&ScanPass { mode, len, tiles });
         // SAFETY: guaranteed by the caller.
         unsafe {
             self.run(cmd, Kernel::Scan, variant, push(0), Launch::Threads(tiles * GROUP));
@@ -182,10 +187,29 @@ impl VolumeStage {
         }
     }
 
-    fn level_push(&self, level: usize, op: [u32; 4]) -> VolumePush {
+    /// Multigrid level `level` and the next coarser one (zero past the coarsest).
+    fn level_pass(&self, level: usize) -> LevelPass {
         let l = self.grid.levels[level];
-        let coarse = self.grid.levels.get(level + 1).map_or([0; 4], |c| [c.dims[0], c.dims[1], c.dims[2], c.offset]);
-        VolumePush { dims: [l.dims[0], l.dims[1], l.dims[2], l.offset], coarse, op }
+        let coarse = self.grid.levels.get(level + 1);
+        LevelPass {
+            dims: l.dims,
+            first: l.offset,
+            coarse_dims: coarse.map_or([0; 3], |c| c.dims),
+            coarse_first: coarse.map_or(0, |c| c.offset),
+        }
+    }
+
+    /// A smoothing pass on `level` in `mode`, with the partials when `partials`.
+    fn smoothing_push(&self, level: usize, mode: u32, partials: bool) -> VolumePush {
+        let l = self.level_pass(level);
+        VolumePush::from(&SmoothingPass {
+            dims: l.dims,
+            first: l.first,
+            coarse_dims: l.coarse_dims,
+            coarse_first: l.coarse_first,
+            mode,
+            partials: u32::from(partials),
+        })
     }
 
     /// Step 6: the pressure solve and the gradient subtraction.
@@ -195,14 +219,13 @@ impl VolumeStage {
         let cells = Launch::Indirect(0);
         let multigrid = self.params.preconditioner == Preconditioner::Multigrid;
         let partials = self.grid.cells().div_ceil(GROUP);
-        let reduce =
-            |mode: u32| VolumePush { dims: [0; 4], coarse: [0; 4], op: [mode, 0, partials, levels as u32 + 1] };
+        let reduce = |mode: u32| VolumePush::from(&ReducePass { mode, partials, dispatches: levels as u32 + 1 });
         let none = VolumePush::default();
         // SAFETY: guaranteed by the caller.
         unsafe {
             if multigrid {
                 for level in 0..levels - 1 {
-                    let push = self.level_push(level, [0; 4]);
+                    let push = VolumePush::from(&self.level_pass(level));
                     self.run(cmd, Kernel::MgCoarsen, variant, push, Launch::Indirect(level + 1));
                 }
             }
@@ -240,16 +263,22 @@ impl VolumeStage {
         unsafe {
             for level in 0..levels - 1 {
                 let at = Launch::Indirect(level);
-                self.run(cmd, Kernel::MgSmooth, variant, self.level_push(level, [0; 4]), at);
-                self.run(cmd, Kernel::MgRestrict, variant, self.level_push(level, [0; 4]), Launch::Indirect(level + 1));
+                self.run(cmd, Kernel::MgSmooth, variant, self.smoothing_push(level, 0, false), at);
+                let restrict = VolumePush::from(&self.level_pass(level));
+                self.run(cmd, Kernel::MgRestrict, variant, restrict, Launch::Indirect(level + 1));
             }
-            let coarsest = self.level_push(levels - 1, [0, u32::from(levels == 1), COARSEST_SWEEPS, 0]);
+            let last = self.level_pass(levels - 1);
+            let coarsest = VolumePush::from(&CoarsestPass {
+                dims: last.dims,
+                first: last.first,
+                partials: u32::from(levels == 1),
+                sweeps: COARSEST_SWEEPS,
+            });
             self.run(cmd, Kernel::MgCoarsest, variant, coarsest, Launch::Indirect(levels));
             for level in (0..levels - 1).rev() {
                 let at = Launch::Indirect(level);
-                let partials = u32::from(level == 0);
-                self.run(cmd, Kernel::MgSmooth, variant, self.level_push(level, [1, 0, 0, 0]), at);
-                self.run(cmd, Kernel::MgSmooth, variant, self.level_push(level, [2, partials, 0, 0]), at);
+                self.run(cmd, Kernel::MgSmooth, variant, self.smoothing_push(level, 1, false), at);
+                self.run(cmd, Kernel::MgSmooth, variant, self.smoothing_push(level, 2, level == 0), at);
             }
         }
     }
@@ -260,9 +289,9 @@ impl VolumeStage {
         let s = s[0];
         Ok(VolumeStats {
             iterations: s.iterations,
-            converged: s.converged == 1 && s.status == 0,
+            converged: s.converged == 1 && s.status == vol_status::OK,
             relative_residual: if s.bmax > 0.0 { s.rmax / s.bmax } else { 0.0 },
-            non_finite: s.status == 2,
+            non_finite: s.status == vol_status::NONFINITE,
         })
     }
 }

@@ -7,15 +7,13 @@
 //! version used; it converges in a handful of iterations and gives the GPU
 //! solvers an independent answer to agree with.
 
-use glam::{Vec3, Vec4, Vec4Swizzles};
+use glam::{Mat4, Vec3, Vec4, Vec4Swizzles};
 
 use super::grid::GridLayout;
-use crate::gpu_types::{GpuCollider, GpuVolumeParams};
+pub(crate) use crate::codes::vol_cell::{AIR, FLUID, SOLID};
+use crate::codes::vol_mode;
+use crate::gpu_types::{ColliderShape, VolumeStep};
 use crate::sim::reference::MeshField;
-
-pub(crate) const AIR: u32 = 0;
-pub(crate) const FLUID: u32 = 1;
-pub(crate) const SOLID: u32 = 2;
 
 /// Every intermediate result of one volume step.
 #[derive(Debug, Clone, PartialEq)]
@@ -42,13 +40,13 @@ pub(crate) struct VolumeSnapshot {
     pub iterations: u32,
 }
 
-fn affine(m: &[[f32; 4]; 4], p: Vec3) -> Vec3 {
-    let c = |k: usize| Vec3::new(m[k][0], m[k][1], m[k][2]);
+fn affine(m: &Mat4, p: Vec3) -> Vec3 {
+    let c = |k: usize| m.col(k).truncate();
     ((c(0) * p.x + c(1) * p.y) + c(2) * p.z) + c(3)
 }
 
-fn linear(m: &[[f32; 4]; 4], v: Vec3) -> Vec3 {
-    let c = |k: usize| Vec3::new(m[k][0], m[k][1], m[k][2]);
+fn linear(m: &Mat4, v: Vec3) -> Vec3 {
+    let c = |k: usize| m.col(k).truncate();
     (c(0) * v.x + c(1) * v.y) + c(2) * v.z
 }
 
@@ -105,19 +103,19 @@ fn cell_of(g: Vec3, dims: [u32; 3]) -> Option<[i64; 3]> {
     }
 }
 
-fn inside(colliders: &[GpuCollider], p: Vec3) -> bool {
+fn inside(colliders: &[ColliderShape], p: Vec3) -> bool {
     // (the mesh collider is checked by the caller, in the head frame)
     colliders.iter().any(|c| {
-        let a = Vec3::from_slice(&c.a_radius[..3]);
+        let a = c.a;
         let mut closest = a;
         if c.is_capsule() {
-            let ab = Vec3::from_slice(&c.b_kind[..3]) - a;
+            let ab = c.b - a;
             let len2 = ab.dot(ab);
             let t = if len2 > 0.0 { ((p - a).dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
             closest = a + ab * t;
         }
         let d = p - closest;
-        d.dot(d) < c.radius() * c.radius()
+        d.dot(d) < c.radius * c.radius
     })
 }
 
@@ -125,17 +123,17 @@ fn inside(colliders: &[GpuCollider], p: Vec3) -> bool {
 /// everything it computed; `velocities` get the update.
 pub(crate) fn step(
     grid: &GridLayout,
-    p: &GpuVolumeParams,
-    colliders: &[GpuCollider],
+    p: &VolumeStep,
+    colliders: &[ColliderShape],
     mesh: Option<MeshField<'_>>,
     positions: &[Vec4],
     velocities: &mut [Vec4],
 ) -> VolumeSnapshot {
-    let mesh = mesh.filter(|_| p.mesh_dims[3] == 1);
+    let mesh = mesh.filter(|_| p.mesh_solid == 1);
     let n = positions.len();
     let dims = Dims(grid.dims);
     let cells = dims.count();
-    let colliders = &colliders[..(p.colliders() as usize).min(colliders.len())];
+    let colliders = &colliders[..(p.colliders as usize).min(colliders.len())];
     // 1. Bin.
     let grid_pos: Vec<Vec4> = positions.iter().map(|x| affine(&p.grid_from_world, x.xyz()).extend(x.w)).collect();
     let grid_vel: Vec<Vec3> = velocities.iter().map(|v| linear(&p.axes, v.xyz())).collect();
@@ -251,10 +249,9 @@ pub(crate) fn step(
         iterations: 0,
     };
     // 6. Pressure.
-    let mode = p.mode();
-    if mode == 1.0 {
+    if p.mode == vol_mode::FLIP as f32 {
         snapshot.rhs = rhs(grid, &snapshot.labels, &snapshot.face_vel);
-        let (pressure, iterations) = mic_pcg(grid, &snapshot.labels, &snapshot.rhs, p.tolerance().into(), 1000);
+        let (pressure, iterations) = mic_pcg(grid, &snapshot.labels, &snapshot.rhs, p.tolerance.into(), 1000);
         snapshot.pressure = pressure.iter().map(|&v| v as f32).collect();
         snapshot.iterations = iterations;
         subtract_gradient(grid, &snapshot.labels, &snapshot.pressure, &mut snapshot.face_vel);
@@ -266,12 +263,9 @@ pub(crate) fn step(
             continue;
         }
         let v = grid_to_particle(grid, p, &snapshot, g.xyz(), grid_vel[i]);
-        let to_world = glam::Mat3::from_cols(
-            Vec3::from_slice(&p.axes[0][..3]),
-            Vec3::from_slice(&p.axes[1][..3]),
-            Vec3::from_slice(&p.axes[2][..3]),
-        )
-        .transpose();
+        let to_world =
+            glam::Mat3::from_cols(p.axes.col(0).truncate(), p.axes.col(1).truncate(), p.axes.col(2).truncate())
+                .transpose();
         velocities[i] = (to_world * v).extend(0.0);
     }
     snapshot
@@ -508,9 +502,9 @@ fn sample_cells(grid: &GridLayout, cells: &[Vec4], g: Vec3) -> Vec4 {
 }
 
 /// The updated velocity (grid axes) of a particle at grid position `g` with velocity `v`.
-fn grid_to_particle(grid: &GridLayout, p: &GpuVolumeParams, s: &VolumeSnapshot, g: Vec3, v: Vec3) -> Vec3 {
-    if p.mode() == 1.0 {
-        let alpha = p.flip_ratio();
+fn grid_to_particle(grid: &GridLayout, p: &VolumeStep, s: &VolumeSnapshot, g: Vec3, v: Vec3) -> Vec3 {
+    if p.mode == vol_mode::FLIP as f32 {
+        let alpha = p.flip_ratio;
         let [u, vv, w] = [0, 1, 2].map(|a| sample_faces(grid, &s.face_vel, &s.face_star, g, a));
         let pic = Vec3::new(u.0, vv.0, w.0);
         let flip = v + Vec3::new(u.1, vv.1, w.1);
@@ -518,13 +512,13 @@ fn grid_to_particle(grid: &GridLayout, p: &GpuVolumeParams, s: &VolumeSnapshot, 
     }
     let cell = sample_cells(grid, &s.cells, g);
     let mut v = v;
-    let friction = p.friction();
+    let friction = p.friction;
     if cell.w > 0.0 {
         let mean = cell.xyz() / cell.w;
         v = v * (1.0 - friction) + mean * friction;
     }
-    let threshold = p.repulsion_threshold();
-    if p.repulsion() > 0.0 && cell.w > threshold {
+    let threshold = p.repulsion_threshold;
+    if p.repulsion > 0.0 && cell.w > threshold {
         let dims = Dims(grid.dims);
         let c = [0, 1, 2].map(|a| (g[a] as i64).min(i64::from(grid.dims[a]) - 1));
         let mut gradient = Vec3::ZERO;
@@ -538,7 +532,7 @@ fn grid_to_particle(grid: &GridLayout, p: &GpuVolumeParams, s: &VolumeSnapshot, 
         let len = gradient.length();
         if len > 0.0 {
             let excess = ((cell.w - threshold) / threshold.max(1e-6)).min(1.0);
-            v -= gradient * (p.repulsion() * p.dt() * excess / len);
+            v -= gradient * (p.repulsion * p.dt * excess / len);
         }
     }
     v

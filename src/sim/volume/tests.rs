@@ -7,7 +7,8 @@ use rand_pcg::Pcg32;
 use super::grid::GridLayout;
 use super::reference::{self, face_index, Dims, VolumeSnapshot, FLUID, SOLID};
 use super::{Preconditioner, VolumeMode, VolumeParams, VolumeStage, VolumeStats};
-use crate::gpu_types::{GpuCollider, GpuVolumeParams};
+use crate::codes::collider_kind::SPHERE;
+use crate::gpu_types::{ColliderShape, GpuCollider, GpuVolumeParams, VolumeStep};
 use crate::sim::MAX_COLLIDERS;
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::{Buffer, BufferDesc};
@@ -25,8 +26,8 @@ fn run_gpu(
     gpu: &TestGpu,
     grid: &GridLayout,
     params: &VolumeParams,
-    block: &GpuVolumeParams,
-    colliders: &[GpuCollider],
+    block: &VolumeStep,
+    colliders: &[ColliderShape],
     positions: &[Vec4],
     velocities: &[Vec4],
 ) -> GpuRun {
@@ -46,7 +47,7 @@ fn run_gpu(
         },
     )
     .expect("buffer");
-    let mut padded = colliders.to_vec();
+    let mut padded: Vec<GpuCollider> = colliders.iter().map(GpuCollider::from).collect();
     padded.resize(MAX_COLLIDERS, GpuCollider::default());
     d.upload_pod(&collider_buffer, &padded).expect("upload");
     let no_mesh = Buffer::storage(d, "test no mesh collider", 16).expect("buffer");
@@ -59,7 +60,7 @@ fn run_gpu(
         // SAFETY: a recording command buffer of this device; submit_once waited for
         // all earlier work (the uploads).
         unsafe {
-            stage.record_uploads(cmd, block);
+            stage.record_uploads(cmd, &GpuVolumeParams::from(block));
             d.cmd_barrier(cmd, &[uploaded], &[], &[]);
             stage.record(cmd, 0, ["sort", "transfer", "pressure", "update"], None);
         }
@@ -91,8 +92,13 @@ fn unit_grid(dims: [u32; 3], particles: usize) -> GridLayout {
     GridLayout::placed(dims, 1.0, Vec3::ZERO, particles as u32)
 }
 
-fn block(grid: &GridLayout, params: &VolumeParams, previous: Mat4, colliders: u32) -> GpuVolumeParams {
-    grid.gpu_params(params, &previous, &Mat4::IDENTITY, 1.0 / 60.0, colliders, None)
+fn block(grid: &GridLayout, params: &VolumeParams, previous: Mat4, colliders: u32) -> VolumeStep {
+    grid.step_params(params, &previous, &Mat4::IDENTITY, 1.0 / 60.0, colliders, None)
+}
+
+/// A sphere collider as the volume stage sees it.
+fn sphere(center: Vec3, radius: f32) -> ColliderShape {
+    ColliderShape { a: center, radius, b: center, kind: SPHERE as f32 }
 }
 
 fn random_particles(rng: &mut Pcg32, n: usize, lo: Vec3, hi: Vec3, speed: f32) -> (Vec<Vec4>, Vec<Vec4>) {
@@ -187,7 +193,7 @@ fn transfer_and_friction_match_the_reference() {
     let grid = unit_grid([12, 11, 9], positions.len());
     let params = VolumeParams { repulsion_threshold: 2.0, repulsion: 5.0, friction: 0.3, ..friction_params() };
     // A moving sphere marks solid cells and gives their faces a velocity.
-    let colliders = [GpuCollider { a_radius: [6.0, 5.0, 4.0, 2.2], b_kind: [6.0, 5.0, 4.0, 0.0] }];
+    let colliders = [sphere(Vec3::new(6.0, 5.0, 4.0), 2.2)];
     let previous = Mat4::from_translation(Vec3::new(-0.01, 0.02, 0.0));
     let b = block(&grid, &params, previous, 1);
     let run = run_gpu(&gpu, &grid, &params, &b, &colliders, &positions, &velocities);
@@ -259,7 +265,7 @@ fn projection_is_divergence_free_and_agrees_with_mic_pcg() {
     let mut rng = Pcg32::seed_from_u64(9);
     let (positions, velocities) = random_particles(&mut rng, 6000, Vec3::new(2.0, 2.5, 3.0), Vec3::splat(14.0), 1.0);
     let grid = unit_grid([16, 16, 16], positions.len());
-    let colliders = [GpuCollider { a_radius: [8.0, 8.0, 8.0, 3.0], b_kind: [8.0, 8.0, 8.0, 0.0] }];
+    let colliders = [sphere(Vec3::splat(8.0), 3.0)];
     let previous = Mat4::from_translation(Vec3::new(0.0, 0.01, 0.0));
     let (mut iterations, mut residuals) = (Vec::new(), Vec::new());
     // Both ways of reducing: subgroup arithmetic where the device has it, and the

@@ -1,0 +1,149 @@
+// Flags and enumeration values shared by the Rust side and the shaders,
+// defined here once.
+//
+// Each group below becomes a module of `u32` constants in the crate
+// (`codes::sim_flags::GRAVITY`) and, through build.rs, which includes this
+// file (`include!`), a macro of every shader named by the group's prefix and
+// the constant's name (`-DSIM_GRAVITY=1u`). A shader that declares one of
+// these names itself fails the build (`limits::redeclared_constants`), and
+// `gpu_types::tests` runs a shader that writes every one of them back, so the
+// two sides cannot drift. Plain items only: no `crate::` paths, no inner doc
+// comments (the file is compiled in two places).
+
+/// Declares groups of shared codes: a module of constants per group and
+/// [`SHADER_CODES`], every code with the name the shaders see it by.
+macro_rules! shader_codes {
+    ($(
+        $(#[doc = $group_doc:literal])*
+        $group:ident = $prefix:literal {
+            $( $(#[doc = $doc:literal])* $name:ident = $value:expr ),* $(,)?
+        }
+    )*) => {
+        $(
+            $(#[doc = $group_doc])*
+            #[allow(dead_code)] // a group may have members only the shaders use
+            pub mod $group {
+                $( $(#[doc = $doc])* pub const $name: u32 = $value; )*
+            }
+        )*
+        /// Every code with the name the shaders see it by (`PREFIX_NAME`).
+        #[cfg_attr(not(test), allow(dead_code))] // used by build.rs and the tests
+        pub const SHADER_CODES: &[(&str, u32)] = &[
+            $( $( (concat!($prefix, stringify!($name)), $group::$name), )* )*
+        ];
+    };
+}
+
+shader_codes! {
+    /// Switches of one simulation sub-step (`sim_flags(p)` of `SimStepParams`).
+    sim_flags = "SIM_" {
+        /// Gravity acts.
+        GRAVITY = 1,
+        /// Wind acts.
+        WIND = 1 << 1,
+        /// The rest-shape spring acts.
+        SPRING = 1 << 2,
+        /// Bending constraints act.
+        BENDING = 1 << 3,
+        /// Body collisions act (spheres, capsules, the mesh collider).
+        COLLISIONS = 1 << 4,
+        /// The DFTL solver replaces the PBD iterations.
+        DFTL = 1 << 5,
+        /// The global shape constraint acts.
+        GLOBAL_SHAPE = 1 << 6,
+        /// The global shape targets are raised by the static sag.
+        SAG_FREE = 1 << 7,
+        /// The local shape constraints act.
+        LOCAL_SHAPE = 1 << 8,
+        /// A mesh collider is set and collisions act.
+        MESH = 1 << 9,
+    }
+
+    /// A collider's shape (`collider_kind(c)`, stored as a float).
+    collider_kind = "COLLIDER_" {
+        /// The points within the radius of the centre.
+        SPHERE = 0,
+        /// The points within the radius of a segment.
+        CAPSULE = 1,
+    }
+
+    /// What a volume cell holds (the cell labels of the FLIP stage).
+    vol_cell = "VOL_" {
+        /// No hair: pressure 0.
+        AIR = 0,
+        /// Hair: a pressure unknown.
+        FLUID = 1,
+        /// Inside a collider: a Neumann boundary.
+        SOLID = 2,
+    }
+
+    /// The volume stage's mode (`vol_mode(p)`, stored as a float).
+    vol_mode = "VOL_MODE_" {
+        /// The stage is off.
+        OFF = 0,
+        /// FLIP with a pressure projection.
+        FLIP = 1,
+        /// Density friction and repulsion.
+        FRICTION = 2,
+    }
+
+    /// The pressure solve's preconditioner (`vol_preconditioner(p)`).
+    vol_precond = "VOL_PRECOND_" {
+        /// Jacobi (the diagonal).
+        JACOBI = 0,
+        /// A multigrid V-cycle.
+        MULTIGRID = 1,
+    }
+
+    /// How the pressure solve ended (`PcgScalars::status`).
+    vol_status = "VOL_STATUS_" {
+        /// Converged or stopped at the iteration cap.
+        OK = 0,
+        /// The conjugate-gradient recurrence broke down.
+        BREAKDOWN = 1,
+        /// A value was NaN or infinite.
+        NONFINITE = 2,
+    }
+
+    /// The pressure matrix's stencil word per cell (`volume_ops.glsl`).
+    vol_stencil = "VOL_STENCIL_" {
+        /// The cell is fluid.
+        FLUID = 1 << 16,
+        /// Where the count of non-solid neighbours starts.
+        COUNT_SHIFT = 8,
+    }
+
+    /// A light's kind (`Light::position_kind.w`, stored as a float).
+    light_kind = "LIGHT_" {
+        /// Parallel rays along a direction.
+        DIRECTIONAL = 0,
+        /// From a point, in every direction.
+        POINT = 1,
+        /// From a point, inside a cone.
+        SPOT = 2,
+    }
+
+    /// How a shadow-casting light's shadow is made (`ShadowMap::params.z`, stored as a float).
+    shadow_kind = "SHADOW_" {
+        /// A deep opacity map.
+        DEEP_OPACITY = 0,
+        /// Transmittance through the simulation's density volume.
+        DENSITY_VOLUME = 1,
+    }
+
+    /// The draw pass's shading model (`DrawParams::counts.w`).
+    shading = "SHADING_" {
+        /// Kajiya-Kay diffuse and two shifted highlights.
+        KAJIYA_KAY = 0,
+        /// Marschner through lookup tables.
+        MARSCHNER = 1,
+    }
+
+    /// "None" words that buffers are cleared to.
+    sentinel = "" {
+        /// No node in a per-pixel list, no depth stored (transparency).
+        OIT_END = 0xffff_ffff,
+        /// No triangle or distance yet (mesh collider build).
+        SDF_NONE = 0xffff_ffff,
+    }
+}

@@ -1,0 +1,56 @@
+//! Blocks of the simulation step and the mesh collider build
+//! (`glsl/include/sim.glsl`, `sdf.glsl`). Their members are private to
+//! `gpu_types`: the rest of the crate writes and reads them through their
+//! views ([`super::SimStep`], [`super::StepRange`], [`super::ColliderShape`],
+//! [`super::SdfPass`]), which name every lane.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::vk::reflect::gpu_struct;
+
+/// Per-sub-step parameters of the simulation stages (`SimStepParams`); view: [`super::SimStep`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct SimStepParams {
+    pub(super) head: [[f32; 4]; 4],
+    pub(super) gravity_dt: [f32; 4],
+    pub(super) wind: [f32; 4],
+    pub(super) wind_noise: [f32; 4],
+    pub(super) bending: [f32; 4],
+    pub(super) counts: [u32; 4],
+    pub(super) layout_info: [u32; 4],
+    pub(super) shape: [f32; 4],
+    pub(super) previous_head: [[f32; 4]; 4],
+    pub(super) mesh_grid: [f32; 4],
+    pub(super) mesh_dims: [u32; 4],
+}
+gpu_struct!(SimStepParams => "SimStepParams" {
+    head, gravity_dt, wind, wind_noise, bending, counts, layout_info, shape, previous_head, mesh_grid, mesh_dims
+});
+
+/// Push constants of the simulation step kernel (`SimPush`); view: [`super::StepRange`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct SimPush {
+    pub(super) range: [u32; 4],
+}
+gpu_struct!(SimPush => "SimPush" { range });
+
+/// Push constants of the mesh collider's build kernels (`SdfPush`); view: [`super::SdfPass`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct SdfPush {
+    pub(super) origin_cell: [f32; 4],
+    pub(super) dims: [u32; 4],
+    pub(super) pass_info: [u32; 4],
+}
+gpu_struct!(SdfPush => "SdfPush" { origin_cell, dims, pass_info });
+
+/// A collider in world space (`Collider`); view: [`super::ColliderShape`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct GpuCollider {
+    pub(super) a_radius: [f32; 4],
+    pub(super) b_kind: [f32; 4],
+}
+gpu_struct!(GpuCollider => "Collider" { a_radius, b_kind });

@@ -1,0 +1,188 @@
+//! The GPU packing of one sub-step: the knobs, the head's pose and the bodies
+//! as the step kernel, the volume stage and the CPU reference read them
+//! ([`SimStep`], [`ColliderShape`](crate::gpu_types::ColliderShape)). Which
+//! lane of the parameter block holds which field is written once, in
+//! `gpu_types/views.rs`; this file decides what the fields hold.
+
+use glam::Mat4;
+
+use super::mesh_collider::MeshGrid;
+use super::params::{SimParams, SolverMode};
+use super::step::Packing;
+use crate::codes::sim_flags;
+use crate::gpu_types::SimStep;
+
+/// The `SIM_*` switches for `p`, with a mesh collider set when `mesh`.
+pub(crate) fn flags(p: &SimParams, mesh: bool) -> u32 {
+    let switches = [
+        (p.gravity_enabled, sim_flags::GRAVITY),
+        (p.wind_enabled, sim_flags::WIND),
+        (p.spring_enabled, sim_flags::SPRING),
+        (p.bending_enabled, sim_flags::BENDING),
+        (p.collisions_enabled, sim_flags::COLLISIONS),
+        (p.solver == SolverMode::Dftl, sim_flags::DFTL),
+        (p.global_shape_stiffness > 0.0, sim_flags::GLOBAL_SHAPE),
+        (p.sag_free, sim_flags::SAG_FREE),
+        (p.local_shape_stiffness > 0.0 && p.solver == SolverMode::Pbd, sim_flags::LOCAL_SHAPE),
+        (mesh && p.collisions_enabled, sim_flags::MESH),
+    ];
+    switches.iter().filter(|(on, _)| *on).fold(0, |flags, (_, flag)| flags | flag)
+}
+
+/// Stiffness per iteration equivalent to `k` per sub-step (Müller et al.'s
+/// k' = 1 − (1 − k)^(1/n)), so that a constraint's strength does not depend on
+/// the iteration count.
+pub(crate) fn per_iteration(p: &SimParams, k: f32) -> f32 {
+    let n = match p.solver {
+        SolverMode::Pbd => p.iterations,
+        SolverMode::Dftl => 1,
+    };
+    1.0 - (1.0 - k).powf(1.0 / n as f32)
+}
+
+/// Where and when one sub-step happens.
+pub(crate) struct SubstepPose {
+    /// World-from-head transform at the start of the sub-step.
+    pub previous_head: Mat4,
+    /// World-from-head transform at its end.
+    pub head: Mat4,
+    /// Simulated time at its end, s.
+    pub time: f32,
+    /// Its index since the simulation started (wraps).
+    pub index: u32,
+}
+
+/// What a simulation's groom and device fix for every sub-step.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SimShape {
+    pub strands: u32,
+    pub points: u32,
+    pub packing: Packing,
+}
+
+/// The step kernel's parameters of one sub-step of `p` at `pose`, with
+/// `colliders` colliders and the mesh collider's grid when one is set.
+pub(crate) fn sim_step(
+    p: &SimParams,
+    pose: &SubstepPose,
+    shape: SimShape,
+    colliders: u32,
+    mesh: Option<&MeshGrid>,
+) -> SimStep {
+    let unset = MeshGrid { origin: glam::Vec3::ZERO, cell: 1.0, dims: [0; 3] };
+    let grid = mesh.unwrap_or(&unset);
+    SimStep {
+        head: pose.head,
+        gravity: p.gravity,
+        dt: p.substep_dt(),
+        wind: p.wind,
+        wind_turbulence: p.wind_turbulence,
+        wind_frequency: p.wind_frequency,
+        time: pose.time,
+        spring_stiffness: p.spring_stiffness,
+        damping: p.damping,
+        bending_root: per_iteration(p, p.bending_root),
+        bending_tip: per_iteration(p, p.bending_tip),
+        dftl_damping: p.dftl_damping,
+        strands: shape.strands,
+        points: shape.points,
+        iterations: p.iterations,
+        flags: flags(p, mesh.is_some()),
+        colliders,
+        hairs_per_group: shape.packing.hairs_per_group,
+        step_index: pose.index,
+        sync_group: shape.packing.sync_group,
+        global_shape: per_iteration(p, p.global_shape_stiffness),
+        global_shape_range: p.global_shape_range,
+        local_shape: p.local_shape_stiffness,
+        mesh_friction: p.mesh_friction,
+        previous_head: pose.previous_head,
+        mesh_origin: grid.origin,
+        mesh_cell: grid.cell,
+        mesh_dims: grid.dims,
+        mesh_set: u32::from(mesh.is_some()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::gpu_types::SimStepParams;
+
+    /// Every knob lands in its own field, and through the packed block and
+    /// back unchanged: a field packed into a wrong or shared lane fails.
+    #[test]
+    fn every_knob_reaches_its_field_and_survives_the_packing() {
+        let p = SimParams {
+            gravity: Vec3::new(0.5, -9.0, 0.25),
+            wind: Vec3::new(1.5, 0.0, -2.5),
+            wind_turbulence: 0.375,
+            wind_frequency: 2.25,
+            spring_stiffness: 3.5,
+            damping: 0.0625,
+            bending_root: 0.75,
+            bending_tip: 0.125,
+            dftl_damping: 0.8125,
+            global_shape_stiffness: 0.5,
+            global_shape_range: 0.625,
+            local_shape_stiffness: 0.4375,
+            mesh_friction: 0.15625,
+            iterations: 7,
+            substeps: 2,
+            ..SimParams::default()
+        };
+        let pose = SubstepPose {
+            previous_head: Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0)),
+            head: Mat4::from_rotation_y(0.5),
+            time: 4.75,
+            index: 11,
+        };
+        let shape = SimShape { strands: 13, points: 17, packing: Packing { sync_group: 8, hairs_per_group: 3 } };
+        let grid = MeshGrid { origin: Vec3::new(-0.5, -0.25, -0.125), cell: 0.03125, dims: [21, 22, 23] };
+        let s = sim_step(&p, &pose, shape, 5, Some(&grid));
+        let expected = SimStep {
+            head: pose.head,
+            gravity: p.gravity,
+            dt: p.dt / 2.0,
+            wind: p.wind,
+            wind_turbulence: 0.375,
+            wind_frequency: 2.25,
+            time: 4.75,
+            spring_stiffness: 3.5,
+            damping: 0.0625,
+            bending_root: 1.0 - 0.25f32.powf(1.0 / 7.0),
+            bending_tip: 1.0 - 0.875f32.powf(1.0 / 7.0),
+            dftl_damping: 0.8125,
+            strands: 13,
+            points: 17,
+            iterations: 7,
+            flags: sim_flags::GRAVITY
+                | sim_flags::SPRING
+                | sim_flags::BENDING
+                | sim_flags::COLLISIONS
+                | sim_flags::GLOBAL_SHAPE
+                | sim_flags::SAG_FREE
+                | sim_flags::LOCAL_SHAPE
+                | sim_flags::MESH,
+            colliders: 5,
+            hairs_per_group: 3,
+            step_index: 11,
+            sync_group: 8,
+            global_shape: 1.0 - 0.5f32.powf(1.0 / 7.0),
+            global_shape_range: 0.625,
+            local_shape: 0.4375,
+            mesh_friction: 0.15625,
+            previous_head: pose.previous_head,
+            mesh_origin: grid.origin,
+            mesh_cell: 0.03125,
+            mesh_dims: [21, 22, 23],
+            mesh_set: 1,
+        };
+        assert_eq!(s, expected);
+        assert_eq!(SimStep::from(&SimStepParams::from(&s)), s, "the packing loses or mixes fields");
+        let unset = sim_step(&p, &pose, shape, 0, None);
+        assert_eq!((unset.mesh_set, unset.flags & sim_flags::MESH, unset.mesh_cell), (0, 0, 1.0));
+    }
+}

@@ -1,0 +1,145 @@
+//! How a step becomes sub-steps: [`SubstepPlanner`], the host-side
+//! bookkeeping shared by [`crate::sim::HairSim`] and [`crate::sim::CpuHairSim`]
+//! (parameters, colliders, the head transform of the previous step, simulated
+//! time and the sub-step counter). Both turn a step into the same
+//! [`SubstepInputs`], so GPU and CPU run on identical numbers.
+
+use super::body::{validate_colliders, Collider, RigidTransform};
+use super::mesh_collider::MeshGrid;
+use super::packing::{self, SimShape, SubstepPose};
+use super::params::SimParams;
+use super::volume::VolumeParams;
+use crate::codes::sim_flags;
+use crate::error::Result;
+use crate::gpu_types::{ColliderShape, SimStep, VolumeStep};
+
+/// Everything one sub-step needs, identical for the GPU stages and the CPU reference.
+pub(crate) struct SubstepInputs {
+    pub params: SimStep,
+    /// The colliders in the world at the end of the sub-step.
+    pub colliders: Vec<ColliderShape>,
+}
+
+impl SubstepInputs {
+    /// The volume stage's parameters for this sub-step.
+    pub(crate) fn volume_params(
+        &self,
+        grid: &super::volume::grid::GridLayout,
+        params: &VolumeParams,
+        colliders: u32,
+    ) -> VolumeStep {
+        let p = &self.params;
+        let colliders = if p.flags & sim_flags::COLLISIONS != 0 { colliders } else { 0 };
+        let mesh = (p.flags & sim_flags::MESH != 0).then_some(MeshGrid {
+            origin: p.mesh_origin,
+            cell: p.mesh_cell,
+            dims: p.mesh_dims,
+        });
+        grid.step_params(params, &p.previous_head, &p.head, p.dt, colliders, mesh.as_ref())
+    }
+}
+
+/// See the module docs.
+#[derive(Debug, Clone)]
+pub(crate) struct SubstepPlanner {
+    pub params: SimParams,
+    pub colliders: Vec<Collider>,
+    /// The mesh collider's grid, when set.
+    pub mesh: Option<MeshGrid>,
+    pub head: RigidTransform,
+    pub time: f64,
+    pub substep: u32,
+    pub strands: u32,
+    pub points: u32,
+    /// Subgroup size of the device the GPU stages run on.
+    pub subgroup_size: u32,
+}
+
+/// Says, through `log`, when the sag-free rest state is asked for but cannot be
+/// met: a shape stiffness under 1 % per sub-step leaves every particle
+/// uncompensated (see `sim_shape_target`), so the groom sags as without it.
+fn warn_unmet_sag_free(params: &SimParams) {
+    let k = params.global_shape_stiffness;
+    if params.sag_free && params.gravity_enabled && k > 0.0 && k < 0.01 {
+        log::warn!(
+            "vkhair: sag-free rest state not met: global_shape_stiffness {k} holds less than 1 % per sub-step, \
+             so no particle is compensated and the groom sags under gravity"
+        );
+    }
+}
+
+impl SubstepPlanner {
+    pub(crate) fn new(
+        params: &SimParams,
+        head: &RigidTransform,
+        strands: usize,
+        points: usize,
+        subgroup_size: u32,
+    ) -> Result<Self> {
+        params.validate()?;
+        head.validate()?;
+        warn_unmet_sag_free(params);
+        Ok(SubstepPlanner {
+            params: params.clone(),
+            colliders: Vec::new(),
+            mesh: None,
+            head: *head,
+            time: 0.0,
+            substep: 0,
+            strands: strands as u32,
+            points: points as u32,
+            subgroup_size,
+        })
+    }
+
+    pub(crate) fn set_params(&mut self, params: &SimParams) -> Result<()> {
+        params.validate()?;
+        warn_unmet_sag_free(params);
+        self.params = params.clone();
+        Ok(())
+    }
+
+    pub(crate) fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
+        validate_colliders(colliders)?;
+        self.colliders = colliders.to_vec();
+        Ok(())
+    }
+
+    /// How the solver packs hairs for the current parameters.
+    pub(crate) fn packing(&self) -> super::step::Packing {
+        super::step::packing(
+            self.points,
+            self.subgroup_size,
+            self.params.hairs_per_workgroup,
+            self.params.subgroup_sync,
+        )
+    }
+
+    /// The sub-steps of the next step, which ends with the head at `head`.
+    pub(crate) fn next(&mut self, head: &RigidTransform) -> Result<Vec<SubstepInputs>> {
+        head.validate()?;
+        let p = &self.params;
+        let dt = p.substep_dt();
+        let shape = SimShape { strands: self.strands, points: self.points, packing: self.packing() };
+        let inputs = (0..p.substeps)
+            .map(|k| {
+                let at = |k: u32| self.head.lerp(head, k as f32 / p.substeps as f32).matrix();
+                let pose = SubstepPose {
+                    previous_head: at(k),
+                    head: at(k + 1),
+                    time: (self.time + f64::from(dt) * f64::from(k + 1)) as f32,
+                    index: self.substep.wrapping_add(k),
+                };
+                let colliders = self.colliders.len() as u32;
+                SubstepInputs {
+                    params: packing::sim_step(p, &pose, shape, colliders, self.mesh.as_ref()),
+                    colliders: self.colliders.iter().map(|c| c.in_world(&pose.head)).collect(),
+                }
+            })
+            .collect();
+        self.head = *head;
+        self.time += f64::from(p.dt);
+        self.substep = self.substep.wrapping_add(p.substeps);
+        Ok(inputs)
+    }
+}

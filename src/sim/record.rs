@@ -1,0 +1,177 @@
+//! Recording a step ([`HairSim::record_step`]): the uploads of the
+//! sub-steps' parameters and colliders, the step kernel's dispatch and, with
+//! the volume stage on, its kernels after each sub-step.
+
+use ash::vk;
+
+use super::planner::SubstepInputs;
+use super::{state, step, volume, HairSim, SimStage};
+use crate::error::Result;
+use crate::gpu_types::{ColliderShape, GpuCollider, GpuVolumeParams, SimPush, SimStepParams, StepRange};
+use crate::profiler::{GpuProfiler, PassScope};
+use crate::sim::RigidTransform;
+use crate::vk::barrier::{self, AccessKind};
+use crate::vk::debug::LabelColor;
+use crate::vk::device::Device;
+
+/// Recording.
+impl HairSim {
+    /// Records one step that ends with the head at `head` into `cmd`, with a debug
+    /// label and (when a profiler is given) a timestamp scope per stage: with the
+    /// volume stage off one dispatch and two barriers (uploads of the sub-steps'
+    /// parameters, then the dispatch); with it on, per sub-step the step dispatch
+    /// followed by the volume stage's kernels. Leaves the step pipeline or the
+    /// volume stage's last kernel bound.
+    ///
+    /// # Safety
+    /// `cmd` is a command buffer of the context's device in the recording state,
+    /// outside a render pass, for a queue of the graphics family (or the context's
+    /// compute queue, as [`crate::schedule::FrameScheduler`] uses it). The buffers of this
+    /// simulation must not be in use by other pending work that conflicts with it
+    /// (the recorded barriers order it after everything earlier in submission order).
+    /// With a profiler, its `begin_frame` was called for the frame being recorded.
+    pub unsafe fn record_step(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        head: &RigidTransform,
+        mut profiler: Option<&mut GpuProfiler>,
+    ) -> Result<()> {
+        let inputs = self.planner.next(head)?;
+        // SAFETY (whole body): guaranteed by the caller; all buffers belong to this
+        // device, and update sizes are multiples of 4 below 64 KiB (by construction).
+        unsafe {
+            self.record_uploads(cmd, &inputs);
+            self.pending_rest.clear();
+            let Some(volume) = &self.volume else {
+                self.record_dispatch(cmd, self.current, [0, inputs.len() as u32], &mut profiler);
+                self.current = 1 - self.current;
+                return Ok(());
+            };
+            let between = barrier::memory(&[AccessKind::ComputeWrite], barrier::COMPUTE_READ_WRITE);
+            let mut current = self.current;
+            for (k, sub) in inputs.iter().enumerate() {
+                if k > 0 {
+                    self.device.cmd_barrier(cmd, &[entry_barrier()], &[], &[]);
+                    self.record_volume_uploads(cmd, volume, sub);
+                    self.device.cmd_barrier(cmd, &[uploaded_barrier()], &[], &[]);
+                }
+                self.record_dispatch(cmd, current, [k as u32, 1], &mut profiler);
+                self.device.cmd_barrier(cmd, &[between], &[], &[]);
+                let labels = SimStage::VOLUME.map(SimStage::label);
+                // The barrier above made the step's writes visible.
+                volume.record(cmd, 1 - current, labels, profiler.as_deref_mut());
+                current = 1 - current;
+            }
+            self.current = current;
+        }
+        Ok(())
+    }
+
+    /// Records the uploads of a step between the entry and the uploaded barrier:
+    /// the sub-steps' parameters and colliders, pending rest data, and with the
+    /// volume stage its uploads for the first sub-step.
+    ///
+    /// # Safety
+    /// As [`HairSim::record_step`].
+    unsafe fn record_uploads(&self, cmd: vk::CommandBuffer, inputs: &[SubstepInputs]) {
+        let d = &self.device;
+        let params: Vec<SimStepParams> = inputs.iter().map(|sub| SimStepParams::from(&sub.params)).collect();
+        // SAFETY: guaranteed by the caller; sizes are multiples of 4, each update
+        // below 64 KiB (at most MAX_SUBSTEPS parameter blocks of 256 bytes, at
+        // most MAX_COLLIDERS colliders of 32 bytes).
+        unsafe {
+            d.cmd_barrier(cmd, &[entry_barrier()], &[], &[]);
+            d.raw.cmd_update_buffer(cmd, self.gpu.params.raw(), 0, bytemuck::cast_slice(&params));
+            for (k, sub) in inputs.iter().enumerate().filter(|(_, sub)| !sub.colliders.is_empty()) {
+                let offset = state::collider_offset(k);
+                let colliders = gpu_colliders(&sub.colliders);
+                d.raw.cmd_update_buffer(cmd, self.gpu.colliders.raw(), offset, bytemuck::cast_slice(&colliders));
+            }
+            for range in &self.pending_rest {
+                let rest = bytemuck::cast_slice(&self.shape.rest[range.clone()]);
+                let lengths = bytemuck::cast_slice(&self.shape.rest_lengths[range.clone()]);
+                update_chunked(d, cmd, self.gpu.rest.raw(), range.start as u64 * 16, rest);
+                update_chunked(d, cmd, self.gpu.rest_lengths.raw(), range.start as u64 * 4, lengths);
+            }
+            if let (Some(volume), Some(first)) = (&self.volume, inputs.first()) {
+                self.record_volume_uploads(cmd, volume, first);
+            }
+            d.cmd_barrier(cmd, &[uploaded_barrier()], &[], &[]);
+        }
+    }
+
+    /// The volume stage's uploads for sub-step `sub`: its parameters and the
+    /// colliders it sees.
+    ///
+    /// # Safety
+    /// As [`HairSim::record_step`], between an entry and an uploaded barrier.
+    unsafe fn record_volume_uploads(&self, cmd: vk::CommandBuffer, volume: &volume::VolumeStage, sub: &SubstepInputs) {
+        let colliders = self.planner.colliders.len() as u32;
+        // SAFETY: guaranteed by the caller; at most MAX_COLLIDERS colliders of 32 bytes.
+        unsafe {
+            if !sub.colliders.is_empty() {
+                let gpu = gpu_colliders(&sub.colliders);
+                self.device.raw.cmd_update_buffer(cmd, self.gpu.volume_colliders.raw(), 0, bytemuck::cast_slice(&gpu));
+            }
+            let params = GpuVolumeParams::from(&sub.volume_params(&volume.grid, &volume.params, colliders));
+            volume.record_uploads(cmd, &params);
+        }
+    }
+
+    /// Records the step kernel for sub-steps `range` = [first, count], reading
+    /// half `parity` of the double buffer, in a timestamp scope.
+    ///
+    /// # Safety
+    /// As [`HairSim::record_step`], after the uploads' barrier.
+    unsafe fn record_dispatch(
+        &self,
+        cmd: vk::CommandBuffer,
+        parity: usize,
+        range: [u32; 2],
+        profiler: &mut Option<&mut GpuProfiler>,
+    ) {
+        let (strands, groups) = (self.planner.strands, self.planner.packing().hairs_per_group);
+        let push = SimPush::from(&StepRange { first: range[0], count: range[1] });
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            PassScope::record(&self.device, cmd, profiler, SimStage::Step.label(), LabelColor::Compute, || {
+                self.pipeline.bind(cmd, &[self.sets[parity]]);
+                self.pipeline.push(cmd, &push);
+                self.pipeline.dispatch_threads(cmd, [step::threads(strands, groups), 1, 1]);
+            });
+        }
+    }
+}
+
+/// The colliders of a sub-step as the GPU buffers hold them.
+fn gpu_colliders(colliders: &[ColliderShape]) -> Vec<GpuCollider> {
+    colliders.iter().map(GpuCollider::from).collect()
+}
+
+/// Earlier work (a previous step's reads and writes) before a step's uploads.
+fn entry_barrier() -> vk::MemoryBarrier2<'static> {
+    barrier::memory(
+        &[AccessKind::AnyWrite],
+        &[AccessKind::TransferWrite, AccessKind::ComputeRead, AccessKind::ComputeWrite, AccessKind::ComputeUniformRead],
+    )
+}
+
+/// A step's uploads before the kernels that read them.
+fn uploaded_barrier() -> vk::MemoryBarrier2<'static> {
+    barrier::memory(
+        &[AccessKind::TransferWrite],
+        &[AccessKind::ComputeUniformRead, AccessKind::ComputeRead, AccessKind::ComputeWrite, AccessKind::IndirectRead],
+    )
+}
+
+/// `vkCmdUpdateBuffer` in chunks of at most 64 KiB.
+///
+/// # Safety
+/// `cmd` is recording; `buffer` has TRANSFER_DST usage and room for the data;
+/// `offset` and the data length are multiples of 4.
+unsafe fn update_chunked(d: &Device, cmd: vk::CommandBuffer, buffer: vk::Buffer, offset: u64, data: &[u8]) {
+    for (k, chunk) in data.chunks(65536).enumerate() {
+        // SAFETY: guaranteed by the caller.
+        unsafe { d.raw.cmd_update_buffer(cmd, buffer, offset + k as u64 * 65536, chunk) };
+    }
+}
