@@ -12,6 +12,7 @@
 //! open their scopes through one helper, [`PassScope`], coloured by the kind of
 //! work; both timestamps are written at `ALL_COMMANDS`.
 
+use std::cell::RefCell;
 use std::sync::Arc;
 
 use ash::vk;
@@ -46,6 +47,32 @@ struct Slot {
     scopes: Vec<Scope>,
     queries: u32,
     open: u32,
+}
+
+/// What recording scopes changes: the slots and the frame being recorded.
+/// Behind a `RefCell`, so that vkhair's passes can open scopes through a
+/// shared [`Timing`] handle.
+struct Recording {
+    slots: Vec<Slot>,
+    current: Option<usize>,
+}
+
+/// Where a vkhair pass writes its timestamps: the frame's profiler, or nowhere
+/// (debug labels only). `Copy`, so it is passed by value through every
+/// recording function instead of threading a mutable borrow.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Timing<'a>(Option<&'a GpuProfiler>);
+
+impl<'a> Timing<'a> {
+    /// Timestamps into `profiler` when given.
+    pub(crate) fn of(profiler: Option<&'a GpuProfiler>) -> Self {
+        Timing(profiler)
+    }
+
+    /// The profiler, when there is one.
+    pub(crate) fn profiler(self) -> Option<&'a GpuProfiler> {
+        self.0
+    }
 }
 
 /// Timestamp-query profiler for passes recorded into the host's command buffers.
@@ -89,9 +116,8 @@ struct Slot {
 pub struct GpuProfiler {
     device: Arc<Device>,
     pool: vk::QueryPool,
-    slots: Vec<Slot>,
+    recording: RefCell<Recording>,
     queries_per_slot: u32,
-    current: Option<usize>,
     enabled: bool,
     period_ns: f64,
     valid_mask: u64,
@@ -131,9 +157,11 @@ impl GpuProfiler {
         Ok(GpuProfiler {
             calibration,
             pool,
-            slots: (0..frames_in_flight).map(|_| Slot::default()).collect(),
+            recording: RefCell::new(Recording {
+                slots: (0..frames_in_flight).map(|_| Slot::default()).collect(),
+                current: None,
+            }),
             queries_per_slot,
-            current: None,
             enabled: true,
             period_ns: f64::from(device.info.timestamp_period),
             valid_mask: if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 },
@@ -166,7 +194,7 @@ impl GpuProfiler {
     /// pass, submitted to the graphics queue family; the command buffer that recorded
     /// frame `frame − frames_in_flight` has completed (the usual frames-in-flight wait).
     pub unsafe fn begin_frame(&mut self, cmd: vk::CommandBuffer, frame: u64) -> Option<ProfileReport> {
-        let index = (frame % self.slots.len() as u64) as usize;
+        let index = (frame % self.recording.get_mut().slots.len() as u64) as usize;
         let report = self.read_slot(index);
         if report.is_some() {
             self.latest.clone_from(&report);
@@ -174,8 +202,9 @@ impl GpuProfiler {
         let first = index as u32 * self.queries_per_slot;
         // SAFETY: guaranteed by the caller; the range lies within the pool.
         unsafe { self.device.raw.cmd_reset_query_pool(cmd, self.pool, first, self.queries_per_slot) };
-        self.slots[index] = Slot { frame: Some(frame), ..Slot::default() };
-        self.current = Some(index);
+        let recording = self.recording.get_mut();
+        recording.slots[index] = Slot { frame: Some(frame), ..Slot::default() };
+        recording.current = Some(index);
         report
     }
 
@@ -194,12 +223,13 @@ impl GpuProfiler {
     ///
     /// # Safety
     /// As for [`GpuProfiler::begin_scope`].
-    pub(crate) unsafe fn begin_scope_as(&mut self, cmd: vk::CommandBuffer, name: &str, kind: LabelColor) -> ScopeId {
+    pub(crate) unsafe fn begin_scope_as(&self, cmd: vk::CommandBuffer, name: &str, kind: LabelColor) -> ScopeId {
         // SAFETY: guaranteed by the caller.
         unsafe { self.device.cmd_begin_label(cmd, name, kind) };
-        let Some(index) = self.current.filter(|_| self.enabled) else { return ScopeId(None) };
+        let mut recording = self.recording.borrow_mut();
+        let Some(index) = recording.current.filter(|_| self.enabled) else { return ScopeId(None) };
         let first = index as u32 * self.queries_per_slot;
-        let slot = &mut self.slots[index];
+        let slot = &mut recording.slots[index];
         if slot.queries + 2 > self.queries_per_slot {
             slot.open += 1;
             return ScopeId(None);
@@ -218,9 +248,19 @@ impl GpuProfiler {
     /// # Safety
     /// As for [`GpuProfiler::begin_scope`], in the same command buffer.
     pub unsafe fn end_scope(&mut self, cmd: vk::CommandBuffer, scope: ScopeId) {
-        if let Some(index) = self.current {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.end_scope_shared(cmd, scope) }
+    }
+
+    /// [`GpuProfiler::end_scope`] through a shared reference (vkhair's passes).
+    ///
+    /// # Safety
+    /// As for [`GpuProfiler::end_scope`].
+    pub(crate) unsafe fn end_scope_shared(&self, cmd: vk::CommandBuffer, scope: ScopeId) {
+        let mut recording = self.recording.borrow_mut();
+        if let Some(index) = recording.current {
             let first = index as u32 * self.queries_per_slot;
-            let slot = &mut self.slots[index];
+            let slot = &mut recording.slots[index];
             slot.open = slot.open.saturating_sub(1);
             if let Some(s) = scope.0.and_then(|i| slot.scopes.get_mut(i as usize)) {
                 let query = s.begin + 1;
@@ -236,13 +276,13 @@ impl GpuProfiler {
     /// Reads back every slot whose frame is complete, newest last; for a host that
     /// has waited for all its frames (end of a run).
     pub fn drain(&mut self) -> Vec<ProfileReport> {
-        let mut order: Vec<usize> = (0..self.slots.len()).filter(|&i| self.slots[i].frame.is_some()).collect();
-        order.sort_by_key(|&i| self.slots[i].frame);
+        let slots = &self.recording.get_mut().slots;
+        let mut order: Vec<usize> = (0..slots.len()).filter(|&i| slots[i].frame.is_some()).collect();
+        order.sort_by_key(|&i| slots[i].frame);
         let reports: Vec<_> = order.into_iter().filter_map(|i| self.read_slot(i)).collect();
-        for i in 0..self.slots.len() {
-            self.slots[i] = Slot::default();
-        }
-        self.current = None;
+        let recording = self.recording.get_mut();
+        recording.slots.iter_mut().for_each(|slot| *slot = Slot::default());
+        recording.current = None;
         if let Some(last) = reports.last() {
             self.latest = Some(last.clone());
         }
@@ -250,7 +290,8 @@ impl GpuProfiler {
     }
 
     fn read_slot(&self, index: usize) -> Option<ProfileReport> {
-        let slot = &self.slots[index];
+        let recording = self.recording.borrow();
+        let slot = &recording.slots[index];
         let frame = slot.frame?;
         if slot.queries == 0 {
             return None;

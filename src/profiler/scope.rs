@@ -3,7 +3,7 @@
 
 use ash::vk;
 
-use super::{GpuProfiler, ScopeId};
+use super::{ScopeId, Timing};
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 
@@ -31,13 +31,13 @@ impl PassScope {
     pub(crate) unsafe fn open(
         device: &Device,
         cmd: vk::CommandBuffer,
-        profiler: &mut Option<&mut GpuProfiler>,
+        timing: Timing<'_>,
         label: &str,
         kind: LabelColor,
     ) -> PassScope {
         // SAFETY: guaranteed by the caller.
         unsafe {
-            match profiler.as_deref_mut() {
+            match timing.profiler() {
                 Some(p) => PassScope { id: Some(p.begin_scope_as(cmd, label, kind)) },
                 None => {
                     device.cmd_begin_label(cmd, label, kind);
@@ -52,11 +52,11 @@ impl PassScope {
     /// # Safety
     /// As for [`PassScope::open`], in the same command buffer and with the same
     /// profiler, scopes closed innermost first.
-    pub(crate) unsafe fn close(self, device: &Device, cmd: vk::CommandBuffer, profiler: &mut Option<&mut GpuProfiler>) {
+    pub(crate) unsafe fn close(self, device: &Device, cmd: vk::CommandBuffer, timing: Timing<'_>) {
         // SAFETY: guaranteed by the caller.
         unsafe {
-            match (profiler.as_deref_mut(), self.id) {
-                (Some(p), Some(id)) => p.end_scope(cmd, id),
+            match (timing.profiler(), self.id) {
+                (Some(p), Some(id)) => p.end_scope_shared(cmd, id),
                 _ => device.cmd_end_label(cmd),
             }
         }
@@ -69,16 +69,16 @@ impl PassScope {
     pub(crate) unsafe fn record<T>(
         device: &Device,
         cmd: vk::CommandBuffer,
-        profiler: &mut Option<&mut GpuProfiler>,
+        timing: Timing<'_>,
         label: &str,
         kind: LabelColor,
         body: impl FnOnce() -> T,
     ) -> T {
         // SAFETY: guaranteed by the caller.
         unsafe {
-            let scope = PassScope::open(device, cmd, profiler, label, kind);
+            let scope = PassScope::open(device, cmd, timing, label, kind);
             let out = body();
-            scope.close(device, cmd, profiler);
+            scope.close(device, cmd, timing);
             out
         }
     }

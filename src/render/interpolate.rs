@@ -21,7 +21,7 @@ use super::smooth::SmoothPass;
 use super::InterpolationMode;
 use crate::error::{Error, Result};
 use crate::gpu_types::InterpolatePush;
-use crate::profiler::GpuProfiler;
+use crate::profiler::Timing;
 use crate::sim::SimState;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
@@ -155,7 +155,7 @@ impl InterpolatePass {
         cmd: vk::CommandBuffer,
         mode: InterpolationMode,
         push: &InterpolatePush,
-        profiler: &mut Option<&mut GpuProfiler>,
+        timing: Timing<'_>,
     ) {
         let d = &self.device;
         let p = match mode {
@@ -164,7 +164,7 @@ impl InterpolatePass {
         };
         // SAFETY: guaranteed by the caller: one patch per key segment of each unit.
         unsafe {
-            pass::record_capture(d, cmd, RenderPass::Interpolate, profiler, |cmd| {
+            pass::record_capture(d, cmd, RenderPass::Interpolate, timing, |cmd| {
                 p.pipeline.bind(cmd, &[p.set]);
                 p.pipeline.push(cmd, push);
                 d.raw.cmd_draw(cmd, push.strands * (push.points - 1), 1, 0, 0);

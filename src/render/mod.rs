@@ -28,8 +28,6 @@
 mod draw;
 mod interpolate;
 pub mod marschner;
-mod oit;
-mod output;
 mod params;
 pub(crate) mod pass;
 mod readback;
@@ -41,8 +39,8 @@ mod shadow;
 mod smooth;
 mod target;
 
+pub use draw::OitStats;
 pub use marschner::MarschnerParams;
-pub use oit::OitStats;
 pub use params::{
     Detail, InterpolationMode, LodParams, OitParams, Primitive, RenderParams, Transparency, MAX_HAIRS_PER_KEY,
     MAX_SMOOTHING_LEVEL,
@@ -60,14 +58,13 @@ use ash::vk;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuLight, InterpolatePush, SmoothPush};
-use crate::profiler::GpuProfiler;
+use crate::profiler::{GpuProfiler, Timing};
 use crate::sim::KeyHairs;
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use draw::DrawPass;
 use interpolate::InterpolatePass;
-use oit::OitPass;
 use resolve::ResolvePass;
 use shadow::{Bounds, Shadows};
 use smooth::SmoothPass;
@@ -131,7 +128,6 @@ pub struct Renderer {
     interpolate: InterpolatePass,
     shadows: Shadows,
     draw: DrawPass,
-    oit: OitPass,
     resolve: ResolvePass,
     material: HairMaterial,
     lights: Vec<GpuLight>,
@@ -203,7 +199,6 @@ impl Renderer {
             interpolate,
             shadows,
             draw,
-            oit: OitPass::new(&device)?,
             resolve: ResolvePass::new(&device),
             material: HairMaterial::default(),
             lights: Vec::new(),
@@ -289,7 +284,6 @@ impl Renderer {
             // The draw's descriptor sets name images and buffers that were (or, after
             // a failure half way, may have been) replaced.
             self.draw.forget();
-            self.oit.forget();
         }
         changed.map(|_| ())
     }
@@ -380,7 +374,7 @@ impl Renderer {
         cmd: vk::CommandBuffer,
         sim: impl Into<KeyHairs<'a>>,
         camera: Option<&Camera>,
-        mut profiler: Option<&mut GpuProfiler>,
+        profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
         let sim = sim.into();
         check_device(&self.device, &sim)?;
@@ -397,11 +391,12 @@ impl Renderer {
             &[AccessKind::VertexRead, AccessKind::TessellationRead, AccessKind::TessellationWrite],
         );
         let (smooth_push, interpolate_push) = (self.smooth_push(sim.alpha), self.interpolate_push());
+        let timing = Timing::of(profiler.as_deref());
         // SAFETY: guaranteed by the caller.
         unsafe {
             self.device.cmd_barrier(cmd, &[entry], &[], &[]);
-            self.smooth.record(cmd, sim.current, &smooth_push, &mut profiler);
-            self.interpolate.record(cmd, self.params.interpolation, &interpolate_push, &mut profiler);
+            self.smooth.record(cmd, sim.current, &smooth_push, timing);
+            self.interpolate.record(cmd, self.params.interpolation, &interpolate_push, timing);
         }
         Ok(())
     }
@@ -442,12 +437,13 @@ impl Renderer {
         &mut self,
         cmd: vk::CommandBuffer,
         sim: impl Into<KeyHairs<'a>>,
-        mut profiler: Option<&mut GpuProfiler>,
+        profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
         let sim = sim.into();
         let bounds = Bounds { centre: self.placement.head_center, radius: self.placement.bound_radius };
         // SAFETY: guaranteed by the caller.
-        unsafe { self.shadows.record(cmd, &sim, &self.lights, bounds, self.hair_counts(), &mut profiler) }
+        let timing = Timing::of(profiler.as_deref());
+        unsafe { self.shadows.record(cmd, &sim, &self.lights, bounds, self.hair_counts(), timing) }
     }
 
     /// The opacity atlas (format [`SHADOW_ATLAS_FORMAT`], one tile per caster, two tiles

@@ -24,7 +24,7 @@ use std::sync::Arc;
 use ash::vk;
 
 use crate::error::Result;
-use crate::profiler::{GpuProfiler, PassScope};
+use crate::profiler::{PassScope, Timing};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
@@ -94,14 +94,9 @@ impl RenderPass {
     ///
     /// # Safety
     /// As for [`PassScope::open`].
-    pub(crate) unsafe fn open(
-        self,
-        device: &Device,
-        cmd: vk::CommandBuffer,
-        profiler: &mut Option<&mut GpuProfiler>,
-    ) -> PassScope {
+    pub(crate) unsafe fn open(self, device: &Device, cmd: vk::CommandBuffer, timing: Timing<'_>) -> PassScope {
         // SAFETY: guaranteed by the caller.
-        unsafe { PassScope::open(device, cmd, profiler, self.label(), self.kind()) }
+        unsafe { PassScope::open(device, cmd, timing, self.label(), self.kind()) }
     }
 }
 
@@ -153,7 +148,7 @@ pub(super) unsafe fn record_capture(
     device: &Device,
     cmd: vk::CommandBuffer,
     pass: RenderPass,
-    profiler: &mut Option<&mut GpuProfiler>,
+    timing: Timing<'_>,
     record: impl FnOnce(vk::CommandBuffer),
 ) {
     let written = barrier::memory(&[AccessKind::TessellationWrite], CAPTURE_READERS);
@@ -161,12 +156,12 @@ pub(super) unsafe fn record_capture(
     let rendering = rendering::info(extent, &[], None);
     // SAFETY: guaranteed by the caller; every object belongs to this device.
     unsafe {
-        let scope = pass.open(device, cmd, profiler);
+        let scope = pass.open(device, cmd, timing);
         device.raw.cmd_begin_rendering(cmd, &rendering);
         device.cmd_set_full_viewport(cmd, extent);
         record(cmd);
         device.raw.cmd_end_rendering(cmd);
         device.cmd_barrier(cmd, &[written], &[], &[]);
-        scope.close(device, cmd, profiler);
+        scope.close(device, cmd, timing);
     }
 }

@@ -15,9 +15,10 @@ use ash::vk;
 
 use super::draw::{DrawTarget, TargetKey};
 use super::pass::RenderPass;
+use super::Primitive;
 use crate::error::Result;
-use crate::profiler::GpuProfiler;
-use crate::vk::barrier::{self, AccessKind};
+use crate::profiler::Timing;
+use crate::vk::barrier::{self, AccessKind, Barriers};
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc, Sampler};
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
@@ -25,9 +26,9 @@ use crate::vk::rendering::{self, Load};
 use crate::vk::shaders::{RENDER_RESOLVE_FRAG, RENDER_RESOLVE_VERT};
 
 /// Color format of the supersampled hair image (linear, with coverage in alpha).
-pub(super) const SUPERSAMPLED_COLOR: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+const SUPERSAMPLED_COLOR: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// Depth format of the supersampled hair image.
-pub(super) const SUPERSAMPLED_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
+const SUPERSAMPLED_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
 
 /// Images twice the host target's size and the resolve pipelines reading them.
 pub(super) struct Supersampling {
@@ -111,28 +112,30 @@ impl Supersampling {
 
 impl Supersampling {
     /// The extent the hair is drawn at: twice the target's.
-    pub(super) fn extent(&self) -> vk::Extent2D {
+    fn extent(&self) -> vk::Extent2D {
         self.color.extent
     }
 
-    /// The colour and depth views.
-    pub(super) fn views(&self) -> (vk::ImageView, vk::ImageView) {
-        (self.color.view(), self.depth.view())
-    }
-
-    /// The draw's attachments: colour cleared to transparent, depth to 1.
-    pub(super) fn attachments(
-        &self,
-    ) -> ([vk::RenderingAttachmentInfo<'static>; 1], vk::RenderingAttachmentInfo<'static>) {
-        (
-            [rendering::color(self.color.view(), Load::color([0.0; 4]))],
-            rendering::depth(self.depth.view(), Load::depth(1.0)),
-        )
+    /// Where the frame's hair is drawn: these images, colour cleared to
+    /// transparent and depth to 1, after the barriers that make them attachments.
+    pub(super) fn draw_target(&self, primitive: Primitive) -> DrawTarget {
+        DrawTarget {
+            key: TargetKey {
+                color: SUPERSAMPLED_COLOR,
+                depth: SUPERSAMPLED_DEPTH,
+                samples: vk::SampleCountFlags::TYPE_1,
+                primitive,
+            },
+            extent: self.extent(),
+            color: (self.color.view(), Load::color([0.0; 4])),
+            depth: Some((self.depth.view(), Load::depth(1.0))),
+            before: Barriers { images: self.to_attachments().to_vec(), ..Barriers::default() },
+        }
     }
 
     /// Barriers before the draw: both images from the last resolve's sampling to
     /// attachments (contents discarded).
-    pub(super) fn to_attachments(&self) -> [vk::ImageMemoryBarrier2<'static>; 2] {
+    fn to_attachments(&self) -> [vk::ImageMemoryBarrier2<'static>; 2] {
         let sampled = &[AccessKind::FragmentSampledRead];
         [
             barrier::image(
@@ -220,7 +223,7 @@ impl ResolvePass {
     }
 
     /// Records the resolve of `images` into the host's `target` in its own scope,
-    /// after `attachments` (the barrier ordering the host's earlier attachment
+    /// after the target's barriers (which order the host's earlier attachment
     /// writes).
     ///
     /// # Safety
@@ -231,24 +234,26 @@ impl ResolvePass {
         &self,
         cmd: vk::CommandBuffer,
         images: &mut Supersampling,
-        target: &DrawTarget<'_>,
-        attachments: vk::MemoryBarrier2<'_>,
-        profiler: &mut Option<&mut GpuProfiler>,
+        target: &DrawTarget,
+        timing: Timing<'_>,
     ) -> Result<()> {
         let d = &self.device;
         let to_sampled = images.to_sampled();
+        let color = [rendering::color(target.color.0, target.color.1)];
+        let depth = target.depth.map(|(view, load)| rendering::depth(view, load));
+        let info = rendering::info(target.extent, &color, depth.as_ref());
         // Made (or found) before anything is recorded: a failure leaves `cmd` as it was.
         let (pipeline, set) = images.pipeline(target.key)?;
         // SAFETY: guaranteed by the caller; the images are this pass's.
         unsafe {
-            let scope = RenderPass::Resolve.open(d, cmd, profiler);
-            d.cmd_barrier(cmd, &[attachments], &[], &to_sampled);
-            d.raw.cmd_begin_rendering(cmd, target.rendering);
+            let scope = RenderPass::Resolve.open(d, cmd, timing);
+            d.cmd_barrier(cmd, &target.before.memory, &[], &to_sampled);
+            d.raw.cmd_begin_rendering(cmd, &info);
             d.cmd_set_full_viewport(cmd, target.extent);
             pipeline.bind(cmd, &[*set]);
             d.raw.cmd_draw(cmd, 3, 1, 0, 0);
             d.raw.cmd_end_rendering(cmd);
-            scope.close(d, cmd, profiler);
+            scope.close(d, cmd, timing);
         }
         Ok(())
     }

@@ -18,7 +18,7 @@ use glam::Vec4;
 use super::pass::{self, RenderPass};
 use crate::error::Result;
 use crate::gpu_types::SmoothPush;
-use crate::profiler::GpuProfiler;
+use crate::profiler::Timing;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::pipeline::GraphicsPipeline;
@@ -70,18 +70,12 @@ impl SmoothPass {
     /// `cmd` is a recording command buffer of this device outside a render pass,
     /// the simulation's writes to half `half` (the latest state) made visible to
     /// vertex shaders before.
-    pub(super) unsafe fn record(
-        &self,
-        cmd: vk::CommandBuffer,
-        half: usize,
-        push: &SmoothPush,
-        profiler: &mut Option<&mut GpuProfiler>,
-    ) {
+    pub(super) unsafe fn record(&self, cmd: vk::CommandBuffer, half: usize, push: &SmoothPush, timing: Timing<'_>) {
         let d = &self.device;
         let vertices = push.strands * (push.points - 1) * 4;
         // SAFETY: guaranteed by the caller.
         unsafe {
-            pass::record_capture(d, cmd, RenderPass::Smooth, profiler, |cmd| {
+            pass::record_capture(d, cmd, RenderPass::Smooth, timing, |cmd| {
                 self.pipeline.bind(cmd, &[self.sets[half]]);
                 self.pipeline.push(cmd, push);
                 d.raw.cmd_draw(cmd, vertices, 1, 0, 0);

@@ -53,8 +53,7 @@ use gpu_allocator::MemoryLocation;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::groom::Groom;
-use crate::profiler::PassScope;
-use crate::profiler::{GpuProfiler, ProfileReport};
+use crate::profiler::{GpuProfiler, PassScope, ProfileReport, Timing};
 use crate::sim::{Collider, HairSim, KeyHairs, RigidTransform, SimParams, SimState};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
@@ -298,7 +297,7 @@ impl FrameScheduler {
                 unsafe {
                     if !latency {
                         let meta = Meta::of(sim, *steps);
-                        scoped(&device, &mut profiler, cmd, label, |_| {
+                        scoped(&device, Timing::of(profiler.as_deref()), cmd, label, |_| {
                             self.mirror.record_update(cmd, Parts::of_sim(sim), meta)
                         });
                     }
@@ -308,7 +307,7 @@ impl FrameScheduler {
                     }
                     if latency {
                         let meta = Meta::of(sim, *steps);
-                        scoped(&device, &mut profiler, cmd, label, |_| {
+                        scoped(&device, Timing::of(profiler.as_deref()), cmd, label, |_| {
                             self.mirror.record_update(cmd, Parts::of_sim(sim), meta)
                         });
                     }
@@ -324,7 +323,9 @@ impl FrameScheduler {
                     // SAFETY: guaranteed by the caller; the slot is ready once the
                     // returned wait is satisfied.
                     unsafe {
-                        scoped(&device, &mut profiler, cmd, label, |_| self.mirror.record_update(cmd, parts, p.meta))
+                        scoped(&device, Timing::of(profiler.as_deref()), cmd, label, |_| {
+                            self.mirror.record_update(cmd, parts, p.meta)
+                        })
                     };
                     sync.waits.push(SemaphoreWait { semaphore: wait.semaphore, value: wait.value, stage: wait.stage });
                 }
@@ -338,7 +339,9 @@ impl FrameScheduler {
                 if let Some(job) = take {
                     let meta = worker.wait_end(job, self.slots)?;
                     // SAFETY: guaranteed by the caller; the job is finished.
-                    unsafe { consume(&mut self.mirror, slots, cmd, job, self.slots, meta, &mut profiler)? };
+                    unsafe {
+                        consume(&mut self.mirror, slots, cmd, job, self.slots, meta, Timing::of(profiler.as_deref()))?
+                    };
                     worker.ack(job);
                 }
                 if !latency {
@@ -416,13 +419,13 @@ impl FrameScheduler {
 /// caller's.
 unsafe fn scoped(
     device: &Device,
-    profiler: &mut Option<&mut GpuProfiler>,
+    timing: Timing<'_>,
     cmd: vk::CommandBuffer,
     name: &str,
     f: impl FnOnce(vk::CommandBuffer),
 ) {
     // SAFETY: guaranteed by the caller.
-    unsafe { PassScope::record(device, cmd, profiler, name, LabelColor::Transfer, || f(cmd)) }
+    unsafe { PassScope::record(device, cmd, timing, name, LabelColor::Transfer, || f(cmd)) }
 }
 
 /// Takes a finished SECOND DEVICE job's slot into the mirror.
@@ -437,7 +440,7 @@ unsafe fn consume(
     job: u64,
     count: usize,
     meta: Meta,
-    profiler: &mut Option<&mut GpuProfiler>,
+    timing: Timing<'_>,
 ) -> Result<()> {
     let slot = job as usize % count;
     let layout = mirror.layout();
@@ -451,7 +454,7 @@ unsafe fn consume(
     // SAFETY: guaranteed by the caller.
     unsafe {
         let device = mirror.device().clone();
-        scoped(&device, profiler, cmd, "vkhair hand-off", |cmd| match slots {
+        scoped(&device, timing, cmd, "vkhair hand-off", |cmd| match slots {
             RenderSlots::External(buffers) => {
                 let b = buffers[slot].raw();
                 let family = mirror.device().graphics.family;

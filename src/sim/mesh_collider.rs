@@ -34,7 +34,7 @@ use crate::error::{Error, Result};
 use crate::gpu_types::{SdfPass, SdfPush};
 use crate::groom::mesh::TriMesh;
 use crate::groom::sdf::MeshSdf;
-use crate::profiler::{GpuProfiler, PassScope, ProfileReport};
+use crate::profiler::{GpuProfiler, PassScope, ProfileReport, Timing};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
 use crate::vk::debug::LabelColor;
@@ -218,34 +218,41 @@ impl MeshCollider {
                     let frame = p.latest().map_or(0, |r| r.frame + 1);
                     let _ = p.begin_frame(cmd, frame);
                 }
-                PassScope::record(d, cmd, &mut profiler, MESH_COLLIDER_BUILD_LABEL, LabelColor::Compute, || {
-                    d.raw.cmd_fill_buffer(cmd, distance.raw(), 0, vk::WHOLE_SIZE, sentinel::SDF_NONE);
-                    d.raw.cmd_fill_buffer(cmd, ids[0].raw(), 0, vk::WHOLE_SIZE, sentinel::SDF_NONE);
-                    d.raw.cmd_fill_buffer(cmd, votes.raw(), 0, vk::WHOLE_SIZE, 0);
-                    d.cmd_barrier(cmd, &[filled], &[], &[]);
-                    seed.bind(cmd, &[seed_set]);
-                    for mode in 0..2 {
-                        seed.push(cmd, &with(SdfPass { seed_mode: mode, ..base }));
-                        seed.dispatch_threads(cmd, [triangles as u32, 1, 1]);
-                        d.cmd_barrier(cmd, &[between], &[], &[]);
-                    }
-                    for (k, &step) in steps.iter().enumerate() {
-                        flood.bind(cmd, &[flood_sets[k % 2]]);
-                        flood.push(cmd, &with(SdfPass { jump: step, ..base }));
-                        flood.dispatch_threads(cmd, [points, 1, 1]);
-                        d.cmd_barrier(cmd, &[between], &[], &[]);
-                    }
-                    sign.bind(cmd, &[sign_set]);
-                    for axis in 0..3usize {
-                        let lines = dims[(axis + 1) % 3] * dims[(axis + 2) % 3];
-                        sign.push(cmd, &with(SdfPass { ray_axis: axis as u32, ..base }));
-                        sign.dispatch_threads(cmd, [lines, 1, 1]);
-                        d.cmd_barrier(cmd, &[between], &[], &[]);
-                    }
-                    finalize.bind(cmd, &[finalize_set]);
-                    finalize.push(cmd, &with(base));
-                    finalize.dispatch_threads(cmd, [points, 1, 1]);
-                });
+                PassScope::record(
+                    d,
+                    cmd,
+                    Timing::of(profiler.as_deref()),
+                    MESH_COLLIDER_BUILD_LABEL,
+                    LabelColor::Compute,
+                    || {
+                        d.raw.cmd_fill_buffer(cmd, distance.raw(), 0, vk::WHOLE_SIZE, sentinel::SDF_NONE);
+                        d.raw.cmd_fill_buffer(cmd, ids[0].raw(), 0, vk::WHOLE_SIZE, sentinel::SDF_NONE);
+                        d.raw.cmd_fill_buffer(cmd, votes.raw(), 0, vk::WHOLE_SIZE, 0);
+                        d.cmd_barrier(cmd, &[filled], &[], &[]);
+                        seed.bind(cmd, &[seed_set]);
+                        for mode in 0..2 {
+                            seed.push(cmd, &with(SdfPass { seed_mode: mode, ..base }));
+                            seed.dispatch_threads(cmd, [triangles as u32, 1, 1]);
+                            d.cmd_barrier(cmd, &[between], &[], &[]);
+                        }
+                        for (k, &step) in steps.iter().enumerate() {
+                            flood.bind(cmd, &[flood_sets[k % 2]]);
+                            flood.push(cmd, &with(SdfPass { jump: step, ..base }));
+                            flood.dispatch_threads(cmd, [points, 1, 1]);
+                            d.cmd_barrier(cmd, &[between], &[], &[]);
+                        }
+                        sign.bind(cmd, &[sign_set]);
+                        for axis in 0..3usize {
+                            let lines = dims[(axis + 1) % 3] * dims[(axis + 2) % 3];
+                            sign.push(cmd, &with(SdfPass { ray_axis: axis as u32, ..base }));
+                            sign.dispatch_threads(cmd, [lines, 1, 1]);
+                            d.cmd_barrier(cmd, &[between], &[], &[]);
+                        }
+                        finalize.bind(cmd, &[finalize_set]);
+                        finalize.push(cmd, &with(base));
+                        finalize.dispatch_threads(cmd, [points, 1, 1]);
+                    },
+                );
             }
         })?;
         Ok(MeshCollider { field, origin, cell, dims, device })

@@ -8,7 +8,7 @@ use super::planner::SubstepInputs;
 use super::{state, step, volume, HairSim, SimStage};
 use crate::error::Result;
 use crate::gpu_types::{ColliderShape, GpuCollider, GpuVolumeParams, SimPush, SimStepParams, StepRange};
-use crate::profiler::{GpuProfiler, PassScope};
+use crate::profiler::{GpuProfiler, PassScope, Timing};
 use crate::sim::RigidTransform;
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::debug::LabelColor;
@@ -34,8 +34,9 @@ impl HairSim {
         &mut self,
         cmd: vk::CommandBuffer,
         head: &RigidTransform,
-        mut profiler: Option<&mut GpuProfiler>,
+        profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
+        let timing = Timing::of(profiler.as_deref());
         let inputs = self.planner.next(head)?;
         // SAFETY (whole body): guaranteed by the caller; all buffers belong to this
         // device, and update sizes are multiples of 4 below 64 KiB (by construction).
@@ -43,7 +44,7 @@ impl HairSim {
             self.record_uploads(cmd, &inputs);
             self.pending_rest.clear();
             let Some(volume) = &self.volume else {
-                self.record_dispatch(cmd, self.current, [0, inputs.len() as u32], &mut profiler);
+                self.record_dispatch(cmd, self.current, [0, inputs.len() as u32], timing);
                 self.current = 1 - self.current;
                 return Ok(());
             };
@@ -55,11 +56,11 @@ impl HairSim {
                     self.record_volume_uploads(cmd, volume, sub);
                     self.device.cmd_barrier(cmd, &[uploaded_barrier()], &[], &[]);
                 }
-                self.record_dispatch(cmd, current, [k as u32, 1], &mut profiler);
+                self.record_dispatch(cmd, current, [k as u32, 1], timing);
                 self.device.cmd_barrier(cmd, &[between], &[], &[]);
                 let labels = SimStage::VOLUME.map(SimStage::label);
                 // The barrier above made the step's writes visible.
-                volume.record(cmd, 1 - current, labels, profiler.as_deref_mut());
+                volume.record(cmd, 1 - current, labels, timing);
                 current = 1 - current;
             }
             self.current = current;
@@ -123,18 +124,12 @@ impl HairSim {
     ///
     /// # Safety
     /// As [`HairSim::record_step`], after the uploads' barrier.
-    unsafe fn record_dispatch(
-        &self,
-        cmd: vk::CommandBuffer,
-        parity: usize,
-        range: [u32; 2],
-        profiler: &mut Option<&mut GpuProfiler>,
-    ) {
+    unsafe fn record_dispatch(&self, cmd: vk::CommandBuffer, parity: usize, range: [u32; 2], timing: Timing<'_>) {
         let (strands, groups) = (self.planner.strands, self.planner.packing().hairs_per_group);
         let push = SimPush::from(&StepRange { first: range[0], count: range[1] });
         // SAFETY: guaranteed by the caller.
         unsafe {
-            PassScope::record(&self.device, cmd, profiler, SimStage::Step.label(), LabelColor::Compute, || {
+            PassScope::record(&self.device, cmd, timing, SimStage::Step.label(), LabelColor::Compute, || {
                 self.pipeline.bind(cmd, &[self.sets[parity]]);
                 self.pipeline.push(cmd, &push);
                 self.pipeline.dispatch_threads(cmd, [step::threads(strands, groups), 1, 1]);

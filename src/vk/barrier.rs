@@ -203,7 +203,24 @@ pub(crate) fn memory(src: &[AccessKind], dst: &[AccessKind]) -> vk::MemoryBarrie
         .dst_access_mask(dst_access)
 }
 
+/// Memory barriers and image layout transitions recorded together before a
+/// pass (what makes its attachments or inputs ready).
+#[derive(Clone, Default)]
+pub(crate) struct Barriers {
+    pub memory: Vec<vk::MemoryBarrier2<'static>>,
+    pub images: Vec<vk::ImageMemoryBarrier2<'static>>,
+}
+
 impl Device {
+    /// Records `barriers` as one `vkCmdPipelineBarrier2`.
+    ///
+    /// # Safety
+    /// As for [`Device::cmd_barrier`].
+    pub(crate) unsafe fn cmd_barriers(&self, cmd: vk::CommandBuffer, barriers: &Barriers) {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.cmd_barrier(cmd, &barriers.memory, &[], &barriers.images) };
+    }
+
     /// Records one `vkCmdPipelineBarrier2` with the given barriers.
     ///
     /// # Safety

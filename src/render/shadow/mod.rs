@@ -26,7 +26,7 @@ use glam::Vec3;
 use super::shading::MAX_LIGHTS;
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuLight, GpuShadowParams};
-use crate::profiler::GpuProfiler;
+use crate::profiler::Timing;
 use crate::sim::KeyHairs;
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
@@ -315,7 +315,7 @@ impl Shadows {
         lights: &[GpuLight],
         bounds: Bounds,
         (hairs, per_hair): (u32, u32),
-        profiler: &mut Option<&mut GpuProfiler>,
+        timing: Timing<'_>,
     ) -> Result<()> {
         let params = &self.params;
         let mut uniforms = no_shadows();
@@ -369,12 +369,12 @@ impl Shadows {
             d.cmd_barrier(cmd, &[before_update], &[], &[]);
             d.raw.cmd_update_buffer(cmd, self.uniforms.raw(), 0, bytemuck::bytes_of(&uniforms));
             if any_map {
-                self.maps.record(cmd, updated, &uniforms, hairs * (per_hair - 1) * 2, profiler);
+                self.maps.record(cmd, updated, &uniforms, hairs * (per_hair - 1) * 2, timing);
             } else {
                 d.cmd_barrier(cmd, &[updated], &[], &[]);
             }
             if let Some((source, bytes)) = copy {
-                self.volume.record(cmd, source, bytes, &volume_maps, profiler);
+                self.volume.record(cmd, source, bytes, &volume_maps, timing);
             }
         }
         Ok(())

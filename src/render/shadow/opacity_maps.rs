@@ -22,7 +22,7 @@ use super::{ShadowParams, SHADOW_ATLAS_FORMAT};
 use crate::codes::shadow_kind;
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuLight, GpuShadowMap, GpuShadowParams};
-use crate::profiler::{GpuProfiler, PassScope};
+use crate::profiler::{PassScope, Timing};
 use crate::render::pass::RenderPass;
 use crate::vk::buffer::Buffer;
 use crate::vk::debug::LabelColor;
@@ -107,7 +107,7 @@ impl OpacityMaps {
         before: vk::MemoryBarrier2<'_>,
         uniforms: &GpuShadowParams,
         vertices: u32,
-        profiler: &mut Option<&mut GpuProfiler>,
+        timing: Timing<'_>,
     ) {
         let d = &self.device;
         let maps = uniforms.map_count();
@@ -121,7 +121,7 @@ impl OpacityMaps {
         let draw_tiles = |cmd: vk::CommandBuffer,
                           pass: &(GraphicsPipeline, vk::DescriptorSet),
                           stage: RenderPass,
-                          profiler: &mut Option<&mut GpuProfiler>| {
+                          timing: Timing<'_>| {
             // SAFETY: inside the rendering instance recorded below.
             unsafe {
                 pass.0.bind(cmd, &[pass.1]);
@@ -130,7 +130,7 @@ impl OpacityMaps {
                         continue; // density volume: no map
                     }
                     let label = format!("{}, light {}", stage.label(), light_of(k));
-                    let scope = PassScope::open(d, cmd, profiler, &label, LabelColor::Graphics);
+                    let scope = PassScope::open(d, cmd, timing, &label, LabelColor::Graphics);
                     let [x, y, w, h] = map.tile;
                     let viewport = vk::Viewport { x, y, width: w, height: h, min_depth: 0.0, max_depth: 1.0 };
                     let scissor = vk::Rect2D {
@@ -141,25 +141,25 @@ impl OpacityMaps {
                     d.raw.cmd_set_scissor(cmd, 0, &[scissor]);
                     pass.0.push(cmd, &(k as u32));
                     d.raw.cmd_draw(cmd, vertices, 1, 0, 0);
-                    scope.close(d, cmd, profiler);
+                    scope.close(d, cmd, timing);
                 }
             }
         };
         // SAFETY: guaranteed by the caller; every object belongs to this device.
         unsafe {
             d.cmd_barrier(cmd, &[before], &[], &self.atlas.to_depth_pass());
-            let scope = RenderPass::ShadowDepth.open(d, cmd, profiler);
+            let scope = RenderPass::ShadowDepth.open(d, cmd, timing);
             d.raw.cmd_begin_rendering(cmd, &depth_rendering);
-            draw_tiles(cmd, &self.depth_pass, RenderPass::ShadowDepth, profiler);
+            draw_tiles(cmd, &self.depth_pass, RenderPass::ShadowDepth, timing);
             d.raw.cmd_end_rendering(cmd);
             d.cmd_barrier(cmd, &[], &[], &self.atlas.to_opacity_pass());
-            scope.close(d, cmd, profiler);
-            let scope = RenderPass::ShadowOpacity.open(d, cmd, profiler);
+            scope.close(d, cmd, timing);
+            let scope = RenderPass::ShadowOpacity.open(d, cmd, timing);
             d.raw.cmd_begin_rendering(cmd, &opacity_rendering);
-            draw_tiles(cmd, &self.opacity_pass, RenderPass::ShadowOpacity, profiler);
+            draw_tiles(cmd, &self.opacity_pass, RenderPass::ShadowOpacity, timing);
             d.raw.cmd_end_rendering(cmd);
             d.cmd_barrier(cmd, &[], &[], &[self.atlas.to_sampled()]);
-            scope.close(d, cmd, profiler);
+            scope.close(d, cmd, timing);
         }
     }
 }

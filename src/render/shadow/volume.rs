@@ -11,7 +11,7 @@ use ash::vk;
 use crate::codes::shadow_kind;
 use crate::error::Result;
 use crate::gpu_types::{GpuLight, GpuShadowMap};
-use crate::profiler::GpuProfiler;
+use crate::profiler::Timing;
 use crate::render::pass::RenderPass;
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
@@ -78,7 +78,7 @@ impl VolumeShadows {
         source: vk::Buffer,
         bytes: u64,
         maps: &[u32],
-        profiler: &mut Option<&mut GpuProfiler>,
+        timing: Timing<'_>,
     ) {
         let d = &self.device;
         let before = barrier::memory(
@@ -89,7 +89,7 @@ impl VolumeShadows {
         let computed = barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::FragmentRead]);
         // SAFETY: guaranteed by the caller; the buffers belong to this device.
         unsafe {
-            let scope = RenderPass::ShadowVolume.open(d, cmd, profiler);
+            let scope = RenderPass::ShadowVolume.open(d, cmd, timing);
             d.cmd_barrier(cmd, &[before], &[], &[]);
             let region = vk::BufferCopy { src_offset: 0, dst_offset: 0, size: bytes };
             d.raw.cmd_copy_buffer(cmd, source, self.density.raw(), &[region]);
@@ -100,7 +100,7 @@ impl VolumeShadows {
                 self.pipeline.dispatch_threads(cmd, [self.cells, 1, 1]);
             }
             d.cmd_barrier(cmd, &[computed], &[], &[]);
-            scope.close(d, cmd, profiler);
+            scope.close(d, cmd, timing);
         }
     }
 }

@@ -13,8 +13,7 @@ use crate::error::Result;
 use crate::gpu_types::{
     CoarsestPass, GpuVolumeParams, LevelPass, PcgScalars, RadixPass, ReducePass, ScanPass, SmoothingPass, VolumePush,
 };
-use crate::profiler::GpuProfiler;
-use crate::profiler::PassScope;
+use crate::profiler::{PassScope, Timing};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
 use crate::vk::debug::LabelColor;
@@ -119,29 +118,23 @@ impl VolumeStage {
     /// # Safety
     /// `cmd` is recording on this device outside a render pass; the profiler, when
     /// given, had `begin_frame` called for this frame.
-    pub(crate) unsafe fn record(
-        &self,
-        cmd: vk::CommandBuffer,
-        variant: usize,
-        labels: [&str; 4],
-        mut profiler: Option<&mut GpuProfiler>,
-    ) {
-        let scoped = |profiler: &mut Option<&mut GpuProfiler>, label: &str, body: &dyn Fn()| {
+    pub(crate) unsafe fn record(&self, cmd: vk::CommandBuffer, variant: usize, labels: [&str; 4], timing: Timing<'_>) {
+        let scoped = |label: &str, body: &dyn Fn()| {
             // SAFETY: guaranteed by the caller.
-            unsafe { PassScope::record(&self.device, cmd, profiler, label, LabelColor::Compute, body) }
+            unsafe { PassScope::record(&self.device, cmd, timing, label, LabelColor::Compute, body) }
         };
         // SAFETY (all closures): guaranteed by the caller.
-        scoped(&mut profiler, labels[0], &|| unsafe { self.record_sort(cmd, variant) });
-        scoped(&mut profiler, labels[1], &|| unsafe {
+        scoped(labels[0], &|| unsafe { self.record_sort(cmd, variant) });
+        scoped(labels[1], &|| unsafe {
             let [nx, ny, nz] = self.grid.dims;
             let extended = (nx + 1) * (ny + 1) * (nz + 1);
             self.run(cmd, Kernel::Gather, variant, VolumePush::default(), Launch::Threads(extended));
             self.run(cmd, Kernel::Mark, variant, VolumePush::default(), Launch::Threads(self.grid.cells()));
         });
         if self.params.mode == VolumeMode::Flip {
-            scoped(&mut profiler, labels[2], &|| unsafe { self.record_pressure(cmd, variant) });
+            scoped(labels[2], &|| unsafe { self.record_pressure(cmd, variant) });
         }
-        scoped(&mut profiler, labels[3], &|| unsafe {
+        scoped(labels[3], &|| unsafe {
             self.run(cmd, Kernel::G2p, variant, VolumePush::default(), Launch::Threads(self.grid.particles));
         });
     }

@@ -62,7 +62,7 @@ fn run_gpu(
         unsafe {
             stage.record_uploads(cmd, &GpuVolumeParams::from(block));
             d.cmd_barrier(cmd, &[uploaded], &[], &[]);
-            stage.record(cmd, 0, ["sort", "transfer", "pressure", "update"], None);
+            stage.record(cmd, 0, ["sort", "transfer", "pressure", "update"], crate::profiler::Timing::default());
         }
     })
     .expect("submit");

@@ -1,20 +1,19 @@
-//! Pass 4 with transparency (`glsl/render/oit_*`, [`Transparency`]): the hair
-//! as transparent strands composited over the target.
+//! Pass 4 with transparency ([`Transparency::Exact`] and [`Transparency::Fast`],
+//! `glsl/render/oit_*`): the hair as transparent strands composited over the
+//! target. What both modes share lives here; what differs, in `exact.rs` and
+//! `fast.rs`.
 //!
 //! 1. **Build** (in the [`RenderPass::Draw`] scope): the ribbons of the draw
 //!    pass's vertex and geometry stages, with their true width and a coverage
 //!    per fragment, depth-tested against the target's depth (not written). Every
 //!    surviving fragment is shaded once and either pushed onto its pixel's list
-//!    (exact: a node from a pool of [`OitParams::fragments_per_pixel`] per pixel;
-//!    beyond it, counted and added to two accumulation images instead) or added
-//!    to two accumulation images (fast: weighted blended). Both keep the nearest
-//!    depth of a fragment at least half opaque.
+//!    (exact; beyond the pool, counted and added to the weighted sums instead)
+//!    or added to the weighted sums (fast). Both keep the nearest depth of a
+//!    fragment at least half opaque.
 //! 2. **Composite** ([`RenderPass::Composite`]): one full-screen triangle blends
-//!    each pixel's hair over the target as premultiplied colour (exact: the
-//!    [`OitParams::sorted_fragments`] nearest sorted, the rest and the pool's
-//!    overflow an order-independent tail behind them), then a second one writes that nearest
-//!    half-opaque depth into the target's depth where it is nearer, so later
-//!    host passes see the hair.
+//!    each pixel's hair over the target as premultiplied colour, then a second
+//!    one writes that nearest half-opaque depth into the target's depth where
+//!    it is nearer, so later host passes see the hair.
 //!
 //! The pass owns the lists, the accumulation images and their pipelines for the
 //! current extent and mode; when either changes, the old ones are retired and
@@ -26,36 +25,31 @@ use std::sync::Arc;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use super::draw::{DrawInputs, DrawPass, TargetKey};
-use super::marschner::MarschnerParams;
-use super::pass::RenderPass;
-use super::{OitParams, Transparency};
+use super::exact::{self, Lists};
+use super::fast::{self, WeightedSums, ABSORBANCE, WEIGHTED_SUM};
+use super::shading::ShadingResources;
+use super::{DrawFrame, TargetKey};
+use crate::codes::sentinel::OIT_END;
 use crate::error::{Error, Result};
-use crate::gpu_types::{DrawParams, OitCounters};
-use crate::profiler::GpuProfiler;
+use crate::gpu_types::OitCounters;
+use crate::render::pass::RenderPass;
+use crate::render::{OitParams, Transparency};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::device::Device;
-use crate::vk::image::{Image, ImageDesc, Sampler};
+use crate::vk::image::Sampler;
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
-use crate::vk::rendering::{self, Load};
-use crate::vk::shaders::{
-    ShaderSource, RENDER_DRAW_VERT, RENDER_OIT_BUILD_FRAG, RENDER_OIT_DEPTH_FRAG, RENDER_OIT_GEOM,
-    RENDER_OIT_RESOLVE_FRAG, RENDER_OIT_WEIGHTED_FRAG, RENDER_OIT_WEIGHTED_RESOLVE_FRAG, RENDER_RESOLVE_VERT,
-};
+use crate::vk::rendering;
+use crate::vk::shaders::{ShaderSource, RENDER_DRAW_VERT, RENDER_OIT_DEPTH_FRAG, RENDER_OIT_GEOM, RENDER_RESOLVE_VERT};
 
-/// Format of the weighted colour and weight sums (fast mode; the exact mode's
-/// overflow: weight 1).
-const WEIGHTED_SUM: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
-/// Format of the absorbance sum (fast mode; the exact mode's overflow).
-const ABSORBANCE: vk::Format = vk::Format::R32_SFLOAT;
-/// Bytes of one stored fragment (colour and alpha as half floats, depth, next).
-const NODE_BYTES: u64 = 16;
-/// The "no node" / "no depth" word the lists and the opaque depths are cleared to.
-const END: u32 = crate::codes::sentinel::OIT_END;
+/// A transparency mode's fragment stages: the build's and the composite's.
+pub(super) struct ModeShaders {
+    pub build: &'static ShaderSource,
+    pub composite: &'static ShaderSource,
+}
 
 /// What the last exact-mode frame stored, read by
-/// [`super::Renderer::transparency_stats`].
+/// [`crate::render::Renderer::transparency_stats`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct OitStats {
     /// Hair fragments that passed the depth test.
@@ -70,49 +64,44 @@ pub struct OitStats {
 }
 
 /// The pipelines of one target and their descriptor sets.
-struct OitPipelines {
+struct Pipelines {
     build: (GraphicsPipeline, vk::DescriptorSet),
     composite: (GraphicsPipeline, vk::DescriptorSet),
     depth: Option<(GraphicsPipeline, vk::DescriptorSet)>,
 }
 
 /// The buffers and images of one extent and mode, and the pipelines bound to them.
-struct OitResources {
+struct Resources {
     extent: vk::Extent2D,
     mode: Transparency,
-    capacity: u32,
     /// Per pixel: the nearest half-opaque depth.
     opaque: Buffer,
-    /// Exact mode: per pixel the newest node of its list, and the node pool.
-    lists: Option<(Buffer, Buffer)>,
+    /// Exact mode: the lists.
+    lists: Option<Lists>,
     /// Weighted sums and absorbance (fast mode; the exact mode's overflow).
-    sums: (Image, Image),
-    pipelines: HashMap<TargetKey, OitPipelines>,
+    sums: WeightedSums,
+    pipelines: HashMap<TargetKey, Pipelines>,
 }
 
-/// Where the transparent hair goes: a target with `key`'s formats, its colour
-/// and depth attachments loaded as their first use in the frame needs.
-pub(super) struct OitTarget<'a> {
-    pub key: TargetKey,
-    pub extent: vk::Extent2D,
-    pub color: (vk::ImageView, Load),
-    pub depth: Option<(vk::ImageView, Load)>,
-    /// Barriers that make the target ready for the build.
-    pub before: (&'a [vk::MemoryBarrier2<'a>], &'a [vk::ImageMemoryBarrier2<'a>]),
+impl Resources {
+    /// Nodes in the exact mode's pool (fast mode: none).
+    fn capacity(&self) -> u32 {
+        self.lists.as_ref().map_or(0, |l| l.capacity)
+    }
 }
 
 /// The transparency pass: the per-frame counters, the resources of the current
 /// extent and mode, and those of earlier ones still used by frames in flight.
-pub(super) struct OitPass {
+pub(super) struct TransparentPass {
     device: Arc<Device>,
     /// [`OitCounters`], host-visible so the host reads what a frame stored.
     counters: Buffer,
     nearest: Sampler,
-    current: Option<OitResources>,
-    retired: Vec<(u64, OitResources)>,
+    current: Option<Resources>,
+    retired: Vec<(u64, Resources)>,
 }
 
-impl OitPass {
+impl TransparentPass {
     pub(super) fn new(device: &Arc<Device>) -> Result<Self> {
         let counters = Buffer::new(
             device,
@@ -123,7 +112,7 @@ impl OitPass {
                 location: MemoryLocation::GpuToCpu,
             },
         )?;
-        Ok(OitPass {
+        Ok(TransparentPass {
             device: device.clone(),
             counters,
             nearest: Sampler::nearest(device, "vkhair transparency sums")?,
@@ -135,13 +124,11 @@ impl OitPass {
     /// Bytes of GPU memory the exact or fast mode needs at `extent`.
     pub(super) fn memory_bytes(mode: Transparency, params: &OitParams, extent: vk::Extent2D) -> u64 {
         let pixels = u64::from(extent.width) * u64::from(extent.height);
-        // Both: the counters, a depth word per pixel, the RGBA32F sums and the
-        // R32F absorbance.
-        let shared = std::mem::size_of::<OitCounters>() as u64 + (4 + 16 + 4) * pixels;
+        // Both: the counters, a depth word per pixel and the weighted sums.
+        let shared = std::mem::size_of::<OitCounters>() as u64 + (4 + fast::BYTES_PER_PIXEL) * pixels;
         match mode {
             Transparency::Off => 0,
-            // A head word per pixel and the node pool.
-            Transparency::Exact => shared + 4 * pixels + NODE_BYTES * pool_capacity(params, extent),
+            Transparency::Exact => shared + Lists::memory_bytes(params, extent),
             Transparency::Fast => shared,
         }
     }
@@ -184,18 +171,15 @@ impl OitPass {
     }
 }
 
-/// Nodes in the exact mode's pool at `extent`.
-fn pool_capacity(params: &OitParams, extent: vk::Extent2D) -> u64 {
-    let pixels = f64::from(extent.width) * f64::from(extent.height);
-    ((pixels * f64::from(params.fragments_per_pixel)).ceil() as u64).max(1)
-}
-
 /// Resources: made for an extent and mode, kept while they stay.
-impl OitPass {
+impl TransparentPass {
     /// Makes the resources for `mode` at `extent` the current ones (retiring others).
     fn prepare(&mut self, frame: u64, mode: Transparency, params: &OitParams, extent: vk::Extent2D) -> Result<()> {
-        let capacity = pool_capacity(params, extent);
-        let fits = |r: &OitResources| r.extent == extent && r.mode == mode && u64::from(r.capacity) == capacity;
+        let capacity = match mode {
+            Transparency::Exact => exact::pool_capacity(params, extent),
+            _ => 0,
+        };
+        let fits = |r: &Resources| r.extent == extent && r.mode == mode && u64::from(r.capacity()) == capacity;
         if let Some(old) = self.current.take_if(|r| !fits(r)) {
             // Frames up to the previous one may still be using them.
             self.retired.push((frame.saturating_sub(1), old));
@@ -204,66 +188,37 @@ impl OitPass {
             return Ok(());
         }
         let d = &self.device;
-        let node_bytes = capacity * NODE_BYTES;
-        if capacity > u64::from(u32::MAX) || node_bytes > u64::from(d.info.max_storage_buffer_range) {
-            return Err(Error::param(
-                "oit.fragments_per_pixel",
-                params.fragments_per_pixel,
-                format!(
-                    "a pool of at most {} bytes at {}×{} (this one needs {node_bytes})",
-                    d.info.max_storage_buffer_range, extent.width, extent.height
-                ),
-            ));
-        }
-        let pixels = u64::from(extent.width) * u64::from(extent.height);
-        let opaque = Buffer::storage(d, "vkhair transparency opaque depth", 4 * pixels)?;
         let lists = match mode {
-            Transparency::Exact => Some((
-                Buffer::storage(d, "vkhair transparency heads", 4 * pixels)?,
-                Buffer::storage(d, "vkhair transparency nodes", node_bytes)?,
-            )),
+            Transparency::Exact => Some(Lists::new(d, params, extent)?),
             _ => None,
         };
-        let image = |name, format| {
-            Image::new(
-                d,
-                &ImageDesc {
-                    name,
-                    extent,
-                    format,
-                    usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
-                    samples: vk::SampleCountFlags::TYPE_1,
-                    aspect: vk::ImageAspectFlags::COLOR,
-                },
-            )
-        };
-        let sums = (
-            image("vkhair transparency weighted sums", WEIGHTED_SUM)?,
-            image("vkhair transparency absorbance", ABSORBANCE)?,
-        );
-        self.current = Some(OitResources {
+        let pixels = u64::from(extent.width) * u64::from(extent.height);
+        self.current = Some(Resources {
             extent,
             mode,
-            capacity: capacity as u32,
-            opaque,
+            opaque: Buffer::storage(d, "vkhair transparency opaque depth", 4 * pixels)?,
             lists,
-            sums,
+            sums: WeightedSums::new(d, extent)?,
             pipelines: HashMap::new(),
         });
         Ok(())
     }
 
-    /// Makes the pipelines for `key` on first use, bound to the draw's shading
-    /// inputs and the current resources.
-    fn make_pipelines(&mut self, key: TargetKey, draw: &DrawPass, inputs: &DrawInputs<'_>) -> Result<()> {
+    /// Makes the pipelines for `frame`'s target on first use, bound to the
+    /// shading inputs and the current resources.
+    fn make_pipelines(&mut self, frame: &DrawFrame<'_>, shading: &ShadingResources) -> Result<()> {
         let Some(res) = self.current.as_mut() else {
             return Err(Error::incompatible("transparency", "pipelines requested before the resources"));
         };
+        let key = frame.target.key;
         if res.pipelines.contains_key(&key) {
             return Ok(());
         }
         let d = &self.device;
-        let exact = res.mode == Transparency::Exact;
+        let shaders = match res.mode {
+            Transparency::Exact => exact::SHADERS,
+            _ => fast::SHADERS,
+        };
         let has_depth = key.depth != vk::Format::UNDEFINED;
         let weighted_formats = [WEIGHTED_SUM, ABSORBANCE];
         let target_formats = [key.color];
@@ -281,15 +236,14 @@ impl OitPass {
             rasterizer_discard: false,
         };
         let mut ours = vec![(9, &self.counters), (12, &res.opaque)];
-        if let Some((heads, nodes)) = &res.lists {
-            ours.extend([(10, heads), (11, nodes)]);
+        if let Some(lists) = &res.lists {
+            ours.extend(lists.bindings());
         }
-        let (shading_buffers, shading_images) = draw.shading_bindings(inputs);
+        let (shading_buffers, shading_images) = shading.bindings(&frame.inputs);
         let mut buffers = shading_buffers.to_vec();
         buffers.extend_from_slice(&ours);
 
-        let build_frag: &ShaderSource = if exact { &RENDER_OIT_BUILD_FRAG } else { &RENDER_OIT_WEIGHTED_FRAG };
-        let build_stages = [&RENDER_DRAW_VERT, &RENDER_OIT_GEOM, build_frag];
+        let build_stages = [&RENDER_DRAW_VERT, &RENDER_OIT_GEOM, shaders.build];
         let build = GraphicsPipeline::new(
             d,
             &GraphicsDesc {
@@ -307,9 +261,7 @@ impl OitPass {
         )?;
         let build_set = build.declared_resource_set(0, &buffers, &shading_images)?;
 
-        let composite_frag: &ShaderSource =
-            if exact { &RENDER_OIT_RESOLVE_FRAG } else { &RENDER_OIT_WEIGHTED_RESOLVE_FRAG };
-        let composite_stages = [&RENDER_RESOLVE_VERT, composite_frag];
+        let composite_stages = [&RENDER_RESOLVE_VERT, shaders.composite];
         let composite = GraphicsPipeline::new(
             d,
             &desc(
@@ -322,8 +274,7 @@ impl OitPass {
             ),
             1,
         )?;
-        let (sum, absorbance) = &res.sums;
-        let sums = [(0, sum.view(), self.nearest.raw), (1, absorbance.view(), self.nearest.raw)];
+        let sums = [(0, res.sums.sum.view(), self.nearest.raw), (1, res.sums.absorbance.view(), self.nearest.raw)];
         let composite_set = composite.declared_resource_set(0, &ours, &sums)?;
 
         let depth = if has_depth {
@@ -345,32 +296,26 @@ impl OitPass {
             None
         };
         res.pipelines
-            .insert(key, OitPipelines { build: (build, build_set), composite: (composite, composite_set), depth });
+            .insert(key, Pipelines { build: (build, build_set), composite: (composite, composite_set), depth });
         Ok(())
     }
 }
 
 /// Recording.
-impl OitPass {
-    /// Records the build in the draw's scope and the composite in its own, into
-    /// `target`, for the host's frame `frame`.
+impl TransparentPass {
+    /// Records `frame` in `mode`: the build in the draw's scope and the
+    /// composite in its own.
     ///
     /// # Safety
-    /// As for [`DrawPass::record`]; `target`'s attachments are in attachment layouts
-    /// after `target.before`; frames `frames_in_flight` before `frame` completed.
-    #[allow(clippy::too_many_arguments)]
+    /// As for `DrawPass::record`.
     pub(super) unsafe fn record(
         &mut self,
-        cmd: vk::CommandBuffer,
-        frame: u64,
-        (mode, params): (Transparency, &OitParams),
-        draw: &mut DrawPass,
-        target: &OitTarget<'_>,
-        inputs: &DrawInputs<'_>,
-        (draw_params, marschner): (&DrawParams, &MarschnerParams),
-        vertices: u32,
-        profiler: &mut Option<&mut GpuProfiler>,
+        frame: &DrawFrame<'_>,
+        mode: Transparency,
+        params: &OitParams,
+        shading: &mut ShadingResources,
     ) -> Result<()> {
+        let target = &frame.target;
         if target.key.samples != vk::SampleCountFlags::TYPE_1 {
             return Err(Error::incompatible(
                 "render target",
@@ -378,16 +323,16 @@ impl OitPass {
             ));
         }
         // Made (or found) before anything is recorded: a failure leaves `cmd` as it was.
-        self.prepare(frame, mode, params, target.extent)?;
-        self.make_pipelines(target.key, draw, inputs)?;
+        self.prepare(frame.frame, mode, params, target.extent)?;
+        self.make_pipelines(frame, shading)?;
         let Some(res) = self.current.as_ref() else {
             return Err(Error::incompatible("transparency", "no resources after preparing them"));
         };
         let pipelines = &res.pipelines[&target.key];
-        let d = &*self.device;
+        let (d, cmd, timing) = (&*self.device, frame.cmd, frame.timing);
         let counters = OitCounters {
             used: 0,
-            capacity: res.capacity,
+            capacity: res.capacity(),
             width: target.extent.width,
             sorted: params.sorted_fragments,
         };
@@ -398,53 +343,32 @@ impl OitPass {
         let built = barrier::memory(&[AccessKind::FragmentWrite], &[AccessKind::FragmentRead]);
         let depth_order = barrier::memory(barrier::ATTACHMENTS, barrier::ATTACHMENTS);
         let to_host = barrier::memory(&[AccessKind::FragmentWrite], &[AccessKind::HostRead]);
-        let sampled = &[AccessKind::FragmentSampledRead];
-        let (to_sums, from_sums): (Vec<_>, Vec<_>) = [&res.sums.0, &res.sums.1]
-            .into_iter()
-            .map(|image| {
-                (
-                    barrier::image(
-                        image,
-                        sampled,
-                        barrier::COLOR_ATTACHMENT,
-                        vk::ImageLayout::UNDEFINED,
-                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                    ),
-                    barrier::image(
-                        image,
-                        barrier::COLOR_ATTACHMENT,
-                        sampled,
-                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                        vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                    ),
-                )
-            })
-            .unzip();
-        let sums = [&res.sums.0, &res.sums.1].map(|i| rendering::color(i.view(), Load::color([0.0; 4])));
-        let depth_first = target.depth.map(|(view, load)| rendering::depth(view, load));
-        let depth_again = target.depth.map(|(view, _)| rendering::depth(view, Load::Keep));
+        let (to_sums, from_sums) = res.sums.barriers();
+        let sums = res.sums.attachments();
+        let depth_first = target.depth_attachment();
+        let depth_again = target.depth_kept();
         let build_rendering = rendering::info(target.extent, &sums, depth_first.as_ref());
-        let color = [rendering::color(target.color.0, target.color.1)];
+        let color = target.color_attachment();
         let composite_rendering = rendering::info(target.extent, &color, depth_again.as_ref());
         // SAFETY: guaranteed by the caller; every object belongs to this device.
         unsafe {
-            let scope = RenderPass::Draw.open(d, cmd, profiler);
-            draw.record_updates(cmd, target.before, draw_params, marschner);
+            let scope = RenderPass::Draw.open(d, cmd, timing);
+            shading.record_updates(cmd, &target.before, &frame.params, &frame.marschner);
             d.cmd_barrier(cmd, &[to_clear], &[], &to_sums);
-            if let Some((heads, _)) = &res.lists {
-                d.raw.cmd_fill_buffer(cmd, heads.raw(), 0, vk::WHOLE_SIZE, END);
+            if let Some(lists) = &res.lists {
+                lists.record_clear(d, cmd);
             }
-            d.raw.cmd_fill_buffer(cmd, res.opaque.raw(), 0, vk::WHOLE_SIZE, END);
+            d.raw.cmd_fill_buffer(cmd, res.opaque.raw(), 0, vk::WHOLE_SIZE, OIT_END);
             d.raw.cmd_update_buffer(cmd, self.counters.raw(), 0, bytemuck::bytes_of(&counters));
             d.cmd_barrier(cmd, &[cleared], &[], &[]);
             d.raw.cmd_begin_rendering(cmd, &build_rendering);
             d.cmd_set_full_viewport(cmd, target.extent);
             pipelines.build.0.bind(cmd, &[pipelines.build.1]);
-            d.raw.cmd_draw(cmd, vertices, 1, 0, 0);
+            d.raw.cmd_draw(cmd, frame.vertices, 1, 0, 0);
             d.raw.cmd_end_rendering(cmd);
-            scope.close(d, cmd, profiler);
+            scope.close(d, cmd, timing);
 
-            let scope = RenderPass::Composite.open(d, cmd, profiler);
+            let scope = RenderPass::Composite.open(d, cmd, timing);
             d.cmd_barrier(cmd, &[built, depth_order], &[], &from_sums);
             d.raw.cmd_begin_rendering(cmd, &composite_rendering);
             d.cmd_set_full_viewport(cmd, target.extent);
@@ -454,7 +378,7 @@ impl OitPass {
             }
             d.raw.cmd_end_rendering(cmd);
             d.cmd_barrier(cmd, &[to_host], &[], &[]);
-            scope.close(d, cmd, profiler);
+            scope.close(d, cmd, timing);
         }
         Ok(())
     }

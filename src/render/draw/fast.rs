@@ -1,0 +1,88 @@
+//! Pass 4 with [`Transparency::Fast`](crate::render::Transparency::Fast):
+//! weighted blended transparency (`glsl/render/oit_weighted*.frag`). Every
+//! hair fragment adds its weighted, premultiplied colour and its absorbance
+//! into two float images; the composite divides and blends them over the
+//! target. The same two images take the exact mode's overflow (weight 1).
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::transparent::ModeShaders;
+use crate::error::Result;
+use crate::vk::barrier::{self, AccessKind};
+use crate::vk::device::Device;
+use crate::vk::image::{Image, ImageDesc};
+use crate::vk::rendering::{self, Load};
+use crate::vk::shaders::{RENDER_OIT_WEIGHTED_FRAG, RENDER_OIT_WEIGHTED_RESOLVE_FRAG};
+
+/// The build's and the composite's fragment stages.
+pub(super) const SHADERS: ModeShaders =
+    ModeShaders { build: &RENDER_OIT_WEIGHTED_FRAG, composite: &RENDER_OIT_WEIGHTED_RESOLVE_FRAG };
+
+/// Format of the weighted colour and weight sums.
+pub(super) const WEIGHTED_SUM: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+/// Format of the absorbance sum.
+pub(super) const ABSORBANCE: vk::Format = vk::Format::R32_SFLOAT;
+/// Bytes per pixel of the two images.
+pub(super) const BYTES_PER_PIXEL: u64 = 16 + 4;
+
+/// The weighted sums and the absorbance, attachments of the build and
+/// sampled by the composite.
+pub(super) struct WeightedSums {
+    pub sum: Image,
+    pub absorbance: Image,
+}
+
+impl WeightedSums {
+    pub(super) fn new(device: &Arc<Device>, extent: vk::Extent2D) -> Result<Self> {
+        let image = |name, format| {
+            Image::new(
+                device,
+                &ImageDesc {
+                    name,
+                    extent,
+                    format,
+                    usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+                    samples: vk::SampleCountFlags::TYPE_1,
+                    aspect: vk::ImageAspectFlags::COLOR,
+                },
+            )
+        };
+        Ok(WeightedSums {
+            sum: image("vkhair transparency weighted sums", WEIGHTED_SUM)?,
+            absorbance: image("vkhair transparency absorbance", ABSORBANCE)?,
+        })
+    }
+
+    /// The build's attachments: both cleared to zero.
+    pub(super) fn attachments(&self) -> [vk::RenderingAttachmentInfo<'static>; 2] {
+        [&self.sum, &self.absorbance].map(|i| rendering::color(i.view(), Load::color([0.0; 4])))
+    }
+
+    /// Barriers before the build (from the last composite's sampling to
+    /// attachments, contents discarded) and after it (to sampling).
+    pub(super) fn barriers(&self) -> ([vk::ImageMemoryBarrier2<'static>; 2], [vk::ImageMemoryBarrier2<'static>; 2]) {
+        let sampled = &[AccessKind::FragmentSampledRead];
+        let images = [&self.sum, &self.absorbance];
+        let to_attachments = images.map(|image| {
+            barrier::image(
+                image,
+                sampled,
+                barrier::COLOR_ATTACHMENT,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            )
+        });
+        let to_sampled = images.map(|image| {
+            barrier::image(
+                image,
+                barrier::COLOR_ATTACHMENT,
+                sampled,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            )
+        });
+        (to_attachments, to_sampled)
+    }
+}

@@ -1,0 +1,369 @@
+//! Pass 4 — drawing the hair into the host's target, and pass 5, the
+//! supersampling resolve ([`super::resolve`]), which [`Renderer::record_draw`]
+//! records after it.
+//!
+//! One frame of pass 4 is a [`DrawFrame`]: the host's command buffer and frame
+//! index, the profiler handle, the [`DrawTarget`] (the host's images, or the
+//! supersampling images twice their size), what the shading reads and the
+//! frame's uniform block. Every mode draws the same ribbons
+//! (`glsl/render/draw.vert`, `draw.geom`/`oit.geom`) with the same shading
+//! (`hair_shading.glsl`, [`shading::ShadingResources`]) and differs only in
+//! how fragments reach the target, one file each:
+//!
+//! - [`Transparency::Off`] — `opaque.rs`: a depth pre-pass and a shaded draw
+//!   of the nearest layer;
+//! - [`Transparency::Exact`] — `transparent.rs` with `exact.rs`: per-pixel
+//!   fragment lists, the nearest sorted;
+//! - [`Transparency::Fast`] — `transparent.rs` with `fast.rs`: weighted blended
+//!   sums.
+
+mod exact;
+mod fast;
+mod opaque;
+mod shading;
+mod transparent;
+
+use std::sync::Arc;
+
+use ash::vk;
+
+pub use transparent::OitStats;
+
+use super::marschner::MarschnerParams;
+use super::shading::{Camera, HairMaterial, MAX_LIGHTS};
+use super::{OitParams, Primitive, RenderTarget, Renderer, Transparency};
+use crate::error::{Error, Result};
+use crate::gpu_types::{DrawParams, GpuLight};
+use crate::profiler::{GpuProfiler, Timing};
+use crate::vk::barrier::{self, AccessKind, Barriers};
+use crate::vk::buffer::Buffer;
+use crate::vk::device::Device;
+use crate::vk::rendering::{self, Load};
+use opaque::OpaquePipelines;
+use shading::ShadingResources;
+use transparent::TransparentPass;
+
+/// Formats, sample count and primitive a draw pipeline is made for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(super) struct TargetKey {
+    pub color: vk::Format,
+    pub depth: vk::Format,
+    pub samples: vk::SampleCountFlags,
+    pub primitive: Primitive,
+}
+
+/// Where a frame's hair goes: images with `key`'s formats, how each
+/// attachment's earlier contents are loaded the first time the frame uses it,
+/// and the barriers that make them ready.
+#[derive(Clone)]
+pub(super) struct DrawTarget {
+    pub key: TargetKey,
+    pub extent: vk::Extent2D,
+    pub color: (vk::ImageView, Load),
+    pub depth: Option<(vk::ImageView, Load)>,
+    pub before: Barriers,
+}
+
+impl DrawTarget {
+    /// The colour attachment as the frame first uses it.
+    fn color_attachment(&self) -> [vk::RenderingAttachmentInfo<'static>; 1] {
+        [rendering::color(self.color.0, self.color.1)]
+    }
+
+    /// The depth attachment as the frame first uses it.
+    fn depth_attachment(&self) -> Option<vk::RenderingAttachmentInfo<'static>> {
+        self.depth.map(|(view, load)| rendering::depth(view, load))
+    }
+
+    /// The depth attachment once the frame has used it (its contents kept).
+    fn depth_kept(&self) -> Option<vk::RenderingAttachmentInfo<'static>> {
+        self.depth.map(|(view, _)| rendering::depth(view, Load::Keep))
+    }
+}
+
+/// What the draw reads besides its own resources.
+pub(super) struct DrawInputs<'a> {
+    /// Interpolated hair positions and (tangent, t).
+    pub hairs: (&'a Buffer, &'a Buffer),
+    /// The frame's shadow uniforms.
+    pub shadow_uniforms: &'a Buffer,
+    /// The opacity atlas and its sampler.
+    pub atlas: (vk::ImageView, vk::Sampler),
+    /// Per-cell transmittance of density-volume lights.
+    pub transmittance: &'a Buffer,
+}
+
+/// One frame of pass 4: everything its modes record with and into.
+pub(super) struct DrawFrame<'a> {
+    /// The host's command buffer, recording outside a render pass.
+    pub cmd: vk::CommandBuffer,
+    /// The host's frame index.
+    pub frame: u64,
+    /// Where the pass's timestamps go.
+    pub timing: Timing<'a>,
+    /// Where the hair goes.
+    pub target: DrawTarget,
+    /// What the shading reads besides the pass's own resources.
+    pub inputs: DrawInputs<'a>,
+    /// The frame's uniform block.
+    pub params: DrawParams,
+    /// The Marschner tables' parameters (rebuilt when they change).
+    pub marschner: MarschnerParams,
+    /// Line vertices of the frame's hairs (two per segment).
+    pub vertices: u32,
+}
+
+/// Pass 4: the shading every mode shares, the opaque pipelines and the
+/// transparency modes' resources.
+pub(super) struct DrawPass {
+    shading: ShadingResources,
+    opaque: OpaquePipelines,
+    transparent: TransparentPass,
+}
+
+impl DrawPass {
+    pub(super) fn new(device: &Arc<Device>) -> Result<Self> {
+        Ok(DrawPass {
+            shading: ShadingResources::new(device)?,
+            opaque: OpaquePipelines::new(device),
+            transparent: TransparentPass::new(device)?,
+        })
+    }
+
+    /// Drops every pipeline and set (the draw's inputs changed); the caller made
+    /// sure no pending work uses them.
+    pub(super) fn forget(&mut self) {
+        self.opaque.forget();
+        self.transparent.forget();
+    }
+
+    /// Records `frame` in `mode` (`oit` its transparency parameters).
+    ///
+    /// # Safety
+    /// `frame.cmd` is a recording command buffer of this device outside a render
+    /// pass; after `frame.target.before`, the target's attachments are in
+    /// attachment layouts with earlier writes visible; the inputs were written
+    /// earlier in submission order with barriers to the draw's stages (the
+    /// capture and shadow passes leave them so); the frames `frames_in_flight`
+    /// before `frame.frame` completed.
+    unsafe fn record(&mut self, frame: &DrawFrame<'_>, mode: Transparency, oit: &OitParams) -> Result<()> {
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            match mode {
+                Transparency::Off => self.opaque.record(frame, &mut self.shading),
+                _ => self.transparent.record(frame, mode, oit, &mut self.shading),
+            }
+        }
+    }
+
+    /// Builds the Marschner tables for `params` and reads them back (M, then N;
+    /// submits and waits).
+    pub(super) fn read_marschner_tables(
+        &mut self,
+        params: &MarschnerParams,
+    ) -> Result<(Vec<glam::Vec4>, Vec<glam::Vec4>)> {
+        self.shading.read_marschner_tables(params)
+    }
+}
+
+/// Passes 4–5: the draw and the resolve.
+impl Renderer {
+    /// Records the draw pass for the host's frame `frame`: the hairs prepared by
+    /// [`Renderer::record_prepare`] into the host's `target`, seen by `camera`. The
+    /// color (and depth) image is loaded, drawn into with depth test and write
+    /// against what the host drew, and stored. With [`super::RenderParams::supersampling`],
+    /// the hair is drawn at twice the size into the renderer's own images and
+    /// resolved into `target` (depth tested, not written). When the target's size
+    /// changes, the images of the old size are kept until `frame` is
+    /// [`super::RenderParams::frames_in_flight`] frames later. Viewport and scissor are
+    /// left set to the full target and one of vkhair's pipelines bound; vkhair
+    /// binds no vertex or index buffers, so the host's stay bound, and the host
+    /// binds its own pipeline and pushes its constants again afterwards
+    /// (`tests/viewer.rs` draws after the hair relying on exactly this).
+    ///
+    /// With [`super::RenderParams::transparency`] on, the hair is composited over
+    /// the target's colour instead (see `render/draw/transparent.rs`): each
+    /// fragment depth-tested against the target's depth, and the depth of the
+    /// nearest fragment at least half opaque written where it is nearer (not
+    /// with supersampling, whose resolve leaves the host's depth as it was); the
+    /// target must then be single-sample.
+    ///
+    /// # Safety
+    /// As for [`Renderer::record_prepare`], which must have been recorded before in
+    /// submission order. `target`'s views belong to the context's device, are in the
+    /// layouts [`RenderTarget`] names, and are not used by other pending work in a
+    /// conflicting way; writes to them recorded earlier on the same queue are ordered
+    /// before the draw by the recorded barrier. Frame indices increase by one per host
+    /// frame, and the command buffers of frame `frame − frames_in_flight` and earlier
+    /// have completed (the usual frames-in-flight wait).
+    pub unsafe fn record_draw(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: u64,
+        target: &RenderTarget,
+        camera: &Camera,
+        profiler: Option<&mut GpuProfiler>,
+    ) -> Result<()> {
+        if target.extent.width == 0 || target.extent.height == 0 {
+            return Err(Error::param(
+                "render target extent",
+                format!("{:?}", target.extent),
+                "non-zero width and height",
+            ));
+        }
+        if self.last_frame.is_some_and(|last| frame < last) {
+            return Err(Error::incompatible(
+                "frame",
+                format!("{frame} is before the previous frame {:?}", self.last_frame),
+            ));
+        }
+        self.last_frame = Some(frame);
+        self.resolve.collect_retired(frame, self.params.frames_in_flight);
+        self.draw.transparent.collect_retired(frame, self.params.frames_in_flight);
+        let finite = camera.view.is_finite() && camera.projection.is_finite() && camera.fov_y.is_finite();
+        if !finite {
+            return Err(Error::param(
+                "camera",
+                "a non-finite matrix or field of view",
+                "finite view, projection and field of view",
+            ));
+        }
+        // The host's earlier attachment writes (its head, its clear) before ours.
+        let host_writes = Barriers {
+            memory: vec![barrier::memory(HOST_ATTACHMENT_WRITES, barrier::ATTACHMENTS)],
+            ..Barriers::default()
+        };
+        let has_depth = target.depth_format != vk::Format::UNDEFINED;
+        let host = DrawTarget {
+            key: TargetKey {
+                color: target.color_format,
+                depth: target.depth_format,
+                samples: target.samples,
+                primitive: self.params.primitive,
+            },
+            extent: target.extent,
+            color: (target.color, Load::Keep),
+            depth: has_depth.then_some((target.depth, Load::Keep)),
+            before: host_writes,
+        };
+        // With supersampling, the hair goes into the renderer's own images first.
+        let mut images = match self.params.supersampling {
+            true => Some(self.resolve.take(frame, target.extent)?),
+            false => None,
+        };
+        let drawn = match &images {
+            Some(images) => images.draw_target(self.params.primitive),
+            None => host.clone(),
+        };
+        let mode = self.params.transparency;
+        let frame = DrawFrame {
+            cmd,
+            frame,
+            timing: Timing::of(profiler.as_deref()),
+            params: draw_params(
+                mode != Transparency::Off,
+                &self.material,
+                &self.lights,
+                self.detail.width_scale,
+                self.hair_counts(),
+                camera,
+                drawn.extent,
+            ),
+            vertices: self.line_vertices(),
+            target: drawn,
+            inputs: DrawInputs {
+                hairs: self.interpolate.hairs(),
+                shadow_uniforms: self.shadows.uniforms(),
+                atlas: self.shadows.atlas(),
+                transmittance: self.shadows.transmittance(),
+            },
+            marschner: self.material.marschner,
+        };
+        // SAFETY: guaranteed by the caller; the supersampling images are this
+        // renderer's and earlier resolves that sampled them are ordered by the barriers.
+        let result = unsafe {
+            let drawn = self.draw.record(&frame, mode, &self.params.oit);
+            match &mut images {
+                Some(images) => drawn.and_then(|_| self.resolve.record(cmd, images, &host, frame.timing)),
+                None => drawn,
+            }
+        };
+        if let Some(images) = images {
+            self.resolve.restore(images);
+        }
+        result
+    }
+
+    /// Sets of size-dependent images waiting for their frames to complete
+    /// (supersampling images and transparency lists).
+    pub fn retired_image_sets(&self) -> usize {
+        self.resolve.retired_count() + self.draw.transparent.retired_count()
+    }
+
+    /// What the latest frame drawn with [`Transparency::Exact`] stored: fragments
+    /// offered, stored, and overflowed because the pool was full (those are
+    /// composited unsorted behind the stored ones). Read from
+    /// host-visible memory: valid once that frame's commands completed and before
+    /// the next frame's are submitted. `None` unless the latest frame drawn with
+    /// transparency was an exact-mode frame.
+    pub fn transparency_stats(&self) -> Option<OitStats> {
+        self.draw.transparent.stats()
+    }
+
+    /// GPU memory the transparency mode of the current parameters needs for a
+    /// target of `extent` (the supersampled extent where supersampling is on), bytes.
+    pub fn transparency_memory(&self, extent: vk::Extent2D) -> u64 {
+        let scale = if self.params.supersampling { 2 } else { 1 };
+        let drawn = vk::Extent2D { width: extent.width * scale, height: extent.height * scale };
+        TransparentPass::memory_bytes(self.params.transparency, &self.params.oit, drawn)
+    }
+}
+
+/// Writes a host may have made to its attachments before the draw.
+const HOST_ATTACHMENT_WRITES: &[AccessKind] =
+    &[AccessKind::ColorAttachmentWrite, AccessKind::DepthAttachmentWrite, AccessKind::AnyTransferWrite];
+
+/// Fraction of a band of `n` hair widths that `n` hairs placed at random across
+/// it cover: 1 − (1 − 1/n)^n (1 for one hair, toward 1 − 1/e for many).
+pub(super) fn band_density(n: f32) -> f32 {
+    let n = n.max(1.0);
+    1.0 - (1.0 - 1.0 / n).powf(n)
+}
+
+/// The draw's uniform block for `hairs` hairs of `per_hair` vertices with
+/// `material`, `lights` and the width factor of the frame's detail, seen by
+/// `camera` into a target of `extent`; `transparent` strands are drawn with
+/// their coverage (no least width).
+pub(super) fn draw_params(
+    transparent: bool,
+    material: &HairMaterial,
+    lights: &[GpuLight],
+    width_scale: f32,
+    (hairs, per_hair): (u32, u32),
+    camera: &Camera,
+    extent: vk::Extent2D,
+) -> DrawParams {
+    let m = material;
+    let mut gpu_lights = [GpuLight::default(); MAX_LIGHTS];
+    gpu_lights[..lights.len()].copy_from_slice(lights);
+    // World size of one pixel at distance 1.
+    let pixel = 2.0 * (0.5 * camera.fov_y).tan() / extent.height.max(1) as f32;
+    DrawParams {
+        view_proj: (camera.projection * camera.view).to_cols_array_2d(),
+        camera: camera.position().extend(pixel).to_array(),
+        root_color: m.root_color.extend(m.ambient).to_array(),
+        tip_color: m.tip_color.extend(m.diffuse_wrap).to_array(),
+        primary: m.primary_color.extend(m.primary_exponent).to_array(),
+        secondary: m.secondary_color.extend(m.secondary_exponent).to_array(),
+        shifts: [m.primary_shift, m.secondary_shift, m.shift_jitter, m.highlight_breakup],
+        widths: [m.root_width * width_scale, m.tip_width * width_scale, m.least_pixel_width, 0.0],
+        coverage: [
+            if transparent { 1.0 } else { 0.0 },
+            m.opacity,
+            m.represented_hairs,
+            band_density(m.represented_hairs),
+        ],
+        counts: [hairs, per_hair, lights.len() as u32, m.shading.code()],
+        lights: gpu_lights,
+    }
+}

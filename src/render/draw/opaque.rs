@@ -1,0 +1,126 @@
+//! Pass 4 with [`Transparency::Off`](crate::render::Transparency::Off)
+//! (`glsl/render/draw.*`): the hairs as camera-facing ribbons expanded in the
+//! geometry stage (or lines), shaded with Kajiya-Kay diffuse and two shifted
+//! highlights (or Marschner) for every light, into the target's colour and
+//! depth (depth-tested against what the host drew). With a depth image the
+//! ribbons are drawn twice in one rendering instance: first depth only (no
+//! fragment stage), then shaded with depth writes off and the depth test
+//! passing only fragments at the nearest depth, so that hidden layers of hair
+//! are not shaded. Pipelines are made on first use for each [`TargetKey`].
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use super::shading::ShadingResources;
+use super::{DrawFrame, TargetKey};
+use crate::error::Result;
+use crate::render::pass::RenderPass;
+use crate::render::Primitive;
+use crate::vk::device::Device;
+use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
+use crate::vk::rendering;
+use crate::vk::shaders::{ShaderSource, RENDER_DRAW_FRAG, RENDER_DRAW_GEOM, RENDER_DRAW_VERT};
+use ash::vk;
+
+/// The pipelines of one target: the depth pre-pass (targets with a depth image)
+/// and the shading draw, each with its descriptor set.
+struct Pipelines {
+    depth: Option<(GraphicsPipeline, vk::DescriptorSet)>,
+    shade: (GraphicsPipeline, vk::DescriptorSet),
+}
+
+/// The opaque draw's pipelines per target.
+pub(super) struct OpaquePipelines {
+    device: Arc<Device>,
+    pipelines: HashMap<TargetKey, Pipelines>,
+}
+
+impl OpaquePipelines {
+    pub(super) fn new(device: &Arc<Device>) -> Self {
+        OpaquePipelines { device: device.clone(), pipelines: HashMap::new() }
+    }
+
+    /// Drops every pipeline and set (their resources changed); the caller made sure
+    /// no pending work uses them.
+    pub(super) fn forget(&mut self) {
+        self.pipelines.clear();
+    }
+
+    /// Makes the pipelines and descriptor sets for `frame`'s target on first use.
+    fn make(&mut self, frame: &DrawFrame<'_>, shading: &ShadingResources) -> Result<()> {
+        let key = frame.target.key;
+        if self.pipelines.contains_key(&key) {
+            return Ok(());
+        }
+        let (buffers, images) = shading.bindings(&frame.inputs);
+        let color_formats = [key.color];
+        let has_depth = key.depth != vk::Format::UNDEFINED;
+        // Lines skip the geometry stage: the fragment stage reads the vertex
+        // stage's outputs at the same locations.
+        let stages: &[&ShaderSource] = if key.primitive == Primitive::Lines {
+            &[&RENDER_DRAW_VERT, &RENDER_DRAW_FRAG]
+        } else {
+            &[&RENDER_DRAW_VERT, &RENDER_DRAW_GEOM, &RENDER_DRAW_FRAG]
+        };
+        let desc = |name, stages, depth_write, blend| GraphicsDesc {
+            name,
+            stages,
+            topology: vk::PrimitiveTopology::LINE_LIST,
+            patch_control_points: 0,
+            color_formats: &color_formats,
+            depth_format: key.depth,
+            samples: key.samples,
+            depth_test: has_depth,
+            depth_write,
+            blend,
+            rasterizer_discard: false,
+        };
+        // The geometry is the same in both: only the hair positions (bindings 1
+        // and 2) and the uniform block.
+        let depth = if has_depth {
+            let geometry = &stages[..stages.len() - 1];
+            let pipeline =
+                GraphicsPipeline::new(&self.device, &desc("vkhair hair depth", geometry, true, Blend::NoColor), 1)?;
+            let set = pipeline.resource_set(0, &buffers[..3], &[])?;
+            Some((pipeline, set))
+        } else {
+            None
+        };
+        let pipeline = GraphicsPipeline::new(&self.device, &desc("vkhair hair draw", stages, false, Blend::None), 1)?;
+        let set = pipeline.resource_set(0, &buffers, &images)?;
+        self.pipelines.insert(key, Pipelines { depth, shade: (pipeline, set) });
+        Ok(())
+    }
+
+    /// Records `frame` in the draw's scope: the target's barriers, the shading
+    /// updates and one draw of the frame's line vertices (twice with a depth
+    /// pre-pass).
+    ///
+    /// # Safety
+    /// As for `DrawPass::record`.
+    pub(super) unsafe fn record(&mut self, frame: &DrawFrame<'_>, shading: &mut ShadingResources) -> Result<()> {
+        // Made (or found) before anything is recorded: a failure leaves `cmd` as it was.
+        self.make(frame, shading)?;
+        let (d, cmd, target) = (&*self.device, frame.cmd, &frame.target);
+        let color = target.color_attachment();
+        let depth = target.depth_attachment();
+        let info = rendering::info(target.extent, &color, depth.as_ref());
+        // SAFETY: guaranteed by the caller; all objects belong to this device.
+        unsafe {
+            let scope = RenderPass::Draw.open(d, cmd, frame.timing);
+            shading.record_updates(cmd, &target.before, &frame.params, &frame.marschner);
+            let pipelines = &self.pipelines[&target.key];
+            d.raw.cmd_begin_rendering(cmd, &info);
+            d.cmd_set_full_viewport(cmd, target.extent);
+            // Within one rendering instance, rasterization order puts the depth
+            // pre-pass's writes before the shading draw's tests.
+            for (pipeline, set) in pipelines.depth.iter().chain([&pipelines.shade]) {
+                pipeline.bind(cmd, &[*set]);
+                d.raw.cmd_draw(cmd, frame.vertices, 1, 0, 0);
+            }
+            d.raw.cmd_end_rendering(cmd);
+            scope.close(d, cmd, frame.timing);
+        }
+        Ok(())
+    }
+}
