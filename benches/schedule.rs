@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, Criterion};
 use glam::Vec3;
-use vkhair::groom::scenes::{self, THESIS_HEAD_CENTER};
+use vkhair::groom::scenes::{self, THESIS_BOUNDING_RADIUS, THESIS_HEAD_CENTER};
 use vkhair::headless::{Offscreen, Submit};
 use vkhair::render::{Camera, Light, RenderParams, Renderer, ShadowParams};
 use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, SchedulerOptions};
@@ -78,20 +78,7 @@ fn setup(
         FrameScheduler::new(ctx, &groom, &params, &RigidTransform::default(), &motion::thesis_colliders(), &options)
             .expect("scheduler");
     let mut renderer = Renderer::new(ctx, scheduler.key_hairs(), &RenderParams::default()).expect("renderer");
-    let spot = |offset: Vec3, color: Vec3| Light::Spot {
-        position: THESIS_HEAD_CENTER + offset,
-        direction: -offset,
-        outer_angle: 0.6,
-        inner_angle: 0.4,
-        color,
-    };
-    renderer
-        .set_lights(&[
-            spot(Vec3::new(-0.6, 0.5, 0.8), Vec3::splat(1.1)),
-            spot(Vec3::new(0.9, 0.1, 0.4), Vec3::new(0.25, 0.27, 0.33)),
-            Light::Directional { direction: Vec3::new(0.2, -0.3, 1.0), color: Vec3::splat(0.25) },
-        ])
-        .expect("lights");
+    renderer.set_lights(&Light::thesis_rig(THESIS_HEAD_CENTER, THESIS_BOUNDING_RADIUS)).expect("lights");
     let shadows = ShadowParams { casters: vec![0.into(), 1.into()], ..ShadowParams::default() };
     renderer.set_shadows(scheduler.key_hairs(), &shadows).expect("shadows");
     let camera = Camera::look_at(

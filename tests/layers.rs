@@ -215,3 +215,64 @@ fn the_packed_member_check_sees_a_raw_read() {
     assert_eq!(packed_member_reads(source), vec!["1: .counts", "2: .gravity_dt"]);
     assert!(SHADER_VIEWS.len() > 80, "the view table has only {} fields", SHADER_VIEWS.len());
 }
+
+/// The commands a source names through `commands::` (one name, or a braced
+/// list) or `super::super::` (a sibling command seen from inside a command's
+/// folder), outside comments.
+fn commands_named(source: &str) -> BTreeSet<String> {
+    let mut found = BTreeSet::new();
+    for line in source.lines() {
+        let code = line.split("//").next().unwrap_or_default();
+        for prefix in ["commands::", "super::super::"] {
+            for (i, _) in code.match_indices(prefix) {
+                let rest = &code[i + prefix.len()..];
+                let names = match rest.strip_prefix('{') {
+                    Some(list) => list.split('}').next().unwrap_or_default().to_owned(),
+                    None => rest.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect(),
+                };
+                for name in names.split(',').map(|n| n.trim().split("::").next().unwrap_or_default().trim()) {
+                    if !name.is_empty() {
+                        found.insert(name.to_owned());
+                    }
+                }
+            }
+        }
+    }
+    found
+}
+
+/// Each of the tool's commands lives in its own folder under
+/// tools/src/commands/ and imports no other command: what two commands share
+/// lives beside `commands/`.
+#[test]
+fn no_command_imports_another() {
+    let commands = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/src/commands");
+    let mut names = Vec::new();
+    let mut violations = Vec::new();
+    for entry in std::fs::read_dir(&commands).expect("tools/src/commands") {
+        let path = entry.expect("entry").path();
+        if !path.is_dir() {
+            continue;
+        }
+        let own = path.file_name().and_then(|n| n.to_str()).expect("folder name").to_owned();
+        names.push(own.clone());
+        let mut files = Vec::new();
+        rust_files(&path, &mut files);
+        for file in files {
+            let source = std::fs::read_to_string(&file).expect("source");
+            for other in commands_named(&source).into_iter().filter(|n| *n != own) {
+                violations.push(format!("{}: imports the {other} command", file.display()));
+            }
+        }
+    }
+    assert!(names.len() >= 9, "found only the commands {names:?}");
+    assert!(violations.is_empty(), "commands importing commands:\n{}", violations.join("\n"));
+}
+
+#[test]
+fn the_command_check_sees_an_import() {
+    let source = "use crate::commands::render::bench_frames;\nuse crate::commands::{plot, bench::measure};\n\
+                  use super::super::simulate::check;\n// crate::commands::grow in a comment\nuse super::frames;\n";
+    let names: Vec<String> = commands_named(source).into_iter().collect();
+    assert_eq!(names, ["bench", "plot", "render", "simulate"]);
+}

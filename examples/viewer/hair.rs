@@ -88,23 +88,6 @@ fn read_groom(path: &Path) -> Result<Groom, BoxError> {
     Ok(groom)
 }
 
-/// Key and fill spots and a rim light around `center`, for a scene of `radius`.
-fn lights(center: Vec3, radius: f32) -> Vec<Light> {
-    let k = radius / 0.465; // the thesis head of hair's radius, meters
-    let spot = |offset: Vec3, color: Vec3| Light::Spot {
-        position: center + k * offset,
-        direction: -offset,
-        outer_angle: 0.6,
-        inner_angle: 0.4,
-        color: color * k * k,
-    };
-    vec![
-        spot(Vec3::new(-0.6, 0.5, 0.8), Vec3::splat(1.1)),
-        spot(Vec3::new(0.9, 0.1, 0.4), Vec3::new(0.25, 0.27, 0.33)),
-        Light::Directional { direction: Vec3::new(0.2, -0.3, 1.0), color: Vec3::new(0.25, 0.22, 0.2) },
-    ]
-}
-
 /// The simulation, the renderer and the controls.
 pub struct Hair {
     pub sim: HairSim,
@@ -131,7 +114,7 @@ impl Hair {
         let mut config = config;
         config.render.frames_in_flight = FRAMES_IN_FLIGHT;
         if config.lights.is_empty() {
-            config.lights = lights(scene.center, scene.radius);
+            config.lights = Light::thesis_rig(scene.center, scene.radius).to_vec();
         }
         let head = RigidTransform::default();
         let mut sim = HairSim::new(ctx, &scene.groom, &config.sim, &head)?;

@@ -10,6 +10,9 @@ use crate::error::Result;
 pub const THESIS_HEAD_RADIUS: f32 = 0.1;
 /// Centre of the `thesis` scene's head sphere, meters.
 pub const THESIS_HEAD_CENTER: Vec3 = Vec3::new(0.0, 1.6, 0.0);
+/// Radius of the sphere around the `thesis` scene's head and hair, meters: the
+/// size its lights are laid out for (`render::Light::thesis_rig`).
+pub const THESIS_BOUNDING_RADIUS: f32 = 0.465;
 
 /// The scalp of the `thesis` scene: a head-sized sphere, crown and back covered, face free.
 pub fn thesis_scalp() -> Scalp {

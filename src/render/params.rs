@@ -85,21 +85,26 @@ impl Default for RenderParams {
     }
 }
 
-/// How the draw pass blends hair into the target.
+/// How the draw pass blends hair into the target (with the `clap` feature, a
+/// command-line value: `off`, `fast`, `exact`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum Transparency {
     /// Opaque ribbons at least [`super::HairMaterial::least_pixel_width`] wide,
     /// nearest layer only (a depth pre-pass, then one shaded layer).
     #[default]
+    #[cfg_attr(feature = "clap", value(help = "Opaque ribbons at least a pixel wide, nearest layer only"))]
     Off,
     /// Weighted blended order-independent transparency (one pass, two
     /// accumulation images, no lists): every fragment shaded once, the colours
     /// averaged with weights falling with depth, the total opacity exact.
+    #[cfg_attr(feature = "clap", value(help = "Weighted blended transparency: one pass, no lists"))]
     Fast,
     /// Per-pixel linked lists of every fragment (shaded once when stored), the
     /// [`OitParams::sorted_fragments`] nearest sorted exactly per pixel and the rest
     /// blended as an order-independent tail.
+    #[cfg_attr(feature = "clap", value(help = "Per-pixel lists, the nearest fragments sorted exactly"))]
     Exact,
 }
 

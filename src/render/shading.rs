@@ -86,6 +86,30 @@ pub enum Light {
 }
 
 impl Light {
+    /// The thesis scene's three lights around a head of hair of bounding
+    /// radius `radius` centred at `center`: a key spot (light 0) and a fill spot
+    /// (light 1), the two that cast shadows in the thesis' setup, and a dim
+    /// directional rim light. At the thesis' own size
+    /// ([`crate::groom::scenes::THESIS_BOUNDING_RADIUS`]) the spots sit at its
+    /// offsets from the centre; for another size the offsets scale with the
+    /// radius and the spots' radiance with its square, so that the same light
+    /// reaches the hair.
+    pub fn thesis_rig(center: Vec3, radius: f32) -> [Light; 3] {
+        let k = radius / crate::groom::scenes::THESIS_BOUNDING_RADIUS;
+        let spot = |offset: Vec3, color: Vec3| Light::Spot {
+            position: center + k * offset,
+            direction: -offset,
+            outer_angle: 0.6,
+            inner_angle: 0.4,
+            color: color * k * k,
+        };
+        [
+            spot(Vec3::new(-0.6, 0.5, 0.8), Vec3::splat(1.1)),
+            spot(Vec3::new(0.9, 0.1, 0.4), Vec3::new(0.25, 0.27, 0.33)),
+            Light::Directional { direction: Vec3::new(0.2, -0.3, 1.0), color: Vec3::new(0.25, 0.22, 0.2) },
+        ]
+    }
+
     pub(crate) fn to_gpu(self) -> Result<GpuLight> {
         let bad = || Error::param("light", format!("{self:?}"), "finite with a non-zero direction");
         Ok(match self {
@@ -295,4 +319,29 @@ pub(crate) fn noise_texels() -> Vec<u8> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::Light;
+    use crate::groom::scenes::THESIS_BOUNDING_RADIUS;
+
+    /// At the thesis' size the key spot sits at the thesis' offset; at twice the
+    /// size twice as far and four times as bright, pointing at the same centre.
+    #[test]
+    fn the_thesis_rig_scales_with_the_head_of_hair() {
+        let center = Vec3::new(0.0, 1.6, 0.0);
+        let [key, fill, rim] = Light::thesis_rig(center, THESIS_BOUNDING_RADIUS);
+        let Light::Spot { position, direction, color, .. } = key else { panic!("the key light is a spot") };
+        assert_eq!(position, center + Vec3::new(-0.6, 0.5, 0.8));
+        assert_eq!((direction, color), (Vec3::new(0.6, -0.5, -0.8), Vec3::splat(1.1)));
+        assert!(matches!(fill, Light::Spot { .. }) && matches!(rim, Light::Directional { .. }));
+        let [big, ..] = Light::thesis_rig(center, 2.0 * THESIS_BOUNDING_RADIUS);
+        let Light::Spot { position, direction, color, .. } = big else { panic!("the key light is a spot") };
+        assert!((position - (center + 2.0 * Vec3::new(-0.6, 0.5, 0.8))).length() < 1e-6);
+        assert_eq!(direction, Vec3::new(0.6, -0.5, -0.8));
+        assert!((color - Vec3::splat(4.4)).length() < 1e-5);
+    }
 }

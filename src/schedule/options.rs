@@ -6,12 +6,16 @@ use ash::vk;
 
 use crate::context::GpuContext;
 
-/// Where the simulation runs.
+/// Where the simulation runs (with the `clap` feature, a command-line value:
+/// `single`, `async`, `second-device`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum ScheduleMode {
     /// Recorded into the host's command buffer, in order with rendering.
+    #[cfg_attr(feature = "clap", value(name = "single"))]
     SingleQueue,
     /// Submitted by vkhair to a second queue of the rendering device.
+    #[cfg_attr(feature = "clap", value(name = "async"))]
     AsyncCompute,
     /// On a second logical device, driven by a worker thread.
     SecondDevice,
@@ -28,13 +32,17 @@ impl ScheduleMode {
     }
 }
 
-/// How SECOND DEVICE mode moves the state to the rendering device.
+/// How SECOND DEVICE mode moves the state to the rendering device (with the
+/// `clap` feature, a command-line value: `external`, `staging`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum HandOff {
     /// Memory exported by the simulation device and imported by the rendering
     /// device (`VK_KHR_external_memory_fd`): no host copy.
+    #[cfg_attr(feature = "clap", value(name = "external"))]
     ExternalMemory,
     /// Host-visible buffers on both devices, copied by the render thread.
+    #[cfg_attr(feature = "clap", value(name = "staging"))]
     HostStaging,
 }
 

@@ -10,6 +10,9 @@ use vkhair::files::write_atomic;
 
 pub type Error = Box<dyn std::error::Error + Send + Sync>;
 
+/// What a command returns: nothing, or the error `main` prints.
+pub type CliResult = Result<(), Error>;
+
 /// `println!` that never panics: a closed pipe ends the program as it does any
 /// Unix tool (SIGPIPE, see [`restore_sigpipe`]); any other failure (a full disk)
 /// is reported on stderr with exit status 1.

@@ -31,11 +31,16 @@ fn a_quick_bench_reports_every_stage_with_its_reference_and_writes_json_and_a_ch
         &out_arg,
         "--sintel",
         &missing,
+        "--iterations",
+        "7",
     ];
     let r = run(&args, LIMIT);
     r.assert_ok();
     assert!(r.stdout.contains("skipped Sintel"), "{}", r.stdout);
+    // The simulation knobs every simulating command takes reach bench's rows.
+    assert!(r.stdout.contains("parameters: 7 iterations, Pbd solver"), "{}", r.stdout);
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("parse");
+    assert_eq!(v["iterations"], 7, "{v}");
     for key in [
         "gpu_ms_per_step",
         "cpu_ms_per_step",

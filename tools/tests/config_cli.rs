@@ -145,3 +145,40 @@ fn an_input_groom_is_held_in_its_style_by_default() {
     );
     assert!(from_file.contains("style: global shape 0.00"), "{from_file}");
 }
+
+/// The simulation knobs are one argument group: every flag works the same on
+/// `simulate` and `render` (and `bench`, tools/tests/bench_cli.rs), reaching
+/// the parameters the simulation runs with.
+#[test]
+fn every_simulation_knob_flag_works_on_every_command_that_simulates() {
+    let knobs = [
+        "--iterations",
+        "7",
+        "--substeps",
+        "2",
+        "--dftl",
+        "--volume",
+        "friction",
+        "--grid",
+        "12",
+        "--jacobi",
+        "--max-iterations",
+        "9",
+        "--motion",
+        "still",
+    ];
+    let expected = "parameters: 7 iterations, Dftl solver, volume Friction at [12, 12, 12], 2 sub-steps, \
+                    Jacobi pressure solve capped at 9 iterations, motion Still";
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("frames").display().to_string();
+    let render = ["render", "--frames", "1", "--width", "32", "--height", "32", "--no-shadows", "--out", &out];
+    for command in [&["simulate", "--steps", "2"][..], &render[..]] {
+        let out = vkhair().args(command).args(knobs).output().expect("run");
+        let stdout = clean(&out);
+        assert!(stdout.contains(expected), "{}: {stdout}", command[0]);
+    }
+    // A flag the scene cannot honour is refused before any work.
+    let out = vkhair().args(["render", "--volume", "off", "--volume-shadows"]).output().expect("run");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--volume-shadows needs the simulation's volume stage"));
+}

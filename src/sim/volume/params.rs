@@ -5,8 +5,10 @@ use crate::error::{Error, Result};
 /// Most cells a volume grid may have (2²²: 4,194,304, e.g. 161³ or 256 × 128 × 128).
 pub const MAX_VOLUME_CELLS: u64 = 1 << 22;
 
-/// What the volume stage does with the grid.
+/// What the volume stage does with the grid (with the `clap` feature, a
+/// command-line value: `off`, `flip`, `friction`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum VolumeMode {
     /// No volume stage: key hairs do not interact (the cheapest).

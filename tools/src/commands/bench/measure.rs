@@ -9,6 +9,7 @@ use vkhair::groom::Groom;
 use vkhair::sim::{motion, Collider, CpuHairSim, HairSim, RigidTransform, SimParams, SimStage};
 use vkhair::{GpuContext, GpuProfiler, ProfileReport, RecordedWork};
 
+use crate::args::sim::MotionArg;
 use crate::output::Error;
 use crate::profile::percentile;
 
@@ -58,19 +59,24 @@ pub struct SimCase<'a> {
     pub params: SimParams,
     /// Whether to run the CPU reference beside the GPU.
     pub cpu: bool,
+    /// How the head moves (about the thesis scene's neck).
+    pub motion: MotionArg,
 }
 
-/// The head of step `i`: the shaking motion.
-fn head(i: usize) -> RigidTransform {
-    motion::reference_motion((i + 1) as f32 / 60.0)
+impl SimCase<'_> {
+    /// The head at the end of step `i`.
+    fn head(&self, i: usize) -> RigidTransform {
+        self.motion.head((i + 1) as f32 / 60.0, motion::NECK_PIVOT, 0.35)
+    }
 }
 
 /// The work of one step: a run of three steps less a run of one (what a
 /// submission adds around its steps cancels out), halved.
-fn work_per_step(ctx: &GpuContext, sim: &mut HairSim, first: usize) -> Result<RecordedWork, Error> {
+fn work_per_step(ctx: &GpuContext, case: &SimCase<'_>, sim: &mut HairSim) -> Result<RecordedWork, Error> {
+    let first = 0;
     let mut run = |steps: usize, from: usize| -> Result<RecordedWork, Error> {
         let before = ctx.recorded_work();
-        sim.run(steps, |i| head(from + i), None)?;
+        sim.run(steps, |i| case.head(from + i), None)?;
         Ok(ctx.recorded_work() - before)
     };
     let one = run(1, first)?;
@@ -104,20 +110,20 @@ pub fn measure_sim(ctx: &GpuContext, case: &SimCase<'_>, samples: usize) -> Resu
         false => None,
     };
     let mut profiler = GpuProfiler::new(ctx, 1, 16 * case.params.substeps)?;
-    let work = work_per_step(ctx, &mut gpu, 0)?;
+    let work = work_per_step(ctx, case, &mut gpu)?;
     let mut figures = SimFigures { work, ..SimFigures::default() };
     let warm_up = 2;
     for i in 0..samples + warm_up {
         let step = 4 + i;
         let started = Instant::now();
         let report = gpu
-            .run(1, |_| head(step), Some(&mut profiler))?
+            .run(1, |_| case.head(step), Some(&mut profiler))?
             .ok_or("the device wrote no timestamps (the bench needs timestamp queries)")?;
         let wall = started.elapsed().as_secs_f64() * 1e3;
         let cpu_ms = match &mut cpu {
             Some(cpu) => {
                 let started = Instant::now();
-                cpu.step(&head(step))?;
+                cpu.step(&case.head(step))?;
                 Some((started.elapsed().as_secs_f64() * 1e3, cpu.last_volume_time().as_secs_f64() * 1e3))
             }
             None => None,

@@ -3,22 +3,23 @@
 
 use std::path::{Path, PathBuf};
 
-use clap::ValueEnum;
 use glam::Vec3;
 use vkhair::config::Config;
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::scenes;
 use vkhair::groom::sdf::MeshSdf;
-use vkhair::sim::{
-    motion, HairSim, MeshCollider, Preconditioner, RigidTransform, SimParams, SolverMode, VolumeMode, VolumeParams,
-};
+use vkhair::sim::{motion, HairSim, MeshCollider, RigidTransform, SimParams, VolumeMode, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
-use crate::groom_input::InputArgs;
-use crate::output::progress;
+use crate::args::input::InputArgs;
+use crate::args::sim::SimArgs;
+use crate::output::{progress, CliResult};
 use crate::profile::{host_now_ns, percentile, Profile, ProfileArgs};
-use crate::sim_check::{share_inside, tip_drift, write_final, Reference, StepCheck};
-use crate::{say, CliResult};
+use crate::say;
+
+mod check;
+
+use check::{share_inside, tip_drift, write_final, Reference, StepCheck};
 
 #[derive(clap::Args)]
 pub struct SimulateArgs {
@@ -30,34 +31,13 @@ pub struct SimulateArgs {
     /// Parameter file (TOML, see `vkhair config`); the flags below win over it.
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Constraint iterations [default: 20].
-    #[arg(long)]
-    iterations: Option<u32>,
-    /// Use the DFTL solver instead of PBD iterations.
-    #[arg(long)]
-    dftl: bool,
+    #[command(flatten)]
+    sim: SimArgs,
     /// Also run the CPU reference: every 10 steps it takes one step from the GPU's
     /// state and must land within a stated tolerance of the GPU's step; without
     /// FLIP the whole run is compared too. Exits non-zero beyond the tolerance.
     #[arg(long)]
     check: bool,
-    /// Volume stage (hair-hair interaction): FLIP on a MAC grid, density friction,
-    /// or off [default: flip].
-    #[arg(long, value_enum)]
-    volume: Option<VolumeArg>,
-    /// Volume grid cells per axis [default: 32].
-    #[arg(long)]
-    grid: Option<u32>,
-    /// Use the Jacobi preconditioner instead of multigrid for the pressure solve.
-    #[arg(long)]
-    jacobi: bool,
-    /// Iteration cap of the pressure solve [default: 40].
-    #[arg(long)]
-    max_iterations: Option<u32>,
-    /// Head motion about the neck: still, the shake (0.6 rad at 1 Hz) or violent
-    /// (for soak runs: 1.2 rad at 3 Hz with a nod and jolts of the whole head).
-    #[arg(long, value_enum, default_value = "shake")]
-    motion: MotionArg,
     /// Write the simulated strands after the last step as a .hair file: in the
     /// input's frame (the head's motion undone) and units (--scale undone), one
     /// strand per input strand with --points points each.
@@ -67,70 +47,17 @@ pub struct SimulateArgs {
     profile_out: ProfileArgs,
 }
 
-/// `--motion`: how the head moves (about the neck `pivot`).
-#[derive(Clone, Copy, ValueEnum)]
-pub enum MotionArg {
-    /// The head stays still (does the groom hold its style?).
-    Still,
-    /// 0.6 rad at 1 Hz, with a nod.
-    Shake,
-    /// For soak runs: 1.2 rad at 3 Hz with a nod, and the whole head jolted by a
-    /// tenth of the groom's size.
-    Violent,
-}
-
-impl MotionArg {
-    /// The head at `time` seconds, for a groom of bounding-box size `size`.
-    pub fn head(self, time: f32, pivot: Vec3, size: f32) -> RigidTransform {
-        match self {
-            MotionArg::Still => RigidTransform::default(),
-            MotionArg::Shake => motion::shaking_head_about(time, 0.6, 1.0, pivot),
-            MotionArg::Violent => motion::violent_about(time, pivot, 0.1 * size),
-        }
-    }
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum VolumeArg {
-    Off,
-    Flip,
-    Friction,
-}
-
 /// The simulation parameters: the tool's defaults (FLIP at 32³; an `--input`
 /// groom held in its authored style, [`SimParams::styled`]), then the `--config`
 /// file, then the flags given. Checked before any GPU work.
 fn simulate_params(a: &SimulateArgs) -> Result<Config, vkhair::Error> {
     let sim = if a.input.input.is_some() { SimParams::styled() } else { SimParams::default() };
     let base = Config { sim: SimParams { volume: VolumeParams::flip([32, 32, 32]), ..sim }, ..Config::default() };
-    let config = match &a.config {
+    let mut config = match &a.config {
         Some(path) => base.load_over(path)?,
         None => base,
     };
-    let mut config = config;
-    let params = &mut config.sim;
-    if let Some(iterations) = a.iterations {
-        params.iterations = iterations;
-    }
-    if a.dftl {
-        params.solver = SolverMode::Dftl;
-    }
-    if let Some(volume) = a.volume {
-        params.volume.mode = match volume {
-            VolumeArg::Off => VolumeMode::Off,
-            VolumeArg::Flip => VolumeMode::Flip,
-            VolumeArg::Friction => VolumeMode::Friction,
-        };
-    }
-    if let Some(grid) = a.grid {
-        params.volume.resolution = [grid; 3];
-    }
-    if a.jacobi {
-        params.volume.preconditioner = Preconditioner::Jacobi;
-    }
-    if let Some(cap) = a.max_iterations {
-        params.volume.max_iterations = cap;
-    }
+    a.sim.apply(&mut config.sim);
     config.validate()?;
     Ok(config)
 }
@@ -179,7 +106,7 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let (lo, hi) = groom.bounds();
     let size = (hi - lo).max_element();
-    let head = |i: usize| a.motion.head((i + 1) as f32 * params.dt, pivot, size);
+    let head = |i: usize| a.sim.motion.head((i + 1) as f32 * params.dt, pivot, size);
     let mut sim = HairSim::new(&ctx, &groom, &params, &RigidTransform::default())?;
     sim.set_colliders(&colliders)?;
     let field = match &mesh {
@@ -209,11 +136,8 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
         params.dt
     );
     say!(
-        "parameters: {} iterations, {:?} solver, volume {:?} at {:?}{}",
-        params.iterations,
-        params.solver,
-        params.volume.mode,
-        params.volume.resolution,
+        "{}{}",
+        a.sim.describe(&params),
         a.config.as_ref().map(|c| format!(" (from {} and the flags)", c.display())).unwrap_or_default()
     );
     say!(

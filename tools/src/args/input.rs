@@ -10,7 +10,7 @@ use vkhair::groom::{Groom, Repairs};
 use crate::output::Error;
 
 /// The groom and character mesh a user gives `render` and `simulate`.
-#[derive(clap::Args)]
+#[derive(clap::Args, Clone, Debug)]
 pub struct InputArgs {
     /// Groom file (.hair or .tfx) instead of the `thesis` scene (its groom, head
     /// and colliders); it holds its authored style (a shape constraint over the

@@ -1,4 +1,5 @@
-//! `vkhair plot`: a benchmark CSV as a PNG chart.
+//! A benchmark CSV as a PNG chart (`vkhair plot`, and `vkhair bench` for the
+//! charts it writes beside its CSVs).
 //!
 //! - `render.csv` (benches/render.rs): GPU ms per frame against camera distance,
 //!   one line per resolution, and the drawn segment count.
@@ -19,17 +20,6 @@ use plotters::prelude::*;
 
 /// Where Debian's fonts-dejavu-core puts the font the chart is labelled with.
 const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
-
-#[derive(clap::Args)]
-pub struct PlotArgs {
-    /// CSV written by `cargo bench --bench render` or `--bench volume`, or the
-    /// scaling.csv or transparency.csv of `vkhair bench`.
-    #[arg(default_value = "target/vkhair-bench/render.csv")]
-    csv: PathBuf,
-    /// Output PNG (default: the CSV's path with a .png extension).
-    #[arg(long)]
-    out: Option<PathBuf>,
-}
 
 use crate::output::{write_png, Error};
 use crate::say;
@@ -187,11 +177,6 @@ fn volume_lines(t: &Table) -> Result<(Lines, Lines), Error> {
         }
     }
     Ok((time, solves))
-}
-
-pub fn plot(a: &PlotArgs) -> Result<(), Error> {
-    let out = a.out.clone().unwrap_or_else(|| a.csv.with_extension("png"));
-    plot_file(&a.csv, &out)
 }
 
 /// Charts the benchmark CSV `csv` into the PNG `out`.

@@ -8,16 +8,19 @@ use vkhair::render::{Camera, HairMaterial, LodParams, Renderer};
 use vkhair::sim::{HairSim, RigidTransform};
 use vkhair::{GpuContext, GpuProfiler};
 
-use super::{check_options, framing, make_renderer, parameters, scene, RenderArgs};
+use super::measure::Samples;
+use crate::args::scene::SceneArgs;
+use crate::args::sim::SimArgs;
 use crate::output::Error;
+use crate::scene::{self, framing, make_renderer, parameters};
 
 /// What `vkhair bench` measures of a frame: the render passes' GPU time (from
 /// their timestamp scopes), the wall time of the submission holding them (the
 /// simulation's steps go in a submission of their own before it), and what
 /// the render passes record.
 pub struct FrameFigures {
-    pub gpu: crate::bench_measure::Samples,
-    pub wall: crate::bench_measure::Samples,
+    pub gpu: Samples,
+    pub wall: Samples,
     pub work: vkhair::RecordedWork,
     pub hairs: u64,
     pub segments: u64,
@@ -128,20 +131,28 @@ fn draw_unlit(
 }
 
 /// Renders `samples` frames (after two warm-up frames) of the scene `render`
-/// would draw with `args` (its flags, e.g. `["--width", "1280"]`), the
-/// simulation on the same queue, and measures the render passes; with `unlit`,
-/// then draws the last state once more unlit ([`FrameFigures::unlit`]).
-pub fn bench_frames(ctx: &GpuContext, args: &[&str], samples: usize, unlit: bool) -> Result<FrameFigures, Error> {
+/// would draw with `args` (its scene flags, e.g. `["--width", "1280"]`) and
+/// the simulation knobs `sim`, the simulation on the same queue, and measures
+/// the render passes; with `unlit`, then draws the last state once more unlit
+/// ([`FrameFigures::unlit`]).
+pub fn bench_frames(
+    ctx: &GpuContext,
+    args: &[&str],
+    sim: &SimArgs,
+    samples: usize,
+    unlit: bool,
+) -> Result<FrameFigures, Error> {
     #[derive(clap::Parser)]
     struct Wrapper {
         #[command(flatten)]
-        render: RenderArgs,
+        scene: SceneArgs,
     }
-    let a = <Wrapper as clap::Parser>::try_parse_from(std::iter::once("render").chain(args.iter().copied()))
+    let mut a = <Wrapper as clap::Parser>::try_parse_from(std::iter::once("render").chain(args.iter().copied()))
         .map_err(|e| format!("bench render arguments: {e}"))?
-        .render;
-    check_options(&a)?;
-    let s = scene(&a)?;
+        .scene;
+    a.sim = sim.clone();
+    a.check()?;
+    let s = scene::load(&a)?;
     let config = parameters(&a, &s)?;
     let mut sim = HairSim::new(ctx, &s.groom, &config.sim, &RigidTransform::default())?;
     sim.set_colliders(&s.colliders)?;
@@ -165,7 +176,7 @@ pub fn bench_frames(ctx: &GpuContext, args: &[&str], samples: usize, unlit: bool
     };
     for frame in 0..samples + 2 {
         let heads: Vec<RigidTransform> =
-            (0..2).map(|k| a.motion.head((frame * 2 + k + 1) as f32 * config.sim.dt, s.pivot, size)).collect();
+            (0..2).map(|k| a.sim.motion.head((frame * 2 + k + 1) as f32 * config.sim.dt, s.pivot, size)).collect();
         sim.run(heads.len(), |k| heads[k], None)?;
         let started = std::time::Instant::now();
         let mut render_work = vkhair::RecordedWork::default();

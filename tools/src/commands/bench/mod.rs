@@ -23,12 +23,16 @@ use vkhair::groom::{scenes, Groom};
 use vkhair::sim::{motion, Collider, SimParams, VolumeMode, VolumeParams};
 use vkhair::{ContextOptions, GpuContext, RecordedWork};
 
-use crate::bench_measure::{fitted_exponent, measure_sim, Samples, SimCase, SimFigures};
+use crate::args::sim::SimArgs;
+use crate::chart::plot_file;
 use crate::output::Error;
-use crate::render_cmd::bench_frames;
 use crate::say;
+use frames::bench_frames;
+use measure::{fitted_exponent, measure_sim, Samples, SimCase, SimFigures};
 use modes::{render_rows, write_modes};
 
+mod frames;
+mod measure;
 mod modes;
 
 /// Peak memory bandwidth of a few GPUs, bytes per second (vendors' figures): the
@@ -69,6 +73,27 @@ pub struct BenchArgs {
     /// tools/gpu-bench.sh on a machine with a GPU.
     #[arg(long)]
     require_gpu: bool,
+    /// Simulation knobs for every row (each row sets its own volume mode and grid).
+    #[command(flatten)]
+    sim: SimArgs,
+}
+
+/// What every measurement of a run shares.
+struct Bench<'a> {
+    ctx: &'a GpuContext,
+    args: &'a BenchArgs,
+    clock: Clocking,
+}
+
+impl Bench<'_> {
+    /// The simulation parameters of a row: vkhair's defaults, the --sim flags,
+    /// then the row's volume `mode` on a `grid`³ grid.
+    fn params(&self, mode: VolumeMode, grid: u32) -> SimParams {
+        let mut params = SimParams::default();
+        self.args.sim.apply(&mut params);
+        params.volume = VolumeParams { mode, resolution: [grid; 3], ..params.volume };
+        params
+    }
 }
 
 /// One stage's figures on one scene.
@@ -239,7 +264,7 @@ fn bench_scenes(a: &BenchArgs) -> Result<(Vec<Scene>, Vec<String>), Error> {
     }];
     let (hair, bust) = (a.sintel.join("sintel_hair.tfx"), a.sintel.join("sintel_bust.obj"));
     if hair.is_file() && bust.is_file() {
-        let groom = crate::groom_input::load_scaled(&hair, false, 0.01, 32)?.groom;
+        let groom = crate::args::input::load_scaled(&hair, false, 0.01, 32)?.groom;
         let mut args = size((1280, 720));
         for s in ["--input", &hair.display().to_string(), "--obj", &bust.display().to_string(), "--scale", "0.01"] {
             args.push(s.to_owned());
@@ -261,13 +286,6 @@ fn bench_scenes(a: &BenchArgs) -> Result<(Vec<Scene>, Vec<String>), Error> {
     Ok((list, skipped))
 }
 
-fn volume(mode: VolumeMode, grid: u32) -> SimParams {
-    SimParams {
-        volume: VolumeParams { mode, resolution: [grid; 3], ..VolumeParams::default() },
-        ..SimParams::default()
-    }
-}
-
 /// One scaling curve: (work, GPU ms, CPU ms) per point.
 struct Curve {
     axis: &'static str,
@@ -283,12 +301,13 @@ impl Curve {
     }
 }
 
-fn scaling(ctx: &GpuContext, a: &BenchArgs, clock: Clocking) -> Result<Vec<Curve>, Error> {
+fn scaling(b: &Bench<'_>) -> Result<Vec<Curve>, Error> {
+    let (ctx, a, clock) = (b.ctx, b.args, b.clock);
     let n = a.scaling_samples.max(1);
     let colliders = motion::thesis_colliders();
-    let off = volume(VolumeMode::Off, 32);
+    let off = b.params(VolumeMode::Off, 32);
     let sim = |groom: &Groom, params: &SimParams| {
-        let case = SimCase { groom, colliders: &colliders, params: params.clone(), cpu: true };
+        let case = SimCase { groom, colliders: &colliders, params: params.clone(), cpu: true, motion: a.sim.motion };
         measure_sim(ctx, &case, n)
     };
     let sim_point = |groom: &Groom, params: &SimParams| {
@@ -319,7 +338,7 @@ fn scaling(ctx: &GpuContext, a: &BenchArgs, clock: Clocking) -> Result<Vec<Curve
     let mut curve = Curve { axis: "grid (FLIP volume stage alone; thesis)", unit: "cells", points: Vec::new() };
     let without = sim(&thesis, &off)?;
     for &g in grids {
-        let f = sim(&thesis, &volume(VolumeMode::Flip, g))?;
+        let f = sim(&thesis, &b.params(VolumeMode::Flip, g))?;
         let gpu = volume_alone(&f, &without, clock).median();
         curve.points.push((f64::from(g).powi(3), gpu, f.volume_cpu.median()));
     }
@@ -327,7 +346,7 @@ fn scaling(ctx: &GpuContext, a: &BenchArgs, clock: Clocking) -> Result<Vec<Curve
     let mut curve = Curve { axis: "resolution (render frame; thesis)", unit: "pixels", points: Vec::new() };
     for &(w, h) in sizes {
         let (w, h) = (w.to_string(), h.to_string());
-        let f = bench_frames(ctx, &["--width", &w, "--height", &h], n, false)?;
+        let f = bench_frames(ctx, &["--width", &w, "--height", &h], &a.sim, n, false)?;
         curve.points.push((f.pixels as f64, clock.figure(&f.gpu, &f.wall).median(), f64::NAN));
     }
     curves.push(curve);
@@ -404,6 +423,9 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     say!("{} ({}): {} samples per figure, GPU and CPU reference interleaved", info.name, info.driver, a.samples);
     let clock = Clocking::new(&ctx)?;
     say!("{}", clock.describe());
+    let b = Bench { ctx: &ctx, args: a, clock };
+    let base = b.params(VolumeMode::Off, 32);
+    say!("{} (each row sets its own volume stage)", a.sim.describe(&base));
     let (scenes, skipped) = bench_scenes(a)?;
     let mut rows = Vec::new();
     let mut modes = Vec::new();
@@ -414,30 +436,36 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
             s.groom.strand_count(),
             s.groom.point_count() / s.groom.strand_count().max(1)
         );
-        let case = |params: SimParams| SimCase { groom: &s.groom, colliders: &s.colliders, params, cpu: true };
-        let off = measure_sim(&ctx, &case(volume(VolumeMode::Off, 32)), a.samples)?;
+        let case = |mode: VolumeMode| SimCase {
+            groom: &s.groom,
+            colliders: &s.colliders,
+            params: b.params(mode, 32),
+            cpu: true,
+            motion: a.sim.motion,
+        };
+        let off = measure_sim(&ctx, &case(VolumeMode::Off), a.samples)?;
         rows.extend(sim_rows(&s.name, "sim, volume off", &off, clock, None));
-        let f = measure_sim(&ctx, &case(volume(VolumeMode::Friction, 32)), a.samples)?;
+        let f = measure_sim(&ctx, &case(VolumeMode::Friction), a.samples)?;
         rows.extend(sim_rows(&s.name, "sim, density friction 32³", &f, clock, Some(&off)));
-        let f = measure_sim(&ctx, &case(volume(VolumeMode::Flip, 32)), a.samples)?;
+        let f = measure_sim(&ctx, &case(VolumeMode::Flip), a.samples)?;
         rows.extend(sim_rows(&s.name, "sim, FLIP 32³", &f, clock, Some(&off)));
         if let Some(args) = &s.render_args {
-            render_rows(&ctx, &s.name, args, a.samples, clock, &mut rows, &mut modes)?;
+            render_rows(&b, &s.name, args, &mut rows, &mut modes)?;
         }
     }
     print_rows(&rows);
     say!("err: a frame drawn once more unlit against render::reference::composite_strands, mean absolute error over hair pixels in 8-bit sRGB steps");
     if !modes.is_empty() {
         let csv = write_modes(&a.out, &modes)?;
-        crate::plot_cmd::plot_file(&csv, &csv.with_extension("png"))?;
+        plot_file(&csv, &csv.with_extension("png"))?;
     }
-    let curves = scaling(&ctx, a, clock)?;
+    let curves = scaling(&b)?;
     for c in &curves {
         let (g, cpu) = c.exponents();
         say!("scaling, {}: time ∝ {}^{g:.2} on the GPU, ^{cpu:.2} on the CPU reference", c.axis, c.unit);
     }
     let csv = write_scaling(&a.out, &curves)?;
-    crate::plot_cmd::plot_file(&csv, &csv.with_extension("png"))?;
+    plot_file(&csv, &csv.with_extension("png"))?;
     if let Some(path) = &a.json {
         let find = |stage: &str| rows.iter().find(|r| r.scene == scenes[0].name && r.stage == stage);
         let (off, flip) = (find("sim, volume off"), find("sim, FLIP 32³: volume stage alone"));
@@ -457,6 +485,9 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
             "samples": a.samples,
             "gpu_figures": clock.describe(),
             "scene": scenes[0].name,
+            "iterations": base.iterations,
+            "substeps": base.substeps,
+            "solver": format!("{:?}", base.solver),
             "gpu_ms_per_step": median(off, false),
             "cpu_ms_per_step": median(off, true),
             "dispatches_per_step": off.map(|r| r.work.dispatches),

@@ -6,11 +6,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use glam::{Vec3, Vec4};
-use vkhair::GpuContext;
 
-use super::{Clocking, Row};
+use super::frames::bench_frames;
+use super::{Bench, Row};
 use crate::output::Error;
-use crate::render_cmd::bench_frames;
 use crate::say;
 
 /// The modes measured: the tool's default first (exact, K = 8), then the others.
@@ -34,14 +33,13 @@ type Reference = (Vec<Vec<Vec4>>, Vec<Vec3>);
 /// Measures the render frame `args` of scene `scene` in every mode of [`MODES`],
 /// pushing a row of the table and one of the mode chart for each.
 pub(super) fn render_rows(
-    ctx: &GpuContext,
+    b: &Bench<'_>,
     scene: &str,
     args: &[String],
-    samples: usize,
-    clock: Clocking,
     rows: &mut Vec<Row>,
     modes: &mut Vec<ModeRow>,
 ) -> Result<(), Error> {
+    let (ctx, samples, clock) = (b.ctx, b.args.samples, b.clock);
     let mut reference: Option<Reference> = None;
     for (mode, k) in MODES {
         let k = k.to_string();
@@ -49,7 +47,7 @@ pub(super) fn render_rows(
         if let Some(mode) = mode {
             with_mode.extend(["--transparency", mode, "--sorted-fragments", &k]);
         }
-        let f = bench_frames(ctx, &with_mode, samples, true)?;
+        let f = bench_frames(ctx, &with_mode, &b.args.sim, samples, true)?;
         let mib = f.transparency_bytes as f64 / (1024.0 * 1024.0);
         let label = match mode {
             None => format!("exact K = {k} (default)"),

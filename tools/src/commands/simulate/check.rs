@@ -9,7 +9,8 @@ use vkhair::groom::sdf::MeshSdf;
 use vkhair::groom::Groom;
 use vkhair::sim::{Collider, CpuHairSim, RigidTransform, SimParams, SimState, REFERENCE_STEP_TOLERANCE_M};
 
-use crate::{say, CliResult};
+use crate::output::CliResult;
+use crate::say;
 
 /// Share of free particles inside `field` (head frame), with the head at `head`.
 pub fn share_inside(state: &SimState, field: &MeshSdf, head: &RigidTransform) -> f64 {

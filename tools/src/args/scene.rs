@@ -1,0 +1,96 @@
+//! The rendered scene's flags, shared by `render` and the frames `bench`
+//! measures: the image, the groom, the render and material knobs, the lights'
+//! shadows and the simulation knobs.
+
+use std::path::PathBuf;
+
+use vkhair::render::Transparency;
+
+use super::input::InputArgs;
+use super::sim::SimArgs;
+use crate::output::MIN_IMAGE_SIDE;
+
+#[derive(clap::Args, Clone, Debug)]
+pub struct SceneArgs {
+    /// Image width, pixels.
+    #[arg(long, default_value_t = 640)]
+    pub width: u32,
+    /// Image height, pixels.
+    #[arg(long, default_value_t = 480)]
+    pub height: u32,
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Parameter file (TOML, see `vkhair config`): simulation, rendering, lights and
+    /// material; the flags below win over it.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Hairs grown per key hair [default: 16].
+    #[arg(long)]
+    pub hairs_per_key: Option<u32>,
+    /// Smoothed segments per key segment [default: 4].
+    #[arg(long)]
+    pub level: Option<u32>,
+    /// Camera distance from the centre of the groom and mesh, in their units
+    /// [default: framed to their bounds].
+    #[arg(long)]
+    pub distance: Option<f32>,
+    /// Supersample 2× and resolve with the 5-tap filter.
+    #[arg(long)]
+    pub ssaa: bool,
+    /// Turn level of detail off (always full detail).
+    #[arg(long)]
+    pub no_lod: bool,
+    /// Grow hairs inside triangles of key-hair roots (barycentric) instead of
+    /// around each key hair.
+    #[arg(long)]
+    pub barycentric: bool,
+    /// Shade with Marschner lookup tables instead of Kajiya-Kay.
+    #[arg(long)]
+    pub marschner: bool,
+    /// Draw one-pixel lines instead of ribbons (opaque: turns transparency off
+    /// unless --transparency is given).
+    #[arg(long)]
+    pub lines: bool,
+    /// How hair is blended: opaque ribbons, weighted blended transparency or
+    /// per-pixel sorted lists [default: the --config file's, else exact].
+    #[arg(long, value_enum)]
+    pub transparency: Option<Transparency>,
+    /// Fragments sorted exactly per pixel by --transparency exact (1..=32) [default: 8].
+    #[arg(long)]
+    pub sorted_fragments: Option<u32>,
+    /// No self-shadowing (by default the two spot lights cast deep opacity maps).
+    #[arg(long)]
+    pub no_shadows: bool,
+    /// Side of each light's opacity map, texels.
+    #[arg(long, default_value_t = 512)]
+    pub shadow_resolution: u32,
+    /// Shadow the spot lights through the simulation's density volume instead of
+    /// opacity maps (turns the simulation's FLIP volume stage on).
+    #[arg(long)]
+    pub volume_shadows: bool,
+    #[command(flatten)]
+    pub sim: SimArgs,
+}
+
+impl SceneArgs {
+    /// Options that mean something only with others, and values out of range: an
+    /// error saying what the option needs, before any file is read or GPU work done.
+    pub fn check(&self) -> Result<(), String> {
+        if self.width < MIN_IMAGE_SIDE || self.height < MIN_IMAGE_SIDE {
+            return Err(format!(
+                "--width and --height must be at least {MIN_IMAGE_SIDE} pixels (got {}×{})",
+                self.width, self.height
+            ));
+        }
+        self.input.check()?;
+        if self.volume_shadows && self.sim.volume == Some(vkhair::sim::VolumeMode::Off) {
+            return Err("--volume-shadows needs the simulation's volume stage (--volume off turns it off)".into());
+        }
+        if let Some(d) = self.distance {
+            if !(d.is_finite() && d > 0.0) {
+                return Err(format!("--distance must be a finite number above 0 (got {d})"));
+            }
+        }
+        Ok(())
+    }
+}

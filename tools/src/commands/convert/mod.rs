@@ -1,0 +1,53 @@
+//! `vkhair convert`: a groom file resampled and/or thinned to key hairs,
+//! written as a .hair file.
+
+use std::path::{Path, PathBuf};
+
+use vkhair::groom::cyhair::HairFile;
+
+use crate::args::input::load;
+use crate::output::CliResult;
+use crate::say;
+
+#[derive(clap::Args)]
+pub struct ConvertArgs {
+    /// Input groom (.hair or .tfx).
+    input: PathBuf,
+    /// Resample every strand to this many points by arc length.
+    #[arg(long)]
+    points: Option<usize>,
+    /// Keep this many strands, spread evenly (key hairs).
+    #[arg(long)]
+    key_hairs: Option<usize>,
+    /// Output .hair file.
+    #[arg(long)]
+    out: PathBuf,
+    /// Refuse a file with defects instead of repairing it (see `render --strict`).
+    #[arg(long)]
+    strict: bool,
+}
+
+pub fn convert(a: &ConvertArgs) -> CliResult {
+    write_converted(&a.input, a.points, a.key_hairs, &a.out, a.strict)
+}
+
+fn write_converted(
+    input: &Path,
+    points: Option<usize>,
+    key_hairs: Option<usize>,
+    out: &Path,
+    strict: bool,
+) -> CliResult {
+    let (mut groom, _) = load(input, strict)?;
+    if let Some(n) = key_hairs {
+        groom = groom.select_evenly(n)?;
+    }
+    if let Some(n) = points {
+        groom = groom.resampled(n)?;
+    }
+    let s = groom.stats();
+    HairFile::new(groom, &format!("from {}", input.file_name().and_then(|n| n.to_str()).unwrap_or("input")))
+        .save(out)?;
+    say!("wrote {}: {} strands, {} points", out.display(), s.strands, s.points);
+    Ok(())
+}

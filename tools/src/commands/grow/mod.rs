@@ -1,0 +1,123 @@
+//! `vkhair grow`: strands grown on a scalp, written as a .hair file.
+
+use std::path::PathBuf;
+
+use clap::ValueEnum;
+use glam::Vec3;
+use vkhair::groom::cyhair::HairFile;
+use vkhair::groom::grow::{grow, GrowParams, Scalp};
+use vkhair::groom::mesh::TriMesh;
+use vkhair::groom::scenes;
+
+use crate::output::CliResult;
+use crate::say;
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum ScalpKind {
+    /// The `thesis` reference scene (1750 × 6 on a head sphere); other options ignored.
+    Thesis,
+    /// A sphere cap around +Y, face (+Z) left free.
+    Sphere,
+    /// An ellipsoid cap around +Y, face (+Z) left free.
+    Ellipsoid,
+    /// Upward-facing triangles in the top part of an OBJ mesh (--obj).
+    Obj,
+}
+
+#[derive(clap::Args)]
+pub struct GrowArgs {
+    /// Scalp shape.
+    #[arg(long, value_enum, default_value = "thesis")]
+    scalp: ScalpKind,
+    /// OBJ mesh for --scalp obj.
+    #[arg(long)]
+    obj: Option<PathBuf>,
+    /// Sphere radius / ellipsoid semi-axes "x,y,z" (scalp units).
+    #[arg(long, default_value = "0.1")]
+    radius: String,
+    /// Centre of the sphere/ellipsoid "x,y,z".
+    #[arg(long, default_value = "0,0,0")]
+    center: String,
+    /// Roots within this angle of +Y, degrees (sphere/ellipsoid).
+    #[arg(long, default_value_t = 110.0)]
+    max_angle: f32,
+    /// OBJ: only triangles above this fraction of the mesh height.
+    #[arg(long, default_value_t = 0.8)]
+    min_height: f32,
+    /// OBJ: only triangles whose normal·up is at least this.
+    #[arg(long, default_value_t = 0.2)]
+    min_up_dot: f32,
+    /// Number of strands.
+    #[arg(long, default_value_t = 1000)]
+    strands: usize,
+    /// Points per strand.
+    #[arg(long, default_value_t = 16)]
+    points: usize,
+    /// Strand length (scalp units); default 0.3, or 35 % of the mesh height for OBJ.
+    #[arg(long)]
+    length: Option<f32>,
+    /// Bend toward gravity, radians over the strand.
+    #[arg(long, default_value_t = 2.5)]
+    droop: f32,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output .hair file.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn parse_vec3(name: &str, s: &str) -> Result<Vec3, String> {
+    let parts: Vec<f32> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("--{name} {s:?}: {e}"))?;
+    match parts.as_slice() {
+        [v] => Ok(Vec3::splat(*v)),
+        [x, y, z] => Ok(Vec3::new(*x, *y, *z)),
+        _ => Err(format!("--{name} {s:?}: give one value or three separated by commas")),
+    }
+}
+
+pub fn grow_groom(a: &GrowArgs) -> CliResult {
+    let groom = match a.scalp {
+        ScalpKind::Thesis => scenes::thesis()?,
+        kind => {
+            let mut length = a.length.unwrap_or(0.3);
+            let scalp = match kind {
+                ScalpKind::Obj => {
+                    let path = a.obj.as_ref().ok_or("--scalp obj needs --obj FILE.obj")?;
+                    let mesh = TriMesh::load_obj(path)?;
+                    let (lo, hi) = mesh.bounds();
+                    if a.length.is_none() {
+                        length = 0.35 * (hi.y - lo.y);
+                    }
+                    Scalp::Mesh { mesh, up: Vec3::Y, min_height: a.min_height, min_up_dot: a.min_up_dot }
+                }
+                _ => {
+                    let radii = parse_vec3("radius", &a.radius)?;
+                    let center = parse_vec3("center", &a.center)?;
+                    let mut scalp = Scalp::sphere_cap(center, radii.x, a.max_angle.to_radians());
+                    if let Scalp::Ellipsoid { radii: r, .. } = &mut scalp {
+                        *r = radii;
+                    }
+                    scalp
+                }
+            };
+            let params = GrowParams {
+                strands: a.strands,
+                points_per_strand: a.points,
+                length,
+                droop: a.droop,
+                seed: a.seed,
+                ..GrowParams::default()
+            };
+            grow(&scalp, &params)?
+        }
+    };
+    let s = groom.stats();
+    HairFile::new(groom, "grown by vkhair").save(&a.out)?;
+    say!("wrote {}: {} strands, {} points, mean length {:.4}", a.out.display(), s.strands, s.points, s.strand_length.1);
+    Ok(())
+}

@@ -1,0 +1,224 @@
+//! `vkhair render`: headless frames of a simulated, rendered head of hair.
+
+use std::path::PathBuf;
+
+use glam::Vec3;
+use vkhair::headless::{MeshDrawer, Offscreen, Submit};
+use vkhair::render::Transparency;
+use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, SchedulerOptions};
+use vkhair::sim::RigidTransform;
+use vkhair::{ContextOptions, GpuContext, GpuProfiler};
+
+use crate::args::scene::SceneArgs;
+use crate::output::{progress, Error, FrameSink};
+use crate::profile::{host_now_ns, Profile, ProfileArgs};
+use crate::say;
+use crate::scene::{self, framing, make_renderer, parameters};
+
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Frames to render (30 per second of motion).
+    #[arg(long, default_value_t = 24)]
+    frames: usize,
+    /// Output folder for frame PNGs and the contact sheet.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// Where the simulation runs [default: async compute when the device has a
+    /// second queue, else single queue].
+    #[arg(long, value_enum)]
+    schedule: Option<ScheduleMode>,
+    /// SECOND DEVICE hand-off [default: external memory when both devices can
+    /// share it, else staging].
+    #[arg(long, value_enum)]
+    hand_off: Option<HandOff>,
+    /// Show each frame's own steps (latency) instead of the previous frame's while
+    /// this frame's run (throughput).
+    #[arg(long)]
+    latency: bool,
+    /// Device name substring for the simulation device of --schedule second-device
+    /// (default: a second logical device of the rendering GPU).
+    #[arg(long)]
+    sim_device: Option<String>,
+    #[command(flatten)]
+    profile_out: ProfileArgs,
+}
+
+/// The flags `render` adds to the scene's: values out of range and options that
+/// need others, before any file is read or GPU work done.
+fn check_options(a: &RenderArgs) -> Result<(), String> {
+    a.scene.check()?;
+    if a.frames == 0 {
+        return Err("--frames must be at least 1".into());
+    }
+    if a.schedule != Some(ScheduleMode::SecondDevice) {
+        let given = [("--hand-off", a.hand_off.is_some()), ("--sim-device", a.sim_device.is_some())];
+        if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
+            return Err(format!("{flag} needs --schedule second-device"));
+        }
+    }
+    Ok(())
+}
+
+/// The scheduler options the flags ask for (creating the simulation device).
+fn schedule_options(a: &RenderArgs) -> Result<SchedulerOptions, vkhair::Error> {
+    let sim_device = match a.schedule {
+        Some(ScheduleMode::SecondDevice) => {
+            let options = ContextOptions { device_name: a.sim_device.clone(), ..ContextOptions::default() };
+            Some(GpuContext::headless(&options)?)
+        }
+        _ => None,
+    };
+    Ok(SchedulerOptions {
+        mode: a.schedule,
+        sim_device,
+        hand_off: a.hand_off,
+        pipelining: if a.latency { Pipelining::Latency } else { Pipelining::Throughput },
+        frames_in_flight: 1,
+        ..SchedulerOptions::default()
+    })
+}
+
+pub fn render(a: &RenderArgs) -> Result<(), Error> {
+    check_options(a)?;
+    let sa = &a.scene;
+    let s = scene::load(sa)?;
+    let config = parameters(sa, &s)?;
+    let ctx = GpuContext::headless(&ContextOptions::default())?;
+    let sim_params = config.sim.clone();
+    let options = schedule_options(a)?;
+    let mut sim = FrameScheduler::new(&ctx, &s.groom, &sim_params, &RigidTransform::default(), &s.colliders, &options)?;
+    say!("simulation: {} ({})", sim.mode().name(), sim.reason());
+    say!("{}", sa.sim.describe(&sim_params));
+    if sa.input.colliding() {
+        sim.set_mesh_collider(Some(&s.head_mesh), &config.mesh_collider)?;
+        say!(
+            "mesh collider: {} triangles at {} grid points along the longest axis",
+            s.head_mesh.triangles.len(),
+            config.mesh_collider.resolution
+        );
+    }
+    let renderer = make_renderer(sa, &ctx, &config, sim.key_hairs(), s.radius)?;
+    let offscreen = Offscreen::new(&ctx, sa.width, sa.height)?;
+    // The head mesh (lit along the key spot light's direction) takes that light's hair
+    // shadow the way a host would, through glsl/include/shadow.glsl.
+    let head = if sa.no_shadows || sa.volume_shadows {
+        MeshDrawer::new(&ctx, &s.head_mesh)?
+    } else {
+        MeshDrawer::with_hair_shadows(&ctx, &s.head_mesh, &renderer, 0)?
+    };
+    let camera = framing(&s, sa.distance, sa.width as f32 / sa.height as f32)?;
+    let mut renderer = renderer;
+    let mut profiler = GpuProfiler::new(&ctx, 1, 64)?;
+    std::fs::create_dir_all(&a.out).map_err(|e| format!("cannot create {}: {e}", a.out.display()))?;
+    let (strands, points) = sim.key_hairs().size();
+    let (hairs, per_hair) = renderer.hair_counts();
+    say!(
+        "{}: {strands} key hairs × {points} points → {hairs} hairs × {} segments ({} segments), {}×{}, {} frames",
+        ctx.info().name,
+        per_hair - 1,
+        hairs as u64 * (per_hair as u64 - 1),
+        sa.width,
+        sa.height,
+        a.frames
+    );
+    let bar = progress(a.frames, "frames");
+    let steps_per_frame = 2; // 1/60 s steps, 30 frames per second
+    let (lo, hi) = s.groom.bounds();
+    let size = (hi - lo).max_element();
+    let mut profile = Profile::new("frame");
+    let sim_track = format!("simulation, {}", sim.mode().name());
+    let mut last_sim_frame = None;
+    let mut sink = FrameSink::new(&a.out, sa.width, sa.height, a.frames);
+    for frame in 0..a.frames {
+        let first_step = frame * steps_per_frame;
+        let heads: Vec<RigidTransform> = (0..steps_per_frame)
+            .map(|k| sa.sim.motion.head((first_step + k + 1) as f32 * sim_params.dt, s.pivot, size))
+            .collect();
+        let started = host_now_ns();
+        ctx.run_frame("vkhair render frame", |cmd| {
+            // SAFETY: run_frame hands over a recording command buffer of the
+            // context's device, submits it with the returned waits and waits for it;
+            // the profiler's single slot was drained after the previous frame.
+            unsafe {
+                profiler.begin_frame(cmd, frame as u64);
+                let sync = sim.record_frame(cmd, &heads, Some(&mut profiler))?;
+                renderer.record_prepare(cmd, sim.key_hairs(), Some(&camera), Some(&mut profiler))?;
+                renderer.record_shadows(cmd, sim.key_hairs(), Some(&mut profiler))?;
+                offscreen.record_clear(cmd, Vec3::splat(0.02));
+                let scope = profiler.begin_scope(cmd, "host: head mesh");
+                let h = sim.key_hairs().head();
+                let view_proj = camera.projection * camera.view;
+                head.record(
+                    cmd,
+                    &offscreen.target(),
+                    view_proj,
+                    (h.rotation, h.translation),
+                    Vec3::new(0.55, 0.4, 0.32),
+                    Vec3::new(0.6, -0.5, -0.8),
+                );
+                profiler.end_scope(cmd, scope);
+                renderer.record_draw(cmd, frame as u64, &offscreen.target(), &camera, Some(&mut profiler))?;
+                Ok(sync)
+            }
+        })?;
+        profile.add_cpu_span("frame: record, submit, wait", started, host_now_ns());
+        for report in profiler.drain() {
+            profile.add(&report, "graphics queue", 1);
+        }
+        // The simulation's own queue or device (ASYNC COMPUTE, SECOND DEVICE): its
+        // latest report, once per simulated frame.
+        if let Some(report) = sim.sim_profile().filter(|r| Some(r.frame) != last_sim_frame) {
+            last_sim_frame = Some(report.frame);
+            profile.add(&report, &sim_track, 1);
+        }
+        let read = host_now_ns();
+        let mut rgba = sink.buffer();
+        offscreen.read_rgba8_into(&mut rgba)?;
+        sink.push(frame, rgba)?;
+        profile.add_cpu_span("frame: read back, hand to the PNG writer", read, host_now_ns());
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    sink.finish()?;
+    profile.print_table();
+    let mode = renderer.params().transparency;
+    if mode != Transparency::Off {
+        let extent = vkhair::ash::vk::Extent2D { width: sa.width, height: sa.height };
+        let mib = renderer.transparency_memory(extent) as f64 / (1024.0 * 1024.0);
+        say!("transparency: {mode:?}, {mib:.1} MiB of lists or accumulation images");
+    }
+    if let Some(stats) = renderer.transparency_stats() {
+        say!(
+            "last frame: {} hair fragments, {} stored, {} beyond the pool blended unsorted (pool of {}; raise oit.fragments_per_pixel if many are)",
+            stats.fragments,
+            stats.stored,
+            stats.overflowed,
+            stats.capacity
+        );
+    }
+    say!("wrote {} frames and contact_sheet.png to {}", a.frames, a.out.display());
+    a.profile_out.write(&profile, || {
+        serde_json::json!({
+            "command": "render",
+            "device": ctx.info().name,
+            "scene": sa.input.input.as_ref().map_or("thesis".to_owned(), |p| p.display().to_string()),
+            "simulation": sim.mode().name(),
+            "key_hairs": strands,
+            "points_per_key_hair": points,
+            "hairs": hairs,
+            "segments_per_hair": per_hair - 1,
+            "width": sa.width,
+            "height": sa.height,
+            "frames": a.frames,
+            "iterations": sim_params.iterations,
+            "substeps": sim_params.substeps,
+            "volume": format!("{:?}", sim_params.volume.mode),
+        })
+    })?;
+    if let Some(credit) = s.credit {
+        say!("{credit}");
+    }
+    Ok(())
+}

@@ -1,0 +1,110 @@
+//! The scene `render` draws and `bench` measures: the groom (the `thesis`
+//! scene, or the user's `--input` with its `--obj` mesh), its bounds, the
+//! camera that frames it, and ([`parameters`]) the parameters and renderer
+//! of the flags.
+
+mod parameters;
+
+use std::path::PathBuf;
+
+use glam::Vec3;
+use vkhair::groom::mesh::TriMesh;
+use vkhair::groom::scenes::{self, THESIS_BOUNDING_RADIUS, THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS};
+use vkhair::groom::Groom;
+use vkhair::render::Camera;
+use vkhair::sim::{motion, Collider};
+
+pub use parameters::{make_renderer, parameters};
+
+use crate::args::input::Scaled;
+use crate::args::scene::SceneArgs;
+use crate::output::Error;
+
+/// A loaded scene.
+pub struct Scene {
+    pub groom: Groom,
+    pub colliders: Vec<Collider>,
+    pub head_mesh: TriMesh,
+    pub center: Vec3,
+    /// Radius of the sphere around the groom and the mesh (their units).
+    pub radius: f32,
+    /// Root and tip thickness the groom file gives (its units after --scale).
+    pub thickness: Option<(f32, f32)>,
+    /// Where the head turns about.
+    pub pivot: Vec3,
+    /// The credit line a picture of it must carry.
+    pub credit: Option<&'static str>,
+}
+
+/// The sphere around a set of points: centre of the box and half its diagonal.
+fn bounds_sphere(points: impl Iterator<Item = Vec3>) -> (Vec3, f32) {
+    let (lo, hi) =
+        points.fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    (0.5 * (lo + hi), 0.5 * (hi - lo).length())
+}
+
+/// The scene of `a`'s flags.
+pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
+    let sintel =
+        |p: &Option<PathBuf>| p.as_ref().is_some_and(|p| p.to_string_lossy().to_lowercase().contains("sintel"));
+    let (groom, thickness, colliders, head_mesh, pivot, credit) = match &a.input.input {
+        None => {
+            let head = TriMesh::uv_sphere(THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS * 0.97, 24, 32)?;
+            (scenes::thesis()?, None, motion::thesis_colliders(), head, Some(motion::NECK_PIVOT), None)
+        }
+        Some(path) => {
+            let scale = a.input.scale();
+            let Scaled { groom, thickness } = a.input.groom(path)?;
+            let head_mesh = match &a.input.obj {
+                Some(obj) => {
+                    let m = TriMesh::load_obj(obj)?;
+                    TriMesh::new(m.positions.iter().map(|p| *p * scale).collect(), m.triangles)?
+                }
+                None => {
+                    // A stand-in head under the roots, sized by the groom's largest
+                    // extent (a flat groom has no extent along one axis).
+                    let (lo, hi) = groom.bounds();
+                    let r = 0.25 * (hi - lo).max_element();
+                    TriMesh::uv_sphere(0.5 * (lo + hi), r, 16, 24)?
+                }
+            };
+            let credit = (sintel(&a.input.input) || sintel(&a.input.obj))
+                .then_some("Sintel © Blender Foundation | durian.blender.org (CC BY 3.0)");
+            (groom, thickness, Vec::new(), head_mesh, None, credit)
+        }
+    };
+    let (center, radius) = bounds_sphere(groom.positions().iter().chain(&head_mesh.positions).copied());
+    if !(center.is_finite() && radius.is_finite() && radius > 0.0) {
+        return Err(format!("the groom and mesh span no finite volume (bounding radius {radius})").into());
+    }
+    let (lo, _) = groom.bounds();
+    let pivot = pivot.unwrap_or(Vec3::new(center.x, lo.y, center.z));
+    Ok(Scene { groom, colliders, head_mesh, center, radius, thickness, pivot, credit })
+}
+
+/// How much wider than given the render's lengths are drawn for a scene of
+/// bounding radius `radius`: 1 for anything a head of hair in meters could be
+/// (5 cm to 1.5 m), else the factor that gives the thesis head's proportions.
+pub fn drawing_scale(radius: f32) -> f32 {
+    if (0.05..=1.5).contains(&radius) {
+        1.0
+    } else {
+        radius / THESIS_BOUNDING_RADIUS
+    }
+}
+
+/// Vertical field of view of the tool's camera, radians.
+const FOV_Y: f32 = 0.698_131_7; // 40°
+
+/// The camera looking at the scene from the front (+Z): at `distance` when
+/// given, else far enough that the bounding sphere fits the image's shorter side.
+pub fn framing(s: &Scene, distance: Option<f32>, aspect: f32) -> Result<Camera, vkhair::Error> {
+    let half = 0.5 * FOV_Y;
+    let half_narrow = if aspect >= 1.0 { half } else { (half.tan() * aspect).atan() };
+    let d = distance.unwrap_or(s.radius / half_narrow.sin());
+    let r = s.radius;
+    let eye = s.center + Vec3::new(0.0, 0.1 * r, d);
+    let near = (d - 1.5 * r).max(0.002 * d);
+    let far = d + 1.5 * r;
+    Camera::look_at(eye, s.center, FOV_Y, aspect, near, far)
+}

@@ -1,0 +1,130 @@
+//! The parameters and the renderer of a scene's flags.
+
+use vkhair::config::Config;
+use vkhair::render::{
+    InterpolationMode, Light, Primitive, Renderer, ShadingMode, ShadowCaster, ShadowParams, Transparency,
+};
+use vkhair::sim::{KeyHairs, SimParams, VolumeMode, VolumeParams};
+use vkhair::GpuContext;
+
+use super::{drawing_scale, Scene};
+use crate::args::input::strand_widths;
+use crate::args::scene::SceneArgs;
+use crate::say;
+
+/// The parameters: vkhair's defaults (an `--input` groom held in its authored
+/// style, [`SimParams::styled`]; strands as wide as the groom file says when it
+/// says something plausible), then the `--config` file, then the flags given;
+/// the tool's lights when the file lists none. Checked before any GPU work.
+pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
+    let (center, radius) = (s.center, s.radius);
+    let sim = if a.input.input.is_some() { SimParams::styled() } else { SimParams::default() };
+    let mut base = Config { sim, ..Config::default() };
+    // The tool draws soft hair unless told otherwise (the library's default is opaque).
+    base.render.transparency = Transparency::Exact;
+    let k = drawing_scale(radius);
+    let from_groom = strand_widths(s.thickness, k);
+    if let Some((root, tip)) = from_groom {
+        // In the units the scale below converts from, so that they come out as given.
+        (base.material.root_width, base.material.tip_width) = (root / k, tip / k);
+    }
+    let base_widths = (base.material.root_width, base.material.tip_width);
+    let mut config = match &a.config {
+        Some(path) => base.load_over(path)?,
+        None => base,
+    };
+    let r = &mut config.render;
+    if let Some(level) = a.level {
+        r.smoothing_level = level;
+    }
+    if let Some(hairs) = a.hairs_per_key {
+        r.hairs_per_key = hairs;
+    }
+    r.supersampling |= a.ssaa;
+    r.lod.enabled &= !a.no_lod;
+    if a.barycentric {
+        r.interpolation = InterpolationMode::Barycentric;
+    }
+    if a.lines {
+        r.primitive = Primitive::Lines;
+        r.transparency = Transparency::Off;
+    }
+    if let Some(k) = a.sorted_fragments {
+        r.oit.sorted_fragments = k;
+    }
+    if let Some(t) = a.transparency {
+        r.transparency = t;
+    }
+    if a.marschner {
+        config.material.shading = ShadingMode::Marschner;
+    }
+    a.sim.apply(&mut config.sim);
+    if a.volume_shadows && config.sim.volume.mode == VolumeMode::Off {
+        config.sim.volume = VolumeParams::flip([32, 32, 32]);
+    }
+    if config.lights.is_empty() {
+        config.lights = Light::thesis_rig(center, radius).to_vec();
+    }
+    let m = &config.material;
+    let source = match from_groom {
+        _ if a.config.is_some() && (m.root_width, m.tip_width) != base_widths => "--config",
+        Some(_) => "the groom's thickness",
+        None => "vkhair's default",
+    };
+    say!("strand width: {:.1} µm at the root, {:.1} µm at the tip ({source})", m.root_width * 1e6, m.tip_width * 1e6);
+    if k != 1.0 {
+        eprintln!(
+            "vkhair: warning: the groom and mesh span {:.3} units around their centre, not the size of a \
+             head of hair in meters (vkhair's unit); drawing clumps, hair widths and shadow layers {k:.3}× as wide to match \
+             (give --scale to convert the groom itself: the simulation stays in meters)",
+            radius
+        );
+        config.render.clump_width *= k;
+        config.render.lod.full_detail_distance *= k;
+        config.material.root_width *= k;
+        config.material.tip_width *= k;
+    }
+    config.validate()?;
+    Ok(config)
+}
+
+/// The renderer `render` draws with: parameters, lights, the two spot lights'
+/// shadows and the material of `config`.
+pub fn make_renderer(
+    a: &SceneArgs,
+    ctx: &GpuContext,
+    config: &Config,
+    key_hairs: KeyHairs<'_>,
+    radius: f32,
+) -> Result<Renderer, vkhair::Error> {
+    let mut renderer = Renderer::new(ctx, key_hairs, &config.render)?;
+    renderer.set_lights(&config.lights)?;
+    if !a.no_shadows {
+        // The thesis' setup: both spot lights cast shadows through their own maps.
+        let casters = if a.volume_shadows {
+            vec![ShadowCaster::density_volume(0), ShadowCaster::density_volume(1)]
+        } else {
+            vec![0.into(), 1.into()]
+        };
+        let layers = ShadowParams::default().layers.map(|l| l * drawing_scale(radius));
+        let shadows = ShadowParams { casters, resolution: a.shadow_resolution, layers, ..ShadowParams::default() };
+        renderer.set_shadows(key_hairs, &shadows)?;
+    }
+    let mut material = config.material.clone();
+    if material.represented_hairs == 1.0 {
+        material.represented_hairs = represented_hairs(renderer.hair_counts().0);
+    }
+    renderer.set_material(&material)?;
+    Ok(renderer)
+}
+
+/// Hairs on a full head of real hair, for the tool's default of
+/// [`vkhair::render::HairMaterial::represented_hairs`].
+pub const FULL_HEAD_HAIRS: f32 = 100_000.0;
+
+/// The tool's default hairs per drawn strand for `drawn` strands: a full head
+/// ([`FULL_HEAD_HAIRS`]) over the strands drawn at full detail, at least 1
+/// (`material.represented_hairs` in a `--config` file other than 1 wins).
+pub fn represented_hairs(drawn: u32) -> f32 {
+    (FULL_HEAD_HAIRS / drawn.max(1) as f32).clamp(1.0, 10_000.0)
+}
