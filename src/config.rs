@@ -39,6 +39,11 @@ use crate::error::{Error, Result};
 use crate::render::{HairMaterial, Light, RenderParams, MAX_LIGHTS};
 use crate::sim::{MeshColliderParams, SimParams};
 
+/// The most vkhair reads of a parameter file unless
+/// [`crate::files::MAX_INPUT_ENV`] says otherwise: 1 MiB (the defaults take
+/// about 2 KiB).
+pub const MAX_CONFIG_BYTES: u64 = 1 << 20;
+
 /// Everything a parameter file can set.
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -58,9 +63,17 @@ pub struct Config {
 }
 
 impl Config {
-    /// Reads `path` and applies it over `self` (see [`Config::apply`]).
+    /// Reads `path` (at most [`MAX_CONFIG_BYTES`], or
+    /// [`crate::files::MAX_INPUT_ENV`]'s cap) and applies it over `self` (see
+    /// [`Config::apply`]).
     pub fn load_over(&self, path: &Path) -> Result<Config> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.into(), source })?;
+        let cap = crate::files::input_cap(MAX_CONFIG_BYTES)?;
+        let data = crate::files::read_capped(path, cap, "a parameter file")?;
+        let text = String::from_utf8(data).map_err(|e| {
+            let valid = e.utf8_error().valid_up_to();
+            let line = 1 + e.as_bytes()[..valid].iter().filter(|&&b| b == b'\n').count();
+            Error::Config { path: path.into(), line: Some(line), key: String::new(), reason: "not UTF-8 text".into() }
+        })?;
         self.apply(&text, path)
     }
 
@@ -102,7 +115,7 @@ impl Config {
         if self.lights.len() > MAX_LIGHTS {
             return Err(Error::param("lights", self.lights.len(), format!("at most {MAX_LIGHTS}")));
         }
-        self.lights.iter().try_for_each(|l| l.to_gpu().map(|_| ()))
+        self.lights.iter().try_for_each(Light::validate)
     }
 
     /// This configuration as TOML with every key commented out, under a header
@@ -179,6 +192,10 @@ fn key_at(text: &str, offset: usize) -> String {
     let line = line_of(text, offset);
     let lines: Vec<&str> = text.lines().collect();
     let own = lines.get(line - 1).copied().unwrap_or_default();
+    if own.trim_start().starts_with('[') {
+        // A table header names itself, whatever table came before it.
+        return own.trim().trim_matches(['[', ']']).trim().to_owned();
+    }
     let key = own.split('=').next().unwrap_or_default().trim().trim_matches(['[', ']']).trim();
     let section = lines[..line.saturating_sub(1).min(lines.len())]
         .iter()
@@ -264,6 +281,9 @@ mod tests {
         assert_eq!((line, key.as_str(), reason.as_str()), (Some(5), "sim.volume.resolutoin", "unknown key"));
         let (line, key, _) = config_error("colour = 1\n");
         assert_eq!((line, key.as_str()), (Some(1), "colour"));
+        // An unknown table after another names itself, not a key of the one before.
+        let (line, key, reason) = config_error("[sim]\ndt = 0.01\n[bogus]\nx = 1\n");
+        assert_eq!((line, key.as_str(), reason.as_str()), (Some(3), "bogus", "unknown key"));
     }
 
     #[test]

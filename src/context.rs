@@ -26,8 +26,9 @@ pub struct ContextOptions {
     pub validation: bool,
     /// Where validation warnings/errors go (also logged through `log`). Default: none.
     pub validation_log: Option<ValidationLog>,
-    /// Device name substring to force; default: `VKHAIR_DEVICE`, else the best device
-    /// (discrete > integrated > virtual > CPU).
+    /// Device name substring to force; default: `VKHAIR_DEVICE` (a value that is
+    /// not UTF-8 matches no device), else the best device (discrete > integrated >
+    /// virtual > CPU).
     pub device_name: Option<String>,
     /// Application name reported to the driver. Default: `"vkhair"`.
     pub app_name: String,
@@ -38,7 +39,11 @@ impl Default for ContextOptions {
         ContextOptions {
             validation: std::env::var(VALIDATION_ENV).is_ok_and(|v| v == "1"),
             validation_log: None,
-            device_name: std::env::var(DEVICE_ENV).ok().filter(|s| !s.is_empty()),
+            // Not UTF-8: kept (lossily), so that it matches no device and says so
+            // rather than being ignored.
+            device_name: std::env::var_os(DEVICE_ENV)
+                .filter(|s| !s.is_empty())
+                .map(|s| s.to_string_lossy().into_owned()),
             app_name: "vkhair".into(),
         }
     }

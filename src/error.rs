@@ -141,6 +141,30 @@ pub enum Error {
         /// What was wrong with it.
         source: Box<Error>,
     },
+    /// An input file is larger than what vkhair reads of such a file: its
+    /// format's limits, or [`crate::files::MAX_INPUT_ENV`]'s cap on files with
+    /// no header to bound them (set it to read larger ones).
+    #[error("{}: more than {cap} bytes, the most vkhair reads of {what}{hint}", path.display())]
+    InputTooLarge {
+        /// The file.
+        path: PathBuf,
+        /// What kind of file it is.
+        what: &'static str,
+        /// The cap, bytes.
+        cap: u64,
+        /// How to raise the cap, when it can be raised.
+        hint: &'static str,
+    },
+    /// An output was not written because writing it would clobber what it
+    /// should not: a symbolic link in the output's place, an input of the same
+    /// run, another output of the same run.
+    #[error("{}: not written: {reason}", path.display())]
+    OutputRefused {
+        /// The output path.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
     /// Reading or writing a file failed.
     #[error("{path}: {source}")]
     Io {
@@ -203,6 +227,12 @@ pub enum Error {
     /// A groom has no strands.
     #[error("the groom has no strands")]
     EmptyGroom,
+    /// Repairing a groom dropped every strand: what was dropped and why.
+    #[error("no strand remains after repairing the groom: {repairs}")]
+    NothingLeft {
+        /// What the repair dropped ([`crate::groom::Repairs`] as text).
+        repairs: String,
+    },
     /// More strands than [`crate::groom::MAX_STRANDS`].
     #[error("{count} strands exceed the limit of {max}")]
     TooManyStrands {
@@ -325,7 +355,7 @@ impl Error {
     /// This error as the reason the file at `path` could not be read.
     pub(crate) fn in_asset(self, path: &std::path::Path) -> Error {
         match self {
-            e @ (Error::Io { .. } | Error::Asset { .. }) => e,
+            e @ (Error::Io { .. } | Error::Asset { .. } | Error::InputTooLarge { .. }) => e,
             e => Error::Asset { path: path.to_path_buf(), source: Box::new(e) },
         }
     }

@@ -1,31 +1,154 @@
-//! Writing files so that they appear whole or not at all.
+//! Reading input files with a bound decided before reading, and writing files
+//! so that they appear whole or not at all.
+//!
+//! Every file the crate reads goes through [`read_announced`] (a binary
+//! format whose header says how long the file is: `.hair`, `.tfx`) or
+//! [`read_capped`] (text formats: OBJ meshes, TOML parameter files), so that a
+//! wrong path — a device such as `/dev/zero`, a FIFO, a huge file — gives an
+//! error naming the file and the cap instead of exhausting memory.
 
-use std::io::Write;
+use std::fs::File;
+use std::io::{Read, Write};
 use std::os::unix::fs::PermissionsExt;
 use std::path::Path;
 
 use crate::error::{Error, Result};
 
+/// The environment variable that sets the cap (bytes) on input files with no
+/// header to bound them (OBJ meshes, TOML parameter files, the tool's CSVs),
+/// for a real file larger than the defaults.
+pub const MAX_INPUT_ENV: &str = "VKHAIR_MAX_INPUT_BYTES";
+
+/// The cap on a headerless input whose default cap is `default`: the value of
+/// [`MAX_INPUT_ENV`] when set (a whole number of bytes), else `default`.
+pub fn input_cap(default: u64) -> Result<u64> {
+    match std::env::var_os(MAX_INPUT_ENV) {
+        None => Ok(default),
+        Some(value) => value.to_str().and_then(|v| v.trim().parse::<u64>().ok()).filter(|&v| v > 0).ok_or_else(|| {
+            Error::param("VKHAIR_MAX_INPUT_BYTES", value.to_string_lossy(), "a whole number of bytes above 0")
+        }),
+    }
+}
+
+fn open_input(path: &Path) -> Result<(File, Option<u64>)> {
+    use std::os::unix::fs::OpenOptionsExt;
+    let io = |source| Error::Io { path: path.into(), source };
+    // Opened without blocking: a FIFO no process writes to reads as empty
+    // instead of blocking forever. Reads then block as usual.
+    let file = std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK).open(path).map_err(io)?;
+    {
+        use std::os::fd::AsRawFd;
+        let fd = file.as_raw_fd();
+        // SAFETY: fcntl on a descriptor this function owns; clears O_NONBLOCK.
+        let cleared = unsafe {
+            let flags = libc::fcntl(fd, libc::F_GETFL);
+            flags >= 0 && libc::fcntl(fd, libc::F_SETFL, flags & !libc::O_NONBLOCK) == 0
+        };
+        if !cleared {
+            return Err(io(std::io::Error::last_os_error()));
+        }
+    }
+    let meta = file.metadata().map_err(io)?;
+    if meta.is_dir() {
+        return Err(Error::Io { path: path.into(), source: std::io::Error::other("a folder, not a file") });
+    }
+    // The length of a regular file; devices and FIFOs have none to trust.
+    Ok((file, meta.is_file().then_some(meta.len())))
+}
+
+/// Reads all of `path`, a `what` of at most `cap` bytes: a regular file larger
+/// than `cap` is refused before reading, and anything else (a device, a FIFO)
+/// is read up to `cap` bytes and refused beyond.
+pub fn read_capped(path: &Path, cap: u64, what: &'static str) -> Result<Vec<u8>> {
+    let too_large = || Error::InputTooLarge {
+        path: path.into(),
+        what,
+        cap,
+        hint: " (set VKHAIR_MAX_INPUT_BYTES to read a larger one)",
+    };
+    let (file, len) = open_input(path)?;
+    if len.is_some_and(|len| len > cap) {
+        return Err(too_large());
+    }
+    let mut data = Vec::new();
+    file.take(cap.saturating_add(1))
+        .read_to_end(&mut data)
+        .map_err(|source| Error::Io { path: path.into(), source })?;
+    if data.len() as u64 > cap {
+        return Err(too_large());
+    }
+    Ok(data)
+}
+
+/// Reads the `header_len`-byte header of `path`, then at most the length in
+/// bytes that `announced` computes from it (header included), which refuses a
+/// header that is not the format's or announces more than its limits allow.
+/// A file shorter than its header or its announced length is returned as it
+/// is (the parser reports the truncation); bytes after the announced length
+/// are not read.
+pub fn read_announced(path: &Path, header_len: u64, announced: impl FnOnce(&[u8]) -> Result<u64>) -> Result<Vec<u8>> {
+    let io = |source| Error::Io { path: path.into(), source };
+    let (file, _) = open_input(path)?;
+    let mut reader = file.take(header_len);
+    let mut data = Vec::new();
+    reader.read_to_end(&mut data).map_err(io)?;
+    if (data.len() as u64) < header_len {
+        return Ok(data);
+    }
+    let total = announced(&data).map_err(|e| e.in_asset(path))?;
+    let mut rest = reader.into_inner().take(total.saturating_sub(header_len));
+    rest.read_to_end(&mut data).map_err(io)?;
+    Ok(data)
+}
+
+/// Temporary files being written by [`write_atomic`] in this process.
+static IN_PROGRESS: std::sync::Mutex<Vec<std::path::PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Removes the temporary files of every [`write_atomic`] in progress in this
+/// process, then runs `then` with their count while no new one can start: for
+/// a program about to exit on a signal (`then` exits), so that no
+/// `.NAME.*.partial` file stays behind.
+pub fn remove_partial_files_then<R>(then: impl FnOnce(usize) -> R) -> R {
+    let mut files = IN_PROGRESS.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let n = files.len();
+    for path in files.drain(..) {
+        let _ = std::fs::remove_file(path);
+    }
+    then(n)
+}
+
 /// Writes `bytes` to `path` through a temporary file in the same folder that then
 /// replaces `path`: a failed write, a full disk or a killed process leaves either
-/// the old file or none, never a truncated one. The error names `path`.
+/// the old file or none, never a truncated one (a process that handles its
+/// signals removes the temporary file with [`remove_partial_files_then`]). The error
+/// names `path`.
 ///
-/// A `path` that is a symbolic link has its target replaced (the link stays); one
-/// that is not a regular file (`/dev/stdout`, a pipe, a device) is written in place,
-/// since it cannot be replaced.
+/// A symbolic link in `path`'s place is never followed to a file: the write is
+/// refused ([`Error::OutputRefused`]), since replacing the link's target
+/// could clobber a file the caller never named. A `path` that is not a regular
+/// file, or a link to one that is not (`/dev/stdout`, a pipe, a device), is
+/// written in place, since it cannot be replaced.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let io = |source| Error::Io { path: path.into(), source };
-    let resolved = match std::fs::canonicalize(path) {
-        Ok(target) => target,
-        Err(_) => path.to_path_buf(), // not there yet (or a dangling link: replaced)
-    };
-    if resolved.exists() && !resolved.is_file() {
-        let mut file = std::fs::OpenOptions::new().write(true).open(&resolved).map_err(io)?;
-        file.write_all(bytes).map_err(io)?;
-        return file.flush().map_err(io);
+    let special = |p: &Path| std::fs::metadata(p).is_ok_and(|m| !m.is_file() && !m.is_dir());
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() && !special(path) => {
+            let target = std::fs::read_link(path).map(|t| t.display().to_string()).unwrap_or_default();
+            return Err(Error::OutputRefused {
+                path: path.into(),
+                reason: format!(
+                    "a symbolic link (to {target}) is in its place; vkhair does not write through links to files \
+                     (remove the link or choose another path)"
+                ),
+            });
+        }
+        Ok(_) if special(path) => {
+            let mut file = std::fs::OpenOptions::new().write(true).open(path).map_err(io)?;
+            file.write_all(bytes).map_err(io)?;
+            return file.flush().map_err(io);
+        }
+        _ => {}
     }
-    let path_buf = resolved;
-    let path = path_buf.as_path();
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -37,16 +160,27 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         Ok(old) => old.permissions(),
         Err(_) => std::fs::Permissions::from_mode(0o666),
     };
-    let mut file = tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(".partial")
-        .permissions(permissions)
-        .tempfile_in(dir)
-        .map_err(io)?;
-    file.write_all(bytes).map_err(io)?;
-    file.as_file().sync_all().map_err(io)?;
-    file.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+    // Made and registered under the lock, so that a signal's clean-up
+    // (remove_partial_files_then) either removes it or runs before it exists.
+    let (mut file, partial) = {
+        let mut in_progress = IN_PROGRESS.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        let file = tempfile::Builder::new()
+            .prefix(&format!(".{name}."))
+            .suffix(".partial")
+            .permissions(permissions)
+            .tempfile_in(dir)
+            .map_err(io)?;
+        let partial = file.path().to_path_buf();
+        in_progress.push(partial.clone());
+        (file, partial)
+    };
+    let written = file
+        .write_all(bytes)
+        .and_then(|_| file.as_file().sync_all())
+        .map_err(io)
+        .and_then(|_| file.persist(path).map(drop).map_err(|e| io(e.error)));
+    IN_PROGRESS.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).retain(|p| *p != partial);
+    written
 }
 
 #[cfg(test)]
@@ -95,15 +229,57 @@ mod tests {
         assert!(!kind.is_file(), "/dev/full was replaced by a regular file");
     }
 
+    /// A link planted in an output's place (`out/frame_0000.png -> ../victim`)
+    /// is refused, and neither the link nor its target changes; a dangling
+    /// link too. A link to a device (`/dev/stdout` is one) is written through.
     #[test]
-    fn a_link_keeps_pointing_at_the_new_contents() {
+    fn a_link_in_the_outputs_place_is_refused_not_followed() {
         let dir = tempfile::tempdir().expect("temp dir");
-        let target = dir.path().join("target.bin");
-        let link = dir.path().join("link.bin");
-        std::fs::write(&target, b"old").expect("write");
-        std::os::unix::fs::symlink(&target, &link).expect("link");
-        write_atomic(&link, b"new").expect("write through the link");
+        let victim = dir.path().join("victim.txt");
+        let link = dir.path().join("frame_0000.png");
+        std::fs::write(&victim, b"precious").expect("write");
+        std::os::unix::fs::symlink(&victim, &link).expect("link");
+        let err = write_atomic(&link, b"png bytes").expect_err("a link to a file");
+        assert!(matches!(err, Error::OutputRefused { .. }), "{err}");
+        assert!(err.to_string().contains("symbolic link"), "{err}");
+        assert_eq!(std::fs::read(&victim).expect("read"), b"precious");
         assert!(std::fs::symlink_metadata(&link).expect("link").file_type().is_symlink());
-        assert_eq!(std::fs::read(&target).expect("read"), b"new");
+        let dangling = dir.path().join("dangling.json");
+        std::os::unix::fs::symlink(dir.path().join("nowhere"), &dangling).expect("link");
+        assert!(matches!(write_atomic(&dangling, b"{}"), Err(Error::OutputRefused { .. })));
+        assert!(!dir.path().join("nowhere").exists());
+        let null_link = dir.path().join("null");
+        std::os::unix::fs::symlink("/dev/null", &null_link).expect("link");
+        write_atomic(&null_link, b"discarded").expect("a link to a device is written through");
+        let leftovers = std::fs::read_dir(dir.path()).expect("list").filter_map(|e| e.ok());
+        assert!(leftovers.map(|e| e.file_name()).all(|n| !n.to_string_lossy().ends_with(".partial")));
+    }
+
+    /// Reads are bounded: a regular file over the cap is refused before reading,
+    /// a device is read up to the cap, a header-bounded read stops at what the
+    /// header announces.
+    #[test]
+    fn reads_stop_at_their_bound() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let big = dir.path().join("big.obj");
+        std::fs::write(&big, vec![b'#'; 1000]).expect("write");
+        let err = read_capped(&big, 999, "an OBJ mesh").expect_err("over the cap");
+        assert!(matches!(err, Error::InputTooLarge { cap: 999, .. }), "{err}");
+        assert!(err.to_string().contains("big.obj") && err.to_string().contains("VKHAIR_MAX_INPUT_BYTES"), "{err}");
+        assert_eq!(read_capped(&big, 1000, "an OBJ mesh").expect("at the cap").len(), 1000);
+        if Path::new("/dev/zero").exists() {
+            let err = read_capped(Path::new("/dev/zero"), 4096, "an OBJ mesh").expect_err("an endless device");
+            assert!(matches!(err, Error::InputTooLarge { .. }), "{err}");
+            let data = read_announced(Path::new("/dev/zero"), 16, |_| Ok(100)).expect("bounded by the header");
+            assert_eq!(data.len(), 100);
+            let refused = read_announced(Path::new("/dev/zero"), 16, |_| Err(Error::EmptyGroom));
+            assert!(refused.expect_err("refused header").to_string().contains("/dev/zero"));
+        } else {
+            eprintln!("SKIPPED the device half: this system has no /dev/zero");
+        }
+        let short = dir.path().join("short.hair");
+        std::fs::write(&short, b"HAI").expect("write");
+        assert_eq!(read_announced(&short, 128, |_| panic!("no header to read")).expect("short").len(), 3);
+        assert!(read_capped(dir.path(), 10, "a folder").is_err());
     }
 }

@@ -20,6 +20,7 @@ fn is_file_error(e: &Error) -> bool {
             | Error::Malformed { .. }
             | Error::Unsupported { .. }
             | Error::EmptyGroom
+            | Error::NothingLeft { .. }
             | Error::TooManyStrands { .. }
             | Error::TooManyPoints { .. }
             | Error::StrandPointCount { .. }

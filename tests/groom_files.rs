@@ -437,3 +437,23 @@ fn unreadable_assets_name_their_file() {
     assert!(matches!(HairFile::open(&missing), Err(Error::Io { path, .. }) if path == missing));
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+/// The README's caps: an OBJ file over 256 MiB is refused before reading (a
+/// sparse file: nothing is written or read), naming the file and the cap; a
+/// `.hair` file is bounded by its format's limits, 520 MiB.
+#[test]
+fn input_caps_hold_before_reading() {
+    use vkhair::groom::mesh::{TriMesh, MAX_OBJ_BYTES};
+    assert_eq!(MAX_OBJ_BYTES, 256 << 20);
+    assert_eq!(HairFile::MAX_FILE_BYTES, (520 << 20) + 128);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let big = dir.path().join("big.obj");
+    std::fs::File::create(&big).expect("create").set_len(MAX_OBJ_BYTES + 1).expect("sparse");
+    match TriMesh::load_obj(&big) {
+        Err(e @ Error::InputTooLarge { cap, .. }) => {
+            assert_eq!(cap, MAX_OBJ_BYTES);
+            assert!(e.to_string().contains("big.obj"), "{e}");
+        }
+        other => panic!("expected InputTooLarge, got {other:?}"),
+    }
+}

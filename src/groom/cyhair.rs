@@ -32,6 +32,88 @@ const HAS_TRANSPARENCY: u32 = 8;
 const HAS_COLORS: u32 = 16;
 const KNOWN_FLAGS: u32 = 31;
 
+/// The header and the arrays it announces of the `.hair` file at `path`.
+fn read(path: &Path) -> Result<Vec<u8>> {
+    crate::files::read_announced(path, HEADER_SIZE, |header| {
+        let h = Header::read(&Reader { data: header, format: FileFormat::CyHair })?;
+        Ok(HEADER_SIZE + Header::arrays_len(h.hair_count, h.point_count, h.flags))
+    })
+}
+
+/// What the 128-byte header says, checked against the format and the limits.
+struct Header {
+    hair_count: u64,
+    point_count: u64,
+    flags: u32,
+    defaults: HairDefaults,
+    info: [u8; INFO_LEN],
+}
+
+impl Header {
+    fn read(r: &Reader<'_>) -> Result<Header> {
+        let magic = r.bytes(0, 4, "signature")?;
+        if magic != MAGIC {
+            return Err(Error::BadMagic {
+                format: FileFormat::CyHair,
+                reason: format!("signature is {magic:02x?}, expected \"HAIR\""),
+            });
+        }
+        r.bytes(0, HEADER_SIZE, "header")?;
+        let hair_count = u64::from(r.u32(4, "hair count")?);
+        let point_count = u64::from(r.u32(8, "point count")?);
+        let flags = r.u32(12, "array flags")?;
+        let defaults = HairDefaults {
+            segments: r.u32(16, "default segments")?,
+            thickness: r.f32(20, "default thickness")?,
+            transparency: r.f32(24, "default transparency")?,
+            color: [r.f32(28, "default color")?, r.f32(32, "default color")?, r.f32(36, "default color")?],
+        };
+        let mut info = [0u8; INFO_LEN];
+        info.copy_from_slice(r.bytes(40, INFO_LEN as u64, "info string")?);
+        if flags & !KNOWN_FLAGS != 0 {
+            return Err(Error::Unsupported {
+                format: FileFormat::CyHair,
+                reason: format!("unknown array flags {:#x}", flags & !KNOWN_FLAGS),
+            });
+        }
+        if flags & HAS_POINTS == 0 {
+            return Err(Error::Unsupported {
+                format: FileFormat::CyHair,
+                reason: "the file has no points array".into(),
+            });
+        }
+        if hair_count == 0 {
+            return Err(Error::EmptyGroom);
+        }
+        if hair_count > MAX_STRANDS as u64 {
+            return Err(Error::TooManyStrands { count: hair_count, max: MAX_STRANDS as u64 });
+        }
+        if point_count > MAX_POINTS as u64 {
+            return Err(Error::TooManyPoints { count: point_count, max: MAX_POINTS as u64 });
+        }
+        if !defaults.thickness.is_finite()
+            || !defaults.transparency.is_finite()
+            || !defaults.color.iter().all(|c| c.is_finite())
+        {
+            return Err(Error::Malformed {
+                format: FileFormat::CyHair,
+                reason: "a header default is NaN or infinite".into(),
+            });
+        }
+        Ok(Header { hair_count, point_count, flags, defaults, info })
+    }
+
+    /// Bytes of the arrays after the header.
+    fn arrays_len(hair_count: u64, point_count: u64, flags: u32) -> u64 {
+        let per_point = 12
+            + if flags & HAS_THICKNESS != 0 { 4 } else { 0 }
+            + if flags & HAS_TRANSPARENCY != 0 { 4 } else { 0 }
+            + if flags & HAS_COLORS != 0 { 12 } else { 0 };
+        let segments_bytes = if flags & HAS_SEGMENTS != 0 { 2 * hair_count } else { 0 };
+        segments_bytes + per_point * point_count
+    }
+}
+
 /// Header defaults that apply where an array is absent.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HairDefaults {
@@ -87,20 +169,24 @@ impl HairFile {
         String::from_utf8_lossy(&self.info[..end]).into_owned()
     }
 
-    /// Reads a `.hair` file from disk, refusing any defect.
+    /// Reads a `.hair` file from disk, refusing any defect. Only the header and
+    /// the arrays it announces are read (at most [`HairFile::MAX_FILE_BYTES`]).
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
-        Self::parse(&data).map_err(|e| e.in_asset(path))
+        Self::parse(&read(path)?).map_err(|e| e.in_asset(path))
     }
 
     /// Reads a `.hair` file from disk, repairing what can be repaired (see
     /// [`Groom::repaired`]).
     pub fn open_repairing(path: impl AsRef<Path>) -> Result<(Self, Repairs)> {
         let path = path.as_ref();
-        let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
-        Self::parse_repairing(&data).map_err(|e| e.in_asset(path))
+        Self::parse_repairing(&read(path)?).map_err(|e| e.in_asset(path))
     }
+
+    /// The largest `.hair` file the limits allow ([`MAX_STRANDS`] hairs of a
+    /// segments array, [`MAX_POINTS`] points of every array): what vkhair
+    /// reads of one at most.
+    pub const MAX_FILE_BYTES: u64 = HEADER_SIZE + 2 * MAX_STRANDS as u64 + 32 * MAX_POINTS as u64;
 
     /// Parses `.hair` bytes, repairing what can be repaired (see
     /// [`Groom::repaired`]).
@@ -125,62 +211,11 @@ impl HairFile {
 
     fn parse_as(data: &[u8], load: Load) -> Result<(Self, Option<Repairs>)> {
         let r = Reader { data, format: FileFormat::CyHair };
-        let magic = r.bytes(0, 4, "signature")?;
-        if magic != MAGIC {
-            return Err(Error::BadMagic {
-                format: FileFormat::CyHair,
-                reason: format!("signature is {magic:02x?}, expected \"HAIR\""),
-            });
-        }
-        r.bytes(0, HEADER_SIZE, "header")?;
-        let hair_count = u64::from(r.u32(4, "hair count")?);
-        let point_count = u64::from(r.u32(8, "point count")?);
-        let flags = r.u32(12, "array flags")?;
-        let defaults = HairDefaults {
-            segments: r.u32(16, "default segments")?,
-            thickness: r.f32(20, "default thickness")?,
-            transparency: r.f32(24, "default transparency")?,
-            color: [r.f32(28, "default color")?, r.f32(32, "default color")?, r.f32(36, "default color")?],
-        };
-        let mut info = [0u8; INFO_LEN];
-        info.copy_from_slice(r.bytes(40, INFO_LEN as u64, "info string")?);
+        let Header { hair_count, point_count, flags, defaults, info } = Header::read(&r)?;
         let malformed = |reason: String| Error::Malformed { format: FileFormat::CyHair, reason };
-
-        if flags & !KNOWN_FLAGS != 0 {
-            return Err(Error::Unsupported {
-                format: FileFormat::CyHair,
-                reason: format!("unknown array flags {:#x}", flags & !KNOWN_FLAGS),
-            });
-        }
-        if flags & HAS_POINTS == 0 {
-            return Err(Error::Unsupported {
-                format: FileFormat::CyHair,
-                reason: "the file has no points array".into(),
-            });
-        }
-        if hair_count == 0 {
-            return Err(Error::EmptyGroom);
-        }
-        if hair_count > MAX_STRANDS as u64 {
-            return Err(Error::TooManyStrands { count: hair_count, max: MAX_STRANDS as u64 });
-        }
-        if point_count > MAX_POINTS as u64 {
-            return Err(Error::TooManyPoints { count: point_count, max: MAX_POINTS as u64 });
-        }
-        if !defaults.thickness.is_finite()
-            || !defaults.transparency.is_finite()
-            || !defaults.color.iter().all(|c| c.is_finite())
-        {
-            return Err(malformed("a header default is NaN or infinite".into()));
-        }
         // Size check of everything the header announces, before allocating.
-        let per_point = 12
-            + if flags & HAS_THICKNESS != 0 { 4 } else { 0 }
-            + if flags & HAS_TRANSPARENCY != 0 { 4 } else { 0 }
-            + if flags & HAS_COLORS != 0 { 12 } else { 0 };
         let segments_bytes = if flags & HAS_SEGMENTS != 0 { 2 * hair_count } else { 0 };
-        let needed = segments_bytes + per_point * point_count;
-        r.bytes(HEADER_SIZE, needed, "arrays announced by the header")?;
+        r.bytes(HEADER_SIZE, Header::arrays_len(hair_count, point_count, flags), "arrays announced by the header")?;
 
         let mut offset = HEADER_SIZE;
         let counts: Vec<u32> = if flags & HAS_SEGMENTS != 0 {

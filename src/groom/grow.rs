@@ -55,23 +55,24 @@ impl Scalp {
 }
 
 /// How strands grow. Lengths are in the scalp's unit.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct GrowParams {
     /// Number of strands (1..=4,194,304). Default: 1000.
     pub strands: usize,
     /// Points per strand (2..=65,536). Default: 16.
     pub points_per_strand: usize,
-    /// Strand length, scalp units (> 0). Default: 0.3.
+    /// Strand length, scalp units (0 < length ≤ 1e6). Default: 0.3.
     pub length: f32,
     /// Random length variation as a fraction of `length` (0..1). Default: 0.1.
     pub length_jitter: f32,
-    /// Bending toward gravity, radians per unit normalised length (≥ 0). Default: 2.5.
+    /// Bending toward gravity, radians per unit normalised length (0..=1000). Default: 2.5.
     pub droop: f32,
-    /// Gravity direction (non-zero; normalised). Default: −Y.
+    /// Gravity direction (non-zero, each component within ±1e6; normalised). Default: −Y.
     pub gravity: Vec3,
     /// Random tilt of the root direction, radians (0..=π/2). Default: 0.15.
     pub direction_jitter: f32,
-    /// Ratio of the last segment's length to the first (> 0). Default: 2.0.
+    /// Ratio of the last segment's length to the first (0 < ratio ≤ 1000). Default: 2.0.
     pub segment_growth: f32,
     /// Direction added to every root direction before the strand bends under
     /// gravity (combing: e.g. backward to keep hair off the face; length ≈ strength).
@@ -99,7 +100,8 @@ impl Default for GrowParams {
 }
 
 impl GrowParams {
-    fn validate(&self) -> Result<()> {
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<()> {
         if !(1..=MAX_STRANDS).contains(&self.strands) {
             return Err(Error::param("strands", self.strands, format!("1..={MAX_STRANDS}")));
         }
@@ -116,20 +118,20 @@ impl GrowParams {
                 max: MAX_POINTS as u64,
             });
         }
-        let positive = |name, v: f32| {
-            if v.is_finite() && v > 0.0 {
+        let positive = |name, v: f32, max: f32| {
+            if v.is_finite() && v > 0.0 && v <= max {
                 Ok(())
             } else {
-                Err(Error::param(name, v, "finite and > 0"))
+                Err(Error::param(name, v, format!("(0, {max}]")))
             }
         };
-        positive("length", self.length)?;
-        positive("segment_growth", self.segment_growth)?;
+        positive("length", self.length, 1e6)?;
+        positive("segment_growth", self.segment_growth, 1e3)?;
         if !(self.length_jitter.is_finite() && (0.0..1.0).contains(&self.length_jitter)) {
             return Err(Error::param("length_jitter", self.length_jitter, "0..1"));
         }
-        if !(self.droop.is_finite() && self.droop >= 0.0) {
-            return Err(Error::param("droop", self.droop, "finite and ≥ 0"));
+        if !(self.droop.is_finite() && (0.0..=1e3).contains(&self.droop)) {
+            return Err(Error::param("droop", self.droop, "0..=1000"));
         }
         if !(self.direction_jitter.is_finite() && (0.0..=std::f32::consts::FRAC_PI_2).contains(&self.direction_jitter))
         {
@@ -138,8 +140,9 @@ impl GrowParams {
         if !self.comb.is_finite() || self.comb.length() > 100.0 {
             return Err(Error::param("comb", self.comb, "finite and at most 100 long"));
         }
-        if !self.gravity.is_finite() || self.gravity.length_squared() < 1e-12 {
-            return Err(Error::param("gravity", self.gravity, "finite and non-zero"));
+        if !self.gravity.is_finite() || self.gravity.abs().max_element() > 1e6 || self.gravity.length_squared() < 1e-12
+        {
+            return Err(Error::param("gravity", self.gravity, "finite, non-zero, each component within ±1e6"));
         }
         Ok(())
     }

@@ -9,6 +9,10 @@ use crate::error::{Error, FileFormat, Result};
 /// Most triangles a mesh may have (16,777,216).
 pub const MAX_TRIANGLES: usize = 1 << 24;
 
+/// The most vkhair reads of an OBJ file unless [`crate::files::MAX_INPUT_ENV`]
+/// says otherwise: 256 MiB (a head mesh is a few MiB).
+pub const MAX_OBJ_BYTES: u64 = 256 << 20;
+
 /// An indexed triangle mesh.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TriMesh {
@@ -38,22 +42,30 @@ impl TriMesh {
         Ok(TriMesh { positions, triangles })
     }
 
-    /// Loads every object of an OBJ file into one mesh (faces are triangulated).
+    /// Loads every object of an OBJ file into one mesh (faces are triangulated);
+    /// a file over [`MAX_OBJ_BYTES`] (or [`crate::files::MAX_INPUT_ENV`]'s cap)
+    /// is refused before reading.
     pub fn load_obj(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
+        let data = crate::files::read_capped(path, crate::files::input_cap(MAX_OBJ_BYTES)?, "an OBJ mesh")?;
         Self::parse_obj(&data).map_err(|e| e.in_asset(path))
     }
 
-    /// Parses OBJ text (materials are ignored).
+    /// Parses OBJ text (materials are ignored). A file without faces (only
+    /// points or polylines) is refused, and a vertex that is not finite is
+    /// named by its number in the file (counting from 1, as faces do) and line.
     pub fn parse_obj(data: &[u8]) -> Result<Self> {
-        if let Err(e) = std::str::from_utf8(data) {
-            let line = 1 + data[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count();
-            return Err(Error::Malformed {
-                format: FileFormat::Obj,
-                reason: format!("line {line} is not UTF-8 text (an OBJ file is text; is this a binary file?)"),
-            });
-        }
+        let text = match std::str::from_utf8(data) {
+            Ok(text) => text,
+            Err(e) => {
+                let line = 1 + data[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count();
+                return Err(Error::Malformed {
+                    format: FileFormat::Obj,
+                    reason: format!("line {line} is not UTF-8 text (an OBJ file is text; is this a binary file?)"),
+                });
+            }
+        };
+        check_obj_statements(text)?;
         let options =
             tobj::LoadOptions { single_index: false, triangulate: true, ignore_points: true, ignore_lines: true };
         let mut reader = std::io::BufReader::new(data);
@@ -121,4 +133,35 @@ impl TriMesh {
         let [a, b, c] = self.corners(i);
         (b - a).cross(c - a)
     }
+}
+
+/// What `tobj` does not say about an OBJ text: a vertex that is not finite
+/// (by its number in the file and its line) and a file with no face.
+fn check_obj_statements(text: &str) -> Result<()> {
+    let malformed = |reason: String| Error::Malformed { format: FileFormat::Obj, reason };
+    let (mut vertices, mut faces) = (0usize, 0usize);
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                vertices += 1;
+                let coords: Vec<&str> = words.take(3).collect();
+                let finite = coords.len() == 3 && coords.iter().all(|w| w.parse::<f32>().is_ok_and(f32::is_finite));
+                if !finite {
+                    return Err(malformed(format!(
+                        "vertex {vertices} (line {}) is not three finite numbers",
+                        number + 1
+                    )));
+                }
+            }
+            Some("f") => faces += 1,
+            _ => {}
+        }
+    }
+    if faces == 0 {
+        return Err(malformed(format!(
+            "no face (`f`) in {vertices} vertices: a mesh needs triangles, and points and polylines are not surfaces"
+        )));
+    }
+    Ok(())
 }

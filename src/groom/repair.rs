@@ -146,7 +146,7 @@ impl Groom {
             }
         }
         if strands.is_empty() {
-            return Err(Error::EmptyGroom);
+            return Err(Error::NothingLeft { repairs: repairs.to_string() });
         }
         let (lo, hi) = strands
             .iter()
@@ -176,7 +176,7 @@ impl Groom {
             repairs.kept_points.extend(kept);
         }
         if counts.is_empty() {
-            return Err(Error::EmptyGroom);
+            return Err(Error::NothingLeft { repairs: repairs.to_string() });
         }
         let pick = |v: &Vec<f32>| repairs.kept_points.iter().map(|&i| v[i]).collect();
         let attributes = Attributes {
@@ -248,9 +248,14 @@ mod tests {
         }
     }
 
+    /// When repairing drops every strand, the error says how many and why.
     #[test]
-    fn nothing_left_is_an_empty_groom() {
-        let positions = vec![Vec3::NAN, Vec3::ZERO];
-        assert!(matches!(Groom::repaired(positions, &[2], Attributes::default()), Err(Error::EmptyGroom)));
+    fn nothing_left_says_what_was_dropped() {
+        let positions = vec![Vec3::NAN, Vec3::ZERO, Vec3::ONE, Vec3::INFINITY, Vec3::X];
+        let err = Groom::repaired(positions, &[2, 2, 1], Attributes::default()).expect_err("nothing left");
+        assert!(matches!(err, Error::NothingLeft { .. }), "{err:?}");
+        let text = err.to_string();
+        assert!(text.contains("2 strands with NaN or infinite values"), "{text}");
+        assert!(text.contains("1 strand with fewer than two points"), "{text}");
     }
 }

@@ -94,8 +94,8 @@ impl MeshSdf {
         if !(8..=MAX_SDF_RESOLUTION).contains(&resolution) {
             return Err(Error::param("sdf resolution", resolution, format!("8..={MAX_SDF_RESOLUTION}")));
         }
-        if !(margin.is_finite() && margin >= 0.0) {
-            return Err(Error::param("sdf margin", margin, "finite and ≥ 0"));
+        if !(margin.is_finite() && (0.0..=1e3).contains(&margin)) {
+            return Err(Error::param("sdf margin", margin, "0..=1000"));
         }
         Ok(())
     }

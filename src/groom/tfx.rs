@@ -18,6 +18,84 @@ use crate::error::{Error, FileFormat, Result};
 
 const HEADER_SIZE: u64 = 160;
 
+/// The header and the arrays it points at of the `.tfx` file at `path`.
+fn read(path: &Path) -> Result<Vec<u8>> {
+    crate::files::read_announced(path, HEADER_SIZE, |header| {
+        Header::read(&Reader { data: header, format: FileFormat::TressFx }).map(|h| h.len())
+    })
+}
+
+/// Names of the arrays in the order of the header's offsets.
+const ARRAYS: [&str; 5] = ["vertex positions", "strand UVs", "vertex UVs", "strand thickness", "vertex colors"];
+
+/// What the 160-byte header says, checked against the format and the limits.
+struct Header {
+    version: f32,
+    strands: u64,
+    per_strand: u64,
+    /// Byte offsets of the arrays in [`ARRAYS`] order, 0 for absent ones.
+    offsets: [u64; 5],
+}
+
+impl Header {
+    fn read(r: &Reader<'_>) -> Result<Header> {
+        r.bytes(0, HEADER_SIZE, "header")?;
+        let version = r.f32(0, "version")?;
+        if !(version.is_finite() && (3.0..5.0).contains(&version)) {
+            return Err(Error::BadMagic {
+                format: FileFormat::TressFx,
+                reason: format!("version {version} is not 3.x or 4.x"),
+            });
+        }
+        let strands = u64::from(r.u32(4, "strand count")?);
+        let per_strand = u64::from(r.u32(8, "vertices per strand")?);
+        let mut offsets = [0u64; 5];
+        for (i, offset) in offsets.iter_mut().enumerate() {
+            *offset = u64::from(r.u32(12 + 4 * i as u64, "array offset")?);
+        }
+        if strands == 0 {
+            return Err(Error::EmptyGroom);
+        }
+        if strands > MAX_STRANDS as u64 {
+            return Err(Error::TooManyStrands { count: strands, max: MAX_STRANDS as u64 });
+        }
+        if !(2..=MAX_POINTS_PER_STRAND as u64).contains(&per_strand) {
+            return Err(Error::StrandPointCount { strand: 0, points: per_strand, max: MAX_POINTS_PER_STRAND as u64 });
+        }
+        let points = strands * per_strand;
+        if points > MAX_POINTS as u64 {
+            return Err(Error::TooManyPoints { count: points, max: MAX_POINTS as u64 });
+        }
+        if offsets[0] == 0 {
+            return Err(Error::Malformed {
+                format: FileFormat::TressFx,
+                reason: "the file has no vertex positions".into(),
+            });
+        }
+        for (name, &offset) in ARRAYS.iter().zip(&offsets) {
+            if offset != 0 && offset < HEADER_SIZE {
+                return Err(Error::Malformed {
+                    format: FileFormat::TressFx,
+                    reason: format!("the {name} start at byte {offset}, inside the {HEADER_SIZE}-byte header"),
+                });
+            }
+        }
+        Ok(Header { version, strands, per_strand, offsets })
+    }
+
+    /// Bytes of each array in [`ARRAYS`] order.
+    fn array_lens(&self) -> [u64; 5] {
+        let points = self.strands * self.per_strand;
+        [16 * points, 8 * self.strands, 8 * points, 4 * self.strands, 16 * points]
+    }
+
+    /// Bytes to the end of the last array present.
+    fn len(&self) -> u64 {
+        let ends = self.offsets.iter().zip(self.array_lens()).map(|(&at, len)| if at == 0 { 0 } else { at + len });
+        ends.fold(HEADER_SIZE, u64::max)
+    }
+}
+
 /// A `.tfx` file: the groom plus what TressFX stores beside the strands.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TfxFile {
@@ -33,11 +111,11 @@ pub struct TfxFile {
 }
 
 impl TfxFile {
-    /// Reads a `.tfx` file from disk, refusing any defect.
+    /// Reads a `.tfx` file from disk, refusing any defect. Only the header and
+    /// the arrays it points at are read.
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
-        Self::parse(&data).map_err(|e| e.in_asset(path))
+        Self::parse(&read(path)?).map_err(|e| e.in_asset(path))
     }
 
     /// Reads a `.tfx` file from disk, repairing what can be repaired (see
@@ -45,8 +123,7 @@ impl TfxFile {
     /// negative counts as non-finite).
     pub fn open_repairing(path: impl AsRef<Path>) -> Result<(Self, Repairs)> {
         let path = path.as_ref();
-        let data = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
-        Self::parse_repairing(&data).map_err(|e| e.in_asset(path))
+        Self::parse_repairing(&read(path)?).map_err(|e| e.in_asset(path))
     }
 
     /// Parses `.tfx` bytes, refusing any defect.
@@ -63,39 +140,9 @@ impl TfxFile {
 
     fn parse_as(data: &[u8], load: Load) -> Result<(Self, Option<Repairs>)> {
         let r = Reader { data, format: FileFormat::TressFx };
-        r.bytes(0, HEADER_SIZE, "header")?;
-        let version = r.f32(0, "version")?;
-        if !(version.is_finite() && (3.0..5.0).contains(&version)) {
-            return Err(Error::BadMagic {
-                format: FileFormat::TressFx,
-                reason: format!("version {version} is not 3.x or 4.x"),
-            });
-        }
-        let strands = u64::from(r.u32(4, "strand count")?);
-        let per_strand = u64::from(r.u32(8, "vertices per strand")?);
-        let offsets: Vec<u64> =
-            (0..5).map(|i| r.u32(12 + 4 * i, "array offset").map(u64::from)).collect::<Result<_>>()?;
-        let [positions_at, strand_uv_at, _vertex_uv_at, thickness_at, colors_at] =
-            [offsets[0], offsets[1], offsets[2], offsets[3], offsets[4]];
-        if strands == 0 {
-            return Err(Error::EmptyGroom);
-        }
-        if strands > MAX_STRANDS as u64 {
-            return Err(Error::TooManyStrands { count: strands, max: MAX_STRANDS as u64 });
-        }
-        if !(2..=MAX_POINTS_PER_STRAND as u64).contains(&per_strand) {
-            return Err(Error::StrandPointCount { strand: 0, points: per_strand, max: MAX_POINTS_PER_STRAND as u64 });
-        }
+        let Header { version, strands, per_strand, offsets } = Header::read(&r)?;
+        let [positions_at, strand_uv_at, _vertex_uv_at, thickness_at, colors_at] = offsets;
         let points = strands * per_strand;
-        if points > MAX_POINTS as u64 {
-            return Err(Error::TooManyPoints { count: points, max: MAX_POINTS as u64 });
-        }
-        if positions_at == 0 {
-            return Err(Error::Malformed {
-                format: FileFormat::TressFx,
-                reason: "the file has no vertex positions".into(),
-            });
-        }
         let raw = r.f32s(positions_at, 4 * points, "vertex positions")?;
         let mut positions: Vec<Vec3> = raw.chunks_exact(4).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
         let inverse_mass: Vec<f32> = raw.chunks_exact(4).map(|c| c[3]).collect();

@@ -137,11 +137,11 @@ impl Default for OitParams {
 pub struct LodParams {
     /// Whether detail falls with distance. Default: true.
     pub enabled: bool,
-    /// Distance up to which full detail is drawn, meters (> 0). Default: 0.6.
+    /// Distance up to which full detail is drawn, meters (1e-4..=1e6). Default: 0.6.
     pub full_detail_distance: f32,
-    /// Fewest hairs per key hair (≥ 1). Default: 2.
+    /// Fewest hairs per key hair (1..=64). Default: 2.
     pub min_hairs_per_key: u32,
-    /// Lowest smoothing level (≥ 1). Default: 1.
+    /// Lowest smoothing level (1..=64). Default: 1.
     pub min_smoothing_level: u32,
 }
 
@@ -206,6 +206,28 @@ impl RenderParams {
         let f = self.oit.fragments_per_pixel;
         if !(f.is_finite() && (0.01..=256.0).contains(&f)) {
             return Err(Error::param("oit.fragments_per_pixel", f, "0.01..=256"));
+        }
+        let lod = &self.lod;
+        let d = lod.full_detail_distance;
+        if !(d.is_finite() && (1e-4..=1e6).contains(&d)) {
+            return Err(Error::param("lod.full_detail_distance", d, "1e-4..=1e6 meters"));
+        }
+        if !(1..=MAX_HAIRS_PER_KEY).contains(&lod.min_hairs_per_key) {
+            return Err(Error::param(
+                "lod.min_hairs_per_key",
+                lod.min_hairs_per_key,
+                format!("1..={MAX_HAIRS_PER_KEY}"),
+            ));
+        }
+        if !(1..=MAX_SMOOTHING_LEVEL).contains(&lod.min_smoothing_level) {
+            return Err(Error::param(
+                "lod.min_smoothing_level",
+                lod.min_smoothing_level,
+                format!("1..={MAX_SMOOTHING_LEVEL}"),
+            ));
+        }
+        if !(1..=16).contains(&self.frames_in_flight) {
+            return Err(Error::param("frames_in_flight", self.frames_in_flight, "1..=16"));
         }
         if self.transparency != Transparency::Off && self.primitive == Primitive::Lines {
             return Err(Error::param(

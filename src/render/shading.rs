@@ -58,29 +58,29 @@ impl Camera {
 pub enum Light {
     /// Parallel light travelling along `direction`.
     Directional {
-        /// Direction of travel.
+        /// Direction of travel (finite, non-zero).
         direction: Vec3,
-        /// Linear RGB radiance.
+        /// Linear RGB radiance (each 0..=1e6).
         color: Vec3,
     },
     /// A point light; radiance falls off with the squared distance.
     Point {
-        /// Position, meters.
+        /// Position, meters (each within ±1e6).
         position: Vec3,
-        /// Linear RGB intensity (radiance at 1 m).
+        /// Linear RGB intensity (radiance at 1 m; each 0..=1e6).
         color: Vec3,
     },
     /// A spot light: a point light within a cone.
     Spot {
-        /// Position, meters.
+        /// Position, meters (each within ±1e6).
         position: Vec3,
-        /// Direction the cone points.
+        /// Direction the cone points (finite, non-zero).
         direction: Vec3,
-        /// Half-angle where the cone ends, radians.
+        /// Half-angle where the cone ends, radians (< π).
         outer_angle: f32,
-        /// Half-angle of full intensity, radians (≤ outer_angle).
+        /// Half-angle of full intensity, radians (0..=outer_angle).
         inner_angle: f32,
-        /// Linear RGB intensity (radiance at 1 m).
+        /// Linear RGB intensity (radiance at 1 m; each 0..=1e6).
         color: Vec3,
     },
 }
@@ -110,40 +110,62 @@ impl Light {
         ]
     }
 
+    /// Checks the light: a colour of finite components in 0..=1e6, a position
+    /// within 1e6 m of the origin on every axis, a finite non-zero direction,
+    /// and 0 ≤ inner ≤ outer < π for a spot; the error names the field.
+    pub fn validate(&self) -> Result<()> {
+        let color = match *self {
+            Light::Directional { color, .. } | Light::Point { color, .. } | Light::Spot { color, .. } => color,
+        };
+        if !(color.is_finite() && color.min_element() >= 0.0 && color.max_element() <= 1e6) {
+            return Err(Error::param("light color", color, "finite, each component 0..=1e6"));
+        }
+        if let Light::Point { position, .. } | Light::Spot { position, .. } = *self {
+            if !(position.is_finite() && position.abs().max_element() <= 1e6) {
+                return Err(Error::param("light position", position, "finite, each component within ±1e6 m"));
+            }
+        }
+        if let Light::Directional { direction, .. } | Light::Spot { direction, .. } = *self {
+            if !(direction.is_finite() && direction.abs().max_element() <= 1e6) || direction.try_normalize().is_none() {
+                return Err(Error::param("light direction", direction, "finite and non-zero"));
+            }
+        }
+        if let Light::Spot { outer_angle, inner_angle, .. } = *self {
+            let ordered = outer_angle.is_finite()
+                && inner_angle.is_finite()
+                && 0.0 <= inner_angle
+                && inner_angle <= outer_angle
+                && outer_angle < std::f32::consts::PI;
+            if !ordered {
+                return Err(Error::param(
+                    "light inner_angle and outer_angle",
+                    format!("{inner_angle} and {outer_angle}"),
+                    "0 ≤ inner_angle ≤ outer_angle < π radians",
+                ));
+            }
+        }
+        Ok(())
+    }
+
     pub(crate) fn to_gpu(self) -> Result<GpuLight> {
-        let bad = || Error::param("light", format!("{self:?}"), "finite with a non-zero direction");
+        self.validate()?;
+        let normal = |d: Vec3| d.normalize();
         Ok(match self {
             Light::Directional { direction, color } => {
-                let d = direction.try_normalize().ok_or_else(bad)?;
-                if !color.is_finite() {
-                    return Err(bad());
-                }
+                let d = normal(direction);
                 GpuLight {
                     position_kind: [0.0, 0.0, 0.0, light_kind::DIRECTIONAL as f32],
                     direction_cone: [d.x, d.y, d.z, 0.0],
                     color_range: color.extend(0.0).to_array(),
                 }
             }
-            Light::Point { position, color } => {
-                if !position.is_finite() || !color.is_finite() {
-                    return Err(bad());
-                }
-                GpuLight {
-                    position_kind: position.extend(light_kind::POINT as f32).to_array(),
-                    direction_cone: [0.0, -1.0, 0.0, 0.0],
-                    color_range: color.extend(0.0).to_array(),
-                }
-            }
+            Light::Point { position, color } => GpuLight {
+                position_kind: position.extend(light_kind::POINT as f32).to_array(),
+                direction_cone: [0.0, -1.0, 0.0, 0.0],
+                color_range: color.extend(0.0).to_array(),
+            },
             Light::Spot { position, direction, outer_angle, inner_angle, color } => {
-                let d = direction.try_normalize().ok_or_else(bad)?;
-                let angles_ok = outer_angle.is_finite()
-                    && inner_angle.is_finite()
-                    && 0.0 <= inner_angle
-                    && inner_angle <= outer_angle
-                    && outer_angle < std::f32::consts::PI;
-                if !position.is_finite() || !color.is_finite() || !angles_ok {
-                    return Err(bad());
-                }
+                let d = normal(direction);
                 GpuLight {
                     position_kind: position.extend(light_kind::SPOT as f32).to_array(),
                     direction_cone: [d.x, d.y, d.z, outer_angle.cos()],
@@ -180,22 +202,22 @@ impl ShadingMode {
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct HairMaterial {
-    /// Albedo at the root, linear RGB. Default: dark brown (0.10, 0.05, 0.02).
+    /// Albedo at the root, linear RGB (each 0..=1000). Default: dark brown (0.10, 0.05, 0.02).
     pub root_color: Vec3,
-    /// Albedo at the tip, linear RGB. Default: (0.25, 0.14, 0.06).
+    /// Albedo at the tip, linear RGB (each 0..=1000). Default: (0.25, 0.14, 0.06).
     pub tip_color: Vec3,
     /// Ambient fraction of the albedo (0..=1). Default: 0.08.
     pub ambient: f32,
     /// How far diffuse light wraps around to the side away from the light
     /// (0 = none, 1 = half way). Default: 0.3.
     pub diffuse_wrap: f32,
-    /// Primary highlight color, linear RGB. Default: (0.35, 0.33, 0.30).
+    /// Primary highlight color, linear RGB (each 0..=1000). Default: (0.35, 0.33, 0.30).
     pub primary_color: Vec3,
     /// Primary highlight exponent (≥ 1). Default: 80.
     pub primary_exponent: f32,
     /// Primary tangent shift along the strand normal (−1..=1). Default: −0.1 (toward the tip).
     pub primary_shift: f32,
-    /// Secondary highlight color (multiplied by the albedo). Default: (1.0, 0.8, 0.6).
+    /// Secondary highlight color (multiplied by the albedo; each 0..=1000). Default: (1.0, 0.8, 0.6).
     pub secondary_color: Vec3,
     /// Secondary highlight exponent (≥ 1). Default: 12.
     pub secondary_exponent: f32,
@@ -205,9 +227,9 @@ pub struct HairMaterial {
     pub shift_jitter: f32,
     /// How much noise breaks up the secondary highlight (0..=1). Default: 0.7.
     pub highlight_breakup: f32,
-    /// Ribbon width at the root, meters (≥ 0). Default: 0.00012.
+    /// Ribbon width at the root, meters (0..=1). Default: 0.00012.
     pub root_width: f32,
-    /// Ribbon width at the tip, meters (≥ 0). Default: 0.00005.
+    /// Ribbon width at the tip, meters (0..=1). Default: 0.00005.
     pub tip_width: f32,
     /// Least ribbon width on screen, pixels (0 = none), for opaque hair only
     /// ([`super::Transparency::Off`]); transparent strands keep their true width
@@ -264,8 +286,8 @@ impl HairMaterial {
             ("secondary_color", self.secondary_color),
         ];
         for (name, c) in colors {
-            if !c.is_finite() || c.min_element() < 0.0 {
-                return Err(Error::param(name, c, "finite and ≥ 0"));
+            if !c.is_finite() || c.min_element() < 0.0 || c.max_element() > 1000.0 {
+                return Err(Error::param(name, c, "finite, each component 0..=1000"));
             }
         }
         let ranges = [

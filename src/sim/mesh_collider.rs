@@ -50,7 +50,7 @@ pub struct MeshColliderParams {
     /// 8..=256 (the other axes get the same cell size). Default 64.
     pub resolution: u32,
     /// Room around the mesh's bounds on every side, in the mesh's units (two more
-    /// cells are always added). Default 0.02.
+    /// cells are always added; 0..=1000). Default 0.02.
     pub margin: f32,
 }
 

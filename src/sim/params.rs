@@ -41,11 +41,12 @@ pub struct SimParams {
     pub iterations: u32,
     /// Solver mode. Default: [`SolverMode::Pbd`].
     pub solver: SolverMode,
-    /// Gravity, m/s². Default: (0, −9.81, 0).
+    /// Gravity, m/s² (each component within ±10,000). Default: (0, −9.81, 0).
     pub gravity: Vec3,
     /// Whether gravity acts. Default: true.
     pub gravity_enabled: bool,
-    /// Wind acceleration (direction × strength), m/s². Default: (0, 0, 0).
+    /// Wind acceleration (direction × strength), m/s² (each component within
+    /// ±10,000). Default: (0, 0, 0).
     pub wind: Vec3,
     /// Wind turbulence: relative strength of the gust noise (0..=1). Default: 0.3.
     pub wind_turbulence: f32,
@@ -201,8 +202,12 @@ impl SimParams {
         if !(1..=1000).contains(&self.iterations) {
             return Err(Error::param("iterations", self.iterations, "1..=1000"));
         }
-        finite_vec("gravity", self.gravity)?;
-        finite_vec("wind", self.wind)?;
+        for (name, v) in [("gravity", self.gravity), ("wind", self.wind)] {
+            finite_vec(name, v)?;
+            if v.abs().max_element() > 1e4 {
+                return Err(Error::param(name, v, "each component within ±10,000 m/s²"));
+            }
+        }
         in_range("wind_turbulence", self.wind_turbulence, 0.0, 1.0)?;
         in_range("wind_frequency", self.wind_frequency, 0.0, 1000.0)?;
         in_range("spring_stiffness", self.spring_stiffness, 0.0, 1e6)?;

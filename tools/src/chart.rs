@@ -26,6 +26,13 @@ use crate::say;
 
 type Lines = BTreeMap<String, Vec<(f64, f64)>>;
 
+/// The most `plot` reads of a CSV unless `VKHAIR_MAX_INPUT_BYTES` says
+/// otherwise: 64 MiB (the benchmarks write a few KiB).
+const MAX_CSV_BYTES: u64 = 64 << 20;
+
+/// Rows left out of a chart that are named one by one; beyond, a count.
+const NAMED_ROWS: usize = 5;
+
 /// Chart size, pixels.
 const SIZE: (u32, u32) = (1100, 500);
 
@@ -42,7 +49,13 @@ struct Table {
 
 impl Table {
     fn read(path: &Path) -> Result<Self, Error> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let cap = vkhair::files::input_cap(MAX_CSV_BYTES)?;
+        let bytes = vkhair::files::read_capped(path, cap, "a benchmark CSV").map_err(|e| match e {
+            vkhair::Error::Io { source, .. } => format!("cannot read {}: {source}", path.display()).into(),
+            e => Error::from(e),
+        })?;
+        let text =
+            String::from_utf8(bytes).map_err(|_| format!("{} is not UTF-8 text (a CSV is text)", path.display()))?;
         let mut lines = text.lines().filter(|l| !l.trim().is_empty());
         let header = lines
             .next()
@@ -176,6 +189,9 @@ fn volume_lines(t: &Table) -> Result<(Lines, Lines), Error> {
             solves.entry(name).or_default().push((n, t.number(r, iterations)?));
         }
     }
+    if time.is_empty() {
+        return Err(format!("{}: no row with a grid to plot", t.path.display()).into());
+    }
     Ok((time, solves))
 }
 
@@ -230,15 +246,25 @@ fn mode_panels(table: &Table, root: &DrawingArea<BitMapBackend<'_>, Shift>) -> R
     let (scene, mode) = (table.column("scene")?, table.column("mode")?);
     let (ms, mib, error) = (table.column("gpu_ms")?, table.column("memory_mib")?, table.column("error_srgb_steps")?);
     let (mut time, mut memory) = (Labelled::new(), Labelled::new());
+    let mut left_out = Vec::new();
     for r in 0..table.rows.len() {
         let name = table.rows[r].get(scene).cloned().unwrap_or_default();
         let label = table.rows[r].get(mode).cloned().unwrap_or_default();
         let Ok(e) = table.number(r, error) else {
-            say!("{name}, {label}: no error figure (line {}), left out of the chart", r + 2);
+            if left_out.len() < NAMED_ROWS {
+                say!("{name}, {label}: no error figure (line {}), left out of the chart", r + 2);
+            }
+            left_out.push(r);
             continue;
         };
         time.entry(name.clone()).or_default().push((e, table.number(r, ms)?, label.clone()));
         memory.entry(name).or_default().push((e, table.number(r, mib)?, label));
+    }
+    if left_out.len() > NAMED_ROWS {
+        say!("… and {} more rows without an error figure, left out of the chart", left_out.len() - NAMED_ROWS);
+    }
+    if time.is_empty() {
+        return Err(format!("{}: no row has an error figure to plot", table.path.display()).into());
     }
     let palette: Vec<String> = time.keys().cloned().collect();
     let (left, right) = root.split_horizontally(SIZE.0 / 2);

@@ -9,6 +9,7 @@
 mod args;
 mod chart;
 mod commands;
+mod destinations;
 mod output;
 mod profile;
 mod scene;
@@ -52,6 +53,7 @@ enum Command {
 
 fn main() -> ExitCode {
     output::restore_sigpipe();
+    output::exit_cleanly_on_signals();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match cli.command {

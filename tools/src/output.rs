@@ -45,6 +45,25 @@ pub fn restore_sigpipe() {
     }
 }
 
+/// On SIGINT or SIGTERM, removes the temporary files of the writes in progress
+/// (no `.NAME.*.partial` stays behind; a file being replaced keeps its old
+/// contents) and exits with the conventional status, 128 + the signal.
+pub fn exit_cleanly_on_signals() {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let mut signals = match signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) {
+        Ok(signals) => signals,
+        Err(e) => {
+            eprintln!("vkhair: warning: signals are not handled ({e}); an interrupted write may leave a .partial file");
+            return;
+        }
+    };
+    std::thread::spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            vkhair::files::remove_partial_files_then(|_| std::process::exit(128 + signal))
+        }
+    });
+}
+
 /// A progress bar over `len` `units` ("frames", "steps") with elapsed time and
 /// ETA, on stderr (hidden when stderr is not a terminal).
 pub fn progress(len: usize, units: &str) -> indicatif::ProgressBar {
@@ -59,6 +78,8 @@ pub fn progress(len: usize, units: &str) -> indicatif::ProgressBar {
 /// Smallest image side the tool renders: below it neither the frames nor the
 /// contact sheet (frames halved) would be useful images.
 pub const MIN_IMAGE_SIDE: u32 = 16;
+/// Largest image side the tool renders (the headless target's limit).
+pub const MAX_IMAGE_SIDE: u32 = 8192;
 
 /// An RGBA8 image as PNG bytes.
 pub fn encode_png(width: u32, height: u32, rgba: &[u8]) -> Result<Vec<u8>, Error> {
@@ -117,6 +138,46 @@ fn sheet(thumbs: &[Vec<u8>], tw: u32, th: u32) -> (u32, u32, Vec<u8>) {
         }
     }
     (sw, sh, out)
+}
+
+/// Whether `name` is a file `render` writes: `frame_NNNN.png` (four digits or
+/// more) or `contact_sheet.png`; the frame's index when it is a frame.
+fn owned_name(name: &str) -> Option<Option<usize>> {
+    if name == "contact_sheet.png" {
+        return Some(None);
+    }
+    let digits = name.strip_prefix("frame_")?.strip_suffix(".png")?;
+    (digits.len() >= 4 && digits.bytes().all(|b| b.is_ascii_digit())).then(|| digits.parse().ok())
+}
+
+/// Prepares `dir` for a run of `frames` frames: refuses when a file the run
+/// writes (`frame_NNNN.png`, `contact_sheet.png`) is a symbolic link, and
+/// removes the frames of an earlier run that this one will not overwrite
+/// (their index is `frames` or more), so that the folder holds one run. Only
+/// those names are touched. Returns how many frames were removed.
+pub fn clear_stale_frames(dir: &Path, frames: usize) -> Result<usize, Error> {
+    let list = std::fs::read_dir(dir).map_err(|e| format!("cannot list {}: {e}", dir.display()))?;
+    let mut stale = Vec::new();
+    for entry in list {
+        let entry = entry.map_err(|e| format!("cannot list {}: {e}", dir.display()))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some(index) = owned_name(&name) else { continue };
+        let path = entry.path();
+        if std::fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_symlink()) {
+            return Err(format!(
+                "--out {}: {name} is a symbolic link; vkhair does not write through links (remove it)",
+                dir.display()
+            )
+            .into());
+        }
+        if index.is_some_and(|i| i >= frames) {
+            stale.push(path);
+        }
+    }
+    for path in &stale {
+        std::fs::remove_file(path).map_err(|e| format!("cannot remove {}: {e}", path.display()))?;
+    }
+    Ok(stale.len())
 }
 
 /// Writes frames as `frame_NNNN.png` on a worker thread and keeps only the

@@ -8,6 +8,7 @@ use serde_json::{json, Value};
 use vkhair::files::write_atomic;
 use vkhair::{Clock, ProfileReport};
 
+use crate::destinations::{Kind, Output};
 use crate::output::Error;
 use crate::say;
 
@@ -76,6 +77,14 @@ pub struct ProfileArgs {
 }
 
 impl ProfileArgs {
+    /// The outputs these flags name, for [`crate::destinations::check`].
+    pub fn outputs(&self) -> Vec<Output<'_>> {
+        [("--trace", &self.trace), ("--json", &self.json)]
+            .into_iter()
+            .filter_map(|(flag, path)| path.as_deref().map(|path| Output { flag, path, kind: Kind::File(&["json"]) }))
+            .collect()
+    }
+
     /// Writes the files asked for from `profile`, the summary with `context`
     /// (made only when it is asked for), saying where each went.
     pub fn write(&self, profile: &Profile, context: impl FnOnce() -> Value) -> Result<(), Error> {

@@ -130,7 +130,7 @@ fn tiny_images_are_refused_with_a_clear_message() {
     let out = dir.path().join("frames");
     for (w, h) in [("1", "480"), ("640", "15")] {
         run(&["render", "--width", w, "--height", h, "--out", out.to_str().expect("utf-8")], LIMIT)
-            .assert_error("--width and --height must be at least 16 pixels");
+            .assert_error("--width and --height must be 16..=8192 pixels");
         assert!(!out.exists(), "a refused render created its output folder");
     }
     // The smallest size allowed gives valid images, the contact sheet included.

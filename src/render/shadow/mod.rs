@@ -43,7 +43,8 @@ pub const MAX_SHADOW_MAPS: usize = crate::limits::MAX_SHADOW_MAPS as usize;
 pub const SHADOW_ATLAS_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 
 /// How a light's shadow is computed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ShadowMethod {
     /// Deep opacity maps: two passes over the rendered hairs per light.
     #[default]
@@ -55,7 +56,8 @@ pub enum ShadowMethod {
 }
 
 /// A shadow-casting light.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ShadowCaster {
     /// Index into [`crate::render::Renderer::set_lights`]' list (a directional or spot light
     /// for deep opacity maps; any light for the density volume).
@@ -97,14 +99,15 @@ impl ShadowCaster {
 }
 
 /// Self-shadowing through deep opacity maps or the density volume.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct ShadowParams {
     /// The lights that cast shadows, at most [`MAX_SHADOW_MAPS`]. Default: none.
     pub casters: Vec<ShadowCaster>,
     /// Side of each light's map, texels (16..=4096). Default: 512.
     pub resolution: u32,
     /// Where the three layers end behind the depth at which the hair starts, meters
-    /// (increasing, > 0). Default: 0.01, 0.03, 0.08.
+    /// (increasing, in (0, 1000]). Default: 0.01, 0.03, 0.08.
     pub layers: [f32; 3],
     /// Opacity one strand fragment adds (0..=1). Default: 0.05.
     pub opacity: f32,
@@ -115,7 +118,7 @@ pub struct ShadowParams {
     /// Density volume: shadowing cross-section of one simulated particle, m²
     /// (transmittance = exp(−σ ∫ particles per m³ ds); ≥ 0). It matches deep opacity
     /// maps when σ = extinction · opacity · hairs per key · map texel size · key
-    /// segment length. Default: 1e-4 (the thesis scene at the defaults).
+    /// segment length (0..=1000). Default: 1e-4 (the thesis scene at the defaults).
     pub volume_cross_section: f32,
     /// Density volume: ray-marching step, cells (0.1..=2). Default: 0.5.
     pub volume_step: f32,
@@ -155,8 +158,8 @@ impl ShadowParams {
             return Err(Error::param("shadow resolution", self.resolution, "16..=4096"));
         }
         let [a, b, c] = self.layers;
-        if !(a.is_finite() && c.is_finite() && 0.0 < a && a < b && b < c) {
-            return Err(Error::param("shadow layers", format!("{:?}", self.layers), "finite, > 0 and increasing"));
+        if !(a.is_finite() && c.is_finite() && 0.0 < a && a < b && b < c && c <= 1e3) {
+            return Err(Error::param("shadow layers", format!("{:?}", self.layers), "increasing, in (0, 1000] m"));
         }
         if !(self.opacity.is_finite() && (0.0..=1.0).contains(&self.opacity)) {
             return Err(Error::param("shadow opacity", self.opacity, "0..=1"));
@@ -167,8 +170,8 @@ impl ShadowParams {
         if self.pcf_radius > 3 {
             return Err(Error::param("shadow pcf_radius", self.pcf_radius, "at most 3"));
         }
-        if !(self.volume_cross_section.is_finite() && self.volume_cross_section >= 0.0) {
-            return Err(Error::param("shadow volume_cross_section", self.volume_cross_section, "finite and ≥ 0"));
+        if !(self.volume_cross_section.is_finite() && (0.0..=1e3).contains(&self.volume_cross_section)) {
+            return Err(Error::param("shadow volume_cross_section", self.volume_cross_section, "0..=1000 m²"));
         }
         if !(self.volume_step.is_finite() && (0.1..=2.0).contains(&self.volume_step)) {
             return Err(Error::param("shadow volume_step", self.volume_step, "0.1..=2"));

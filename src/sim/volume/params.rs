@@ -61,11 +61,11 @@ pub struct VolumeParams {
     /// velocity per sub-step (0..=1). Default: 0.1.
     pub friction: f32,
     /// Friction mode: acceleration pushing particles down the density gradient where
-    /// the density exceeds `repulsion_threshold`, m/s² (≥ 0; 0 switches it off).
+    /// the density exceeds `repulsion_threshold`, m/s² (0..=1e6; 0 switches it off).
     /// Default: 2.
     pub repulsion: f32,
     /// Friction mode: density (summed trilinear particle weights per cell) above which
-    /// repulsion acts (> 0). Default: 8.
+    /// repulsion acts (0 < threshold ≤ 1e6). Default: 8.
     pub repulsion_threshold: f32,
 }
 
@@ -124,8 +124,9 @@ impl VolumeParams {
         if !(self.repulsion.is_finite() && self.repulsion >= 0.0 && self.repulsion <= 1e6) {
             return Err(Error::param("volume repulsion", self.repulsion, "0..=1e6 m/s²"));
         }
-        if !(self.repulsion_threshold.is_finite() && self.repulsion_threshold > 0.0) {
-            return Err(Error::param("volume repulsion_threshold", self.repulsion_threshold, "finite and > 0"));
+        if !(self.repulsion_threshold.is_finite() && self.repulsion_threshold > 0.0 && self.repulsion_threshold <= 1e6)
+        {
+            return Err(Error::param("volume repulsion_threshold", self.repulsion_threshold, "(0, 1e6]"));
         }
         Ok(())
     }

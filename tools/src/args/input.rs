@@ -71,6 +71,11 @@ impl InputArgs {
         Ok(())
     }
 
+    /// The files these flags read.
+    pub fn files(&self) -> Vec<&Path> {
+        [self.input.as_deref(), self.obj.as_deref()].into_iter().flatten().collect()
+    }
+
     /// The --scale factor.
     pub fn scale(&self) -> f32 {
         self.scale.unwrap_or(1.0)

@@ -8,7 +8,7 @@ use vkhair::render::Transparency;
 
 use super::input::InputArgs;
 use super::sim::SimArgs;
-use crate::output::MIN_IMAGE_SIDE;
+use crate::output::{MAX_IMAGE_SIDE, MIN_IMAGE_SIDE};
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct SceneArgs {
@@ -76,11 +76,15 @@ impl SceneArgs {
     /// Options that mean something only with others, and values out of range: an
     /// error saying what the option needs, before any file is read or GPU work done.
     pub fn check(&self) -> Result<(), String> {
-        if self.width < MIN_IMAGE_SIDE || self.height < MIN_IMAGE_SIDE {
+        let sides = MIN_IMAGE_SIDE..=MAX_IMAGE_SIDE;
+        if !sides.contains(&self.width) || !sides.contains(&self.height) {
             return Err(format!(
-                "--width and --height must be at least {MIN_IMAGE_SIDE} pixels (got {}×{})",
+                "--width and --height must be {MIN_IMAGE_SIDE}..={MAX_IMAGE_SIDE} pixels (got {}×{})",
                 self.width, self.height
             ));
+        }
+        if !(16..=4096).contains(&self.shadow_resolution) {
+            return Err(format!("--shadow-resolution must be 16..=4096 texels (got {})", self.shadow_resolution));
         }
         self.input.check()?;
         if self.volume_shadows && self.sim.volume == Some(vkhair::sim::VolumeMode::Off) {

@@ -108,7 +108,16 @@ pub fn make_renderer(
         };
         let layers = ShadowParams::default().layers.map(|l| l * drawing_scale(radius));
         let shadows = ShadowParams { casters, resolution: a.shadow_resolution, layers, ..ShadowParams::default() };
-        renderer.set_shadows(key_hairs, &shadows)?;
+        renderer.set_shadows(key_hairs, &shadows).map_err(|e| match e {
+            vkhair::Error::UnsupportedFeature { .. } => vkhair::Error::UnsupportedFeature {
+                what: "shadows of a point light",
+                reason: "the --config file makes light 0 or 1, the two that cast shadows, a point light, which \
+                         has no deep opacity map; render with --volume-shadows or --no-shadows, or make it a spot \
+                         or directional light"
+                    .into(),
+            },
+            e => e,
+        })?;
     }
     let mut material = config.material.clone();
     if material.represented_hairs == 1.0 {

@@ -25,6 +25,7 @@ use vkhair::{ContextOptions, GpuContext, RecordedWork};
 
 use crate::args::sim::SimArgs;
 use crate::chart::plot_file;
+use crate::destinations::{self, Kind, Output};
 use crate::output::Error;
 use crate::say;
 use frames::bench_frames;
@@ -303,7 +304,7 @@ impl Curve {
 
 fn scaling(b: &Bench<'_>) -> Result<Vec<Curve>, Error> {
     let (ctx, a, clock) = (b.ctx, b.args, b.clock);
-    let n = a.scaling_samples.max(1);
+    let n = a.scaling_samples;
     let colliders = motion::thesis_colliders();
     let off = b.params(VolumeMode::Off, 32);
     let sim = |groom: &Groom, params: &SimParams| {
@@ -411,6 +412,12 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     if a.samples == 0 {
         return Err("--samples must be at least 1 (the report's figures are medians of 20 by default)".into());
     }
+    if a.scaling_samples == 0 {
+        return Err("--scaling-samples must be at least 1 (each point of a curve is a median of 5 by default)".into());
+    }
+    let mut outputs = vec![Output { flag: "--out", path: &a.out, kind: Kind::Folder }];
+    outputs.extend(a.json.as_deref().map(|path| Output { flag: "--json", path, kind: Kind::File(&["json"]) }));
+    destinations::check(&[], &outputs)?;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let info = ctx.info();
     if a.require_gpu && info.device_type == vkhair::ash::vk::PhysicalDeviceType::CPU {

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use vkhair::groom::cyhair::HairFile;
 
 use crate::args::input::load;
+use crate::destinations::{self, Kind, Output};
 use crate::output::CliResult;
 use crate::say;
 
@@ -28,6 +29,7 @@ pub struct ConvertArgs {
 }
 
 pub fn convert(a: &ConvertArgs) -> CliResult {
+    destinations::check(&[&a.input], &[Output { flag: "--out", path: &a.out, kind: Kind::File(&["hair"]) }])?;
     write_converted(&a.input, a.points, a.key_hairs, &a.out, a.strict)
 }
 

@@ -8,7 +8,8 @@ use crate::output::CliResult;
 use crate::say;
 
 pub fn devices() -> CliResult {
-    let reports = list_devices(&ContextOptions::default())?;
+    let options = ContextOptions::default();
+    let reports = list_devices(&options)?;
     if reports.is_empty() {
         say!("no Vulkan devices (install mesa-vulkan-drivers for lavapipe)");
     }
@@ -52,5 +53,12 @@ pub fn devices() -> CliResult {
         }
     }
     say!("(* = chosen; force a device with {}=<name substring>)", vkhair::DEVICE_ENV);
-    Ok(())
+    match &options.device_name {
+        Some(name) if !reports.iter().any(|r| r.chosen) => Err(format!(
+            "{}={name:?} matches no usable device above: vkhair would choose none (unset it to choose the best)",
+            vkhair::DEVICE_ENV
+        )
+        .into()),
+        _ => Ok(()),
+    }
 }

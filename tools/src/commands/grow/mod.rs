@@ -9,6 +9,7 @@ use vkhair::groom::grow::{grow, GrowParams, Scalp};
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::scenes;
 
+use crate::destinations::{self, Kind, Output};
 use crate::output::CliResult;
 use crate::say;
 
@@ -81,6 +82,11 @@ fn parse_vec3(name: &str, s: &str) -> Result<Vec3, String> {
 }
 
 pub fn grow_groom(a: &GrowArgs) -> CliResult {
+    if !(a.max_angle.is_finite() && a.max_angle > 0.0 && a.max_angle <= 180.0) {
+        return Err(format!("--max-angle must be within (0, 180] degrees (got {})", a.max_angle).into());
+    }
+    let inputs: Vec<&std::path::Path> = a.obj.iter().map(|p| p.as_path()).collect();
+    destinations::check(&inputs, &[Output { flag: "--out", path: &a.out, kind: Kind::File(&["hair"]) }])?;
     let groom = match a.scalp {
         ScalpKind::Thesis => scenes::thesis()?,
         kind => {

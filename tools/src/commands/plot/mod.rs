@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use crate::chart::plot_file;
+use crate::destinations::{self, Kind, Output};
 use crate::output::CliResult;
 
 #[derive(clap::Args)]
@@ -19,5 +20,6 @@ pub struct PlotArgs {
 
 pub fn plot(a: &PlotArgs) -> CliResult {
     let out = a.out.clone().unwrap_or_else(|| a.csv.with_extension("png"));
+    destinations::check(&[&a.csv], &[Output { flag: "--out", path: &out, kind: Kind::File(&["png"]) }])?;
     plot_file(&a.csv, &out)
 }

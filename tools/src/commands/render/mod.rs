@@ -10,7 +10,8 @@ use vkhair::sim::RigidTransform;
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
 use crate::args::scene::SceneArgs;
-use crate::output::{progress, Error, FrameSink};
+use crate::destinations::{self, Kind, Output};
+use crate::output::{clear_stale_frames, progress, Error, FrameSink};
 use crate::profile::{host_now_ns, Profile, ProfileArgs};
 use crate::say;
 use crate::scene::{self, framing, make_renderer, parameters};
@@ -83,6 +84,15 @@ fn schedule_options(a: &RenderArgs) -> Result<SchedulerOptions, vkhair::Error> {
 pub fn render(a: &RenderArgs) -> Result<(), Error> {
     check_options(a)?;
     let sa = &a.scene;
+    let mut inputs = sa.input.files();
+    inputs.extend(sa.config.as_deref());
+    let mut outputs = vec![Output { flag: "--out", path: &a.out, kind: Kind::Folder }];
+    outputs.extend(a.profile_out.outputs());
+    destinations::check(&inputs, &outputs)?;
+    let stale = clear_stale_frames(&a.out, a.frames)?;
+    if stale > 0 {
+        say!("removed {stale} frames of an earlier run from {} (this run writes {})", a.out.display(), a.frames);
+    }
     let s = scene::load(sa)?;
     let config = parameters(sa, &s)?;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
@@ -111,7 +121,6 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     let camera = framing(&s, sa.distance, sa.width as f32 / sa.height as f32)?;
     let mut renderer = renderer;
     let mut profiler = GpuProfiler::new(&ctx, 1, 64)?;
-    std::fs::create_dir_all(&a.out).map_err(|e| format!("cannot create {}: {e}", a.out.display()))?;
     let (strands, points) = sim.key_hairs().size();
     let (hairs, per_hair) = renderer.hair_counts();
     say!(

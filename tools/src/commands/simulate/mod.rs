@@ -13,6 +13,7 @@ use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
 use crate::args::input::InputArgs;
 use crate::args::sim::SimArgs;
+use crate::destinations::{self, Kind, Output};
 use crate::output::{progress, CliResult};
 use crate::profile::{host_now_ns, percentile, Profile, ProfileArgs};
 use crate::say;
@@ -88,6 +89,12 @@ fn check_options(a: &SimulateArgs) -> Result<(), String> {
 
 pub fn simulate(a: &SimulateArgs) -> CliResult {
     check_options(a)?;
+    let mut inputs = a.input.files();
+    inputs.extend(a.config.as_deref());
+    let mut outputs: Vec<Output> =
+        a.out.as_deref().map(|path| Output { flag: "--out", path, kind: Kind::File(&["hair"]) }).into_iter().collect();
+    outputs.extend(a.profile_out.outputs());
+    destinations::check(&inputs, &outputs)?;
     let scale = a.input.scale();
     let (groom, colliders, label, pivot) = match &a.input.input {
         None => (scenes::thesis()?, motion::thesis_colliders(), "thesis scene".to_owned(), motion::NECK_PIVOT),
