@@ -1,6 +1,6 @@
 //! The scene `render` draws and `bench` measures: the groom (the `thesis`
 //! scene, or the user's `--input` with its `--obj` mesh), its bounds, the
-//! camera that frames it, and ([`parameters`]) the parameters and renderer
+//! camera that frames it, and ([`mod@parameters`]) the parameters and renderer
 //! of the flags.
 
 mod parameters;
