@@ -36,7 +36,6 @@ const STAGES: &[(&str, shaderc::ShaderKind, &str)] = &[
     ("vert", shaderc::ShaderKind::Vertex, "Vertex"),
     ("tesc", shaderc::ShaderKind::TessControl, "TessControl"),
     ("tese", shaderc::ShaderKind::TessEvaluation, "TessEvaluation"),
-    ("geom", shaderc::ShaderKind::Geometry, "Geometry"),
     ("frag", shaderc::ShaderKind::Fragment, "Fragment"),
 ];
 

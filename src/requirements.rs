@@ -24,7 +24,6 @@ macro_rules! features {
 
 const CORE: &[Feature<vk::PhysicalDeviceFeatures>] = features!(vk::PhysicalDeviceFeatures:
     tessellation_shader => "tessellationShader",
-    geometry_shader => "geometryShader",
     vertex_pipeline_stores_and_atomics => "vertexPipelineStoresAndAtomics",
     fragment_stores_and_atomics => "fragmentStoresAndAtomics",
 );

@@ -291,8 +291,8 @@ fn hair_is_hidden_behind_what_the_host_drew() {
 }
 
 /// Level of detail: at the distances of the thesis' Table 5 the number of segments
-/// actually drawn (geometry-shader invocations, one per segment, counted by a
-/// pipeline-statistics query) falls with distance, while the image keeps covering.
+/// actually drawn (input-assembly primitives, two triangles per segment, counted
+/// by a pipeline-statistics query) falls with distance, while the image keeps covering.
 #[test]
 fn detail_falls_with_distance() {
     use vkhair::ash::vk;
@@ -302,7 +302,7 @@ fn detail_falls_with_distance() {
     let info = vk::QueryPoolCreateInfo::default()
         .query_type(vk::QueryType::PIPELINE_STATISTICS)
         .query_count(1)
-        .pipeline_statistics(vk::QueryPipelineStatisticFlags::GEOMETRY_SHADER_INVOCATIONS);
+        .pipeline_statistics(vk::QueryPipelineStatisticFlags::INPUT_ASSEMBLY_PRIMITIVES);
     // SAFETY: valid create info on the context's device; destroyed below.
     let pool = unsafe { device.create_query_pool(&info, None) }.expect("query pool (pipelineStatisticsQuery)");
     let center = scenes::THESIS_HEAD_CENTER;
@@ -343,8 +343,8 @@ fn detail_falls_with_distance() {
         .expect("results");
         let (hairs, per_hair) = s.renderer.hair_counts();
         let segments = u64::from(hairs) * u64::from(per_hair - 1);
-        // Every segment goes through the geometry stage twice: depth pre-pass, shading.
-        assert_eq!(count[0], 2 * segments, "GS invocations = 2 × segments at {distance} m");
+        // Every segment is two triangles, drawn twice: depth pre-pass, shading.
+        assert_eq!(count[0], 4 * segments, "assembled triangles = 4 × segments at {distance} m");
         let covered = hair_pixels(&s.offscreen.read_rgba8().expect("readback")).len();
         eprintln!("{distance} m: {:?}, {segments} segments drawn, {covered} pixels", s.renderer.detail());
         drawn.push((segments, covered));

@@ -107,7 +107,7 @@ vec3 shade_hair(vec3 pos, vec3 tangent, float t_along, uint hair) {
     return color;
 }
 
-// Alpha of a transparent strand fragment from `cover` (the geometry stage's
+// Alpha of a transparent strand fragment from `cover` (the ribbon vertex stage's
 // g_cover: x signed distance from the band's centre line, y its half width,
 // both in pixels): the length of the band's cross-section inside the pixel's
 // box filter (its exact coverage c: at most 1, at most the band's width),

@@ -319,10 +319,15 @@ impl Renderer {
         (self.interpolation_units() * self.detail.hairs_per_key, self.smoothed_vertices_per_strand())
     }
 
-    /// Line vertices of the latest prepared frame's hairs (two per segment).
-    fn line_vertices(&self) -> u32 {
+    /// Vertices the draw of the latest prepared frame's hairs takes: six per
+    /// segment for ribbons (two triangles), two for lines.
+    fn draw_vertices(&self) -> u32 {
         let (hairs, per_hair) = self.hair_counts();
-        hairs * (per_hair - 1) * 2
+        let per_segment = match self.params.primitive {
+            Primitive::Ribbons => 6,
+            Primitive::Lines => 2,
+        };
+        hairs * (per_hair - 1) * per_segment
     }
 
     /// Radius around the rest bounds' centre that the hair can reach.

@@ -47,10 +47,11 @@ pub struct RenderParams {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Primitive {
-    /// Camera-facing quads from the geometry stage, [`super::HairMaterial`] widths.
+    /// Camera-facing quads pulled by the vertex stage (two triangles per segment),
+    /// [`super::HairMaterial`] widths.
     #[default]
     Ribbons,
-    /// One-pixel lines (no geometry stage; cheapest).
+    /// One-pixel lines (two vertices per segment; cheapest).
     Lines,
 }
 

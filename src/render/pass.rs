@@ -129,13 +129,8 @@ pub(super) fn capture_pipeline(
 }
 
 /// Shader stages that read what a capture pass stored.
-const CAPTURE_READERS: &[AccessKind] = &[
-    AccessKind::VertexRead,
-    AccessKind::TessellationRead,
-    AccessKind::GeometryRead,
-    AccessKind::FragmentRead,
-    AccessKind::ComputeRead,
-];
+const CAPTURE_READERS: &[AccessKind] =
+    &[AccessKind::VertexRead, AccessKind::TessellationRead, AccessKind::FragmentRead, AccessKind::ComputeRead];
 
 /// Records one storing pass: its scope, an attachment-less rendering instance
 /// around `record`, then a barrier making its tessellation-stage storage writes

@@ -54,7 +54,6 @@ impl Layout {
 const READERS: &[AccessKind] = &[
     AccessKind::VertexRead,
     AccessKind::TessellationRead,
-    AccessKind::GeometryRead,
     AccessKind::FragmentRead,
     AccessKind::ComputeRead,
     AccessKind::TransferRead,

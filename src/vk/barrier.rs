@@ -33,10 +33,6 @@ pub(crate) enum AccessKind {
     TessellationRead,
     /// Storage writes in tessellation evaluation shaders (the capture passes).
     TessellationWrite,
-    /// Storage reads in geometry shaders.
-    GeometryRead,
-    /// Uniform reads in geometry shaders.
-    GeometryUniformRead,
     /// Storage reads in fragment shaders.
     FragmentRead,
     /// Storage writes in fragment shaders.
@@ -85,8 +81,6 @@ impl AccessKind {
             VertexUniformRead => (Stage::VERTEX_SHADER, Acc::UNIFORM_READ),
             TessellationRead => (Stage::TESSELLATION_EVALUATION_SHADER, Acc::SHADER_STORAGE_READ),
             TessellationWrite => (Stage::TESSELLATION_EVALUATION_SHADER, Acc::SHADER_STORAGE_WRITE),
-            GeometryRead => (Stage::GEOMETRY_SHADER, Acc::SHADER_STORAGE_READ),
-            GeometryUniformRead => (Stage::GEOMETRY_SHADER, Acc::UNIFORM_READ),
             FragmentRead => (Stage::FRAGMENT_SHADER, Acc::SHADER_STORAGE_READ),
             FragmentWrite => (Stage::FRAGMENT_SHADER, Acc::SHADER_STORAGE_WRITE),
             FragmentUniformRead => (Stage::FRAGMENT_SHADER, Acc::UNIFORM_READ),

@@ -213,7 +213,6 @@ fn stage_of(model: ExecutionModel) -> Option<vk::ShaderStageFlags> {
         ExecutionModel::Vertex => vk::ShaderStageFlags::VERTEX,
         ExecutionModel::TessellationControl => vk::ShaderStageFlags::TESSELLATION_CONTROL,
         ExecutionModel::TessellationEvaluation => vk::ShaderStageFlags::TESSELLATION_EVALUATION,
-        ExecutionModel::Geometry => vk::ShaderStageFlags::GEOMETRY,
         ExecutionModel::Fragment => vk::ShaderStageFlags::FRAGMENT,
         _ => return None,
     })

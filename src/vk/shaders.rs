@@ -7,7 +7,6 @@ pub(crate) enum ShaderStage {
     Vertex,
     TessControl,
     TessEvaluation,
-    Geometry,
     Fragment,
 }
 
@@ -19,7 +18,6 @@ impl ShaderStage {
             ShaderStage::Vertex => F::VERTEX,
             ShaderStage::TessControl => F::TESSELLATION_CONTROL,
             ShaderStage::TessEvaluation => F::TESSELLATION_EVALUATION,
-            ShaderStage::Geometry => F::GEOMETRY,
             ShaderStage::Fragment => F::FRAGMENT,
         }
     }

@@ -53,6 +53,7 @@ enum Command {
 
 fn main() -> ExitCode {
     output::restore_sigpipe();
+    output::bound_heap_growth();
     output::exit_cleanly_on_signals();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();

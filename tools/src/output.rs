@@ -45,6 +45,20 @@ pub fn restore_sigpipe() {
     }
 }
 
+/// Keeps the process's memory flat however long a run is: large allocations
+/// (frames, lavapipe's per-submission buffers) are mapped and unmapped
+/// instead of cut from the heap, where glibc's growing threshold for that
+/// would leave them to fragment it a little more every frame.
+pub fn bound_heap_growth() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: mallopt only sets the allocator's tuning; called before any
+    // other thread exists.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, 128 << 10);
+        libc::mallopt(libc::M_TRIM_THRESHOLD, 128 << 10);
+    }
+}
+
 /// On SIGINT or SIGTERM, removes the temporary files of the writes in progress
 /// (no `.NAME.*.partial` stays behind; a file being replaced keeps its old
 /// contents) and exits with the conventional status, 128 + the signal.

@@ -6,7 +6,7 @@
 //! index, the profiler handle, the [`DrawTarget`] (the host's images, or the
 //! supersampling images twice their size), what the shading reads and the
 //! frame's uniform block. Every mode draws the same ribbons
-//! (`glsl/render/draw.vert`, `draw.geom`/`oit.geom`) with the same shading
+//! (`glsl/render/ribbon.vert`, two triangles a segment) with the same shading
 //! (`hair_shading.glsl`, [`shading::ShadingResources`]) and differs only in
 //! how fragments reach the target, one file each:
 //!
@@ -109,7 +109,8 @@ pub(super) struct DrawFrame<'a> {
     pub params: DrawParams,
     /// The Marschner tables' parameters (rebuilt when they change).
     pub marschner: MarschnerParams,
-    /// Line vertices of the frame's hairs (two per segment).
+    /// Vertices of the frame's hairs: six per segment (two triangles) for
+    /// ribbons, two for lines.
     pub vertices: u32,
 }
 
@@ -269,7 +270,7 @@ impl Renderer {
                 camera,
                 drawn.extent,
             ),
-            vertices: self.line_vertices(),
+            vertices: self.draw_vertices(),
             target: drawn,
             inputs: DrawInputs {
                 hairs: self.interpolate.hairs(),

@@ -1,6 +1,6 @@
 //! Pass 4 with [`Transparency::Off`](crate::render::Transparency::Off)
-//! (`glsl/render/draw.*`): the hairs as camera-facing ribbons expanded in the
-//! geometry stage (or lines), shaded with Kajiya-Kay diffuse and two shifted
+//! (`glsl/render/ribbon.vert`, `draw.*`): the hairs as camera-facing ribbons
+//! placed by the vertex stage, two triangles a segment (or lines), shaded with Kajiya-Kay diffuse and two shifted
 //! highlights (or Marschner) for every light, into the target's colour and
 //! depth (depth-tested against what the host drew). With a depth image the
 //! ribbons are drawn twice in one rendering instance: first depth only (no
@@ -19,7 +19,7 @@ use crate::render::Primitive;
 use crate::vk::device::Device;
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
 use crate::vk::rendering;
-use crate::vk::shaders::{ShaderSource, RENDER_DRAW_FRAG, RENDER_DRAW_GEOM, RENDER_DRAW_VERT};
+use crate::vk::shaders::{ShaderSource, RENDER_DRAW_FRAG, RENDER_DRAW_VERT, RENDER_RIBBON_VERT};
 use ash::vk;
 
 /// The pipelines of one target: the depth pre-pass (targets with a depth image)
@@ -55,17 +55,18 @@ impl OpaquePipelines {
         let (buffers, images) = shading.bindings(&frame.inputs);
         let color_formats = [key.color];
         let has_depth = key.depth != vk::Format::UNDEFINED;
-        // Lines skip the geometry stage: the fragment stage reads the vertex
-        // stage's outputs at the same locations.
-        let stages: &[&ShaderSource] = if key.primitive == Primitive::Lines {
-            &[&RENDER_DRAW_VERT, &RENDER_DRAW_FRAG]
+        // Ribbons are two triangles a segment placed by the vertex stage; lines
+        // one line a segment. Either way the fragment stage reads the same
+        // outputs at the same locations.
+        let (stages, topology): (&[&ShaderSource], _) = if key.primitive == Primitive::Lines {
+            (&[&RENDER_DRAW_VERT, &RENDER_DRAW_FRAG], vk::PrimitiveTopology::LINE_LIST)
         } else {
-            &[&RENDER_DRAW_VERT, &RENDER_DRAW_GEOM, &RENDER_DRAW_FRAG]
+            (&[&RENDER_RIBBON_VERT, &RENDER_DRAW_FRAG], vk::PrimitiveTopology::TRIANGLE_LIST)
         };
         let desc = |name, stages, depth_write, blend| GraphicsDesc {
             name,
             stages,
-            topology: vk::PrimitiveTopology::LINE_LIST,
+            topology,
             patch_control_points: 0,
             color_formats: &color_formats,
             depth_format: key.depth,

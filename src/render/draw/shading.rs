@@ -115,5 +115,4 @@ impl ShadingResources {
 }
 
 /// Stages that read the draw's uniform block.
-const UNIFORM_READERS: &[AccessKind] =
-    &[AccessKind::VertexUniformRead, AccessKind::GeometryUniformRead, AccessKind::FragmentUniformRead];
+const UNIFORM_READERS: &[AccessKind] = &[AccessKind::VertexUniformRead, AccessKind::FragmentUniformRead];

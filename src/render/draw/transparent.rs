@@ -4,7 +4,7 @@
 //! `fast.rs`.
 //!
 //! 1. **Build** (in the [`RenderPass::Draw`] scope): the ribbons of the draw
-//!    pass's vertex and geometry stages, with their true width and a coverage
+//!    pass's vertex stage (`ribbon.vert`'s coverage variant), with their true width and a coverage
 //!    per fragment, depth-tested against the target's depth (not written). Every
 //!    surviving fragment is shaded once and either pushed onto its pixel's list
 //!    (exact; beyond the pool, counted and added to the weighted sums instead)
@@ -40,7 +40,7 @@ use crate::vk::device::Device;
 use crate::vk::image::Sampler;
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
 use crate::vk::rendering;
-use crate::vk::shaders::{ShaderSource, RENDER_DRAW_VERT, RENDER_OIT_DEPTH_FRAG, RENDER_OIT_GEOM, RENDER_RESOLVE_VERT};
+use crate::vk::shaders::{ShaderSource, RENDER_OIT_DEPTH_FRAG, RENDER_RESOLVE_VERT, RENDER_RIBBON_VERT_COVERAGE};
 
 /// A transparency mode's fragment stages: the build's and the composite's.
 pub(super) struct ModeShaders {
@@ -243,11 +243,10 @@ impl TransparentPass {
         let mut buffers = shading_buffers.to_vec();
         buffers.extend_from_slice(&ours);
 
-        let build_stages = [&RENDER_DRAW_VERT, &RENDER_OIT_GEOM, shaders.build];
+        let build_stages = [&RENDER_RIBBON_VERT_COVERAGE, shaders.build];
         let build = GraphicsPipeline::new(
             d,
             &GraphicsDesc {
-                topology: vk::PrimitiveTopology::LINE_LIST,
                 ..desc(
                     "vkhair hair transparency build",
                     &build_stages,

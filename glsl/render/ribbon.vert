@@ -1,0 +1,85 @@
+#version 460
+// Draw pass, vertex stage of ribbons (no vertex buffer, no geometry stage):
+// vertices 6s..6s+5 are the two triangles of segment s of the interpolated
+// hairs (hair-major), a camera-facing ribbon of mix(root width, tip width)
+// world units, at least `least width` pixels wide. Each vertex reads both
+// ends of its segment (for the ribbon's direction) and places its corner.
+//
+// Transparent strands (the VKHAIR_COVERAGE variant, drawn with dp.coverage.x = 1) have no
+// least width: their ribbon is at least one pixel wide plus half a pixel each
+// side, and g_cover carries the signed distance from the centre line and the
+// true half width, in pixels, from which the fragment stage computes the
+// strand's coverage. A transparent strand standing for n hairs
+// (dp.coverage.z) is a band n hair widths wide.
+//
+// vkhair variant: VKHAIR_COVERAGE
+#include "render.glsl"
+
+layout(std140, set = 0, binding = 0) uniform Draw { DrawParams dp; };
+layout(std430, set = 0, binding = 1) readonly buffer HairPos { vec4 hair_pos[]; };
+layout(std430, set = 0, binding = 2) readonly buffer HairTan { vec4 hair_tan[]; };
+
+// The depth pre-pass and the shading draw must rasterize the same depths: the
+// same module in both pipelines, and no fused multiply-adds that a compiler
+// could choose differently in each.
+precise gl_Position;
+
+layout(location = 0) out vec3 g_pos;
+layout(location = 1) out vec3 g_tan;
+layout(location = 2) out float g_t;
+layout(location = 3) flat out uint g_hair;
+#ifdef VKHAIR_COVERAGE
+layout(location = 4) out vec2 g_cover;
+#endif
+
+// The two triangles of a ribbon, corners 0..5: (end 0, −), (end 0, +),
+// (end 1, −) and (end 0, +), (end 1, +), (end 1, −) — the end of the segment
+// (0 the first, 1 the second) and the side of its centre line.
+uint corner_end(uint c) {
+    return (c == 2u || c >= 4u) ? 1u : 0u;
+}
+
+float corner_side(uint c) {
+    return (c == 1u || c == 3u || c == 4u) ? 1.0 : -1.0;
+}
+
+void main() {
+    uint per_hair = dp.counts.y;
+    uint segs = per_hair - 1u;
+    uint seg = uint(gl_VertexIndex) / 6u;
+    uint corner = uint(gl_VertexIndex) - seg * 6u;
+    uint hair = seg / segs;
+    uint first = hair * per_hair + (seg - hair * segs);
+    uint e = corner_end(corner);
+    vec3 p0 = hair_pos[first].xyz;
+    vec3 p1 = hair_pos[first + 1u].xyz;
+    vec3 pos = e == 0u ? p0 : p1;
+    vec4 tan_t = hair_tan[first + e];
+    vec3 along = p1 - p0;
+    float len = length(along);
+    vec3 dir = len > 0.0 ? along / len : hair_tan[first].xyz;
+    vec3 to_camera = dp.camera.xyz - pos;
+    float distance_to_camera = length(to_camera);
+    vec3 side = cross(dir, to_camera);
+    float side_len = length(side);
+    side = side_len > 1e-12 ? side / side_len : vec3(1.0, 0.0, 0.0);
+    float width = mix(dp.widths.x, dp.widths.y, tan_t.w);
+#ifdef VKHAIR_COVERAGE
+    // A transparent strand standing for n hairs is a band of n hair widths.
+    width *= dp.coverage.z;
+    float pixel = max(dp.camera.w * distance_to_camera, 1e-12);
+    float half_true = 0.5 * width / pixel;
+    float half_drawn = (max(half_true, 0.5) + 0.5) * pixel;
+#else
+    float half_drawn = 0.5 * max(width, dp.widths.z * dp.camera.w * distance_to_camera);
+#endif
+    float s = corner_side(corner);
+    g_pos = pos + side * (half_drawn * s);
+#ifdef VKHAIR_COVERAGE
+    g_cover = vec2(half_drawn / pixel * s, half_true);
+#endif
+    g_tan = tan_t.xyz;
+    g_t = tan_t.w;
+    g_hair = hair;
+    gl_Position = dp.view_proj * vec4(g_pos, 1.0);
+}
