@@ -54,6 +54,9 @@ const ACCEPTED: &[(&str, &str)] = &[
     ("render.clump_width", "0"),
     ("render.root_width", "0"),
     ("render.tip_width", "0"),
+    // Config: [render.oit]: 0 is the device's limit; any size from 64 KiB
+    ("render.oit.max_buffer_bytes", "0"),
+    ("render.oit.max_buffer_bytes", "4000000000"),
     // Config: [material]
     ("material.ambient", "0"),
     ("material.diffuse_wrap", "0"),

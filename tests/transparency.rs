@@ -393,3 +393,103 @@ fn bad_transparency_parameters_and_targets_are_refused() {
         "a multisampled target was not refused: {result:?}"
     );
 }
+
+/// The pool split over several buffers (a small `max_buffer_bytes` forces
+/// eight) stores what one buffer stores and draws the same image; a request
+/// beyond eight buffers is capped, reported, and the rest joins the tail.
+#[test]
+fn a_pool_split_over_buffers_draws_what_one_buffer_draws() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(300, 8, 5);
+    let m = material(WIDTH, OPACITY);
+    let extent = vkhair::ash::vk::Extent2D { width: W, height: H };
+    let mut p = params(Transparency::Exact);
+    // 28,800 nodes: in one buffer by default, in eight of 3,600 at 64 KiB each.
+    p.oit.fragments_per_pixel = 1.5;
+    let mut s = scene(&gpu, &groom, &p, &m);
+    let one = draw(&gpu, &mut s);
+    let whole = s.renderer.transparency_stats().expect("stats");
+    let pool = s.renderer.transparency_pool(extent).expect("an exact pool");
+    assert_eq!((pool.buffers, pool.capacity, pool.requested), (1, 28_800, 28_800), "{pool:?}");
+
+    p.oit.max_buffer_bytes = 65_536;
+    s.renderer.set_params(&p).expect("params");
+    let split = draw(&gpu, &mut s);
+    let stats = s.renderer.transparency_stats().expect("stats");
+    let pool = s.renderer.transparency_pool(extent).expect("an exact pool");
+    println!("one buffer: {whole:?}; split: {pool:?}, {stats:?}");
+    assert_eq!((pool.buffers, pool.nodes_per_buffer, pool.capacity), (8, 3_600, 28_800), "{pool:?}");
+    assert_eq!(stats, whole, "the split pool stored other fragments");
+    assert_eq!(stats.overflowed, 0, "the pool overflowed: {stats:?}");
+    assert!(stats.stored > 2 * pool.nodes_per_buffer, "too few fragments to reach the third buffer: {stats:?}");
+    let worst = one.iter().zip(&split).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0f32, f32::max);
+    println!("largest difference between the two images: {worst} (linear)");
+    assert!(worst <= 2.0 / 255.0, "the split pool draws another image: a difference of {worst}");
+
+    // Eight buffers of 64 KiB hold 32,768 of the 153,600 nodes 8 per pixel asks for.
+    p.oit.fragments_per_pixel = 8.0;
+    s.renderer.set_params(&p).expect("params");
+    let capped = draw(&gpu, &mut s);
+    let stats = s.renderer.transparency_stats().expect("stats");
+    let pool = s.renderer.transparency_pool(extent).expect("an exact pool");
+    println!("capped: {pool:?}, {stats:?}");
+    assert!(pool.is_capped(), "{pool:?}");
+    assert_eq!((pool.buffers, pool.capacity, pool.requested), (8, 32_768, 153_600), "{pool:?}");
+    assert_eq!((stats.capacity, stats.requested), (32_768, 153_600), "{stats:?}");
+    let truth = reference(&s, WIDTH, OPACITY);
+    let (e_one, e_capped) = (mae(&one, &truth), mae(&capped, &truth));
+    println!("error against the reference: {e_one:.2} with one buffer, {e_capped:.2} capped");
+    assert!(e_capped <= e_one * 1.05 + 0.05, "the capped pool drew worse: {e_capped:.2} against {e_one:.2}");
+}
+
+/// 720p, 1080p and 4K in the exact mode with the default pool (8 fragments per
+/// pixel): the pool is split over as many buffers as the device's buffer range
+/// needs, nothing is capped where eight suffice, and the exact image covers the
+/// pixels the fast mode's does.
+#[test]
+fn every_size_renders_in_the_exact_mode() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(120, 8, 3);
+    let m = material(0.002, OPACITY);
+    let info = gpu.ctx().info();
+    let buffer_bytes = u64::from(info.max_storage_buffer_range).min(info.max_memory_allocation_size);
+    println!("device: {} bytes per buffer", buffer_bytes);
+    for (w, h) in [(1280u32, 720u32), (1920, 1080), (3840, 2160)] {
+        let extent = vkhair::ash::vk::Extent2D { width: w, height: h };
+        let sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
+        let offscreen = Offscreen::new(gpu.ctx(), w, h).expect("offscreen");
+        let camera = common::front_camera(0.9, (w, h));
+        let mut hair_pixels = Vec::new();
+        for mode in [Transparency::Fast, Transparency::Exact] {
+            let mut renderer = Renderer::new(gpu.ctx(), &sim, &params(mode)).expect("renderer");
+            renderer.set_material(&m).expect("material");
+            let host = common::HostFrame { clear: BACKGROUND, before: None, after: None };
+            let rgba = common::draw_frame(&gpu, (&sim, &mut renderer), &offscreen, &camera, &host);
+            let image = linear_rgb(&rgba);
+            hair_pixels.push(image.iter().filter(|c| (**c - BACKGROUND).abs().max_element() > 0.01).count());
+            if mode == Transparency::Exact {
+                let pool = renderer.transparency_pool(extent).expect("an exact pool");
+                let stats = renderer.transparency_stats().expect("stats");
+                println!("{w}×{h}: {pool:?}, {stats:?}");
+                let bytes = u64::from(w) * u64::from(h) * 8 * 16;
+                let needed = bytes.div_ceil(buffer_bytes);
+                assert_eq!(pool.requested, u64::from(w) * u64::from(h) * 8, "{pool:?}");
+                if needed <= 8 {
+                    assert_eq!(u64::from(pool.buffers), needed, "{pool:?}");
+                    assert!(!pool.is_capped(), "{pool:?}");
+                } else {
+                    println!(
+                        "{w}×{h}: this device's buffers hold {:.2} fragments per pixel",
+                        pool.fragments_per_pixel()
+                    );
+                }
+                assert_eq!(stats.overflowed, 0, "{stats:?}");
+                assert!(stats.stored > 1000, "too few fragments: {stats:?}");
+            }
+        }
+        println!("{w}×{h}: hair pixels fast {}, exact {}", hair_pixels[0], hair_pixels[1]);
+        assert!(hair_pixels[1] > 1000, "no hair at {w}×{h}");
+        let (a, b) = (hair_pixels[0] as f64, hair_pixels[1] as f64);
+        assert!((a - b).abs() <= 0.01 * a, "the exact mode covers other pixels than the fast one at {w}×{h}");
+    }
+}

@@ -38,6 +38,6 @@ void main() {
     out_overflow = vec4(0.0);
     out_absorbance = vec4(0.0);
     uint next = atomicExchange(oit_heads[pixel], node);
-    oit_nodes[node] = uvec4(packHalf2x16(color.rg), packHalf2x16(vec2(color.b, alpha)),
-                            floatBitsToUint(gl_FragCoord.z), next);
+    oit_store(node, uvec4(packHalf2x16(color.rg), packHalf2x16(vec2(color.b, alpha)),
+                          floatBitsToUint(gl_FragCoord.z), next));
 }

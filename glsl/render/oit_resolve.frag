@@ -31,7 +31,7 @@ void main() {
     // Each stored node is on exactly one list: at most min(used, capacity) steps.
     uint steps = min(oit.used, oit.capacity);
     for (uint step = 0u; node != OIT_END && step < steps; step++) {
-        uvec4 record = oit_nodes[node];
+        uvec4 record = oit_load(node);
         node = record.w;
         vec4 c = vec4(unpackHalf2x16(record.x), unpackHalf2x16(record.y));
         float z = uintBitsToFloat(record.z);

@@ -133,8 +133,10 @@ pub(crate) struct OitCounters {
     pub width: u32,
     /// Fragments sorted exactly per pixel (K).
     pub sorted: u32,
+    /// Nodes per buffer of the pool (node n is entry n mod this of buffer n / this).
+    pub pool_nodes: u32,
 }
-gpu_struct!(OitCounters => "OitCounters" { used, capacity, width, sorted });
+gpu_struct!(OitCounters => "OitCounters" { used, capacity, width, sorted, pool_nodes });
 
 /// Push constants of the Marschner table builder (`MarschnerPush` in `glsl/include/marschner.glsl`).
 #[repr(C)]

@@ -39,7 +39,7 @@ mod shadow;
 mod smooth;
 mod target;
 
-pub use draw::OitStats;
+pub use draw::{OitPool, OitStats};
 pub use marschner::MarschnerParams;
 pub use params::{
     Detail, InterpolationMode, LodParams, OitParams, Primitive, RenderParams, Transparency, MAX_HAIRS_PER_KEY,

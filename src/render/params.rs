@@ -109,6 +109,9 @@ pub enum Transparency {
     Exact,
 }
 
+/// Smallest [`OitParams::max_buffer_bytes`] other than 0 (64 KiB).
+pub const MIN_POOL_BUFFER_BYTES: u32 = 65_536;
+
 /// Sizes of the transparent modes ([`Transparency::Fast`], [`Transparency::Exact`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -118,13 +121,21 @@ pub struct OitParams {
     /// Fragment pool of the exact mode, in fragments per pixel of the drawn extent
     /// (0.01..=256; 16 bytes each): fragments beyond it are counted and
     /// composited unsorted, in the order-independent tail behind the sorted
-    /// ones (none is lost; the order of those is approximate). Default: 8.
+    /// ones (none is lost; the order of those is approximate). The pool is
+    /// split over up to 8 storage buffers, each within the device's
+    /// `maxStorageBufferRange`; a device whose 8 buffers cannot hold the request
+    /// gets the pool they can hold ([`super::OitPool`], [`super::OitStats::requested`]).
+    /// Default: 8.
     pub fragments_per_pixel: f32,
+    /// Largest buffer of the exact mode's pool, bytes: 0 for the device's limits,
+    /// else 65,536..=4,294,967,295 (the device's limits still apply), e.g. to
+    /// keep each buffer within a host allocator's block. Default: 0.
+    pub max_buffer_bytes: u32,
 }
 
 impl Default for OitParams {
     fn default() -> Self {
-        OitParams { sorted_fragments: 8, fragments_per_pixel: 8.0 }
+        OitParams { sorted_fragments: 8, fragments_per_pixel: 8.0, max_buffer_bytes: 0 }
     }
 }
 
@@ -207,6 +218,10 @@ impl RenderParams {
         let f = self.oit.fragments_per_pixel;
         if !(f.is_finite() && (0.01..=256.0).contains(&f)) {
             return Err(Error::param("oit.fragments_per_pixel", f, "0.01..=256"));
+        }
+        let b = self.oit.max_buffer_bytes;
+        if b != 0 && b < MIN_POOL_BUFFER_BYTES {
+            return Err(Error::param("oit.max_buffer_bytes", b, format!("0 or {MIN_POOL_BUFFER_BYTES}..=4294967295")));
         }
         let lod = &self.lod;
         let d = lod.full_detail_distance;

@@ -43,6 +43,8 @@ pub struct DeviceInfo {
     pub max_tessellation_level: u32,
     /// Largest storage buffer range, bytes.
     pub max_storage_buffer_range: u32,
+    /// Largest single memory allocation, bytes (`maxMemoryAllocationSize`).
+    pub max_memory_allocation_size: u64,
     /// Invocations per subgroup (SPIR-V 1.5 modules always see this size).
     pub subgroup_size: u32,
     /// Whether compute shaders have subgroup arithmetic on subgroups of at least 4
@@ -64,8 +66,10 @@ impl DeviceInfo {
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
         let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
         let mut ids = vk::PhysicalDeviceIDProperties::default();
+        let mut maintenance3 = vk::PhysicalDeviceMaintenance3Properties::default();
         let mut props2 = vk::PhysicalDeviceProperties2::default()
             .push_next(&mut driver)
+            .push_next(&mut maintenance3)
             .push_next(&mut subgroup)
             .push_next(&mut ids);
         // SAFETY: `physical` was enumerated from `instance`, which is alive.
@@ -92,6 +96,7 @@ impl DeviceInfo {
             max_compute_invocations: props.limits.max_compute_work_group_invocations,
             max_tessellation_level: props.limits.max_tessellation_generation_level,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
+            max_memory_allocation_size: maintenance3.max_memory_allocation_size,
             subgroup_size: subgroup.subgroup_size,
             subgroup_reductions: subgroup.supported_operations.contains(vk::SubgroupFeatureFlags::ARITHMETIC)
                 && subgroup.supported_stages.contains(vk::ShaderStageFlags::COMPUTE)

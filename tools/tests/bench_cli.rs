@@ -78,10 +78,24 @@ fn a_quick_bench_reports_every_stage_with_its_reference_and_writes_json_and_a_ch
     assert!(default < 0.5 * off, "the default (exact) frame's error {default} is not below half of off's {off}");
     let csv = std::fs::read_to_string(out.join("transparency.csv")).expect("transparency.csv");
     assert_eq!(csv.lines().count(), 6, "a header and a row per mode: {csv}");
+    // The frame in the off and the default (exact) mode at the top level, the
+    // figures of their rows; Sintel's are null where it was skipped.
+    let figure = |stage: &str| {
+        frames
+            .iter()
+            .find(|f| f["stage"].as_str().is_some_and(|s| s.contains(stage)))
+            .map(|f| f["gpu_ms_per_frame"].clone())
+    };
+    assert_eq!(Some(v["frame_ms_off"].clone()), figure("transparency off"), "{v}");
+    assert_eq!(Some(v["frame_ms_exact"].clone()), figure("segments"), "{v}");
+    assert!(v["frame_ms_off"].is_number() && v["frame_ms_exact"].is_number(), "{v}");
+    assert!(v["sintel_frame_ms_off"].is_null() && v["sintel_frame_ms_exact"].is_null(), "{v}");
     let (w, h, _) = common::read_png(&out.join("transparency.png"));
     assert_eq!((w, h), (1100, 500));
     let scaling = v["scaling"].as_array().expect("scaling");
     assert_eq!(scaling.len(), 4, "hairs, points, grid, resolution");
+    let pixels: Vec<_> = scaling[3]["points"].as_array().expect("points").iter().map(|p| p["work"].clone()).collect();
+    assert_eq!(pixels, [serde_json::json!(160.0 * 120.0), serde_json::json!(1920.0 * 1080.0)], "a point at 1080p");
     assert!(scaling[0]["gpu_exponent"].is_number() && scaling[0]["cpu_exponent"].is_number(), "{}", scaling[0]);
     let png = out.join("scaling.png");
     let (w, h, _) = common::read_png(&png);

@@ -12,10 +12,10 @@ use ash::vk;
 
 use super::transparent::ModeShaders;
 use crate::codes::sentinel::OIT_END;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::render::OitParams;
 use crate::vk::buffer::Buffer;
-use crate::vk::device::Device;
+use crate::vk::device::{Device, DeviceInfo};
 use crate::vk::shaders::{RENDER_OIT_BUILD_FRAG, RENDER_OIT_RESOLVE_FRAG};
 
 /// The build's and the composite's fragment stages.
@@ -25,53 +25,107 @@ pub(super) const SHADERS: ModeShaders =
 /// Bytes of one stored fragment (colour and alpha as half floats, depth, next).
 const NODE_BYTES: u64 = 16;
 
-/// Nodes in the pool at `extent`.
-pub(super) fn pool_capacity(params: &OitParams, extent: vk::Extent2D) -> u64 {
-    let pixels = f64::from(extent.width) * f64::from(extent.height);
-    ((pixels * f64::from(params.fragments_per_pixel)).ceil() as u64).max(1)
+/// The pool's storage-buffer bindings (`OitNodes0`..`OitNodes7` in
+/// `glsl/include/oit.glsl`), in the order of the pool's buffers: a pool larger
+/// than one buffer's range is split over up to this many buffers.
+const POOL_BINDINGS: [u32; 8] = [11, 13, 14, 15, 16, 17, 18, 19];
+
+/// The exact mode's fragment pool for one extent on one device: what
+/// [`OitParams::fragments_per_pixel`] asks for and what the device holds.
+///
+/// The pool is split over up to 8 storage buffers, each at most the device's
+/// `maxStorageBufferRange` and `maxMemoryAllocationSize`; where even 8 cannot
+/// hold the request, the pool holds what they can and the fragments beyond it
+/// join the order-independent tail (counted in [`OitStats::overflowed`](super::OitStats)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OitPool {
+    /// Pixels the lists cover (of the drawn extent: twice each side with supersampling).
+    pub pixels: u64,
+    /// Nodes `fragments_per_pixel` asks for at the extent.
+    pub requested: u64,
+    /// Nodes the pool holds: `requested`, or fewer where the device's buffers
+    /// cannot hold them.
+    pub capacity: u64,
+    /// Buffers the pool is split over (1..=8).
+    pub buffers: u32,
+    /// Nodes in each buffer (the last may hold fewer).
+    pub nodes_per_buffer: u64,
+}
+
+impl OitPool {
+    /// The pool for `params` at `extent` on a device with `info`'s limits.
+    pub(crate) fn plan(info: &DeviceInfo, params: &OitParams, extent: vk::Extent2D) -> Self {
+        let pixels = f64::from(extent.width) * f64::from(extent.height);
+        let requested = ((pixels * f64::from(params.fragments_per_pixel)).ceil() as u64).max(1);
+        let mut buffer_bytes = u64::from(info.max_storage_buffer_range).min(info.max_memory_allocation_size);
+        if params.max_buffer_bytes != 0 {
+            buffer_bytes = buffer_bytes.min(u64::from(params.max_buffer_bytes));
+        }
+        let most_per_buffer = (buffer_bytes / NODE_BYTES).clamp(1, u64::from(u32::MAX));
+        // Node indices stay below the end-of-list marker.
+        let most = (most_per_buffer * POOL_BINDINGS.len() as u64).min(u64::from(OIT_END) - 1);
+        let capacity = requested.min(most);
+        let buffers = capacity.div_ceil(most_per_buffer);
+        let pixels = u64::from(extent.width) * u64::from(extent.height);
+        OitPool { pixels, requested, capacity, buffers: buffers as u32, nodes_per_buffer: capacity.div_ceil(buffers) }
+    }
+
+    /// Bytes of the pool's buffers.
+    pub fn bytes(&self) -> u64 {
+        self.capacity * NODE_BYTES
+    }
+
+    /// Bytes the requested pool would take.
+    pub fn requested_bytes(&self) -> u64 {
+        self.requested * NODE_BYTES
+    }
+
+    /// Fragments per pixel the pool holds (the requested
+    /// [`OitParams::fragments_per_pixel`] unless the device held fewer).
+    pub fn fragments_per_pixel(&self) -> f64 {
+        self.capacity as f64 / self.pixels.max(1) as f64
+    }
+
+    /// Whether the device held fewer nodes than requested.
+    pub fn is_capped(&self) -> bool {
+        self.capacity < self.requested
+    }
 }
 
 /// The lists: per pixel the newest node of its list, and the node pool.
 pub(super) struct Lists {
     heads: Buffer,
-    nodes: Buffer,
-    /// Nodes in the pool.
-    pub capacity: u32,
+    nodes: Vec<Buffer>,
+    pub pool: OitPool,
 }
 
 impl Lists {
-    /// The lists for `extent`; an error naming `fragments_per_pixel` when the
-    /// pool exceeds what one storage buffer of the device can address.
-    pub(super) fn new(device: &Arc<Device>, params: &OitParams, extent: vk::Extent2D) -> Result<Self> {
-        let capacity = pool_capacity(params, extent);
-        let node_bytes = capacity * NODE_BYTES;
-        if capacity > u64::from(u32::MAX) || node_bytes > u64::from(device.info.max_storage_buffer_range) {
-            return Err(Error::param(
-                "oit.fragments_per_pixel",
-                params.fragments_per_pixel,
-                format!(
-                    "a pool of at most {} bytes at {}×{} (this one needs {node_bytes})",
-                    device.info.max_storage_buffer_range, extent.width, extent.height
-                ),
-            ));
-        }
+    /// The lists of `pool` at `extent`.
+    pub(super) fn new(device: &Arc<Device>, pool: OitPool, extent: vk::Extent2D) -> Result<Self> {
         let pixels = u64::from(extent.width) * u64::from(extent.height);
-        Ok(Lists {
-            heads: Buffer::storage(device, "vkhair transparency heads", 4 * pixels)?,
-            nodes: Buffer::storage(device, "vkhair transparency nodes", node_bytes)?,
-            capacity: capacity as u32,
-        })
+        let mut nodes = Vec::with_capacity(pool.buffers as usize);
+        for i in 0..u64::from(pool.buffers) {
+            let count = pool.nodes_per_buffer.min(pool.capacity - i * pool.nodes_per_buffer);
+            nodes.push(Buffer::storage(device, &format!("vkhair transparency nodes {i}"), count * NODE_BYTES)?);
+        }
+        Ok(Lists { heads: Buffer::storage(device, "vkhair transparency heads", 4 * pixels)?, nodes, pool })
     }
 
     /// Bytes of the heads and the pool at `extent`.
-    pub(super) fn memory_bytes(params: &OitParams, extent: vk::Extent2D) -> u64 {
-        let pixels = u64::from(extent.width) * u64::from(extent.height);
-        4 * pixels + NODE_BYTES * pool_capacity(params, extent)
+    pub(super) fn memory_bytes(pool: &OitPool, extent: vk::Extent2D) -> u64 {
+        4 * u64::from(extent.width) * u64::from(extent.height) + pool.bytes()
     }
 
-    /// The heads and the pool by binding.
-    pub(super) fn bindings(&self) -> [(u32, &Buffer); 2] {
-        [(10, &self.heads), (11, &self.nodes)]
+    /// The heads and the pool's buffers by binding; bindings past the pool's
+    /// buffers name its first one (never addressed).
+    pub(super) fn bindings(&self) -> Vec<(u32, &Buffer)> {
+        let mut out = vec![(10, &self.heads)];
+        for (i, binding) in POOL_BINDINGS.iter().enumerate() {
+            if let Some(buffer) = self.nodes.get(i).or(self.nodes.first()) {
+                out.push((*binding, buffer));
+            }
+        }
+        out
     }
 
     /// Records every list emptied (transfer writes).

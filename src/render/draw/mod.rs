@@ -27,6 +27,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
+pub use exact::OitPool;
 pub use transparent::OitStats;
 
 use super::marschner::MarschnerParams;
@@ -301,6 +302,13 @@ impl Renderer {
         self.resolve.retired_count() + self.draw.transparent.retired_count()
     }
 
+    /// The extent the hair is drawn at for a target of `extent`: twice each
+    /// side with supersampling.
+    fn drawn_extent(&self, extent: vk::Extent2D) -> vk::Extent2D {
+        let scale = if self.params.supersampling { 2 } else { 1 };
+        vk::Extent2D { width: extent.width.saturating_mul(scale), height: extent.height.saturating_mul(scale) }
+    }
+
     /// What the latest frame drawn with [`Transparency::Exact`] stored: fragments
     /// offered, stored, and overflowed because the pool was full (those are
     /// composited unsorted behind the stored ones). Read from
@@ -314,9 +322,20 @@ impl Renderer {
     /// GPU memory the transparency mode of the current parameters needs for a
     /// target of `extent` (the supersampled extent where supersampling is on), bytes.
     pub fn transparency_memory(&self, extent: vk::Extent2D) -> u64 {
-        let scale = if self.params.supersampling { 2 } else { 1 };
-        let drawn = vk::Extent2D { width: extent.width * scale, height: extent.height * scale };
-        TransparentPass::memory_bytes(self.params.transparency, &self.params.oit, drawn)
+        let drawn = self.drawn_extent(extent);
+        TransparentPass::memory_bytes(&self.device.info, self.params.transparency, &self.params.oit, drawn)
+    }
+
+    /// The exact mode's fragment pool for a target of `extent` (the
+    /// supersampled extent where supersampling is on) on this device: what
+    /// [`OitParams::fragments_per_pixel`] asks for and what the device's buffers
+    /// hold ([`OitPool::is_capped`] when fewer). `None` unless the current mode
+    /// is [`Transparency::Exact`].
+    pub fn transparency_pool(&self, extent: vk::Extent2D) -> Option<OitPool> {
+        if self.params.transparency != Transparency::Exact {
+            return None;
+        }
+        Some(OitPool::plan(&self.device.info, &self.params.oit, self.drawn_extent(extent)))
     }
 }
 

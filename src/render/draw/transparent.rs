@@ -25,7 +25,7 @@ use std::sync::Arc;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use super::exact::{self, Lists};
+use super::exact::{self, Lists, OitPool};
 use super::fast::{self, WeightedSums, ABSORBANCE, WEIGHTED_SUM};
 use super::shading::ShadingResources;
 use super::{DrawFrame, TargetKey};
@@ -36,7 +36,7 @@ use crate::render::pass::RenderPass;
 use crate::render::{OitParams, Transparency};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::{Buffer, BufferDesc};
-use crate::vk::device::Device;
+use crate::vk::device::{Device, DeviceInfo};
 use crate::vk::image::Sampler;
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
 use crate::vk::rendering;
@@ -61,6 +61,10 @@ pub struct OitStats {
     pub overflowed: u64,
     /// Fragments the pool holds.
     pub capacity: u64,
+    /// Fragments [`OitParams::fragments_per_pixel`] asked the pool to hold:
+    /// more than `capacity` where the device's buffers could not hold them
+    /// (see [`OitPool`]).
+    pub requested: u64,
 }
 
 /// The pipelines of one target and their descriptor sets.
@@ -84,9 +88,9 @@ struct Resources {
 }
 
 impl Resources {
-    /// Nodes in the exact mode's pool (fast mode: none).
-    fn capacity(&self) -> u32 {
-        self.lists.as_ref().map_or(0, |l| l.capacity)
+    /// The exact mode's pool (fast mode: none).
+    fn pool(&self) -> Option<OitPool> {
+        self.lists.as_ref().map(|l| l.pool)
     }
 }
 
@@ -121,14 +125,14 @@ impl TransparentPass {
         })
     }
 
-    /// Bytes of GPU memory the exact or fast mode needs at `extent`.
-    pub(super) fn memory_bytes(mode: Transparency, params: &OitParams, extent: vk::Extent2D) -> u64 {
+    /// Bytes of GPU memory the exact or fast mode needs at `extent` on a device with `info`'s limits.
+    pub(super) fn memory_bytes(info: &DeviceInfo, mode: Transparency, params: &OitParams, extent: vk::Extent2D) -> u64 {
         let pixels = u64::from(extent.width) * u64::from(extent.height);
         // Both: the counters, a depth word per pixel and the weighted sums.
         let shared = std::mem::size_of::<OitCounters>() as u64 + (4 + fast::BYTES_PER_PIXEL) * pixels;
         match mode {
             Transparency::Off => 0,
-            Transparency::Exact => shared + Lists::memory_bytes(params, extent),
+            Transparency::Exact => shared + Lists::memory_bytes(&OitPool::plan(info, params, extent), extent),
             Transparency::Fast => shared,
         }
     }
@@ -156,9 +160,7 @@ impl TransparentPass {
     /// valid once that frame completed and before the next one is submitted.
     pub(super) fn stats(&self) -> Option<OitStats> {
         // The current resources are those of the latest transparent frame.
-        if self.current.as_ref()?.mode != Transparency::Exact {
-            return None;
-        }
+        let pool = self.current.as_ref().filter(|r| r.mode == Transparency::Exact)?.pool()?;
         let bytes = self.counters.mapped()?;
         let counters: OitCounters = bytemuck::pod_read_unaligned(bytes.get(..std::mem::size_of::<OitCounters>())?);
         let stored = counters.used.min(counters.capacity);
@@ -167,6 +169,7 @@ impl TransparentPass {
             stored: u64::from(stored),
             overflowed: u64::from(counters.used - stored),
             capacity: u64::from(counters.capacity),
+            requested: pool.requested,
         })
     }
 }
@@ -175,11 +178,11 @@ impl TransparentPass {
 impl TransparentPass {
     /// Makes the resources for `mode` at `extent` the current ones (retiring others).
     fn prepare(&mut self, frame: u64, mode: Transparency, params: &OitParams, extent: vk::Extent2D) -> Result<()> {
-        let capacity = match mode {
-            Transparency::Exact => exact::pool_capacity(params, extent),
-            _ => 0,
+        let pool = match mode {
+            Transparency::Exact => Some(OitPool::plan(&self.device.info, params, extent)),
+            _ => None,
         };
-        let fits = |r: &Resources| r.extent == extent && r.mode == mode && u64::from(r.capacity()) == capacity;
+        let fits = |r: &Resources| r.extent == extent && r.mode == mode && r.pool() == pool;
         if let Some(old) = self.current.take_if(|r| !fits(r)) {
             // Frames up to the previous one may still be using them.
             self.retired.push((frame.saturating_sub(1), old));
@@ -188,9 +191,9 @@ impl TransparentPass {
             return Ok(());
         }
         let d = &self.device;
-        let lists = match mode {
-            Transparency::Exact => Some(Lists::new(d, params, extent)?),
-            _ => None,
+        let lists = match pool {
+            Some(pool) => Some(Lists::new(d, pool, extent)?),
+            None => None,
         };
         let pixels = u64::from(extent.width) * u64::from(extent.height);
         self.current = Some(Resources {
@@ -329,11 +332,15 @@ impl TransparentPass {
         };
         let pipelines = &res.pipelines[&target.key];
         let (d, cmd, timing) = (&*self.device, frame.cmd, frame.timing);
+        let pool = res.pool();
+        // The plan keeps both below the end-of-list marker.
+        let capacity = pool.map_or(0, |p| p.capacity as u32);
         let counters = OitCounters {
             used: 0,
-            capacity: res.capacity(),
+            capacity,
             width: target.extent.width,
             sorted: params.sorted_fragments,
+            pool_nodes: pool.map_or(1, |p| p.nodes_per_buffer as u32),
         };
         let storage = &[AccessKind::FragmentRead, AccessKind::FragmentWrite];
         // The previous frame's composite read the lists (and the host read the counters).

@@ -124,6 +124,20 @@ pub fn make_renderer(
         material.represented_hairs = represented_hairs(renderer.hair_counts().0);
     }
     renderer.set_material(&material)?;
+    let extent = vkhair::ash::vk::Extent2D { width: a.width, height: a.height };
+    if let Some(pool) = renderer.transparency_pool(extent).filter(|p| p.is_capped()) {
+        eprintln!(
+            "vkhair: warning: at {}×{} this device holds {:.2} of the {} fragments per pixel oit.fragments_per_pixel \
+             asks for ({} of {} MiB in {} buffers); the fragments beyond the pool join the order-independent tail",
+            a.width,
+            a.height,
+            pool.fragments_per_pixel(),
+            config.render.oit.fragments_per_pixel,
+            pool.bytes() >> 20,
+            pool.requested_bytes() >> 20,
+            pool.buffers
+        );
+    }
     Ok(renderer)
 }
 

@@ -50,8 +50,9 @@ pub(super) fn render_rows(
         let f = bench_frames(ctx, &with_mode, &b.args.sim, samples, true)?;
         let mib = f.transparency_bytes as f64 / (1024.0 * 1024.0);
         let label = match mode {
-            None => format!("exact K = {k} (default)"),
+            None => DEFAULT_EXACT.to_owned(),
             Some("exact") => format!("exact K = {k}"),
+            Some("off") => OFF.to_owned(),
             Some(m) => m.to_owned(),
         };
         let stage = match mode {
@@ -76,6 +77,16 @@ pub(super) fn render_rows(
         rows.push(row);
     }
     Ok(())
+}
+
+/// Labels of the off mode's and the default exact mode's rows.
+pub(super) const OFF: &str = "off";
+pub(super) const DEFAULT_EXACT: &str = "exact K = 8 (default)";
+
+/// The GPU figure (median, ms) of `scene`'s frame in the mode labelled `mode`
+/// ([`OFF`], [`DEFAULT_EXACT`]); NaN where it was not measured.
+pub(super) fn frame_ms(modes: &[ModeRow], scene: Option<&str>, mode: &str) -> f64 {
+    modes.iter().find(|m| Some(m.scene.as_str()) == scene && m.mode == mode).map_or(f64::NAN, |m| m.gpu_ms)
 }
 
 /// Writes `transparency.csv` into `out`: scene, mode, GPU ms, MiB, error.

@@ -200,11 +200,12 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     }
     if let Some(stats) = renderer.transparency_stats() {
         say!(
-            "last frame: {} hair fragments, {} stored, {} beyond the pool blended unsorted (pool of {}; raise oit.fragments_per_pixel if many are)",
+            "last frame: {} hair fragments, {} stored, {} beyond the pool blended unsorted (pool of {}{}; raise oit.fragments_per_pixel if many are)",
             stats.fragments,
             stats.stored,
             stats.overflowed,
-            stats.capacity
+            stats.capacity,
+            if stats.capacity < stats.requested { format!(" of the {} asked for", stats.requested) } else { String::new() }
         );
     }
     say!("wrote {} frames and contact_sheet.png to {}", a.frames, a.out.display());
