@@ -52,7 +52,7 @@ vec3 shade_hair(vec3 pos, vec3 tangent, float t_along, uint hair) {
     float n_len = length(n);
     n = n_len > 1e-6 ? n / n_len : v;
     vec2 uv = vec2(float(hair % 997u) / 997.0, t_along * 4.0);
-    vec2 noise_value = texture(noise, uv).rg;
+    vec2 noise_value = textureLod(noise, uv, 0.0).rg;
     float jitter = (noise_value.g - 0.5) * dp.shifts.z;
     vec3 t1 = normalize(t + n * (dp.shifts.x + jitter));
     vec3 t2 = normalize(t + n * (dp.shifts.y + jitter));
@@ -88,9 +88,9 @@ vec3 shade_hair(vec3 pos, vec3 tangent, float t_along, uint hair) {
             // Texel i of a table holds t = i / (size − 1): address texel centres.
             float size = float(textureSize(marschner_m, 0).x);
             vec2 m_uv = (vec2(sin_i, sin_o) * 0.5 + 0.5) * ((size - 1.0) / size) + 0.5 / size;
-            vec4 m = texture(marschner_m, m_uv);
+            vec4 m = textureLod(marschner_m, m_uv, 0.0);
             vec2 n_uv = vec2(cos_phi * 0.5 + 0.5, m.a) * ((size - 1.0) / size) + 0.5 / size;
-            vec4 nn = texture(marschner_n, n_uv);
+            vec4 nn = textureLod(marschner_n, n_uv, 0.0);
             vec3 s = dp.primary.rgb * (m.r * nn.r) + sqrt(albedo) * (m.g * nn.g + m.b * nn.b) * breakup;
             color += radiance * s * sqrt(max(1.0 - sin_i * sin_i, 0.0));
             continue;

@@ -1,6 +1,7 @@
 #version 460
-// Exact transparency, build: every hair fragment that passes the depth test is
-// shaded once and pushed onto its pixel's list (a node from the pool). When the
+// Exact transparency, build: every hair fragment that passes the depth test
+// takes the colour of its segment's shaded ends (shade_points.comp) and its
+// coverage, and is pushed onto its pixel's list (a node from the pool). When the
 // pool is full it is counted and added to the overflow sums instead (colour
 // premultiplied, alpha, absorbance −ln(1 − alpha); additive blending), which the
 // resolve folds into the order-independent tail: nothing is lost. Early tests:
@@ -10,11 +11,9 @@
 
 layout(early_fragment_tests) in;
 
-layout(location = 0) in vec3 g_pos;
-layout(location = 1) in vec3 g_tan;
-layout(location = 2) in float g_t;
-layout(location = 3) flat in uint g_hair;
-layout(location = 4) in vec2 g_cover;
+// The colour shade_points.comp gave the segment's ends, and the coverage inputs.
+layout(location = 0) in vec3 g_color;
+layout(location = 1) in vec2 g_cover;
 
 layout(location = 0) out vec4 out_overflow;
 layout(location = 1) out vec4 out_absorbance;
@@ -24,7 +23,7 @@ void main() {
     if (alpha < OIT_LEAST_ALPHA) {
         discard;
     }
-    vec3 color = shade_hair(g_pos, g_tan, g_t, g_hair);
+    vec3 color = g_color;
     uint pixel = oit_pixel(gl_FragCoord);
     if (alpha >= OIT_OPAQUE_ALPHA) {
         atomicMin(oit_opaque[pixel], floatBitsToUint(gl_FragCoord.z));

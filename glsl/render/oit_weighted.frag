@@ -8,11 +8,9 @@
 
 layout(early_fragment_tests) in;
 
-layout(location = 0) in vec3 g_pos;
-layout(location = 1) in vec3 g_tan;
-layout(location = 2) in float g_t;
-layout(location = 3) flat in uint g_hair;
-layout(location = 4) in vec2 g_cover;
+// The colour shade_points.comp gave the segment's ends, and the coverage inputs.
+layout(location = 0) in vec3 g_color;
+layout(location = 1) in vec2 g_cover;
 
 layout(location = 0) out vec4 out_sum;
 layout(location = 1) out vec4 out_absorbance;
@@ -22,7 +20,7 @@ void main() {
     if (alpha < OIT_LEAST_ALPHA) {
         discard;
     }
-    vec3 color = shade_hair(g_pos, g_tan, g_t, g_hair);
+    vec3 color = g_color;
     if (alpha >= OIT_OPAQUE_ALPHA) {
         atomicMin(oit_opaque[oit_pixel(gl_FragCoord)], floatBitsToUint(gl_FragCoord.z));
     }

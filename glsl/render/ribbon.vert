@@ -10,7 +10,9 @@
 // side, and g_cover carries the signed distance from the centre line and the
 // true half width, in pixels, from which the fragment stage computes the
 // strand's coverage. A transparent strand standing for n hairs
-// (dp.coverage.z) is a band n hair widths wide.
+// (dp.coverage.z) is a band n hair widths wide. Its vertices carry the colour
+// shade_points.comp gave each end of the segment (g_color), not the inputs of
+// per-fragment shading.
 //
 // vkhair variant: VKHAIR_COVERAGE
 #include "render.glsl"
@@ -24,12 +26,16 @@ layout(std430, set = 0, binding = 2) readonly buffer HairTan { vec4 hair_tan[]; 
 // could choose differently in each.
 precise gl_Position;
 
+#ifdef VKHAIR_COVERAGE
+// Per hair vertex: its shaded colour (shade_points.comp).
+layout(std430, set = 0, binding = 20) readonly buffer PointColor { vec4 point_color[]; };
+layout(location = 0) out vec3 g_color;
+layout(location = 1) out vec2 g_cover;
+#else
 layout(location = 0) out vec3 g_pos;
 layout(location = 1) out vec3 g_tan;
 layout(location = 2) out float g_t;
 layout(location = 3) flat out uint g_hair;
-#ifdef VKHAIR_COVERAGE
-layout(location = 4) out vec2 g_cover;
 #endif
 
 // The two triangles of a ribbon, corners 0..5: (end 0, −), (end 0, +),
@@ -74,12 +80,15 @@ void main() {
     float half_drawn = 0.5 * max(width, dp.widths.z * dp.camera.w * distance_to_camera);
 #endif
     float s = corner_side(corner);
-    g_pos = pos + side * (half_drawn * s);
+    vec3 corner_pos = pos + side * (half_drawn * s);
 #ifdef VKHAIR_COVERAGE
+    g_color = point_color[first + e].rgb;
     g_cover = vec2(half_drawn / pixel * s, half_true);
-#endif
+#else
+    g_pos = corner_pos;
     g_tan = tan_t.xyz;
     g_t = tan_t.w;
     g_hair = hair;
-    gl_Position = dp.view_proj * vec4(g_pos, 1.0);
+#endif
+    gl_Position = dp.view_proj * vec4(corner_pos, 1.0);
 }

@@ -172,7 +172,8 @@ impl MarschnerTables {
             return;
         }
         use crate::vk::barrier::{self, AccessKind};
-        let sampled = &[AccessKind::FragmentSampledRead];
+        // The draw's fragment stages and the transparent modes' vertex shading sample them.
+        let sampled = &[AccessKind::FragmentSampledRead, AccessKind::ComputeSampledRead];
         let write = &[AccessKind::ComputeWrite];
         let before: Vec<_> = [&self.m, &self.n]
             .iter()

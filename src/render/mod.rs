@@ -14,7 +14,7 @@
 //! 3. **Shadows** (`shadow/`, optional): deep opacity maps of the
 //!    shadow-casting lights from the interpolated hairs, or the transmittance
 //!    through the simulation's density volume.
-//! 4. **Draw** (`draw.rs`): the hairs as camera-facing ribbons (or lines),
+//! 4. **Draw** (`draw/`): the hairs as camera-facing ribbons (or lines),
 //!    Kajiya-Kay diffuse plus two shifted specular highlights, or Marschner
 //!    ([`HairMaterial`]), for every [`Light`], into the host's color and depth
 //!    images ([`RenderTarget`]), attenuated by the shadows.

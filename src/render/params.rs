@@ -98,11 +98,13 @@ pub enum Transparency {
     #[cfg_attr(feature = "clap", value(help = "Opaque ribbons at least a pixel wide, nearest layer only"))]
     Off,
     /// Weighted blended order-independent transparency (one pass, two
-    /// accumulation images, no lists): every fragment shaded once, the colours
-    /// averaged with weights falling with depth, the total opacity exact.
+    /// accumulation images, no lists): every hair vertex shaded once and its
+    /// colour carried along the ribbon, the fragments' colours averaged with
+    /// weights falling with depth, the total opacity exact.
     #[cfg_attr(feature = "clap", value(help = "Weighted blended transparency: one pass, no lists"))]
     Fast,
-    /// Per-pixel linked lists of every fragment (shaded once when stored), the
+    /// Per-pixel linked lists of every fragment (coloured by the hair's vertices,
+    /// each shaded once per frame), the
     /// [`OitParams::sorted_fragments`] nearest sorted exactly per pixel and the rest
     /// blended as an order-independent tail.
     #[cfg_attr(feature = "clap", value(help = "Per-pixel lists, the nearest fragments sorted exactly"))]

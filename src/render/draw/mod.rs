@@ -8,7 +8,9 @@
 //! frame's uniform block. Every mode draws the same ribbons
 //! (`glsl/render/ribbon.vert`, two triangles a segment) with the same shading
 //! (`hair_shading.glsl`, [`shading::ShadingResources`]) and differs only in
-//! how fragments reach the target, one file each:
+//! where the shading runs (per fragment when opaque; per hair vertex in a
+//! compute dispatch, `shade_points.comp`, for the transparent modes, whose
+//! fragments only add coverage) and how fragments reach the target, one file each:
 //!
 //! - [`Transparency::Off`] — `opaque.rs`: a depth pre-pass and a shaded draw
 //!   of the nearest layer;

@@ -114,5 +114,7 @@ impl ShadingResources {
     }
 }
 
-/// Stages that read the draw's uniform block.
-const UNIFORM_READERS: &[AccessKind] = &[AccessKind::VertexUniformRead, AccessKind::FragmentUniformRead];
+/// Stages that read the draw's uniform block (the transparent modes' vertex
+/// shading is a compute dispatch).
+const UNIFORM_READERS: &[AccessKind] =
+    &[AccessKind::VertexUniformRead, AccessKind::FragmentUniformRead, AccessKind::ComputeUniformRead];

@@ -3,10 +3,12 @@
 //! target. What both modes share lives here; what differs, in `exact.rs` and
 //! `fast.rs`.
 //!
-//! 1. **Build** (in the [`RenderPass::Draw`] scope): the ribbons of the draw
-//!    pass's vertex stage (`ribbon.vert`'s coverage variant), with their true width and a coverage
-//!    per fragment, depth-tested against the target's depth (not written). Every
-//!    surviving fragment is shaded once and either pushed onto its pixel's list
+//! 1. **Build** (in the [`RenderPass::Draw`] scope): every vertex of the hairs
+//!    shaded once (`shade_points.comp`, a dispatch); then the ribbons of the draw
+//!    pass's vertex stage (`ribbon.vert`'s coverage variant), with their true
+//!    width, the shaded colour of their ends and a coverage per fragment,
+//!    depth-tested against the target's depth (not written). Every surviving
+//!    fragment takes its colour and coverage and is either pushed onto its pixel's list
 //!    (exact; beyond the pool, counted and added to the weighted sums instead)
 //!    or added to the weighted sums (fast). Both keep the nearest depth of a
 //!    fragment at least half opaque.
@@ -38,9 +40,11 @@ use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::device::{Device, DeviceInfo};
 use crate::vk::image::Sampler;
-use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
+use crate::vk::pipeline::{Blend, ComputePipeline, GraphicsDesc, GraphicsPipeline};
 use crate::vk::rendering;
-use crate::vk::shaders::{ShaderSource, RENDER_OIT_DEPTH_FRAG, RENDER_RESOLVE_VERT, RENDER_RIBBON_VERT_COVERAGE};
+use crate::vk::shaders::{
+    ShaderSource, RENDER_OIT_DEPTH_FRAG, RENDER_RESOLVE_VERT, RENDER_RIBBON_VERT_COVERAGE, RENDER_SHADE_POINTS_COMP,
+};
 
 /// A transparency mode's fragment stages: the build's and the composite's.
 pub(super) struct ModeShaders {
@@ -69,6 +73,7 @@ pub struct OitStats {
 
 /// The pipelines of one target and their descriptor sets.
 struct Pipelines {
+    points: (ComputePipeline, vk::DescriptorSet),
     build: (GraphicsPipeline, vk::DescriptorSet),
     composite: (GraphicsPipeline, vk::DescriptorSet),
     depth: Option<(GraphicsPipeline, vk::DescriptorSet)>,
@@ -100,6 +105,9 @@ pub(super) struct TransparentPass {
     device: Arc<Device>,
     /// [`OitCounters`], host-visible so the host reads what a frame stored.
     counters: Buffer,
+    /// Per hair vertex its shaded colour (`shade_points.comp`), sized like the
+    /// hair positions on first use.
+    colors: Option<Buffer>,
     nearest: Sampler,
     current: Option<Resources>,
     retired: Vec<(u64, Resources)>,
@@ -119,6 +127,7 @@ impl TransparentPass {
         Ok(TransparentPass {
             device: device.clone(),
             counters,
+            colors: None,
             nearest: Sampler::nearest(device, "vkhair transparency sums")?,
             current: None,
             retired: Vec::new(),
@@ -143,6 +152,7 @@ impl TransparentPass {
         if let Some(current) = &mut self.current {
             current.pipelines.clear();
         }
+        self.colors = None;
     }
 
     /// Frees retired resources whose last frame is `frames_in_flight` frames before `frame`.
@@ -238,7 +248,14 @@ impl TransparentPass {
             blend,
             rasterizer_discard: false,
         };
-        let mut ours = vec![(9, &self.counters), (12, &res.opaque)];
+        let hair_bytes = frame.inputs.hairs.0.size();
+        if self.colors.as_ref().is_none_or(|c| c.size() != hair_bytes) {
+            self.colors = Some(Buffer::storage(d, "vkhair hair vertex colors", hair_bytes)?);
+        }
+        let Some(colors) = self.colors.as_ref() else {
+            return Err(Error::incompatible("transparency", "no vertex colours after making them"));
+        };
+        let mut ours = vec![(9, &self.counters), (12, &res.opaque), (20, colors)];
         if let Some(lists) = &res.lists {
             ours.extend(lists.bindings());
         }
@@ -246,6 +263,8 @@ impl TransparentPass {
         let mut buffers = shading_buffers.to_vec();
         buffers.extend_from_slice(&ours);
 
+        let points = ComputePipeline::new(d, &RENDER_SHADE_POINTS_COMP, 1)?;
+        let points_set = points.declared_resource_set(0, &buffers, &shading_images)?;
         let build_stages = [&RENDER_RIBBON_VERT_COVERAGE, shaders.build];
         let build = GraphicsPipeline::new(
             d,
@@ -297,8 +316,15 @@ impl TransparentPass {
         } else {
             None
         };
-        res.pipelines
-            .insert(key, Pipelines { build: (build, build_set), composite: (composite, composite_set), depth });
+        res.pipelines.insert(
+            key,
+            Pipelines {
+                points: (points, points_set),
+                build: (build, build_set),
+                composite: (composite, composite_set),
+                depth,
+            },
+        );
         Ok(())
     }
 }
@@ -347,6 +373,10 @@ impl TransparentPass {
         let to_clear = barrier::memory(storage, &[AccessKind::TransferWrite]);
         let cleared = barrier::memory(&[AccessKind::TransferWrite], storage);
         let built = barrier::memory(&[AccessKind::FragmentWrite], &[AccessKind::FragmentRead]);
+        // The previous frame's ribbons read the colours this frame's dispatch writes.
+        let to_shade = barrier::memory(&[AccessKind::VertexRead], &[AccessKind::ComputeWrite]);
+        let shaded = barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::VertexRead]);
+        let (hairs, per_hair) = (frame.params.counts[0], frame.params.counts[1]);
         let depth_order = barrier::memory(barrier::ATTACHMENTS, barrier::ATTACHMENTS);
         let to_host = barrier::memory(&[AccessKind::FragmentWrite], &[AccessKind::HostRead]);
         let (to_sums, from_sums) = res.sums.barriers();
@@ -360,13 +390,15 @@ impl TransparentPass {
         unsafe {
             let scope = RenderPass::Draw.open(d, cmd, timing);
             shading.record_updates(cmd, &target.before, &frame.params, &frame.marschner);
-            d.cmd_barrier(cmd, &[to_clear], &[], &to_sums);
+            d.cmd_barrier(cmd, &[to_clear, to_shade], &[], &to_sums);
+            pipelines.points.0.bind(cmd, &[pipelines.points.1]);
+            pipelines.points.0.dispatch_threads(cmd, [hairs.saturating_mul(per_hair), 1, 1]);
             if let Some(lists) = &res.lists {
                 lists.record_clear(d, cmd);
             }
             d.raw.cmd_fill_buffer(cmd, res.opaque.raw(), 0, vk::WHOLE_SIZE, OIT_END);
             d.raw.cmd_update_buffer(cmd, self.counters.raw(), 0, bytemuck::bytes_of(&counters));
-            d.cmd_barrier(cmd, &[cleared], &[], &[]);
+            d.cmd_barrier(cmd, &[cleared, shaded], &[], &[]);
             d.raw.cmd_begin_rendering(cmd, &build_rendering);
             d.cmd_set_full_viewport(cmd, target.extent);
             pipelines.build.0.bind(cmd, &[pipelines.build.1]);

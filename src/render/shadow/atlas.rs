@@ -210,5 +210,6 @@ impl ShadowAtlas {
     }
 }
 
-/// Fragment-shader sampling: how the draw and the opacity pass read the images.
-const FRAGMENT_SAMPLED: &[AccessKind] = &[AccessKind::FragmentSampledRead];
+/// How the draw (fragment stages; the transparent modes' vertex shading, a
+/// compute dispatch) and the opacity pass read the images.
+const FRAGMENT_SAMPLED: &[AccessKind] = &[AccessKind::FragmentSampledRead, AccessKind::ComputeSampledRead];

@@ -86,7 +86,8 @@ impl VolumeShadows {
             &[AccessKind::TransferRead, AccessKind::TransferWrite],
         );
         let copied = barrier::memory(&[AccessKind::TransferWrite], &[AccessKind::ComputeRead]);
-        let computed = barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::FragmentRead]);
+        let computed =
+            barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::FragmentRead, AccessKind::ComputeRead]);
         // SAFETY: guaranteed by the caller; the buffers belong to this device.
         unsafe {
             let scope = RenderPass::ShadowVolume.open(d, cmd, timing);

@@ -118,6 +118,21 @@ impl ComputePipeline {
         Ok(target)
     }
 
+    /// Allocates descriptor set `set` and binds those of `buffers` and `images`
+    /// (combined image-samplers) that the shader declares.
+    pub(crate) fn declared_resource_set(
+        &self,
+        set: u32,
+        buffers: &[(u32, &Buffer)],
+        images: &[(u32, vk::ImageView, vk::Sampler)],
+    ) -> Result<vk::DescriptorSet> {
+        let images: Vec<_> = images.iter().copied().filter(|(b, _, _)| self.layout.declares(set, *b)).collect();
+        let buffers = self.layout.declared(set, buffers);
+        let target = self.layout.resource_set(set, &self.name, &buffers, &images)?;
+        self.note_traffic(target, set, &buffers);
+        Ok(target)
+    }
+
     /// Allocates descriptor set `set` with buffer and combined image-sampler bindings.
     #[cfg(test)]
     pub(crate) fn resource_set(
