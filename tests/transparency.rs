@@ -545,3 +545,45 @@ fn lit_transparent_hair_takes_the_shading_of_opaque_hair() {
     // build gave 3.0; every ribbon taking its first end's colour, 7.3).
     assert!(mean < 7.0, "transparent hair shaded {mean:.2} steps away from opaque hair");
 }
+
+/// The composite keeps K fragments in arrays sized by the smallest variant that
+/// holds K (4, 8, 16 or 32): each K just past a variant's size sorts one more
+/// fragment than the one before it (pixels more than an 8-bit step apart where
+/// pixels hold that many), and the error against the reference falls from K = 4
+/// to K = 32.
+#[test]
+fn every_k_sorts_its_k_nearest_fragments() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(2000, 8, 5);
+    // Strands 4 mm wide (about 3 pixels) and faint: many pixels hold more than 17 fragments.
+    const WIDE: f32 = 0.004;
+    let m = material(WIDE, 0.3);
+    let mut s = scene(&gpu, &groom, &params(Transparency::Exact), &m);
+    let mut images = Vec::new();
+    for k in [4u32, 5, 8, 9, 16, 17, 32] {
+        let mut p = params(Transparency::Exact);
+        p.oit.sorted_fragments = k;
+        // A pool that holds them all: which fragments overflow would vary from draw to draw.
+        p.oit.fragments_per_pixel = 64.0;
+        s.renderer.set_params(&p).expect("params");
+        images.push((k, draw(&gpu, &mut s)));
+        let stats = s.renderer.transparency_stats().expect("stats");
+        assert_eq!(stats.overflowed, 0, "{stats:?}");
+    }
+    let truth = reference(&s, WIDE, 0.3);
+    println!("{:?}", s.renderer.transparency_stats());
+    for pair in images.windows(2) {
+        let ((a, x), (b, y)) = (&pair[0], &pair[1]);
+        // More than one 8-bit step: the order in which fragments reach a list
+        // (and so the tail's sums) varies by a step from draw to draw.
+        let to8 = |c: Vec3| c.to_array().map(|v| v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0);
+        let step = |p: Vec3, q: Vec3| (0..3).map(|i| (to8(p)[i] - to8(q)[i]).abs()).fold(0.0f32, f32::max);
+        let differing = x.iter().zip(y).filter(|(p, q)| step(**p, **q) > 1.0).count();
+        println!("K {a} → {b}: {differing} pixels differ; error {:.3} → {:.3}", mae(x, &truth), mae(y, &truth));
+        if b - a == 1 {
+            assert!(differing > 20, "K = {b} drew what K = {a} drew: its composite keeps fewer than {b}");
+        }
+    }
+    let (first, last) = (mae(&images[0].1, &truth), mae(&images[images.len() - 1].1, &truth));
+    assert!(last < first, "K = 32 is no nearer the reference than K = 4: {last:.3} against {first:.3}");
+}

@@ -16,11 +16,22 @@ use crate::error::Result;
 use crate::render::OitParams;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::{Device, DeviceInfo};
-use crate::vk::shaders::{RENDER_OIT_BUILD_FRAG, RENDER_OIT_RESOLVE_FRAG};
+use crate::vk::shaders::{
+    RENDER_OIT_BUILD_FRAG, RENDER_OIT_RESOLVE_FRAG, RENDER_OIT_RESOLVE_FRAG_SORT_16, RENDER_OIT_RESOLVE_FRAG_SORT_4,
+    RENDER_OIT_RESOLVE_FRAG_SORT_8,
+};
 
-/// The build's and the composite's fragment stages.
-pub(super) const SHADERS: ModeShaders =
-    ModeShaders { build: &RENDER_OIT_BUILD_FRAG, composite: &RENDER_OIT_RESOLVE_FRAG };
+/// The build's and the composite's fragment stages for `sorted` (K) fragments
+/// sorted per pixel: the composite variant with the smallest arrays that hold K.
+pub(super) fn shaders(sorted: u32) -> ModeShaders {
+    let composite = match sorted {
+        0..=4 => &RENDER_OIT_RESOLVE_FRAG_SORT_4,
+        5..=8 => &RENDER_OIT_RESOLVE_FRAG_SORT_8,
+        9..=16 => &RENDER_OIT_RESOLVE_FRAG_SORT_16,
+        _ => &RENDER_OIT_RESOLVE_FRAG,
+    };
+    ModeShaders { build: &RENDER_OIT_BUILD_FRAG, composite }
+}
 
 /// Bytes of one stored fragment (colour and alpha as half floats, depth, next).
 const NODE_BYTES: u64 = 16;

@@ -89,7 +89,8 @@ struct Resources {
     lists: Option<Lists>,
     /// Weighted sums and absorbance (fast mode; the exact mode's overflow).
     sums: WeightedSums,
-    pipelines: HashMap<TargetKey, Pipelines>,
+    /// By target and composite shader (the exact mode's depends on K).
+    pipelines: HashMap<(TargetKey, &'static str), Pipelines>,
 }
 
 impl Resources {
@@ -219,19 +220,20 @@ impl TransparentPass {
 
     /// Makes the pipelines for `frame`'s target on first use, bound to the
     /// shading inputs and the current resources.
-    fn make_pipelines(&mut self, frame: &DrawFrame<'_>, shading: &ShadingResources) -> Result<()> {
+    fn make_pipelines(
+        &mut self,
+        frame: &DrawFrame<'_>,
+        shaders: &ModeShaders,
+        shading: &ShadingResources,
+    ) -> Result<()> {
         let Some(res) = self.current.as_mut() else {
             return Err(Error::incompatible("transparency", "pipelines requested before the resources"));
         };
         let key = frame.target.key;
-        if res.pipelines.contains_key(&key) {
+        if res.pipelines.contains_key(&(key, shaders.composite.name)) {
             return Ok(());
         }
         let d = &self.device;
-        let shaders = match res.mode {
-            Transparency::Exact => exact::SHADERS,
-            _ => fast::SHADERS,
-        };
         let has_depth = key.depth != vk::Format::UNDEFINED;
         let weighted_formats = [WEIGHTED_SUM, ABSORBANCE];
         let target_formats = [key.color];
@@ -317,7 +319,7 @@ impl TransparentPass {
             None
         };
         res.pipelines.insert(
-            key,
+            (key, shaders.composite.name),
             Pipelines {
                 points: (points, points_set),
                 build: (build, build_set),
@@ -352,11 +354,17 @@ impl TransparentPass {
         }
         // Made (or found) before anything is recorded: a failure leaves `cmd` as it was.
         self.prepare(frame.frame, mode, params, target.extent)?;
-        self.make_pipelines(frame, shading)?;
+        let shaders = match mode {
+            Transparency::Exact => exact::shaders(params.sorted_fragments),
+            _ => fast::SHADERS,
+        };
+        self.make_pipelines(frame, &shaders, shading)?;
         let Some(res) = self.current.as_ref() else {
             return Err(Error::incompatible("transparency", "no resources after preparing them"));
         };
-        let pipelines = &res.pipelines[&target.key];
+        let Some(pipelines) = res.pipelines.get(&(target.key, shaders.composite.name)) else {
+            return Err(Error::incompatible("transparency", "no pipelines after making them"));
+        };
         let (d, cmd, timing) = (&*self.device, frame.cmd, frame.timing);
         let pool = res.pool();
         // The plan keeps both below the end-of-list marker.
