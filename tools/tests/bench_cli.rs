@@ -22,7 +22,10 @@ fn a_quick_bench_reports_every_stage_with_its_reference_and_writes_json_and_a_ch
         "bench",
         "--quick",
         "--samples",
-        "3",
+        "8",
+        // Every simulation figure past its budget at once: 5 samples each.
+        "--figure-seconds",
+        "0.001",
         "--scaling-samples",
         "1",
         "--json",
@@ -62,12 +65,14 @@ fn a_quick_bench_reports_every_stage_with_its_reference_and_writes_json_and_a_ch
             assert!(row["gpu_ms_per_step"].as_f64().is_some_and(|x| x > 0.0), "{row}");
             assert!(row["cpu_ms_per_step"].as_f64().is_some_and(|x| x > 0.0), "{row}");
             assert!(row["bandwidth_bound_ms"]["H100 SXM"].is_number(), "{row}");
+            assert_eq!(row["samples"], 5, "a figure past its budget keeps 5 samples: {row}");
         }
     }
     let frames: Vec<_> = stages.iter().filter(|s| s["per"] == "frame").collect();
     assert_eq!(frames.len(), 5, "the thesis frame in the default mode, off, fast, exact K = 4 and 16");
     for frame in &frames {
         assert!(frame["gpu_ms_per_frame"].as_f64().is_some_and(|x| x > 0.0), "{frame}");
+        assert_eq!(frame["samples"], 8, "frames take every sample asked for: {frame}");
         assert!(frame["error_vs_reference_srgb_steps"].as_f64().is_some_and(|x| x > 0.0), "{frame}");
     }
     let error = |stage: &str| {

@@ -369,7 +369,7 @@ fn cases(f: &Fixtures, out: &Path) -> Vec<Case> {
             ],
         ),
         (&["convert"], &["--points", "--key-hairs"]),
-        (&["bench", "--quick"], &["--samples", "--scaling-samples"]),
+        (&["bench", "--quick"], &["--samples", "--scaling-samples", "--figure-seconds"]),
         (&["bench", "--quick", "--samples", "1"], &["--large"]),
     ];
     for (base, names) in flags {

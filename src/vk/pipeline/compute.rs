@@ -126,9 +126,8 @@ impl ComputePipeline {
         buffers: &[(u32, &Buffer)],
         images: &[(u32, vk::ImageView, vk::Sampler)],
     ) -> Result<vk::DescriptorSet> {
-        let images: Vec<_> = images.iter().copied().filter(|(b, _, _)| self.layout.declares(set, *b)).collect();
         let buffers = self.layout.declared(set, buffers);
-        let target = self.layout.resource_set(set, &self.name, &buffers, &images)?;
+        let target = self.layout.resource_set(set, &self.name, &buffers, &self.layout.declared_images(set, images))?;
         self.note_traffic(target, set, &buffers);
         Ok(target)
     }

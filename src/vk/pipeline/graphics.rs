@@ -171,8 +171,7 @@ impl GraphicsPipeline {
         buffers: &[(u32, &Buffer)],
         images: &[(u32, vk::ImageView, vk::Sampler)],
     ) -> Result<vk::DescriptorSet> {
-        let images: Vec<_> = images.iter().copied().filter(|(b, _, _)| self.layout.declares(set, *b)).collect();
-        self.resource_set(set, &self.layout.declared(set, buffers), &images)
+        self.resource_set(set, &self.layout.declared(set, buffers), &self.layout.declared_images(set, images))
     }
 
     /// Allocates descriptor set `set` with buffer and combined image-sampler bindings.

@@ -141,6 +141,16 @@ impl Layout {
         buffers.iter().filter(|(binding, _)| self.declares(set, *binding)).copied().collect()
     }
 
+    /// The entries of `images` (combined image-samplers) whose binding the
+    /// pipeline declares in `set`.
+    fn declared_images(
+        &self,
+        set: u32,
+        images: &[(u32, vk::ImageView, vk::Sampler)],
+    ) -> Vec<(u32, vk::ImageView, vk::Sampler)> {
+        images.iter().filter(|(binding, _, _)| self.declares(set, *binding)).copied().collect()
+    }
+
     /// Points storage-image bindings of `set` at views in GENERAL layout.
     fn write_storage_images(&self, target: vk::DescriptorSet, set: u32, images: &[(u32, vk::ImageView)]) -> Result<()> {
         let images: Vec<_> = images.iter().map(|&(binding, view)| (binding, view, vk::Sampler::null())).collect();

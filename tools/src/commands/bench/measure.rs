@@ -97,7 +97,18 @@ fn volume_ms(report: &ProfileReport) -> f64 {
 
 /// Measures `samples` steps of `case`, GPU and CPU reference interleaved, after
 /// two warm-up steps each.
-pub fn measure_sim(ctx: &GpuContext, case: &SimCase<'_>, samples: usize) -> Result<SimFigures, Error> {
+/// Samples every figure takes however long they take (fewer only when `--samples` asks for fewer).
+pub const MIN_SAMPLES: usize = 5;
+
+/// Measures `samples` steps of `case` (after two warm-up steps), GPU and CPU
+/// reference alternating; past [`MIN_SAMPLES`], stops early once the samples
+/// have taken `budget` (a large groom's CPU reference takes seconds a step).
+pub fn measure_sim(
+    ctx: &GpuContext,
+    case: &SimCase<'_>,
+    samples: usize,
+    budget: std::time::Duration,
+) -> Result<SimFigures, Error> {
     let start = RigidTransform::default();
     let mut gpu = HairSim::new(ctx, case.groom, &case.params, &start)?;
     gpu.set_colliders(case.colliders)?;
@@ -113,7 +124,13 @@ pub fn measure_sim(ctx: &GpuContext, case: &SimCase<'_>, samples: usize) -> Resu
     let work = work_per_step(ctx, case, &mut gpu)?;
     let mut figures = SimFigures { work, ..SimFigures::default() };
     let warm_up = 2;
+    let mut measuring = Instant::now();
     for i in 0..samples + warm_up {
+        if i == warm_up {
+            measuring = Instant::now();
+        } else if i > warm_up + MIN_SAMPLES - 1 && measuring.elapsed() >= budget {
+            break;
+        }
         let step = 4 + i;
         let started = Instant::now();
         let report = gpu

@@ -51,6 +51,11 @@ pub struct BenchArgs {
     /// Samples per figure (the report gives their median and p95).
     #[arg(long, default_value_t = 20)]
     samples: usize,
+    /// Seconds the samples of one simulation figure may take: past them it
+    /// stops sampling, keeping at least 5 (a large groom's CPU reference takes
+    /// seconds a step).
+    #[arg(long, default_value_t = 10.0)]
+    figure_seconds: f64,
     /// Samples per point of the scaling curves.
     #[arg(long, default_value_t = 5)]
     scaling_samples: usize,
@@ -87,6 +92,11 @@ struct Bench<'a> {
 }
 
 impl Bench<'_> {
+    /// How long the samples of one simulation figure may take.
+    fn budget(&self) -> std::time::Duration {
+        std::time::Duration::from_secs_f64(self.args.figure_seconds)
+    }
+
     /// The simulation parameters of a row: vkhair's defaults, the --sim flags,
     /// then the row's volume `mode` on a `grid`³ grid.
     fn params(&self, mode: VolumeMode, grid: u32) -> SimParams {
@@ -309,7 +319,7 @@ fn scaling(b: &Bench<'_>) -> Result<Vec<Curve>, Error> {
     let off = b.params(VolumeMode::Off, 32);
     let sim = |groom: &Groom, params: &SimParams| {
         let case = SimCase { groom, colliders: &colliders, params: params.clone(), cpu: true, motion: a.sim.motion };
-        measure_sim(ctx, &case, n)
+        measure_sim(ctx, &case, n, b.budget())
     };
     let sim_point = |groom: &Groom, params: &SimParams| {
         sim(groom, params).map(|f| (clock.figure(&f.gpu, &f.gpu_wall).median(), f.cpu.median()))
@@ -415,6 +425,9 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     if a.samples == 0 {
         return Err("--samples must be at least 1 (the report's figures are medians of 20 by default)".into());
     }
+    if !(a.figure_seconds.is_finite() && a.figure_seconds > 0.0 && a.figure_seconds <= 1e6) {
+        return Err(format!("--figure-seconds must be a number of seconds above 0 (got {})", a.figure_seconds).into());
+    }
     if a.scaling_samples == 0 {
         return Err("--scaling-samples must be at least 1 (each point of a curve is a median of 5 by default)".into());
     }
@@ -453,11 +466,11 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
             cpu: true,
             motion: a.sim.motion,
         };
-        let off = measure_sim(&ctx, &case(VolumeMode::Off), a.samples)?;
+        let off = measure_sim(&ctx, &case(VolumeMode::Off), a.samples, b.budget())?;
         rows.extend(sim_rows(&s.name, "sim, volume off", &off, clock, None));
-        let f = measure_sim(&ctx, &case(VolumeMode::Friction), a.samples)?;
+        let f = measure_sim(&ctx, &case(VolumeMode::Friction), a.samples, b.budget())?;
         rows.extend(sim_rows(&s.name, "sim, density friction 32³", &f, clock, Some(&off)));
-        let f = measure_sim(&ctx, &case(VolumeMode::Flip), a.samples)?;
+        let f = measure_sim(&ctx, &case(VolumeMode::Flip), a.samples, b.budget())?;
         rows.extend(sim_rows(&s.name, "sim, FLIP 32³", &f, clock, Some(&off)));
         if let Some(args) = &s.render_args {
             render_rows(&b, &s.name, args, &mut rows, &mut modes)?;
