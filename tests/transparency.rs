@@ -357,6 +357,15 @@ fn bad_transparency_parameters_and_targets_are_refused() {
         let name = field(p.validate());
         assert!(name.starts_with("oit."), "K {k}, fragments {f}: refused as {name}");
     }
+    // A pool buffer of 0 (the device's limits) or at least 64 KiB.
+    let mut p = params(Transparency::Exact);
+    for (bytes, refused) in [(1, true), (65_535, true), (65_536, false), (0, false), (u32::MAX, false)] {
+        p.oit.max_buffer_bytes = bytes;
+        match refused {
+            true => assert_eq!(field(p.validate()), "oit.max_buffer_bytes", "{bytes} bytes"),
+            false => assert!(p.validate().is_ok(), "{bytes} bytes refused"),
+        }
+    }
     let lines = RenderParams { primitive: vkhair::render::Primitive::Lines, ..params(Transparency::Fast) };
     assert_eq!(field(lines.validate()), "transparency");
     assert!(RenderParams { primitive: vkhair::render::Primitive::Lines, ..params(Transparency::Off) }

@@ -14,12 +14,14 @@ layout(std430, set = 0, binding = 2) readonly buffer HairTan { vec4 hair_tan[]; 
 // Per hair vertex: shaded colour (rgb), as hair_pos.
 layout(std430, set = 0, binding = 20) writeonly buffer PointColor { vec4 point_color[]; };
 
+// A grid-stride loop: the dispatch stays within the 65,535 workgroups every
+// device offers however many vertices there are.
 void main() {
-    uint i = gl_GlobalInvocationID.x;
     uint per_hair = dp.counts.y;
-    if (i >= dp.counts.x * per_hair) {
-        return;
+    uint total = dp.counts.x * per_hair;
+    uint stride = gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+    for (uint i = gl_GlobalInvocationID.x; i < total; i += stride) {
+        vec4 tan_t = hair_tan[i];
+        point_color[i] = vec4(shade_hair(hair_pos[i].xyz, tan_t.xyz, tan_t.w, i / per_hair), 1.0);
     }
-    vec4 tan_t = hair_tan[i];
-    point_color[i] = vec4(shade_hair(hair_pos[i].xyz, tan_t.xyz, tan_t.w, i / per_hair), 1.0);
 }

@@ -162,7 +162,7 @@ impl MarschnerTables {
     }
 
     /// Records a rebuild when `params` differ from what the tables hold; leaves both
-    /// tables in SHADER_READ_ONLY_OPTIMAL, visible to fragment shaders.
+    /// tables in SHADER_READ_ONLY_OPTIMAL, visible to fragment and compute shaders.
     ///
     /// # Safety
     /// `cmd` is recording outside a render pass; earlier reads of the tables were

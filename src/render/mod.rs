@@ -186,7 +186,7 @@ impl Renderer {
         let smooth = SmoothPass::new(&device, sim.halves, sim.before, strands as u64 * stride)?;
         let interpolate = InterpolatePass::new(&device, sim.rest, &triangles, &smooth, hair_vertices)?;
         interpolate.check_mode(params.interpolation)?;
-        let draw = DrawPass::new(&device)?;
+        let draw = DrawPass::new(&device, hair_vertices)?;
         let shadows = Shadows::new(&device, interpolate.hairs().0)?;
         let detail = params.detail_at(0.0);
         Ok(Renderer {

@@ -20,7 +20,12 @@ fn full_hd_and_4k_render_in_the_default_mode_and_a_capped_pool_is_reported() {
     let config = dir.path().join("pool.toml");
     std::fs::write(&config, "[render.oit]\nfragments_per_pixel = 16\n").expect("config");
     let c = config.to_str().expect("utf-8");
-    let cases: [(u32, u32, Option<&str>); 3] = [(1920, 1080, None), (3840, 2160, None), (3840, 2160, Some(c))];
+    // On any device: pool buffers of 64 KiB hold 8 × 4,096 of the 16.6 M nodes 1080p asks for.
+    let small = dir.path().join("small.toml");
+    std::fs::write(&small, "[render.oit]\nmax_buffer_bytes = 65536\n").expect("config");
+    let sm = small.to_str().expect("utf-8");
+    let cases: [(u32, u32, Option<&str>); 4] =
+        [(1920, 1080, None), (3840, 2160, None), (3840, 2160, Some(c)), (1920, 1080, Some(sm))];
     for (w, h, config) in cases {
         let out = dir.path().join(format!("{w}x{h}{}", if config.is_some() { "-16" } else { "" }));
         let (ws, hs, o) = (w.to_string(), h.to_string(), out.display().to_string());
@@ -40,6 +45,10 @@ fn full_hd_and_4k_render_in_the_default_mode_and_a_capped_pool_is_reported() {
         // lavapipe: 8 buffers of 128 MiB hold 8 fragments per pixel at 4K, not 16.
         let small_buffers = r.stdout.contains("llvmpipe");
         match config {
+            Some(path) if path == sm => {
+                assert!(capped, "the capped pool went unreported: {}", r.stderr);
+                assert!(r.stderr.contains("holds 0.02 of the 8 fragments per pixel"), "{}", r.stderr);
+            }
             Some(_) if small_buffers => {
                 assert!(capped, "the capped pool went unreported: {}", r.stderr);
                 assert!(r.stderr.contains("join the order-independent tail"), "{}", r.stderr);

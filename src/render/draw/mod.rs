@@ -126,11 +126,12 @@ pub(super) struct DrawPass {
 }
 
 impl DrawPass {
-    pub(super) fn new(device: &Arc<Device>) -> Result<Self> {
+    /// The pass for a renderer drawing at most `hair_vertices` hair vertices.
+    pub(super) fn new(device: &Arc<Device>, hair_vertices: u64) -> Result<Self> {
         Ok(DrawPass {
             shading: ShadingResources::new(device)?,
             opaque: OpaquePipelines::new(device),
-            transparent: TransparentPass::new(device)?,
+            transparent: TransparentPass::new(device, hair_vertices)?,
         })
     }
 
@@ -325,7 +326,7 @@ impl Renderer {
     /// target of `extent` (the supersampled extent where supersampling is on), bytes.
     pub fn transparency_memory(&self, extent: vk::Extent2D) -> u64 {
         let drawn = self.drawn_extent(extent);
-        TransparentPass::memory_bytes(&self.device.info, self.params.transparency, &self.params.oit, drawn)
+        self.draw.transparent.memory_bytes(&self.device.info, self.params.transparency, &self.params.oit, drawn)
     }
 
     /// The exact mode's fragment pool for a target of `extent` (the

@@ -46,6 +46,9 @@ use crate::vk::shaders::{
     ShaderSource, RENDER_OIT_DEPTH_FRAG, RENDER_RESOLVE_VERT, RENDER_RIBBON_VERT_COVERAGE, RENDER_SHADE_POINTS_COMP,
 };
 
+/// Workgroups of a dispatch that every device runs (`maxComputeWorkGroupCount`'s minimum).
+const MAX_WORKGROUPS: u32 = 65_535;
+
 /// A transparency mode's fragment stages: the build's and the composite's.
 pub(super) struct ModeShaders {
     pub build: &'static ShaderSource,
@@ -106,16 +109,17 @@ pub(super) struct TransparentPass {
     device: Arc<Device>,
     /// [`OitCounters`], host-visible so the host reads what a frame stored.
     counters: Buffer,
-    /// Per hair vertex its shaded colour (`shade_points.comp`), sized like the
-    /// hair positions on first use.
-    colors: Option<Buffer>,
+    /// Per hair vertex its shaded colour (`shade_points.comp`), one vec4 for
+    /// each vertex the renderer can draw.
+    colors: Buffer,
     nearest: Sampler,
     current: Option<Resources>,
     retired: Vec<(u64, Resources)>,
 }
 
 impl TransparentPass {
-    pub(super) fn new(device: &Arc<Device>) -> Result<Self> {
+    /// The pass for a renderer drawing at most `hair_vertices` hair vertices.
+    pub(super) fn new(device: &Arc<Device>, hair_vertices: u64) -> Result<Self> {
         let counters = Buffer::new(
             device,
             &BufferDesc {
@@ -128,7 +132,7 @@ impl TransparentPass {
         Ok(TransparentPass {
             device: device.clone(),
             counters,
-            colors: None,
+            colors: Buffer::storage(device, "vkhair hair vertex colors", hair_vertices.max(1) * 16)?,
             nearest: Sampler::nearest(device, "vkhair transparency sums")?,
             current: None,
             retired: Vec::new(),
@@ -136,10 +140,17 @@ impl TransparentPass {
     }
 
     /// Bytes of GPU memory the exact or fast mode needs at `extent` on a device with `info`'s limits.
-    pub(super) fn memory_bytes(info: &DeviceInfo, mode: Transparency, params: &OitParams, extent: vk::Extent2D) -> u64 {
+    pub(super) fn memory_bytes(
+        &self,
+        info: &DeviceInfo,
+        mode: Transparency,
+        params: &OitParams,
+        extent: vk::Extent2D,
+    ) -> u64 {
         let pixels = u64::from(extent.width) * u64::from(extent.height);
-        // Both: the counters, a depth word per pixel and the weighted sums.
-        let shared = std::mem::size_of::<OitCounters>() as u64 + (4 + fast::BYTES_PER_PIXEL) * pixels;
+        // Both: the counters, the vertex colours, a depth word per pixel and the weighted sums.
+        let shared =
+            std::mem::size_of::<OitCounters>() as u64 + self.colors.size() + (4 + fast::BYTES_PER_PIXEL) * pixels;
         match mode {
             Transparency::Off => 0,
             Transparency::Exact => shared + Lists::memory_bytes(&OitPool::plan(info, params, extent), extent),
@@ -153,7 +164,6 @@ impl TransparentPass {
         if let Some(current) = &mut self.current {
             current.pipelines.clear();
         }
-        self.colors = None;
     }
 
     /// Frees retired resources whose last frame is `frames_in_flight` frames before `frame`.
@@ -202,6 +212,17 @@ impl TransparentPass {
             return Ok(());
         }
         let d = &self.device;
+        // The per-pixel words (list heads, nearest opaque depth) are one buffer each.
+        let pixel_words = 4 * u64::from(extent.width) * u64::from(extent.height);
+        if pixel_words > u64::from(d.info.max_storage_buffer_range) {
+            return Err(Error::incompatible(
+                "render target",
+                format!(
+                    "transparent hair drawn at {}×{} needs {pixel_words} bytes of per-pixel words, more than                      this device's storage buffer range ({} bytes): draw smaller or without supersampling",
+                    extent.width, extent.height, d.info.max_storage_buffer_range
+                ),
+            ));
+        }
         let lists = match pool {
             Some(pool) => Some(Lists::new(d, pool, extent)?),
             None => None,
@@ -250,14 +271,7 @@ impl TransparentPass {
             blend,
             rasterizer_discard: false,
         };
-        let hair_bytes = frame.inputs.hairs.0.size();
-        if self.colors.as_ref().is_none_or(|c| c.size() != hair_bytes) {
-            self.colors = Some(Buffer::storage(d, "vkhair hair vertex colors", hair_bytes)?);
-        }
-        let Some(colors) = self.colors.as_ref() else {
-            return Err(Error::incompatible("transparency", "no vertex colours after making them"));
-        };
-        let mut ours = vec![(9, &self.counters), (12, &res.opaque), (20, colors)];
+        let mut ours = vec![(9, &self.counters), (12, &res.opaque), (20, &self.colors)];
         if let Some(lists) = &res.lists {
             ours.extend(lists.bindings());
         }
@@ -400,7 +414,10 @@ impl TransparentPass {
             shading.record_updates(cmd, &target.before, &frame.params, &frame.marschner);
             d.cmd_barrier(cmd, &[to_clear, to_shade], &[], &to_sums);
             pipelines.points.0.bind(cmd, &[pipelines.points.1]);
-            pipelines.points.0.dispatch_threads(cmd, [hairs.saturating_mul(per_hair), 1, 1]);
+            // At most 65,535 workgroups (every device's limit); the shader loops over the rest.
+            let per_group = pipelines.points.0.workgroup_size()[0];
+            let threads = hairs.saturating_mul(per_hair).min(MAX_WORKGROUPS.saturating_mul(per_group));
+            pipelines.points.0.dispatch_threads(cmd, [threads, 1, 1]);
             if let Some(lists) = &res.lists {
                 lists.record_clear(d, cmd);
             }

@@ -183,7 +183,7 @@ impl ShadowAtlas {
         ]
     }
 
-    /// Barrier after the opacity pass: the atlas to fragment-shader sampling.
+    /// Barrier after the opacity pass: the atlas to fragment- and compute-shader sampling.
     pub(super) fn to_sampled(&self) -> vk::ImageMemoryBarrier2<'static> {
         barrier::image(
             &self.atlas,

@@ -66,7 +66,7 @@ impl VolumeShadows {
 
     /// Copies `bytes` of the simulation's density from `source`, then computes the
     /// transmittance of volume maps `maps` (indices into the uniforms, written
-    /// before with a barrier to compute reads), visible to fragment shaders after.
+    /// before with a barrier to compute reads), visible to fragment and compute shaders after.
     ///
     /// # Safety
     /// `cmd` is recording outside a render pass; `source` is the simulation's cell

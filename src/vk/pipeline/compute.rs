@@ -74,7 +74,7 @@ impl ComputePipeline {
         })
     }
 
-    #[cfg(test)]
+    /// Invocations per workgroup in each dimension.
     pub(crate) fn workgroup_size(&self) -> [u32; 3] {
         self.workgroup_size
     }

@@ -95,8 +95,6 @@ fn volume_ms(report: &ProfileReport) -> f64 {
     report.passes.iter().filter(|p| volume.contains(&p.name.as_str())).map(|p| p.nanoseconds).sum::<f64>() / 1e6
 }
 
-/// Measures `samples` steps of `case`, GPU and CPU reference interleaved, after
-/// two warm-up steps each.
 /// Samples every figure takes however long they take (fewer only when `--samples` asks for fewer).
 pub const MIN_SAMPLES: usize = 5;
 

@@ -30,7 +30,7 @@ use crate::output::Error;
 use crate::say;
 use frames::bench_frames;
 use measure::{fitted_exponent, measure_sim, Samples, SimCase, SimFigures};
-use modes::{frame_ms, render_rows, write_modes, DEFAULT_EXACT, OFF};
+use modes::{default_exact, frame_ms, render_rows, write_modes, OFF};
 
 mod frames;
 mod measure;
@@ -505,7 +505,7 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
         // (the first scene) at 800×600 and Sintel at 1280×720, where measured.
         let thesis = scenes.first().map(|s| s.name.as_str());
         let sintel = scenes.iter().find(|s| s.name.starts_with("Sintel")).map(|s| s.name.as_str());
-        let frame = |scene, mode| finite(frame_ms(&modes, scene, mode));
+        let frame = |scene: Option<&str>, mode: &str| finite(frame_ms(&modes, scene, mode));
         let summary = json!({
             "command": "bench",
             "device": info.name,
@@ -523,9 +523,9 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
             "volume_gpu_ms_per_step": median(flip, false),
             "volume_cpu_ms_per_step": median(flip, true),
             "frame_ms_off": frame(thesis, OFF),
-            "frame_ms_exact": frame(thesis, DEFAULT_EXACT),
+            "frame_ms_exact": frame(thesis, &default_exact()),
             "sintel_frame_ms_off": frame(sintel, OFF),
-            "sintel_frame_ms_exact": frame(sintel, DEFAULT_EXACT),
+            "sintel_frame_ms_exact": frame(sintel, &default_exact()),
             "bandwidth_bytes_per_s": PEAK_BANDWIDTH.iter().map(|(n, b)| json!({"device": n, "bytes_per_s": b})).collect::<Vec<_>>(),
             "stages": rows.iter().map(Row::json).collect::<Vec<_>>(),
             "scaling": curves.iter().map(|c| {

@@ -50,7 +50,7 @@ pub(super) fn render_rows(
         let f = bench_frames(ctx, &with_mode, &b.args.sim, samples, true)?;
         let mib = f.transparency_bytes as f64 / (1024.0 * 1024.0);
         let label = match mode {
-            None => DEFAULT_EXACT.to_owned(),
+            None => default_exact(),
             Some("exact") => format!("exact K = {k}"),
             Some("off") => OFF.to_owned(),
             Some(m) => m.to_owned(),
@@ -79,12 +79,16 @@ pub(super) fn render_rows(
     Ok(())
 }
 
-/// Labels of the off mode's and the default exact mode's rows.
+/// Label of the off mode's row.
 pub(super) const OFF: &str = "off";
-pub(super) const DEFAULT_EXACT: &str = "exact K = 8 (default)";
+
+/// Label of the default mode's row (exact, vkhair's default K).
+pub(super) fn default_exact() -> String {
+    format!("exact K = {} (default)", vkhair::render::OitParams::default().sorted_fragments)
+}
 
 /// The GPU figure (median, ms) of `scene`'s frame in the mode labelled `mode`
-/// ([`OFF`], [`DEFAULT_EXACT`]); NaN where it was not measured.
+/// ([`OFF`], [`default_exact`]); NaN where it was not measured.
 pub(super) fn frame_ms(modes: &[ModeRow], scene: Option<&str>, mode: &str) -> f64 {
     modes.iter().find(|m| Some(m.scene.as_str()) == scene && m.mode == mode).map_or(f64::NAN, |m| m.gpu_ms)
 }

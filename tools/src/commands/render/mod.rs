@@ -196,7 +196,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     if mode != Transparency::Off {
         let extent = vkhair::ash::vk::Extent2D { width: sa.width, height: sa.height };
         let mib = renderer.transparency_memory(extent) as f64 / (1024.0 * 1024.0);
-        say!("transparency: {mode:?}, {mib:.1} MiB of lists or accumulation images");
+        say!("transparency: {mode:?}, {mib:.1} MiB of lists, accumulation images and vertex colours");
     }
     if let Some(stats) = renderer.transparency_stats() {
         say!(
