@@ -66,8 +66,8 @@ pub struct OitPool {
 impl OitPool {
     /// The pool for `params` at `extent` on a device with `info`'s limits.
     pub(crate) fn plan(info: &DeviceInfo, params: &OitParams, extent: vk::Extent2D) -> Self {
-        let pixels = f64::from(extent.width) * f64::from(extent.height);
-        let requested = ((pixels * f64::from(params.fragments_per_pixel)).ceil() as u64).max(1);
+        let pixels = u64::from(extent.width) * u64::from(extent.height);
+        let requested = ((pixels as f64 * f64::from(params.fragments_per_pixel)).ceil() as u64).max(1);
         let mut buffer_bytes = u64::from(info.max_storage_buffer_range).min(info.max_memory_allocation_size);
         if params.max_buffer_bytes != 0 {
             buffer_bytes = buffer_bytes.min(u64::from(params.max_buffer_bytes));
@@ -77,7 +77,6 @@ impl OitPool {
         let most = (most_per_buffer * POOL_BINDINGS.len() as u64).min(u64::from(OIT_END) - 1);
         let capacity = requested.min(most);
         let buffers = capacity.div_ceil(most_per_buffer);
-        let pixels = u64::from(extent.width) * u64::from(extent.height);
         OitPool { pixels, requested, capacity, buffers: buffers as u32, nodes_per_buffer: capacity.div_ceil(buffers) }
     }
 
@@ -111,20 +110,19 @@ pub(super) struct Lists {
 }
 
 impl Lists {
-    /// The lists of `pool` at `extent`.
-    pub(super) fn new(device: &Arc<Device>, pool: OitPool, extent: vk::Extent2D) -> Result<Self> {
-        let pixels = u64::from(extent.width) * u64::from(extent.height);
+    /// The lists of `pool`, a head per pixel it covers.
+    pub(super) fn new(device: &Arc<Device>, pool: OitPool) -> Result<Self> {
         let mut nodes = Vec::with_capacity(pool.buffers as usize);
         for i in 0..u64::from(pool.buffers) {
             let count = pool.nodes_per_buffer.min(pool.capacity - i * pool.nodes_per_buffer);
             nodes.push(Buffer::storage(device, &format!("vkhair transparency nodes {i}"), count * NODE_BYTES)?);
         }
-        Ok(Lists { heads: Buffer::storage(device, "vkhair transparency heads", 4 * pixels)?, nodes, pool })
+        Ok(Lists { heads: Buffer::storage(device, "vkhair transparency heads", 4 * pool.pixels)?, nodes, pool })
     }
 
-    /// Bytes of the heads and the pool at `extent`.
-    pub(super) fn memory_bytes(pool: &OitPool, extent: vk::Extent2D) -> u64 {
-        4 * u64::from(extent.width) * u64::from(extent.height) + pool.bytes()
+    /// Bytes of the heads and the pool.
+    pub(super) fn memory_bytes(pool: &OitPool) -> u64 {
+        4 * pool.pixels + pool.bytes()
     }
 
     /// The heads and the pool's buffers by binding; bindings past the pool's

@@ -153,7 +153,7 @@ impl TransparentPass {
             std::mem::size_of::<OitCounters>() as u64 + self.colors.size() + (4 + fast::BYTES_PER_PIXEL) * pixels;
         match mode {
             Transparency::Off => 0,
-            Transparency::Exact => shared + Lists::memory_bytes(&OitPool::plan(info, params, extent), extent),
+            Transparency::Exact => shared + Lists::memory_bytes(&OitPool::plan(info, params, extent)),
             Transparency::Fast => shared,
         }
     }
@@ -224,7 +224,7 @@ impl TransparentPass {
             ));
         }
         let lists = match pool {
-            Some(pool) => Some(Lists::new(d, pool, extent)?),
+            Some(pool) => Some(Lists::new(d, pool)?),
             None => None,
         };
         let pixels = u64::from(extent.width) * u64::from(extent.height);
