@@ -139,6 +139,31 @@ shader_codes! {
         MARSCHNER = 1,
     }
 
+    /// How the interpolation pass lays out its isolines.
+    interpolate = "INTERPOLATE_" {
+        /// Hairs (isolines) grown per patch instance (at most 64, the least
+        /// `maxTessellationGenerationLevel` Vulkan allows). More hairs per key
+        /// hair take more instances of the patches. Few lines per patch: a
+        /// software tessellator (lavapipe) spends time in the square of a
+        /// patch's output: a one-frame `vkhair render` of Sintel at 64 hairs per
+        /// key hair took 1.7 s at 4 lines per patch against 10.0 s at 64.
+        LINES_PER_INSTANCE = 4,
+        /// Most hairs grown per key hair (or scalp triangle): 16 instances.
+        /// Also the stride of the random seeds of interpolated hairs
+        /// (`key · MAX_HAIRS_PER_KEY + hair`), so no two hairs share one.
+        MAX_HAIRS_PER_KEY = 1024,
+    }
+
+    /// Transparent bands (`ribbon.vert`, `render::reference::strand_band`).
+    band = "BAND_" {
+        /// Widest a band spreads, in multiples of the n hair widths it stands
+        /// for: Sintel's and the thesis' error against a full head fell with
+        /// the spread while its fragments grew (thesis 800×600: no spread 9.8
+        /// steps, 1.36 M fragments; 2× 8.7, 1.99 M; 4× 7.6, 2.96 M; unbounded
+        /// 6.9, 4.3 M).
+        MAX_SPREAD = 2,
+    }
+
     /// "None" words that buffers are cleared to.
     sentinel = "" {
         /// No node in a per-pixel list, no depth stored (transparency).

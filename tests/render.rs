@@ -142,6 +142,98 @@ fn interpolation_grows_stable_clumps() {
     assert!(drift < 1e-3, "clump coordinates changed between frames by {drift}");
 }
 
+/// Hairs per key hair beyond one patch's isolines (instances of the patches,
+/// up to the most, 1024): every hair of both interpolation modes, a last
+/// partial instance included, stored where the CPU puts it (within 1e-5 m), each
+/// with a clump coordinate or blend of its own.
+#[test]
+fn hairs_beyond_one_patch_take_instances() {
+    use vkhair::render::{scalp, InterpolationMode, MAX_HAIRS_PER_KEY};
+    let gpu = Gpu::new();
+    let groom =
+        grow(&scenes::thesis_scalp(), &GrowParams { strands: 24, points_per_strand: 6, ..GrowParams::default() })
+            .expect("groom");
+    let sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    let state = sim.read_state().expect("state");
+    let triangles = scalp::root_triangles(&state);
+    assert!(!triangles.is_empty());
+    for (mode, hairs_per_key) in [
+        (InterpolationMode::SingleStrand, 150),
+        (InterpolationMode::Barycentric, 129),
+        (InterpolationMode::SingleStrand, MAX_HAIRS_PER_KEY),
+    ] {
+        let render = RenderParams { hairs_per_key, interpolation: mode, smoothing_level: 2, ..RenderParams::default() };
+        let mut renderer = Renderer::new(gpu.ctx(), &sim, &render).expect("renderer");
+        renderer.prepare_now(&sim, None).expect("prepare");
+        let (hairs, per_hair) = renderer.hair_counts();
+        let units = if mode == InterpolationMode::Barycentric { triangles.len() } else { 24 };
+        assert_eq!(hairs as usize, units * hairs_per_key as usize);
+        let stride = per_hair as usize;
+        let (smoothed, tangents) = renderer.read_smoothed().expect("smoothed");
+        let (positions, _) = renderer.read_hairs().expect("hairs");
+        let references = renderer.reference_vectors().expect("references");
+        let mut worst = 0.0f32;
+        let mut offsets = std::collections::BTreeSet::new();
+        for unit in 0..units {
+            for h in 0..hairs_per_key as usize {
+                for k in [0, stride / 2, stride - 1] {
+                    let got = positions[(unit * hairs_per_key as usize + h) * stride + k].truncate();
+                    let expected = match mode {
+                        InterpolationMode::SingleStrand => {
+                            let (p, t) =
+                                (smoothed[unit * stride + k].truncate(), tangents[unit * stride + k].truncate());
+                            let s = k as f32 / (stride - 1) as f32;
+                            let w =
+                                render.clump_width * (render.root_width + (render.tip_width - render.root_width) * s);
+                            let c = reference::clump_coordinate(unit as u32, h as u32);
+                            let (b1, b2) = reference::key_frame(t, references[unit].truncate());
+                            p + (c.x * b1 + c.y * b2) * w
+                        }
+                        InterpolationMode::Barycentric => {
+                            let w = reference::barycentric_weights(unit as u32, h as u32);
+                            let key = |i: usize| smoothed[triangles[unit][i] as usize * stride + k].truncate();
+                            w.x * key(0) + w.y * key(1) + w.z * key(2)
+                        }
+                    };
+                    worst = worst.max((got - expected).length());
+                    if k == stride - 1 {
+                        offsets.insert(got.to_array().map(f32::to_bits));
+                    }
+                }
+            }
+        }
+        eprintln!("{mode:?}, {hairs_per_key} hairs per key: largest difference to the CPU {worst:e} m");
+        assert!(worst < 1e-5, "{mode:?} {hairs_per_key}: {worst}");
+        assert_eq!(offsets.len(), units * hairs_per_key as usize, "two hairs share a place");
+    }
+    let too_many = RenderParams { hairs_per_key: MAX_HAIRS_PER_KEY + 1, ..RenderParams::default() };
+    assert!(matches!(Renderer::new(gpu.ctx(), &sim, &too_many), Err(Error::InvalidParameter { .. })));
+    // A renderer holds its creation's hairs per key hair in either mode...
+    assert!(triangles.len() > 24, "{} triangles", triangles.len());
+    let single = RenderParams { hairs_per_key: 100, ..RenderParams::default() };
+    let mut renderer = Renderer::new(gpu.ctx(), &sim, &single).expect("renderer");
+    let bary =
+        |hairs_per_key| RenderParams { interpolation: InterpolationMode::Barycentric, hairs_per_key, ..single.clone() };
+    assert!(matches!(renderer.set_params(&bary(101)), Err(Error::InvalidParameter { .. })));
+    renderer.set_params(&bary(100)).expect("either mode at the creation's count");
+    // ...unless the storage range cannot hold the barycentric mode's: then only
+    // as many hairs as its creation's mode draws.
+    let range = u64::from(gpu.ctx().info().max_storage_buffer_range);
+    let stride = 5 * 64 + 1;
+    let per_key = ((range / (24 * stride * 16)) as u32).min(MAX_HAIRS_PER_KEY);
+    if (triangles.len() * per_key as usize * stride as usize * 16) as u64 <= range {
+        eprintln!("skipped: this device's storage range ({range} bytes) holds both modes at {per_key} hairs per key");
+        return;
+    }
+    let big = RenderParams { hairs_per_key: per_key, smoothing_level: 64, ..RenderParams::default() };
+    let mut renderer = Renderer::new(gpu.ctx(), &sim, &big).expect("renderer");
+    let big_bary =
+        |hairs_per_key| RenderParams { interpolation: InterpolationMode::Barycentric, hairs_per_key, ..big.clone() };
+    let fits = (24 * per_key as usize / triangles.len()) as u32;
+    assert!(matches!(renderer.set_params(&big_bary(fits + 1)), Err(Error::InvalidParameter { .. })));
+    renderer.set_params(&big_bary(fits)).expect("as many hairs as the renderer holds");
+}
+
 // ---- Drawing -----------------------------------------------------------------
 
 use vkhair::groom::mesh::TriMesh;
@@ -347,6 +439,15 @@ fn detail_falls_with_distance() {
         assert_eq!(count[0], 4 * segments, "assembled triangles = 4 × segments at {distance} m");
         let covered = hair_pixels(&s.offscreen.read_rgba8().expect("readback")).len();
         eprintln!("{distance} m: {:?}, {segments} segments drawn, {covered} pixels", s.renderer.detail());
+        // Fewer strands stand for more hairs each and lie farther apart.
+        let detail = s.renderer.detail().hairs_per_key as f32;
+        let full = s.renderer.params().hairs_per_key as f32;
+        let n = s.renderer.material().represented_hairs;
+        assert!((s.renderer.strand_hairs() - n * full / detail).abs() < 1e-5 * n * full);
+        let share = (std::f32::consts::PI / detail).sqrt() * s.renderer.params().clump_width;
+        let spacing = s.renderer.strand_spacing();
+        assert!((spacing.0 - share * s.renderer.params().root_width).abs() < 1e-7, "{spacing:?}");
+        assert!((spacing.1 - share * s.renderer.params().tip_width).abs() < 1e-7, "{spacing:?}");
         drawn.push((segments, covered));
     }
     // SAFETY: no pending work uses the pool.

@@ -83,6 +83,7 @@ fn reference(s: &Scene, width: f32, opacity: f32) -> Vec<Vec3> {
         extent: (W, H),
         widths: (width, width),
         represented_hairs: 1.0,
+        band_spacing: s.renderer.strand_spacing(),
         opacity,
         color: &color,
         background: BACKGROUND,
@@ -121,6 +122,58 @@ fn each_mode_against_the_exact_reference() {
     let [off, fast, exact] = [errors[0], errors[1], errors[2]];
     assert!(exact <= 0.5 * off, "exact's error {exact:.2} is not at most half of off's {off:.2}");
     assert!(fast < off, "fast's error {fast:.2} is not below off's {off:.2}");
+}
+
+/// Strands standing for several hairs, sparser than the hairs they stand for:
+/// each is drawn as a band spread over the space to its neighbours
+/// (`Renderer::strand_spacing`, `reference::strand_band`), and the exact mode
+/// matches the CPU reference of those bands, not of bands n hair widths wide.
+#[test]
+fn sparse_strands_are_drawn_as_bands_spread_to_their_neighbours() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(300, 8, 5);
+    // Bands over two pixels wide (a pixel is about 5.5 mm here), so that the
+    // exact mode's coverage is exact.
+    let (width, n) = (0.001, 6.0);
+    let m = HairMaterial { represented_hairs: n, ..material(width, OPACITY) };
+    let mut p = RenderParams { hairs_per_key: 4, clump_width: 0.1, ..params(Transparency::Exact) };
+    p.oit.sorted_fragments = 32;
+    let mut s = scene(&gpu, &groom, &p, &m);
+    let image = draw(&gpu, &mut s);
+    let spacing = s.renderer.strand_spacing();
+    let root_share = (std::f32::consts::PI / 4.0).sqrt() * 0.1;
+    assert!(
+        (spacing.0 - root_share * p.root_width).abs() < 1e-7 && (spacing.1 - root_share * p.tip_width).abs() < 1e-7
+    );
+    let (band, density) = vkhair::render::reference::strand_band(width, n, spacing.0);
+    assert!(band > n * width, "the spread is wider than the hairs side by side: {band} vs {}", n * width);
+    assert!((density - (1.0 - (1.0 - width / band).powf(n))).abs() < 1e-6);
+    let strands = s.renderer.read_strands().expect("hairs");
+    let color = |t: f32| ROOT.lerp(TIP, t);
+    let reference_with = |band_spacing: (f32, f32)| -> Vec<Vec3> {
+        composite_strands(&CompositeScene {
+            hairs: &strands,
+            view_proj: s.camera.projection * s.camera.view,
+            camera: s.camera.position(),
+            extent: (W, H),
+            widths: (width, width),
+            represented_hairs: n,
+            band_spacing,
+            opacity: OPACITY,
+            color: &color,
+            background: BACKGROUND,
+        })
+        .iter()
+        .map(|p| p.truncate())
+        .collect()
+    };
+    let spread = mae(&image, &reference_with(spacing));
+    let unspread = mae(&image, &reference_with((0.0, 0.0)));
+    println!("error against the spread bands {spread:.2}, against bands n hairs wide {unspread:.2} (8-bit sRGB steps)");
+    // lavapipe: 2.5 against 11.2 (the ribbons' joints overlap where the
+    // reference's quads meet edge to edge).
+    assert!(spread < 3.5, "{spread:.2}");
+    assert!(unspread > 3.0 * spread, "{unspread:.2} vs {spread:.2}");
 }
 
 #[test]
@@ -245,6 +298,7 @@ fn crown_coverage(gpu: &Gpu, groom: &Groom, hairs_per_key: u32, represented_hair
         extent: (W, H),
         widths: (m.root_width, m.tip_width),
         represented_hairs,
+        band_spacing: s.renderer.strand_spacing(),
         opacity: m.opacity,
         color: &|_| Vec3::ONE,
         background: Vec3::ZERO,

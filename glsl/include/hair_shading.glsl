@@ -109,15 +109,15 @@ vec3 shade_hair(vec3 pos, vec3 tangent, float t_along, uint hair) {
 
 // Alpha of a transparent strand fragment from `cover` (the ribbon vertex stage's
 // g_cover: x signed distance from the band's centre line, y its half width,
-// both in pixels): the length of the band's cross-section inside the pixel's
-// box filter (its exact coverage c: at most 1, at most the band's width),
-// times the band's density dp.coverage.w (the fraction of it its n hairs cover,
-// 1 − (1 − 1/n)^n for hairs placed at random) and the strand opacity dp.coverage.y.
-float strand_alpha(vec2 cover) {
+// both in pixels, z its density): the length of the band's cross-section
+// inside the pixel's box filter (its exact coverage c: at most 1, at most the
+// band's width), times the band's density (the fraction of it its n hairs
+// cover, placed at random) and the strand opacity dp.coverage.y.
+float strand_alpha(vec3 cover) {
     float d = abs(cover.x);
     float h = cover.y;
     float c = clamp(min(d + 0.5, h) - max(d - 0.5, -h), 0.0, 1.0);
-    return dp.coverage.y * dp.coverage.w * c;
+    return dp.coverage.y * cover.z * c;
 }
 
 #endif

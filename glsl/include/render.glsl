@@ -26,6 +26,13 @@ struct InterpolatePush {
     float tip_width;      // fraction of clump_width at the tip
 };
 
+// Interpolated hair `first + i` of the isoline at tessellation coordinate y
+// among `lines` isolines (y = i / lines): the hair an evaluation of the
+// interpolation pass stores.
+uint isoline_hair(uint first, float y, uint lines) {
+    return first + min(uint(y * float(lines) + 0.5), lines - 1u);
+}
+
 vec3 quat_rotate(vec4 q, vec3 v) {
     vec3 t = 2.0 * cross(q.xyz, v);
     return v + q.w * t + cross(q.xyz, t);
@@ -34,7 +41,7 @@ vec3 quat_rotate(vec4 q, vec3 v) {
 // The stable random clump coordinate of interpolated hair `hair` of key `key`:
 // uniform in the unit disk, the same every frame.
 vec2 clump_coordinate(uint key, uint hair) {
-    uint seed = key * 64u + hair;
+    uint seed = key * INTERPOLATE_MAX_HAIRS_PER_KEY + hair;
     float r = sqrt(hash_unit(seed * 2u + 0x9e3779b9u));
     float a = 6.28318530718 * hash_unit(seed * 2u + 0x7f4a7c15u);
     return r * vec2(cos(a), sin(a));
@@ -43,7 +50,7 @@ vec2 clump_coordinate(uint key, uint hair) {
 // Stable random barycentric weights of hair `hair` of scalp triangle `tri`:
 // uniform over the triangle (the square-root warp), summing to 1.
 vec3 barycentric_weights(uint tri, uint hair) {
-    uint seed = tri * 64u + hair;
+    uint seed = tri * INTERPOLATE_MAX_HAIRS_PER_KEY + hair;
     float r1 = sqrt(hash_unit(seed * 2u + 0x51ed270bu));
     float r2 = hash_unit(seed * 2u + 0x2545f491u);
     float u = 1.0 - r1;
@@ -87,7 +94,8 @@ struct DrawParams {
     vec4 secondary;       // rgb secondary highlight color, w exponent
     vec4 shifts;          // x primary shift, y secondary shift, z shift jitter, w highlight breakup
     vec4 widths;          // x root width (m), y tip width (m), z least width (pixels), w unused
-    vec4 coverage;        // x 1 for transparent strands (coverage, no least width), y opacity, z hairs a strand stands for
+    vec4 coverage;        // x 1 for transparent strands (coverage, no least width), y opacity, z hairs a strand stands for, w unused
+    vec4 band;            // x spacing of the drawn strands at the root (m), y at the tip (m), zw unused
     uvec4 counts;         // x hairs, y vertices per hair, z lights, w shading mode (0 Kajiya-Kay, 1 Marschner)
     Light lights[MAX_LIGHTS];
 };

@@ -64,7 +64,9 @@ uint shadow_layer_of(float d, vec3 ends) {
 }
 
 // Light transmittance (0..1) reaching world position p through the hair of map
-// m: exp(−k · opacity), averaged over (2r+1)² texels of the tile (PCF).
+// m: exp(−k · opacity), the opacity averaged over (2r+1)² texels of the tile
+// (r = m.params.y) before the exponential: the filter spreads the opacity of
+// sparse strands over the space their hairs fill.
 float shadow_transmittance(sampler2D atlas, ShadowMap m, vec3 p) {
     vec4 clip = m.view_proj * vec4(p, 1.0);
     if (clip.w <= 0.0) {
@@ -85,11 +87,11 @@ float shadow_transmittance(sampler2D atlas, ShadowMap m, vec3 p) {
         for (int x = -r; x <= r; ++x) {
             vec4 s = texelFetch(atlas, clamp(centre + ivec2(x, y), lo, hi), 0);
             float opacity = s.a > 0.0 ? shadow_layer_opacity(depth - s.a, s.rgb, m.layers.xyz) : 0.0;
-            sum += exp(-m.layers.w * opacity);
+            sum += opacity;
         }
     }
     float n = float(2 * r + 1);
-    return sum / (n * n);
+    return exp(-m.layers.w * sum / (n * n));
 }
 
 #ifdef VKHAIR_SHADOW_DENSITY

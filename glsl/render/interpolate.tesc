@@ -1,16 +1,23 @@
 #version 460
-// Interpolation pass, control stage: `hairs` isolines (one per interpolated
-// hair) of `level` segments each, per key segment.
+// Interpolation pass, control stage: the isolines of instance n are hairs
+// n·INTERPOLATE_LINES_PER_INSTANCE onwards, at most that many of the `hairs`
+// per key segment (one isoline per interpolated hair), of `level` segments each.
 #include "render.glsl"
 
 layout(vertices = 1) out;
 layout(push_constant) uniform Push { InterpolatePush pc; };
 
 layout(location = 0) flat in uint v_patch[];
+layout(location = 1) flat in uint v_instance[];
 layout(location = 0) patch out uint p_patch;
+layout(location = 1) patch out uint p_first_hair;
 
 void main() {
+    uint first = v_instance[0] * INTERPOLATE_LINES_PER_INSTANCE;
     p_patch = v_patch[0];
-    gl_TessLevelOuter[0] = float(pc.hairs);
+    p_first_hair = first;
+    uint lines = pc.hairs > first ? min(pc.hairs - first, INTERPOLATE_LINES_PER_INSTANCE) : 0u;
+    // No lines: the patch is discarded.
+    gl_TessLevelOuter[0] = float(lines);
     gl_TessLevelOuter[1] = float(pc.level);
 }

@@ -13,13 +13,15 @@ layout(std430, set = 0, binding = 4) writeonly buffer HairTan { vec4 hair_tan[];
 layout(std430, set = 0, binding = 5) readonly buffer Triangles { uvec4 triangles[]; };
 
 layout(location = 0) patch in uint p_patch;
+layout(location = 1) patch in uint p_first_hair;
 
 void main() {
     uint segs = pc.points - 1u;
     uint tri = p_patch / segs;
     uint seg = p_patch - tri * segs;
     uint j = uint(gl_TessCoord.x * float(pc.level) + 0.5);
-    uint h = min(uint(gl_TessCoord.y * float(pc.hairs) + 0.5), pc.hairs - 1u);
+    uint lines = min(pc.hairs - p_first_hair, INTERPOLATE_LINES_PER_INSTANCE);
+    uint h = isoline_hair(p_first_hair, gl_TessCoord.y, lines);
     if (j < pc.level || seg + 1u == segs) {
         uint k = seg * pc.level + j;
         uvec3 keys = triangles[tri].xyz;

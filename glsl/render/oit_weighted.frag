@@ -10,7 +10,7 @@ layout(early_fragment_tests) in;
 
 // The colour shade_points.comp gave the segment's ends, and the coverage inputs.
 layout(location = 0) in vec3 g_color;
-layout(location = 1) in vec2 g_cover;
+layout(location = 1) in vec3 g_cover;
 
 layout(location = 0) out vec4 out_sum;
 layout(location = 1) out vec4 out_absorbance;

@@ -7,12 +7,16 @@
 //
 // Transparent strands (the VKHAIR_COVERAGE variant, drawn with dp.coverage.x = 1) have no
 // least width: their ribbon is at least one pixel wide plus half a pixel each
-// side, and g_cover carries the signed distance from the centre line and the
-// true half width, in pixels, from which the fragment stage computes the
-// strand's coverage. A transparent strand standing for n hairs
-// (dp.coverage.z) is a band n hair widths wide. Its vertices carry the colour
-// shade_points.comp gave each end of the segment (g_color), not the inputs of
-// per-fragment shading.
+// side, and g_cover carries the signed distance from the centre line, the
+// true half width, in pixels, and the band's density, from which the fragment
+// stage computes the strand's coverage. A transparent strand standing for n
+// hairs (dp.coverage.z) is a band n hair widths wide, or (1 − 1/n) of the
+// spacing of the drawn strands there (dp.band) where that is wider, up to
+// BAND_MAX_SPREAD × n hair widths, so that neighbouring bands meet as the hairs
+// they stand for would (one hair stays one hair); its density is
+// the fraction of it n hairs of width w at random across it cover,
+// 1 − (1 − w / band)^n. Its vertices carry the colour shade_points.comp gave
+// each end of the segment (g_color), not the inputs of per-fragment shading.
 //
 // vkhair variant: VKHAIR_COVERAGE
 #include "render.glsl"
@@ -30,7 +34,7 @@ precise gl_Position;
 // Per hair vertex: its shaded colour (shade_points.comp).
 layout(std430, set = 0, binding = 20) readonly buffer PointColor { vec4 point_color[]; };
 layout(location = 0) out vec3 g_color;
-layout(location = 1) out vec2 g_cover;
+layout(location = 1) out vec3 g_cover;
 #else
 layout(location = 0) out vec3 g_pos;
 layout(location = 1) out vec3 g_tan;
@@ -71,8 +75,13 @@ void main() {
     side = side_len > 1e-12 ? side / side_len : vec3(1.0, 0.0, 0.0);
     float width = mix(dp.widths.x, dp.widths.y, tan_t.w);
 #ifdef VKHAIR_COVERAGE
-    // A transparent strand standing for n hairs is a band of n hair widths.
-    width *= dp.coverage.z;
+    // A transparent strand standing for n hairs is a band of n hair widths, at
+    // least the strands' spacing.
+    float hair_width = width;
+    float n = dp.coverage.z;
+    float spread = (1.0 - 1.0 / max(n, 1.0)) * mix(dp.band.x, dp.band.y, tan_t.w);
+    width = max(n * hair_width, min(spread, float(BAND_MAX_SPREAD) * n * hair_width));
+    float density = width > 0.0 ? 1.0 - pow(max(1.0 - hair_width / width, 0.0), n) : 0.0;
     float pixel = max(dp.camera.w * distance_to_camera, 1e-12);
     float half_true = 0.5 * width / pixel;
     float half_drawn = (max(half_true, 0.5) + 0.5) * pixel;
@@ -83,7 +92,7 @@ void main() {
     vec3 corner_pos = pos + side * (half_drawn * s);
 #ifdef VKHAIR_COVERAGE
     g_color = point_color[first + e].rgb;
-    g_cover = vec2(half_drawn / pixel * s, half_true);
+    g_cover = vec3(half_drawn / pixel * s, half_true, density);
 #else
     g_pos = corner_pos;
     g_tan = tan_t.xyz;

@@ -112,13 +112,16 @@ pub(crate) struct DrawParams {
     /// 1 for transparent strands (coverage, no least width), opacity, hairs a
     /// strand stands for.
     pub coverage: [f32; 4],
+    /// Spacing of the drawn strands at the root and at the tip (m): a
+    /// transparent strand's band is at least this wide.
+    pub band: [f32; 4],
     /// Hairs, vertices per hair, lights.
     pub counts: [u32; 4],
     /// The lights.
     pub lights: [GpuLight; limits::MAX_LIGHTS as usize],
 }
 gpu_struct!(DrawParams => "DrawParams" {
-    view_proj, camera, root_color, tip_color, primary, secondary, shifts, widths, coverage, counts, lights
+    view_proj, camera, root_color, tip_color, primary, secondary, shifts, widths, coverage, band, counts, lights
 });
 
 /// The transparency passes' per-frame words (`OitCounters` in `glsl/include/oit.glsl`).

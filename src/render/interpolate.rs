@@ -1,7 +1,8 @@
 //! Pass 2 — single-strand interpolation (`glsl/render/interpolate.*`): a draw
-//! with no vertex buffer, one patch per key segment; the control stage's line
-//! count is the number of hairs grown from each key hair, its segment count the
-//! smoothing level. Each vertex is the smoothed key vertex plus an offset in
+//! with no vertex buffer, one patch per key segment and instance; the control
+//! stage's line count is the number of hairs the instance grows from each key
+//! hair (instance n grows hairs 4n to 4n + 3, `codes::interpolate`), its
+//! segment count the smoothing level. Each vertex is the smoothed key vertex plus an offset in
 //! the key hair's frame: a stable random clump coordinate (uniform in the unit
 //! disk, fixed per hair) × clump width × mix(root width, tip width) along the
 //! strand. The frame is built on the GPU from the smoothed tangent and the key
@@ -19,6 +20,7 @@ use glam::{Vec3, Vec4};
 use super::pass::{self, RenderPass};
 use super::smooth::SmoothPass;
 use super::InterpolationMode;
+use crate::codes;
 use crate::error::{Error, Result};
 use crate::gpu_types::InterpolatePush;
 use crate::profiler::Timing;
@@ -47,6 +49,14 @@ fn reference_vectors(rest: &SimState) -> Vec<Vec4> {
         .collect()
 }
 
+/// Mean area of `triangles` of key-hair roots of `rest`, m² (0 for none).
+fn mean_area(rest: &SimState, triangles: &[[u32; 3]]) -> f32 {
+    let root = |k: u32| rest.rest[k as usize * rest.points].truncate();
+    let sum: f32 =
+        triangles.iter().map(|t| 0.5 * (root(t[1]) - root(t[0])).cross(root(t[2]) - root(t[0])).length()).sum();
+    sum / triangles.len().max(1) as f32
+}
+
 /// The interpolation pass: its two pipelines, the key frames and scalp
 /// triangles it reads, and the hairs it stores.
 pub(super) struct InterpolatePass {
@@ -58,6 +68,8 @@ pub(super) struct InterpolatePass {
     /// Scalp triangles between key-hair roots (barycentric mode).
     _triangle_buffer: Buffer,
     triangles: u32,
+    /// Mean area of the scalp triangles at rest, m² (0 without triangles).
+    mean_triangle_area: f32,
     /// Interpolated positions, hair after hair.
     positions: Buffer,
     /// Interpolated (tangent, t along the hair), as `positions`.
@@ -117,6 +129,7 @@ impl InterpolatePass {
             reference,
             _triangle_buffer: triangle_buffer,
             triangles: triangles.len() as u32,
+            mean_triangle_area: mean_area(rest, triangles),
             positions,
             tangents,
         })
@@ -125,6 +138,11 @@ impl InterpolatePass {
     /// Scalp triangles between key-hair roots.
     pub(super) fn triangles(&self) -> u32 {
         self.triangles
+    }
+
+    /// Mean area of the scalp triangles at rest, m² (0 without triangles).
+    pub(super) fn mean_triangle_area(&self) -> f32 {
+        self.mean_triangle_area
     }
 
     /// Rejects `mode` when it cannot grow hairs from these key hairs.
@@ -167,7 +185,8 @@ impl InterpolatePass {
             pass::record_capture(d, cmd, RenderPass::Interpolate, timing, |cmd| {
                 p.pipeline.bind(cmd, &[p.set]);
                 p.pipeline.push(cmd, push);
-                d.raw.cmd_draw(cmd, push.strands * (push.points - 1), 1, 0, 0);
+                let instances = push.hairs.div_ceil(codes::interpolate::LINES_PER_INSTANCE);
+                d.raw.cmd_draw(cmd, push.strands * (push.points - 1), instances, 0, 0);
             });
         }
     }

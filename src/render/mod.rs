@@ -66,7 +66,7 @@ use crate::vk::device::Device;
 use draw::DrawPass;
 use interpolate::InterpolatePass;
 use resolve::ResolvePass;
-use shadow::{Bounds, Shadows};
+use shadow::{Bounds, DrawnHairs, ShadowFootprint, Shadows};
 use smooth::SmoothPass;
 use target::Placement;
 pub use target::RenderTarget;
@@ -121,9 +121,10 @@ pub struct Renderer {
     params: RenderParams,
     strands: u32,
     points: u32,
-    /// Smoothing level and hairs per key the buffers were sized for.
+    /// Smoothing level and interpolated hairs (all units together) the
+    /// buffers were sized for.
     capacity_level: u32,
-    capacity_hairs: u32,
+    capacity_hairs: u64,
     smooth: SmoothPass,
     interpolate: InterpolatePass,
     shadows: Shadows,
@@ -171,9 +172,17 @@ impl Renderer {
         // Sized for the level asked for at creation: level-of-detail only lowers it.
         let stride = (points as u64 - 1) * u64::from(params.smoothing_level) + 1;
         let triangles = scalp::root_triangles(sim.rest);
-        // Room for either mode: key hairs or scalp triangles, each growing hairs.
-        let units = (strands as u64).max(triangles.len() as u64);
-        let hair_vertices = units * stride * u64::from(params.hairs_per_key);
+        // Room for the hairs of either mode (key hairs or scalp triangles, each
+        // growing hairs) where the device's storage range holds them, else for
+        // the mode asked for.
+        let units = match params.interpolation {
+            InterpolationMode::SingleStrand => strands as u64,
+            InterpolationMode::Barycentric => triangles.len() as u64,
+        };
+        let both = (strands as u64).max(triangles.len() as u64) * u64::from(params.hairs_per_key);
+        let fits = |hairs: u64| hairs * stride * 16 <= u64::from(device.info.max_storage_buffer_range);
+        let capacity_hairs = if fits(both) { both } else { units * u64::from(params.hairs_per_key) };
+        let hair_vertices = capacity_hairs * stride;
         if hair_vertices * 16 > u64::from(device.info.max_storage_buffer_range) {
             return Err(Error::device(
                 "the interpolated hairs",
@@ -194,7 +203,7 @@ impl Renderer {
             strands: strands as u32,
             points: points as u32,
             capacity_level: params.smoothing_level,
-            capacity_hairs: params.hairs_per_key,
+            capacity_hairs,
             smooth,
             interpolate,
             shadows,
@@ -216,7 +225,11 @@ impl Renderer {
     }
 
     /// Changes parameters from the next recorded frame on (validated first). The
-    /// smoothing level may not exceed the one the renderer was created with.
+    /// smoothing level may not exceed the one the renderer was created with, nor
+    /// the hairs drawn at full detail (key hairs, or scalp triangles in
+    /// barycentric mode, × `hairs_per_key`) those it holds: those of its
+    /// creation's `hairs_per_key` in either mode, or only in its creation's mode
+    /// where the device's `maxStorageBufferRange` cannot hold both.
     pub fn set_params(&mut self, params: &RenderParams) -> Result<()> {
         params.validate()?;
         if params.smoothing_level > self.capacity_level {
@@ -227,11 +240,17 @@ impl Renderer {
             ));
         }
         self.interpolate.check_mode(params.interpolation)?;
-        if params.hairs_per_key > self.capacity_hairs {
+        let units = u64::from(self.units_of(params.interpolation));
+        if units * u64::from(params.hairs_per_key) > self.capacity_hairs {
             return Err(Error::param(
                 "hairs_per_key",
                 params.hairs_per_key,
-                format!("at most {}, the count this renderer was created for", self.capacity_hairs),
+                format!(
+                    "at most {} in {:?} interpolation: {} hairs, those this renderer was created for",
+                    self.capacity_hairs / units.max(1),
+                    params.interpolation,
+                    self.capacity_hairs
+                ),
             ));
         }
         self.params = params.clone();
@@ -308,9 +327,43 @@ impl Renderer {
 
     /// Key hairs, or scalp triangles in barycentric mode: what hairs are grown from.
     fn interpolation_units(&self) -> u32 {
-        match self.params.interpolation {
+        self.units_of(self.params.interpolation)
+    }
+
+    /// Key hairs, or scalp triangles: what `mode` grows hairs from.
+    fn units_of(&self, mode: InterpolationMode) -> u32 {
+        match mode {
             InterpolationMode::SingleStrand => self.strands,
             InterpolationMode::Barycentric => self.interpolate.triangles(),
+        }
+    }
+
+    /// Real hairs each hair drawn in the latest prepared frame stands for:
+    /// [`HairMaterial::represented_hairs`] at full detail, more where level of
+    /// detail draws fewer hairs (× full `hairs_per_key` / the frame's).
+    pub fn strand_hairs(&self) -> f32 {
+        self.material.represented_hairs * self.params.hairs_per_key as f32 / self.detail.hairs_per_key.max(1) as f32
+    }
+
+    /// Spacing of the hairs drawn in the latest prepared frame at the root and
+    /// at the tip, meters: in single-strand mode the side of each one's share
+    /// of its clump's disk (clump radius × √(π / hairs_per_key) at the
+    /// frame's detail), in barycentric mode of its share of a mean scalp
+    /// triangle (√(area / hairs_per_key)). A transparent strand standing for
+    /// several hairs is a band at least about this wide
+    /// ([`reference::strand_band`]).
+    pub fn strand_spacing(&self) -> (f32, f32) {
+        let hairs = self.detail.hairs_per_key.max(1) as f32;
+        let p = &self.params;
+        match p.interpolation {
+            InterpolationMode::SingleStrand => {
+                let share = (std::f32::consts::PI / hairs).sqrt() * p.clump_width;
+                (share * p.root_width, share * p.tip_width)
+            }
+            InterpolationMode::Barycentric => {
+                let side = (self.interpolate.mean_triangle_area() / hairs).sqrt();
+                (side, side)
+            }
         }
     }
 
@@ -446,9 +499,12 @@ impl Renderer {
     ) -> Result<()> {
         let sim = sim.into();
         let bounds = Bounds { centre: self.placement.head_center, radius: self.placement.bound_radius };
-        // SAFETY: guaranteed by the caller.
         let timing = Timing::of(profiler.as_deref());
-        unsafe { self.shadows.record(cmd, &sim, &self.lights, bounds, self.hair_counts(), timing) }
+        let (root, tip) = self.strand_spacing();
+        let footprint = ShadowFootprint { hairs: self.strand_hairs(), spacing: 0.5 * (root + tip) };
+        let drawn = DrawnHairs { counts: self.hair_counts(), footprint };
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.shadows.record(cmd, &sim, &self.lights, bounds, drawn, timing) }
     }
 
     /// The opacity atlas (format [`SHADOW_ATLAS_FORMAT`], one tile per caster, two tiles

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 pub const MAX_SMOOTHING_LEVEL: u32 = 64;
 
 /// Most hairs grown around (or between) key hairs.
-pub const MAX_HAIRS_PER_KEY: u32 = 64;
+pub const MAX_HAIRS_PER_KEY: u32 = crate::codes::interpolate::MAX_HAIRS_PER_KEY;
 
 /// Rendering parameters.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -16,7 +16,7 @@ pub struct RenderParams {
     /// Smoothed segments per key segment (1..=64). Default: 4 (a 6-point key hair
     /// becomes 20 segments, as in the thesis scene).
     pub smoothing_level: u32,
-    /// Hairs grown around each key hair (1..=64). Default: 16 (1750 key hairs give
+    /// Hairs grown around each key hair (1..=1024, [`MAX_HAIRS_PER_KEY`]). Default: 16 (1750 key hairs give
     /// 28,000 hairs, as in the thesis scene).
     pub hairs_per_key: u32,
     /// Radius of a clump around its key hair, meters (≥ 0). Default: 0.012.
@@ -153,7 +153,7 @@ pub struct LodParams {
     pub enabled: bool,
     /// Distance up to which full detail is drawn, meters (1e-4..=1e6). Default: 0.6.
     pub full_detail_distance: f32,
-    /// Fewest hairs per key hair (1..=64). Default: 2.
+    /// Fewest hairs per key hair (1..=1024). Default: 2.
     pub min_hairs_per_key: u32,
     /// Lowest smoothing level (1..=64). Default: 1.
     pub min_smoothing_level: u32,

@@ -55,7 +55,7 @@ pub fn smooth_strand(points: &[Vec3], level: u32) -> Vec<(Vec3, Vec3)> {
 /// The stable clump coordinate of interpolated hair `hair` of key hair `key`,
 /// uniform in the unit disk (as `clump_coordinate` in `render.glsl`).
 pub fn clump_coordinate(key: u32, hair: u32) -> glam::Vec2 {
-    let seed = key.wrapping_mul(64).wrapping_add(hair);
+    let seed = key.wrapping_mul(crate::codes::interpolate::MAX_HAIRS_PER_KEY).wrapping_add(hair);
     let r = crate::hash::hash_unit(seed.wrapping_mul(2).wrapping_add(0x9e37_79b9)).sqrt();
     let a = std::f32::consts::TAU * crate::hash::hash_unit(seed.wrapping_mul(2).wrapping_add(0x7f4a_7c15));
     glam::Vec2::new(r * a.cos(), r * a.sin())
@@ -64,7 +64,7 @@ pub fn clump_coordinate(key: u32, hair: u32) -> glam::Vec2 {
 /// Barycentric weights of hair `hair` of scalp triangle `tri`, as
 /// `barycentric_weights` in `render.glsl`.
 pub fn barycentric_weights(tri: u32, hair: u32) -> Vec3 {
-    let seed = tri.wrapping_mul(64).wrapping_add(hair);
+    let seed = tri.wrapping_mul(crate::codes::interpolate::MAX_HAIRS_PER_KEY).wrapping_add(hair);
     let r1 = crate::hash::hash_unit(seed.wrapping_mul(2).wrapping_add(0x51ed_270b)).sqrt();
     let r2 = crate::hash::hash_unit(seed.wrapping_mul(2).wrapping_add(0x2545_f491));
     let u = 1.0 - r1;
@@ -145,12 +145,30 @@ pub struct CompositeScene<'a> {
     /// Real hairs each drawn strand stands for (as
     /// [`super::HairMaterial::represented_hairs`]).
     pub represented_hairs: f32,
+    /// Least band width at the root and at the tip, meters: the spacing of the
+    /// drawn strands ([`super::Renderer::strand_spacing`]; 0 for none).
+    pub band_spacing: (f32, f32),
     /// Opacity of a strand where it covers a sample.
     pub opacity: f32,
     /// Linear colour of the hair at t.
     pub color: &'a (dyn Fn(f32) -> Vec3 + Sync),
     /// Linear background colour.
     pub background: Vec3,
+}
+
+/// The band a transparent strand standing for `n` hairs of width `hair_width`
+/// is drawn as, where the drawn strands lie `spacing` apart (meters): its width,
+/// `max(n · hair_width, min((1 − 1/n) · spacing, 2 · n · hair_width))` (the
+/// hairs spread over the space between the drawn strands, up to twice as wide
+/// as side by side, `codes::band::MAX_SPREAD`; one hair stays one hair), and
+/// its density, the fraction of it `n` hairs placed at random across it cover,
+/// `1 − (1 − hair_width / width)^n` (as `ribbon.vert`).
+pub fn strand_band(hair_width: f32, n: f32, spacing: f32) -> (f32, f32) {
+    let n = n.max(1.0);
+    let most = crate::codes::band::MAX_SPREAD as f32 * n * hair_width;
+    let width = (n * hair_width).max(((1.0 - 1.0 / n) * spacing).min(most));
+    let density = if width > 0.0 { 1.0 - (1.0 - hair_width / width).max(0.0).powf(n) } else { 0.0 };
+    (width, density)
 }
 
 /// Sub-samples per pixel side of [`composite_strands`] (16 per pixel).
@@ -175,11 +193,17 @@ struct ScreenTriangle {
     columns: (u32, u32),
 }
 
+/// Width and density of `scene`'s bands at `t` along the hair ([`strand_band`]).
+fn band_at(scene: &CompositeScene<'_>, t: f32) -> (f32, f32) {
+    let hair_width = scene.widths.0 + (scene.widths.1 - scene.widths.0) * t;
+    let spacing = scene.band_spacing.0 + (scene.band_spacing.1 - scene.band_spacing.0) * t;
+    strand_band(hair_width, scene.represented_hairs, spacing)
+}
+
 /// The ribbon triangles of `scene` (the draw pass's camera-facing quads).
 fn screen_triangles(scene: &CompositeScene<'_>) -> Vec<ScreenTriangle> {
     let (w, h) = scene.extent;
     let n = COMPOSITE_SAMPLES as f32;
-    let n_hairs = scene.represented_hairs.max(1.0);
     let project = |p: Vec3| {
         let c = scene.view_proj * p.extend(1.0);
         let ndc = c.truncate() / c.w;
@@ -194,7 +218,8 @@ fn screen_triangles(scene: &CompositeScene<'_>) -> Vec<ScreenTriangle> {
             for (i, v) in [seg[0], seg[1]].into_iter().enumerate() {
                 let p = v.truncate();
                 let side = dir.cross(scene.camera - p).try_normalize().unwrap_or(Vec3::X);
-                let half = 0.5 * n_hairs * (scene.widths.0 + (scene.widths.1 - scene.widths.0) * v.w);
+                let (band, _) = band_at(scene, v.w);
+                let half = 0.5 * band;
                 for (k, s) in [-1.0, 1.0].into_iter().enumerate() {
                     let (xy, z, cw) = project(p + side * half * s);
                     corners[2 * i + k] = (xy, z, cw, v.w);
@@ -232,8 +257,9 @@ fn screen_triangles(scene: &CompositeScene<'_>) -> Vec<ScreenTriangle> {
 
 /// The exact transparent image of `scene` (the ground truth of the transparency
 /// modes): every segment of every hair becomes the draw pass's camera-facing
-/// quad of its true width (a band `represented_hairs` widths wide, of opacity
-/// `opacity` times the band's density), every quad is point-sampled at 4×4
+/// quad of its true width (a band `represented_hairs` widths wide or the
+/// strands' spacing where that is wider, of opacity `opacity` times the band's
+/// density at the sample, [`strand_band`]), every quad is point-sampled at 4×4
 /// samples per pixel with perspective-correct t, each sample's fragments are
 /// sorted by depth and composited front to back over the background, and the
 /// samples of a pixel are averaged. Linear RGB and hair alpha, rows from the top.
@@ -252,8 +278,6 @@ fn composite_on(scene: &CompositeScene<'_>, threads: usize) -> Vec<glam::Vec4> {
         return Vec::new();
     }
     let n = COMPOSITE_SAMPLES;
-    let n_hairs = scene.represented_hairs.max(1.0);
-    let alpha = scene.opacity * (1.0 - (1.0 - 1.0 / n_hairs).powf(n_hairs));
     let triangles = screen_triangles(scene);
     let band_samples = BAND_ROWS * n;
     let bands = h.div_ceil(BAND_ROWS).max(1);
@@ -269,7 +293,7 @@ fn composite_on(scene: &CompositeScene<'_>, threads: usize) -> Vec<glam::Vec4> {
     std::thread::scope(|s| {
         for _ in 0..threads {
             s.spawn(|| {
-                let mut samples: Vec<Vec<(f32, Vec3)>> = vec![Vec::new(); (w * n * band_samples) as usize];
+                let mut samples: Vec<Vec<Fragment>> = vec![Vec::new(); (w * n * band_samples) as usize];
                 // The lock is released as soon as a band is taken (the guard is
                 // consumed by the closure). A poisoned lock means another band
                 // panicked; that panic is re-raised by the scope.
@@ -279,13 +303,16 @@ fn composite_on(scene: &CompositeScene<'_>, threads: usize) -> Vec<glam::Vec4> {
                     for &i in list {
                         rasterize(&triangles[i as usize], top, top + band_samples - 1, w * n, scene, &mut samples);
                     }
-                    resolve_band(&mut samples, pixels, w, alpha, scene.background);
+                    resolve_band(&mut samples, pixels, w, scene.background);
                 }
             });
         }
     });
     image
 }
+
+/// A sample's fragment: depth, linear colour, alpha.
+type Fragment = (f32, Vec3, f32);
 
 /// Adds the fragments of `t` in sample rows `top..=bottom` to `samples` (rows
 /// from `top`, `row_len` samples each).
@@ -295,7 +322,7 @@ fn rasterize(
     bottom: u32,
     row_len: u32,
     scene: &CompositeScene<'_>,
-    samples: &mut [Vec<(f32, Vec3)>],
+    samples: &mut [Vec<Fragment>],
 ) {
     let n = COMPOSITE_SAMPLES as f32;
     let c = &t.corners;
@@ -319,22 +346,23 @@ fn rasterize(
             if !(0.0..=1.0).contains(&depth) {
                 continue;
             }
-            samples[((sy - top) * row_len + sx) as usize].push((depth, (scene.color)(along)));
+            let alpha = scene.opacity * band_at(scene, along).1;
+            samples[((sy - top) * row_len + sx) as usize].push((depth, (scene.color)(along), alpha));
         }
     }
 }
 
 /// Sorts and composites each sample of a band and averages them into `pixels`
 /// (the band's rows of the image), leaving `samples` empty for the next band.
-fn resolve_band(samples: &mut [Vec<(f32, Vec3)>], pixels: &mut [glam::Vec4], w: u32, alpha: f32, background: Vec3) {
+fn resolve_band(samples: &mut [Vec<Fragment>], pixels: &mut [glam::Vec4], w: u32, background: Vec3) {
     let n = COMPOSITE_SAMPLES;
     let rows = pixels.len() as u32 / w;
     for (index, fragments) in samples.iter_mut().enumerate().take((rows * n * w * n) as usize) {
         fragments.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut sum = Vec3::ZERO;
         let mut transmittance = 1.0;
-        for (_, c) in fragments.iter() {
-            sum += transmittance * alpha * *c;
+        for &(_, c, alpha) in fragments.iter() {
+            sum += transmittance * alpha * c;
             transmittance *= 1.0 - alpha;
         }
         fragments.clear();
@@ -363,27 +391,79 @@ pub fn linear_rgb(rgba8: &[u8]) -> Vec<Vec3> {
 /// (the hair); and how many pixels that is. `None` when no pixel has hair or
 /// the sizes differ.
 pub fn srgb_error(image: &[Vec3], reference: &[Vec3], background: Vec3) -> Option<(f64, usize)> {
+    srgb_error_stats(image, reference, background).map(|e| (e.mean, e.pixels))
+}
+
+/// How far an image is from a reference over its hair pixels ([`srgb_error_stats`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageError {
+    /// Mean absolute difference per pixel (the mean of its three channels), 8-bit sRGB steps.
+    pub mean: f64,
+    /// The 95th percentile of the per-pixel differences (nearest rank), steps.
+    pub p95: f64,
+    /// Hair pixels compared.
+    pub pixels: usize,
+}
+
+/// The per-pixel absolute difference of two linear RGB images in 8-bit sRGB
+/// steps (the mean over the three channels), over the pixels where either
+/// differs from `background` by more than one step (the hair): its mean and
+/// 95th percentile. `None` when no pixel has hair or the sizes differ.
+pub fn srgb_error_stats(image: &[Vec3], reference: &[Vec3], background: Vec3) -> Option<ImageError> {
     if image.len() != reference.len() {
         return None;
     }
     let srgb = |c: f32| if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 } * 255.0;
     let background = background.to_array().map(srgb);
-    let mut sum = 0.0;
-    let mut count = 0usize;
+    let mut errors = Vec::new();
     for (a, b) in image.iter().zip(reference) {
         let (a, b) = (a.to_array().map(srgb), b.to_array().map(srgb));
         let hair = (0..3).any(|i| (a[i] - background[i]).abs() > 1.0 || (b[i] - background[i]).abs() > 1.0);
         if hair {
-            sum += (0..3).map(|i| f64::from((a[i] - b[i]).abs())).sum::<f64>() / 3.0;
-            count += 1;
+            errors.push((0..3).map(|i| f64::from((a[i] - b[i]).abs())).sum::<f64>() / 3.0);
         }
     }
-    (count > 0).then(|| (sum / count as f64, count))
+    if errors.is_empty() {
+        return None;
+    }
+    let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+    errors.sort_by(f64::total_cmp);
+    // Nearest rank: the smallest difference at least 95 % of the pixels do not exceed.
+    let rank = ((0.95 * errors.len() as f64).ceil() as usize).clamp(1, errors.len());
+    Some(ImageError { mean, p95: errors[rank - 1], pixels: errors.len() })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The error's figures over hair pixels only: 20 hair pixels differing by
+    /// 0..=19 steps (sRGB-exact values), background pixels equal in both left out.
+    #[test]
+    fn image_error_counts_hair_pixels_with_mean_and_p95() {
+        let linear = |v: f32| {
+            let c = v / 255.0;
+            if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            }
+        };
+        let background = Vec3::splat(linear(10.0));
+        let mut image = vec![background; 30];
+        let mut reference = vec![background; 30];
+        for i in 0..20 {
+            reference[i] = Vec3::splat(linear(100.0));
+            image[i] = Vec3::splat(linear(100.0 + i as f32));
+        }
+        let e = srgb_error_stats(&image, &reference, background).expect("hair");
+        assert_eq!(e.pixels, 20);
+        assert!((e.mean - 9.5).abs() < 1e-3, "{e:?}");
+        assert!((e.p95 - 18.0).abs() < 1e-3, "19 of 20 differ by at most 18: {e:?}");
+        assert_eq!(srgb_error(&image, &reference, background).map(|e| e.1), Some(20));
+        assert!(srgb_error_stats(&[background], &[background], background).is_none(), "no hair");
+        assert!(srgb_error_stats(&image, &reference[1..], background).is_none(), "sizes differ");
+    }
 
     /// Crossing hairs over several bands: one thread and three give the same
     /// image to the bit, and every band has hair in it.
@@ -415,6 +495,7 @@ mod tests {
             extent: (40, 30),
             widths: (0.01, 0.004),
             represented_hairs: 3.0,
+            band_spacing: (0.02, 0.05),
             opacity: 0.7,
             color: &color,
             background: Vec3::splat(0.1),

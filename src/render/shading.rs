@@ -238,10 +238,16 @@ pub struct HairMaterial {
     /// Opacity of one strand where it covers a whole pixel, for transparent hair
     /// (0..=1). Default: 0.8.
     pub opacity: f32,
-    /// Real hairs each drawn strand stands for (1..=10,000), for transparent hair:
-    /// the strand is drawn as a band n hair widths wide, whose alpha where it
-    /// covers fraction c of a pixel is `opacity · c · (1 − (1 − 1/n)^n)` (the
-    /// part of the band n hairs placed at random cover). Default: 1.
+    /// Real hairs each drawn strand stands for (1..=10,000; more where level of
+    /// detail draws fewer strands, [`super::Renderer::strand_hairs`]). In every
+    /// mode a strand's opacity-map fragments add n hairs' opacity
+    /// ([`super::ShadowParams::opacity`]). For transparent hair the strand is
+    /// drawn as a band n hair widths wide, or (1 − 1/n) × the drawn strands'
+    /// spacing where that is wider ([`super::Renderer::strand_spacing`]), up to
+    /// twice n hair widths, whose
+    /// alpha where it covers fraction c of a pixel is `opacity · c · density`,
+    /// the density being the part of the band n hairs placed at random cover
+    /// ([`super::reference::strand_band`]). Default: 1.
     pub represented_hairs: f32,
     /// Shading model. Default: [`ShadingMode::KajiyaKay`].
     pub shading: ShadingMode,

@@ -340,6 +340,7 @@ fn cases(f: &Fixtures, out: &Path) -> Vec<Case> {
                 "--level",
                 "--distance",
                 "--sorted-fragments",
+                "--fragments-per-pixel",
                 "--shadow-resolution",
                 "--scale",
                 "--points",

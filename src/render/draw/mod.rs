@@ -269,7 +269,11 @@ impl Renderer {
                 mode != Transparency::Off,
                 &self.material,
                 &self.lights,
-                self.detail.width_scale,
+                StrandFootprint {
+                    width_scale: self.detail.width_scale,
+                    hairs: self.strand_hairs(),
+                    spacing: self.strand_spacing(),
+                },
                 self.hair_counts(),
                 camera,
                 drawn.extent,
@@ -346,27 +350,35 @@ impl Renderer {
 const HOST_ATTACHMENT_WRITES: &[AccessKind] =
     &[AccessKind::ColorAttachmentWrite, AccessKind::DepthAttachmentWrite, AccessKind::AnyTransferWrite];
 
-/// Fraction of a band of `n` hair widths that `n` hairs placed at random across
-/// it cover: 1 − (1 − 1/n)^n (1 for one hair, toward 1 − 1/e for many).
-pub(super) fn band_density(n: f32) -> f32 {
-    let n = n.max(1.0);
-    1.0 - (1.0 - 1.0 / n).powf(n)
+/// How the frame's drawn strands stand for the real hairs.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct StrandFootprint {
+    /// Width factor of opaque ribbons at the frame's detail.
+    pub width_scale: f32,
+    /// Real hairs each drawn strand stands for (transparent bands).
+    pub hairs: f32,
+    /// Spacing of the drawn strands at the root and at the tip, m.
+    pub spacing: (f32, f32),
 }
 
 /// The draw's uniform block for `hairs` hairs of `per_hair` vertices with
-/// `material`, `lights` and the width factor of the frame's detail, seen by
-/// `camera` into a target of `extent`; `transparent` strands are drawn with
-/// their coverage (no least width).
+/// `material`, `lights` and the frame's strand `footprint`, seen by `camera`
+/// into a target of `extent`; `transparent` strands are drawn with their
+/// coverage (no least width, bands standing for the footprint's hairs),
+/// opaque ones at the footprint's width factor.
 pub(super) fn draw_params(
     transparent: bool,
     material: &HairMaterial,
     lights: &[GpuLight],
-    width_scale: f32,
+    footprint: StrandFootprint,
     (hairs, per_hair): (u32, u32),
     camera: &Camera,
     extent: vk::Extent2D,
 ) -> DrawParams {
     let m = material;
+    // Transparent bands stand for the hairs level of detail leaves out; opaque
+    // ribbons widen instead.
+    let width_scale = if transparent { 1.0 } else { footprint.width_scale };
     let mut gpu_lights = [GpuLight::default(); MAX_LIGHTS];
     gpu_lights[..lights.len()].copy_from_slice(lights);
     // World size of one pixel at distance 1.
@@ -380,12 +392,8 @@ pub(super) fn draw_params(
         secondary: m.secondary_color.extend(m.secondary_exponent).to_array(),
         shifts: [m.primary_shift, m.secondary_shift, m.shift_jitter, m.highlight_breakup],
         widths: [m.root_width * width_scale, m.tip_width * width_scale, m.least_pixel_width, 0.0],
-        coverage: [
-            if transparent { 1.0 } else { 0.0 },
-            m.opacity,
-            m.represented_hairs,
-            band_density(m.represented_hairs),
-        ],
+        coverage: [if transparent { 1.0 } else { 0.0 }, m.opacity, footprint.hairs, 0.0],
+        band: [footprint.spacing.0, footprint.spacing.1, 0.0, 0.0],
         counts: [hairs, per_hair, lights.len() as u32, m.shading.code()],
         lights: gpu_lights,
     }

@@ -34,7 +34,7 @@ use crate::vk::device::Device;
 use opacity_maps::OpacityMaps;
 use volume::VolumeShadows;
 
-pub(crate) use opacity_maps::light_map;
+pub(crate) use opacity_maps::{light_map, ShadowFootprint};
 
 /// Most lights that cast shadows.
 pub const MAX_SHADOW_MAPS: usize = crate::limits::MAX_SHADOW_MAPS as usize;
@@ -109,16 +109,21 @@ pub struct ShadowParams {
     /// Where the three layers end behind the depth at which the hair starts, meters
     /// (increasing, in (0, 1000]). Default: 0.01, 0.03, 0.08.
     pub layers: [f32; 3],
-    /// Opacity one strand fragment adds (0..=1). Default: 0.05.
+    /// Opacity one hair's fragment adds (0..=1); a drawn strand standing for n
+    /// hairs ([`super::Renderer::strand_hairs`]) adds n times it. Default: 0.05.
     pub opacity: f32,
     /// Extinction k of transmittance = exp(−k · opacity) (0..=100). Default: 1.
     pub extinction: f32,
-    /// Radius of the percentage-closer filter, texels (0..=3; 1 = 3 × 3). Default: 1.
+    /// Radius of the filter averaging the opacity around a lookup, texels (0..=3;
+    /// 1 = 3 × 3). Where each drawn strand stands for n > 1 hairs, a map's filter
+    /// reaches the neighbouring strands: its radius is at least (1 − 1/n) × the
+    /// strands' spacing half-way along them ([`super::Renderer::strand_spacing`]),
+    /// up to 3 texels. Default: 1.
     pub pcf_radius: u32,
     /// Density volume: shadowing cross-section of one simulated particle, m²
     /// (transmittance = exp(−σ ∫ particles per m³ ds); ≥ 0). It matches deep opacity
-    /// maps when σ = extinction · opacity · hairs per key · map texel size · key
-    /// segment length (0..=1000). Default: 1e-4 (the thesis scene at the defaults).
+    /// maps when σ = extinction · opacity · represented hairs · hairs per key · map
+    /// texel size · key segment length (0..=1000). Default: 1e-4 (the thesis scene at the defaults).
     pub volume_cross_section: f32,
     /// Density volume: ray-marching step, cells (0.1..=2). Default: 0.5.
     pub volume_step: f32,
@@ -233,9 +238,19 @@ const SHADOW_READERS: &[AccessKind] = &[
     AccessKind::ComputeSampledRead,
 ];
 
+/// The hairs a frame draws: how many, of how many vertices, and what each
+/// stands for.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct DrawnHairs {
+    /// Hairs and vertices per hair.
+    pub counts: (u32, u32),
+    /// The real hairs each stands for and their spacing.
+    pub footprint: ShadowFootprint,
+}
+
 /// The hair's bounding sphere in the world at the frame: what a map is fitted to.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Bounds {
+pub(crate) struct Bounds {
     pub centre: Vec3,
     pub radius: f32,
 }
@@ -305,8 +320,8 @@ impl Shadows {
     }
 
     /// Records the frame's shadows: the uniforms for `lights` and the casters,
-    /// then the opacity maps of `hairs` hairs of `per_hair` vertices fitted to
-    /// `bounds`, then the density-volume transmittance from `sim`'s volume.
+    /// then the opacity maps of the `drawn` hairs fitted to `bounds`, then the
+    /// density-volume transmittance from `sim`'s volume.
     ///
     /// # Safety
     /// `cmd` is a recording command buffer of this device outside a render pass,
@@ -317,9 +332,10 @@ impl Shadows {
         sim: &KeyHairs<'_>,
         lights: &[GpuLight],
         bounds: Bounds,
-        (hairs, per_hair): (u32, u32),
+        drawn: DrawnHairs,
         timing: Timing<'_>,
     ) -> Result<()> {
+        let DrawnHairs { counts: (hairs, per_hair), footprint } = drawn;
         let params = &self.params;
         let mut uniforms = no_shadows();
         let (mut tile, mut slot) = (0, 0);
@@ -335,7 +351,7 @@ impl Shadows {
             uniforms.maps[k] = match caster.method {
                 ShadowMethod::DeepOpacity => {
                     tile += 1;
-                    light_map(gpu, caster.light, bounds.centre, bounds.radius, params, tile - 1)?
+                    light_map(gpu, caster.light, bounds, params, tile - 1, footprint)?
                 }
                 ShadowMethod::DensityVolume => {
                     slot += 1;

@@ -18,7 +18,7 @@ use ash::vk;
 use glam::{Vec3, Vec4};
 
 use super::atlas::{ShadowAtlas, DEPTH_FORMAT, Z0_FORMAT};
-use super::{ShadowParams, SHADOW_ATLAS_FORMAT};
+use super::{Bounds, ShadowParams, SHADOW_ATLAS_FORMAT};
 use crate::codes::shadow_kind;
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuLight, GpuShadowMap, GpuShadowParams};
@@ -164,23 +164,54 @@ impl OpacityMaps {
     }
 }
 
-/// The light's map for hair within the sphere (`centre`, `radius`): matrices
-/// fitted to the sphere, layers and filter from `params`, atlas tile `index`.
+/// How the drawn strands stand for real hairs, as the opacity maps see them.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ShadowFootprint {
+    /// Real hairs each drawn strand stands for.
+    pub hairs: f32,
+    /// Spacing of the drawn strands half-way along them, m.
+    pub spacing: f32,
+}
+
+impl ShadowFootprint {
+    /// One drawn strand per hair: the maps as `ShadowParams` set them.
+    #[cfg(test)]
+    pub(crate) const ONE_HAIR: ShadowFootprint = ShadowFootprint { hairs: 1.0, spacing: 0.0 };
+
+    /// The filter radius of a map whose texels are `texel` m wide: a lookup
+    /// reaches the neighbouring drawn strands, whose hairs spread over
+    /// (1 − 1/n) × spacing (as the transparent bands), up to 3 texels; at
+    /// least `radius`.
+    pub(crate) fn filter_radius(&self, radius: u32, texel: f32) -> u32 {
+        let spread = (1.0 - 1.0 / self.hairs.max(1.0)) * self.spacing;
+        let wanted = if texel > 0.0 { (spread / texel).round() } else { 0.0 };
+        radius.max(wanted.clamp(0.0, 3.0) as u32)
+    }
+}
+
+/// The light's map for hair within `bounds`: matrices fitted to the sphere,
+/// layers and filter from `params` (the filter widened for the `footprint`'s
+/// spacing), atlas tile `index`; each fragment of a strand standing for
+/// `footprint.hairs` hairs adds their opacity, `params.opacity · hairs`.
 pub(crate) fn light_map(
     light: &GpuLight,
     light_index: usize,
-    centre: Vec3,
-    radius: f32,
+    bounds: Bounds,
     params: &ShadowParams,
     index: usize,
+    footprint: ShadowFootprint,
 ) -> Result<GpuShadowMap> {
+    let Bounds { centre, radius } = bounds;
     let kind = light.kind();
     let direction = light.direction().normalize_or_zero();
     let radius = radius.max(1e-4);
+    // World size of a texel at the hair's centre.
+    let texel;
     let (view, projection) = match kind {
         0 => {
             let eye = centre - direction * (2.0 * radius);
             let view = glam::camera::rh::view::look_at_mat4(eye, centre, up_for(direction));
+            texel = 2.0 * radius / params.resolution as f32;
             (
                 view,
                 glam::camera::rh::proj::vulkan::orthographic(
@@ -203,6 +234,7 @@ pub(crate) fn light_map(
             let aim = if distance > 1e-6 { to_centre / distance } else { direction };
             let near = (distance - radius).max(radius * 0.01);
             let view = glam::camera::rh::view::look_at_mat4(eye, eye + aim, up_for(aim));
+            texel = 2.0 * distance * half.tan() / params.resolution as f32;
             (view, glam::camera::rh::proj::vulkan::perspective(2.0 * half, 1.0, near, distance + radius))
         }
         _ => {
@@ -220,7 +252,12 @@ pub(crate) fn light_map(
         view_z: (-row).to_array(),
         layers: Vec4::new(params.layers[0], params.layers[1], params.layers[2], params.extinction).to_array(),
         tile: params.tile(index),
-        params: [params.opacity, params.pcf_radius as f32, shadow_kind::DEEP_OPACITY as f32, 0.0],
+        params: [
+            params.opacity * footprint.hairs,
+            footprint.filter_radius(params.pcf_radius, texel) as f32,
+            shadow_kind::DEEP_OPACITY as f32,
+            0.0,
+        ],
     })
 }
 

@@ -119,7 +119,15 @@ fn build(spec: Spec, params: ShadowParams, lights: &[Light]) -> Slab {
             unsafe { renderer.record_shadows(cmd, &sim, None) }.expect("record")
         })
         .expect("submit");
-    let map = light_map(&lights[0].to_gpu().expect("light"), 0, centre, radius, &params, 0).expect("map");
+    let map = light_map(
+        &lights[0].to_gpu().expect("light"),
+        0,
+        Bounds { centre, radius },
+        &params,
+        0,
+        ShadowFootprint::ONE_HAIR,
+    )
+    .expect("map");
     let rows = (-spec.rows / 2..spec.rows / 2).map(|r| (r as f32 + 0.5) * texel).collect();
     let particles = all.into_iter().flatten().collect();
     Slab { gpu, renderer, sim, map, params, rows, texel, particles }
@@ -393,6 +401,60 @@ fn pcf_softens_only_the_shadow_edge() {
     eprintln!("edge row: pcf 0 {}, pcf 1 {} (exact {exact})", at_edge[0], at_edge[1]);
     assert!((at_edge[0] - exact).abs() < 1e-4, "unfiltered edge {}", at_edge[0]);
     assert!(at_edge[1] > exact + 0.05 && at_edge[1] < 1.0 - 0.05, "filtered edge {}", at_edge[1]);
+}
+
+/// The filter averages opacity, not transmittance: at the edge row a 3 × 3
+/// filter sees 6 covered texels of 9, so the light passes as through 6/9 of
+/// the slab's strands (exp(−k · 6/9 · opacity)), darker than the mean of the
+/// texels' transmittances ((6 · t + 3) / 9).
+#[test]
+fn the_filter_averages_opacity() {
+    let (spec, params) = slab_params(vec![0.into()], 1);
+    let s = build(spec, params, &[ALONG_Z]);
+    let edge = behind(&s, 7, Probe::Map(0));
+    let strands = (PER_ROW * SHEETS) as f32;
+    let averaged_opacity = (-1.5f32 * 0.04 * strands * 6.0 / 9.0).exp();
+    let averaged_transmittance = (6.0 * through(PER_ROW * SHEETS) + 3.0) / 9.0;
+    eprintln!("edge {edge}: opacity averaged {averaged_opacity}, transmittance averaged {averaged_transmittance}");
+    assert!((edge - averaged_opacity).abs() < 1e-4, "edge {edge} vs {averaged_opacity}");
+}
+
+/// A drawn strand standing for n hairs (`HairMaterial::represented_hairs`)
+/// adds n hairs' opacity: behind the slab the light passes as through n times
+/// its strands.
+#[test]
+fn strands_standing_for_several_hairs_shadow_as_many() {
+    let (spec, params) = slab_params(vec![0.into()], 0);
+    let mut s = build(spec, params, &[ALONG_Z]);
+    let one = behind(&s, 4, Probe::Map(0));
+    assert!((one - through(PER_ROW * SHEETS)).abs() < 1e-4, "{one}");
+    let material = crate::render::HairMaterial { represented_hairs: 3.0, ..crate::render::HairMaterial::default() };
+    s.renderer.set_material(&material).expect("material");
+    s.gpu
+        .ctx()
+        .run_commands("shadows", |cmd| {
+            // SAFETY: a recording command buffer of this device after the prepare.
+            unsafe { s.renderer.record_shadows(cmd, &s.sim, None) }.expect("record")
+        })
+        .expect("submit");
+    let three = behind(&s, 4, Probe::Map(0));
+    let expected = through(3 * PER_ROW * SHEETS);
+    assert!((three - expected).abs() < 1e-3 * expected.max(1e-3), "{three} vs {expected}");
+}
+
+/// The filter reaches the neighbouring drawn strands where each stands for
+/// several hairs: its radius is (1 − 1/n) × spacing in texels, rounded, up to
+/// 3, never below the one asked for; one hair per strand keeps that one.
+#[test]
+fn the_filter_widens_for_sparse_strands_only() {
+    let footprint = |hairs: f32, spacing: f32| ShadowFootprint { hairs, spacing };
+    assert_eq!(footprint(1.0, 0.05).filter_radius(1, 0.001), 1, "one hair per strand");
+    assert_eq!(footprint(1.0, 0.05).filter_radius(0, 0.001), 0);
+    assert_eq!(footprint(4.0, 0.002).filter_radius(0, 0.001), 2, "0.75 × 2 mm over 1 mm texels");
+    assert_eq!(footprint(4.0, 0.002).filter_radius(3, 0.001), 3, "never below the radius asked for");
+    assert_eq!(footprint(73.0, 0.0056).filter_radius(1, 0.00186), 3);
+    assert_eq!(footprint(73.0, 0.5).filter_radius(1, 0.001), 3, "at most 3");
+    assert_eq!(footprint(73.0, 0.5).filter_radius(1, 0.0), 1, "a degenerate map");
 }
 
 /// The atlas full: four lights (two directional, a spot, a directional) each

@@ -58,6 +58,10 @@ pub struct SceneArgs {
     /// Fragments sorted exactly per pixel by --transparency exact (1..=32) [default: 8].
     #[arg(long)]
     pub sorted_fragments: Option<u32>,
+    /// Fragment pool of --transparency exact, fragments per pixel (0.01..=256;
+    /// fragments beyond it are blended unsorted) [default: 8].
+    #[arg(long)]
+    pub fragments_per_pixel: Option<f32>,
     /// No self-shadowing (by default the two spot lights cast deep opacity maps).
     #[arg(long)]
     pub no_shadows: bool,

@@ -14,7 +14,7 @@ use vkhair::groom::Groom;
 use vkhair::render::Camera;
 use vkhair::sim::{motion, Collider};
 
-pub use parameters::{make_renderer, parameters};
+pub use parameters::{make_renderer, parameters, FULL_HEAD_HAIRS};
 
 use crate::args::input::Scaled;
 use crate::args::scene::SceneArgs;

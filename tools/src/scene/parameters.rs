@@ -52,6 +52,9 @@ pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
     if let Some(k) = a.sorted_fragments {
         r.oit.sorted_fragments = k;
     }
+    if let Some(f) = a.fragments_per_pixel {
+        r.oit.fragments_per_pixel = f;
+    }
     if let Some(t) = a.transparency {
         r.transparency = t;
     }

@@ -29,7 +29,24 @@ pub struct FrameFigures {
     pub transparency_bytes: u64,
     /// The last frame drawn once more unlit, when asked for.
     pub unlit: Option<UnlitFrame>,
+    /// The last frame as drawn (linear RGB per pixel, rows from the top), when
+    /// asked for.
+    pub lit: Option<Vec<Vec3>>,
 }
+
+/// What [`bench_frames`] keeps of its last frame besides the figures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Keep {
+    /// Nothing.
+    Figures,
+    /// The frame drawn once more unlit ([`FrameFigures::unlit`]).
+    Unlit,
+    /// The frame as drawn ([`FrameFigures::lit`]).
+    Lit,
+}
+
+/// Background of the bench's lit frames (linear).
+pub const LIT_BACKGROUND: Vec3 = Vec3::splat(0.02);
 
 /// Albedo at the root and the tip of the unlit frame.
 const UNLIT_ROOT: Vec3 = Vec3::new(0.9, 0.2, 0.05);
@@ -51,6 +68,8 @@ pub struct UnlitFrame {
     camera: Vec3,
     extent: (u32, u32),
     material: HairMaterial,
+    /// The drawn strands' spacing at the root and tip (m).
+    spacing: (f32, f32),
 }
 
 impl UnlitFrame {
@@ -65,6 +84,7 @@ impl UnlitFrame {
             extent: self.extent,
             widths: (self.material.root_width, self.material.tip_width),
             represented_hairs: self.material.represented_hairs,
+            band_spacing: self.spacing,
             opacity: self.material.opacity,
             color: &color,
             background: UNLIT_BACKGROUND,
@@ -127,20 +147,20 @@ fn draw_unlit(
         camera: camera.position(),
         extent: (w, h),
         material,
+        spacing: renderer.strand_spacing(),
     })
 }
 
 /// Renders `samples` frames (after two warm-up frames) of the scene `render`
 /// would draw with `args` (its scene flags, e.g. `["--width", "1280"]`) and
 /// the simulation knobs `sim`, the simulation on the same queue, and measures
-/// the render passes; with `unlit`, then draws the last state once more unlit
-/// ([`FrameFigures::unlit`]).
+/// the render passes; then keeps what `keep` asks for of the last frame.
 pub fn bench_frames(
     ctx: &GpuContext,
     args: &[&str],
     sim: &SimArgs,
     samples: usize,
-    unlit: bool,
+    keep: Keep,
 ) -> Result<FrameFigures, Error> {
     #[derive(clap::Parser)]
     struct Wrapper {
@@ -173,6 +193,7 @@ pub fn bench_frames(
         transparency_bytes: renderer
             .transparency_memory(vkhair::ash::vk::Extent2D { width: a.width, height: a.height }),
         unlit: None,
+        lit: None,
     };
     for frame in 0..samples + 2 {
         let heads: Vec<RigidTransform> =
@@ -190,7 +211,7 @@ pub fn bench_frames(
                     let before = ctx.recorded_work();
                     renderer.record_prepare(cmd, &sim, Some(&camera), Some(&mut profiler))?;
                     renderer.record_shadows(cmd, &sim, Some(&mut profiler))?;
-                    offscreen.record_clear(cmd, Vec3::splat(0.02));
+                    offscreen.record_clear(cmd, LIT_BACKGROUND);
                     renderer.record_draw(cmd, frame as u64, &offscreen.target(), &camera, Some(&mut profiler))?;
                     render_work = ctx.recorded_work() - before;
                     Ok(())
@@ -206,8 +227,12 @@ pub fn bench_frames(
             figures.work = render_work;
         }
     }
-    if unlit {
-        figures.unlit = Some(draw_unlit(ctx, &sim, &mut renderer, &offscreen, &camera, samples as u64 + 2)?);
+    match keep {
+        Keep::Figures => {}
+        Keep::Unlit => {
+            figures.unlit = Some(draw_unlit(ctx, &sim, &mut renderer, &offscreen, &camera, samples as u64 + 2)?)
+        }
+        Keep::Lit => figures.lit = Some(linear_rgb(&offscreen.read_rgba8()?)),
     }
     Ok(figures)
 }

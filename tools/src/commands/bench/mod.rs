@@ -28,13 +28,14 @@ use crate::chart::plot_file;
 use crate::destinations::{self, Kind, Output};
 use crate::output::Error;
 use crate::say;
-use frames::bench_frames;
+use frames::{bench_frames, Keep};
 use measure::{fitted_exponent, measure_sim, Samples, SimCase, SimFigures};
 use modes::{default_exact, frame_ms, render_rows, write_modes, OFF};
 
 mod frames;
 mod measure;
 mod modes;
+mod truth;
 
 /// Peak memory bandwidth of a few GPUs, bytes per second (vendors' figures): the
 /// physical bound of a stage that moves its bytes once.
@@ -360,7 +361,7 @@ fn scaling(b: &Bench<'_>) -> Result<Vec<Curve>, Error> {
     let mut curve = Curve { axis: "resolution (render frame; thesis)", unit: "pixels", points: Vec::new() };
     for &(w, h) in sizes {
         let (w, h) = (w.to_string(), h.to_string());
-        let f = bench_frames(ctx, &["--width", &w, "--height", &h], &a.sim, n, false)?;
+        let f = bench_frames(ctx, &["--width", &w, "--height", &h], &a.sim, n, Keep::Figures)?;
         curve.points.push((f.pixels as f64, clock.figure(&f.gpu, &f.wall).median(), f64::NAN));
     }
     curves.push(curve);
@@ -452,6 +453,7 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     let (scenes, skipped) = bench_scenes(a)?;
     let mut rows = Vec::new();
     let mut modes = Vec::new();
+    let mut truth = None;
     for s in &scenes {
         say!(
             "{}: {} key hairs × {} points",
@@ -474,6 +476,27 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
         rows.extend(sim_rows(&s.name, "sim, FLIP 32³", &f, clock, Some(&off)));
         if let Some(args) = &s.render_args {
             render_rows(&b, &s.name, args, &mut rows, &mut modes)?;
+            if s.name.starts_with("Sintel") {
+                if a.quick {
+                    say!(
+                        "{}: no ground-truth comparison in a --quick run (a full head of strands takes seconds)",
+                        s.name
+                    );
+                } else {
+                    let t = truth::against_full_head(&b, args, s.groom.strand_count())?;
+                    say!(
+                        "{}: the default frame ({} strands) against a full head ({} strands, one hair each): mean {:.1}, \
+                         p95 {:.1} 8-bit sRGB steps over {} hair pixels",
+                        s.name,
+                        t.default_strands,
+                        t.truth_strands,
+                        t.error.mean,
+                        t.error.p95,
+                        t.error.pixels
+                    );
+                    truth = Some(t);
+                }
+            }
         }
     }
     print_rows(&rows);
@@ -526,6 +549,13 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
             "frame_ms_exact": frame(thesis, &default_exact()),
             "sintel_frame_ms_off": frame(sintel, OFF),
             "sintel_frame_ms_exact": frame(sintel, &default_exact()),
+            "sintel_truth": truth.as_ref().map(|t| json!({
+                "mean_error": finite(t.error.mean),
+                "p95_error": finite(t.error.p95),
+                "hair_pixels": t.error.pixels,
+                "default_strands": t.default_strands,
+                "truth_strands": t.truth_strands,
+            })),
             "bandwidth_bytes_per_s": PEAK_BANDWIDTH.iter().map(|(n, b)| json!({"device": n, "bytes_per_s": b})).collect::<Vec<_>>(),
             "stages": rows.iter().map(Row::json).collect::<Vec<_>>(),
             "scaling": curves.iter().map(|c| {

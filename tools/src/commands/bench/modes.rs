@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Vec3, Vec4};
 
-use super::frames::bench_frames;
+use super::frames::{bench_frames, Keep};
 use super::{Bench, Row};
 use crate::output::Error;
 use crate::say;
@@ -47,7 +47,7 @@ pub(super) fn render_rows(
         if let Some(mode) = mode {
             with_mode.extend(["--transparency", mode, "--sorted-fragments", &k]);
         }
-        let f = bench_frames(ctx, &with_mode, &b.args.sim, samples, true)?;
+        let f = bench_frames(ctx, &with_mode, &b.args.sim, samples, Keep::Unlit)?;
         let mib = f.transparency_bytes as f64 / (1024.0 * 1024.0);
         let label = match mode {
             None => default_exact(),

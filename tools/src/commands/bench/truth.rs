@@ -1,0 +1,48 @@
+//! Sintel's default frame against its ground truth: a full head of thin
+//! strands, one hair each (`hairs_per_key` such that key hairs × it ≈ 100,000,
+//! level of detail off, a pool and K large enough that every fragment is
+//! sorted), the same simulated state and camera. The figure is the error of
+//! the default frame over hair pixels, as `render::reference::srgb_error_stats`.
+
+use vkhair::render::reference::{srgb_error_stats, ImageError};
+
+use super::frames::{bench_frames, Keep, LIT_BACKGROUND};
+use super::Bench;
+use crate::output::Error;
+use crate::scene::FULL_HEAD_HAIRS;
+
+/// The default frame of `args` (a render scene's flags) against its ground
+/// truth, and the strands each draws at full detail.
+pub struct TruthFigures {
+    pub error: ImageError,
+    pub default_strands: u64,
+    pub truth_strands: u64,
+}
+
+/// Renders the default frame of `args` and its ground truth (`key_hairs` key
+/// hairs grown to a full head) after the same steps, and compares them.
+pub fn against_full_head(b: &Bench<'_>, args: &[String], key_hairs: usize) -> Result<TruthFigures, Error> {
+    let base: Vec<&str> = args.iter().map(String::as_str).collect();
+    let default = bench_frames(b.ctx, &base, &b.args.sim, 1, Keep::Lit)?;
+    let per_key =
+        ((FULL_HEAD_HAIRS / key_hairs.max(1) as f32).round() as u32).clamp(1, vkhair::render::MAX_HAIRS_PER_KEY);
+    let per_key = per_key.to_string();
+    let mut truth_args = base.clone();
+    truth_args.extend([
+        "--hairs-per-key",
+        &per_key,
+        "--no-lod",
+        "--transparency",
+        "exact",
+        "--sorted-fragments",
+        "32",
+        "--fragments-per-pixel",
+        "24",
+    ]);
+    let truth = bench_frames(b.ctx, &truth_args, &b.args.sim, 1, Keep::Lit)?;
+    let (Some(image), Some(reference)) = (&default.lit, &truth.lit) else {
+        return Err("the bench kept no frame to compare".into());
+    };
+    let error = srgb_error_stats(image, reference, LIT_BACKGROUND).ok_or("the ground truth shows no hair")?;
+    Ok(TruthFigures { error, default_strands: default.hairs, truth_strands: truth.hairs })
+}
