@@ -406,17 +406,24 @@ fn pcf_softens_only_the_shadow_edge() {
 /// The filter averages opacity, not transmittance: at the edge row a 3 × 3
 /// filter sees 6 covered texels of 9, so the light passes as through 6/9 of
 /// the slab's strands (exp(−k · 6/9 · opacity)), darker than the mean of the
-/// texels' transmittances ((6 · t + 3) / 9).
+/// texels' transmittances ((6 · t + 3) / 9). At radius 2 the 5 × 5 box sees 15
+/// covered texels of 25.
 #[test]
 fn the_filter_averages_opacity() {
-    let (spec, params) = slab_params(vec![0.into()], 1);
-    let s = build(spec, params, &[ALONG_Z]);
-    let edge = behind(&s, 7, Probe::Map(0));
     let strands = (PER_ROW * SHEETS) as f32;
     let averaged_opacity = (-1.5f32 * 0.04 * strands * 6.0 / 9.0).exp();
     let averaged_transmittance = (6.0 * through(PER_ROW * SHEETS) + 3.0) / 9.0;
-    eprintln!("edge {edge}: opacity averaged {averaged_opacity}, transmittance averaged {averaged_transmittance}");
-    assert!((edge - averaged_opacity).abs() < 1e-4, "edge {edge} vs {averaged_opacity}");
+    let box_of_25 = (-1.5f32 * 0.04 * strands * 15.0 / 25.0).exp();
+    for (radius, expected) in [(1, averaged_opacity), (2, box_of_25)] {
+        let (spec, params) = slab_params(vec![0.into()], radius);
+        let s = build(spec, params, &[ALONG_Z]);
+        let edge = behind(&s, 7, Probe::Map(0));
+        eprintln!(
+            "radius {radius}: edge {edge}, expected {expected} (transmittance averaged over 3 × 3: \
+             {averaged_transmittance})"
+        );
+        assert!((edge - expected).abs() < 1e-4, "radius {radius}: edge {edge} vs {expected}");
+    }
 }
 
 /// A drawn strand standing for n hairs (`HairMaterial::represented_hairs`)
