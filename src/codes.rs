@@ -148,9 +148,10 @@ shader_codes! {
         /// patch's output: a one-frame `vkhair render` of Sintel at 64 hairs per
         /// key hair took 1.7 s at 4 lines per patch against 10.0 s at 64.
         LINES_PER_INSTANCE = 4,
-        /// Most hairs grown per key hair (or scalp triangle): 16 instances.
+        /// Most hairs grown per key hair (or scalp triangle): 256 instances of 4.
         /// Also the stride of the random seeds of interpolated hairs
-        /// (`key · MAX_HAIRS_PER_KEY + hair`), so no two hairs share one.
+        /// (`key · MAX_HAIRS_PER_KEY + hair`): distinct for the hairs of up to
+        /// 2^21 key hairs or scalp triangles (the hash takes twice the seed).
         MAX_HAIRS_PER_KEY = 1024,
     }
 

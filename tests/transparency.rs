@@ -170,10 +170,11 @@ fn sparse_strands_are_drawn_as_bands_spread_to_their_neighbours() {
     let spread = mae(&image, &reference_with(spacing));
     let unspread = mae(&image, &reference_with((0.0, 0.0)));
     println!("error against the spread bands {spread:.2}, against bands n hairs wide {unspread:.2} (8-bit sRGB steps)");
-    // lavapipe: 2.5 against 11.2 (the ribbons' joints overlap where the
-    // reference's quads meet edge to edge).
-    assert!(spread < 3.5, "{spread:.2}");
-    assert!(unspread > 3.0 * spread, "{unspread:.2} vs {spread:.2}");
+    // lavapipe: 2.5 to 3.0 against 11.2 to 11.4 (the ribbons' joints overlap
+    // where the reference's quads meet edge to edge, and beyond K = 32 the
+    // tail's order follows the atomics).
+    assert!(spread < 4.0, "{spread:.2}");
+    assert!(unspread > 2.5 * spread, "{unspread:.2} vs {spread:.2}");
 }
 
 #[test]

@@ -24,7 +24,7 @@ struct ShadowMap {
     vec4 layers;      // xyz ends of the three layers behind z0 (m), w extinction k
     vec4 tile;        // xy first texel of the tile in the atlas, zw its size (texels);
                       // volume maps: x first cell in the transmittance array
-    vec4 params;      // x opacity per strand fragment, y PCF radius (texels), z method (SHADOW_*), w unused
+    vec4 params;      // x opacity per drawn strand's fragment, y opacity filter radius (texels), z method (SHADOW_*), w unused
 };
 
 // The SHADOW_* methods are injected by build.rs from src/codes.rs.

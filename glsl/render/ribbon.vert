@@ -75,11 +75,10 @@ void main() {
     side = side_len > 1e-12 ? side / side_len : vec3(1.0, 0.0, 0.0);
     float width = mix(dp.widths.x, dp.widths.y, tan_t.w);
 #ifdef VKHAIR_COVERAGE
-    // A transparent strand standing for n hairs is a band of n hair widths, at
-    // least the strands' spacing.
+    // A transparent strand standing for n hairs: its band (reference::strand_band).
     float hair_width = width;
-    float n = dp.coverage.z;
-    float spread = (1.0 - 1.0 / max(n, 1.0)) * mix(dp.band.x, dp.band.y, tan_t.w);
+    float n = max(dp.coverage.z, 1.0);
+    float spread = (1.0 - 1.0 / n) * mix(dp.band.x, dp.band.y, tan_t.w);
     width = max(n * hair_width, min(spread, float(BAND_MAX_SPREAD) * n * hair_width));
     float density = width > 0.0 ? 1.0 - pow(max(1.0 - hair_width / width, 0.0), n) : 0.0;
     float pixel = max(dp.camera.w * distance_to_camera, 1e-12);

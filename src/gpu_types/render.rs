@@ -112,8 +112,8 @@ pub(crate) struct DrawParams {
     /// 1 for transparent strands (coverage, no least width), opacity, hairs a
     /// strand stands for.
     pub coverage: [f32; 4],
-    /// Spacing of the drawn strands at the root and at the tip (m): a
-    /// transparent strand's band is at least this wide.
+    /// Spacing of the drawn strands at the root and at the tip (m), which a
+    /// transparent strand's band spreads over (`reference::strand_band`).
     pub band: [f32; 4],
     /// Hairs, vertices per hair, lights.
     pub counts: [u32; 4],
@@ -176,7 +176,8 @@ pub(crate) struct GpuShadowMap {
     pub layers: [f32; 4],
     /// xy first texel of the tile, zw its size (texels).
     pub tile: [f32; 4],
-    /// x opacity per strand fragment, y PCF radius (texels).
+    /// x opacity per drawn strand's fragment (per hair × hairs it stands for),
+    /// y radius of the opacity-averaging filter (texels).
     pub params: [f32; 4],
 }
 gpu_struct!(GpuShadowMap => "ShadowMap" { view_proj, view_z, layers, tile, params });

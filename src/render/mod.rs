@@ -172,6 +172,12 @@ impl Renderer {
         // Sized for the level asked for at creation: level-of-detail only lowers it.
         let stride = (points as u64 - 1) * u64::from(params.smoothing_level) + 1;
         let triangles = scalp::root_triangles(sim.rest);
+        if params.interpolation == InterpolationMode::Barycentric && triangles.is_empty() {
+            return Err(Error::unsupported(
+                "barycentric interpolation",
+                "it needs at least 3 key hairs whose roots form a triangle",
+            ));
+        }
         // Room for the hairs of either mode (key hairs or scalp triangles, each
         // growing hairs) where the device's storage range holds them, else for
         // the mode asked for.
@@ -350,8 +356,7 @@ impl Renderer {
     /// of its clump's disk (clump radius × √(π / hairs_per_key) at the
     /// frame's detail), in barycentric mode of its share of a mean scalp
     /// triangle (√(area / hairs_per_key)). A transparent strand standing for
-    /// several hairs is a band at least about this wide
-    /// ([`reference::strand_band`]).
+    /// several hairs spreads over part of it ([`reference::strand_band`]).
     pub fn strand_spacing(&self) -> (f32, f32) {
         let hairs = self.detail.hairs_per_key.max(1) as f32;
         let p = &self.params;

@@ -143,10 +143,11 @@ pub struct CompositeScene<'a> {
     /// Hair width at the root and at the tip, meters.
     pub widths: (f32, f32),
     /// Real hairs each drawn strand stands for (as
-    /// [`super::HairMaterial::represented_hairs`]).
+    /// [`super::Renderer::strand_hairs`]).
     pub represented_hairs: f32,
-    /// Least band width at the root and at the tip, meters: the spacing of the
-    /// drawn strands ([`super::Renderer::strand_spacing`]; 0 for none).
+    /// Spacing of the drawn strands at the root and at the tip, meters, which
+    /// the bands spread over ([`strand_band`], [`super::Renderer::strand_spacing`];
+    /// 0 for none).
     pub band_spacing: (f32, f32),
     /// Opacity of a strand where it covers a sample.
     pub opacity: f32,
@@ -179,10 +180,10 @@ pub const COMPOSITE_SAMPLES: u32 = 4;
 const BAND_ROWS: u32 = 8;
 
 /// One triangle of a ribbon quad in screen space: per corner the pixel
-/// position, depth, clip w and t along the hair.
+/// position, depth, clip w, t along the hair and the band's density there.
 #[derive(Clone, Copy)]
 struct ScreenTriangle {
-    corners: [(glam::Vec2, f32, f32, f32); 3],
+    corners: [(glam::Vec2, f32, f32, f32, f32); 3],
     /// Twice the signed area.
     area: f32,
     /// The quad's second triangle (half-open on the shared diagonal).
@@ -214,15 +215,15 @@ fn screen_triangles(scene: &CompositeScene<'_>) -> Vec<ScreenTriangle> {
         for seg in hair.windows(2) {
             let (p0, p1) = (seg[0].truncate(), seg[1].truncate());
             let Some(dir) = (p1 - p0).try_normalize() else { continue };
-            let mut corners = [(glam::Vec2::ZERO, 0.0, 0.0, 0.0); 4];
+            let mut corners = [(glam::Vec2::ZERO, 0.0, 0.0, 0.0, 0.0); 4];
             for (i, v) in [seg[0], seg[1]].into_iter().enumerate() {
                 let p = v.truncate();
                 let side = dir.cross(scene.camera - p).try_normalize().unwrap_or(Vec3::X);
-                let (band, _) = band_at(scene, v.w);
+                let (band, density) = band_at(scene, v.w);
                 let half = 0.5 * band;
                 for (k, s) in [-1.0, 1.0].into_iter().enumerate() {
                     let (xy, z, cw) = project(p + side * half * s);
-                    corners[2 * i + k] = (xy, z, cw, v.w);
+                    corners[2 * i + k] = (xy, z, cw, v.w, density);
                 }
             }
             if corners.iter().any(|c| c.2.is_nan() || c.2 <= 0.0) {
@@ -257,9 +258,9 @@ fn screen_triangles(scene: &CompositeScene<'_>) -> Vec<ScreenTriangle> {
 
 /// The exact transparent image of `scene` (the ground truth of the transparency
 /// modes): every segment of every hair becomes the draw pass's camera-facing
-/// quad of its true width (a band `represented_hairs` widths wide or the
-/// strands' spacing where that is wider, of opacity `opacity` times the band's
-/// density at the sample, [`strand_band`]), every quad is point-sampled at 4×4
+/// quad of its band's width ([`strand_band`]), of opacity `opacity` times the
+/// band's density at its ends interpolated as the draw interpolates it), every
+/// quad is point-sampled at 4×4
 /// samples per pixel with perspective-correct t, each sample's fragments are
 /// sorted by depth and composited front to back over the background, and the
 /// samples of a pixel are averaged. Linear RGB and hair alpha, rows from the top.
@@ -343,10 +344,13 @@ fn rasterize(
             let depth = b[0] * c[0].1 + b[1] * c[1].1 + b[2] * c[2].1;
             let inv_w = b[0] / c[0].2 + b[1] / c[1].2 + b[2] / c[2].2;
             let along = (b[0] * c[0].3 / c[0].2 + b[1] * c[1].3 / c[1].2 + b[2] * c[2].3 / c[2].2) / inv_w;
+            // The density at the segment's ends, interpolated as the draw's
+            // vertex outputs are.
+            let density = (b[0] * c[0].4 / c[0].2 + b[1] * c[1].4 / c[1].2 + b[2] * c[2].4 / c[2].2) / inv_w;
             if !(0.0..=1.0).contains(&depth) {
                 continue;
             }
-            let alpha = scene.opacity * band_at(scene, along).1;
+            let alpha = scene.opacity * density;
             samples[((sy - top) * row_len + sx) as usize].push((depth, (scene.color)(along), alpha));
         }
     }
@@ -436,6 +440,23 @@ pub fn srgb_error_stats(image: &[Vec3], reference: &[Vec3], background: Vec3) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A band's width and density: one hair stays one hair, no spacing leaves
+    /// n widths, a wide spacing spreads to the bound (MAX_SPREAD × n widths).
+    #[test]
+    fn strand_bands_spread_within_their_bound() {
+        let w = 1e-4;
+        assert_eq!(strand_band(w, 1.0, 0.5), (w, 1.0), "one hair");
+        let (width, density) = strand_band(w, 4.0, 0.0);
+        assert!((width - 4.0 * w).abs() < 1e-9 && (density - (1.0 - 0.75f32.powi(4))).abs() < 1e-6);
+        let (width, density) = strand_band(w, 4.0, 1.0);
+        let most = crate::codes::band::MAX_SPREAD as f32 * 4.0 * w;
+        assert!((width - most).abs() < 1e-9, "{width} vs {most}");
+        assert!((density - (1.0 - (1.0 - w / most).powi(4))).abs() < 1e-6);
+        let (width, _) = strand_band(w, 4.0, 6.0 * w);
+        assert!((width - 4.5 * w).abs() < 1e-9, "(1 − 1/4) × 6 widths: {width}");
+        assert_eq!(strand_band(0.0, 4.0, 0.0), (0.0, 0.0), "no width, no band");
+    }
 
     /// The error's figures over hair pixels only: 20 hair pixels differing by
     /// 0..=19 steps (sRGB-exact values), background pixels equal in both left out.

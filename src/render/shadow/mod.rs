@@ -8,7 +8,7 @@
 //!
 //! The draw pass reads the maps through `shadow()` (`glsl/include/shadow.glsl`):
 //! opacity interpolated linearly inside the three layers, transmittance
-//! exp(−k · opacity), averaged over (2r+1)² texels; density-volume lights look
+//! exp(−k · opacity), the opacity averaged over (2r+1)² texels first; density-volume lights look
 //! their cell's transmittance up. Both passes reuse the strands the
 //! interpolation pass captured, at the frame's level of detail.
 
@@ -117,8 +117,8 @@ pub struct ShadowParams {
     /// Radius of the filter averaging the opacity around a lookup, texels (0..=3;
     /// 1 = 3 × 3). Where each drawn strand stands for n > 1 hairs, a map's filter
     /// reaches the neighbouring strands: its radius is at least (1 − 1/n) × the
-    /// strands' spacing half-way along them ([`super::Renderer::strand_spacing`]),
-    /// up to 3 texels. Default: 1.
+    /// strands' spacing half-way along them ([`super::Renderer::strand_spacing`])
+    /// in texels, rounded to the nearest, up to 3. Default: 1.
     pub pcf_radius: u32,
     /// Density volume: shadowing cross-section of one simulated particle, m²
     /// (transmittance = exp(−σ ∫ particles per m³ ds); ≥ 0). It matches deep opacity

@@ -180,8 +180,8 @@ impl ShadowFootprint {
 
     /// The filter radius of a map whose texels are `texel` m wide: a lookup
     /// reaches the neighbouring drawn strands, whose hairs spread over
-    /// (1 − 1/n) × spacing (as the transparent bands), up to 3 texels; at
-    /// least `radius`.
+    /// (1 − 1/n) × spacing (as the transparent bands), in texels rounded to the
+    /// nearest, up to 3; at least `radius`.
     pub(crate) fn filter_radius(&self, radius: u32, texel: f32) -> u32 {
         let spread = (1.0 - 1.0 / self.hairs.max(1.0)) * self.spacing;
         let wanted = if texel > 0.0 { (spread / texel).round() } else { 0.0 };

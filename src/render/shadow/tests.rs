@@ -383,7 +383,7 @@ fn spot_light_opacity_maps_shadow_like_the_strand_count() {
     assert!(front > 0.999, "in front of the slab: {front}");
 }
 
-/// Percentage-closer filtering: inside the slab a 3 × 3 filter sees the same
+/// The lookup filter: inside the slab a 3 × 3 filter sees the same
 /// count everywhere (exact), at its edge row it blends with empty texels
 /// (softer than without filtering).
 #[test]
@@ -457,8 +457,9 @@ fn the_filter_widens_for_sparse_strands_only() {
     let footprint = |hairs: f32, spacing: f32| ShadowFootprint { hairs, spacing };
     assert_eq!(footprint(1.0, 0.05).filter_radius(1, 0.001), 1, "one hair per strand");
     assert_eq!(footprint(1.0, 0.05).filter_radius(0, 0.001), 0);
-    assert_eq!(footprint(4.0, 0.002).filter_radius(0, 0.001), 2, "0.75 × 2 mm over 1 mm texels");
-    assert_eq!(footprint(4.0, 0.002).filter_radius(3, 0.001), 3, "never below the radius asked for");
+    assert_eq!(footprint(4.0, 0.0024).filter_radius(0, 0.001), 2, "0.75 × 2.4 mm over 1 mm texels");
+    assert_eq!(footprint(4.0, 0.0018).filter_radius(0, 0.001), 1, "0.75 × 1.8 mm: 1.35 texels");
+    assert_eq!(footprint(4.0, 0.0024).filter_radius(3, 0.001), 3, "never below the radius asked for");
     assert_eq!(footprint(73.0, 0.0056).filter_radius(1, 0.00186), 3);
     assert_eq!(footprint(73.0, 0.5).filter_radius(1, 0.001), 3, "at most 3");
     assert_eq!(footprint(73.0, 0.5).filter_radius(1, 0.0), 1, "a degenerate map");

@@ -1,7 +1,7 @@
 //! Sintel's default frame against its ground truth: a full head of thin
-//! strands, one hair each (`hairs_per_key` such that key hairs × it ≈ 100,000,
-//! level of detail off, a pool and K large enough that every fragment is
-//! sorted), the same simulated state and camera. The figure is the error of
+//! strands, one hair each (single-strand interpolation, `hairs_per_key` such
+//! that key hairs × it ≈ 100,000, level of detail off, K = 32 and a pool of 24
+//! fragments per pixel), the same simulated state and camera. The figure is the error of
 //! the default frame over hair pixels, as `render::reference::srgb_error_stats`.
 
 use vkhair::render::reference::{srgb_error_stats, ImageError};
