@@ -11,13 +11,16 @@ layout(location = 0) flat in uint v_patch[];
 layout(location = 1) flat in uint v_instance[];
 layout(location = 0) patch out uint p_patch;
 layout(location = 1) patch out uint p_first_hair;
+layout(location = 2) patch out uint p_lines;
 
 void main() {
+    // The draw has ceil(hairs / INTERPOLATE_LINES_PER_INSTANCE) instances, so
+    // every instance grows at least one hair.
     uint first = v_instance[0] * INTERPOLATE_LINES_PER_INSTANCE;
+    uint lines = min(pc.hairs - first, INTERPOLATE_LINES_PER_INSTANCE);
     p_patch = v_patch[0];
     p_first_hair = first;
-    uint lines = pc.hairs > first ? min(pc.hairs - first, INTERPOLATE_LINES_PER_INSTANCE) : 0u;
-    // No lines: the patch is discarded.
+    p_lines = lines;
     gl_TessLevelOuter[0] = float(lines);
     gl_TessLevelOuter[1] = float(pc.level);
 }

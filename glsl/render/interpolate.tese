@@ -15,14 +15,14 @@ layout(std430, set = 0, binding = 4) writeonly buffer HairTan { vec4 hair_tan[];
 
 layout(location = 0) patch in uint p_patch;
 layout(location = 1) patch in uint p_first_hair;
+layout(location = 2) patch in uint p_lines;
 
 void main() {
     uint segs = pc.points - 1u;
     uint key = p_patch / segs;
     uint seg = p_patch - key * segs;
     uint j = uint(gl_TessCoord.x * float(pc.level) + 0.5);
-    uint lines = min(pc.hairs - p_first_hair, INTERPOLATE_LINES_PER_INSTANCE);
-    uint h = isoline_hair(p_first_hair, gl_TessCoord.y, lines);
+    uint h = isoline_hair(p_first_hair, gl_TessCoord.y, p_lines);
     if (j < pc.level || seg + 1u == segs) {
         uint k = seg * pc.level + j;
         uint src = key * pc.stride + k;

@@ -14,14 +14,14 @@ layout(std430, set = 0, binding = 5) readonly buffer Triangles { uvec4 triangles
 
 layout(location = 0) patch in uint p_patch;
 layout(location = 1) patch in uint p_first_hair;
+layout(location = 2) patch in uint p_lines;
 
 void main() {
     uint segs = pc.points - 1u;
     uint tri = p_patch / segs;
     uint seg = p_patch - tri * segs;
     uint j = uint(gl_TessCoord.x * float(pc.level) + 0.5);
-    uint lines = min(pc.hairs - p_first_hair, INTERPOLATE_LINES_PER_INSTANCE);
-    uint h = isoline_hair(p_first_hair, gl_TessCoord.y, lines);
+    uint h = isoline_hair(p_first_hair, gl_TessCoord.y, p_lines);
     if (j < pc.level || seg + 1u == segs) {
         uint k = seg * pc.level + j;
         uvec3 keys = triangles[tri].xyz;

@@ -1,8 +1,8 @@
 //! Pass 2 — single-strand interpolation (`glsl/render/interpolate.*`): a draw
 //! with no vertex buffer, one patch per key segment and instance; the control
 //! stage's line count is the number of hairs the instance grows from each key
-//! hair (instance n grows hairs 4n to 4n + 3, `codes::interpolate`), its
-//! segment count the smoothing level. Each vertex is the smoothed key vertex plus an offset in
+//! hair (instance n grows `LINES_PER_INSTANCE` hairs from n × that on,
+//! `codes::interpolate`), its segment count the smoothing level. Each vertex is the smoothed key vertex plus an offset in
 //! the key hair's frame: a stable random clump coordinate (uniform in the unit
 //! disk, fixed per hair) × clump width × mix(root width, tip width) along the
 //! strand. The frame is built on the GPU from the smoothed tangent and the key
@@ -47,6 +47,27 @@ fn reference_vectors(rest: &SimState) -> Vec<Vec4> {
             n.extend(0.0)
         })
         .collect()
+}
+
+/// Rejects `mode` when it cannot grow hairs from key hairs whose roots form
+/// `triangles` scalp triangles.
+pub(super) fn check_mode(mode: InterpolationMode, triangles: u32) -> Result<()> {
+    if mode == InterpolationMode::Barycentric && triangles == 0 {
+        return Err(Error::unsupported(
+            "barycentric interpolation",
+            "it needs at least 3 key hairs whose roots form a triangle",
+        ));
+    }
+    Ok(())
+}
+
+/// What `mode` grows hairs from: the `strands` key hairs, or the `triangles`
+/// scalp triangles between their roots.
+pub(super) fn units(mode: InterpolationMode, strands: u32, triangles: u32) -> u32 {
+    match mode {
+        InterpolationMode::SingleStrand => strands,
+        InterpolationMode::Barycentric => triangles,
+    }
 }
 
 /// Mean area of `triangles` of key-hair roots of `rest`, m² (0 for none).
@@ -147,13 +168,12 @@ impl InterpolatePass {
 
     /// Rejects `mode` when it cannot grow hairs from these key hairs.
     pub(super) fn check_mode(&self, mode: InterpolationMode) -> Result<()> {
-        if mode == InterpolationMode::Barycentric && self.triangles == 0 {
-            return Err(Error::unsupported(
-                "barycentric interpolation",
-                "it needs at least 3 key hairs whose roots form a triangle",
-            ));
-        }
-        Ok(())
+        check_mode(mode, self.triangles)
+    }
+
+    /// Key hairs (of `strands`), or scalp triangles: what `mode` grows hairs from.
+    pub(super) fn units(&self, mode: InterpolationMode, strands: u32) -> u32 {
+        units(mode, strands, self.triangles)
     }
 
     /// The interpolated hairs: positions and (tangent, t).

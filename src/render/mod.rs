@@ -172,19 +172,11 @@ impl Renderer {
         // Sized for the level asked for at creation: level-of-detail only lowers it.
         let stride = (points as u64 - 1) * u64::from(params.smoothing_level) + 1;
         let triangles = scalp::root_triangles(sim.rest);
-        if params.interpolation == InterpolationMode::Barycentric && triangles.is_empty() {
-            return Err(Error::unsupported(
-                "barycentric interpolation",
-                "it needs at least 3 key hairs whose roots form a triangle",
-            ));
-        }
+        interpolate::check_mode(params.interpolation, triangles.len() as u32)?;
         // Room for the hairs of either mode (key hairs or scalp triangles, each
         // growing hairs) where the device's storage range holds them, else for
         // the mode asked for.
-        let units = match params.interpolation {
-            InterpolationMode::SingleStrand => strands as u64,
-            InterpolationMode::Barycentric => triangles.len() as u64,
-        };
+        let units = u64::from(interpolate::units(params.interpolation, strands as u32, triangles.len() as u32));
         let both = (strands as u64).max(triangles.len() as u64) * u64::from(params.hairs_per_key);
         let fits = |hairs: u64| hairs * stride * 16 <= u64::from(device.info.max_storage_buffer_range);
         let capacity_hairs = if fits(both) { both } else { units * u64::from(params.hairs_per_key) };
@@ -200,7 +192,6 @@ impl Renderer {
         }
         let smooth = SmoothPass::new(&device, sim.halves, sim.before, strands as u64 * stride)?;
         let interpolate = InterpolatePass::new(&device, sim.rest, &triangles, &smooth, hair_vertices)?;
-        interpolate.check_mode(params.interpolation)?;
         let draw = DrawPass::new(&device, hair_vertices)?;
         let shadows = Shadows::new(&device, interpolate.hairs().0)?;
         let detail = params.detail_at(0.0);
@@ -338,10 +329,7 @@ impl Renderer {
 
     /// Key hairs, or scalp triangles: what `mode` grows hairs from.
     fn units_of(&self, mode: InterpolationMode) -> u32 {
-        match mode {
-            InterpolationMode::SingleStrand => self.strands,
-            InterpolationMode::Barycentric => self.interpolate.triangles(),
-        }
+        self.interpolate.units(mode, self.strands)
     }
 
     /// Real hairs each hair drawn in the latest prepared frame stands for:

@@ -167,9 +167,17 @@ pub struct CompositeScene<'a> {
 pub fn strand_band(hair_width: f32, n: f32, spacing: f32) -> (f32, f32) {
     let n = n.max(1.0);
     let most = crate::codes::band::MAX_SPREAD as f32 * n * hair_width;
-    let width = (n * hair_width).max(((1.0 - 1.0 / n) * spacing).min(most));
+    let width = (n * hair_width).max(strand_spread(n, spacing).min(most));
     let density = if width > 0.0 { 1.0 - (1.0 - hair_width / width).max(0.0).powf(n) } else { 0.0 };
     (width, density)
+}
+
+/// The width the hairs of a drawn strand standing for `n` hairs spread over
+/// where the drawn strands lie `spacing` apart: (1 − 1/n) × spacing (none for
+/// one hair). The transparent bands ([`strand_band`]) and the opacity maps'
+/// filter reach follow it.
+pub fn strand_spread(n: f32, spacing: f32) -> f32 {
+    (1.0 - 1.0 / n.max(1.0)) * spacing
 }
 
 /// Sub-samples per pixel side of [`composite_strands`] (16 per pixel).
