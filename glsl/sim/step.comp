@@ -45,6 +45,12 @@
 // share the last set's barrier). The arithmetic is exactly that of projecting
 // the pair in one place, which the CPU reference does.
 //
+// The pipeline is specialised (constant 0, STEP_FEATURES) to the switches a
+// dispatch can meet: a switch outside it is off whatever the parameters say,
+// and its code is compiled out. A CPU device runs both sides of a branch its
+// lanes disagree on, so code for switched-off features would cost as much as
+// running it; the all-ones default keeps every feature.
+//
 // DFTL mode instead places each point at its rest distance from its parent,
 // root to tip, in one sweep (with collisions) and keeps the correction
 // vectors in shared memory for the velocity update.
@@ -52,6 +58,7 @@
 #include "sim.glsl"
 
 layout(local_size_x = SIM_WORKGROUP) in;
+layout(constant_id = 0) const uint STEP_FEATURES = 0xFFFFFFFFu;
 
 // x: the first sub-step of this dispatch (index into `steps`), y: how many.
 layout(push_constant) uniform Push { SimPush push; };
@@ -83,6 +90,11 @@ shared vec3 s_local_offset[SIM_WORKGROUP];
 SimStepParams params;
 uint collider_base;
 
+// The switches of the sub-step being run, within the pipeline's features.
+uint step_flags() {
+    return sim_flags(params) & STEP_FEATURES;
+}
+
 // Ends a constraint set: makes every shared-memory write of the sync group visible.
 // `group` is uniform over the dispatch, so barrier() stays in uniform control flow.
 void sync(uint group) {
@@ -102,7 +114,7 @@ vec3 collide_all(vec3 p, float radius) {
     for (uint c = 0u; c < sim_colliders(params); c++) {
         p = sim_collide(colliders[collider_base + c], p, radius);
     }
-    if ((sim_flags(params) & SIM_MESH) != 0u) {
+    if ((step_flags() & SIM_MESH) != 0u) {
         p = mesh_collide(sim_head(params), mesh_grid(), p, radius);
     }
     return p;
@@ -185,7 +197,7 @@ vec2 bend_at(uint strand_base, uint c, uint points) {
 // Stage 1 for the own point: its predicted position (w: inverse mass) from the
 // position `x` and velocity `v` at the start of the sub-step.
 vec4 predict(vec4 x, vec3 v, vec3 rest_head, uint strand) {
-    uint flags = sim_flags(params);
+    uint flags = step_flags();
     float dt = sim_dt(params);
     vec3 rest_world = sim_transform_point(sim_head(params), rest_head);
     if (x.w == 0.0) {
@@ -228,7 +240,7 @@ void main() {
     // What stays the same over the step: the state (in registers from here to the
     // store), the rest data and each constraint set's partner, rest distance and
     // stiffness.
-    bool bending = (sim_flags(params) & SIM_BENDING) != 0u;
+    bool bending = (step_flags() & SIM_BENDING) != 0u;
     vec4 x = vec4(0.0);
     vec3 v = vec3(0.0);
     vec3 rest_head = vec3(0.0);
@@ -284,7 +296,7 @@ void main() {
     for (uint sub = 0u; sub < step_range_count(push); sub++) {
         params = steps[step_range_first(push) + sub];
         collider_base = (step_range_first(push) + sub) * SIM_MAX_COLLIDERS;
-        uint flags = sim_flags(params);
+        uint flags = step_flags();
         bool collisions = (flags & SIM_COLLISIONS) != 0u;
         bool global_shape = (flags & SIM_GLOBAL_SHAPE) != 0u;
         bool local_shape = (flags & SIM_LOCAL_SHAPE) != 0u;
@@ -348,11 +360,15 @@ void main() {
                 if (live) { s_pos[1u - src][lid] = own; }
                 sync(group);
                 src = 1u - src;
-                own = project_end(own, lid, off_bend_a, first_bend_a, bend_a.x, bend_a.y, src);
-                if (live) { s_pos[1u - src][lid] = own; }
-                sync(group);
-                src = 1u - src;
-                own = project_end(own, lid, off_bend_b, first_bend_b, bend_b.x, bend_b.y, src);
+                // Without bending the two sets move nothing: they are skipped
+                // (`bending` is uniform, so are the barriers inside).
+                if (bending) {
+                    own = project_end(own, lid, off_bend_a, first_bend_a, bend_a.x, bend_a.y, src);
+                    if (live) { s_pos[1u - src][lid] = own; }
+                    sync(group);
+                    src = 1u - src;
+                    own = project_end(own, lid, off_bend_b, first_bend_b, bend_b.x, bend_b.y, src);
+                }
                 if (local_shape && it + 1u == sim_iterations(params)) {
                     if (live) { s_pos[1u - src][lid] = own; }
                     sync(group);

@@ -167,7 +167,8 @@ impl SimStage {
 pub struct HairSim {
     device: Arc<Device>,
     gpu: GpuState,
-    /// The step kernel.
+    /// The step kernel, with a variant for each set of switches met so far
+    /// ([`HairSim::prepare_step`]).
     pipeline: ComputePipeline,
     /// Its descriptor sets reading half 0 and half 1 of the double buffer.
     sets: [vk::DescriptorSet; 2],
@@ -218,7 +219,15 @@ impl HairSim {
             mesh: None,
         };
         sim.configure_volume(&params.volume)?;
+        sim.prepare_step()?;
         Ok(sim)
+    }
+
+    /// Compiles, unless it exists, the step kernel's variant for the current
+    /// parameters and mesh collider (the kernel specialised to the switches they
+    /// turn on), so that recording a step does not compile it.
+    fn prepare_step(&mut self) -> Result<()> {
+        self.pipeline.prepare_variant(packing::flags(&self.planner.params, self.mesh.is_some()))
     }
 
     /// Creates, rebuilds or drops the volume stage for `params`. The grid is fitted
@@ -259,7 +268,8 @@ impl HairSim {
     pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
         params.validate()?;
         self.configure_volume(&params.volume)?;
-        self.planner.set_params(params)
+        self.planner.set_params(params)?;
+        self.prepare_step()
     }
 
     /// Replaces the colliders (in the head frame; at most [`MAX_COLLIDERS`]).
@@ -289,6 +299,7 @@ impl HairSim {
         }
         self.planner.mesh = mesh.as_ref().map(MeshCollider::grid);
         let previous = std::mem::replace(&mut self.mesh, mesh);
+        self.prepare_step()?;
         // The volume stage binds the field too: rebuild it around the new one.
         if self.volume.take().is_some() {
             let params = self.planner.params.volume.clone();

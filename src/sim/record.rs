@@ -38,13 +38,17 @@ impl HairSim {
     ) -> Result<()> {
         let timing = Timing::of(profiler.as_deref());
         let inputs = self.planner.next(head)?;
+        // The kernel specialised to the switches of these sub-steps (prepared
+        // already unless the parameters changed behind `set_params`' back).
+        let features = inputs.iter().fold(0, |f, sub| f | sub.params.flags);
+        self.pipeline.prepare_variant(features)?;
         // SAFETY (whole body): guaranteed by the caller; all buffers belong to this
         // device, and update sizes are multiples of 4 below 64 KiB (by construction).
         unsafe {
             self.record_uploads(cmd, &inputs);
             self.pending_rest.clear();
             let Some(volume) = &self.volume else {
-                self.record_dispatch(cmd, self.current, [0, inputs.len() as u32], timing);
+                self.record_dispatch(cmd, self.current, [0, inputs.len() as u32], features, timing);
                 self.current = 1 - self.current;
                 return Ok(());
             };
@@ -56,7 +60,7 @@ impl HairSim {
                     self.record_volume_uploads(cmd, volume, sub);
                     self.device.cmd_barrier(cmd, &[uploaded_barrier()], &[], &[]);
                 }
-                self.record_dispatch(cmd, current, [k as u32, 1], timing);
+                self.record_dispatch(cmd, current, [k as u32, 1], features, timing);
                 self.device.cmd_barrier(cmd, &[between], &[], &[]);
                 let labels = SimStage::VOLUME.map(SimStage::label);
                 // The barrier above made the step's writes visible.
@@ -120,17 +124,25 @@ impl HairSim {
     }
 
     /// Records the step kernel for sub-steps `range` = [first, count], reading
-    /// half `parity` of the double buffer, in a timestamp scope.
+    /// half `parity` of the double buffer, in a timestamp scope, with the
+    /// kernel's variant for the switches `features`.
     ///
     /// # Safety
     /// As [`HairSim::record_step`], after the uploads' barrier.
-    unsafe fn record_dispatch(&self, cmd: vk::CommandBuffer, parity: usize, range: [u32; 2], timing: Timing<'_>) {
+    unsafe fn record_dispatch(
+        &self,
+        cmd: vk::CommandBuffer,
+        parity: usize,
+        range: [u32; 2],
+        features: u32,
+        timing: Timing<'_>,
+    ) {
         let (strands, groups) = (self.planner.strands, self.planner.packing().hairs_per_group);
         let push = SimPush::from(&StepRange { first: range[0], count: range[1] });
         // SAFETY: guaranteed by the caller.
         unsafe {
             PassScope::record(&self.device, cmd, timing, SimStage::Step.label(), LabelColor::Compute, || {
-                self.pipeline.bind(cmd, &[self.sets[parity]]);
+                self.pipeline.bind_variant(cmd, features, &[self.sets[parity]]);
                 self.pipeline.push(cmd, &push);
                 self.pipeline.dispatch_threads(cmd, [step::threads(strands, groups), 1, 1]);
             });

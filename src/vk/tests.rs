@@ -108,6 +108,48 @@ fn scale_add_matches_cpu() {
 }
 
 #[test]
+fn a_variant_sets_specialisation_constant_0() {
+    let gpu = TestGpu::new();
+    let d = gpu.device();
+    let mut pipeline = ComputePipeline::new(d, &shaders::CORE_SCALE_ADD_COMP, 3).expect("pipeline");
+    pipeline.prepare_variant(3).expect("variant");
+    // Preparing it again keeps the one there is.
+    pipeline.prepare_variant(3).expect("variant again");
+    let n = 100usize;
+    let src: Vec<f32> = (0..n).map(|i| i as f32 * 0.5).collect();
+    let src_buf = storage(d, "src", 4 * n as u64);
+    d.upload_pod(&src_buf, &src).expect("upload");
+    let set_for = |dst: &Buffer| pipeline.buffer_set(0, &[(0, &src_buf), (1, dst)]).expect("set");
+    let push = ScaleAddPush { count: n as u32, scale: 2.0, bias: 0.25, pad0: 0 };
+    // Constant 0 (BIAS_TIMES) at its default 1, at 3 (the variant), and at 7,
+    // never prepared: that binds the default pipeline.
+    let mut results = Vec::new();
+    for constant in [None, Some(3), Some(7)] {
+        let dst = storage(d, "dst", 4 * n as u64);
+        let set = set_for(&dst);
+        d.submit_once("scale_add variant", |cmd| {
+            // SAFETY: recording command buffer of this device.
+            unsafe {
+                match constant {
+                    None => pipeline.bind(cmd, &[set]),
+                    Some(c) => pipeline.bind_variant(cmd, c, &[set]),
+                }
+                pipeline.push(cmd, &push);
+                pipeline.dispatch_threads(cmd, [n as u32, 1, 1]);
+            }
+        })
+        .expect("submit");
+        results.push(d.readback_pod::<f32>(&dst, n).expect("readback"));
+    }
+    // Exact: the inputs and results are small multiples of powers of two.
+    for (i, x) in src.iter().enumerate() {
+        assert_eq!(results[0][i], 2.0 * x + 0.25, "default, element {i}");
+        assert_eq!(results[1][i], 2.0 * x + 0.75, "variant 3, element {i}");
+        assert_eq!(results[2][i], 2.0 * x + 0.25, "unprepared variant 7 falls back, element {i}");
+    }
+}
+
+#[test]
 fn layout_probe_round_trips_every_member() {
     let gpu = TestGpu::new();
     let d = gpu.device();

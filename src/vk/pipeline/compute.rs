@@ -12,10 +12,16 @@ use crate::vk::device::Device;
 use crate::vk::reflect::reflect;
 use crate::vk::shaders::ShaderSource;
 
-/// A compute pipeline.
+/// A compute pipeline, and variants of it with its specialisation constant 0
+/// set (see [`ComputePipeline::prepare_variant`]).
 pub(crate) struct ComputePipeline {
     layout: Layout,
+    /// The pipeline with every specialisation constant at its default.
     raw: vk::Pipeline,
+    /// Variants by the value of specialisation constant 0; destroyed with the pipeline.
+    variants: HashMap<u32, vk::Pipeline>,
+    words: &'static [u32],
+    full_subgroups: bool,
     workgroup_size: [u32; 3],
     name: String,
     /// Bytes read and written through each buffer descriptor set (for the counters).
@@ -46,32 +52,29 @@ impl ComputePipeline {
             .workgroup_size
             .ok_or_else(|| Error::Shader { shader: shader.name.to_owned(), reason: "not a compute shader".into() })?;
         let layout = Layout::new(device, shader.name, &[reflection], max_sets)?;
-        let module = shader_module(device, shader)?;
-        let flags = if full_subgroups {
-            vk::PipelineShaderStageCreateFlags::REQUIRE_FULL_SUBGROUPS
-        } else {
-            vk::PipelineShaderStageCreateFlags::empty()
-        };
-        let stage = vk::PipelineShaderStageCreateInfo::default()
-            .flags(flags)
-            .stage(vk::ShaderStageFlags::COMPUTE)
-            .module(module)
-            .name(c"main");
-        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout.raw);
-        // SAFETY: module and layout are alive; the module is destroyed right after.
-        let result = unsafe { device.raw.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
-        // SAFETY: the module is no longer needed once the pipeline exists.
-        unsafe { device.raw.destroy_shader_module(module, None) };
-        let raw = result.map_err(|(_, r)| Error::Vulkan { call: "vkCreateComputePipelines", result: r })?[0];
-        device.set_name(raw, shader.name);
+        let raw = create(&layout, shader.words, shader.name, full_subgroups, None)?;
         Ok(ComputePipeline {
             layout,
             raw,
+            variants: HashMap::new(),
+            words: shader.words,
+            full_subgroups,
             workgroup_size,
             name: shader.name.to_owned(),
             traffic: Mutex::default(),
             bound: Mutex::default(),
         })
+    }
+
+    /// Creates, unless it exists, the variant with specialisation constant 0 set to
+    /// `constant` (a `uint`); it shares the layout and descriptor sets of the pipeline.
+    pub(crate) fn prepare_variant(&mut self, constant: u32) -> Result<()> {
+        if !self.variants.contains_key(&constant) {
+            let name = format!("{} [constant 0 = {constant:#x}]", self.name);
+            let raw = create(&self.layout, self.words, &name, self.full_subgroups, Some(constant))?;
+            self.variants.insert(constant, raw);
+        }
+        Ok(())
     }
 
     /// Invocations per workgroup in each dimension.
@@ -156,11 +159,31 @@ impl ComputePipeline {
     /// # Safety
     /// `cmd` is a recording command buffer of this device.
     pub(crate) unsafe fn bind(&self, cmd: vk::CommandBuffer, sets: &[vk::DescriptorSet]) {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.bind_raw(cmd, self.raw, sets) };
+    }
+
+    /// As [`ComputePipeline::bind`], the variant prepared for `constant`; the
+    /// pipeline itself (every constant at its default) when there is none.
+    ///
+    /// # Safety
+    /// As [`ComputePipeline::bind`].
+    pub(crate) unsafe fn bind_variant(&self, cmd: vk::CommandBuffer, constant: u32, sets: &[vk::DescriptorSet]) {
+        let raw = self.variants.get(&constant).copied().unwrap_or(self.raw);
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.bind_raw(cmd, raw, sets) };
+    }
+
+    /// Binds `raw` (this pipeline or one of its variants) and `sets`.
+    ///
+    /// # Safety
+    /// As [`ComputePipeline::bind`].
+    unsafe fn bind_raw(&self, cmd: vk::CommandBuffer, raw: vk::Pipeline, sets: &[vk::DescriptorSet]) {
         if let (Ok(map), Ok(mut bound)) = (self.traffic.lock(), self.bound.lock()) {
             *bound = sets.iter().filter_map(|s| map.get(s)).fold((0, 0), |a, t| (a.0 + t.0, a.1 + t.1));
         }
         // SAFETY: guaranteed by the caller.
-        unsafe { self.layout.bind(cmd, vk::PipelineBindPoint::COMPUTE, self.raw, sets) };
+        unsafe { self.layout.bind(cmd, vk::PipelineBindPoint::COMPUTE, raw, sets) };
     }
 
     /// Records push constants; their size must equal the shader's block.
@@ -204,9 +227,48 @@ impl ComputePipeline {
     }
 }
 
+/// Creates a compute pipeline of `words` with `layout`, specialisation constant 0
+/// set to `constant` when given.
+fn create(
+    layout: &Layout,
+    words: &'static [u32],
+    name: &str,
+    full_subgroups: bool,
+    constant: Option<u32>,
+) -> Result<vk::Pipeline> {
+    let device = &layout.device;
+    let module = shader_module(device, words, name)?;
+    let flags = if full_subgroups {
+        vk::PipelineShaderStageCreateFlags::REQUIRE_FULL_SUBGROUPS
+    } else {
+        vk::PipelineShaderStageCreateFlags::empty()
+    };
+    let entries = [vk::SpecializationMapEntry { constant_id: 0, offset: 0, size: 4 }];
+    let data = constant.unwrap_or(0).to_ne_bytes();
+    let specialization = vk::SpecializationInfo::default().map_entries(&entries).data(&data);
+    let mut stage = vk::PipelineShaderStageCreateInfo::default()
+        .flags(flags)
+        .stage(vk::ShaderStageFlags::COMPUTE)
+        .module(module)
+        .name(c"main");
+    if constant.is_some() {
+        stage = stage.specialization_info(&specialization);
+    }
+    let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout.raw);
+    // SAFETY: module and layout are alive; the module is destroyed right after.
+    let result = unsafe { device.raw.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
+    // SAFETY: the module is no longer needed once the pipeline exists.
+    unsafe { device.raw.destroy_shader_module(module, None) };
+    let raw = result.map_err(|(_, r)| Error::Vulkan { call: "vkCreateComputePipelines", result: r })?[0];
+    device.set_name(raw, name);
+    Ok(raw)
+}
+
 impl Drop for ComputePipeline {
     fn drop(&mut self) {
-        // SAFETY: pipeline of this device, no longer used by pending work.
-        unsafe { self.layout.device.raw.destroy_pipeline(self.raw, None) };
+        for raw in std::iter::once(self.raw).chain(self.variants.values().copied()) {
+            // SAFETY: pipelines of this device, no longer used by pending work.
+            unsafe { self.layout.device.raw.destroy_pipeline(raw, None) };
+        }
     }
 }

@@ -58,7 +58,7 @@ impl GraphicsPipeline {
         let layout = Layout::new(device, desc.name, &reflections, max_sets)?;
         let mut modules = Vec::new();
         for s in desc.stages {
-            match shader_module(device, s) {
+            match shader_module(device, s.words, s.name) {
                 Ok(m) => modules.push(m),
                 Err(e) => {
                     // SAFETY: modules created above, unused.

@@ -13,7 +13,6 @@ use ash::vk;
 use super::buffer::Buffer;
 use super::device::Device;
 use super::reflect::{Binding, Reflection};
-use super::shaders::ShaderSource;
 use crate::error::{Error, Result};
 
 mod compute;
@@ -278,11 +277,11 @@ impl Drop for Layout {
     }
 }
 
-fn shader_module(device: &Device, shader: &ShaderSource) -> Result<vk::ShaderModule> {
-    let info = vk::ShaderModuleCreateInfo::default().code(shader.words);
+fn shader_module(device: &Device, words: &[u32], name: &str) -> Result<vk::ShaderModule> {
+    let info = vk::ShaderModuleCreateInfo::default().code(words);
     // SAFETY: the words are SPIR-V validated by spirv-val at build time.
     let module = unsafe { device.raw.create_shader_module(&info, None) }.map_err(Error::vk("vkCreateShaderModule"))?;
-    device.set_name(module, shader.name);
+    device.set_name(module, name);
     Ok(module)
 }
 
