@@ -218,6 +218,9 @@ fn gpu_matches_cpu_for_4_16_32_and_64_points() {
         compare(gpu.ctx(), &groom, &dftl, &[20]);
         let workgroup_sync = SimParams { subgroup_sync: false, hairs_per_workgroup: 1, ..SimParams::default() };
         compare(gpu.ctx(), &groom, &workgroup_sync, &[5]);
+        // The sequential sweep, by one lane per hair of a subgroup or workgroup.
+        let local = SimParams { iterations: 4, local_shape_stiffness: 0.5, ..SimParams::styled() };
+        compare(gpu.ctx(), &groom, &local, &[5]);
     }
 }
 

@@ -20,7 +20,7 @@
 //        e. (with SIM_LOCAL_SHAPE, in the last iteration only, so that its
 //           stiffness is the fraction removed per sub-step whatever the
 //           iteration count) the local shape constraints, swept root to tip by
-//           each hair's root invocation (Gauss-Seidel: a correction reaches
+//           one invocation per hair (Gauss-Seidel: a correction reaches
 //           the tip within the sweep): segment (j−1, j) is pulled toward its
 //           rest offset carried along by the smallest rotation taking the
 //           parent segment's rest direction onto its current one (parallel
@@ -148,15 +148,18 @@ vec4 project_end(vec4 own, uint lid, int offset, bool first, float rest_d, float
 
 // Sweeps the local shape constraints of the hair whose root sits at invocation
 // `root`, root to tip, in place in half `src` (see the header). The segments'
-// rest data are in s_local (direction of the parent segment, offset).
+// rest data are in s_local (direction of the parent segment, offset). The two
+// points before the segment are carried in registers: they are what the
+// previous segment left in shared memory.
 void local_shape_sweep(uint root, uint points, uint src) {
+    vec4 grandparent = vec4(0.0);
+    vec4 parent = s_pos[src][root];
     for (uint j = 1u; j < points; j++) {
-        vec4 parent = s_pos[src][root + j - 1u];
         vec4 child = s_pos[src][root + j];
         precise vec3 carried = s_local_offset[root + j];
         vec3 dir = s_local_dir[root + j];
         if (j >= 2u && sim_dot(dir, dir) > 0.0) {
-            precise vec3 d = parent.xyz - s_pos[src][root + j - 2u].xyz;
+            precise vec3 d = parent.xyz - grandparent.xyz;
             precise float len = sqrt(sim_dot(d, d));
             if (len > 0.0) {
                 carried = sim_rotate_between(dir, d / len, carried);
@@ -167,9 +170,13 @@ void local_shape_sweep(uint root, uint points, uint src) {
             precise vec3 delta = (carried - (child.xyz - parent.xyz)) * sim_local_shape(params);
             precise vec3 moved_parent = parent.xyz - delta * (parent.w / w);
             precise vec3 moved_child = child.xyz + delta * (child.w / w);
-            s_pos[src][root + j - 1u] = vec4(moved_parent, parent.w);
-            s_pos[src][root + j] = vec4(moved_child, child.w);
+            parent.xyz = moved_parent;
+            child.xyz = moved_child;
+            s_pos[src][root + j - 1u] = parent;
+            s_pos[src][root + j] = child;
         }
+        grandparent = parent;
+        parent = child;
     }
 }
 
@@ -236,6 +243,14 @@ void main() {
     bool live = in_sync < per_sync && hair < per_group && strand < sim_strands(params);
     uint index = strand * points + i;
     uint base = strand * points;
+    // The sequential sweeps (local shape, DFTL) of the sync group's hairs run on
+    // its first lanes side by side, lane h for its h-th hair, rather than on each
+    // hair's root: neighbouring lanes share a SIMD batch or subgroup.
+    uint swept = sync_index * per_sync + lane;
+    uint swept_strand = gl_WorkGroupID.x * per_group + swept;
+    bool sweeps = lane < per_sync && swept < per_group && swept_strand < sim_strands(params);
+    uint sweep_root = sync_index * group + lane * points;
+    uint sweep_base = swept_strand * points;
 
     // What stays the same over the step: the state (in registers from here to the
     // store), the rest data and each constraint set's partner, rest distance and
@@ -325,19 +340,19 @@ void main() {
 
         // 2. The constraint solve.
         if ((flags & SIM_DFTL) != 0u) {
-            // Follow the leader: sequential down each hair, by its root's invocation.
-            if (live && i == 0u) {
+            // Follow the leader: sequential down each hair, by its sweeping lane.
+            if (sweeps) {
                 for (uint k = 1u; k < points; k++) {
-                    vec4 parent = s_pos[0][lid + k - 1u];
-                    vec4 q = s_pos[0][lid + k];
+                    vec4 parent = s_pos[0][sweep_root + k - 1u];
+                    vec4 q = s_pos[0][sweep_root + k];
                     if (q.w > 0.0) {
                         precise vec3 d = q.xyz - parent.xyz;
                         precise float len = sqrt(dot(d, d));
-                        precise vec3 placed = len > 0.0 ? parent.xyz + d * (s_length[lid + k - 1u] / len) : q.xyz;
+                        precise vec3 placed = len > 0.0 ? parent.xyz + d * (s_length[sweep_root + k - 1u] / len) : q.xyz;
                         if (collisions) {
-                            placed = collide_all(placed, rest[index + k].w);
+                            placed = collide_all(placed, rest[sweep_base + k].w);
                         }
-                        s_pos[0][lid + k] = vec4(placed, q.w);
+                        s_pos[0][sweep_root + k] = vec4(placed, q.w);
                     }
                 }
             }
@@ -373,8 +388,8 @@ void main() {
                     if (live) { s_pos[1u - src][lid] = own; }
                     sync(group);
                     src = 1u - src;
-                    if (live && i == 0u) {
-                        local_shape_sweep(lid, points, src);
+                    if (sweeps) {
+                        local_shape_sweep(sweep_root, points, src);
                     }
                     sync(group);
                     if (live) { own = s_pos[src][lid]; }

@@ -94,7 +94,19 @@ fn a_quick_bench_reports_every_stage_with_its_reference_and_writes_json_and_a_ch
     assert_eq!(Some(v["frame_ms_off"].clone()), figure("transparency off"), "{v}");
     assert_eq!(Some(v["frame_ms_exact"].clone()), figure("segments"), "{v}");
     assert!(v["frame_ms_off"].is_number() && v["frame_ms_exact"].is_number(), "{v}");
-    assert!(v["sintel_frame_ms_off"].is_null() && v["sintel_frame_ms_exact"].is_null(), "{v}");
+    // Without Sintel its figures are null, and so is the ground-truth comparison.
+    for key in ["sintel_frame_ms_off", "sintel_frame_ms_exact", "sintel_step_ms_4it", "sintel_step_ms_20it"] {
+        assert!(v[key].is_null(), "{key}: {v}");
+    }
+    assert!(v["peer_work_step_ms_4it"].is_null() && v["sintel_truth"].is_null(), "{v}");
+    // The FLIP stage's dispatches per step: those of the thesis' volume stage alone.
+    let flip = stages
+        .iter()
+        .find(|s| s["stage"] == "sim, FLIP 32³: volume stage alone")
+        .map(|s| s["dispatches_per_step"].clone())
+        .expect("the FLIP row");
+    assert!(v["flip_dispatches_per_step"].as_u64().is_some_and(|d| d > 1), "{v}");
+    assert_eq!(v["flip_dispatches_per_step"], flip, "{v}");
     let (w, h, _) = common::read_png(&out.join("transparency.png"));
     assert_eq!((w, h), (1100, 500));
     let scaling = v["scaling"].as_array().expect("scaling");

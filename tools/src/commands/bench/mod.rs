@@ -35,6 +35,7 @@ use modes::{default_exact, frame_ms, render_rows, write_modes, OFF};
 mod frames;
 mod measure;
 mod modes;
+mod peer;
 mod truth;
 
 /// Peak memory bandwidth of a few GPUs, bytes per second (vendors' figures): the
@@ -474,6 +475,9 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
         rows.extend(sim_rows(&s.name, "sim, density friction 32³", &f, clock, Some(&off)));
         let f = measure_sim(&ctx, &case(VolumeMode::Flip), a.samples, b.budget())?;
         rows.extend(sim_rows(&s.name, "sim, FLIP 32³", &f, clock, Some(&off)));
+        if s.name.starts_with("Sintel") {
+            rows.extend(peer::rows(&b, &s.name, &s.groom)?);
+        }
         if let Some(args) = &s.render_args {
             render_rows(&b, &s.name, args, &mut rows, &mut modes)?;
             if s.name.starts_with("Sintel") {
@@ -515,6 +519,7 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     if let Some(path) = &a.json {
         let find = |stage: &str| rows.iter().find(|r| r.scene == scenes[0].name && r.stage == stage);
         let (off, flip) = (find("sim, volume off"), find("sim, FLIP 32³: volume stage alone"));
+        let sintel_row = |stage: &str| rows.iter().find(|r| r.scene.starts_with("Sintel") && r.stage == stage);
         let median = |r: Option<&Row>, cpu: bool| {
             finite(r.map_or(f64::NAN, |r| {
                 if cpu {
@@ -543,6 +548,10 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
             "cpu_ms_per_step": median(off, true),
             "dispatches_per_step": off.map(|r| r.work.dispatches),
             "barriers_per_step": off.map(|r| r.work.barriers),
+            "flip_dispatches_per_step": flip.map(|r| r.work.dispatches),
+            "sintel_step_ms_4it": median(sintel_row(peer::STYLED_4), false),
+            "sintel_step_ms_20it": median(sintel_row(peer::STYLED_20), false),
+            "peer_work_step_ms_4it": median(sintel_row(peer::PEER_WORK_4), false),
             "volume_gpu_ms_per_step": median(flip, false),
             "volume_cpu_ms_per_step": median(flip, true),
             "frame_ms_off": frame(thesis, OFF),
