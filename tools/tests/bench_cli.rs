@@ -128,3 +128,42 @@ fn require_gpu_refuses_a_cpu_device() {
         eprintln!("a GPU is present: --require-gpu accepted it (nothing to refuse here)");
     }
 }
+
+/// `tools/gpu-bench.sh --smoke` runs every goal of the GPU report (the thesis
+/// frame, the guides' FLIP step, the drawn strands with transparency) at toy
+/// sizes and writes one report naming each with the device and a GPU figure.
+#[test]
+fn the_gpu_bench_script_runs_every_goal_and_writes_one_report() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tools/gpu-bench.sh");
+    let mut command = std::process::Command::new("bash");
+    command
+        .arg(&script)
+        .arg("--smoke")
+        .env("VKHAIR_BIN", env!("CARGO_BIN_EXE_vkhair"))
+        .env("VKHAIR_OUT", dir.path())
+        .env("VKHAIR_VALIDATION", "1");
+    let r = common::run_command(&mut command, LIMIT);
+    assert!(r.status.success(), "{}\n{}", r.stdout, r.stderr);
+    let report = std::fs::read_to_string(dir.path().join("report.txt")).expect("report.txt");
+    let goals = ["a. thesis full frame", "b. simulation of 300 guides × 32 points, FLIP", "c. 7000 drawn strands"];
+    for goal in goals {
+        assert!(report.contains(goal), "{goal} missing from:\n{report}");
+    }
+    let figures: Vec<f64> = report
+        .lines()
+        .filter_map(|l| l.split_once("GPU ms per frame or step (timestamps, mean): "))
+        .map(|(_, x)| x.trim().parse().expect("a number"))
+        .collect();
+    assert_eq!(figures.len(), 3, "{report}");
+    assert!(figures.iter().all(|&x| x > 0.0), "{report}");
+    assert_eq!(report.matches(" key hairs × ").count(), 3, "each goal names its device and scene:\n{report}");
+    for json in ["thesis_frame.json", "guides_step.json", "strands_frame.json"] {
+        let text = std::fs::read_to_string(dir.path().join("goals").join(json)).expect(json);
+        let v: serde_json::Value = serde_json::from_str(&text).expect("parse");
+        assert!(v["passes"].as_array().is_some_and(|p| !p.is_empty()), "{json}: {v}");
+    }
+    let log = std::fs::read_to_string(dir.path().join("goals/log.txt")).expect("log");
+    assert!(!log.contains("vulkan: ") && !log.contains("panicked"), "{log}");
+    assert!(report.contains("smoke sizes") && !report.contains("bench:"), "the smoke run skips the bench:\n{report}");
+}
