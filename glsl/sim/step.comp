@@ -309,7 +309,10 @@ void main() {
     }
 
     for (uint sub = 0u; sub < step_range_count(push); sub++) {
-        params = steps[step_range_first(push) + sub];
+        // The first sub-step's parameters were loaded above.
+        if (sub > 0u) {
+            params = steps[step_range_first(push) + sub];
+        }
         collider_base = (step_range_first(push) + sub) * SIM_MAX_COLLIDERS;
         uint flags = step_flags();
         bool collisions = (flags & SIM_COLLISIONS) != 0u;
