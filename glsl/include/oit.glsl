@@ -36,11 +36,21 @@ layout(std430, set = 0, binding = 19) buffer OitNodes7 { uvec4 oit_nodes7[]; };
 // Per pixel: the nearest depth (float bits) of a fragment of alpha ≥ OIT_OPAQUE_ALPHA.
 layout(std430, set = 0, binding = 12) buffer OitOpaque { uint oit_opaque[]; };
 
+// Buffers the pool is split over (the pipeline's specialisation constant 0,
+// set from the pool by exact.rs; 8, the most, by default). With one buffer the
+// node index addresses it directly: no division, and no switch whose every
+// case a CPU device would run.
+layout(constant_id = 0) const uint OIT_POOL_BUFFERS = 8u;
+
 uint oit_pixel(vec4 frag_coord) {
     return uint(frag_coord.y) * oit.width + uint(frag_coord.x);
 }
 
 void oit_store(uint node, uvec4 record) {
+    if (OIT_POOL_BUFFERS == 1u) {
+        oit_nodes0[node] = record;
+        return;
+    }
     uint i = node % oit.pool_nodes;
     switch (node / oit.pool_nodes) {
         case 0u: oit_nodes0[i] = record; break;
@@ -55,6 +65,9 @@ void oit_store(uint node, uvec4 record) {
 }
 
 uvec4 oit_load(uint node) {
+    if (OIT_POOL_BUFFERS == 1u) {
+        return oit_nodes0[node];
+    }
     uint i = node % oit.pool_nodes;
     switch (node / oit.pool_nodes) {
         case 0u: return oit_nodes0[i];

@@ -279,27 +279,28 @@ impl TransparentPass {
         let mut buffers = shading_buffers.to_vec();
         buffers.extend_from_slice(&ours);
 
+        // The pool's buffer count specialises the list shaders (oit.glsl).
+        let pool_buffers = res.lists.as_ref().map(|lists| lists.pool.buffers);
         let points = ComputePipeline::new(d, &RENDER_SHADE_POINTS_COMP, 1)?;
         let points_set = points.declared_resource_set(0, &buffers, &shading_images)?;
         let build_stages = [&RENDER_RIBBON_VERT_COVERAGE, shaders.build];
-        let build = GraphicsPipeline::new(
+        let build = GraphicsPipeline::specialised(
             d,
-            &GraphicsDesc {
-                ..desc(
-                    "vkhair hair transparency build",
-                    &build_stages,
-                    &weighted_formats,
-                    has_depth,
-                    false,
-                    Blend::Additive,
-                )
-            },
+            &desc(
+                "vkhair hair transparency build",
+                &build_stages,
+                &weighted_formats,
+                has_depth,
+                false,
+                Blend::Additive,
+            ),
             1,
+            pool_buffers,
         )?;
         let build_set = build.declared_resource_set(0, &buffers, &shading_images)?;
 
         let composite_stages = [&RENDER_RESOLVE_VERT, shaders.composite];
-        let composite = GraphicsPipeline::new(
+        let composite = GraphicsPipeline::specialised(
             d,
             &desc(
                 "vkhair hair transparency composite",
@@ -310,6 +311,7 @@ impl TransparentPass {
                 Blend::Premultiplied,
             ),
             1,
+            pool_buffers,
         )?;
         let sums = [(0, res.sums.sum.view(), self.nearest.raw), (1, res.sums.absorbance.view(), self.nearest.raw)];
         let composite_set = composite.declared_resource_set(0, &ours, &sums)?;

@@ -54,6 +54,17 @@ pub(crate) struct GraphicsPipeline {
 
 impl GraphicsPipeline {
     pub(crate) fn new(device: &Arc<Device>, desc: &GraphicsDesc<'_>, max_sets: u32) -> Result<Self> {
+        Self::specialised(device, desc, max_sets, None)
+    }
+
+    /// As [`GraphicsPipeline::new`], with specialisation constant 0 (a `uint`)
+    /// of every stage that declares one set to `constant` when given.
+    pub(crate) fn specialised(
+        device: &Arc<Device>,
+        desc: &GraphicsDesc<'_>,
+        max_sets: u32,
+        constant: Option<u32>,
+    ) -> Result<Self> {
         let reflections = desc.stages.iter().map(|s| reflect(s)).collect::<Result<Vec<_>>>()?;
         let layout = Layout::new(device, desc.name, &reflections, max_sets)?;
         let mut modules = Vec::new();
@@ -73,6 +84,14 @@ impl GraphicsPipeline {
             .zip(&modules)
             .map(|(s, m)| vk::PipelineShaderStageCreateInfo::default().stage(s.stage.flags()).module(*m).name(c"main"))
             .collect();
+        // A stage that declares no constant 0 ignores the entry.
+        let entries = [vk::SpecializationMapEntry { constant_id: 0, offset: 0, size: 4 }];
+        let data = constant.unwrap_or(0).to_ne_bytes();
+        let specialization = vk::SpecializationInfo::default().map_entries(&entries).data(&data);
+        let stages: Vec<_> = match constant {
+            Some(_) => stages.into_iter().map(|stage| stage.specialization_info(&specialization)).collect(),
+            None => stages,
+        };
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
         let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(desc.topology);
         let tessellation =
