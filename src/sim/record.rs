@@ -38,8 +38,8 @@ impl HairSim {
     ) -> Result<()> {
         let timing = Timing::of(profiler.as_deref());
         let inputs = self.planner.next(head)?;
-        // The kernel specialised to the switches of these sub-steps (prepared
-        // already unless the parameters changed behind `set_params`' back).
+        // The kernel specialised to the switches of these sub-steps: prepared by
+        // `new`, `set_params` and `set_mesh_collider`, so found here.
         let features = inputs.iter().fold(0, |f, sub| f | sub.params.flags);
         self.pipeline.prepare_variant(features)?;
         // SAFETY (whole body): guaranteed by the caller; all buffers belong to this

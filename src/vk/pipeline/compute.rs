@@ -5,7 +5,7 @@ use std::sync::{Arc, Mutex};
 
 use ash::vk;
 
-use super::{shader_module, Layout};
+use super::{shader_module, ConstantZero, Layout};
 use crate::error::{Error, Result};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
@@ -243,16 +243,15 @@ fn create(
     } else {
         vk::PipelineShaderStageCreateFlags::empty()
     };
-    let entries = [vk::SpecializationMapEntry { constant_id: 0, offset: 0, size: 4 }];
-    let data = constant.unwrap_or(0).to_ne_bytes();
-    let specialization = vk::SpecializationInfo::default().map_entries(&entries).data(&data);
+    let constant = constant.map(ConstantZero::new);
+    let specialization = constant.as_ref().map(ConstantZero::info);
     let mut stage = vk::PipelineShaderStageCreateInfo::default()
         .flags(flags)
         .stage(vk::ShaderStageFlags::COMPUTE)
         .module(module)
         .name(c"main");
-    if constant.is_some() {
-        stage = stage.specialization_info(&specialization);
+    if let Some(info) = &specialization {
+        stage = stage.specialization_info(info);
     }
     let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout.raw);
     // SAFETY: module and layout are alive; the module is destroyed right after.

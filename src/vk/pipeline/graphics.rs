@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{shader_module, Layout};
+use super::{shader_module, ConstantZero, Layout};
 use crate::error::{Error, Result};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
@@ -84,12 +84,10 @@ impl GraphicsPipeline {
             .zip(&modules)
             .map(|(s, m)| vk::PipelineShaderStageCreateInfo::default().stage(s.stage.flags()).module(*m).name(c"main"))
             .collect();
-        // A stage that declares no constant 0 ignores the entry.
-        let entries = [vk::SpecializationMapEntry { constant_id: 0, offset: 0, size: 4 }];
-        let data = constant.unwrap_or(0).to_ne_bytes();
-        let specialization = vk::SpecializationInfo::default().map_entries(&entries).data(&data);
-        let stages: Vec<_> = match constant {
-            Some(_) => stages.into_iter().map(|stage| stage.specialization_info(&specialization)).collect(),
+        let constant = constant.map(ConstantZero::new);
+        let specialization = constant.as_ref().map(ConstantZero::info);
+        let stages: Vec<_> = match &specialization {
+            Some(info) => stages.into_iter().map(|stage| stage.specialization_info(info)).collect(),
             None => stages,
         };
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();

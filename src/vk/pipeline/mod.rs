@@ -277,6 +277,26 @@ impl Drop for Layout {
     }
 }
 
+/// Specialisation constant 0 (a `uint`) of a pipeline's stages; a stage that
+/// declares none ignores it.
+struct ConstantZero {
+    entries: [vk::SpecializationMapEntry; 1],
+    data: [u8; 4],
+}
+
+impl ConstantZero {
+    fn new(value: u32) -> Self {
+        ConstantZero {
+            entries: [vk::SpecializationMapEntry { constant_id: 0, offset: 0, size: 4 }],
+            data: value.to_ne_bytes(),
+        }
+    }
+
+    fn info(&self) -> vk::SpecializationInfo<'_> {
+        vk::SpecializationInfo::default().map_entries(&self.entries).data(&self.data)
+    }
+}
+
 fn shader_module(device: &Device, words: &[u32], name: &str) -> Result<vk::ShaderModule> {
     let info = vk::ShaderModuleCreateInfo::default().code(words);
     // SAFETY: the words are SPIR-V validated by spirv-val at build time.
