@@ -553,3 +553,126 @@ fn styled_grooms_still_move() {
     eprintln!("mohawk shaken: tip lag p50 {:.4}", p(&lag, 50));
     assert!(p(&lag, 50) >= 0.03, "the tips followed the head rigidly: lag {}", p(&lag, 50));
 }
+
+/// Runs `steps` steps of GPU and CPU from step `start`, then compares them bit
+/// for bit on lavapipe (within the tolerance elsewhere).
+#[allow(clippy::too_many_arguments, reason = "a test helper naming what it compares")]
+fn run_both(
+    ctx: &GpuContext,
+    gpu: &mut HairSim,
+    cpu: &mut CpuHairSim,
+    start: usize,
+    steps: usize,
+    params: &SimParams,
+    what: &str,
+) -> SimState {
+    gpu.run(steps, |i| head_at(start + i, params), None).expect("gpu run");
+    for i in start..start + steps {
+        cpu.step(&head_at(i, params)).expect("cpu step");
+    }
+    let g = gpu.read_state().expect("readback");
+    assert_finite(&g);
+    let (max, _) = max_difference(&g, cpu.state());
+    assert!(max <= POSITION_TOLERANCE, "{what}: GPU and CPU differ by {max} m");
+    if common::on_lavapipe(ctx) {
+        assert!(common::bits(&g) == common::bits(cpu.state()), "{what}: not bit for bit on lavapipe");
+    }
+    g
+}
+
+/// Simulation level of detail: with a share of the key hairs simulated and the
+/// rest following them, changed between steps, the GPU matches the CPU
+/// reference bit for bit on lavapipe (the volume stage off, with density
+/// friction, with sub-steps); followers' roots stay on the head; and counts
+/// outside 1..=key hairs are refused.
+#[test]
+fn a_level_of_detail_matches_the_cpu_at_every_change() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(60, 12, 9);
+    let friction = vkhair::sim::VolumeParams { mode: vkhair::sim::VolumeMode::Friction, ..Default::default() };
+    let cases = [
+        ("volume off", SimParams { iterations: 6, ..SimParams::default() }),
+        (
+            "density friction, 2 sub-steps",
+            SimParams { iterations: 4, substeps: 2, volume: friction, ..SimParams::default() },
+        ),
+    ];
+    for (name, params) in cases {
+        let head0 = RigidTransform::default();
+        let mut g = HairSim::new(gpu.ctx(), &groom, &params, &head0).expect("gpu sim");
+        let mut c = CpuHairSim::new(&groom, &params, &head0).expect("cpu sim");
+        g.set_colliders(&motion::thesis_colliders()).expect("colliders");
+        c.set_colliders(&motion::thesis_colliders()).expect("colliders");
+        let mut done = 0;
+        for count in [60, 15, 1, 40, 60] {
+            g.set_simulated_hairs(count).expect("gpu level");
+            c.set_simulated_hairs(count).expect("cpu level");
+            assert_eq!(g.simulated_hairs(), count);
+            let state = run_both(gpu.ctx(), &mut g, &mut c, done, 6, &params, &format!("{name}, {count} simulated"));
+            done += 6;
+            let head = head_at(done - 1, &params).matrix();
+            for (p, r) in state.positions.iter().zip(&state.rest) {
+                if p.w == 0.0 {
+                    let pinned = head.transform_point3(r.truncate());
+                    assert!(p.truncate().distance(pinned) < 1e-5, "{name}: a root left the head");
+                }
+            }
+        }
+        for bad in [0, 61] {
+            let e = g.set_simulated_hairs(bad).expect_err("refused").to_string();
+            assert!(e.contains("simulated key hairs") && e.contains("1..=60"), "{e}");
+            assert!(c.set_simulated_hairs(bad).is_err());
+        }
+    }
+}
+
+/// The largest distance between the same point in two states.
+fn largest_gap(a: &SimState, b: &SimState) -> f32 {
+    a.positions.iter().zip(&b.positions).map(|(p, q)| (*p - *q).truncate().length()).fold(0.0, f32::max)
+}
+
+/// No pop when the level drops: during the shake three quarters of the key
+/// hairs stop being simulated, and the gap between that run and one that keeps
+/// every hair simulated grows over steps rather than at once — one step after
+/// the drop it is under 30 % of what it is 30 steps later, when the followers
+/// have taken their guides' shape (snapping them onto it at once would open
+/// the whole gap in the first step). Raising it again moves no hair by a jump
+/// either: the step where they rejoin moves no point more than twice as far as
+/// the step before moved one.
+#[test]
+fn dropping_the_level_moves_no_hair_by_a_jump() {
+    let groom = common::grown_groom(120, 12, 4);
+    let params = SimParams { iterations: 8, ..SimParams::default() };
+    let head0 = RigidTransform::default();
+    let start = || {
+        let mut sim = CpuHairSim::new(&groom, &params, &head0).expect("cpu sim");
+        sim.set_colliders(&motion::thesis_colliders()).expect("colliders");
+        for i in 0..30 {
+            sim.step(&head_at(i, &params)).expect("step");
+        }
+        sim
+    };
+    let (mut full, mut dropped) = (start(), start());
+    dropped.set_simulated_hairs(30).expect("level");
+    let mut gaps = Vec::new();
+    for i in 30..60 {
+        full.step(&head_at(i, &params)).expect("step");
+        dropped.step(&head_at(i, &params)).expect("step");
+        gaps.push(largest_gap(full.state(), dropped.state()));
+    }
+    let (first, last) = (gaps[0], gaps[29]);
+    eprintln!("gap to the fully simulated run: {first} m after one step, {last} m after 30");
+    assert!(last > 0.01, "the followers never left the simulated shape ({last} m)");
+    assert!(first < 0.3 * last, "the level drop moved followers {first} m at once (of {last} m)");
+    // Rejoining: every hair simulated again, the step moves no point more than
+    // twice as far as the farthest point moved in the step before.
+    let previous = dropped.state().clone();
+    dropped.step(&head_at(60, &params)).expect("step");
+    let following = largest_gap(&previous, dropped.state());
+    dropped.set_simulated_hairs(120).expect("level");
+    let previous = dropped.state().clone();
+    dropped.step(&head_at(61, &params)).expect("step");
+    let rejoined = largest_gap(&previous, dropped.state());
+    eprintln!("largest move when the hairs rejoin: {rejoined} m (in the step before: {following} m)");
+    assert!(rejoined <= 2.0 * following, "rejoining moved a point {rejoined} m (against {following} m)");
+}

@@ -75,7 +75,10 @@ layout(std430, set = 0, binding = 10) readonly buffer MeshField { float mesh_fie
 // The positions before the step: written by its first sub-step, for drawing
 // between the last two states (render's blend by the fixed-step driver's alpha).
 layout(std430, set = 0, binding = 11) writeonly buffer PosBefore { vec4 pos_before[]; };
-#include "mesh_sdf.glsl"
+// The key hairs in level-of-detail order (sim/lod.rs): the dispatch simulates
+// the first step_range_simulated(push) of them; follow.comp moves the others.
+layout(std430, set = 0, binding = 12) readonly buffer SimOrder { uint sim_order[]; };
+#include "sim_bodies.glsl"
 
 shared vec4 s_pos[2][SIM_WORKGROUP];
 shared float s_length[SIM_WORKGROUP];
@@ -105,19 +108,9 @@ void sync(uint group) {
     }
 }
 
-// The mesh collider's grid of the sub-step being run.
-MeshGrid mesh_grid() {
-    return MeshGrid(sim_mesh_origin(params), sim_mesh_cell(params), sim_mesh_dims(params));
-}
-
+// p projected out of the bodies of the sub-step being run.
 vec3 collide_all(vec3 p, float radius) {
-    for (uint c = 0u; c < sim_colliders(params); c++) {
-        p = sim_collide(colliders[collider_base + c], p, radius);
-    }
-    if ((step_flags() & SIM_MESH) != 0u) {
-        p = mesh_collide(sim_head(params), mesh_grid(), p, radius);
-    }
-    return p;
+    return sim_collide_bodies(params, step_flags(), collider_base, p, radius);
 }
 
 // One end of a constraint between this invocation's point `own` and the point
@@ -239,18 +232,20 @@ void main() {
     uint in_sync = lane / points;
     uint i = lane - in_sync * points;
     uint hair = sync_index * per_sync + in_sync;
-    uint strand = gl_WorkGroupID.x * per_group + hair;
-    bool live = in_sync < per_sync && hair < per_group && strand < sim_strands(params);
+    uint slot = gl_WorkGroupID.x * per_group + hair;
+    uint simulated = step_range_simulated(push);
+    bool live = in_sync < per_sync && hair < per_group && slot < simulated;
+    uint strand = live ? sim_order[slot] : 0u;
     uint index = strand * points + i;
     uint base = strand * points;
     // The sequential sweeps (local shape, DFTL) of the sync group's hairs run on
     // its first lanes side by side, lane h for its h-th hair, rather than on each
     // hair's root: neighbouring lanes share a SIMD batch or subgroup.
     uint swept = sync_index * per_sync + lane;
-    uint swept_strand = gl_WorkGroupID.x * per_group + swept;
-    bool sweeps = lane < per_sync && swept < per_group && swept_strand < sim_strands(params);
+    uint swept_slot = gl_WorkGroupID.x * per_group + swept;
+    bool sweeps = lane < per_sync && swept < per_group && swept_slot < simulated;
     uint sweep_root = sync_index * group + lane * points;
-    uint sweep_base = swept_strand * points;
+    uint sweep_base = sweeps ? sim_order[swept_slot] * points : 0u;
 
     // What stays the same over the step: the state (in registers from here to the
     // store), the rest data and each constraint set's partner, rest distance and
@@ -409,7 +404,7 @@ void main() {
                 src = 1u - src;
             }
             if ((flags & SIM_MESH) != 0u && collisions && live && own.w > 0.0) {
-                own.xyz = mesh_friction(sim_head(params), sim_previous_head(params), mesh_grid(), own.xyz,
+                own.xyz = mesh_friction(sim_head(params), sim_previous_head(params), sim_mesh_grid(params), own.xyz,
                                         x.xyz, radius, sim_mesh_friction(params));
             }
         }

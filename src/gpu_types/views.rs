@@ -54,6 +54,9 @@ shader_views! {
         bending_tip: float = bending.y,
         /// DFTL velocity correction factor.
         dftl_damping: float = bending.z,
+        /// Share of a follower's deviation from its guide kept per step
+        /// (`sim::lod::FOLLOW_FADE`).
+        follow_fade: float = bending.w,
         /// Key hairs.
         strands: uint = counts.x,
         /// Points per key hair.
@@ -98,6 +101,9 @@ shader_views! {
         first: uint = range.x,
         /// How many sub-steps.
         count: uint = range.y,
+        /// How many key hairs are simulated: the first of the level-of-detail
+        /// order (`sim::lod`); the others follow them.
+        simulated: uint = range.z,
     }
 
     /// One collider in world space at one sub-step (`Collider`).

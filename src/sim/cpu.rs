@@ -1,5 +1,6 @@
 //! The CPU reference simulation.
 
+use super::lod::SimLod;
 use super::planner::SubstepPlanner;
 use super::{reference, volume, Collider, RigidTransform, SimParams, SimState, VolumeGrid, VolumeMode, MAX_SIM_POINTS};
 use crate::error::Result;
@@ -40,6 +41,8 @@ pub struct CpuHairSim {
     mesh: Option<MeshSdf>,
     /// Wall time of the volume stage in the latest step.
     volume_time: std::time::Duration,
+    /// Which key hairs are simulated, and whom the others follow.
+    lod: SimLod,
 }
 
 impl CpuHairSim {
@@ -54,7 +57,8 @@ impl CpuHairSim {
         // The CPU runs the same constraint sets in the same order whatever the packing.
         let planner = SubstepPlanner::new(params, head, state.strands, state.points, MAX_SIM_POINTS as u32)?;
         let volume = cpu_volume_grid(params, &state)?;
-        Ok(CpuHairSim { planner, state, volume, last_volume: None, mesh: None, volume_time: Default::default() })
+        let lod = SimLod::new(&state);
+        Ok(CpuHairSim { planner, state, volume, last_volume: None, mesh: None, volume_time: Default::default(), lod })
     }
 
     /// See [`HairSim::set_params`](super::HairSim::set_params).
@@ -88,9 +92,22 @@ impl CpuHairSim {
     pub fn step(&mut self, head: &RigidTransform) -> Result<()> {
         let inputs = self.planner.next(head)?;
         self.volume_time = std::time::Duration::ZERO;
-        for sub in &inputs {
+        let active = self.lod.active();
+        // The positions the followers start from: of the step without the volume
+        // stage (the GPU runs its sub-steps in one dispatch, then the followers),
+        // of each sub-step with it.
+        let mut before = active.map(|_| self.state.positions.clone());
+        for (k, sub) in inputs.iter().enumerate() {
             let mesh = self.mesh.as_ref().map(reference::MeshField::new);
-            reference::step(&mut self.state, std::slice::from_ref(sub), mesh);
+            reference::step(&mut self.state, std::slice::from_ref(sub), mesh, active);
+            if let Some(before) = &mut before {
+                if self.volume.is_some() {
+                    reference::follow(&mut self.state, before, &self.lod.guides, std::slice::from_ref(sub), mesh);
+                    before.clone_from(&self.state.positions);
+                } else if k + 1 == inputs.len() {
+                    reference::follow(&mut self.state, before, &self.lod.guides, &inputs, mesh);
+                }
+            }
             if let Some(grid) = &self.volume {
                 let started = std::time::Instant::now();
                 let vp = &self.planner.params.volume;
@@ -129,6 +146,16 @@ impl CpuHairSim {
     /// The current state.
     pub fn state(&self) -> &SimState {
         &self.state
+    }
+
+    /// As [`HairSim::set_simulated_hairs`](super::HairSim::set_simulated_hairs).
+    pub fn set_simulated_hairs(&mut self, count: usize) -> Result<()> {
+        self.lod.set(count)
+    }
+
+    /// As [`HairSim::simulated_hairs`](super::HairSim::simulated_hairs).
+    pub fn simulated_hairs(&self) -> usize {
+        self.lod.simulated
     }
 }
 

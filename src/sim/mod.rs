@@ -28,7 +28,13 @@
 //!    and one store of the final state into the other half of the double
 //!    buffer. With the volume stage off, the one dispatch runs every sub-step
 //!    of the step; with it on, one dispatch per sub-step, since the volume
-//!    stage exchanges velocities between all hairs after each.
+//!    stage exchanges velocities between all hairs after each. With a level of
+//!    detail ([`HairSim::set_simulated_hairs`]) the dispatch covers only the
+//!    simulated key hairs;
+//!
+//!    1b. **Followers** (`lod.rs`, `glsl/sim/follow.comp`), with a level of
+//!    detail only: one dispatch after each step dispatch moves the key hairs
+//!    left out with their guides ([`SimStage::Follow`]).
 //! 2. **Volume** ([`volume`], `glsl/sim/volume/`), when
 //!    [`SimParams::volume`] switches it on: particles sorted into a MAC grid,
 //!    then either FLIP (pressure projection with a GPU conjugate-gradient solve)
@@ -45,6 +51,7 @@
 mod body;
 mod cpu;
 mod driver;
+pub mod lod;
 mod mesh_collider;
 pub mod motion;
 mod packing;
@@ -65,6 +72,7 @@ pub(crate) use body::validate_colliders;
 pub use body::{Collider, RigidTransform, MAX_COLLIDERS};
 pub use cpu::{CpuHairSim, REFERENCE_STEP_TOLERANCE_M};
 pub use driver::{FixedStepDriver, StepPlan};
+pub use lod::FOLLOW_FADE;
 pub use mesh_collider::{MeshCollider, MeshColliderParams, MESH_COLLIDER_BUILD_LABEL};
 pub use params::{SimParams, SolverMode, MAX_SIM_POINTS, MAX_SUBSTEPS};
 pub use state::SimState;
@@ -78,6 +86,7 @@ use crate::groom::Groom;
 use crate::profiler::GpuProfiler;
 use crate::vk::device::Device;
 use crate::vk::pipeline::ComputePipeline;
+use crate::vk::shaders::SIM_FOLLOW_COMP;
 use planner::SubstepPlanner;
 use state::GpuState;
 
@@ -88,6 +97,9 @@ pub enum SimStage {
     /// Stage 1: prediction, constraint solve and velocity update of the sub-steps
     /// (all of a step's with the volume stage off, else one), one dispatch.
     Step,
+    /// Stage 1b (with a level of detail, [`HairSim::set_simulated_hairs`]): the
+    /// key hairs left out follow their guides, one dispatch after each step dispatch.
+    Follow,
     /// Stage 2a: binning and counting sort of particles by grid cell.
     VolumeSort,
     /// Stage 2b: cell densities and labels, particle velocities to the MAC faces.
@@ -100,8 +112,9 @@ pub enum SimStage {
 
 impl SimStage {
     /// Every stage in execution order.
-    pub const ALL: [SimStage; 5] = [
+    pub const ALL: [SimStage; 6] = [
         SimStage::Step,
+        SimStage::Follow,
         SimStage::VolumeSort,
         SimStage::VolumeTransfer,
         SimStage::VolumePressure,
@@ -116,6 +129,7 @@ impl SimStage {
     pub fn label(self) -> &'static str {
         match self {
             SimStage::Step => "vkhair sim: step",
+            SimStage::Follow => "vkhair sim: followers",
             SimStage::VolumeSort => "vkhair sim: volume sort",
             SimStage::VolumeTransfer => "vkhair sim: volume transfer",
             SimStage::VolumePressure => "vkhair sim: volume pressure",
@@ -183,6 +197,13 @@ pub struct HairSim {
     volume: Option<volume::VolumeStage>,
     /// The mesh collider, when set.
     mesh: Option<MeshCollider>,
+    /// Which key hairs are simulated, and whom the others follow.
+    lod: lod::SimLod,
+    /// Whether the guides changed since they were last uploaded.
+    pending_guides: bool,
+    /// The follower kernel, with its sets reading half 0 and half 1.
+    follow: ComputePipeline,
+    follow_sets: [vk::DescriptorSet; 2],
 }
 
 impl HairSim {
@@ -200,7 +221,13 @@ impl HairSim {
         // synchronises whole workgroups.
         let subgroup = if device.full_subgroups { device.info.subgroup_size } else { 0 };
         let planner = SubstepPlanner::new(params, head, state.strands, state.points, subgroup)?;
-        let gpu = GpuState::new(&device, state)?;
+        let lod = lod::SimLod::new(state);
+        let gpu = GpuState::new(&device, state, &lod)?;
+        let follow = ComputePipeline::new(&device, &SIM_FOLLOW_COMP, 2)?;
+        let follow_sets = [
+            follow.declared_buffer_set(0, &gpu.follow_bindings(0, None))?,
+            follow.declared_buffer_set(0, &gpu.follow_bindings(1, None))?,
+        ];
         let pipeline = ComputePipeline::with_full_subgroups(&device, step::SHADER, 2, device.full_subgroups)?;
         let sets = [
             pipeline.declared_buffer_set(0, &gpu.bindings(0, None))?,
@@ -217,6 +244,10 @@ impl HairSim {
             current: 0,
             volume: None,
             mesh: None,
+            lod,
+            pending_guides: false,
+            follow,
+            follow_sets,
         };
         sim.configure_volume(&params.volume)?;
         sim.prepare_step()?;
@@ -272,6 +303,27 @@ impl HairSim {
         self.prepare_step()
     }
 
+    /// Simulates only `count` key hairs from the next step on (1 up to every key
+    /// hair; all by default): the first `count` of a spatially progressive
+    /// order of the roots, so that they spread over the scalp at any count. The
+    /// others follow them, each keeping its rest offset from a simulated
+    /// neighbour (its guide) turned with the head, roots pinned; a hair that
+    /// stops being simulated fades into that shape over a few steps
+    /// ([`FOLLOW_FADE`] of its deviation kept per step), one that rejoins
+    /// starts from where it was drawn (see [`lod`]). A step
+    /// then costs about as much as one of `count` key hairs, plus one follower
+    /// dispatch. [`CpuHairSim::set_simulated_hairs`] does the same.
+    pub fn set_simulated_hairs(&mut self, count: usize) -> Result<()> {
+        self.lod.set(count)?;
+        self.pending_guides = true;
+        Ok(())
+    }
+
+    /// How many key hairs are simulated (see [`HairSim::set_simulated_hairs`]).
+    pub fn simulated_hairs(&self) -> usize {
+        self.lod.simulated
+    }
+
     /// Replaces the colliders (in the head frame; at most [`MAX_COLLIDERS`]).
     pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
         self.planner.set_colliders(colliders)
@@ -296,6 +348,10 @@ impl HairSim {
             // SAFETY: the set was allocated by this pipeline for set 0, and the
             // device is idle; recording happens only through `&mut self`.
             unsafe { self.pipeline.rewrite_declared(set, 0, &self.gpu.bindings(parity, field))? };
+        }
+        for (parity, &set) in self.follow_sets.iter().enumerate() {
+            // SAFETY: as above, for the follower kernel's sets.
+            unsafe { self.follow.rewrite_declared(set, 0, &self.gpu.follow_bindings(parity, field))? };
         }
         self.planner.mesh = mesh.as_ref().map(MeshCollider::grid);
         let previous = std::mem::replace(&mut self.mesh, mesh);
@@ -429,7 +485,8 @@ impl HairSim {
     /// Runs `steps` steps with the head at `head(i)` for step i, in one submission
     /// (headless use: tests, tools, benchmarks; this submits and waits). With a
     /// profiler, returns the per-stage GPU timings of the whole run (the profiler
-    /// needs one scope per step, or 5 per sub-step with the volume stage).
+    /// needs one scope per step, or 5 per sub-step with the volume stage, and
+    /// one more per step or sub-step with a level of detail).
     pub fn run(
         &mut self,
         steps: usize,

@@ -47,6 +47,7 @@ impl HairSim {
         unsafe {
             self.record_uploads(cmd, &inputs);
             self.pending_rest.clear();
+            self.pending_guides = false;
             let Some(volume) = &self.volume else {
                 self.record_dispatch(cmd, self.current, [0, inputs.len() as u32], features, timing);
                 self.current = 1 - self.current;
@@ -91,6 +92,10 @@ impl HairSim {
                 let offset = state::collider_offset(k);
                 let colliders = gpu_colliders(&sub.colliders);
                 d.raw.cmd_update_buffer(cmd, self.gpu.colliders.raw(), offset, bytemuck::cast_slice(&colliders));
+            }
+            if self.pending_guides {
+                let guides = bytemuck::cast_slice(&self.lod.guides);
+                update_chunked(d, cmd, self.gpu.guides.raw(), 0, guides);
             }
             for range in &self.pending_rest {
                 let rest = bytemuck::cast_slice(&self.shape.rest[range.clone()]);
@@ -138,14 +143,25 @@ impl HairSim {
         timing: Timing<'_>,
     ) {
         let (strands, groups) = (self.planner.strands, self.planner.packing().hairs_per_group);
-        let push = SimPush::from(&StepRange { first: range[0], count: range[1] });
+        let simulated = self.lod.simulated as u32;
+        let push = SimPush::from(&StepRange { first: range[0], count: range[1], simulated });
         // SAFETY: guaranteed by the caller.
         unsafe {
             PassScope::record(&self.device, cmd, timing, SimStage::Step.label(), LabelColor::Compute, || {
                 self.pipeline.bind_variant(cmd, features, &[self.sets[parity]]);
                 self.pipeline.push(cmd, &push);
-                self.pipeline.dispatch_threads(cmd, [step::threads(strands, groups), 1, 1]);
+                self.pipeline.dispatch_threads(cmd, [step::threads(simulated, groups), 1, 1]);
             });
+            if simulated < strands {
+                // The followers read the guides the step wrote.
+                let stepped = barrier::memory(&[AccessKind::ComputeWrite], barrier::COMPUTE_READ_WRITE);
+                self.device.cmd_barrier(cmd, &[stepped], &[], &[]);
+                PassScope::record(&self.device, cmd, timing, SimStage::Follow.label(), LabelColor::Compute, || {
+                    self.follow.bind(cmd, &[self.follow_sets[parity]]);
+                    self.follow.push(cmd, &push);
+                    self.follow.dispatch_threads(cmd, [strands - simulated, 1, 1]);
+                });
+            }
         }
     }
 }

@@ -225,11 +225,19 @@ fn project(s: &mut [Vec4], i: usize, j: usize, rest_d: f32, k: f32) {
     }
 }
 
+/// Whether strand `s` is simulated (every strand without a level of detail).
+fn simulated(active: Option<&[bool]>, s: usize) -> bool {
+    active.is_none_or(|a| a[s])
+}
+
 /// Stage 1: forces and prediction.
-fn predict(p: &SimStep, state: &SimState, predicted: &mut [Vec4]) {
+fn predict(p: &SimStep, state: &SimState, active: Option<&[bool]>, predicted: &mut [Vec4]) {
     let points = p.points as usize;
     let (dt, flags, gravity, wind) = (p.dt, p.flags, p.gravity, p.wind);
     for (index, out) in predicted.iter_mut().enumerate() {
+        if !simulated(active, index / points) {
+            continue;
+        }
         let strand = (index / points) as u32;
         let x = state.positions[index];
         let rest_world = transform_point(&p.head, state.rest[index].truncate());
@@ -259,6 +267,7 @@ fn solve(
     colliders: &[ColliderShape],
     mesh: Option<MeshField<'_>>,
     state: &SimState,
+    active: Option<&[bool]>,
     predicted: &mut [Vec4],
     correction: &mut [Vec4],
 ) {
@@ -277,7 +286,7 @@ fn solve(
     let global_shape = flags & flags::GLOBAL_SHAPE != 0;
     let (shape_stiffness, shape_range) = (p.global_shape, p.global_shape_range);
     let mut shape = vec![(Vec3::ZERO, 0.0f32); points];
-    for strand in 0..p.strands as usize {
+    for strand in (0..p.strands as usize).filter(|&strand| simulated(active, strand)) {
         let base = strand * points;
         s.copy_from_slice(&predicted[base..base + points]);
         let lengths = &state.rest_lengths[base..base + points];
@@ -398,11 +407,14 @@ fn solve(
 }
 
 /// Stage 3: velocity update, damping, final state.
-fn integrate(p: &SimStep, state: &mut SimState, predicted: &[Vec4], correction: &[Vec4]) {
+fn integrate(p: &SimStep, state: &mut SimState, active: Option<&[bool]>, predicted: &[Vec4], correction: &[Vec4]) {
     let points = p.points as usize;
     let dt = p.dt;
     let dftl = p.flags & flags::DFTL != 0;
     for index in 0..predicted.len() {
+        if !simulated(active, index / points) {
+            continue;
+        }
         let i = index % points;
         let solved = predicted[index];
         let mut v = (solved.truncate() - state.positions[index].truncate()) / dt;
@@ -415,14 +427,112 @@ fn integrate(p: &SimStep, state: &mut SimState, predicted: &[Vec4], correction: 
     }
 }
 
-/// Advances `state` by the given sub-steps, with the mesh collider's field when set.
-pub(crate) fn step(state: &mut SimState, substeps: &[SubstepInputs], mesh: Option<MeshField<'_>>) {
+/// Advances `state` by the given sub-steps, with the mesh collider's field when
+/// set; with `active`, only the strands it marks (the others are left as they are).
+pub(crate) fn step(
+    state: &mut SimState,
+    substeps: &[SubstepInputs],
+    mesh: Option<MeshField<'_>>,
+    active: Option<&[bool]>,
+) {
     let n = state.positions.len();
     let mut predicted = vec![Vec4::ZERO; n];
     let mut correction = vec![Vec4::ZERO; n];
     for sub in substeps {
-        predict(&sub.params, state, &mut predicted);
-        solve(&sub.params, &sub.colliders, mesh, state, &mut predicted, &mut correction);
-        integrate(&sub.params, state, &predicted, &correction);
+        predict(&sub.params, state, active, &mut predicted);
+        solve(&sub.params, &sub.colliders, mesh, state, active, &mut predicted, &mut correction);
+        integrate(&sub.params, state, active, &predicted, &correction);
+    }
+}
+
+/// A frame of `follow`: three columns.
+type Frame = [Vec3; 3];
+
+/// `frame_apply` of `glsl/sim/follow.comp`.
+fn frame_apply(q: &Frame, v: Vec3) -> Vec3 {
+    (q[0] * v.x + q[1] * v.y) + q[2] * v.z
+}
+
+/// `transport` of `glsl/sim/follow.comp`.
+fn transport(q: Frame, rest_segment: Vec3, segment: Vec3) -> Frame {
+    let carried = frame_apply(&q, rest_segment);
+    let rest_len = dot(carried, carried).sqrt();
+    let len = dot(segment, segment).sqrt();
+    if rest_len > 0.0 && len > 0.0 {
+        let (a, b) = (carried / rest_len, segment / len);
+        return q.map(|column| rotate_between(a, b, column));
+    }
+    q
+}
+
+/// The followers of a level of detail after sub-steps `substeps` (as
+/// `glsl/sim/follow.comp`, whose header gives the rule): each strand whose
+/// guide (`guides`) is another one takes its own rest segments turned by its
+/// guide's frames (transported down the guide from the head's), plus its
+/// deviation from that shape before the sub-steps (`before`: the positions
+/// then) times the fade, each point placed at its segment's rest length from
+/// the one before and out of the bodies of the last sub-step (`mesh`: the
+/// mesh collider's field); roots stay pinned to the head; the velocity is the
+/// motion over the sub-steps.
+pub(crate) fn follow(
+    state: &mut SimState,
+    before: &[Vec4],
+    guides: &[u32],
+    substeps: &[SubstepInputs],
+    mesh: Option<MeshField<'_>>,
+) {
+    let (Some(first), Some(last)) = (substeps.first(), substeps.last()) else {
+        return;
+    };
+    let (start, end) = (&first.params, &last.params);
+    let collisions = end.flags & flags::COLLISIONS != 0;
+    let mesh = mesh.filter(|_| end.flags & flags::MESH != 0);
+    let bodies = Bodies { colliders: &last.colliders, mesh, head: &end.head };
+    let points = state.points;
+    let span = end.dt * substeps.len() as f32;
+    let columns = |m: &Mat4| [m.col(0).truncate(), m.col(1).truncate(), m.col(2).truncate()];
+    for (f, &g) in guides.iter().enumerate() {
+        let g = g as usize;
+        if g == f {
+            continue;
+        }
+        let (mut q_old, mut q_new) = (columns(&start.previous_head), columns(&end.head));
+        let (mut y_old, mut y_new) = (Vec3::ZERO, Vec3::ZERO);
+        let (mut placed_before, mut rest_length) = (Vec3::ZERO, 0.0f32);
+        for i in 0..points {
+            let (fi, gi) = (f * points + i, g * points + i);
+            let old = before[fi];
+            let rest = state.rest[fi].truncate();
+            if i == 0 {
+                y_old = transform_point(&start.previous_head, rest);
+                y_new = transform_point(&end.head, rest);
+            } else {
+                let rest_segment = state.rest[gi].truncate() - state.rest[gi - 1].truncate();
+                let old_segment = before[gi].truncate() - before[gi - 1].truncate();
+                let new_segment = state.positions[gi].truncate() - state.positions[gi - 1].truncate();
+                q_old = transport(q_old, rest_segment, old_segment);
+                q_new = transport(q_new, rest_segment, new_segment);
+                let own_segment = rest - state.rest[fi - 1].truncate();
+                rest_length = dot(own_segment, own_segment).sqrt();
+                y_old += frame_apply(&q_old, own_segment);
+                y_new += frame_apply(&q_new, own_segment);
+            }
+            let x = if old.w == 0.0 || i == 0 {
+                y_new.extend(old.w)
+            } else {
+                let kept = (old.truncate() - y_old) * end.follow_fade;
+                let target = y_new + kept;
+                let d = target - placed_before;
+                let len = dot(d, d).sqrt();
+                let mut p = if len > 0.0 { placed_before + d * (rest_length / len) } else { target };
+                if collisions {
+                    p = bodies.collide(p, state.rest[fi].w);
+                }
+                p.extend(old.w)
+            };
+            placed_before = x.truncate();
+            state.positions[fi] = x;
+            state.velocities[fi] = ((x.truncate() - old.truncate()) / span).extend(0.0);
+        }
     }
 }

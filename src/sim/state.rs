@@ -19,6 +19,7 @@ use std::sync::Arc;
 use glam::{Vec3, Vec4};
 
 use super::body::{RigidTransform, MAX_COLLIDERS};
+use super::lod::SimLod;
 use super::params::{SimParams, MAX_SIM_POINTS, MAX_SUBSTEPS};
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuCollider, SimStepParams};
@@ -172,6 +173,9 @@ pub(crate) struct GpuState {
     pub params: Buffer,
     /// Bound as the mesh collider's field while none is set (never read then).
     pub no_mesh: Buffer,
+    /// The key hairs in level-of-detail order (`sim::lod`), and each one's guide.
+    pub order: Buffer,
+    pub guides: Buffer,
 }
 
 /// Byte offset of sub-step `k`'s colliders in [`GpuState::colliders`].
@@ -191,11 +195,14 @@ pub(crate) mod binding {
     pub const VEL_OUT: u32 = 9;
     pub const MESH_FIELD: u32 = 10;
     pub const POS_BEFORE: u32 = 11;
+    pub const ORDER: u32 = 12;
+    /// The follower kernel's (`glsl/sim/follow.comp`) only.
+    pub const GUIDES: u32 = 13;
 }
 
 impl GpuState {
     /// Creates the buffers and uploads `state` into half 0 (this submits and waits).
-    pub(crate) fn new(device: &Arc<Device>, state: &SimState) -> Result<Self> {
+    pub(crate) fn new(device: &Arc<Device>, state: &SimState, lod: &SimLod) -> Result<Self> {
         let n = state.positions.len() as u64;
         let vec4_bytes = n * 16;
         if vec4_bytes > u64::from(device.info.max_storage_buffer_range) {
@@ -224,8 +231,12 @@ impl GpuState {
                 u64::from(MAX_SUBSTEPS) * std::mem::size_of::<SimStepParams>() as u64,
             )?,
             no_mesh: storage("vkhair sim no mesh collider", 16)?,
+            order: storage("vkhair sim level-of-detail order", 4 * state.strands as u64)?,
+            guides: storage("vkhair sim followers' guides", 4 * state.strands as u64)?,
         };
         gpu.upload(device, state, 0)?;
+        device.upload_pod(&gpu.order, &lod.order.order)?;
+        device.upload_pod(&gpu.guides, &lod.guides)?;
         device.upload_pod(&gpu.rest, &state.rest)?;
         device.upload_pod(&gpu.rest_lengths, &state.rest_lengths)?;
         Ok(gpu)
@@ -242,7 +253,7 @@ impl GpuState {
 
     /// Buffers by binding number for half `parity` (reads `parity`, writes the other),
     /// with `mesh` as the mesh collider's field (none: the placeholder).
-    pub(crate) fn bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 10] {
+    pub(crate) fn bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 11] {
         use binding::*;
         [
             (PARAMS, &self.params),
@@ -255,6 +266,24 @@ impl GpuState {
             (VEL_OUT, &self.velocities[1 - parity]),
             (MESH_FIELD, mesh.unwrap_or(&self.no_mesh)),
             (POS_BEFORE, &self.before),
+            (ORDER, &self.order),
+        ]
+    }
+
+    /// The follower kernel's buffers for half `parity` (as [`GpuState::bindings`]).
+    pub(crate) fn follow_bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 10] {
+        use binding::*;
+        [
+            (COLLIDERS, &self.colliders),
+            (MESH_FIELD, mesh.unwrap_or(&self.no_mesh)),
+            (PARAMS, &self.params),
+            (POS_IN, &self.positions[parity]),
+            (REST, &self.rest),
+            (POS_OUT, &self.positions[1 - parity]),
+            (VEL_OUT, &self.velocities[1 - parity]),
+            (POS_BEFORE, &self.before),
+            (ORDER, &self.order),
+            (GUIDES, &self.guides),
         ]
     }
 }

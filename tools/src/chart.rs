@@ -230,7 +230,8 @@ fn scaling_panels(table: &Table, root: &DrawingArea<BitMapBackend<'_>, Shift>) -
         }
     }
     let palette = vec!["GPU".to_owned(), "CPU reference".to_owned()];
-    let panels = root.split_evenly((2, 2));
+    // Two panels a row, as many rows as the axes need.
+    let panels = root.split_evenly((axes.len().div_ceil(2).max(1), 2));
     for ((name, unit, lines), area) in axes.iter().zip(panels.iter()) {
         line_chart(area, name, unit, "ms", lines, &palette)?;
     }

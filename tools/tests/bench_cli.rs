@@ -110,8 +110,13 @@ fn a_quick_bench_reports_every_stage_with_its_reference_and_writes_json_and_a_ch
     let (w, h, _) = common::read_png(&out.join("transparency.png"));
     assert_eq!((w, h), (1100, 500));
     let scaling = v["scaling"].as_array().expect("scaling");
-    assert_eq!(scaling.len(), 4, "hairs, points, grid, resolution");
-    let pixels: Vec<_> = scaling[3]["points"].as_array().expect("points").iter().map(|p| p["work"].clone()).collect();
+    assert_eq!(scaling.len(), 5, "hairs, points, simulated hairs, grid, resolution");
+    // The level-of-detail curve: half the quick run's 200 key hairs, then all.
+    let simulated: Vec<_> =
+        scaling[2]["points"].as_array().expect("points").iter().map(|p| p["work"].clone()).collect();
+    assert_eq!(simulated, [serde_json::json!(100.0), serde_json::json!(200.0)], "{}", scaling[2]);
+    assert!(scaling[2]["axis"].as_str().is_some_and(|a| a.starts_with("simulated key hairs")), "{}", scaling[2]);
+    let pixels: Vec<_> = scaling[4]["points"].as_array().expect("points").iter().map(|p| p["work"].clone()).collect();
     assert_eq!(pixels, [serde_json::json!(160.0 * 120.0), serde_json::json!(1920.0 * 1080.0)], "a point at 1080p");
     assert!(scaling[0]["gpu_exponent"].is_number() && scaling[0]["cpu_exponent"].is_number(), "{}", scaling[0]);
     let png = out.join("scaling.png");

@@ -63,3 +63,24 @@ fn long_runs_show_progress_on_a_terminal() {
     assert!(out.status.success(), "{}{}", out.stdout, out.stderr);
     assert!(out.stdout.contains("steps") && out.stdout.contains("(eta "), "no progress bar:\n{}", out.stdout);
 }
+
+/// `--simulated` simulates a share of the key hairs, the others following
+/// them: it says how many, records the followers' pass, and the GPU still
+/// matches the CPU reference bit for bit on lavapipe; a share outside (0, 1]
+/// is refused before any GPU work.
+#[test]
+fn a_share_of_the_key_hairs_is_simulated_and_checked() {
+    let out = run(&["simulate", "--steps", "20", "--volume", "off", "--simulated", "0.5", "--check"], LIMIT);
+    out.assert_ok();
+    assert!(out.stdout.contains("simulated: 875 of 1750 key hairs"), "{}", out.stdout);
+    assert!(out.stdout.contains("vkhair sim: followers"), "{}", out.stdout);
+    let line = out.stdout.lines().find(|l| l.contains("the whole run")).expect("whole-run line");
+    if out.stdout.contains("llvmpipe") {
+        assert!(line.contains("0 (bit for bit)"), "{line}");
+    }
+    for bad in ["0", "1.5", "nan", "-0.2"] {
+        let out = run(&["simulate", "--steps", "2", &format!("--simulated={bad}")], LIMIT);
+        out.assert_error("--simulated must be a share of the key hairs above 0 and at most 1");
+        assert!(!out.stdout.contains("llvmpipe"), "{bad}: GPU work before the refusal: {}", out.stdout);
+    }
+}

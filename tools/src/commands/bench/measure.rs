@@ -61,6 +61,8 @@ pub struct SimCase<'a> {
     pub cpu: bool,
     /// How the head moves (about the thesis scene's neck).
     pub motion: MotionArg,
+    /// Key hairs simulated (the others follow them); all when `None`.
+    pub simulated: Option<usize>,
 }
 
 impl SimCase<'_> {
@@ -110,10 +112,16 @@ pub fn measure_sim(
     let start = RigidTransform::default();
     let mut gpu = HairSim::new(ctx, case.groom, &case.params, &start)?;
     gpu.set_colliders(case.colliders)?;
+    if let Some(n) = case.simulated {
+        gpu.set_simulated_hairs(n)?;
+    }
     let mut cpu = match case.cpu {
         true => {
             let mut cpu = CpuHairSim::new(case.groom, &case.params, &start)?;
             cpu.set_colliders(case.colliders)?;
+            if let Some(n) = case.simulated {
+                cpu.set_simulated_hairs(n)?;
+            }
             Some(cpu)
         }
         false => None,

@@ -319,10 +319,12 @@ fn scaling(b: &Bench<'_>) -> Result<Vec<Curve>, Error> {
     let n = a.scaling_samples;
     let colliders = motion::thesis_colliders();
     let off = b.params(VolumeMode::Off, 32);
-    let sim = |groom: &Groom, params: &SimParams| {
-        let case = SimCase { groom, colliders: &colliders, params: params.clone(), cpu: true, motion: a.sim.motion };
+    let sim_of = |groom: &Groom, params: &SimParams, simulated: Option<usize>| {
+        let params = params.clone();
+        let case = SimCase { groom, colliders: &colliders, params, cpu: true, motion: a.sim.motion, simulated };
         measure_sim(ctx, &case, n, b.budget())
     };
+    let sim = |groom: &Groom, params: &SimParams| sim_of(groom, params, None);
     let sim_point = |groom: &Groom, params: &SimParams| {
         sim(groom, params).map(|f| (clock.figure(&f.gpu, &f.gpu_wall).median(), f.cpu.median()))
     };
@@ -348,6 +350,18 @@ fn scaling(b: &Bench<'_>) -> Result<Vec<Curve>, Error> {
         let groom = grown(keys, p)?;
         let (g, c) = sim_point(&groom, &off)?;
         curve.points.push((groom.point_count() as f64, g, c));
+    }
+    curves.push(curve);
+    // Simulation level of detail: the same groom with a share of its key hairs
+    // simulated and the rest following them.
+    let groom = grown(keys, 16)?;
+    let shares: &[usize] = if quick { &[2, 1] } else { &[8, 4, 2, 1] };
+    let mut curve =
+        Curve { axis: "simulated key hairs (16 points; volume off)", unit: "key hairs", points: Vec::new() };
+    for &share in shares {
+        let simulated = keys / share;
+        let f = sim_of(&groom, &off, Some(simulated))?;
+        curve.points.push((simulated as f64, clock.figure(&f.gpu, &f.gpu_wall).median(), f.cpu.median()));
     }
     curves.push(curve);
     let thesis = scenes::thesis()?;
@@ -468,6 +482,7 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
             params: b.params(mode, 32),
             cpu: true,
             motion: a.sim.motion,
+            simulated: None,
         };
         let off = measure_sim(&ctx, &case(VolumeMode::Off), a.samples, b.budget())?;
         rows.extend(sim_rows(&s.name, "sim, volume off", &off, clock, None));

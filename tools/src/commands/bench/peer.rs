@@ -58,7 +58,7 @@ pub fn rows(b: &Bench<'_>, scene: &str, groom: &Groom) -> Result<Vec<Row>, Error
     ];
     let mut rows = Vec::new();
     for (stage, params, colliders) in cases {
-        let case = SimCase { groom, colliders, params, cpu: true, motion: b.args.sim.motion };
+        let case = SimCase { groom, colliders, params, cpu: true, motion: b.args.sim.motion, simulated: None };
         let f = measure_sim(b.ctx, &case, b.args.samples, b.budget())?;
         rows.extend(sim_rows(scene, stage, &f, b.clock, None));
     }

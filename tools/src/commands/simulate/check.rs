@@ -50,6 +50,8 @@ pub struct Reference<'a> {
     pub params: &'a SimParams,
     pub colliders: &'a [Collider],
     pub mesh: Option<MeshSdf>,
+    /// Key hairs simulated (`--simulated`), all when `None`.
+    pub simulated: Option<usize>,
 }
 
 impl Reference<'_> {
@@ -75,6 +77,9 @@ impl Reference<'_> {
     fn equip(&self, mut cpu: CpuHairSim) -> Result<CpuHairSim, vkhair::Error> {
         cpu.set_colliders(self.colliders)?;
         cpu.set_mesh_collider(self.mesh.clone());
+        if let Some(count) = self.simulated {
+            cpu.set_simulated_hairs(count)?;
+        }
         Ok(cpu)
     }
 }

@@ -1,0 +1,29 @@
+// Body collisions of a simulation stage (glsl/sim/step.comp, follow.comp). The
+// including shader includes sim.glsl and declares, before the #include, the
+// sub-steps' colliders and the mesh collider's field:
+//     layout(std430, ...) readonly buffer Colliders { Collider colliders[]; };
+//     layout(std430, ...) readonly buffer MeshField { float mesh_field[]; };
+// The CPU twin is `Bodies::collide` in src/sim/reference.rs.
+#ifndef VKHAIR_SIM_BODIES_GLSL
+#define VKHAIR_SIM_BODIES_GLSL
+#include "mesh_sdf.glsl"
+
+// The mesh collider's grid of the sub-step parameters p.
+MeshGrid sim_mesh_grid(SimStepParams p) {
+    return MeshGrid(sim_mesh_origin(p), sim_mesh_cell(p), sim_mesh_dims(p));
+}
+
+// x projected out of every body of the sub-step parameters p, keeping a gap of
+// `radius`: its colliders (from entry `base` of `colliders`), then the mesh
+// collider's field when `flags` has SIM_MESH.
+vec3 sim_collide_bodies(SimStepParams p, uint flags, uint base, vec3 x, float radius) {
+    for (uint c = 0u; c < sim_colliders(p); c++) {
+        x = sim_collide(colliders[base + c], x, radius);
+    }
+    if ((flags & SIM_MESH) != 0u) {
+        x = mesh_collide(sim_head(p), sim_mesh_grid(p), x, radius);
+    }
+    return x;
+}
+
+#endif
