@@ -14,7 +14,6 @@
 //! 9.7 ms of wall time), so there the wall-clock figure is the one reported,
 //! and a stage measured alone is the difference of two steps' wall times.
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use serde_json::{json, Value};
@@ -28,14 +27,14 @@ use crate::chart::plot_file;
 use crate::destinations::{self, Kind, Output};
 use crate::output::Error;
 use crate::say;
-use frames::{bench_frames, Keep};
-use measure::{fitted_exponent, measure_sim, Samples, SimCase, SimFigures};
+use measure::{measure_sim, Samples, SimCase, SimFigures};
 use modes::{default_exact, frame_ms, render_rows, write_modes, OFF};
 
 mod frames;
 mod measure;
 mod modes;
 mod peer;
+mod scaling;
 mod truth;
 
 /// Peak memory bandwidth of a few GPUs, bytes per second (vendors' figures): the
@@ -299,90 +298,6 @@ fn bench_scenes(a: &BenchArgs) -> Result<(Vec<Scene>, Vec<String>), Error> {
     Ok((list, skipped))
 }
 
-/// One scaling curve: (work, GPU ms, CPU ms) per point.
-struct Curve {
-    axis: &'static str,
-    unit: &'static str,
-    points: Vec<(f64, f64, f64)>,
-}
-
-impl Curve {
-    fn exponents(&self) -> (f64, f64) {
-        let gpu: Vec<(f64, f64)> = self.points.iter().map(|p| (p.0, p.1)).collect();
-        let cpu: Vec<(f64, f64)> = self.points.iter().map(|p| (p.0, p.2)).collect();
-        (fitted_exponent(&gpu), fitted_exponent(&cpu))
-    }
-}
-
-fn scaling(b: &Bench<'_>) -> Result<Vec<Curve>, Error> {
-    let (ctx, a, clock) = (b.ctx, b.args, b.clock);
-    let n = a.scaling_samples;
-    let colliders = motion::thesis_colliders();
-    let off = b.params(VolumeMode::Off, 32);
-    let sim_of = |groom: &Groom, params: &SimParams, simulated: Option<usize>| {
-        let params = params.clone();
-        let case = SimCase { groom, colliders: &colliders, params, cpu: true, motion: a.sim.motion, simulated };
-        measure_sim(ctx, &case, n, b.budget())
-    };
-    let sim = |groom: &Groom, params: &SimParams| sim_of(groom, params, None);
-    let sim_point = |groom: &Groom, params: &SimParams| {
-        sim(groom, params).map(|f| (clock.figure(&f.gpu, &f.gpu_wall).median(), f.cpu.median()))
-    };
-    let quick = a.quick;
-    let hairs: &[usize] = if quick { &[200, 400] } else { &[1000, 4000, 16_000, 64_000] };
-    let points: &[usize] = if quick { &[8, 16] } else { &[8, 16, 32, 64] };
-    let grids: &[u32] = if quick { &[8, 16] } else { &[16, 32, 64] };
-    // The quick run keeps a 1080p point: its default (exact) pool needs more
-    // than one buffer on drivers whose storage-buffer range is 128 MiB.
-    let sizes: &[(u32, u32)] =
-        if quick { &[(160, 120), (1920, 1080)] } else { &[(854, 480), (1280, 720), (1920, 1080), (3840, 2160)] };
-    let mut curves = Vec::new();
-    let mut curve = Curve { axis: "key hairs (16 points; volume off)", unit: "particles", points: Vec::new() };
-    for &h in hairs {
-        let groom = grown(h, 16)?;
-        let (g, c) = sim_point(&groom, &off)?;
-        curve.points.push((groom.point_count() as f64, g, c));
-    }
-    curves.push(curve);
-    let keys = if a.quick { 200 } else { 4000 };
-    let mut curve = Curve { axis: "points per key hair (volume off)", unit: "particles", points: Vec::new() };
-    for &p in points {
-        let groom = grown(keys, p)?;
-        let (g, c) = sim_point(&groom, &off)?;
-        curve.points.push((groom.point_count() as f64, g, c));
-    }
-    curves.push(curve);
-    // Simulation level of detail: the same groom with a share of its key hairs
-    // simulated and the rest following them.
-    let groom = grown(keys, 16)?;
-    let shares: &[usize] = if quick { &[2, 1] } else { &[8, 4, 2, 1] };
-    let mut curve =
-        Curve { axis: "simulated key hairs (16 points; volume off)", unit: "key hairs", points: Vec::new() };
-    for &share in shares {
-        let simulated = keys / share;
-        let f = sim_of(&groom, &off, Some(simulated))?;
-        curve.points.push((simulated as f64, clock.figure(&f.gpu, &f.gpu_wall).median(), f.cpu.median()));
-    }
-    curves.push(curve);
-    let thesis = scenes::thesis()?;
-    let mut curve = Curve { axis: "grid (FLIP volume stage alone; thesis)", unit: "cells", points: Vec::new() };
-    let without = sim(&thesis, &off)?;
-    for &g in grids {
-        let f = sim(&thesis, &b.params(VolumeMode::Flip, g))?;
-        let gpu = volume_alone(&f, &without, clock).median();
-        curve.points.push((f64::from(g).powi(3), gpu, f.volume_cpu.median()));
-    }
-    curves.push(curve);
-    let mut curve = Curve { axis: "resolution (render frame; thesis)", unit: "pixels", points: Vec::new() };
-    for &(w, h) in sizes {
-        let (w, h) = (w.to_string(), h.to_string());
-        let f = bench_frames(ctx, &["--width", &w, "--height", &h], &a.sim, n, Keep::Figures)?;
-        curve.points.push((f.pixels as f64, clock.figure(&f.gpu, &f.wall).median(), f64::NAN));
-    }
-    curves.push(curve);
-    Ok(curves)
-}
-
 fn print_rows(rows: &[Row]) {
     say!(
         "{:<22} {:<36} {:>9} {:>9} {:>9} {:>9} {:>7} {:>5} {:>5} {:>9} {:>9} {:>6}",
@@ -417,16 +332,6 @@ fn print_rows(rows: &[Row]) {
             r.error.map_or(String::new(), |e| format!("{e:.1}"))
         );
     }
-}
-
-fn write_scaling(out: &Path, curves: &[Curve]) -> Result<PathBuf, Error> {
-    let mut csv = String::from("axis,unit,work,gpu_ms,cpu_ms\n");
-    for c in curves {
-        for p in &c.points {
-            let _ = writeln!(csv, "{},{},{},{:.4},{:.4}", c.axis, c.unit, p.0, p.1, p.2);
-        }
-    }
-    write_csv(out, "scaling.csv", &csv)
 }
 
 /// Writes `csv` whole as `out/name` (creating `out`); returns its path.
@@ -524,12 +429,12 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
         let csv = write_modes(&a.out, &modes)?;
         plot_file(&csv, &csv.with_extension("png"))?;
     }
-    let curves = scaling(&b)?;
+    let curves = scaling::scaling(&b)?;
     for c in &curves {
         let (g, cpu) = c.exponents();
         say!("scaling, {}: time ∝ {}^{g:.2} on the GPU, ^{cpu:.2} on the CPU reference", c.axis, c.unit);
     }
-    let csv = write_scaling(&a.out, &curves)?;
+    let csv = scaling::write_scaling(&a.out, &curves)?;
     plot_file(&csv, &csv.with_extension("png"))?;
     if let Some(path) = &a.json {
         let find = |stage: &str| rows.iter().find(|r| r.scene == scenes[0].name && r.stage == stage);
