@@ -38,6 +38,32 @@ fn assert_finite(state: &SimState) {
     assert!(state.positions.iter().chain(&state.velocities).all(|v| v.is_finite()), "NaN or Inf in the state");
 }
 
+/// Runs `steps` steps of GPU and CPU from step `start`, then compares them bit
+/// for bit on lavapipe (within the tolerance elsewhere).
+#[allow(clippy::too_many_arguments, reason = "a test helper naming what it compares")]
+fn run_both(
+    ctx: &GpuContext,
+    gpu: &mut HairSim,
+    cpu: &mut CpuHairSim,
+    start: usize,
+    steps: usize,
+    params: &SimParams,
+    what: &str,
+) -> SimState {
+    gpu.run(steps, |i| head_at(start + i, params), None).expect("gpu run");
+    for i in start..start + steps {
+        cpu.step(&head_at(i, params)).expect("cpu step");
+    }
+    let g = gpu.read_state().expect("readback");
+    assert_finite(&g);
+    let (max, _) = max_difference(&g, cpu.state());
+    assert!(max <= POSITION_TOLERANCE, "{what}: GPU and CPU differ by {max} m");
+    if common::on_lavapipe(ctx) {
+        assert!(common::bits(&g) == common::bits(cpu.state()), "{what}: not bit for bit on lavapipe");
+    }
+    g
+}
+
 /// Runs GPU and CPU side by side and compares at each checkpoint.
 fn compare(gpu_ctx: &GpuContext, groom: &Groom, params: &SimParams, checkpoints: &[usize]) {
     let head0 = RigidTransform::default();
@@ -47,14 +73,8 @@ fn compare(gpu_ctx: &GpuContext, groom: &Groom, params: &SimParams, checkpoints:
     cpu.set_colliders(&motion::thesis_colliders()).expect("colliders");
     let mut done = 0;
     for &target in checkpoints {
-        let start = done;
-        gpu.run(target - done, |i| head_at(start + i, params), None).expect("gpu run");
-        for i in done..target {
-            cpu.step(&head_at(i, params)).expect("cpu step");
-        }
+        let g = run_both(gpu_ctx, &mut gpu, &mut cpu, done, target - done, params, &format!("step {target}"));
         done = target;
-        let g = gpu.read_state().expect("readback");
-        assert_finite(&g);
         let (max, equal) = max_difference(&g, cpu.state());
         eprintln!(
             "{:?}, {} points, step {target}: max |gpu − cpu| = {max:e}, {equal}/{} bitwise equal",
@@ -62,10 +82,6 @@ fn compare(gpu_ctx: &GpuContext, groom: &Groom, params: &SimParams, checkpoints:
             g.points,
             g.positions.len()
         );
-        assert!(max <= POSITION_TOLERANCE, "step {target}: GPU and CPU differ by {max} m");
-        if common::on_lavapipe(gpu_ctx) {
-            assert!(common::bits(&g) == common::bits(cpu.state()), "step {target}: not bit for bit on lavapipe");
-        }
     }
 }
 
@@ -179,22 +195,10 @@ fn changed_switches_between_steps_match_the_cpu() {
     let mut c = CpuHairSim::new(&groom, &base, &head0).expect("cpu sim");
     g.set_colliders(&motion::thesis_colliders()).expect("colliders");
     c.set_colliders(&motion::thesis_colliders()).expect("colliders");
-    let mut done = 0;
     for (k, params) in stages.iter().enumerate() {
         g.set_params(params).expect("gpu params");
         c.set_params(params).expect("cpu params");
-        let start = done;
-        g.run(5, |i| head_at(start + i, params), None).expect("gpu run");
-        for i in start..start + 5 {
-            c.step(&head_at(i, params)).expect("cpu step");
-        }
-        done += 5;
-        let state = g.read_state().expect("readback");
-        let (max, _) = max_difference(&state, c.state());
-        assert!(max <= POSITION_TOLERANCE, "stage {k}: GPU and CPU differ by {max} m");
-        if common::on_lavapipe(gpu.ctx()) {
-            assert!(common::bits(&state) == common::bits(c.state()), "stage {k}: not bit for bit on lavapipe");
-        }
+        run_both(gpu.ctx(), &mut g, &mut c, 5 * k, 5, params, &format!("stage {k}"));
     }
 }
 
@@ -552,32 +556,6 @@ fn styled_grooms_still_move() {
     let lag = run_on_sphere(&gpu, &mohawk(200, 8), &params, 15, shake);
     eprintln!("mohawk shaken: tip lag p50 {:.4}", p(&lag, 50));
     assert!(p(&lag, 50) >= 0.03, "the tips followed the head rigidly: lag {}", p(&lag, 50));
-}
-
-/// Runs `steps` steps of GPU and CPU from step `start`, then compares them bit
-/// for bit on lavapipe (within the tolerance elsewhere).
-#[allow(clippy::too_many_arguments, reason = "a test helper naming what it compares")]
-fn run_both(
-    ctx: &GpuContext,
-    gpu: &mut HairSim,
-    cpu: &mut CpuHairSim,
-    start: usize,
-    steps: usize,
-    params: &SimParams,
-    what: &str,
-) -> SimState {
-    gpu.run(steps, |i| head_at(start + i, params), None).expect("gpu run");
-    for i in start..start + steps {
-        cpu.step(&head_at(i, params)).expect("cpu step");
-    }
-    let g = gpu.read_state().expect("readback");
-    assert_finite(&g);
-    let (max, _) = max_difference(&g, cpu.state());
-    assert!(max <= POSITION_TOLERANCE, "{what}: GPU and CPU differ by {max} m");
-    if common::on_lavapipe(ctx) {
-        assert!(common::bits(&g) == common::bits(cpu.state()), "{what}: not bit for bit on lavapipe");
-    }
-    g
 }
 
 /// Simulation level of detail: with a share of the key hairs simulated and the
