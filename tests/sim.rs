@@ -114,8 +114,9 @@ fn gpu_matches_cpu_with_substeps_in_dftl_mode_and_with_local_shape() {
 
 /// The step is one dispatch however many sub-steps it has (with the volume stage
 /// off), between two barriers (uploads, then the kernel), and it writes each
-/// particle's position and velocity once; with the volume stage on, one step
-/// dispatch per sub-step.
+/// particle's position and velocity once; with a level of detail a second
+/// dispatch (the followers) behind a third barrier; with the volume stage on,
+/// one step dispatch per sub-step.
 #[test]
 fn a_step_is_one_dispatch_without_the_volume_stage() {
     let gpu = Gpu::new();
@@ -138,6 +139,16 @@ fn a_step_is_one_dispatch_without_the_volume_stage() {
         assert_eq!(work.bytes_written, 3 * particles * 48, "three vec4 per particle, once per step: {work:?}");
         // Positions, velocities and rest positions (16 bytes each), rest lengths (4).
         assert!(work.bytes_read >= 3 * particles * 52, "{work:?}");
+        // With a level of detail the followers' dispatch follows, behind a barrier.
+        sim.set_simulated_hairs(40).expect("level");
+        let mut run = |steps| {
+            let before = gpu.ctx().recorded_work();
+            sim.run(steps, |i| head_at(i, &params), None).expect("run");
+            gpu.ctx().recorded_work() - before
+        };
+        let (one, four) = (run(1), run(4));
+        let work = four - one;
+        assert_eq!((work.dispatches, work.barriers), (6, 9), "{substeps} sub-steps, a level of detail: {work:?}");
     }
     let params = SimParams {
         substeps: 2,

@@ -20,8 +20,10 @@ impl HairSim {
     /// label and (when a profiler is given) a timestamp scope per stage: with the
     /// volume stage off one dispatch and two barriers (uploads of the sub-steps'
     /// parameters, then the dispatch); with it on, per sub-step the step dispatch
-    /// followed by the volume stage's kernels. Leaves the step pipeline or the
-    /// volume stage's last kernel bound.
+    /// followed by the volume stage's kernels. With a level of detail
+    /// ([`HairSim::set_simulated_hairs`]) each step dispatch is followed by a
+    /// barrier and the followers' dispatch. Leaves the step pipeline, the
+    /// followers' or the volume stage's last kernel bound.
     ///
     /// # Safety
     /// `cmd` is a command buffer of the context's device in the recording state,
