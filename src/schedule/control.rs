@@ -41,6 +41,22 @@ impl FrameScheduler {
         }
     }
 
+    /// Simulates only `count` key hairs from the next step on, the others
+    /// following them (checked now: 1 up to the key hairs; see
+    /// [`crate::sim::HairSim::set_simulated_hairs`]).
+    pub fn set_simulated_hairs(&mut self, count: usize) -> Result<()> {
+        let (strands, _) = self.key_hairs().size();
+        if !(1..=strands).contains(&count) {
+            return Err(Error::param("simulated key hairs", count, format!("1..={strands} (the key hairs)")));
+        }
+        match &mut self.backend {
+            Backend::Local { sim, .. } => sim.set_simulated_hairs(count),
+            Backend::Async { sim, .. } => sim.sim.set_simulated_hairs(count),
+            Backend::Remote { worker, .. } => worker.update(SimUpdate::Simulated(count)),
+            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
+        }
+    }
+
     /// Sets the mesh collider of `mesh` (head frame, the groom's units; `None`
     /// removes it), built on the simulation's device (see
     /// [`crate::sim::HairSim::set_mesh_collider`]). The mesh and parameters are checked now; on

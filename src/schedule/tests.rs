@@ -86,3 +86,25 @@ fn a_stuck_worker_meets_the_deadline() {
     assert!(render.finish_with_messages().is_empty());
     assert!(sim.finish_with_messages().is_empty());
 }
+
+/// A level of detail set on a SECOND DEVICE scheduler reaches its worker: the
+/// count is checked on the host (0 and past the key hairs refused there), and
+/// frames run with it.
+#[test]
+fn a_level_of_detail_reaches_the_worker() {
+    let (render, sim) = (TestGpu::new(), TestGpu::new());
+    let mut s = remote(&render, &sim, Pipelining::Throughput, Duration::from_secs(30));
+    for bad in [0, 9] {
+        let e = s.set_simulated_hairs(bad).expect_err("refused").to_string();
+        assert!(e.contains("simulated key hairs") && e.contains("1..=8"), "{e}");
+    }
+    s.set_simulated_hairs(3).expect("level");
+    for _ in 0..3 {
+        frame(&render, &mut s).expect("frame");
+    }
+    let state = s.read_state().expect("state");
+    assert!(state.positions.iter().all(|p| p.is_finite()), "{state:?}");
+    drop(s);
+    assert!(render.finish_with_messages().is_empty());
+    assert!(sim.finish_with_messages().is_empty());
+}

@@ -84,3 +84,25 @@ fn a_share_of_the_key_hairs_is_simulated_and_checked() {
         assert!(!out.stdout.contains("llvmpipe"), "{bad}: GPU work before the refusal: {}", out.stdout);
     }
 }
+
+/// `render --simulated` sets the level of detail through the frame scheduler,
+/// on one queue and on a second device (its worker thread), and the followers'
+/// pass shows in the simulation's table; a bad share is refused before any GPU
+/// work, as in `bench`.
+#[test]
+fn render_takes_a_share_on_one_queue_and_on_a_second_device() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().display().to_string();
+    for schedule in ["single", "second-device"] {
+        let args = ["render", "--frames", "2", "--width", "96", "--height", "64", "--simulated", "0.5"];
+        let r = run(&[&args[..], &["--schedule", schedule, "--out", &out]].concat(), LIMIT);
+        r.assert_ok();
+        assert!(r.stdout.contains("simulated: 875 of 1750 key hairs"), "{schedule}: {}", r.stdout);
+        assert!(r.stdout.contains("vkhair sim: followers"), "{schedule}: {}", r.stdout);
+    }
+    for command in ["render", "bench"] {
+        let r = run(&[command, "--simulated", "1.01", "--out", &out], LIMIT);
+        r.assert_error("--simulated must be a share of the key hairs above 0 and at most 1");
+        assert!(!r.stdout.contains("llvmpipe"), "{command}: GPU work before the refusal: {}", r.stdout);
+    }
+}

@@ -35,6 +35,11 @@ pub struct SimArgs {
     /// (for soak runs: 1.2 rad at 3 Hz with a nod and jolts of the whole head).
     #[arg(long, value_enum, default_value = "shake")]
     pub motion: MotionArg,
+    /// Simulate only this share of the key hairs (0 < share ≤ 1; at least one):
+    /// the first of a spatially progressive order of the roots; the others
+    /// follow the simulated hair nearest them (simulation level of detail).
+    #[arg(long)]
+    pub simulated: Option<f32>,
 }
 
 impl SimArgs {
@@ -53,6 +58,20 @@ impl SimArgs {
             p.volume.max_iterations,
             self.motion,
         )
+    }
+
+    /// The key hairs `--simulated` leaves simulated of `strands` (none: all),
+    /// checked before any GPU work.
+    pub fn simulated_count(&self, strands: usize) -> Result<Option<usize>, crate::output::Error> {
+        let Some(share) = self.simulated else {
+            return Ok(None);
+        };
+        if !(share.is_finite() && share > 0.0 && share <= 1.0) {
+            return Err(
+                format!("--simulated must be a share of the key hairs above 0 and at most 1 (got {share})").into()
+            );
+        }
+        Ok(Some(((share * strands as f32).ceil() as usize).clamp(1, strands.max(1))))
     }
 
     /// Applies the flags given to `params` (validated later, with the rest).

@@ -174,8 +174,12 @@ pub fn bench_frames(
     a.check()?;
     let s = scene::load(&a)?;
     let config = parameters(&a, &s)?;
+    let simulated = a.sim.simulated_count(s.groom.strand_count())?;
     let mut sim = HairSim::new(ctx, &s.groom, &config.sim, &RigidTransform::default())?;
     sim.set_colliders(&s.colliders)?;
+    if let Some(count) = simulated {
+        sim.set_simulated_hairs(count)?;
+    }
     let mut renderer = make_renderer(&a, ctx, &config, sim.key_hairs(), s.radius)?;
     let offscreen = Offscreen::new(ctx, a.width, a.height)?;
     let camera = framing(&s, a.distance, a.width as f32 / a.height as f32)?;

@@ -349,6 +349,8 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     if !(a.figure_seconds.is_finite() && a.figure_seconds > 0.0 && a.figure_seconds <= 1e6) {
         return Err(format!("--figure-seconds must be a number of seconds above 0 (got {})", a.figure_seconds).into());
     }
+    // A bad --simulated share is refused before any GPU work.
+    a.sim.simulated_count(1)?;
     if a.scaling_samples == 0 {
         return Err("--scaling-samples must be at least 1 (each point of a curve is a median of 5 by default)".into());
     }
@@ -381,13 +383,14 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
             s.groom.strand_count(),
             s.groom.point_count() / s.groom.strand_count().max(1)
         );
+        let simulated = a.sim.simulated_count(s.groom.strand_count())?;
         let case = |mode: VolumeMode| SimCase {
             groom: &s.groom,
             colliders: &s.colliders,
             params: b.params(mode, 32),
             cpu: true,
             motion: a.sim.motion,
-            simulated: None,
+            simulated,
         };
         let off = measure_sim(&ctx, &case(VolumeMode::Off), a.samples, b.budget())?;
         rows.extend(sim_rows(&s.name, "sim, volume off", &off, clock, None));

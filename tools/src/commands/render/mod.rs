@@ -95,11 +95,16 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     }
     let s = scene::load(sa)?;
     let config = parameters(sa, &s)?;
+    let simulated = sa.sim.simulated_count(s.groom.strand_count())?;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let sim_params = config.sim.clone();
     let options = schedule_options(a)?;
     let mut sim = FrameScheduler::new(&ctx, &s.groom, &sim_params, &RigidTransform::default(), &s.colliders, &options)?;
     say!("simulation: {} ({})", sim.mode().name(), sim.reason());
+    if let Some(count) = simulated {
+        sim.set_simulated_hairs(count)?;
+        say!("simulated: {count} of {} key hairs (the others follow them)", s.groom.strand_count());
+    }
     say!("{}", sa.sim.describe(&sim_params));
     if sa.input.colliding() {
         sim.set_mesh_collider(Some(&s.head_mesh), &config.mesh_collider)?;

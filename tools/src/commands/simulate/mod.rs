@@ -34,11 +34,6 @@ pub struct SimulateArgs {
     config: Option<PathBuf>,
     #[command(flatten)]
     sim: SimArgs,
-    /// Simulate only this share of the key hairs (0 < share ≤ 1; at least one):
-    /// the first of a spatially progressive order of the roots; the others
-    /// follow the simulated hair nearest them (simulation level of detail).
-    #[arg(long)]
-    simulated: Option<f32>,
     /// Also run the CPU reference: every 10 steps it takes one step from the GPU's
     /// state and must land within a stated tolerance of the GPU's step; without
     /// FLIP the whole run is compared too. Exits non-zero beyond the tolerance.
@@ -51,18 +46,6 @@ pub struct SimulateArgs {
     out: Option<PathBuf>,
     #[command(flatten)]
     profile_out: ProfileArgs,
-}
-
-/// The key hairs `--simulated` leaves simulated of `strands`, checked before
-/// any GPU work.
-fn simulated_count(share: Option<f32>, strands: usize) -> Result<Option<usize>, crate::output::Error> {
-    let Some(share) = share else {
-        return Ok(None);
-    };
-    if !(share.is_finite() && share > 0.0 && share <= 1.0) {
-        return Err(format!("--simulated must be a share of the key hairs above 0 and at most 1 (got {share})").into());
-    }
-    Ok(Some(((share * strands as f32).ceil() as usize).clamp(1, strands.max(1))))
 }
 
 /// The simulation parameters: the tool's defaults (FLIP at 32³; an `--input`
@@ -125,7 +108,7 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     };
     let config = simulate_params(a)?;
     let params = config.sim.clone();
-    let simulated = simulated_count(a.simulated, groom.strand_count())?;
+    let simulated = a.sim.simulated_count(groom.strand_count())?;
     let mesh = load_mesh(a.input.obj.as_deref(), scale)?;
     let colliding = a.input.colliding();
     let ctx = GpuContext::headless(&ContextOptions::default())?;
