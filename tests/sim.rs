@@ -112,6 +112,18 @@ fn gpu_matches_cpu_with_substeps_in_dftl_mode_and_with_local_shape() {
     compare(gpu.ctx(), &groom, &local, &[1, 20]);
 }
 
+/// The work three steps of `sim` record: a run of four less a run of one, so
+/// that what a submission adds besides its steps cancels out.
+fn work_of_three_steps(ctx: &GpuContext, sim: &mut HairSim, params: &SimParams) -> vkhair::RecordedWork {
+    let mut run = |steps| {
+        let before = ctx.recorded_work();
+        sim.run(steps, |i| head_at(i, params), None).expect("run");
+        ctx.recorded_work() - before
+    };
+    let (one, four) = (run(1), run(4));
+    four - one
+}
+
 /// The step is one dispatch however many sub-steps it has (with the volume stage
 /// off), between two barriers (uploads, then the kernel), and it writes each
 /// particle's position and velocity once; with a level of detail a second
@@ -125,14 +137,7 @@ fn a_step_is_one_dispatch_without_the_volume_stage() {
     for substeps in [1, 4] {
         let params = SimParams { substeps, ..SimParams::default() };
         let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
-        // What one submission adds besides its steps cancels out: 4 steps less 1.
-        let mut run = |steps| {
-            let before = gpu.ctx().recorded_work();
-            sim.run(steps, |i| head_at(i, &params), None).expect("run");
-            gpu.ctx().recorded_work() - before
-        };
-        let (one, four) = (run(1), run(4));
-        let work = four - one;
+        let work = work_of_three_steps(gpu.ctx(), &mut sim, &params);
         assert_eq!(work.dispatches, 3, "{substeps} sub-steps: {work:?}");
         assert_eq!(work.barriers, 6, "{substeps} sub-steps: {work:?}");
         // Positions, velocities and the positions before the step (for drawing between states).
@@ -141,13 +146,7 @@ fn a_step_is_one_dispatch_without_the_volume_stage() {
         assert!(work.bytes_read >= 3 * particles * 52, "{work:?}");
         // With a level of detail the followers' dispatch follows, behind a barrier.
         sim.set_simulated_hairs(40).expect("level");
-        let mut run = |steps| {
-            let before = gpu.ctx().recorded_work();
-            sim.run(steps, |i| head_at(i, &params), None).expect("run");
-            gpu.ctx().recorded_work() - before
-        };
-        let (one, four) = (run(1), run(4));
-        let work = four - one;
+        let work = work_of_three_steps(gpu.ctx(), &mut sim, &params);
         assert_eq!((work.dispatches, work.barriers), (6, 9), "{substeps} sub-steps, a level of detail: {work:?}");
     }
     let params = SimParams {
