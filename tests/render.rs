@@ -19,6 +19,14 @@ fn thesis_sim(gpu: &Gpu) -> HairSim {
     sim
 }
 
+/// A simulation at rest of `strands` key hairs of 6 points grown on the thesis
+/// scalp, default parameters, no colliders.
+fn grown_sim(gpu: &Gpu, strands: usize) -> HairSim {
+    let p = GrowParams { strands, points_per_strand: 6, ..GrowParams::default() };
+    let groom = grow(&scenes::thesis_scalp(), &p).expect("groom");
+    HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim")
+}
+
 /// Smoothed vertices equal a CPU evaluation of the same B-spline of the simulated
 /// key hairs: positions within 1e-5 m, tangents unit length within 1e-5 and within
 /// 1e-4 of the CPU's; root and tip at the key hair's root and tip.
@@ -59,10 +67,7 @@ fn smoothing_matches_the_cpu_bspline() {
 #[test]
 fn smoothing_level_is_validated() {
     let gpu = Gpu::new();
-    let groom =
-        grow(&scenes::thesis_scalp(), &GrowParams { strands: 10, points_per_strand: 6, ..GrowParams::default() })
-            .expect("groom");
-    let sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    let sim = grown_sim(&gpu, 10);
     for bad in [0, 65] {
         assert!(matches!(
             Renderer::new(gpu.ctx(), &sim, &RenderParams { smoothing_level: bad, ..RenderParams::default() }),
@@ -150,10 +155,7 @@ fn interpolation_grows_stable_clumps() {
 fn hairs_beyond_one_patch_take_instances() {
     use vkhair::render::{scalp, InterpolationMode, MAX_HAIRS_PER_KEY};
     let gpu = Gpu::new();
-    let groom =
-        grow(&scenes::thesis_scalp(), &GrowParams { strands: 24, points_per_strand: 6, ..GrowParams::default() })
-            .expect("groom");
-    let sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    let sim = grown_sim(&gpu, 24);
     let state = sim.read_state().expect("state");
     let triangles = scalp::root_triangles(&state);
     assert!(!triangles.is_empty());
