@@ -10,7 +10,9 @@
 
 use glam::{Vec3, Vec4};
 use vkhair::groom::{scenes, Groom};
-use vkhair::sim::{motion, Collider, CpuHairSim, HairSim, RigidTransform, SimParams, SimState, SolverMode};
+use vkhair::sim::{
+    motion, Collider, CpuHairSim, HairSim, PressureSolver, RigidTransform, SimParams, SimState, SolverMode,
+};
 mod common;
 
 use common::{curls, mohawk, p, tip_drift_of, Gpu};
@@ -172,7 +174,11 @@ fn a_pressure_iteration_is_four_passes_per_multigrid_level_and_six_more() {
     // level's solve. (Before the passes were fused: 25 in all.)
     let per_iteration = 5 + 4 * levels_above_coarsest + 1;
     let run = |max_iterations| {
-        let volume = vkhair::sim::VolumeParams { max_iterations, ..vkhair::sim::VolumeParams::flip([32, 32, 32]) };
+        let volume = vkhair::sim::VolumeParams {
+            max_iterations,
+            solver: PressureSolver::Dispatched,
+            ..vkhair::sim::VolumeParams::flip([32, 32, 32])
+        };
         let params = SimParams { volume, ..SimParams::default() };
         let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
         let before = gpu.ctx().recorded_work();
@@ -182,6 +188,41 @@ fn a_pressure_iteration_is_four_passes_per_multigrid_level_and_six_more() {
     let work = run(3) - run(1);
     assert_eq!(work.dispatches, 2 * per_iteration, "{work:?}");
     assert_eq!(work.barriers, 2 * per_iteration, "{work:?}");
+}
+
+/// The volume stage's dispatches per FLIP step with the default solve (in one
+/// workgroup), counted kernel by kernel: at most 40 at 32³ and 64³, and none of
+/// them per pressure iteration.
+#[test]
+fn a_flip_step_is_at_most_forty_dispatches_at_32_and_64_cells_per_axis() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(100, 16, 3);
+    // The step without the volume stage, one dispatch (a_step_is_one_dispatch_…).
+    let work = |volume: vkhair::sim::VolumeParams| {
+        let params = SimParams { volume, ..SimParams::default() };
+        let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
+        work_of_three_steps(gpu.ctx(), &mut sim, &params).dispatches / 3
+    };
+    let step = work(vkhair::sim::VolumeParams::default());
+    assert_eq!(step, 1);
+    // Cell ids of 15 bits (32³) sort in two 8-bit passes, of 19 bits (64³) in four
+    // 6-bit passes, each a count, a 3-pass scan and a scatter; multigrid levels
+    // down to at most 256 cells: 4 at 32³, 5 at 64³ (a coarsening pass between
+    // two). The solve is one dispatch at 32³; at 64³ its shares of 6 iterations
+    // (lavapipe's loop limit, record.rs) take 7 for the cap of 40.
+    for (n, radix_passes, levels, shares) in [(32, 2, 4, 1), (64, 4, 5, 7)] {
+        let sort = 1 + radix_passes * 5 + 1; // bin, passes, reorder
+        let transfer = 2; // gather, mark
+        let pressure = (levels - 1) + 1 + shares + 1; // coarsening, stencil words, the solve, gradient
+        let update = 1;
+        let flip = vkhair::sim::VolumeParams::flip([n; 3]);
+        let volume = work(flip.clone()) - step;
+        assert_eq!(volume, sort + transfer + pressure + update, "{n}³");
+        assert!(volume <= 40, "{n}³: {volume} dispatches");
+    }
+    // At 32³ a cap of 44 iterations still fits one dispatch.
+    let capped = work(vkhair::sim::VolumeParams { max_iterations: 44, ..vkhair::sim::VolumeParams::flip([32; 3]) });
+    assert_eq!(capped - step, 21, "32³: a higher iteration cap records nothing more");
 }
 
 /// The step kernel is specialised to the switches the parameters turn on: a

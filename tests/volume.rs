@@ -3,7 +3,8 @@
 //! runs, bad parameters. Validated like every GPU test.
 //!
 //! Tolerances: with FLIP on, GPU and CPU no longer run identical operations (the
-//! GPU solves the pressure with multigrid-preconditioned CG in f32, the reference
+//! GPU solves the pressure with multigrid-preconditioned CG in f32 (in one
+//! workgroup, or dispatched per kernel and iteration), the reference
 //! with MIC(0)-CG in f64, both to a relative residual of 1e-5), and like any
 //! chaotic system's the trajectories drift apart over a run; so single steps from
 //! the same state are compared, to `REFERENCE_STEP_TOLERANCE_M` (10 µm, the
@@ -13,8 +14,8 @@
 use glam::{Vec3, Vec4};
 use vkhair::groom::Groom;
 use vkhair::sim::{
-    motion, CpuHairSim, HairSim, Preconditioner, RigidTransform, SimParams, SimState, VolumeMode, VolumeParams,
-    REFERENCE_STEP_TOLERANCE_M,
+    motion, CpuHairSim, HairSim, Preconditioner, PressureSolver, RigidTransform, SimParams, SimState, VolumeMode,
+    VolumeParams, REFERENCE_STEP_TOLERANCE_M,
 };
 use vkhair::Error;
 mod common;
@@ -61,10 +62,12 @@ fn run_with_step_checks(
 fn flip_simulation_follows_the_cpu_reference() {
     let gpu = Gpu::new();
     let groom = common::grown_groom(300, 6, 11);
-    // 16³ and the main job's 32³ for FLIP; friction at 16³.
+    // 16³ and the main job's 32³ for FLIP (the solve in one workgroup), the solve
+    // dispatched per kernel and iteration at 16³; friction at 16³.
     for params in [
         flip(16),
         flip(32),
+        SimParams { volume: VolumeParams { solver: PressureSolver::Dispatched, ..flip(16).volume }, ..flip(16) },
         SimParams { volume: VolumeParams { mode: VolumeMode::Friction, ..flip(16).volume }, ..flip(16) },
     ] {
         let head0 = RigidTransform::default();
@@ -212,7 +215,8 @@ fn uniform_motion_passes_through_untouched() {
 }
 
 /// Same input, same device, bitwise the same state: density friction and FLIP
-/// with either preconditioner (sorted gathers, no float atomics), and FLIP with
+/// with either preconditioner and either way of recording the solve (sorted
+/// gathers, no float atomics, sums in a fixed order), and FLIP with
 /// the mesh collider.
 #[test]
 fn every_volume_mode_is_bitwise_deterministic_run_to_run() {
@@ -224,9 +228,12 @@ fn every_volume_mode_is_bitwise_deterministic_run_to_run() {
     let friction = VolumeParams { mode: VolumeMode::Friction, ..flip(16).volume };
     let jacobi = VolumeParams { preconditioner: Preconditioner::Jacobi, ..flip(16).volume };
     let multigrid = VolumeParams { preconditioner: Preconditioner::Multigrid, ..flip(16).volume };
+    let dispatched = VolumeParams { solver: PressureSolver::Dispatched, ..multigrid.clone() };
     let mesh = TriMesh::uv_sphere(THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS, 12, 16).expect("sphere");
-    for (volume, with_mesh) in [(friction, false), (jacobi, false), (multigrid.clone(), false), (multigrid, true)] {
-        let what = format!("{:?} / {:?}, mesh {with_mesh}", volume.mode, volume.preconditioner);
+    let modes =
+        [(friction, false), (jacobi, false), (multigrid.clone(), false), (dispatched, false), (multigrid, true)];
+    for (volume, with_mesh) in modes {
+        let what = format!("{:?} / {:?} / {:?}, mesh {with_mesh}", volume.mode, volume.preconditioner, volume.solver);
         let params = SimParams { volume, ..SimParams::default() };
         let run = || {
             let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");

@@ -269,4 +269,13 @@ shader_views! {
         /// Jacobi sweeps (an even number).
         sweeps: uint = op.z,
     }
+
+    /// A share of the solve in one workgroup (`VolumePush` of `pcg_workgroup`).
+    WorkgroupSolvePass for VolumePush in "volume.glsl" as "VolumePush" prefix "pcg_wg" {
+        /// 1: the first share, which starts the solve; 0: one that goes on from
+        /// the scalars the previous share left.
+        start: uint = op.x,
+        /// Iterations this share may do at most.
+        iterations: uint = op.y,
+    }
 }

@@ -77,7 +77,7 @@ pub use mesh_collider::{MeshCollider, MeshColliderParams, MESH_COLLIDER_BUILD_LA
 pub use params::{SimParams, SolverMode, MAX_SIM_POINTS, MAX_SUBSTEPS};
 pub use state::SimState;
 pub use view::KeyHairs;
-pub use volume::{Preconditioner, VolumeGrid, VolumeMode, VolumeParams, VolumeStats};
+pub use volume::{Preconditioner, PressureSolver, VolumeGrid, VolumeMode, VolumeParams, VolumeStats};
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};

@@ -164,11 +164,13 @@ fn every_simulation_knob_flag_works_on_every_command_that_simulates() {
         "--jacobi",
         "--max-iterations",
         "9",
+        "--pressure",
+        "dispatched",
         "--motion",
         "still",
     ];
     let expected = "parameters: 7 iterations, Dftl solver, volume Friction at [12, 12, 12], 2 sub-steps, \
-                    Jacobi pressure solve capped at 9 iterations, motion Still";
+                    Jacobi pressure solve (Dispatched) capped at 9 iterations, motion Still";
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("frames").display().to_string();
     let render = ["render", "--frames", "1", "--width", "32", "--height", "32", "--no-shadows", "--out", &out];

@@ -24,21 +24,13 @@ layout(std430, set = 0, binding = 23) buffer X { float x[]; };
 layout(std430, set = 0, binding = 24) buffer Tmp { float tmp[]; };
 layout(std430, set = 0, binding = 25) readonly buffer Rhs { float rhs[]; };
 layout(std430, set = 0, binding = 27) writeonly buffer Partials { vec2 partials[]; };
-
-const float OMEGA = 2.0 / 3.0;
-
-// One sweep's value at cell i with word w, from its own value and the sum of
-// its fluid neighbours' values subtracted in order n = 0..5 (done by the caller).
-float sweep(uint i, uint w, float own, float ax) {
-    float diagonal = vol_diagonal(w);
-    precise float value = diagonal > 0.0 ? own + OMEGA * (rhs[i] - ax) / diagonal : 0.0;
-    return value;
-}
+#define VKHAIR_PRESSURE_LEVELS
+#include "pressure_ops.glsl"
 
 // The first sweep from x = 0 at cell j (A x is then exactly +0).
 float first_sweep(uint j) {
     uint w = stencil[j];
-    return vol_is_fluid(w) ? sweep(j, w, 0.0, 0.0) : 0.0;
+    return vol_is_fluid(w) ? mg_sweep(j, w, 0.0, 0.0) : 0.0;
 }
 
 // x at fluid cell `ijk` (level-array index j) with its coarse parent's correction added.
@@ -73,7 +65,7 @@ void main() {
                 ax -= source(vol_neighbor_index(i, dims, n), nb);
             }
         }
-        value = sweep(i, w, own, ax);
+        value = mg_sweep(i, w, own, ax);
     }
     if (live) {
         if (mg_smooth_mode(pc) == 1u) {

@@ -16,6 +16,8 @@ layout(std430, set = 0, binding = 20) writeonly buffer Pressure { float pressure
 layout(std430, set = 0, binding = 23) writeonly buffer Z { float z[]; };
 layout(std430, set = 0, binding = 25) writeonly buffer R { float r[]; };
 layout(std430, set = 0, binding = 27) writeonly buffer Partials { vec2 partials[]; };
+#define VKHAIR_PRESSURE_RHS
+#include "pressure_ops.glsl"
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
@@ -27,14 +29,7 @@ void main() {
         precise float zc = 0.0;
         uint w = stencil[c];
         if (vol_is_fluid(w)) {
-            precise float outflow = 0.0;
-            for (uint axis = 0u; axis < 3u; ++axis) {
-                uvec3 up = ijk;
-                up[axis] += 1u;
-                outflow += face_vel[vol_face_index(up, axis, dims, vol_first_v_face(vp), vol_first_w_face(vp))]
-                    - face_vel[vol_face_index(ijk, axis, dims, vol_first_v_face(vp), vol_first_w_face(vp))];
-            }
-            b = -outflow;
+            b = pressure_rhs(ijk, dims);
             float diagonal = vol_diagonal(w);
             if (vol_preconditioner(vp) == VOL_PRECOND_JACOBI && diagonal > 0.0) {
                 zc = b / diagonal;

@@ -219,11 +219,12 @@ pub(crate) enum Kernel {
     MgSmooth,
     MgRestrict,
     MgCoarsest,
+    PcgWorkgroup,
     G2p,
 }
 
 impl Kernel {
-    pub(crate) const ALL: [Kernel; 19] = [
+    pub(crate) const ALL: [Kernel; 20] = [
         Kernel::Bin,
         Kernel::RadixCount,
         Kernel::RadixScatter,
@@ -242,6 +243,7 @@ impl Kernel {
         Kernel::MgSmooth,
         Kernel::MgRestrict,
         Kernel::MgCoarsest,
+        Kernel::PcgWorkgroup,
         Kernel::G2p,
     ];
 
@@ -276,6 +278,7 @@ impl Kernel {
             Kernel::MgSmooth => &SIM_VOLUME_MG_SMOOTH_COMP,
             Kernel::MgRestrict => &SIM_VOLUME_MG_RESTRICT_COMP,
             Kernel::MgCoarsest => &SIM_VOLUME_MG_COARSEST_COMP,
+            Kernel::PcgWorkgroup => &SIM_VOLUME_PCG_WORKGROUP_COMP,
             Kernel::G2p => &SIM_VOLUME_G2P_COMP,
         }
     }

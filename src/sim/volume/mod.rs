@@ -29,17 +29,23 @@
 //!    particles are sparse, and the gaps between them must not be free surface.
 //! 6. **Pressure** (FLIP only, `pcg_*`, `mg_*`): the Poisson system over fluid
 //!    cells (air p = 0, solid faces Neumann with their velocity), solved by
-//!    preconditioned conjugate gradients entirely on the GPU: dot products
-//!    reduced per workgroup with subgroup operations and then in one workgroup
-//!    in a fixed order; the iteration cap is recorded and a reduction kernel
-//!    sets the indirect dispatches of the remaining iterations to zero once
-//!    max |r| ≤ tolerance · max |b|. The preconditioner is Jacobi or one
+//!    preconditioned conjugate gradients entirely on the GPU, with dot products
+//!    summed in a fixed order, until max |r| ≤ tolerance · max |b| or the
+//!    iteration cap. The preconditioner is Jacobi or one
 //!    multigrid V-cycle. The matrix is read as one stencil word per cell and
-//!    level (`mg_stencil.comp`, once per solve); a V-cycle is four passes per
-//!    level (the two pre-sweeps in one, the prolongation folded into the first
-//!    post-sweep, the next dot product into the last) and an iteration 4 passes
-//!    per level above the coarsest plus 6. Then the pressure difference is subtracted on faces
-//!    between a fluid cell and a non-solid one (`gradient.comp`).
+//!    level (`mg_stencil.comp`, once per solve). Two ways to record it
+//!    ([`PressureSolver`]): by default the whole solve runs in one workgroup
+//!    (`pcg_workgroup.comp`: phases over the cells between workgroup barriers,
+//!    one dispatch, or a few shares of the iterations on large grids, since
+//!    lavapipe leaves any shader loop after 65,535 passes); or dispatched per
+//!    kernel and iteration over the whole device (dot products reduced per
+//!    workgroup with subgroup operations, then in one workgroup; every iteration
+//!    up to the cap recorded, a reduction kernel setting the indirect dispatches
+//!    of the remaining ones to zero once converged), where a V-cycle is four passes
+//!    per level (the two pre-sweeps in one, the prolongation folded into the
+//!    first post-sweep, the next dot product into the last) and an iteration 4
+//!    passes per level above the coarsest plus 6. Then the pressure difference is subtracted on faces between a
+//!    fluid cell and a non-solid one (`gradient.comp`).
 //! 7. **Update** (`g2p.comp`): FLIP/PIC blend ṽ = α(v + Lerp(x, v − v*)) +
 //!    (1 − α)Lerp(x, v), or friction and repulsion from the cells.
 //!
@@ -59,7 +65,7 @@ pub(crate) mod reference;
 mod tests;
 
 pub use grid::VolumeGrid;
-pub use params::{Preconditioner, VolumeMode, VolumeParams, MAX_VOLUME_CELLS};
+pub use params::{Preconditioner, PressureSolver, VolumeMode, VolumeParams, MAX_VOLUME_CELLS};
 pub(crate) use record::VolumeStage;
 
 /// What the latest pressure solve did (read back from the GPU).

@@ -35,6 +35,25 @@ pub enum Preconditioner {
     Multigrid,
 }
 
+/// How the GPU records the pressure solve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "snake_case")]
+pub enum PressureSolver {
+    /// The whole solve (every iteration, its preconditioner and its sums) in one
+    /// workgroup, stopping at the tolerance or the cap: one dispatch up to 32³
+    /// cells, a few on larger grids (shares of the iterations: CPU drivers cut
+    /// long shader loops), dispatched per kernel and iteration above about 1.9
+    /// million cells. Few dispatches and barriers, but one workgroup's worth of
+    /// the device.
+    #[default]
+    Workgroup,
+    /// A dispatch per kernel and iteration over the whole device, every iteration up
+    /// to the cap recorded (those after convergence dispatch zero workgroups):
+    /// 4 passes per multigrid level above the coarsest and 6 more per iteration.
+    Dispatched,
+}
+
 /// Parameters of the volume stage (hair-hair interaction on a grid).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -51,11 +70,14 @@ pub struct VolumeParams {
     pub flip_ratio: f32,
     /// Preconditioner of the GPU pressure solve. Default: [`Preconditioner::Multigrid`].
     pub preconditioner: Preconditioner,
+    /// How the GPU records the pressure solve. Default: [`PressureSolver::Workgroup`].
+    pub solver: PressureSolver,
     /// Tolerance of the pressure solve: it stops when max |residual| ≤ tolerance ×
     /// max |initial divergence| (0 < tolerance < 1). Default: 1e-5.
     pub tolerance: f32,
-    /// Iteration cap of the pressure solve (1..=1000). Every iteration up to the cap is
-    /// recorded; the ones after convergence dispatch zero workgroups. Default: 40.
+    /// Iteration cap of the pressure solve (1..=1000). With
+    /// [`PressureSolver::Dispatched`] every iteration up to the cap is recorded and
+    /// the ones after convergence dispatch zero workgroups. Default: 40.
     pub max_iterations: u32,
     /// Friction mode: share of a particle's velocity replaced by the cells' mean
     /// velocity per sub-step (0..=1). Default: 0.1.
@@ -76,6 +98,7 @@ impl Default for VolumeParams {
             resolution: [32, 32, 32],
             flip_ratio: 0.95,
             preconditioner: Preconditioner::Multigrid,
+            solver: PressureSolver::Workgroup,
             tolerance: 1e-5,
             max_iterations: 40,
             friction: 0.1,

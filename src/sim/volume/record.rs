@@ -6,12 +6,13 @@ use ash::vk;
 
 use super::buffers::{self, Kernel, KernelPipeline, VolumeBuffers, GROUP, INDIRECT_STRIDE, SCAN_TILE, SORT_BLOCK};
 use super::grid::GridLayout;
-use super::params::{Preconditioner, VolumeMode, VolumeParams};
+use super::params::{Preconditioner, PressureSolver, VolumeMode, VolumeParams};
 use super::VolumeStats;
 use crate::codes::vol_status;
 use crate::error::Result;
 use crate::gpu_types::{
     CoarsestPass, GpuVolumeParams, LevelPass, PcgScalars, RadixPass, ReducePass, ScanPass, SmoothingPass, VolumePush,
+    WorkgroupSolvePass,
 };
 use crate::profiler::{PassScope, Timing};
 use crate::vk::barrier::{self, AccessKind};
@@ -21,6 +22,36 @@ use crate::vk::device::Device;
 
 /// Jacobi sweeps on the coarsest multigrid level (even, see `mg_coarsest.comp`).
 const COARSEST_SWEEPS: u32 = 16;
+
+/// Most passes over loop back edges one share of the solve in one workgroup may
+/// make in its iteration loop, the loops inside it included: lavapipe (gallivm's
+/// loop limiter) leaves a loop after 65,535 passes, silently.
+const WORKGROUP_LOOP_BUDGET: u32 = 60_000;
+
+/// Iterations one dispatch of the solve in one workgroup may do on `grid`: the
+/// passes of its iteration loop over the cell loops inside it (each invocation
+/// takes every `GROUP`th cell), the coarsest level's sweeps, the tree reductions
+/// and the level lookups stay within [`WORKGROUP_LOOP_BUDGET`]. None where one
+/// iteration would not (grids above about 1.9 million cells): the solve is then
+/// dispatched per kernel and iteration.
+pub(crate) fn workgroup_share(grid: &GridLayout, preconditioner: Preconditioner) -> Option<u32> {
+    let per = |cells: u32| cells.div_ceil(GROUP);
+    let levels = &grid.levels;
+    let n = levels.len() as u32;
+    // Matrix product, update, r·z and the new direction; three reductions.
+    let mut trips = 4 * per(levels[0].cells()) + 3 * GROUP.ilog2();
+    if preconditioner == Preconditioner::Multigrid {
+        for pair in levels.windows(2) {
+            // Two sweeps down, two up, the restriction; the level lookups.
+            trips += 4 * per(pair[0].cells()) + per(pair[1].cells()) + 8 * n;
+        }
+        trips += COARSEST_SWEEPS;
+    } else {
+        trips += per(levels[0].cells());
+    }
+    let share = WORKGROUP_LOOP_BUDGET / trips;
+    (share > 0).then_some(share)
+}
 
 /// How a kernel is dispatched.
 #[derive(Clone, Copy)]
@@ -205,7 +236,8 @@ impl VolumeStage {
         })
     }
 
-    /// Step 6: the pressure solve and the gradient subtraction.
+    /// Step 6: the pressure solve (in one workgroup, or a dispatch per kernel and
+    /// iteration) and the gradient subtraction.
     unsafe fn record_pressure(&self, cmd: vk::CommandBuffer, variant: usize) {
         let levels = self.grid.levels.len();
         let single = Launch::Indirect(levels);
@@ -224,6 +256,15 @@ impl VolumeStage {
             }
             let words = if multigrid { self.grid.level_cells() } else { self.grid.cells() };
             self.run(cmd, Kernel::MgStencil, variant, none, Launch::Threads(words));
+            let share = workgroup_share(&self.grid, self.params.preconditioner);
+            if let (PressureSolver::Workgroup, Some(share)) = (self.params.solver, share) {
+                for k in 0..self.params.max_iterations.div_ceil(share) {
+                    let push = VolumePush::from(&WorkgroupSolvePass { start: u32::from(k == 0), iterations: share });
+                    self.run(cmd, Kernel::PcgWorkgroup, variant, push, Launch::Threads(GROUP));
+                }
+                self.run(cmd, Kernel::Gradient, variant, none, Launch::Threads(self.grid.faces[2]));
+                return;
+            }
             self.run(cmd, Kernel::PcgInit, variant, none, cells);
             if multigrid {
                 self.record_vcycle(cmd, variant);

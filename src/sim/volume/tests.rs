@@ -6,7 +6,7 @@ use rand_pcg::Pcg32;
 
 use super::grid::GridLayout;
 use super::reference::{self, face_index, Dims, VolumeSnapshot, FLUID, SOLID};
-use super::{Preconditioner, VolumeMode, VolumeParams, VolumeStage, VolumeStats};
+use super::{Preconditioner, PressureSolver, VolumeMode, VolumeParams, VolumeStage, VolumeStats};
 use crate::codes::collider_kind::SPHERE;
 use crate::gpu_types::{ColliderShape, GpuCollider, GpuVolumeParams, VolumeStep};
 use crate::sim::MAX_COLLIDERS;
@@ -270,13 +270,16 @@ fn projection_is_divergence_free_and_agrees_with_mic_pcg() {
     let (mut iterations, mut residuals) = (Vec::new(), Vec::new());
     // Both ways of reducing: subgroup arithmetic where the device has it, and the
     // shared-memory fallback, forced.
+    // Then the solve in one workgroup, which reduces its sums itself.
     let paths = if gpu.device().info.subgroup_reductions { vec![false, true] } else { vec![true] };
-    let runs = paths.into_iter().flat_map(|shared| {
-        [Preconditioner::Jacobi, Preconditioner::Multigrid].map(|preconditioner| (shared, preconditioner))
+    let runs =
+        paths.into_iter().map(|shared| (PressureSolver::Dispatched, shared)).chain([(PressureSolver::Workgroup, true)]);
+    let runs = runs.flat_map(|(solver, shared)| {
+        [Preconditioner::Jacobi, Preconditioner::Multigrid].map(|preconditioner| (solver, shared, preconditioner))
     });
-    for (shared, preconditioner) in runs {
+    for (solver, shared, preconditioner) in runs {
         gpu.device().shared_reductions.store(shared, std::sync::atomic::Ordering::Relaxed);
-        let params = VolumeParams { preconditioner, max_iterations: 200, ..VolumeParams::flip([16, 16, 16]) };
+        let params = VolumeParams { preconditioner, solver, max_iterations: 200, ..VolumeParams::flip([16, 16, 16]) };
         let b = block(&grid, &params, previous, 1);
         let run = run_gpu(&gpu, &grid, &params, &b, &colliders, &positions, &velocities);
         let mut cpu_vel = velocities.clone();
@@ -286,8 +289,8 @@ fn projection_is_divergence_free_and_agrees_with_mic_pcg() {
         let after = max_divergence(&grid, &cpu.labels, &run.snapshot.face_vel);
         let cpu_after = max_divergence(&grid, &cpu.labels, &cpu.face_vel);
         eprintln!(
-            "{preconditioner:?}, shared-memory reductions {shared}: {} iterations (MIC {}), divergence {before} -> \
-             GPU {after}, CPU {cpu_after}; {:?}",
+            "{solver:?} {preconditioner:?}, shared-memory reductions {shared}: {} iterations (MIC {}), divergence \
+             {before} -> GPU {after}, CPU {cpu_after}; {:?}",
             run.stats.iterations, cpu.iterations, run.stats
         );
         assert!(run.stats.converged && run.stats.iterations < params.max_iterations, "{:?}", run.stats);
@@ -303,14 +306,15 @@ fn projection_is_divergence_free_and_agrees_with_mic_pcg() {
         iterations.push(run.stats.iterations);
         residuals.push(run.stats.relative_residual);
     }
-    // The two reductions sum the same values in different orders: the solves take
-    // the same iterations to residuals equal but for rounding.
-    if iterations.len() == 4 {
-        assert_eq!(iterations[..2], iterations[2..], "subgroup and shared-memory reductions disagree");
-        for k in 0..2 {
-            let (a, b) = (residuals[k], residuals[k + 2]);
-            assert!((a - b).abs() <= 1e-4 * a, "residuals {a} and {b}");
-        }
+    // The reductions sum the same values in different orders: the solves take the
+    // same iterations to residuals equal but for rounding; so does the solve in one
+    // workgroup (the last pair), whose per-cell arithmetic is the dispatched kernels'.
+    let n = iterations.len();
+    for k in 0..n - 2 {
+        let (i, j) = (k % 2, k + 2);
+        assert_eq!(iterations[i], iterations[j], "run {j} takes other iterations than run {i}: {iterations:?}");
+        let (a, b) = (residuals[i], residuals[j]);
+        assert!((a - b).abs() <= 1e-2 * a, "residuals {a} and {b} of runs {i} and {j}");
     }
     for pair in iterations.chunks(2) {
         assert!(pair[1] * 2 <= pair[0], "multigrid needs {} iterations, Jacobi {}", pair[1], pair[0]);
@@ -349,21 +353,59 @@ fn a_grid_of_one_multigrid_level_is_solved_by_its_coarsest_pass() {
     let (positions, velocities) = random_particles(&mut rng, 800, Vec3::splat(0.5), Vec3::splat(5.5), 1.0);
     let grid = unit_grid([6, 6, 6], positions.len());
     assert_eq!(grid.levels.len(), 1, "216 cells are the coarsest level already");
-    let params = VolumeParams { max_iterations: 100, ..VolumeParams::flip([6, 6, 6]) };
-    let b = block(&grid, &params, Mat4::IDENTITY, 0);
-    let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
-    let mut cpu_vel = velocities.clone();
-    let cpu = reference::step(&grid, &b, &[], None, &positions, &mut cpu_vel);
-    let before = max_divergence(&grid, &cpu.labels, &cpu.face_star);
-    let after = max_divergence(&grid, &cpu.labels, &run.snapshot.face_vel);
-    eprintln!(
-        "one level: {} iterations (MIC {}), divergence {before} -> {after}",
-        run.stats.iterations, cpu.iterations
-    );
-    assert!(run.stats.converged && !run.stats.non_finite && run.stats.iterations < 100, "{:?}", run.stats);
-    assert!(before > 0.5 && after <= 4e-5 * before, "divergence {before} -> {after}");
-    let pmax = cpu.pressure.iter().fold(0.0f32, |m, p| m.max(p.abs()));
-    for (c, (g, r)) in run.snapshot.pressure.iter().zip(&cpu.pressure).enumerate() {
-        assert!((g - r).abs() <= 1e-3 * pmax, "pressure of cell {c}: GPU {g} vs MIC {r} (max {pmax})");
+    for solver in [PressureSolver::Dispatched, PressureSolver::Workgroup] {
+        let params = VolumeParams { max_iterations: 100, solver, ..VolumeParams::flip([6, 6, 6]) };
+        let b = block(&grid, &params, Mat4::IDENTITY, 0);
+        let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
+        let mut cpu_vel = velocities.clone();
+        let cpu = reference::step(&grid, &b, &[], None, &positions, &mut cpu_vel);
+        let before = max_divergence(&grid, &cpu.labels, &cpu.face_star);
+        let after = max_divergence(&grid, &cpu.labels, &run.snapshot.face_vel);
+        eprintln!(
+            "one level, {solver:?}: {} iterations (MIC {}), divergence {before} -> {after}",
+            run.stats.iterations, cpu.iterations
+        );
+        assert!(run.stats.converged && !run.stats.non_finite && run.stats.iterations < 100, "{:?}", run.stats);
+        assert!(before > 0.5 && after <= 4e-5 * before, "divergence {before} -> {after}");
+        let pmax = cpu.pressure.iter().fold(0.0f32, |m, p| m.max(p.abs()));
+        for (c, (g, r)) in run.snapshot.pressure.iter().zip(&cpu.pressure).enumerate() {
+            assert!((g - r).abs() <= 1e-3 * pmax, "pressure of cell {c}: GPU {g} vs MIC {r} (max {pmax})");
+        }
     }
+}
+
+/// The solve in one workgroup on a grid whose loops would outrun lavapipe's loop
+/// limit in one dispatch: its shares take the dispatched solve's iterations (give
+/// or take one: the sums are reduced in other orders) to the same tolerance.
+#[test]
+fn a_workgroup_solve_of_many_shares_converges_like_the_dispatched_one() {
+    let gpu = TestGpu::new();
+    let mut rng = Pcg32::seed_from_u64(12);
+    let (positions, velocities) = random_particles(&mut rng, 60000, Vec3::new(4.0, 5.0, 6.0), Vec3::splat(58.0), 1.0);
+    let grid = unit_grid([64, 64, 64], positions.len());
+    for preconditioner in [Preconditioner::Jacobi, Preconditioner::Multigrid] {
+        let mut stats = Vec::new();
+        for solver in [PressureSolver::Dispatched, PressureSolver::Workgroup] {
+            let params = VolumeParams { preconditioner, solver, max_iterations: 100, ..VolumeParams::flip([64; 3]) };
+            let b = block(&grid, &params, Mat4::IDENTITY, 0);
+            let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
+            eprintln!("64³, {preconditioner:?}, {solver:?}: {:?}", run.stats);
+            assert!(run.stats.converged && run.stats.relative_residual <= params.tolerance, "{:?}", run.stats);
+            stats.push(run.stats);
+        }
+        assert!(stats[0].iterations.abs_diff(stats[1].iterations) <= 1, "{preconditioner:?}: {stats:?}");
+    }
+}
+
+/// Shares of the solve in one workgroup: the default cap in one dispatch at 32³,
+/// 6 iterations a share at 64³ (lavapipe stopped an unshared 64³ solve after 7),
+/// and no share at all where one iteration would outrun the loop budget.
+#[test]
+fn the_workgroup_solve_is_shared_to_stay_within_the_loop_budget() {
+    use super::record::workgroup_share;
+    let grid = |n: u32| unit_grid([n; 3], 1000);
+    assert_eq!(workgroup_share(&grid(32), Preconditioner::Multigrid), Some(47));
+    assert_eq!(workgroup_share(&grid(64), Preconditioner::Multigrid), Some(6));
+    assert_eq!(workgroup_share(&grid(64), Preconditioner::Jacobi), Some(11));
+    assert_eq!(workgroup_share(&unit_grid([160, 160, 160], 1000), Preconditioner::Multigrid), None);
 }

@@ -3,7 +3,7 @@
 
 use clap::ValueEnum;
 use glam::Vec3;
-use vkhair::sim::{motion, Preconditioner, RigidTransform, SimParams, SolverMode, VolumeMode};
+use vkhair::sim::{motion, Preconditioner, PressureSolver, RigidTransform, SimParams, SolverMode, VolumeMode};
 
 /// Flags over the simulation parameters: each given one wins over the command's
 /// defaults and the `--config` file.
@@ -31,6 +31,10 @@ pub struct SimArgs {
     /// Iteration cap of the pressure solve [default: 40].
     #[arg(long)]
     pub max_iterations: Option<u32>,
+    /// How the GPU records the pressure solve: the whole solve in one workgroup
+    /// (one dispatch) or a dispatch per kernel and iteration [default: workgroup].
+    #[arg(long, value_enum)]
+    pub pressure: Option<PressureSolver>,
     /// Head motion about the neck: still, the shake (0.6 rad at 1 Hz) or violent
     /// (for soak runs: 1.2 rad at 3 Hz with a nod and jolts of the whole head).
     #[arg(long, value_enum, default_value = "shake")]
@@ -47,7 +51,7 @@ impl SimArgs {
     /// as they are after the defaults, the `--config` file and the flags.
     pub fn describe(&self, p: &SimParams) -> String {
         format!(
-            "parameters: {} iterations, {:?} solver, volume {:?} at {:?}, {} sub-step{}, {:?} pressure solve capped at {} iterations, motion {:?}",
+            "parameters: {} iterations, {:?} solver, volume {:?} at {:?}, {} sub-step{}, {:?} pressure solve ({:?}) capped at {} iterations, motion {:?}",
             p.iterations,
             p.solver,
             p.volume.mode,
@@ -55,6 +59,7 @@ impl SimArgs {
             p.substeps,
             if p.substeps == 1 { "" } else { "s" },
             p.volume.preconditioner,
+            p.volume.solver,
             p.volume.max_iterations,
             self.motion,
         )
@@ -96,6 +101,9 @@ impl SimArgs {
         }
         if let Some(cap) = self.max_iterations {
             params.volume.max_iterations = cap;
+        }
+        if let Some(solver) = self.pressure {
+            params.volume.solver = solver;
         }
     }
 }

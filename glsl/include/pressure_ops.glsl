@@ -1,0 +1,68 @@
+// Per-cell arithmetic of the pressure solve, one definition for its dispatched
+// kernels (pcg_init, mg_smooth, mg_restrict) and the solve in one workgroup
+// (pcg_workgroup). Include after volume_ops.glsl and after declaring what the
+// parts used read:
+//   VKHAIR_PRESSURE_RHS:    `vp` (VolumeParams) and `face_vel[]` (binding 17);
+//   VKHAIR_PRESSURE_LEVELS: `x[]` (binding 23) and `rhs[]` (binding 25).
+#ifndef VKHAIR_PRESSURE_OPS_GLSL
+#define VKHAIR_PRESSURE_OPS_GLSL
+
+#include "volume_ops.glsl"
+
+// Damping of the multigrid preconditioner's Jacobi sweeps.
+const float MG_OMEGA = 2.0 / 3.0;
+
+#ifdef VKHAIR_PRESSURE_RHS
+// b of the cell at `ijk`: −(net outflow), the divergence times the cell size.
+float pressure_rhs(uvec3 ijk, uvec3 dims) {
+    precise float outflow = 0.0;
+    for (uint axis = 0u; axis < 3u; ++axis) {
+        uvec3 up = ijk;
+        up[axis] += 1u;
+        outflow += face_vel[vol_face_index(up, axis, dims, vol_first_v_face(vp), vol_first_w_face(vp))]
+            - face_vel[vol_face_index(ijk, axis, dims, vol_first_v_face(vp), vol_first_w_face(vp))];
+    }
+    precise float b = -outflow;
+    return b;
+}
+#endif
+
+#ifdef VKHAIR_PRESSURE_LEVELS
+// A damped Jacobi sweep's value at level-array cell i (word w) from its own
+// value and A·x there: x + ω (rhs − A x) / diag.
+float mg_sweep(uint i, uint w, float own, float ax) {
+    float diagonal = vol_diagonal(w);
+    precise float value = diagonal > 0.0 ? own + MG_OMEGA * (rhs[i] - ax) / diagonal : 0.0;
+    return value;
+}
+
+// The coarse right-hand side of the coarse cell at `coarse` (a fluid one): half
+// the summed residuals rhs − A x of its fluid children on the level of `dims`
+// cells starting at `first` (the factor matches the coarse operator, the same
+// stencil on cells twice as wide).
+float mg_restricted(uvec3 coarse, uint first, uvec3 dims) {
+    precise float sum = 0.0;
+    for (uint k = 0u; k < 8u; ++k) {
+        uvec3 child = coarse * 2u + uvec3(k & 1u, (k >> 1u) & 1u, k >> 2u);
+        if (any(greaterThanEqual(child, dims))) {
+            continue;
+        }
+        uint i = first + vol_cell_index(child, dims);
+        uint w = stencil[i];
+        if (!vol_is_fluid(w)) {
+            continue;
+        }
+        precise float residual = rhs[i] - vol_diagonal(w) * x[i];
+        for (uint n = 0u; n < 6u; ++n) {
+            if (vol_has_fluid_neighbor(w, n)) {
+                residual += x[vol_neighbor_index(i, dims, n)];
+            }
+        }
+        sum += residual;
+    }
+    precise float half_sum = 0.5 * sum;
+    return half_sum;
+}
+#endif
+
+#endif
