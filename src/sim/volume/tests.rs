@@ -407,5 +407,8 @@ fn the_workgroup_solve_is_shared_to_stay_within_the_loop_budget() {
     assert_eq!(workgroup_share(&grid(32), Preconditioner::Multigrid), Some(47));
     assert_eq!(workgroup_share(&grid(64), Preconditioner::Multigrid), Some(6));
     assert_eq!(workgroup_share(&grid(64), Preconditioner::Jacobi), Some(11));
+    // The edge PressureSolver::Workgroup names: about 1.9 million cells.
+    assert_eq!(workgroup_share(&grid(120), Preconditioner::Multigrid), Some(1), "1.73 million cells");
+    assert_eq!(workgroup_share(&grid(128), Preconditioner::Multigrid), None, "2.10 million cells");
     assert_eq!(workgroup_share(&unit_grid([160, 160, 160], 1000), Preconditioner::Multigrid), None);
 }
