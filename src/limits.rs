@@ -25,6 +25,10 @@ const _: () = assert!(VOL_GROUP.is_power_of_two());
 pub const VOL_SORT_BLOCK: u32 = 256;
 /// Elements of one prefix-sum tile, four per invocation.
 pub const VOL_SCAN_TILE: u32 = 1024;
+/// Damped Jacobi sweeps of the multigrid preconditioner on its coarsest level
+/// (an even number).
+pub const VOL_COARSEST_SWEEPS: u32 = 16;
+const _: () = assert!(VOL_COARSEST_SWEEPS.is_multiple_of(2));
 /// Invocations of the per-item compute kernels of the renderer and the tests.
 #[cfg_attr(not(test), allow(dead_code))] // the pipelines read it back from the SPIR-V
 pub const ITEM_GROUP: u32 = 64;
@@ -45,6 +49,7 @@ pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
     ("VOL_GROUP", VOL_GROUP),
     ("VOL_SORT_BLOCK", VOL_SORT_BLOCK),
     ("VOL_SCAN_TILE", VOL_SCAN_TILE),
+    ("VOL_COARSEST_SWEEPS", VOL_COARSEST_SWEEPS),
     ("ITEM_GROUP", ITEM_GROUP),
     ("SDF_MAX_RESOLUTION", SDF_MAX_RESOLUTION),
     ("OIT_MAX_SORTED", OIT_MAX_SORTED),

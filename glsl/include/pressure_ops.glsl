@@ -2,8 +2,9 @@
 // kernels (pcg_init, mg_smooth, mg_restrict) and the solve in one workgroup
 // (pcg_workgroup). Include after volume_ops.glsl and after declaring what the
 // parts used read:
-//   VKHAIR_PRESSURE_RHS:    `vp` (VolumeParams) and `face_vel[]` (binding 17);
-//   VKHAIR_PRESSURE_LEVELS: `x[]` (binding 23) and `rhs[]` (binding 25).
+//   VKHAIR_PRESSURE_RHS:       `vp` (VolumeParams) and `face_vel[]` (binding 17);
+//   VKHAIR_PRESSURE_LEVELS:    `x[]` (binding 23) and `rhs[]` (binding 25);
+//   VKHAIR_PRESSURE_COARSEST:  nothing (it declares its shared memory).
 #ifndef VKHAIR_PRESSURE_OPS_GLSL
 #define VKHAIR_PRESSURE_OPS_GLSL
 
@@ -11,6 +12,13 @@
 
 // Damping of the multigrid preconditioner's Jacobi sweeps.
 const float MG_OMEGA = 2.0 / 3.0;
+
+// The Jacobi preconditioner's z = r / diag of a cell (word w): 0 where the cell
+// is not fluid or has no non-solid neighbour.
+float pcg_jacobi(uint w, float r) {
+    float diagonal = vol_diagonal(w);
+    return vol_is_fluid(w) && diagonal > 0.0 ? r / diagonal : 0.0;
+}
 
 #ifdef VKHAIR_PRESSURE_RHS
 // b of the cell at `ijk`: −(net outflow), the divergence times the cell size.
@@ -62,6 +70,38 @@ float mg_restricted(uvec3 coarse, uint first, uvec3 dims) {
     }
     precise float half_sum = 0.5 * sum;
     return half_sum;
+}
+#endif
+
+#ifdef VKHAIR_PRESSURE_COARSEST
+shared float mg_coarsest_values[2][VOL_GROUP];
+
+// The coarsest multigrid level's solve, one cell per invocation (at most
+// VOL_GROUP cells): VOL_COARSEST_SWEEPS damped Jacobi sweeps from x = 0 in
+// shared memory. `c` is the invocation's cell (its word w, right-hand side b;
+// w = 0 for invocations past the level), the result its value. Every invocation
+// of the workgroup calls it (barriers).
+float mg_coarsest_solve(uint c, uvec3 dims, uint w, float b) {
+    bool fluid_cell = vol_is_fluid(w);
+    float diagonal = vol_diagonal(w);
+    mg_coarsest_values[0][c] = 0.0;
+    barrier();
+    for (uint sweep = 0u; sweep < VOL_COARSEST_SWEEPS; ++sweep) {
+        uint from = sweep & 1u;
+        precise float value = 0.0;
+        if (fluid_cell && diagonal > 0.0) {
+            precise float ax = diagonal * mg_coarsest_values[from][c];
+            for (uint n = 0u; n < 6u; ++n) {
+                if (vol_has_fluid_neighbor(w, n)) {
+                    ax -= mg_coarsest_values[from][vol_neighbor_index(c, dims, n)];
+                }
+            }
+            value = mg_coarsest_values[from][c] + MG_OMEGA * (b - ax) / diagonal;
+        }
+        mg_coarsest_values[1u - from][c] = value;
+        barrier();
+    }
+    return mg_coarsest_values[VOL_COARSEST_SWEEPS & 1u][c];
 }
 #endif
 

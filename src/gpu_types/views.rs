@@ -266,8 +266,6 @@ shader_views! {
         first: uint = dims.w,
         /// 1: the grid has one level, so this pass also writes the partials.
         partials: uint = op.y,
-        /// Jacobi sweeps (an even number).
-        sweeps: uint = op.z,
     }
 
     /// A share of the solve in one workgroup (`VolumePush` of `pcg_workgroup`).

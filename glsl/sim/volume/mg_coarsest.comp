@@ -1,6 +1,6 @@
 #version 460
 // Multigrid preconditioner, coarsest level (at most 256 cells), one workgroup:
-// mg_coarsest_sweeps damped Jacobi sweeps (an even number) from x = 0 in shared memory;
+// VOL_COARSEST_SWEEPS damped Jacobi sweeps from x = 0 in shared memory;
 // with mg_coarsest_partials = 1 (a grid of one level) also the partials (r·z, max |r|) of the
 // conjugate gradients, as the finest level's last sweep gives them otherwise.
 //   mg_coarsest_dims/first: the level.
@@ -16,10 +16,8 @@ layout(std430, set = 0, binding = 30) readonly buffer Stencil { uint stencil[]; 
 layout(std430, set = 0, binding = 23) writeonly buffer X { float x[]; };
 layout(std430, set = 0, binding = 25) readonly buffer Rhs { float rhs[]; };
 layout(std430, set = 0, binding = 27) writeonly buffer Partials { vec2 partials[]; };
-
-shared float values[2][VOL_GROUP];
-
-const float OMEGA = 2.0 / 3.0;
+#define VKHAIR_PRESSURE_COARSEST
+#include "pressure_ops.glsl"
 
 void main() {
     uint c = gl_LocalInvocationID.x;
@@ -27,27 +25,7 @@ void main() {
     bool live = c < dims.x * dims.y * dims.z;
     uint i = mg_coarsest_first(pc) + c;
     uint w = live ? stencil[i] : 0u;
-    bool fluid_cell = vol_is_fluid(w);
-    float diagonal = vol_diagonal(w);
-    float b = fluid_cell ? rhs[i] : 0.0;
-    values[0][c] = 0.0;
-    barrier();
-    for (uint sweep = 0u; sweep < mg_coarsest_sweeps(pc); ++sweep) {
-        uint from = sweep & 1u;
-        precise float value = 0.0;
-        if (fluid_cell && diagonal > 0.0) {
-            precise float ax = diagonal * values[from][c];
-            for (uint n = 0u; n < 6u; ++n) {
-                if (vol_has_fluid_neighbor(w, n)) {
-                    ax -= values[from][vol_neighbor_index(c, dims, n)];
-                }
-            }
-            value = values[from][c] + OMEGA * (b - ax) / diagonal;
-        }
-        values[1u - from][c] = value;
-        barrier();
-    }
-    float result = values[mg_coarsest_sweeps(pc) & 1u][c];
+    float result = mg_coarsest_solve(c, dims, w, vol_is_fluid(w) ? rhs[i] : 0.0);
     if (live) {
         x[i] = result;
     }

@@ -30,9 +30,8 @@ void main() {
         uint w = stencil[c];
         if (vol_is_fluid(w)) {
             b = pressure_rhs(ijk, dims);
-            float diagonal = vol_diagonal(w);
-            if (vol_preconditioner(vp) == VOL_PRECOND_JACOBI && diagonal > 0.0) {
-                zc = b / diagonal;
+            if (vol_preconditioner(vp) == VOL_PRECOND_JACOBI) {
+                zc = pcg_jacobi(w, b);
             }
         }
         r[c] = b;

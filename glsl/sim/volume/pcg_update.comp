@@ -17,6 +17,7 @@ layout(std430, set = 0, binding = 23) writeonly buffer Z { float z[]; };
 layout(std430, set = 0, binding = 25) buffer R { float r[]; };
 layout(std430, set = 0, binding = 26) readonly buffer Scalars { PcgScalars scalars; };
 layout(std430, set = 0, binding = 27) writeonly buffer Partials { vec2 partials[]; };
+#include "pressure_ops.glsl"
 
 void main() {
     uint c = gl_GlobalInvocationID.x;
@@ -28,12 +29,7 @@ void main() {
         pressure[c] = pc;
         r[c] = rc;
         if (vol_preconditioner(vp) == VOL_PRECOND_JACOBI) {
-            precise float zc = 0.0;
-            uint w = stencil[c];
-            float diagonal = vol_diagonal(w);
-            if (vol_is_fluid(w)) {
-                zc = diagonal > 0.0 ? rc / diagonal : 0.0;
-            }
+            float zc = pcg_jacobi(stencil[c], rc);
             z[c] = zc;
             local = vec2(rc * zc, abs(rc));
         }

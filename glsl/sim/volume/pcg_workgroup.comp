@@ -32,13 +32,10 @@ layout(push_constant) uniform Push { VolumePush pc; };
 layout(std430, set = 0, binding = 26) buffer Scalars { PcgScalars scalars; };
 #define VKHAIR_PRESSURE_RHS
 #define VKHAIR_PRESSURE_LEVELS
+#define VKHAIR_PRESSURE_COARSEST
 #include "pressure_ops.glsl"
 
-// Jacobi sweeps on the coarsest level (record.rs COARSEST_SWEEPS).
-const uint COARSEST_SWEEPS = 16u;
-
 shared vec2 sums[VOL_GROUP];
-shared float coarsest[2][VOL_GROUP];
 
 // Every write of every invocation before it is visible to all after it.
 void sync() {
@@ -85,14 +82,8 @@ uint lvl_first(uint level) {
     return first;
 }
 
-// Two sweeps from x = 0 on a level (tmp holds the first).
-void pre_smooth(uint first, uint cells, uvec3 dims) {
-    for (uint c = gl_LocalInvocationIndex; c < cells; c += VOL_GROUP) {
-        uint i = first + c;
-        uint w = stencil[i];
-        tmp[i] = vol_is_fluid(w) ? mg_sweep(i, w, 0.0, 0.0) : 0.0;
-    }
-    sync();
+// One sweep from tmp into x on a level.
+void sweep_tmp_into_x(uint first, uint cells, uvec3 dims) {
     for (uint c = gl_LocalInvocationIndex; c < cells; c += VOL_GROUP) {
         uint i = first + c;
         uint w = stencil[i];
@@ -112,6 +103,17 @@ void pre_smooth(uint first, uint cells, uvec3 dims) {
     sync();
 }
 
+// Two sweeps from x = 0 on a level (tmp holds the first).
+void pre_smooth(uint first, uint cells, uvec3 dims) {
+    for (uint c = gl_LocalInvocationIndex; c < cells; c += VOL_GROUP) {
+        uint i = first + c;
+        uint w = stencil[i];
+        tmp[i] = vol_is_fluid(w) ? mg_sweep(i, w, 0.0, 0.0) : 0.0;
+    }
+    sync();
+    sweep_tmp_into_x(first, cells, dims);
+}
+
 // Half the summed residuals of a coarse cell's fluid children (mg_restrict).
 void restrict_residual(uint first, uvec3 dims, uint coarse_first, uvec3 coarse_dims) {
     uint coarse_cells = coarse_dims.x * coarse_dims.y * coarse_dims.z;
@@ -122,35 +124,15 @@ void restrict_residual(uint first, uvec3 dims, uint coarse_first, uvec3 coarse_d
     sync();
 }
 
-// Jacobi sweeps from x = 0 on the coarsest level (at most VOL_GROUP cells), in
-// shared memory (mg_coarsest).
+// The coarsest level's solve (mg_coarsest) into x.
 void solve_coarsest(uint first, uvec3 dims) {
     uint c = gl_LocalInvocationIndex;
     bool live = c < dims.x * dims.y * dims.z;
     uint i = first + c;
     uint w = live ? stencil[i] : 0u;
-    bool fluid_cell = vol_is_fluid(w);
-    float diagonal = vol_diagonal(w);
-    float b = fluid_cell ? rhs[i] : 0.0;
-    coarsest[0][c] = 0.0;
-    barrier();
-    for (uint s = 0u; s < COARSEST_SWEEPS; ++s) {
-        uint from = s & 1u;
-        precise float value = 0.0;
-        if (fluid_cell && diagonal > 0.0) {
-            precise float ax = diagonal * coarsest[from][c];
-            for (uint n = 0u; n < 6u; ++n) {
-                if (vol_has_fluid_neighbor(w, n)) {
-                    ax -= coarsest[from][vol_neighbor_index(c, dims, n)];
-                }
-            }
-            value = coarsest[from][c] + MG_OMEGA * (b - ax) / diagonal;
-        }
-        coarsest[1u - from][c] = value;
-        barrier();
-    }
+    float result = mg_coarsest_solve(c, dims, w, vol_is_fluid(w) ? rhs[i] : 0.0);
     if (live) {
-        x[i] = coarsest[COARSEST_SWEEPS & 1u][c];
+        x[i] = result;
     }
     sync();
 }
@@ -183,23 +165,7 @@ void post_smooth(uint first, uint cells, uvec3 dims, uint coarse_first, uvec3 co
         tmp[i] = value;
     }
     sync();
-    for (uint c = gl_LocalInvocationIndex; c < cells; c += VOL_GROUP) {
-        uint i = first + c;
-        uint w = stencil[i];
-        precise float value = 0.0;
-        if (vol_is_fluid(w)) {
-            float own = tmp[i];
-            precise float ax = vol_diagonal(w) * own;
-            for (uint n = 0u; n < 6u; ++n) {
-                if (vol_has_fluid_neighbor(w, n)) {
-                    ax -= tmp[vol_neighbor_index(i, dims, n)];
-                }
-            }
-            value = mg_sweep(i, w, own, ax);
-        }
-        x[i] = value;
-    }
-    sync();
+    sweep_tmp_into_x(first, cells, dims);
 }
 
 // z = M r into x (level 0), then (r·z, max |r|).
@@ -207,9 +173,7 @@ vec2 precondition() {
     uint cells = vol_cells(vp);
     if (vol_preconditioner(vp) == VOL_PRECOND_JACOBI) {
         for (uint c = gl_LocalInvocationIndex; c < cells; c += VOL_GROUP) {
-            uint w = stencil[c];
-            float diagonal = vol_diagonal(w);
-            x[c] = vol_is_fluid(w) && diagonal > 0.0 ? rhs[c] / diagonal : 0.0;
+            x[c] = pcg_jacobi(stencil[c], rhs[c]);
         }
         sync();
     } else {

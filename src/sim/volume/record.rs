@@ -20,8 +20,7 @@ use crate::vk::buffer::Buffer;
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 
-/// Jacobi sweeps on the coarsest multigrid level (even, see `mg_coarsest.comp`).
-const COARSEST_SWEEPS: u32 = 16;
+use crate::limits::VOL_COARSEST_SWEEPS;
 
 /// Most passes over loop back edges one share of the solve in one workgroup may
 /// make in its iteration loop, the loops inside it included: lavapipe (gallivm's
@@ -45,7 +44,7 @@ pub(crate) fn workgroup_share(grid: &GridLayout, preconditioner: Preconditioner)
             // Two sweeps down, two up, the restriction; the level lookups.
             trips += 4 * per(pair[0].cells()) + per(pair[1].cells()) + 8 * n;
         }
-        trips += COARSEST_SWEEPS;
+        trips += VOL_COARSEST_SWEEPS;
     } else {
         trips += per(levels[0].cells());
     }
@@ -306,7 +305,6 @@ impl VolumeStage {
                 dims: last.dims,
                 first: last.first,
                 partials: u32::from(levels == 1),
-                sweeps: COARSEST_SWEEPS,
             });
             self.run(cmd, Kernel::MgCoarsest, variant, coarsest, Launch::Indirect(levels));
             for level in (0..levels - 1).rev() {
