@@ -283,6 +283,61 @@ fn stopping_the_simulation_side_returns_errors() {
     }
 }
 
+/// A teleport (by half a metre: below the teleport distance, so only the call
+/// makes it one) and a reset asked of the scheduler between frames reach the
+/// simulation before its next step in every mode: the state before the reset
+/// and at the end is, bit for bit, that of a `HairSim` asked the same at the
+/// same step.
+#[test]
+fn teleports_and_resets_reach_the_simulation_in_every_mode() {
+    let render = Gpu::new();
+    let sim = Gpu::new();
+    let g = groom(16, 4);
+    let p = SimParams::default();
+    let head = |i: usize| motion::violent_motion((i + 1) as f32 / 60.0);
+    let jump = |h: RigidTransform| RigidTransform { translation: h.translation + Vec3::new(0.5, 0.0, 0.0), ..h };
+    // Steps 0..6 shaking, the teleport, steps 6..9 at the jump, the reset, steps 9..12.
+    let heads: Vec<RigidTransform> = (0..12).map(|i| if i < 6 { head(i) } else { jump(head(i)) }).collect();
+    let mut reference = vkhair::sim::HairSim::new(sim.ctx(), &g, &p, &RigidTransform::default()).expect("sim");
+    let mut expected = Vec::new();
+    for (i, h) in heads.iter().enumerate() {
+        if i == 6 {
+            reference.teleport(&jump(heads[5])).expect("teleport");
+        }
+        if i == 9 {
+            expected.push(common::bits(&reference.read_state().expect("state")));
+            reference.reset();
+        }
+        reference.run(1, |_| *h, None).expect("step");
+    }
+    expected.push(common::bits(&reference.read_state().expect("state")));
+    let all = [
+        single(Pipelining::Throughput),
+        second_device(&sim, HandOff::ExternalMemory, Pipelining::Throughput),
+        second_device(&sim, HandOff::HostStaging, Pipelining::Latency),
+    ];
+    for options in all {
+        let mut s =
+            FrameScheduler::new(render.ctx(), &g, &p, &RigidTransform::default(), &[], &options).expect("scheduler");
+        let mut got = Vec::new();
+        for (i, h) in heads.iter().enumerate() {
+            if i == 6 {
+                s.teleport(&jump(heads[5])).expect("teleport");
+            }
+            if i == 9 {
+                got.push(common::bits(&s.read_state().expect("state")));
+                s.reset().expect("reset");
+            }
+            let steps = std::slice::from_ref(h);
+            // SAFETY: recording command buffer of the rendering device, waited for.
+            render.ctx().run_frame("frame", |cmd| unsafe { s.record_frame(cmd, steps, None) }).expect("frame");
+        }
+        got.push(common::bits(&s.read_state().expect("state")));
+        assert!(got[0] == expected[0], "{:?}: not the HairSim's state before the reset", s.mode());
+        assert!(got[1] == expected[1], "{:?}: not the HairSim's state after the reset", s.mode());
+    }
+}
+
 /// Bad input is rejected with typed errors before any work.
 #[test]
 fn bad_input_is_rejected() {

@@ -10,8 +10,8 @@
 
 // The packed blocks below are read only through the accessors of their views
 // (views.glsl, generated from src/gpu_types/views.rs, which names every lane):
-// `sim_*(p)` for SimStepParams, `step_range_*(p)` for SimPush, `collider_*(c)`
-// for Collider. The SIM_* switches (src/codes.rs) and SIM_MAX_COLLIDERS and
+// `sim_*(p)` for SimStepParams, `step_range_*(p)` for SimPush, `state_move_*(p)`
+// for MovePush, `collider_*(c)` for Collider. The SIM_* switches (src/codes.rs) and SIM_MAX_COLLIDERS and
 // SIM_WORKGROUP (src/limits.rs) are injected by build.rs.
 
 // Per-sub-step parameters (one array entry per sub-step, binding 0). Twin:
@@ -33,6 +33,13 @@ struct SimStepParams {
 // Push constants of the step kernel. Twin: gpu_types::SimPush, view gpu_types::StepRange.
 struct SimPush {
     uvec4 range;
+};
+
+// Push constants of the state move kernel (move.comp). Twin: gpu_types::MovePush,
+// view gpu_types::StateMove.
+struct MovePush {
+    mat4 transform;
+    uvec4 info;
 };
 
 // One collider in world space. Twin: gpu_types::GpuCollider, view gpu_types::ColliderShape.

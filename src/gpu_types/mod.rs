@@ -30,7 +30,7 @@ pub(crate) use probe::{LayoutProbe, ScaleAddPush};
 pub(crate) use render::{
     DrawParams, GpuLight, GpuShadowMap, GpuShadowParams, InterpolatePush, MarschnerPush, OitCounters, SmoothPush,
 };
-pub(crate) use sim::{GpuCollider, SdfPush, SimPush, SimStepParams};
+pub(crate) use sim::{GpuCollider, MovePush, SdfPush, SimPush, SimStepParams};
 pub(crate) use volume::{GpuVolumeParams, PcgScalars, VolumePush};
 
 /// The Rust type of a view field of a given kind.
@@ -189,6 +189,7 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<LayoutProbe>(reflection, &mut problems);
     check::<SimStepParams>(reflection, &mut problems);
     check::<SimPush>(reflection, &mut problems);
+    check::<MovePush>(reflection, &mut problems);
     check::<GpuCollider>(reflection, &mut problems);
     check::<SdfPush>(reflection, &mut problems);
     check::<SmoothPush>(reflection, &mut problems);

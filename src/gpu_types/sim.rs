@@ -36,6 +36,15 @@ pub(crate) struct SimPush {
 }
 gpu_struct!(SimPush => "SimPush" { range });
 
+/// Push constants of the state move kernel (`MovePush`); view: [`super::StateMove`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct MovePush {
+    pub(super) transform: [[f32; 4]; 4],
+    pub(super) info: [u32; 4],
+}
+gpu_struct!(MovePush => "MovePush" { transform, info });
+
 /// Push constants of the mesh collider's build kernels (`SdfPush`); view: [`super::SdfPass`].
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]

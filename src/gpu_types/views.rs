@@ -106,6 +106,19 @@ shader_views! {
         simulated: uint = range.z,
     }
 
+    /// A cut or teleport applied to the whole state before a step (`MovePush`,
+    /// `glsl/sim/move.comp`).
+    StateMove for MovePush in "sim.glsl" as "MovePush" prefix "state_move" {
+        /// Teleport: the rigid motion from the old head to the new one (new ·
+        /// old⁻¹), applied to positions and, its rotation, to velocities. Reset:
+        /// the head, placing the rest positions (head frame) in the world.
+        transform: mat4 = transform,
+        /// 1 for a reset to the rest pose (velocities zero), 0 for a teleport.
+        reset: uint = info.x,
+        /// Points of every key hair (strands × points per strand).
+        points: uint = info.y,
+    }
+
     /// One collider in world space at one sub-step (`Collider`).
     ColliderShape for GpuCollider in "sim.glsl" as "Collider" prefix "collider" {
         /// Centre (sphere) or first end (capsule), m.

@@ -5,7 +5,7 @@ use super::worker::SimUpdate;
 use super::{Backend, FrameScheduler};
 use crate::error::{Error, Result};
 use crate::groom::mesh::TriMesh;
-use crate::sim::{Collider, MeshCollider, MeshColliderParams, SimParams};
+use crate::sim::{Collider, MeshCollider, MeshColliderParams, RigidTransform, SimParams};
 
 impl FrameScheduler {
     /// Changes simulation parameters from the next step on (validated now). The
@@ -37,6 +37,34 @@ impl FrameScheduler {
             Backend::Local { sim, .. } => sim.set_colliders(colliders),
             Backend::Async { sim, .. } => sim.sim.set_colliders(colliders),
             Backend::Remote { worker, .. } => worker.update(SimUpdate::Colliders(colliders.to_vec())),
+            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
+        }
+    }
+
+    /// A cut or a respawn: the next step starts with the state moved rigidly to
+    /// the head `to` (checked now; see [`crate::sim::HairSim::teleport`]).
+    pub fn teleport(&mut self, to: &RigidTransform) -> Result<()> {
+        to.validate()?;
+        match &mut self.backend {
+            Backend::Local { sim, .. } => sim.teleport(to),
+            Backend::Async { sim, .. } => sim.sim.teleport(to),
+            Backend::Remote { worker, .. } => worker.update(SimUpdate::Teleport(*to)),
+            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
+        }
+    }
+
+    /// The next step starts from the rest pose (see [`crate::sim::HairSim::reset`]).
+    pub fn reset(&mut self) -> Result<()> {
+        match &mut self.backend {
+            Backend::Local { sim, .. } => {
+                sim.reset();
+                Ok(())
+            }
+            Backend::Async { sim, .. } => {
+                sim.sim.reset();
+                Ok(())
+            }
+            Backend::Remote { worker, .. } => worker.update(SimUpdate::Reset),
             Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
         }
     }

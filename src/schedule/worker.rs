@@ -41,6 +41,8 @@ const SLICE: Duration = Duration::from_millis(20);
 pub(crate) enum SimUpdate {
     Params(Box<SimParams>),
     Colliders(Vec<Collider>),
+    Teleport(RigidTransform),
+    Reset,
     Mesh(Option<Box<(TriMesh, MeshColliderParams)>>),
     /// Key hairs simulated (checked by the sender).
     Simulated(usize),
@@ -273,6 +275,11 @@ fn run(mut side: SimSide, slots: usize, timeout: Duration, shared: &Shared) {
             Request::Step { job, heads } => step(&mut side, shared, job, &heads, slots, timeout),
             Request::Update(SimUpdate::Params(p)) => side.sim.set_params(&p),
             Request::Update(SimUpdate::Colliders(c)) => side.sim.set_colliders(&c),
+            Request::Update(SimUpdate::Teleport(to)) => side.sim.teleport(&to),
+            Request::Update(SimUpdate::Reset) => {
+                side.sim.reset();
+                Ok(())
+            }
             Request::Update(SimUpdate::Simulated(count)) => side.sim.set_simulated_hairs(count),
             Request::Update(SimUpdate::Mesh(m)) => match m.as_deref() {
                 Some((mesh, params)) => side.sim.set_mesh(Some(mesh), params),

@@ -55,7 +55,7 @@ impl CpuHairSim {
     /// See [`HairSim::from_state`](super::HairSim::from_state).
     pub fn from_state(state: SimState, params: &SimParams, head: &RigidTransform) -> Result<Self> {
         // The CPU runs the same constraint sets in the same order whatever the packing.
-        let planner = SubstepPlanner::new(params, head, state.strands, state.points, MAX_SIM_POINTS as u32)?;
+        let planner = SubstepPlanner::new(params, head, state.rest_roots(), state.points, MAX_SIM_POINTS as u32)?;
         let volume = cpu_volume_grid(params, &state)?;
         let lod = SimLod::new(&state);
         Ok(CpuHairSim { planner, state, volume, last_volume: None, mesh: None, volume_time: Default::default(), lod })
@@ -90,7 +90,11 @@ impl CpuHairSim {
 
     /// Advances one step ending with the head at `head`.
     pub fn step(&mut self, head: &RigidTransform) -> Result<()> {
-        let inputs = self.planner.next(head)?;
+        let planned = self.planner.next(head)?;
+        if let Some(start) = &planned.start {
+            reference::move_state(&mut self.state, start);
+        }
+        let inputs = planned.substeps;
         self.volume_time = std::time::Duration::ZERO;
         let active = self.lod.active();
         // The positions the followers start from: of the step without the volume
@@ -125,6 +129,16 @@ impl CpuHairSim {
             }
         }
         Ok(())
+    }
+
+    /// See [`HairSim::teleport`](super::HairSim::teleport).
+    pub fn teleport(&mut self, to: &RigidTransform) -> Result<()> {
+        self.planner.teleport(to)
+    }
+
+    /// See [`HairSim::reset`](super::HairSim::reset).
+    pub fn reset(&mut self) {
+        self.planner.reset();
     }
 
     /// The grid of the volume stage, when it is on.

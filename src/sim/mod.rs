@@ -61,6 +61,7 @@ mod record;
 pub(crate) mod reference;
 mod state;
 mod step;
+mod teleport;
 mod view;
 pub mod volume;
 
@@ -76,6 +77,7 @@ pub use lod::FOLLOW_FADE;
 pub use mesh_collider::{MeshCollider, MeshColliderParams, MESH_COLLIDER_BUILD_LABEL};
 pub use params::{SimParams, SolverMode, MAX_SIM_POINTS, MAX_SUBSTEPS};
 pub use state::SimState;
+pub use teleport::MOVE_LABEL;
 pub use view::KeyHairs;
 pub use volume::{Preconditioner, PressureSolver, VolumeGrid, VolumeMode, VolumeParams, VolumeStats};
 
@@ -204,6 +206,8 @@ pub struct HairSim {
     /// The follower kernel, with its sets reading half 0 and half 1.
     follow: ComputePipeline,
     follow_sets: [vk::DescriptorSet; 2],
+    /// The teleport and reset kernel.
+    mover: teleport::MoveKernel,
 }
 
 impl HairSim {
@@ -220,7 +224,7 @@ impl HairSim {
         // Subgroup-synchronised solving needs full subgroups; without them the solver
         // synchronises whole workgroups.
         let subgroup = if device.full_subgroups { device.info.subgroup_size } else { 0 };
-        let planner = SubstepPlanner::new(params, head, state.strands, state.points, subgroup)?;
+        let planner = SubstepPlanner::new(params, head, state.rest_roots(), state.points, subgroup)?;
         let lod = lod::SimLod::new(state);
         let gpu = GpuState::new(&device, state, &lod)?;
         let follow = ComputePipeline::new(&device, &SIM_FOLLOW_COMP, 2)?;
@@ -228,6 +232,7 @@ impl HairSim {
             follow.declared_buffer_set(0, &gpu.follow_bindings(0, None))?,
             follow.declared_buffer_set(0, &gpu.follow_bindings(1, None))?,
         ];
+        let mover = teleport::MoveKernel::new(&device, &gpu)?;
         let pipeline = ComputePipeline::with_full_subgroups(&device, step::SHADER, 2, device.full_subgroups)?;
         let sets = [
             pipeline.declared_buffer_set(0, &gpu.bindings(0, None))?,
@@ -248,6 +253,7 @@ impl HairSim {
             pending_guides: false,
             follow,
             follow_sets,
+            mover,
         };
         sim.configure_volume(&params.volume)?;
         sim.prepare_step()?;
@@ -285,6 +291,24 @@ impl HairSim {
         self.volume =
             Some(volume::VolumeStage::new(&self.device, grid, params, &g.volume_colliders, mesh_field, &particles)?);
         Ok(())
+    }
+
+    /// A cut or a respawn: the next recorded step starts with the whole state
+    /// (positions, and velocities turned with the head) moved rigidly from the
+    /// current head to `to`, adding no velocity, and interpolates the head from
+    /// `to` (not across the jump) to the head it ends with. Call it, then record
+    /// the step ending at `to` (or wherever the head goes next). A head that
+    /// moves a root farther than [`SimParams::teleport_distance`] in one step is
+    /// taken as a teleport without this call. Keeps a pending [`HairSim::reset`].
+    pub fn teleport(&mut self, to: &RigidTransform) -> Result<()> {
+        self.planner.teleport(to)
+    }
+
+    /// The next recorded step starts from the rest pose, velocities zero, placed
+    /// by the head it starts from (a pending [`HairSim::teleport`]'s target, else
+    /// the current head).
+    pub fn reset(&mut self) {
+        self.planner.reset();
     }
 
     /// Current parameters.

@@ -122,6 +122,12 @@ pub struct SimParams {
     /// The volume stage (hair-hair interaction on a grid) after each sub-step.
     /// Default: off ([`VolumeParams::default`]).
     pub volume: VolumeParams,
+    /// A step whose head moves some root farther than this, meters, is a
+    /// teleport ([`super::HairSim::teleport`]): the whole state moves rigidly with
+    /// the head instead of being dragged across the jump ((0, 1e6]; 1e6 turns it
+    /// off for any scene). Default: 1 (a head moving a meter in one step is a cut,
+    /// not motion).
+    pub teleport_distance: f32,
 }
 
 impl Default for SimParams {
@@ -155,6 +161,7 @@ impl Default for SimParams {
             hairs_per_workgroup: 0,
             subgroup_sync: true,
             volume: VolumeParams::default(),
+            teleport_distance: 1.0,
         }
     }
 }
@@ -221,6 +228,9 @@ impl SimParams {
         in_range("dftl_damping", self.dftl_damping, 0.0, 1.0)?;
         in_range("pearl_radius_root", self.pearl_radius_root, 0.0, 1e6)?;
         in_range("pearl_radius_tip", self.pearl_radius_tip, 0.0, 1e6)?;
+        if !(self.teleport_distance.is_finite() && self.teleport_distance > 0.0 && self.teleport_distance <= 1e6) {
+            return Err(Error::param("teleport_distance", self.teleport_distance, "(0, 1e6] m"));
+        }
         if self.hairs_per_workgroup as usize > MAX_SIM_POINTS / 2 {
             return Err(Error::param("hairs_per_workgroup", self.hairs_per_workgroup, "at most 32"));
         }

@@ -8,6 +8,7 @@ use super::body::{validate_colliders, Collider, RigidTransform};
 use super::mesh_collider::MeshGrid;
 use super::packing::{self, SimShape, SubstepPose};
 use super::params::SimParams;
+use super::teleport::{root_displacement, Move, PendingMove};
 use super::volume::VolumeParams;
 use crate::codes::sim_flags;
 use crate::error::Result;
@@ -39,6 +40,13 @@ impl SubstepInputs {
     }
 }
 
+/// A step as the planner lays it out: the move applied to the state first (a
+/// teleport or reset), then the sub-steps.
+pub(crate) struct PlannedStep {
+    pub start: Option<Move>,
+    pub substeps: Vec<SubstepInputs>,
+}
+
 /// See the module docs.
 #[derive(Debug, Clone)]
 pub(crate) struct SubstepPlanner {
@@ -53,6 +61,10 @@ pub(crate) struct SubstepPlanner {
     pub points: u32,
     /// Subgroup size of the device the GPU stages run on.
     pub subgroup_size: u32,
+    /// The roots at rest (head frame), for the teleport distance.
+    pub roots: Vec<glam::Vec3>,
+    /// A teleport or reset asked for, applied at the start of the next step.
+    pub pending: Option<PendingMove>,
 }
 
 /// Says, through `log`, when the sag-free rest state is asked for but cannot be
@@ -72,7 +84,7 @@ impl SubstepPlanner {
     pub(crate) fn new(
         params: &SimParams,
         head: &RigidTransform,
-        strands: usize,
+        roots: Vec<glam::Vec3>,
         points: usize,
         subgroup_size: u32,
     ) -> Result<Self> {
@@ -86,9 +98,11 @@ impl SubstepPlanner {
             head: *head,
             time: 0.0,
             substep: 0,
-            strands: strands as u32,
+            strands: roots.len() as u32,
             points: points as u32,
             subgroup_size,
+            roots,
+            pending: None,
         })
     }
 
@@ -115,9 +129,41 @@ impl SubstepPlanner {
         )
     }
 
-    /// The sub-steps of the next step, which ends with the head at `head`.
-    pub(crate) fn next(&mut self, head: &RigidTransform) -> Result<Vec<SubstepInputs>> {
+    /// Asks for the next step to start with the state moved rigidly from the
+    /// current head to `to` (keeping a pending reset).
+    pub(crate) fn teleport(&mut self, to: &RigidTransform) -> Result<()> {
+        to.validate()?;
+        let reset = self.pending.is_some_and(|p| p.reset);
+        self.pending = Some(PendingMove { to: *to, reset });
+        Ok(())
+    }
+
+    /// Asks for the next step to start from the rest pose, placed by the head
+    /// it starts from (a pending teleport's, else the current one).
+    pub(crate) fn reset(&mut self) {
+        let to = self.pending.map_or(self.head, |p| p.to);
+        self.pending = Some(PendingMove { to, reset: true });
+    }
+
+    /// The move the next step, ending with the head at `head`, starts with: the
+    /// pending one, or a teleport to `head` when it would move a root farther
+    /// than the teleport distance. The head the step starts from becomes the
+    /// move's.
+    fn start(&mut self, head: &RigidTransform) -> Option<Move> {
+        let pending = self.pending.take();
+        let from = pending.map_or(self.head, |p| p.to);
+        let jump = root_displacement(&self.roots, &from, head) > self.params.teleport_distance;
+        let pending =
+            if jump { Some(PendingMove { to: *head, reset: pending.is_some_and(|p| p.reset) }) } else { pending }?;
+        let start = Move::between(&self.head, &pending);
+        self.head = pending.to;
+        Some(start)
+    }
+
+    /// The next step, which ends with the head at `head`.
+    pub(crate) fn next(&mut self, head: &RigidTransform) -> Result<PlannedStep> {
         head.validate()?;
+        let start = self.start(head);
         let p = &self.params;
         let dt = p.substep_dt();
         let shape = SimShape { strands: self.strands, points: self.points, packing: self.packing() };
@@ -140,6 +186,6 @@ impl SubstepPlanner {
         self.head = *head;
         self.time += f64::from(p.dt);
         self.substep = self.substep.wrapping_add(p.substeps);
-        Ok(inputs)
+        Ok(PlannedStep { start, substeps: inputs })
     }
 }

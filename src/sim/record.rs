@@ -22,8 +22,12 @@ impl HairSim {
     /// parameters, then the dispatch); with it on, per sub-step the step dispatch
     /// followed by the volume stage's kernels. With a level of detail
     /// ([`HairSim::set_simulated_hairs`]) each step dispatch is followed by a
-    /// barrier and the followers' dispatch. Leaves the step pipeline, the
-    /// followers' or the volume stage's last kernel bound.
+    /// barrier and the followers' dispatch. A step that starts with a teleport or
+    /// reset ([`HairSim::teleport`], [`HairSim::reset`], a head moving a root
+    /// farther than [`crate::sim::SimParams::teleport_distance`]) records the move's dispatch
+    /// and two barriers first (debug label [`MOVE_LABEL`](crate::sim::MOVE_LABEL), no timestamp scope).
+    /// Leaves the step pipeline, the followers' or the volume stage's last kernel
+    /// bound.
     ///
     /// # Safety
     /// `cmd` is a command buffer of the context's device in the recording state,
@@ -39,7 +43,8 @@ impl HairSim {
         profiler: Option<&mut GpuProfiler>,
     ) -> Result<()> {
         let timing = Timing::of(profiler.as_deref());
-        let inputs = self.planner.next(head)?;
+        let planned = self.planner.next(head)?;
+        let inputs = planned.substeps;
         // The kernel specialised to the switches of these sub-steps: prepared by
         // `new`, `set_params` and `set_mesh_collider`, so found here.
         let features = inputs.iter().fold(0, |f, sub| f | sub.params.flags);
@@ -48,6 +53,10 @@ impl HairSim {
         // device, and update sizes are multiples of 4 below 64 KiB (by construction).
         unsafe {
             self.record_uploads(cmd, &inputs);
+            if let Some(start) = &planned.start {
+                let points = self.planner.strands * self.planner.points;
+                self.mover.record(cmd, self.current, start, points);
+            }
             self.pending_rest.clear();
             self.pending_guides = false;
             let Some(volume) = &self.volume else {

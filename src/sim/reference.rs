@@ -24,6 +24,20 @@ fn transform_point(m: &Mat4, p: Vec3) -> Vec3 {
     ((c(0) * p.x + c(1) * p.y) + c(2) * p.z) + c(3)
 }
 
+/// A teleport or reset of the whole state (`glsl/sim/move.comp`).
+pub(crate) fn move_state(state: &mut SimState, mv: &super::teleport::Move) {
+    let m = &mv.transform;
+    for (i, (x, v)) in state.positions.iter_mut().zip(&mut state.velocities).enumerate() {
+        if mv.reset {
+            *x = transform_point(m, state.rest[i].truncate()).extend(x.w);
+            *v = Vec4::new(0.0, 0.0, 0.0, v.w);
+        } else {
+            *x = transform_point(m, x.truncate()).extend(x.w);
+            *v = rotate(m, v.truncate()).extend(v.w);
+        }
+    }
+}
+
 /// `sim_to_head`: Rᵀ(p − t) for a rigid `m`.
 fn to_head(m: &Mat4, p: Vec3) -> Vec3 {
     let d = p - m.col(3).truncate();

@@ -83,6 +83,11 @@ impl SimState {
         Ok(state)
     }
 
+    /// Every strand's root at rest (head frame).
+    pub(crate) fn rest_roots(&self) -> Vec<Vec3> {
+        self.rest.iter().step_by(self.points.max(1)).map(|r| r.truncate()).collect()
+    }
+
     /// Points of strand `s` (xyz of `positions`).
     pub fn strand(&self, s: usize) -> impl Iterator<Item = Vec3> + '_ {
         self.positions[s * self.points..(s + 1) * self.points].iter().map(|p| p.truncate())

@@ -1,0 +1,37 @@
+#version 460
+// A cut or teleport (src/sim/teleport.rs), recorded before a step when one is
+// pending: every point of every key hair (simulated or following) in the half
+// the step reads, in place. Teleport: x = T·x and v = R·v with T the rigid
+// motion from the old head to the new one and R its rotation, so the hair
+// keeps its shape and motion relative to the head and gains no velocity.
+// Reset: x = head·rest (the rest pose placed by the head), v = 0. Inverse
+// masses (x.w) and velocity w are kept. The CPU reference
+// (sim::reference::move_state) runs the same operations.
+#include "sim.glsl"
+
+layout(local_size_x = ITEM_GROUP) in;
+
+layout(push_constant) uniform Push { MovePush push; };
+layout(std430, set = 0, binding = 1) buffer PosIn { vec4 pos_in[]; };
+layout(std430, set = 0, binding = 2) buffer VelIn { vec4 vel_in[]; };
+layout(std430, set = 0, binding = 5) readonly buffer Rest { vec4 rest[]; };
+
+// A grid-stride loop: the dispatch stays within the 65,535 workgroups every
+// device offers however many points there are.
+void main() {
+    mat4 m = state_move_transform(push);
+    bool reset = state_move_reset(push) != 0u;
+    uint total = state_move_points(push);
+    uint stride = gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+    for (uint i = gl_GlobalInvocationID.x; i < total; i += stride) {
+        vec4 x = pos_in[i];
+        vec4 v = vel_in[i];
+        if (reset) {
+            pos_in[i] = vec4(sim_transform_point(m, rest[i].xyz), x.w);
+            vel_in[i] = vec4(0.0, 0.0, 0.0, v.w);
+        } else {
+            pos_in[i] = vec4(sim_transform_point(m, x.xyz), x.w);
+            vel_in[i] = vec4(sim_rotate(m, v.xyz), v.w);
+        }
+    }
+}
