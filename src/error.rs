@@ -16,6 +16,8 @@ pub enum FileFormat {
     TressFx,
     /// Wavefront OBJ mesh.
     Obj,
+    /// glTF 2.0 (`.gltf`, `.glb`).
+    Gltf,
 }
 
 impl std::fmt::Display for FileFormat {
@@ -24,6 +26,7 @@ impl std::fmt::Display for FileFormat {
             FileFormat::CyHair => ".hair",
             FileFormat::TressFx => ".tfx",
             FileFormat::Obj => ".obj",
+            FileFormat::Gltf => "glTF",
         })
     }
 }

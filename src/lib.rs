@@ -78,6 +78,7 @@
 #![deny(unsafe_op_in_unsafe_fn)]
 #![warn(missing_docs)]
 
+pub mod character;
 pub(crate) mod codes;
 pub mod config;
 mod context;

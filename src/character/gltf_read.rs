@@ -1,0 +1,223 @@
+//! Reading a skinned, animated character from glTF 2.0 (`.glb`, or `.gltf`
+//! with its buffers in files beside it): the skinned primitives of the first
+//! skinned mesh node, its skin, the node hierarchy and every animation's
+//! translation, rotation and scale channels. Textures, materials, morph targets
+//! and cameras are not read; buffers given as data URIs are refused.
+
+use std::path::Path;
+
+use glam::{Mat4, Quat, Vec3};
+use gltf::animation::util::ReadOutputs;
+use gltf::animation::{Interpolation, Property};
+
+use super::skeleton::{Animation, Channel, Keys, Node, Sampling, Skeleton};
+use super::Character;
+use crate::error::{Error, FileFormat, Result};
+use crate::files;
+
+/// The most bytes read of a glTF document or one of its buffers.
+pub const MAX_GLTF_BYTES: u64 = 1 << 30;
+/// The most vertices of a character's skinned primitives together.
+pub const MAX_CHARACTER_VERTICES: usize = 4 << 20;
+
+fn malformed(reason: impl Into<String>) -> Error {
+    Error::Malformed { format: FileFormat::Gltf, reason: reason.into() }
+}
+
+fn unsupported(reason: impl Into<String>) -> Error {
+    Error::Unsupported { format: FileFormat::Gltf, reason: reason.into() }
+}
+
+/// Reads `path` (see the module docs); errors name the file.
+pub(super) fn load(path: &Path) -> Result<Character> {
+    let bytes = files::read_capped(path, MAX_GLTF_BYTES, "a glTF document")?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    parse(&bytes, Some(dir)).map_err(|e| e.in_asset(path))
+}
+
+/// Parses a glTF document held in memory; external buffers are read from `dir`
+/// (refused without one).
+pub(super) fn parse(bytes: &[u8], dir: Option<&Path>) -> Result<Character> {
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| malformed(e.to_string()))?;
+    let buffers = buffers(&gltf, dir)?;
+    let get = |b: gltf::Buffer<'_>| buffers.get(b.index()).map(Vec::as_slice);
+    let doc = &gltf.document;
+
+    let (mesh, skin) = doc
+        .nodes()
+        .find_map(|n| Some((n.mesh()?, n.skin()?)))
+        .ok_or_else(|| unsupported("no skinned mesh: a node with both a mesh and a skin is needed"))?;
+    let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
+    if joints.is_empty() {
+        return Err(malformed(format!("skin {} has no joints", skin.index())));
+    }
+    let inverse_bind: Vec<Mat4> = match skin.reader(get).read_inverse_bind_matrices() {
+        Some(m) => m.map(|c| Mat4::from_cols_array_2d(&c)).collect(),
+        None => vec![Mat4::IDENTITY; joints.len()],
+    };
+    if inverse_bind.len() != joints.len() || inverse_bind.iter().any(|m| !m.is_finite()) {
+        return Err(malformed(format!(
+            "skin {}: {} inverse bind matrices for {} joints, or one not finite",
+            skin.index(),
+            inverse_bind.len(),
+            joints.len()
+        )));
+    }
+
+    let mut positions = Vec::new();
+    let mut weights = Vec::new();
+    let mut triangles = Vec::new();
+    for (k, primitive) in mesh.primitives().enumerate() {
+        if primitive.mode() != gltf::mesh::Mode::Triangles {
+            continue;
+        }
+        let what = |part: &str| format!("mesh {} primitive {k}: {part}", mesh.index());
+        let reader = primitive.reader(get);
+        let p: Vec<Vec3> =
+            reader.read_positions().ok_or_else(|| malformed(what("no POSITION")))?.map(Vec3::from).collect();
+        let j: Vec<[u16; 4]> =
+            reader.read_joints(0).ok_or_else(|| malformed(what("no JOINTS_0")))?.into_u16().collect();
+        let w: Vec<[f32; 4]> =
+            reader.read_weights(0).ok_or_else(|| malformed(what("no WEIGHTS_0")))?.into_f32().collect();
+        if j.len() != p.len() || w.len() != p.len() {
+            return Err(malformed(what(&format!("{} positions, {} joints, {} weights", p.len(), j.len(), w.len()))));
+        }
+        if positions.len() + p.len() > MAX_CHARACTER_VERTICES {
+            return Err(unsupported(format!("more than {MAX_CHARACTER_VERTICES} skinned vertices")));
+        }
+        let base = positions.len() as u32;
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(i) => i.into_u32().collect(),
+            None => (0..p.len() as u32).collect(),
+        };
+        if let Some(bad) = indices.iter().find(|&&i| i as usize >= p.len()) {
+            return Err(malformed(what(&format!("index {bad} past its {} vertices", p.len()))));
+        }
+        triangles.extend(indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
+        for ((pos, joint), weight) in p.into_iter().zip(j).zip(w) {
+            if !pos.is_finite() {
+                return Err(malformed(what("a position is not finite")));
+            }
+            if let Some(bad) = joint.iter().find(|&&i| usize::from(i) >= joints.len()) {
+                return Err(malformed(what(&format!("joint {bad} past the skin's {} joints", joints.len()))));
+            }
+            let sum: f32 = weight.iter().sum();
+            if !(sum.is_finite() && sum > 0.0 && weight.iter().all(|&x| x >= 0.0)) {
+                return Err(malformed(what(&format!("weights {weight:?} do not add up to a positive sum"))));
+            }
+            positions.push(pos);
+            weights.push((joint, weight.map(|x| x / sum)));
+        }
+    }
+    if triangles.is_empty() {
+        return Err(unsupported(format!("mesh {} has no triangles", mesh.index())));
+    }
+
+    let nodes = nodes(doc)?;
+    let animations = animations(doc, &get)?;
+    let skeleton = Skeleton::new(nodes, joints, inverse_bind, animations)?;
+    Character::new(skeleton, positions, weights, triangles)
+}
+
+/// Every buffer's bytes, checked against its declared length.
+fn buffers(gltf: &gltf::Gltf, dir: Option<&Path>) -> Result<Vec<Vec<u8>>> {
+    let mut out = Vec::new();
+    for buffer in gltf.document.buffers() {
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => gltf
+                .blob
+                .clone()
+                .ok_or_else(|| malformed(format!("buffer {} names a missing BIN chunk", buffer.index())))?,
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                return Err(unsupported(format!("buffer {} is a data URI; use .glb or a .bin file", buffer.index())))
+            }
+            gltf::buffer::Source::Uri(uri) => {
+                let dir = dir.ok_or_else(|| unsupported(format!("buffer {} is an external file", buffer.index())))?;
+                if uri.contains("..") || Path::new(uri).is_absolute() {
+                    return Err(unsupported(format!(
+                        "buffer {} at {uri:?} is outside the document's folder",
+                        buffer.index()
+                    )));
+                }
+                files::read_capped(&dir.join(uri), MAX_GLTF_BYTES, "a glTF buffer")?
+            }
+        };
+        if data.len() < buffer.length() {
+            return Err(Error::Truncated {
+                format: FileFormat::Gltf,
+                what: "a buffer",
+                needed: buffer.length() as u64,
+                available: data.len() as u64,
+            });
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// The node hierarchy with each node's rest transform.
+fn nodes(doc: &gltf::Document) -> Result<Vec<Node>> {
+    let mut nodes: Vec<Node> = doc
+        .nodes()
+        .map(|n| {
+            let (t, r, s) = n.transform().decomposed();
+            Node {
+                name: n.name().unwrap_or_default().to_owned(),
+                parent: None,
+                translation: Vec3::from(t),
+                rotation: Quat::from_array(r),
+                scale: Vec3::from(s),
+            }
+        })
+        .collect();
+    for n in doc.nodes() {
+        for c in n.children() {
+            if nodes[c.index()].parent.replace(n.index()).is_some() {
+                return Err(malformed(format!("node {} has two parents", c.index())));
+            }
+        }
+    }
+    for (i, n) in nodes.iter().enumerate() {
+        let finite = n.translation.is_finite() && n.rotation.is_finite() && n.scale.is_finite();
+        if !finite || n.rotation.length_squared() < 1e-12 {
+            return Err(malformed(format!("node {i} ({:?}) has a transform that is not finite", n.name)));
+        }
+    }
+    Ok(nodes)
+}
+
+/// Every animation's transform channels.
+fn animations<'s>(
+    doc: &gltf::Document,
+    get: &(impl Clone + Fn(gltf::Buffer<'_>) -> Option<&'s [u8]>),
+) -> Result<Vec<Animation>> {
+    let mut out = Vec::new();
+    for a in doc.animations() {
+        let name = a.name().map_or_else(|| format!("animation {}", a.index()), str::to_owned);
+        let mut channels = Vec::new();
+        for c in a.channels() {
+            let what = |part: &str| format!("{name:?} channel {}: {part}", c.index());
+            let reader = c.reader(get.clone());
+            let times: Vec<f32> = reader.read_inputs().ok_or_else(|| malformed(what("no input")))?.collect();
+            let keys = match reader.read_outputs().ok_or_else(|| malformed(what("no output")))? {
+                ReadOutputs::Translations(t) => Keys::Translation(t.map(Vec3::from).collect()),
+                ReadOutputs::Scales(s) => Keys::Scale(s.map(Vec3::from).collect()),
+                ReadOutputs::Rotations(r) => Keys::Rotation(r.into_f32().map(Quat::from_array).collect()),
+                ReadOutputs::MorphTargetWeights(_) => continue,
+            };
+            if c.target().property() == Property::MorphTargetWeights {
+                continue;
+            }
+            let sampling = match c.sampler().interpolation() {
+                Interpolation::Linear => Sampling::Linear,
+                Interpolation::Step => Sampling::Step,
+                Interpolation::CubicSpline => Sampling::CubicSpline,
+            };
+            let channel = Channel { node: c.target().node().index(), times, keys, sampling };
+            channel.validate().map_err(|reason| malformed(what(&reason)))?;
+            channels.push(channel);
+        }
+        out.push(Animation { name, channels });
+    }
+    Ok(out)
+}

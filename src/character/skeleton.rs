@@ -1,0 +1,262 @@
+//! A character's node hierarchy, skin joints and animations, and the pose at
+//! a time: every node's world transform from its rest transform with the
+//! animated channels sampled (linear, step or cubic spline; rotations by
+//! normalised linear interpolation along the shorter arc), then every joint's
+//! skinning matrix (its world transform times its inverse bind matrix).
+
+use glam::{Mat4, Quat, Vec3};
+
+use crate::error::{Error, Result};
+
+/// A node of the hierarchy with its rest transform.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Node {
+    /// Its name ("" when unnamed).
+    pub name: String,
+    /// Its parent node, none for a root.
+    pub parent: Option<usize>,
+    /// Rest translation.
+    pub translation: Vec3,
+    /// Rest rotation.
+    pub rotation: Quat,
+    /// Rest scale.
+    pub scale: Vec3,
+}
+
+/// How a channel interpolates between its keys.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sampling {
+    /// Linear (rotations: normalised linear along the shorter arc).
+    Linear,
+    /// The previous key's value.
+    Step,
+    /// Cubic Hermite spline with in and out tangents per key.
+    CubicSpline,
+}
+
+/// A channel's values: one per key, or three (in tangent, value, out tangent)
+/// for a cubic spline.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Keys {
+    /// Translations.
+    Translation(Vec<Vec3>),
+    /// Rotations (unit quaternions).
+    Rotation(Vec<Quat>),
+    /// Scales.
+    Scale(Vec<Vec3>),
+}
+
+/// One animated property of one node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Channel {
+    /// The node it moves.
+    pub node: usize,
+    /// Key times, seconds, increasing.
+    pub times: Vec<f32>,
+    /// The values.
+    pub keys: Keys,
+    /// How it interpolates.
+    pub sampling: Sampling,
+}
+
+/// An animation: channels over nodes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Animation {
+    /// Its name (or "animation N").
+    pub name: String,
+    /// Its channels.
+    pub channels: Vec<Channel>,
+}
+
+impl Animation {
+    /// The time of its last key, seconds.
+    pub fn duration(&self) -> f32 {
+        self.channels.iter().filter_map(|c| c.times.last().copied()).fold(0.0, f32::max)
+    }
+}
+
+impl Channel {
+    /// Checks times (finite, increasing, at least one) against the values.
+    pub(super) fn validate(&self) -> std::result::Result<(), String> {
+        let n = self.times.len();
+        if n == 0 {
+            return Err("no keys".into());
+        }
+        if self.times.iter().any(|t| !t.is_finite()) || self.times.windows(2).any(|w| w[1] < w[0]) {
+            return Err("key times are not finite and increasing".into());
+        }
+        let per_key = if self.sampling == Sampling::CubicSpline { 3 } else { 1 };
+        let (values, finite) = match &self.keys {
+            Keys::Translation(v) | Keys::Scale(v) => (v.len(), v.iter().all(|x| x.is_finite())),
+            Keys::Rotation(q) => (q.len(), q.iter().all(|x| x.is_finite())),
+        };
+        if values != n * per_key {
+            return Err(format!("{values} values for {n} keys"));
+        }
+        if !finite {
+            return Err("a value is not finite".into());
+        }
+        Ok(())
+    }
+
+    /// The key segment at `t` (clamped to the keys) and the fraction into it.
+    fn segment(&self, t: f32) -> (usize, usize, f32, f32) {
+        let times = &self.times;
+        let last = times.len() - 1;
+        if t <= times[0] {
+            return (0, 0, 0.0, 0.0);
+        }
+        if t >= times[last] {
+            return (last, last, 0.0, 0.0);
+        }
+        let b = times.partition_point(|&k| k <= t).min(last);
+        let a = b - 1;
+        let span = times[b] - times[a];
+        let u = if span > 0.0 { (t - times[a]) / span } else { 0.0 };
+        (a, b, u, span)
+    }
+
+    /// Samples a vector channel.
+    fn sample_vec(&self, v: &[Vec3], t: f32) -> Vec3 {
+        let (a, b, u, span) = self.segment(t);
+        match self.sampling {
+            Sampling::Step => v[a],
+            Sampling::Linear => v[a].lerp(v[b], u),
+            Sampling::CubicSpline => hermite(v[3 * a + 1], v[3 * a + 2] * span, v[3 * b + 1], v[3 * b] * span, u),
+        }
+    }
+
+    /// Samples a rotation channel.
+    fn sample_quat(&self, q: &[Quat], t: f32) -> Quat {
+        let (a, b, u, span) = self.segment(t);
+        let q = match self.sampling {
+            Sampling::Step => q[a],
+            Sampling::Linear => {
+                let end = if q[a].dot(q[b]) < 0.0 { -q[b] } else { q[b] };
+                q[a].lerp(end, u)
+            }
+            Sampling::CubicSpline => {
+                let c = |i: usize| glam::Vec4::from(q[i]);
+                Quat::from_vec4(hermite4(c(3 * a + 1), c(3 * a + 2) * span, c(3 * b + 1), c(3 * b) * span, u))
+            }
+        };
+        q.normalize()
+    }
+}
+
+fn hermite(p0: Vec3, m0: Vec3, p1: Vec3, m1: Vec3, t: f32) -> Vec3 {
+    let (t2, t3) = (t * t, t * t * t);
+    p0 * (2.0 * t3 - 3.0 * t2 + 1.0) + m0 * (t3 - 2.0 * t2 + t) + p1 * (-2.0 * t3 + 3.0 * t2) + m1 * (t3 - t2)
+}
+
+fn hermite4(p0: glam::Vec4, m0: glam::Vec4, p1: glam::Vec4, m1: glam::Vec4, t: f32) -> glam::Vec4 {
+    let (t2, t3) = (t * t, t * t * t);
+    p0 * (2.0 * t3 - 3.0 * t2 + 1.0) + m0 * (t3 - 2.0 * t2 + t) + p1 * (-2.0 * t3 + 3.0 * t2) + m1 * (t3 - t2)
+}
+
+/// The hierarchy, the skin and the animations.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Skeleton {
+    /// Every node, parents before or after children (any order).
+    pub nodes: Vec<Node>,
+    /// The skin's joints: node indices, in the order the vertices' joint indices use.
+    pub joints: Vec<usize>,
+    /// Per joint, the inverse bind matrix.
+    pub inverse_bind: Vec<Mat4>,
+    /// The animations.
+    pub animations: Vec<Animation>,
+    /// Nodes ordered parents first.
+    order: Vec<usize>,
+}
+
+impl Skeleton {
+    /// Checks the hierarchy (no cycle, parents and channels naming nodes that exist).
+    pub fn new(
+        nodes: Vec<Node>,
+        joints: Vec<usize>,
+        inverse_bind: Vec<Mat4>,
+        animations: Vec<Animation>,
+    ) -> Result<Self> {
+        let bad = |reason: String| Error::Malformed { format: crate::error::FileFormat::Gltf, reason };
+        let n = nodes.len();
+        if let Some(j) = joints.iter().find(|&&j| j >= n) {
+            return Err(bad(format!("joint node {j} does not exist ({n} nodes)")));
+        }
+        if joints.len() != inverse_bind.len() {
+            return Err(bad(format!("{} joints, {} inverse bind matrices", joints.len(), inverse_bind.len())));
+        }
+        for a in &animations {
+            if let Some(c) = a.channels.iter().find(|c| c.node >= n) {
+                return Err(bad(format!("{:?} moves node {} ({n} nodes)", a.name, c.node)));
+            }
+        }
+        // Parents first: repeatedly take nodes whose parent is placed.
+        let mut placed = vec![false; n];
+        let mut order = Vec::with_capacity(n);
+        while order.len() < n {
+            let before = order.len();
+            for (i, node) in nodes.iter().enumerate() {
+                let ready = match node.parent {
+                    None => true,
+                    Some(p) => p < n && placed[p],
+                };
+                if !placed[i] && ready {
+                    placed[i] = true;
+                    order.push(i);
+                }
+            }
+            if order.len() == before {
+                return Err(bad("the node hierarchy has a cycle or a missing parent".into()));
+            }
+        }
+        Ok(Skeleton { nodes, joints, inverse_bind, animations, order })
+    }
+
+    /// The animation named `name`, or numbered so.
+    pub fn animation_index(&self, name: &str) -> Result<usize> {
+        if let Some(i) = self.animations.iter().position(|a| a.name == name) {
+            return Ok(i);
+        }
+        match name.parse::<usize>() {
+            Ok(i) if i < self.animations.len() => Ok(i),
+            _ => {
+                let names: Vec<&str> = self.animations.iter().map(|a| a.name.as_str()).collect();
+                Err(Error::param("animation", name, format!("one of {names:?} or an index below {}", names.len())))
+            }
+        }
+    }
+
+    /// Every node's world transform with `animation` (none: the rest pose)
+    /// sampled at `time` seconds (wrapped to its duration when `looped`).
+    pub fn node_transforms(&self, animation: Option<usize>, time: f32, looped: bool) -> Vec<Mat4> {
+        let mut local: Vec<(Vec3, Quat, Vec3)> =
+            self.nodes.iter().map(|n| (n.translation, n.rotation, n.scale)).collect();
+        if let Some(a) = animation.and_then(|a| self.animations.get(a)) {
+            let duration = a.duration();
+            let t = if looped && duration > 0.0 { time.rem_euclid(duration) } else { time };
+            for c in &a.channels {
+                let l = &mut local[c.node];
+                match &c.keys {
+                    Keys::Translation(v) => l.0 = c.sample_vec(v, t),
+                    Keys::Rotation(q) => l.1 = c.sample_quat(q, t),
+                    Keys::Scale(v) => l.2 = c.sample_vec(v, t),
+                }
+            }
+        }
+        let mut world = vec![Mat4::IDENTITY; self.nodes.len()];
+        for &i in &self.order {
+            let (t, r, s) = local[i];
+            let m = Mat4::from_scale_rotation_translation(s, r.normalize(), t);
+            world[i] = match self.nodes[i].parent {
+                Some(p) => world[p] * m,
+                None => m,
+            };
+        }
+        world
+    }
+
+    /// Per joint: world transform · inverse bind matrix, from node transforms.
+    pub fn skinning(&self, world: &[Mat4]) -> Vec<Mat4> {
+        self.joints.iter().zip(&self.inverse_bind).map(|(&j, ib)| world[j] * *ib).collect()
+    }
+}

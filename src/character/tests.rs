@@ -1,0 +1,208 @@
+//! A procedural rig (hips, a neck and a head bone; a body, a neck and a head
+//! of rings of vertices) checked against rotations computed here, and the real
+//! character in `tests/data/`.
+
+use std::f32::consts::FRAC_PI_2;
+
+use glam::{Mat4, Quat, Vec3};
+
+use super::skeleton::{Animation, Channel, Keys, Node, Sampling, Skeleton};
+use super::*;
+
+const NECK: Vec3 = Vec3::new(0.0, 1.5, 0.0);
+const HEAD: Vec3 = Vec3::new(0.0, 1.6, 0.0);
+
+fn node(name: &str, parent: Option<usize>, t: Vec3) -> Node {
+    Node { name: name.into(), parent, translation: t, rotation: Quat::IDENTITY, scale: Vec3::ONE }
+}
+
+/// Rings of `per_ring` vertices of radius `r` at heights `ys`, weighted to
+/// `joint`, with the triangles between neighbouring rings.
+fn tube(out: &mut Character, joint: u16, r: f32, ys: &[f32]) {
+    let per_ring = 16u32;
+    let base = out.positions.len() as u32;
+    for &y in ys {
+        for k in 0..per_ring {
+            let a = k as f32 / per_ring as f32 * std::f32::consts::TAU;
+            out.positions.push(Vec3::new(r * a.cos(), y, r * a.sin()));
+            out.weights.push(([joint, 0, 0, 0], [1.0, 0.0, 0.0, 0.0]));
+        }
+    }
+    for ring in 0..ys.len() as u32 - 1 {
+        for k in 0..per_ring {
+            let (a, b) = (base + ring * per_ring + k, base + ring * per_ring + (k + 1) % per_ring);
+            out.triangles.push([a, b + per_ring, b]);
+            out.triangles.push([a, a + per_ring, b + per_ring]);
+        }
+    }
+}
+
+/// The rig: joints 0 hips (origin), 1 neck (1.5 m), 2 head (1.6 m); the
+/// animation "turn" turns the head a quarter about +Y over one second.
+fn rig() -> Character {
+    let nodes = vec![node("hips", None, Vec3::ZERO), node("neck", Some(0), NECK), node("head", Some(1), HEAD - NECK)];
+    let inverse_bind = vec![Mat4::IDENTITY, Mat4::from_translation(-NECK), Mat4::from_translation(-HEAD)];
+    let turn = Channel {
+        node: 2,
+        times: vec![0.0, 1.0],
+        keys: Keys::Rotation(vec![Quat::IDENTITY, Quat::from_rotation_y(FRAC_PI_2)]),
+        sampling: Sampling::Linear,
+    };
+    let animations = vec![Animation { name: "turn".into(), channels: vec![turn] }];
+    let skeleton = Skeleton::new(nodes, vec![0, 1, 2], inverse_bind, animations).expect("skeleton");
+    let mut c = Character { skeleton, positions: vec![], weights: vec![], triangles: vec![] };
+    tube(&mut c, 0, 0.15, &[0.0, 0.5, 1.0, 1.45]);
+    tube(&mut c, 1, 0.06, &[1.45, 1.52, 1.6]);
+    tube(&mut c, 2, 0.1, &[1.6, 1.65, 1.7, 1.75, 1.8]);
+    Character::new(c.skeleton, c.positions, c.weights, c.triangles).expect("character")
+}
+
+#[test]
+fn the_pose_interpolates_and_the_head_turns_its_vertices_about_its_joint() {
+    let c = rig();
+    let pose = c.pose(Some(0), 0.5);
+    let (_, rotation, translation) = c.joint_transform(&pose, 2).to_scale_rotation_translation();
+    assert!(rotation.angle_between(Quat::from_rotation_y(FRAC_PI_2 / 2.0)) < 1e-5, "{rotation:?}");
+    assert!(translation.distance(HEAD) < 1e-6);
+    let skinned = c.skin(&pose);
+    let turn = Quat::from_rotation_y(FRAC_PI_2 / 2.0);
+    for v in c.region(2) {
+        let expected = HEAD + turn * (c.positions[v] - HEAD);
+        assert!(skinned[v].distance(expected) < 1e-5, "vertex {v}: {} vs {expected}", skinned[v]);
+    }
+    for v in c.region(0) {
+        assert!(skinned[v].distance(c.positions[v]) < 1e-6, "the body does not move");
+    }
+    // Looping: one second later is the same pose.
+    assert!(c.pose(Some(0), 1.5).nodes[2].abs_diff_eq(pose.nodes[2], 1e-5));
+    assert_eq!(c.skeleton.animation_index("turn").expect("by name"), 0);
+    assert_eq!(c.skeleton.animation_index("0").expect("by index"), 0);
+    assert!(c.skeleton.animation_index("walk").is_err());
+}
+
+#[test]
+fn the_head_is_found_by_the_weights_of_the_top() {
+    let c = rig();
+    assert_eq!(c.up_axis(), Vec3::Y);
+    assert_eq!(c.head_joint(), 2);
+    assert_eq!(c.joint_named("neck").expect("neck"), 1);
+    assert!(c.joint_named("tail").is_err());
+}
+
+#[test]
+fn capsules_fit_inside_each_bone_and_follow_it() {
+    let c = rig();
+    let capsules = c.fit_capsules(&[2]);
+    assert_eq!(capsules.iter().map(|k| k.joint).collect::<Vec<_>>(), vec![0, 1], "body and neck, not the head");
+    let neck = capsules[1];
+    assert!((neck.radius - 0.06).abs() < 1e-4, "neck radius {}", neck.radius);
+    let rest = c.pose(None, 0.0);
+    let Collider::Capsule { a, b, .. } = neck.in_world(&c, &rest) else { panic!("a capsule") };
+    // Along the neck's axis (towards the head joint), inside its span.
+    for p in [a, b] {
+        assert!(p.x.abs() < 1e-5 && p.z.abs() < 1e-5 && (1.45..=1.6).contains(&p.y), "{p}");
+    }
+    // The body's capsule ends one radius inside its vertices' span.
+    let Collider::Capsule { a, b, radius } = capsules[0].in_world(&c, &rest) else { panic!("a capsule") };
+    assert!((radius - 0.15).abs() < 1e-4);
+    assert!((a.y.min(b.y) - 0.15).abs() < 1e-4 && (a.y.max(b.y) - 1.3).abs() < 1e-4, "{a} {b}");
+    // In the head's frame a neck capsule turns with it when the head does not:
+    // here only the head turns, so the neck stays.
+    let turned = c.pose(Some(0), 1.0);
+    let head = RigidTransform { rotation: Quat::from_rotation_y(FRAC_PI_2), translation: HEAD };
+    let Collider::Capsule { a, .. } = neck.in_frame(&c, &turned, &head) else { panic!("a capsule") };
+    let world = head.matrix().transform_point3(a);
+    assert!(world.x.abs() < 1e-5 && world.z.abs() < 1e-5, "{world}");
+}
+
+use crate::sim::{Collider, RigidTransform};
+
+#[test]
+fn channels_sample_by_their_interpolation() {
+    let keys = Keys::Translation(vec![Vec3::ZERO, Vec3::X]);
+    let step = Channel { node: 0, times: vec![0.0, 1.0], keys: keys.clone(), sampling: Sampling::Step };
+    let nodes = vec![node("a", None, Vec3::ZERO)];
+    let sk = |c: Channel| {
+        Skeleton::new(
+            nodes.clone(),
+            vec![0],
+            vec![Mat4::IDENTITY],
+            vec![Animation { name: "a".into(), channels: vec![c] }],
+        )
+        .expect("skeleton")
+    };
+    let at = |s: &Skeleton, t: f32| s.node_transforms(Some(0), t, false)[0].transform_point3(Vec3::ZERO);
+    assert_eq!(at(&sk(step), 0.9), Vec3::ZERO, "step keeps the previous key");
+    // A cubic spline with zero tangents: 0.5 at the middle, 0.104 at a fifth (3u² − 2u³).
+    let cubic = Channel {
+        node: 0,
+        times: vec![0.0, 1.0],
+        keys: Keys::Translation(vec![Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::X, Vec3::ZERO]),
+        sampling: Sampling::CubicSpline,
+    };
+    let s = sk(cubic);
+    assert!((at(&s, 0.5).x - 0.5).abs() < 1e-6 && (at(&s, 0.2).x - 0.104).abs() < 1e-6);
+    assert_eq!(at(&s, 5.0), Vec3::X, "clamped past the last key without looping");
+}
+
+#[test]
+fn bad_channels_and_hierarchies_are_refused() {
+    let keys = Keys::Translation(vec![Vec3::ZERO, Vec3::X]);
+    let bad = [
+        Channel { node: 0, times: vec![0.0, f32::NAN], keys: keys.clone(), sampling: Sampling::Linear },
+        Channel { node: 0, times: vec![1.0, 0.0], keys: keys.clone(), sampling: Sampling::Linear },
+        Channel { node: 0, times: vec![0.0], keys: keys.clone(), sampling: Sampling::Linear },
+        Channel { node: 0, times: vec![0.0, 1.0], keys: keys.clone(), sampling: Sampling::CubicSpline },
+        Channel {
+            node: 0,
+            times: vec![0.0, 1.0],
+            keys: Keys::Translation(vec![Vec3::ZERO, Vec3::NAN]),
+            sampling: Sampling::Linear,
+        },
+    ];
+    for c in bad {
+        assert!(c.validate().is_err(), "{c:?}");
+    }
+    let cycle = vec![node("a", Some(1), Vec3::ZERO), node("b", Some(0), Vec3::ZERO)];
+    let err = Skeleton::new(cycle, vec![0], vec![Mat4::IDENTITY], vec![]).expect_err("a cycle");
+    assert!(err.to_string().contains("cycle"), "{err}");
+    let err =
+        Skeleton::new(vec![node("a", None, Vec3::ZERO)], vec![3], vec![Mat4::IDENTITY], vec![]).expect_err("joint");
+    assert!(err.to_string().contains("joint node 3"), "{err}");
+    let c = rig();
+    let err = Character::new(c.skeleton.clone(), c.positions.clone(), c.weights[1..].to_vec(), c.triangles.clone());
+    assert!(err.is_err());
+    let mut weights = c.weights.clone();
+    weights[0].0[0] = 9;
+    assert!(Character::new(c.skeleton, c.positions, weights, c.triangles).is_err(), "a joint past the skin");
+}
+
+/// The real character (`tests/data/mannequiny-0.3.0.glb`, credit in
+/// `tests/data/mannequiny.LICENSE.txt`): 45 joints, the head found by
+/// weights, ten animations, 1.79 m tall, Y-up.
+#[test]
+fn the_mannequin_loads_and_its_head_is_found() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
+    let c = Character::load(path).expect("mannequin");
+    assert_eq!(c.skeleton.joints.len(), 45);
+    assert_eq!(c.positions.len(), 7232 + 64 + 3070);
+    assert_eq!(c.skeleton.animations.len(), 10);
+    assert_eq!(c.up_axis(), Vec3::Y);
+    let head = c.head_joint();
+    assert_eq!(c.skeleton.nodes[c.skeleton.joints[head]].name, "head");
+    let rest = c.skin(&c.pose(None, 0.0));
+    let top = rest.iter().map(|p| p.y).fold(f32::MIN, f32::max);
+    assert!((top - 1.793).abs() < 0.01, "height {top}");
+    let run = c.skeleton.animation_index("run").expect("run");
+    let duration = c.skeleton.animations[run].duration();
+    assert!((duration - 0.63).abs() < 0.02, "run lasts {duration}");
+    let capsules = c.fit_capsules(&[head]);
+    assert!(capsules.len() >= 10, "{} capsules", capsules.len());
+    // Truncated or foreign bytes are refused with an error, never a panic.
+    let bytes = std::fs::read(path).expect("read");
+    for cut in [0, 12, 20, 1000, bytes.len() / 2, bytes.len() - 1] {
+        assert!(Character::parse(&bytes[..cut]).is_err(), "cut at {cut}");
+    }
+    let err = Character::parse(br#"{"asset":{"version":"2.0"},"nodes":[{"name":"a"}]}"#).expect_err("no skin");
+    assert!(err.to_string().contains("no skinned mesh"), "{err}");
+}
