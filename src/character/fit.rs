@@ -1,5 +1,5 @@
 //! Colliders fitted to a character: a capsule per bone, in the bone's own
-//! frame, around the vertices the bone dominates in the rest pose.
+//! frame, around the vertices the bone dominates in the bind pose.
 //!
 //! The capsule's axis runs from the joint toward its child joints (their mean,
 //! when the bone has several; along the vertices' principal direction for a
@@ -53,8 +53,8 @@ impl Character {
     /// [`MIN_CAPSULE_VERTICES`] vertices, except `skip` (e.g. the head, which
     /// gets the mesh collider's field instead), largest first.
     pub fn fit_capsules(&self, skip: &[usize]) -> Vec<BoneCapsule> {
-        let rest = self.pose(None, 0.0);
-        let world = self.skin(&rest);
+        let rest = self.bind_pose();
+        let world = &self.positions;
         let joints = &self.skeleton.joints;
         let mut owned: Vec<Vec<Vec3>> = vec![Vec::new(); joints.len()];
         for (v, p) in world.iter().enumerate() {

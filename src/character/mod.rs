@@ -24,7 +24,7 @@ use std::path::Path;
 
 use glam::{Mat4, Vec3};
 
-pub use fit::BoneCapsule;
+pub use fit::{BoneCapsule, MIN_CAPSULE_VERTICES};
 pub use gltf_read::{MAX_CHARACTER_VERTICES, MAX_GLTF_BYTES};
 use skeleton::Skeleton;
 
@@ -34,6 +34,10 @@ use crate::groom::mesh::TriMesh;
 /// Vertices of the top of a character (by height along its up axis) whose
 /// dominant joints decide which joint is the head: the top 8 %.
 pub const HEAD_TOP_FRACTION: f32 = 0.08;
+
+/// Vertices of the bottom of a character (the feet) that say which way it
+/// faces: the lowest 5 %.
+pub const FEET_FRACTION: f32 = 0.05;
 
 /// A skinned, animated character (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -83,7 +87,9 @@ impl Character {
         Ok(Character { skeleton, positions, weights, triangles })
     }
 
-    /// Reads a `.glb` or `.gltf` file (see [`gltf_read`]'s limits); errors name the file.
+    /// Reads a `.glb`, or a `.gltf` with its buffers in files beside it (at most
+    /// [`MAX_GLTF_BYTES`] each, [`MAX_CHARACTER_VERTICES`] vertices; textures,
+    /// materials and morph targets are not read, data URIs refused); errors name the file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         gltf_read::load(path.as_ref())
     }
@@ -98,6 +104,19 @@ impl Character {
     pub fn pose(&self, animation: Option<usize>, time: f32) -> Pose {
         let nodes = self.skeleton.node_transforms(animation, time, true);
         let skin = self.skeleton.skinning(&nodes);
+        Pose { nodes, skin }
+    }
+
+    /// The bind pose: the mesh as the file gives it, every joint where its
+    /// inverse bind matrix says it was bound (other nodes at rest). Characters
+    /// are usually bound standing (a T or A pose), whatever their nodes' rest
+    /// transforms say, so the fitting and the searches below use this pose.
+    pub fn bind_pose(&self) -> Pose {
+        let mut nodes = self.skeleton.node_transforms(None, 0.0, false);
+        for (&n, ib) in self.skeleton.joints.iter().zip(&self.skeleton.inverse_bind) {
+            nodes[n] = ib.inverse();
+        }
+        let skin = vec![Mat4::IDENTITY; self.skeleton.joints.len()];
         Pose { nodes, skin }
     }
 
@@ -130,18 +149,39 @@ impl Character {
         usize::from(j[k])
     }
 
-    /// The up axis of the rest pose: +Y (glTF's) unless the character is
+    /// The up axis of the bind pose: +Y (glTF's) unless the character is
     /// clearly longer along Z (a Z-up export), then +Z.
     pub fn up_axis(&self) -> Vec3 {
-        let rest = self.skin(&self.pose(None, 0.0));
-        let (lo, hi) =
-            rest.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(l, h), p| (l.min(*p), h.max(*p)));
+        let (lo, hi) = self
+            .positions
+            .iter()
+            .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(l, h), p| (l.min(*p), h.max(*p)));
         let extent = hi - lo;
         if extent.z > 1.5 * extent.y && extent.z >= extent.x {
             Vec3::Z
         } else {
             Vec3::Y
         }
+    }
+
+    /// The direction the character faces in the bind pose, horizontal: where
+    /// its feet point (the lowest [`FEET_FRACTION`] of the vertices lie, on
+    /// average, ahead of the joints that move them); glTF's +Z when the feet
+    /// say nothing.
+    pub fn forward(&self) -> Vec3 {
+        let up = self.up_axis();
+        let rest = self.bind_pose();
+        let skinned = &self.positions;
+        let heights: Vec<f32> = skinned.iter().map(|p| p.dot(up)).collect();
+        let (lo, hi) = heights.iter().fold((f32::MAX, f32::MIN), |(l, h), &y| (l.min(y), h.max(y)));
+        let cut = lo + FEET_FRACTION * (hi - lo);
+        let mut ahead = Vec3::ZERO;
+        for (v, p) in skinned.iter().enumerate().filter(|(v, _)| heights[*v] <= cut) {
+            ahead += *p - self.joint_transform(&rest, self.dominant_joint(v)).transform_point3(Vec3::ZERO);
+        }
+        let flat = ahead - up * ahead.dot(up);
+        let fallback = if up == Vec3::Z { Vec3::NEG_Y } else { Vec3::Z };
+        flat.try_normalize().unwrap_or(fallback)
     }
 
     /// The skin joint named `name`.
@@ -153,11 +193,10 @@ impl Character {
     }
 
     /// The head: the joint that dominates the most vertices of the top
-    /// [`HEAD_TOP_FRACTION`] of the rest pose along [`Character::up_axis`].
+    /// [`HEAD_TOP_FRACTION`] of the bind pose along [`Character::up_axis`].
     pub fn head_joint(&self) -> usize {
         let up = self.up_axis();
-        let rest = self.skin(&self.pose(None, 0.0));
-        let heights: Vec<f32> = rest.iter().map(|p| p.dot(up)).collect();
+        let heights: Vec<f32> = self.positions.iter().map(|p| p.dot(up)).collect();
         let (lo, hi) = heights.iter().fold((f32::MAX, f32::MIN), |(l, h), &y| (l.min(y), h.max(y)));
         let cut = hi - HEAD_TOP_FRACTION * (hi - lo);
         let mut votes = vec![0usize; self.skeleton.joints.len()];
@@ -172,6 +211,42 @@ impl Character {
     /// The vertices `joint` dominates.
     pub fn region(&self, joint: usize) -> Vec<usize> {
         (0..self.positions.len()).filter(|&v| self.dominant_joint(v) == joint).collect()
+    }
+
+    /// The triangles all of whose vertices `joint` dominates (its region:
+    /// the head's is the scalp and face), deformed by `pose`, as their own mesh.
+    pub fn region_mesh(&self, joint: usize, pose: &Pose) -> Result<TriMesh> {
+        let skinned = self.skin(pose);
+        let mut index = vec![u32::MAX; self.positions.len()];
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for t in &self.triangles {
+            if t.iter().all(|&v| self.dominant_joint(v as usize) == joint) {
+                triangles.push(t.map(|v| {
+                    let v = v as usize;
+                    if index[v] == u32::MAX {
+                        index[v] = positions.len() as u32;
+                        positions.push(skinned[v]);
+                    }
+                    index[v]
+                }));
+            }
+        }
+        if triangles.is_empty() {
+            let name = &self.skeleton.nodes[self.skeleton.joints[joint]].name;
+            return Err(Error::incompatible(
+                "character",
+                format!("joint {joint} ({name:?}) dominates no whole triangle"),
+            ));
+        }
+        TriMesh::new(positions, triangles)
+    }
+
+    /// Skin joint `joint`'s frame in `pose` as a rigid transform (its scale
+    /// dropped): what the simulation takes as the head.
+    pub fn rigid_frame(&self, pose: &Pose, joint: usize) -> crate::sim::RigidTransform {
+        let (_, rotation, translation) = self.joint_transform(pose, joint).to_scale_rotation_translation();
+        crate::sim::RigidTransform { rotation: rotation.normalize(), translation }
     }
 
     /// The world transform of skin joint `joint` in `pose`.

@@ -188,6 +188,7 @@ fn the_mannequin_loads_and_its_head_is_found() {
     assert_eq!(c.positions.len(), 7232 + 64 + 3070);
     assert_eq!(c.skeleton.animations.len(), 10);
     assert_eq!(c.up_axis(), Vec3::Y);
+    assert!(c.forward().distance(Vec3::Z) < 1e-3, "the mannequin faces +Z: {}", c.forward());
     let head = c.head_joint();
     assert_eq!(c.skeleton.nodes[c.skeleton.joints[head]].name, "head");
     let rest = c.skin(&c.pose(None, 0.0));
@@ -205,4 +206,21 @@ fn the_mannequin_loads_and_its_head_is_found() {
     }
     let err = Character::parse(br#"{"asset":{"version":"2.0"},"nodes":[{"name":"a"}]}"#).expect_err("no skin");
     assert!(err.to_string().contains("no skinned mesh"), "{err}");
+}
+
+/// Buffers as data URIs, outside the document's folder, or shorter than they
+/// say are refused by name; nothing is read from outside the folder.
+#[test]
+fn buffers_that_cannot_be_read_safely_are_refused() {
+    let doc = |uri: &str, length: usize| {
+        format!(r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"{uri}","byteLength":{length}}}]}}"#)
+    };
+    let err = Character::parse(doc("data:application/octet-stream;base64,AAAA", 3).as_bytes()).expect_err("data URI");
+    assert!(err.to_string().contains("data URI"), "{err}");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let err = gltf_read::parse(doc("../secret.bin", 4).as_bytes(), Some(dir.path())).expect_err("outside");
+    assert!(err.to_string().contains("outside the document's folder"), "{err}");
+    std::fs::write(dir.path().join("short.bin"), [0u8; 2]).expect("write");
+    let err = gltf_read::parse(doc("short.bin", 4).as_bytes(), Some(dir.path())).expect_err("short");
+    assert!(err.to_string().contains("truncated glTF file"), "{err}");
 }

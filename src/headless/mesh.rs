@@ -29,13 +29,27 @@ struct MeshPush {
     translation: [f32; 4],
 }
 
+/// Every triangle's corners and its flat normal at each.
+fn corners(mesh: &TriMesh) -> (Vec<Vec4>, Vec<Vec4>) {
+    let mut positions = Vec::with_capacity(mesh.triangles.len() * 3);
+    let mut normals = Vec::with_capacity(mesh.triangles.len() * 3);
+    for i in 0..mesh.triangles.len() {
+        let n = mesh.scaled_normal(i).normalize_or_zero().extend(0.0);
+        for p in mesh.corners(i) {
+            positions.push(p.extend(1.0));
+            normals.push(n);
+        }
+    }
+    (positions, normals)
+}
+
 /// Draws a triangle mesh with one directional light (the host's head).
 pub struct MeshDrawer {
     device: Arc<Device>,
     pipeline: GraphicsPipeline,
     set: vk::DescriptorSet,
     vertices: u32,
-    _buffers: [Buffer; 2],
+    buffers: [Buffer; 2],
     /// The light whose hair shadow falls on the mesh (shadowed drawers only).
     shadow_light: Option<usize>,
 }
@@ -57,17 +71,25 @@ impl MeshDrawer {
         Self::build(ctx, mesh, Some((renderer, light)))
     }
 
+    /// Replaces the mesh's positions by `mesh`'s, which has the same triangles
+    /// (a skinned character's next pose; flat normals recomputed). This submits
+    /// and waits: call it between frames, after the last frame that drew the
+    /// mesh has completed.
+    pub fn update(&self, mesh: &TriMesh) -> Result<()> {
+        let (positions, normals) = corners(mesh);
+        if positions.len() as u32 != self.vertices {
+            return Err(crate::error::Error::incompatible(
+                "mesh update",
+                format!("{} triangles, the drawer's mesh has {}", mesh.triangles.len(), self.vertices / 3),
+            ));
+        }
+        self.device.upload_pod(&self.buffers[0], &positions)?;
+        self.device.upload_pod(&self.buffers[1], &normals)
+    }
+
     fn build(ctx: &GpuContext, mesh: &TriMesh, shadows: Option<(&Renderer, usize)>) -> Result<Self> {
         let device = ctx.device.clone();
-        let mut positions = Vec::with_capacity(mesh.triangles.len() * 3);
-        let mut normals = Vec::with_capacity(mesh.triangles.len() * 3);
-        for i in 0..mesh.triangles.len() {
-            let n = mesh.scaled_normal(i).normalize_or_zero().extend(0.0);
-            for p in mesh.corners(i) {
-                positions.push(p.extend(1.0));
-                normals.push(n);
-            }
-        }
+        let (positions, normals) = corners(mesh);
         let storage = |name: &str, data: &[Vec4]| -> Result<Buffer> {
             let b = Buffer::storage(&device, name, (data.len() * 16) as u64)?;
             device.upload_pod(&b, data)?;
@@ -111,7 +133,7 @@ impl MeshDrawer {
             pipeline,
             set,
             vertices: positions.len() as u32,
-            _buffers: buffers,
+            buffers,
             shadow_light: shadows.map(|(_, light)| light),
         })
     }

@@ -129,11 +129,44 @@ fn options_that_need_others_say_so() {
         (&["simulate", "--scale", "0.01"], "--scale needs --input"),
         (&["simulate", "--points", "8"], "--points needs --input"),
         (&["simulate", "--no-mesh-collider"], "--no-mesh-collider needs --obj"),
+        (&["render", "--animation", "run"], "--animation needs --gltf"),
+        (&["render", "--head-joint", "head"], "--head-joint needs --gltf"),
+        (&["render", "--gltf", "a.glb", "--input", "g.hair"], "--input cannot go with it"),
+        (&["simulate", "--gltf", "a.glb"], "--gltf works with render"),
     ];
     for (args, message) in cases {
         let out = run(args, LIMIT);
         out.assert_error(message);
         assert!(!out.stdout.contains("key hairs"), "{args:?} started GPU work: {}", out.stdout);
+    }
+}
+
+/// `render --gltf` puts hair on the shared character and follows its run: the
+/// PNGs show the hair (brown) and the body; an unknown animation or joint is
+/// named with the ones the file has, before any GPU work.
+#[test]
+fn render_puts_hair_on_an_animated_gltf_character() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let glb = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/mannequiny-0.3.0.glb");
+    let out = dir.path().join("frames");
+    let args = format!(
+        "render --gltf {glb} --animation run --frames 3 --width 160 --height 160 --shadow-resolution 64 --out {}",
+        out.display()
+    );
+    let run = run_line(&args, LIMIT);
+    run.assert_ok();
+    assert!(run.stdout.contains("head joint \"head\"") && run.stdout.contains("Mannequiny"), "{}", run.stdout);
+    let (_, _, rgba) = common::read_png(&out.join("frame_0002.png"));
+    // Hair: brown pixels (blue under two thirds of red; the pinkish grey body
+    // and the grey background are never that saturated).
+    let brown = rgba.chunks_exact(4).filter(|p| p[0] > 40 && 3 * u32::from(p[2]) < 2 * u32::from(p[0])).count();
+    assert!(brown > 300, "{brown} hair pixels");
+    assert!(common::coverage(&rgba) > 0.1, "the character and hair cover the frame");
+    for (flag, value, message) in
+        [("--animation", "swim", "allowed: one of"), ("--head-joint", "tail", "a joint of the skin")]
+    {
+        let args = format!("render --gltf {glb} {flag} {value} --out {}", out.display());
+        run_line(&args, LIMIT).assert_error(message);
     }
 }
 

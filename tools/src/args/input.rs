@@ -37,6 +37,18 @@ pub struct InputArgs {
     /// warning.
     #[arg(long)]
     pub strict: bool,
+    /// Skinned, animated glTF character (.glb or .gltf, meters): key hairs are
+    /// grown on its head (the joint that dominates the top of the mesh, or
+    /// --head-joint) and move with it through the animation; a capsule per bone
+    /// and the head's distance field keep them out of the body. Instead of --input.
+    #[arg(long)]
+    pub gltf: Option<PathBuf>,
+    /// The --gltf animation, by name or index [default: the first].
+    #[arg(long)]
+    pub animation: Option<String>,
+    /// The --gltf joint the hair grows on, by name [default: found by weights].
+    #[arg(long)]
+    pub head_joint: Option<String>,
 }
 
 impl InputArgs {
@@ -54,6 +66,18 @@ impl InputArgs {
                     "{flag} needs --input (the thesis scene brings its own groom, head and colliders)"
                 ));
             }
+        }
+        if self.gltf.is_some() {
+            let given = [("--input", self.input.is_some()), ("--obj", self.obj.is_some())];
+            if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
+                return Err(format!("--gltf grows hair on its own character: {flag} cannot go with it"));
+            }
+        } else if let Some(flag) =
+            [("--animation", self.animation.is_some()), ("--head-joint", self.head_joint.is_some())]
+                .iter()
+                .find_map(|(f, g)| g.then_some(f))
+        {
+            return Err(format!("{flag} needs --gltf"));
         }
         if self.no_mesh_collider && self.obj.is_none() {
             return Err("--no-mesh-collider needs --obj (there is no mesh to collide with)".into());
@@ -73,7 +97,7 @@ impl InputArgs {
 
     /// The files these flags read.
     pub fn files(&self) -> Vec<&Path> {
-        [self.input.as_deref(), self.obj.as_deref()].into_iter().flatten().collect()
+        [self.input.as_deref(), self.obj.as_deref(), self.gltf.as_deref()].into_iter().flatten().collect()
     }
 
     /// The --scale factor.

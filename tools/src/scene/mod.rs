@@ -3,6 +3,7 @@
 //! camera that frames it, and ([`mod@parameters`]) the parameters and renderer
 //! of the flags.
 
+mod character;
 mod parameters;
 
 use std::path::PathBuf;
@@ -14,6 +15,7 @@ use vkhair::groom::Groom;
 use vkhair::render::Camera;
 use vkhair::sim::{motion, Collider};
 
+pub use character::CharacterScene;
 pub use parameters::{make_renderer, parameters, FULL_HEAD_HAIRS};
 
 use crate::args::input::Scaled;
@@ -34,7 +36,18 @@ pub struct Scene {
     pub pivot: Vec3,
     /// The credit line a picture of it must carry.
     pub credit: Option<&'static str>,
+    /// The `--gltf` character, whose head joint moves the head (the groom,
+    /// colliders and head mesh above are in its frame).
+    pub character: Option<CharacterScene>,
+    /// The head at the start.
+    pub start_head: vkhair::sim::RigidTransform,
+    /// Where the camera looks from, seen from the centre (+Z, or where the
+    /// character faces).
+    pub view_dir: Vec3,
 }
+
+/// The credit line of the shared character.
+const MANNEQUIN_CREDIT: &str = "\"Mannequiny\" by Luciano Muñoz / GDQuest and contributors (CC BY 4.0)";
 
 /// The sphere around a set of points: centre of the box and half its diagonal.
 fn bounds_sphere(points: impl Iterator<Item = Vec3>) -> (Vec3, f32) {
@@ -45,6 +58,9 @@ fn bounds_sphere(points: impl Iterator<Item = Vec3>) -> (Vec3, f32) {
 
 /// The scene of `a`'s flags.
 pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
+    if let Some(ch) = CharacterScene::load(&a.input)? {
+        return character_scene(ch, a);
+    }
     let sintel =
         |p: &Option<PathBuf>| p.as_ref().is_some_and(|p| p.to_string_lossy().to_lowercase().contains("sintel"));
     let (groom, thickness, colliders, head_mesh, pivot, credit) = match &a.input.input {
@@ -79,7 +95,50 @@ pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
     }
     let (lo, _) = groom.bounds();
     let pivot = pivot.unwrap_or(Vec3::new(center.x, lo.y, center.z));
-    Ok(Scene { groom, colliders, head_mesh, center, radius, thickness, pivot, credit })
+    let start_head = vkhair::sim::RigidTransform::default();
+    let view_dir = Vec3::Z;
+    Ok(Scene {
+        groom,
+        colliders,
+        head_mesh,
+        center,
+        radius,
+        thickness,
+        pivot,
+        credit,
+        character: None,
+        start_head,
+        view_dir,
+    })
+}
+
+/// The `--gltf` scene: framed on the hair and the body around the head.
+fn character_scene(ch: CharacterScene, a: &SceneArgs) -> Result<Scene, Error> {
+    let (groom, head_mesh) = ch.groom(a.input.points.unwrap_or(16))?;
+    let start_head = ch.head_at(0.0);
+    let m = start_head.matrix();
+    let body = ch.body_at(0.0)?;
+    let head = m.transform_point3(Vec3::ZERO);
+    let near: Vec<Vec3> = body.positions.iter().copied().filter(|p| p.distance(head) < 0.45).collect();
+    let hair = groom.positions().iter().map(|p| m.transform_point3(*p));
+    let (center, radius) = bounds_sphere(hair.chain(near.iter().copied()));
+    let credit =
+        a.input.gltf.as_ref().is_some_and(|p| p.to_string_lossy().contains("mannequiny")).then_some(MANNEQUIN_CREDIT);
+    let colliders = ch.colliders_at(0.0);
+    let view_dir = ch.character.forward();
+    Ok(Scene {
+        groom,
+        colliders,
+        head_mesh,
+        center,
+        radius,
+        thickness: None,
+        pivot: head,
+        credit,
+        character: Some(ch),
+        start_head,
+        view_dir,
+    })
 }
 
 /// How much wider than given the render's lengths are drawn for a scene of
@@ -96,14 +155,14 @@ pub fn drawing_scale(radius: f32) -> f32 {
 /// Vertical field of view of the tool's camera, radians.
 const FOV_Y: f32 = 0.698_131_7; // 40°
 
-/// The camera looking at the scene from the front (+Z): at `distance` when
+/// The camera looking at the scene from the front (`view_dir`): at `distance` when
 /// given, else far enough that the bounding sphere fits the image's shorter side.
 pub fn framing(s: &Scene, distance: Option<f32>, aspect: f32) -> Result<Camera, vkhair::Error> {
     let half = 0.5 * FOV_Y;
     let half_narrow = if aspect >= 1.0 { half } else { (half.tan() * aspect).atan() };
     let d = distance.unwrap_or(s.radius / half_narrow.sin());
     let r = s.radius;
-    let eye = s.center + Vec3::new(0.0, 0.1 * r, d);
+    let eye = s.center + Vec3::new(0.0, 0.1 * r, 0.0) + s.view_dir * d;
     let near = (d - 1.5 * r).max(0.002 * d);
     let far = d + 1.5 * r;
     Camera::look_at(eye, s.center, FOV_Y, aspect, near, far)

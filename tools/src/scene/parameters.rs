@@ -18,7 +18,8 @@ use crate::say;
 /// the tool's lights when the file lists none. Checked before any GPU work.
 pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
     let (center, radius) = (s.center, s.radius);
-    let sim = if a.input.input.is_some() { SimParams::styled() } else { SimParams::default() };
+    let sim =
+        if a.input.input.is_some() || a.input.gltf.is_some() { SimParams::styled() } else { SimParams::default() };
     let mut base = Config { sim, ..Config::default() };
     // The tool draws soft hair unless told otherwise (the library's default is opaque).
     base.render.transparency = Transparency::Exact;

@@ -99,14 +99,14 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let sim_params = config.sim.clone();
     let options = schedule_options(a)?;
-    let mut sim = FrameScheduler::new(&ctx, &s.groom, &sim_params, &RigidTransform::default(), &s.colliders, &options)?;
+    let mut sim = FrameScheduler::new(&ctx, &s.groom, &sim_params, &s.start_head, &s.colliders, &options)?;
     say!("simulation: {} ({})", sim.mode().name(), sim.reason());
     if let Some(count) = simulated {
         sim.set_simulated_hairs(count)?;
         say!("simulated: {count} of {} key hairs (the others follow them)", s.groom.strand_count());
     }
     say!("{}", sa.sim.describe(&sim_params));
-    if sa.input.colliding() {
+    if sa.input.colliding() || s.character.is_some() {
         sim.set_mesh_collider(Some(&s.head_mesh), &config.mesh_collider)?;
         say!(
             "mesh collider: {} triangles at {} grid points along the longest axis",
@@ -118,10 +118,15 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     let offscreen = Offscreen::new(&ctx, sa.width, sa.height)?;
     // The head mesh (lit along the key spot light's direction) takes that light's hair
     // shadow the way a host would, through glsl/include/shadow.glsl.
+    // A character's whole body is drawn, deformed every frame (in the world).
+    let drawn_mesh = match &s.character {
+        Some(ch) => ch.body_at(0.0)?,
+        None => s.head_mesh.clone(),
+    };
     let head = if sa.no_shadows || sa.volume_shadows {
-        MeshDrawer::new(&ctx, &s.head_mesh)?
+        MeshDrawer::new(&ctx, &drawn_mesh)?
     } else {
-        MeshDrawer::with_hair_shadows(&ctx, &s.head_mesh, &renderer, 0)?
+        MeshDrawer::with_hair_shadows(&ctx, &drawn_mesh, &renderer, 0)?
     };
     let camera = framing(&s, sa.distance, sa.width as f32 / sa.height as f32)?;
     let mut renderer = renderer;
@@ -147,9 +152,18 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     let mut sink = FrameSink::new(&a.out, sa.width, sa.height, a.frames);
     for frame in 0..a.frames {
         let first_step = frame * steps_per_frame;
+        let time = |step: usize| step as f32 * sim_params.dt;
         let heads: Vec<RigidTransform> = (0..steps_per_frame)
-            .map(|k| sa.sim.motion.head((first_step + k + 1) as f32 * sim_params.dt, s.pivot, size))
+            .map(|k| match &s.character {
+                Some(ch) => ch.head_at(time(first_step + k + 1)),
+                None => sa.sim.motion.head(time(first_step + k + 1), s.pivot, size),
+            })
             .collect();
+        if let Some(ch) = &s.character {
+            // The capsules where the body is at the end of this frame's steps, in
+            // the head's frame.
+            sim.set_colliders(&ch.colliders_at(time(first_step + steps_per_frame)))?;
+        }
         let started = host_now_ns();
         ctx.run_frame("vkhair render frame", |cmd| {
             // SAFETY: run_frame hands over a recording command buffer of the
@@ -158,11 +172,19 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
             unsafe {
                 profiler.begin_frame(cmd, frame as u64);
                 let sync = sim.record_frame(cmd, &heads, Some(&mut profiler))?;
+                if let Some(ch) = &s.character {
+                    // The body where the shown hair state is (uploaded before this
+                    // frame is submitted; the previous frame has completed).
+                    head.update(&ch.character.mesh(&ch.pose(time(sim.shown_steps() as usize)))?)?;
+                }
                 renderer.record_prepare(cmd, sim.key_hairs(), Some(&camera), Some(&mut profiler))?;
                 renderer.record_shadows(cmd, sim.key_hairs(), Some(&mut profiler))?;
                 offscreen.record_clear(cmd, Vec3::splat(0.02));
                 let scope = profiler.begin_scope(cmd, "host: head mesh");
-                let h = sim.key_hairs().head();
+                let h = match &s.character {
+                    Some(_) => RigidTransform::default(),
+                    None => sim.key_hairs().head(),
+                };
                 let view_proj = camera.projection * camera.view;
                 head.record(
                     cmd,

@@ -84,6 +84,9 @@ fn check_options(a: &SimulateArgs) -> Result<(), String> {
         return Err("--steps must be at least 1".into());
     }
     a.input.check()?;
+    if a.input.gltf.is_some() {
+        return Err("simulate does not read characters yet: --gltf works with render".into());
+    }
     Ok(())
 }
 
