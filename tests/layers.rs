@@ -14,7 +14,7 @@ const LAYERS: &[&[&str]] = &[
     &["context"],
     &["profiler"],
     &["sim"],
-    &["render"],
+    &["render", "character"],
     &["schedule", "config"],
     &["headless"],
 ];
