@@ -41,6 +41,18 @@ impl FrameScheduler {
         }
     }
 
+    /// The body's colliders in the world at the end of the next step (validated
+    /// now; see [`crate::sim::HairSim::set_body_colliders`]).
+    pub fn set_body_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
+        crate::sim::validate_colliders(colliders)?;
+        match &mut self.backend {
+            Backend::Local { sim, .. } => sim.set_body_colliders(colliders),
+            Backend::Async { sim, .. } => sim.sim.set_body_colliders(colliders),
+            Backend::Remote { worker, .. } => worker.update(SimUpdate::Body(colliders.to_vec())),
+            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
+        }
+    }
+
     /// A cut or a respawn: the next step starts with the state moved rigidly to
     /// the head `to` (checked now; see [`crate::sim::HairSim::teleport`]).
     pub fn teleport(&mut self, to: &RigidTransform) -> Result<()> {

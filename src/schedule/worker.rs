@@ -41,6 +41,7 @@ const SLICE: Duration = Duration::from_millis(20);
 pub(crate) enum SimUpdate {
     Params(Box<SimParams>),
     Colliders(Vec<Collider>),
+    Body(Vec<Collider>),
     Teleport(RigidTransform),
     Reset,
     Mesh(Option<Box<(TriMesh, MeshColliderParams)>>),
@@ -275,6 +276,7 @@ fn run(mut side: SimSide, slots: usize, timeout: Duration, shared: &Shared) {
             Request::Step { job, heads } => step(&mut side, shared, job, &heads, slots, timeout),
             Request::Update(SimUpdate::Params(p)) => side.sim.set_params(&p),
             Request::Update(SimUpdate::Colliders(c)) => side.sim.set_colliders(&c),
+            Request::Update(SimUpdate::Body(c)) => side.sim.set_body_colliders(&c),
             Request::Update(SimUpdate::Teleport(to)) => side.sim.teleport(&to),
             Request::Update(SimUpdate::Reset) => {
                 side.sim.reset();

@@ -54,6 +54,20 @@ impl Collider {
         Ok(())
     }
 
+    /// The collider `t` of the way from `self` to `to` (ends and radius
+    /// linearly; `to` itself when the two are not the same kind).
+    pub(crate) fn lerp(&self, to: &Collider, t: f32) -> Collider {
+        match (*self, *to) {
+            (Collider::Sphere { center: c0, radius: r0 }, Collider::Sphere { center: c1, radius: r1 }) => {
+                Collider::Sphere { center: c0.lerp(c1, t), radius: r0 + (r1 - r0) * t }
+            }
+            (Collider::Capsule { a: a0, b: b0, radius: r0 }, Collider::Capsule { a: a1, b: b1, radius: r1 }) => {
+                Collider::Capsule { a: a0.lerp(a1, t), b: b0.lerp(b1, t), radius: r0 + (r1 - r0) * t }
+            }
+            _ => *to,
+        }
+    }
+
     /// The collider in world space with the head at `head`, as the step kernel
     /// (and the CPU reference) sees it.
     pub(crate) fn in_world(self, head: &Mat4) -> ColliderShape {

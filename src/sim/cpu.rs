@@ -81,6 +81,11 @@ impl CpuHairSim {
         std::mem::replace(&mut self.mesh, mesh)
     }
 
+    /// See [`HairSim::set_body_colliders`](super::HairSim::set_body_colliders).
+    pub fn set_body_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
+        self.planner.set_body_colliders(colliders)
+    }
+
     /// See [`HairSim::set_strand_length`](super::HairSim::set_strand_length).
     pub fn set_strand_length(&mut self, strand: usize, length: f32) -> Result<()> {
         self.state.set_strand_length(strand, length)?;
@@ -115,7 +120,7 @@ impl CpuHairSim {
             if let Some(grid) = &self.volume {
                 let started = std::time::Instant::now();
                 let vp = &self.planner.params.volume;
-                let gpu = sub.volume_params(grid, vp, self.planner.colliders.len() as u32);
+                let gpu = sub.volume_params(grid, vp, self.planner.collider_count());
                 let snapshot = volume::reference::step(
                     grid,
                     &gpu,

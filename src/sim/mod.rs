@@ -348,9 +348,21 @@ impl HairSim {
         self.lod.simulated
     }
 
-    /// Replaces the colliders (in the head frame; at most [`MAX_COLLIDERS`]).
+    /// Replaces the colliders (in the head frame; at most [`MAX_COLLIDERS`]
+    /// together with the body's).
     pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
         self.planner.set_colliders(colliders)
+    }
+
+    /// The colliders of a body that moves on its own bones (shoulders, chest,
+    /// arms), in the world where they are at the end of the next step: each
+    /// sub-step sees every one moved linearly from where it was at the end of
+    /// the previous step (where it is now for the first step, after a change
+    /// of their count, and on a teleport). Set them before every step; they
+    /// keep their place when not set again. At most [`MAX_COLLIDERS`] together
+    /// with the head's; they push particles out as the head's do.
+    pub fn set_body_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
+        self.planner.set_body_colliders(colliders)
     }
 
     /// Sets (or with `None` removes) the mesh collider: from the next step on,

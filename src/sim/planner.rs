@@ -4,6 +4,8 @@
 //! time and the sub-step counter). Both turn a step into the same
 //! [`SubstepInputs`], so GPU and CPU run on identical numbers.
 
+use glam::Mat4;
+
 use super::body::{validate_colliders, Collider, RigidTransform};
 use super::mesh_collider::MeshGrid;
 use super::packing::{self, SimShape, SubstepPose};
@@ -52,6 +54,10 @@ pub(crate) struct PlannedStep {
 pub(crate) struct SubstepPlanner {
     pub params: SimParams,
     pub colliders: Vec<Collider>,
+    /// The body's colliders (world) at the end of the next step, and where
+    /// they were at the end of the previous one.
+    pub body: Vec<Collider>,
+    pub body_before: Vec<Collider>,
     /// The mesh collider's grid, when set.
     pub mesh: Option<MeshGrid>,
     pub head: RigidTransform,
@@ -65,6 +71,15 @@ pub(crate) struct SubstepPlanner {
     pub roots: Vec<glam::Vec3>,
     /// A teleport or reset asked for, applied at the start of the next step.
     pub pending: Option<PendingMove>,
+}
+
+/// Refuses more head and body colliders together than a sub-step holds.
+fn check_total(head: usize, body: usize) -> Result<()> {
+    if head + body > super::body::MAX_COLLIDERS {
+        let allowed = format!("at most {} head and body colliders together", super::body::MAX_COLLIDERS);
+        return Err(crate::error::Error::param("colliders", format!("{head} head + {body} body"), allowed));
+    }
+    Ok(())
 }
 
 /// Says, through `log`, when the sag-free rest state is asked for but cannot be
@@ -94,6 +109,8 @@ impl SubstepPlanner {
         Ok(SubstepPlanner {
             params: params.clone(),
             colliders: Vec::new(),
+            body: Vec::new(),
+            body_before: Vec::new(),
             mesh: None,
             head: *head,
             time: 0.0,
@@ -115,8 +132,23 @@ impl SubstepPlanner {
 
     pub(crate) fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
         validate_colliders(colliders)?;
+        check_total(colliders.len(), self.body.len())?;
         self.colliders = colliders.to_vec();
         Ok(())
+    }
+
+    /// The body's colliders in the world at the end of the next step; the
+    /// sub-steps move each from where it was at the end of the previous step.
+    pub(crate) fn set_body_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
+        validate_colliders(colliders)?;
+        check_total(self.colliders.len(), colliders.len())?;
+        self.body = colliders.to_vec();
+        Ok(())
+    }
+
+    /// Colliders each sub-step sees: the head's, then the body's.
+    pub(crate) fn collider_count(&self) -> u32 {
+        (self.colliders.len() + self.body.len()) as u32
     }
 
     /// How the solver packs hairs for the current parameters.
@@ -164,6 +196,10 @@ impl SubstepPlanner {
     pub(crate) fn next(&mut self, head: &RigidTransform) -> Result<PlannedStep> {
         head.validate()?;
         let start = self.start(head);
+        // A new body (another count) or a cut starts where the body is now.
+        if start.is_some() || self.body_before.len() != self.body.len() {
+            self.body_before.clone_from(&self.body);
+        }
         let p = &self.params;
         let dt = p.substep_dt();
         let shape = SimShape { strands: self.strands, points: self.points, packing: self.packing() };
@@ -176,14 +212,18 @@ impl SubstepPlanner {
                     time: (self.time + f64::from(dt) * f64::from(k + 1)) as f32,
                     index: self.substep.wrapping_add(k),
                 };
-                let colliders = self.colliders.len() as u32;
+                let colliders = self.collider_count();
+                let t = (k + 1) as f32 / p.substeps as f32;
+                let body =
+                    self.body_before.iter().zip(&self.body).map(|(b0, b1)| b0.lerp(b1, t).in_world(&Mat4::IDENTITY));
                 SubstepInputs {
                     params: packing::sim_step(p, &pose, shape, colliders, self.mesh.as_ref()),
-                    colliders: self.colliders.iter().map(|c| c.in_world(&pose.head)).collect(),
+                    colliders: self.colliders.iter().map(|c| c.in_world(&pose.head)).chain(body).collect(),
                 }
             })
             .collect();
         self.head = *head;
+        self.body_before.clone_from(&self.body);
         self.time += f64::from(p.dt);
         self.substep = self.substep.wrapping_add(p.substeps);
         Ok(PlannedStep { start, substeps: inputs })

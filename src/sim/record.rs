@@ -127,7 +127,7 @@ impl HairSim {
     /// # Safety
     /// As [`HairSim::record_step`], between an entry and an uploaded barrier.
     unsafe fn record_volume_uploads(&self, cmd: vk::CommandBuffer, volume: &volume::VolumeStage, sub: &SubstepInputs) {
-        let colliders = self.planner.colliders.len() as u32;
+        let colliders = self.planner.collider_count();
         // SAFETY: guaranteed by the caller; at most MAX_COLLIDERS colliders of 32 bytes.
         unsafe {
             if !sub.colliders.is_empty() {

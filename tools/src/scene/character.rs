@@ -1,7 +1,7 @@
 //! The `--gltf` scene: a skinned, animated character, key hairs grown on its
 //! head in the head joint's frame, the head's region as the mesh collider
-//! (it moves with the head), and a capsule per bone near the head, placed in
-//! the head's frame at every frame's pose.
+//! (it moves with the head), and a capsule per bone near the head as the
+//! simulation's body colliders, placed in the world at every frame's pose.
 
 use glam::{Mat4, Vec3};
 use vkhair::character::{BoneCapsule, Character, Pose};
@@ -84,11 +84,10 @@ impl CharacterScene {
         self.character.rigid_frame(&self.pose(time), self.head)
     }
 
-    /// The capsules at `time`, in the head's frame then.
+    /// The capsules at `time`, in the world (the simulation's body colliders).
     pub fn colliders_at(&self, time: f32) -> Vec<Collider> {
         let pose = self.pose(time);
-        let head = self.character.rigid_frame(&pose, self.head);
-        self.capsules.iter().map(|c| c.in_frame(&self.character, &pose, &head)).collect()
+        self.capsules.iter().map(|c| c.in_world(&self.character, &pose)).collect()
     }
 
     /// The whole character at `time`, in the world.

@@ -124,7 +124,7 @@ fn character_scene(ch: CharacterScene, a: &SceneArgs) -> Result<Scene, Error> {
     let (center, radius) = bounds_sphere(hair.chain(near.iter().copied()));
     let credit =
         a.input.gltf.as_ref().is_some_and(|p| p.to_string_lossy().contains("mannequiny")).then_some(MANNEQUIN_CREDIT);
-    let colliders = ch.colliders_at(0.0);
+    let colliders = Vec::new();
     let view_dir = ch.character.forward();
     Ok(Scene {
         groom,

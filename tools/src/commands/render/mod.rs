@@ -160,9 +160,10 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
             })
             .collect();
         if let Some(ch) = &s.character {
-            // The capsules where the body is at the end of this frame's steps, in
-            // the head's frame.
-            sim.set_colliders(&ch.colliders_at(time(first_step + steps_per_frame)))?;
+            // The capsules where the body is at the end of this frame's steps
+            // (the first step's sub-steps move them there from the previous
+            // frame's; the scheduler takes them per frame, the head per step).
+            sim.set_body_colliders(&ch.colliders_at(time(first_step + steps_per_frame)))?;
         }
         let started = host_now_ns();
         ctx.run_frame("vkhair render frame", |cmd| {
