@@ -4,9 +4,9 @@
 //! The capsule's axis runs from the joint toward its child joints (their mean,
 //! when the bone has several; along the vertices' principal direction for a
 //! bone without children), clipped to the span of its vertices along that
-//! axis; its radius is the median distance of those vertices from the axis, so
-//! that it stays inside the body's surface where the body is round and hair
-//! resting on it is pushed out to about the skin.
+//! axis; its radius is the 90th percentile of those vertices' distances
+//! from the axis: at the skin where the body is round, a little outside it
+//! where it is flat, so that hair resting there floats rather than sinks.
 
 use glam::{Mat4, Vec3};
 
@@ -84,7 +84,7 @@ impl Character {
             let mut radial: Vec<f32> =
                 points.iter().zip(&along).map(|(p, &s)| (*p - origin - axis * s).length()).collect();
             radial.sort_by(f32::total_cmp);
-            let radius = radial[radial.len() / 2];
+            let radius = radial[radial.len() * 9 / 10];
             if !(radius.is_finite() && radius > 0.0) {
                 continue;
             }

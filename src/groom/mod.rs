@@ -23,6 +23,7 @@
 //! every strand the same point count (the GPU simulation wants it) and
 //! [`Groom::select`] picks key hairs.
 
+pub mod binding;
 mod bytes;
 pub mod cyhair;
 pub mod grow;

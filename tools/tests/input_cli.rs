@@ -132,7 +132,7 @@ fn options_that_need_others_say_so() {
         (&["render", "--animation", "run"], "--animation needs --gltf"),
         (&["render", "--head-joint", "head"], "--head-joint needs --gltf"),
         (&["render", "--gltf", "a.glb", "--input", "g.hair"], "--input cannot go with it"),
-        (&["simulate", "--gltf", "a.glb"], "--gltf works with render"),
+        (&["simulate", "--gltf", "a.glb", "--check"], "not --gltf"),
     ];
     for (args, message) in cases {
         let out = run(args, LIMIT);
@@ -168,6 +168,26 @@ fn render_puts_hair_on_an_animated_gltf_character() {
         let args = format!("render --gltf {glb} {flag} {value} --out {}", out.display());
         run_line(&args, LIMIT).assert_error(message);
     }
+}
+
+/// `simulate --gltf` follows the character's run and writes, in `--json`, how
+/// far the roots got from the skinned scalp points they were grown on (float
+/// precision: the mannequin's head is one bone) and the share of points inside
+/// the body.
+#[test]
+fn simulate_measures_roots_and_penetration_on_an_animated_character() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let glb = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/mannequiny-0.3.0.glb");
+    let json = dir.path().join("run.json");
+    let args = format!("simulate --gltf {glb} --animation run --steps 20 --volume off --json {}", json.display());
+    run_line(&args, LIMIT).assert_ok();
+    let text = std::fs::read_to_string(&json).expect("json");
+    let v: serde_json::Value = serde_json::from_str(&text).expect("parse");
+    let root = v["run"]["root_error_max_m"].as_f64().expect("root_error_max_m");
+    let inside = v["run"]["inside_fraction_max"].as_f64().expect("inside_fraction_max");
+    eprintln!("root error {root:e} m, inside {inside}");
+    assert!(root < 1e-3, "roots {root} m from their skinned scalp points");
+    assert!((0.0..0.5).contains(&inside), "inside fraction {inside}");
 }
 
 /// Values out of range name their option; library functions are never suggested.

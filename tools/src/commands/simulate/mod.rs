@@ -18,6 +18,7 @@ use crate::output::{progress, CliResult};
 use crate::profile::{host_now_ns, percentile, Profile, ProfileArgs};
 use crate::say;
 
+mod character;
 mod check;
 
 use check::{share_inside, tip_drift, write_final, Reference, StepCheck};
@@ -84,8 +85,8 @@ fn check_options(a: &SimulateArgs) -> Result<(), String> {
         return Err("--steps must be at least 1".into());
     }
     a.input.check()?;
-    if a.input.gltf.is_some() {
-        return Err("simulate does not read characters yet: --gltf works with render".into());
+    if a.input.gltf.is_some() && a.check {
+        return Err("--check compares the thesis scene or an --input groom with the CPU reference, not --gltf".into());
     }
     Ok(())
 }
@@ -98,6 +99,9 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
         a.out.as_deref().map(|path| Output { flag: "--out", path, kind: Kind::File(&["hair"]) }).into_iter().collect();
     outputs.extend(a.profile_out.outputs());
     destinations::check(&inputs, &outputs)?;
+    if let Some(ch) = crate::scene::CharacterScene::load(&a.input)? {
+        return character::simulate_character(a, ch);
+    }
     let scale = a.input.scale();
     let (groom, colliders, label, pivot) = match &a.input.input {
         None => (scenes::thesis()?, motion::thesis_colliders(), "thesis scene".to_owned(), motion::NECK_PIVOT),

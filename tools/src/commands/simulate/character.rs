@@ -1,0 +1,156 @@
+//! `simulate --gltf`: key hairs grown on an animated character's head, the
+//! head joint driving the simulation's head and the bones' capsules its body
+//! colliders every step, and two measures of how well the hair stays on and
+//! out of the character: the roots' distance from the scalp points they were
+//! grown on, skinned by the animation (`root_error_max_m`), and the share of
+//! free points inside the skinned body near the head (`inside_fraction_max`),
+//! both every 10 steps.
+
+use glam::Vec3;
+use vkhair::groom::binding::{bind_roots, RootBinding, TriangleGrid};
+use vkhair::groom::mesh::TriMesh;
+use vkhair::groom::sdf::MeshSdf;
+use vkhair::sim::{HairSim, SimState};
+use vkhair::{ContextOptions, GpuContext, GpuProfiler};
+
+use super::check::{tip_drift, write_final};
+use super::{simulate_params, SimulateArgs, TRACK};
+use crate::output::{progress, CliResult};
+use crate::profile::{host_now_ns, percentile, Profile};
+use crate::say;
+use crate::scene::CharacterScene;
+
+/// How far a grown root may lie from the scalp it was grown on, meters.
+const ROOT_TOLERANCE: f32 = 1e-3;
+/// The body counted for `inside_fraction_max`: triangles within this of the
+/// head joint at each check, meters.
+const NEAR_HEAD: f32 = 0.6;
+/// Points this close to the body's surface are judged by its nearest triangle, meters.
+const SURFACE: f32 = 0.03;
+/// Grid points along the longest axis of the body's field at each check.
+const BODY_FIELD_RESOLUTION: u32 = 64;
+
+pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
+    let config = simulate_params(a)?;
+    let params = config.sim.clone();
+    let (groom, head_mesh) = ch.groom(a.input.points.unwrap_or(16))?;
+    let time = |step: usize| step as f32 * params.dt;
+    // Roots bound to the character's triangles in the bind pose (world).
+    let bind = ch.character.bind_pose();
+    let bind_frame = ch.character.rigid_frame(&bind, ch.head).matrix();
+    let roots: Vec<Vec3> = (0..groom.strand_count())
+        .filter_map(|s| groom.strand(s).first().map(|r| bind_frame.transform_point3(*r)))
+        .collect();
+    let bound = bind_roots(
+        &roots,
+        &TriMesh::new(ch.character.positions.clone(), ch.character.triangles.clone())?,
+        ROOT_TOLERANCE,
+    )?;
+    let ctx = GpuContext::headless(&ContextOptions::default())?;
+    let mut sim = HairSim::new(&ctx, &groom, &params, &ch.head_at(0.0))?;
+    sim.set_mesh(Some(&head_mesh), &config.mesh_collider)?;
+    let mut profiler = GpuProfiler::new(&ctx, 1, 1024)?;
+    let (strands, points) = sim.size();
+    say!(
+        "character: {strands} key hairs × {points} points on {}, {} steps of {:.4} s",
+        ctx.info().name,
+        a.steps,
+        params.dt
+    );
+    say!("{}", a.sim.describe(&params));
+    let bar = progress(a.steps, "steps");
+    let mut profile = Profile::new("step");
+    let (mut root_error, mut inside) = (0.0f32, 0.0f64);
+    for step in 0..a.steps {
+        sim.set_body_colliders(&ch.colliders_at(time(step + 1)))?;
+        let started = host_now_ns();
+        if let Some(report) = sim.run(1, |_| ch.head_at(time(step + 1)), Some(&mut profiler))? {
+            profile.add(&report, TRACK, 1);
+        }
+        profile.add_cpu_span(&format!("step {step}: record, submit, wait"), started, host_now_ns());
+        if (step + 1) % 10 == 0 || step + 1 == a.steps {
+            let state = sim.read_state()?;
+            let pose = ch.pose(time(step + 1));
+            let skinned = ch.character.skin(&pose);
+            root_error = root_error.max(largest_root_error(&state, &bound, &ch.character.triangles, &skinned));
+            let head = ch.character.joint_transform(&pose, ch.head).transform_point3(Vec3::ZERO);
+            inside = inside.max(share_inside_body(&state, &ch.character.triangles, &skinned, head)?);
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    profile.print_table();
+    let state = sim.read_state()?;
+    let last_head = ch.head_at(time(a.steps));
+    let drift = tip_drift(&state, &last_head);
+    if let (Some(p50), Some(p95)) = (percentile(&drift, 50), percentile(&drift, 95)) {
+        say!(
+            "tip drift from rest (in the head's frame): p50 {:.2} % p95 {:.2} % of strand length",
+            100.0 * p50,
+            100.0 * p95
+        );
+    }
+    say!("roots from their skinned scalp points: at most {root_error:.2e} m (checked every 10 steps)");
+    say!(
+        "points inside the body within {NEAR_HEAD} m of the head: at most {:.3} % (checked every 10 steps)",
+        100.0 * inside
+    );
+    if let Some(out) = &a.out {
+        write_final(out, &state, &last_head, 1.0)?;
+        say!("wrote {}: {strands} strands × {points} points", out.display());
+    }
+    a.profile_out.write(&profile, || {
+        serde_json::json!({
+            "command": "simulate",
+            "device": ctx.info().name,
+            "groom": a.input.gltf.as_ref().map(|p| p.display().to_string()),
+            "key_hairs": strands,
+            "points_per_key_hair": points,
+            "steps": a.steps,
+            "dt_s": params.dt,
+            "iterations": params.iterations,
+            "volume": format!("{:?}", params.volume.mode),
+            "root_error_max_m": root_error,
+            "inside_fraction_max": inside,
+        })
+    })?;
+    Ok(())
+}
+
+/// The largest distance of a simulated root from its bound point on the
+/// skinned mesh.
+fn largest_root_error(state: &SimState, bound: &[RootBinding], triangles: &[[u32; 3]], skinned: &[Vec3]) -> f32 {
+    bound
+        .iter()
+        .enumerate()
+        .map(|(s, b)| state.positions[s * state.points].truncate().distance(b.point(triangles, skinned)))
+        .fold(0.0, f32::max)
+}
+
+/// The share of free points inside the skinned body's triangles near `head`:
+/// within `SURFACE` of the surface by the side of the nearest triangle (its
+/// outward normal), deeper by the sign of the body's distance field (the sign
+/// by the field's ray-parity vote, so the body cut at `NEAR_HEAD` still has an
+/// inside; its cells are too coarse to judge points near the skin).
+fn share_inside_body(
+    state: &SimState,
+    triangles: &[[u32; 3]],
+    skinned: &[Vec3],
+    head: Vec3,
+) -> Result<f64, vkhair::Error> {
+    let near: Vec<[u32; 3]> = triangles
+        .iter()
+        .copied()
+        .filter(|t| t.iter().any(|&v| skinned[v as usize].distance(head) < NEAR_HEAD))
+        .collect();
+    let body = TriMesh::new(skinned.to_vec(), near)?;
+    let field = MeshSdf::build(&body, BODY_FIELD_RESOLUTION, 0.05)?;
+    let grid = TriangleGrid::new(&body, SURFACE)?;
+    let free: Vec<Vec3> = state.positions.iter().filter(|p| p.w > 0.0).map(|p| p.truncate()).collect();
+    let is_inside = |p: Vec3| match grid.nearest(p) {
+        Some(n) => (p - n.point).dot(body.scaled_normal(n.binding.triangle as usize)) < 0.0,
+        None => field.sample(p) < 0.0,
+    };
+    let inside = free.iter().filter(|p| is_inside(**p)).count();
+    Ok(inside as f64 / free.len().max(1) as f64)
+}
