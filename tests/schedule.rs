@@ -335,6 +335,16 @@ fn teleports_and_resets_reach_the_simulation_in_every_mode() {
         got.push(common::bits(&s.read_state().expect("state")));
         assert!(got[0] == expected[0], "{:?}: not the HairSim's state before the reset", s.mode());
         assert!(got[1] == expected[1], "{:?}: not the HairSim's state after the reset", s.mode());
+        // Too many head and body colliders together are refused here, in every
+        // mode, and the simulation goes on (a second device's worker never sees them).
+        let ball = vkhair::sim::Collider::Sphere { center: Vec3::new(0.0, 5.0, 0.0), radius: 0.1 };
+        s.set_body_colliders(&vec![ball; vkhair::sim::MAX_COLLIDERS]).expect("a full body");
+        let err = s.set_colliders(&[ball]).expect_err("one too many");
+        assert!(err.to_string().contains("together"), "{:?}: {err}", s.mode());
+        let steps = std::slice::from_ref(&heads[11]);
+        // SAFETY: as above.
+        render.ctx().run_frame("frame", |cmd| unsafe { s.record_frame(cmd, steps, None) }).expect("still running");
+        s.read_state().expect("still running");
     }
 }
 

@@ -20,6 +20,43 @@ pub const MAX_GLTF_BYTES: u64 = 1 << 30;
 /// The most vertices of a character's skinned primitives together.
 pub const MAX_CHARACTER_VERTICES: usize = 4 << 20;
 
+/// The most indices of the skinned primitives together (three a triangle).
+const MAX_INDICES: usize = 3 << 22;
+/// The most keys of one animation channel.
+const MAX_KEYS: usize = 1 << 20;
+
+use gltf::accessor::{DataType, Dimensions};
+
+/// Checks an accessor before the crate's readers touch it: a type and shape
+/// they expect, 1..=`max` elements, no sparse storage, and every element
+/// inside its buffer view and the view inside its buffer (the readers index
+/// the bytes without checking).
+fn check_accessor(a: &gltf::Accessor<'_>, types: &[DataType], dims: Dimensions, max: usize, what: &str) -> Result<()> {
+    let bad = |why: String| malformed(format!("{what}: accessor {}: {why}", a.index()));
+    if a.sparse().is_some() {
+        return Err(unsupported(format!("{what}: accessor {} is sparse", a.index())));
+    }
+    if !types.contains(&a.data_type()) || a.dimensions() != dims {
+        return Err(bad(format!("{:?} {:?}, not one of {types:?} {dims:?}", a.data_type(), a.dimensions())));
+    }
+    let count = a.count();
+    if count == 0 || count > max {
+        return Err(bad(format!("{count} elements (allowed 1..={max})")));
+    }
+    let view = a.view().ok_or_else(|| bad("no buffer view".into()))?;
+    let size = a.size();
+    let stride = view.stride().unwrap_or(size);
+    if stride < size {
+        return Err(bad(format!("stride {stride} below the element's {size} bytes")));
+    }
+    let end = stride.checked_mul(count - 1).and_then(|n| n.checked_add(a.offset())).and_then(|n| n.checked_add(size));
+    let view_end = view.offset().checked_add(view.length());
+    match (end, view_end) {
+        (Some(end), Some(view_end)) if end <= view.length() && view_end <= view.buffer().length() => Ok(()),
+        _ => Err(bad("elements past the end of the buffer view, or the view past its buffer".into())),
+    }
+}
+
 fn malformed(reason: impl Into<String>) -> Error {
     Error::Malformed { format: FileFormat::Gltf, reason: reason.into() }
 }
@@ -51,13 +88,18 @@ pub(super) fn parse(bytes: &[u8], dir: Option<&Path>) -> Result<Character> {
     if joints.is_empty() {
         return Err(malformed(format!("skin {} has no joints", skin.index())));
     }
+    if let Some(a) = skin.inverse_bind_matrices() {
+        check_accessor(&a, &[DataType::F32], Dimensions::Mat4, joints.len(), "inverse bind matrices")?;
+    }
     let inverse_bind: Vec<Mat4> = match skin.reader(get).read_inverse_bind_matrices() {
         Some(m) => m.map(|c| Mat4::from_cols_array_2d(&c)).collect(),
         None => vec![Mat4::IDENTITY; joints.len()],
     };
-    if inverse_bind.len() != joints.len() || inverse_bind.iter().any(|m| !m.is_finite()) {
+    if inverse_bind.len() != joints.len()
+        || inverse_bind.iter().any(|m| !m.is_finite() || m.determinant().abs() < 1e-12)
+    {
         return Err(malformed(format!(
-            "skin {}: {} inverse bind matrices for {} joints, or one not finite",
+            "skin {}: {} inverse bind matrices for {} joints, or one not finite or singular",
             skin.index(),
             inverse_bind.len(),
             joints.len()
@@ -72,6 +114,37 @@ pub(super) fn parse(bytes: &[u8], dir: Option<&Path>) -> Result<Character> {
             continue;
         }
         let what = |part: &str| format!("mesh {} primitive {k}: {part}", mesh.index());
+        let attribute = |semantic: gltf::Semantic, name: &str| {
+            primitive.get(&semantic).ok_or_else(|| malformed(what(&format!("no {name}"))))
+        };
+        let max = MAX_CHARACTER_VERTICES;
+        check_accessor(
+            &attribute(gltf::Semantic::Positions, "POSITION")?,
+            &[DataType::F32],
+            Dimensions::Vec3,
+            max,
+            &what("POSITION"),
+        )?;
+        let joint_types = [DataType::U8, DataType::U16];
+        check_accessor(
+            &attribute(gltf::Semantic::Joints(0), "JOINTS_0")?,
+            &joint_types,
+            Dimensions::Vec4,
+            max,
+            &what("JOINTS_0"),
+        )?;
+        let weight_types = [DataType::F32, DataType::U8, DataType::U16];
+        check_accessor(
+            &attribute(gltf::Semantic::Weights(0), "WEIGHTS_0")?,
+            &weight_types,
+            Dimensions::Vec4,
+            max,
+            &what("WEIGHTS_0"),
+        )?;
+        if let Some(i) = primitive.indices() {
+            let index_types = [DataType::U8, DataType::U16, DataType::U32];
+            check_accessor(&i, &index_types, Dimensions::Scalar, MAX_INDICES, &what("indices"))?;
+        }
         let reader = primitive.reader(get);
         let p: Vec<Vec3> =
             reader.read_positions().ok_or_else(|| malformed(what("no POSITION")))?.map(Vec3::from).collect();
@@ -90,6 +163,9 @@ pub(super) fn parse(bytes: &[u8], dir: Option<&Path>) -> Result<Character> {
             Some(i) => i.into_u32().collect(),
             None => (0..p.len() as u32).collect(),
         };
+        if !indices.len().is_multiple_of(3) || triangles.len() * 3 + indices.len() > MAX_INDICES {
+            return Err(malformed(what(&format!("{} indices: not whole triangles, or too many", indices.len()))));
+        }
         if let Some(bad) = indices.iter().find(|&&i| i as usize >= p.len()) {
             return Err(malformed(what(&format!("index {bad} past its {} vertices", p.len()))));
         }
@@ -197,6 +273,16 @@ fn animations<'s>(
         let mut channels = Vec::new();
         for c in a.channels() {
             let what = |part: &str| format!("{name:?} channel {}: {part}", c.index());
+            let (input, output) = (c.sampler().input(), c.sampler().output());
+            check_accessor(&input, &[DataType::F32], Dimensions::Scalar, MAX_KEYS, &what("input"))?;
+            let (types, dims): (&[DataType], _) = match c.target().property() {
+                Property::Translation | Property::Scale => (&[DataType::F32], Dimensions::Vec3),
+                Property::Rotation => {
+                    (&[DataType::F32, DataType::I8, DataType::U8, DataType::I16, DataType::U16], Dimensions::Vec4)
+                }
+                Property::MorphTargetWeights => continue,
+            };
+            check_accessor(&output, types, dims, 3 * MAX_KEYS, &what("output"))?;
             let reader = c.reader(get.clone());
             let times: Vec<f32> = reader.read_inputs().ok_or_else(|| malformed(what("no input")))?.collect();
             let keys = match reader.read_outputs().ok_or_else(|| malformed(what("no output")))? {

@@ -78,8 +78,17 @@ impl Character {
             return Err(bad("a vertex position is not finite".into()));
         }
         let joints = skeleton.joints.len();
+        if joints == 0 {
+            return Err(bad("the skin has no joints".into()));
+        }
         if weights.iter().any(|(j, w)| j.iter().zip(w).any(|(&j, &w)| usize::from(j) >= joints && w > 0.0)) {
             return Err(bad(format!("a vertex is weighted to a joint past the skin's {joints}")));
+        }
+        if let Some(v) = weights.iter().position(|(_, w)| {
+            let sum: f32 = w.iter().sum();
+            !(sum.is_finite() && sum > 0.0 && w.iter().all(|&x| x >= 0.0))
+        }) {
+            return Err(bad(format!("vertex {v}'s weights are not positive with a positive sum")));
         }
         if triangles.is_empty() || triangles.iter().flatten().any(|&i| i as usize >= positions.len()) {
             return Err(bad("no triangles, or a triangle naming a vertex that does not exist".into()));
@@ -166,8 +175,8 @@ impl Character {
 
     /// The direction the character faces in the bind pose, horizontal: where
     /// its feet point (the lowest [`FEET_FRACTION`] of the vertices lie, on
-    /// average, ahead of the joints that move them); glTF's +Z when the feet
-    /// say nothing.
+    /// average, ahead of the joints that move them); when the feet say
+    /// nothing, glTF's +Z (−Y for a Z-up character).
     pub fn forward(&self) -> Vec3 {
         let up = self.up_axis();
         let rest = self.bind_pose();

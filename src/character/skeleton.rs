@@ -88,13 +88,13 @@ impl Channel {
         let per_key = if self.sampling == Sampling::CubicSpline { 3 } else { 1 };
         let (values, finite) = match &self.keys {
             Keys::Translation(v) | Keys::Scale(v) => (v.len(), v.iter().all(|x| x.is_finite())),
-            Keys::Rotation(q) => (q.len(), q.iter().all(|x| x.is_finite())),
+            Keys::Rotation(q) => (q.len(), q.iter().all(|x| x.is_finite() && x.length_squared() >= 1e-12)),
         };
         if values != n * per_key {
             return Err(format!("{values} values for {n} keys"));
         }
         if !finite {
-            return Err("a value is not finite".into());
+            return Err("a value is not finite (or a rotation is not a rotation)".into());
         }
         Ok(())
     }
@@ -103,7 +103,8 @@ impl Channel {
     fn segment(&self, t: f32) -> (usize, usize, f32, f32) {
         let times = &self.times;
         let last = times.len() - 1;
-        if t <= times[0] {
+        // A NaN time samples the first key.
+        if t.is_nan() || t <= times[0] {
             return (0, 0, 0.0, 0.0);
         }
         if t >= times[last] {
@@ -189,25 +190,27 @@ impl Skeleton {
             if let Some(c) = a.channels.iter().find(|c| c.node >= n) {
                 return Err(bad(format!("{:?} moves node {} ({n} nodes)", a.name, c.node)));
             }
+            for (k, c) in a.channels.iter().enumerate() {
+                c.validate().map_err(|why| bad(format!("{:?} channel {k}: {why}", a.name)))?;
+            }
         }
-        // Parents first: repeatedly take nodes whose parent is placed.
-        let mut placed = vec![false; n];
+        // Parents first: from the roots down through each node's children.
+        let mut children = vec![Vec::new(); n];
         let mut order = Vec::with_capacity(n);
-        while order.len() < n {
-            let before = order.len();
-            for (i, node) in nodes.iter().enumerate() {
-                let ready = match node.parent {
-                    None => true,
-                    Some(p) => p < n && placed[p],
-                };
-                if !placed[i] && ready {
-                    placed[i] = true;
-                    order.push(i);
-                }
+        for (i, node) in nodes.iter().enumerate() {
+            match node.parent {
+                Some(p) if p < n => children[p].push(i),
+                Some(_) => return Err(bad(format!("node {i}'s parent does not exist"))),
+                None => order.push(i),
             }
-            if order.len() == before {
-                return Err(bad("the node hierarchy has a cycle or a missing parent".into()));
-            }
+        }
+        let mut next = 0;
+        while next < order.len() {
+            order.extend_from_slice(&children[order[next]]);
+            next += 1;
+        }
+        if order.len() != n {
+            return Err(bad("the node hierarchy has a cycle".into()));
         }
         Ok(Skeleton { nodes, joints, inverse_bind, animations, order })
     }
@@ -227,7 +230,8 @@ impl Skeleton {
     }
 
     /// Every node's world transform with `animation` (none: the rest pose)
-    /// sampled at `time` seconds (wrapped to its duration when `looped`).
+    /// sampled at `time` seconds (wrapped to its duration when `looped`; a
+    /// time that is not finite samples the first keys).
     pub fn node_transforms(&self, animation: Option<usize>, time: f32, looped: bool) -> Vec<Mat4> {
         let mut local: Vec<(Vec3, Quat, Vec3)> =
             self.nodes.iter().map(|n| (n.translation, n.rotation, n.scale)).collect();

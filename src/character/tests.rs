@@ -224,3 +224,129 @@ fn buffers_that_cannot_be_read_safely_are_refused() {
     let err = gltf_read::parse(doc("short.bin", 4).as_bytes(), Some(dir.path())).expect_err("short");
     assert!(err.to_string().contains("truncated glTF file"), "{err}");
 }
+
+/// The mannequin's GLB with its JSON chunk changed by `edit`.
+fn mutated(bytes: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().expect("length")) as usize;
+    let mut json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).expect("json");
+    edit(&mut json);
+    let mut text = serde_json::to_vec(&json).expect("json");
+    while !text.len().is_multiple_of(4) {
+        text.push(b' ');
+    }
+    let rest = &bytes[20 + json_len..];
+    let mut out = Vec::new();
+    out.extend_from_slice(&bytes[0..8]);
+    out.extend_from_slice(&((12 + 8 + text.len() + rest.len()) as u32).to_le_bytes());
+    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&text);
+    out.extend_from_slice(rest);
+    out
+}
+
+/// Accessors the readers would index blindly (a joint stored as floats, no
+/// elements, more elements than their view holds, a stride shorter than an
+/// element, a sparse one), a degenerate rotation key and a singular inverse
+/// bind matrix are refused with an error naming them: never a panic.
+#[test]
+fn malformed_accessors_and_keys_are_refused_not_read() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
+    let bytes = std::fs::read(path).expect("read");
+    assert!(Character::parse(&mutated(&bytes, |_| {})).is_ok(), "the unchanged JSON still loads");
+    let attribute = |j: &serde_json::Value, name: &str| {
+        j["meshes"][0]["primitives"][0]["attributes"][name].as_u64().expect("attribute") as usize
+    };
+    type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+    let cases: Vec<(&str, Edit)> = vec![
+        (
+            "JOINTS_0",
+            Box::new(move |j| {
+                let a = attribute(j, "JOINTS_0");
+                j["accessors"][a]["componentType"] = 5126.into();
+            }),
+        ),
+        (
+            "POSITION",
+            Box::new(move |j| {
+                let a = attribute(j, "POSITION");
+                j["accessors"][a]["count"] = 0.into();
+            }),
+        ),
+        (
+            "POSITION",
+            Box::new(move |j| {
+                let a = attribute(j, "POSITION");
+                j["accessors"][a]["count"] = 4_000_000.into();
+            }),
+        ),
+        (
+            "WEIGHTS_0",
+            Box::new(move |j| {
+                let a = attribute(j, "WEIGHTS_0");
+                let v = j["accessors"][a]["bufferView"].as_u64().expect("view") as usize;
+                j["bufferViews"][v]["byteStride"] = 4.into();
+            }),
+        ),
+        (
+            "POSITION",
+            Box::new(move |j| {
+                let a = attribute(j, "POSITION");
+                j["accessors"][a]["sparse"] = serde_json::json!({
+                    "count": 1,
+                    "indices": {"bufferView": 0, "componentType": 5125},
+                    "values": {"bufferView": 0}
+                });
+            }),
+        ),
+        (
+            "inverse bind",
+            Box::new(|j| {
+                let a = j["skins"][0]["inverseBindMatrices"].as_u64().expect("ibm") as usize;
+                j["accessors"][a]["type"] = "VEC4".into();
+            }),
+        ),
+    ];
+    for (k, (what, edit)) in cases.into_iter().enumerate() {
+        let err = Character::parse(&mutated(&bytes, edit)).expect_err("refused");
+        eprintln!("case {k}: {err}");
+        assert!(err.to_string().contains(what), "case {k}: {err}");
+    }
+}
+
+/// Hostile parts given through the public constructors: a NaN or infinite time
+/// samples the first keys; a zero rotation key, zero weights and a skin without
+/// joints are refused; a long chain of nodes listed child first is ordered in
+/// one pass.
+#[test]
+fn hostile_parts_are_refused_or_harmless() {
+    let c = rig();
+    for t in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        let pose = c.pose(Some(0), t);
+        assert!(pose.nodes.iter().all(|m| m.is_finite()), "time {t}");
+    }
+    let zero = Channel {
+        node: 0,
+        times: vec![0.0, 1.0],
+        keys: Keys::Rotation(vec![Quat::IDENTITY, Quat::from_xyzw(0.0, 0.0, 0.0, 0.0)]),
+        sampling: Sampling::Linear,
+    };
+    let err = Skeleton::new(
+        vec![node("a", None, Vec3::ZERO)],
+        vec![0],
+        vec![Mat4::IDENTITY],
+        vec![Animation { name: "z".into(), channels: vec![zero] }],
+    )
+    .expect_err("zero rotation");
+    assert!(err.to_string().contains("channel 0"), "{err}");
+    let mut weights = c.weights.clone();
+    weights[3].1 = [0.0; 4];
+    let err =
+        Character::new(c.skeleton.clone(), c.positions.clone(), weights, c.triangles.clone()).expect_err("weights");
+    assert!(err.to_string().contains("vertex 3"), "{err}");
+    let chain: Vec<Node> = (0..200_000).map(|i| node("n", (i + 1 < 200_000).then_some(i + 1), Vec3::ZERO)).collect();
+    let started = std::time::Instant::now();
+    let sk = Skeleton::new(chain, vec![0], vec![Mat4::IDENTITY], vec![]).expect("a long chain");
+    eprintln!("200,000 nodes child first ordered in {:?}", started.elapsed());
+    assert_eq!(sk.node_transforms(None, 0.0, false).len(), 200_000);
+}

@@ -26,8 +26,8 @@ impl RootBinding {
 }
 
 /// Binds every root to the nearest point of `mesh`. A root farther than
-/// `tolerance` from the mesh is refused, the error naming the strand and its
-/// distance.
+/// `tolerance` (in the mesh's units) from the mesh is refused, the error
+/// naming the strand and its distance.
 pub fn bind_roots(roots: &[Vec3], mesh: &TriMesh, tolerance: f32) -> Result<Vec<RootBinding>> {
     let grid = TriangleGrid::new(mesh, tolerance)?;
     roots
@@ -39,7 +39,7 @@ pub fn bind_roots(roots: &[Vec3], mesh: &TriMesh, tolerance: f32) -> Result<Vec<
             }
             match grid.nearest(root) {
                 Some(n) => Ok(n.binding),
-                None => Err(far(s, tolerance)),
+                None => Err(far(s, distance_to(mesh, root), tolerance)),
             }
         })
         .collect()
@@ -52,7 +52,7 @@ pub struct Nearest {
     pub binding: RootBinding,
     /// The point.
     pub point: Vec3,
-    /// Its distance from the query.
+    /// Its distance from the query, in the mesh's units.
     pub distance: f32,
 }
 
@@ -69,7 +69,7 @@ pub struct TriangleGrid<'m> {
 }
 
 impl<'m> TriangleGrid<'m> {
-    /// Buckets `mesh` for queries within `radius` (finite, > 0).
+    /// Buckets `mesh` for queries within `radius` (in the mesh's units; finite, > 0).
     pub fn new(mesh: &'m TriMesh, radius: f32) -> Result<Self> {
         if !(radius.is_finite() && radius > 0.0) {
             return Err(Error::param("nearest-point radius", radius, "finite and > 0"));
@@ -126,12 +126,24 @@ impl<'m> TriangleGrid<'m> {
     }
 }
 
-fn far(strand: usize, tolerance: f32) -> Error {
+fn far(strand: usize, distance: f32, tolerance: f32) -> Error {
     Error::param(
         "root",
-        format!("strand {strand}: farther from the scalp"),
+        format!("strand {strand}, {distance} from the scalp"),
         format!("within {tolerance} of the scalp mesh"),
     )
+}
+
+/// The distance from `p` to the nearest point of `mesh`, every triangle tried
+/// (for the error of a root too far for the grid).
+fn distance_to(mesh: &TriMesh, p: Vec3) -> f32 {
+    mesh.triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+            p.distance(closest_on_triangle(p, a, b, c).0)
+        })
+        .fold(f32::INFINITY, f32::min)
 }
 
 /// The point of triangle `a b c` nearest `p`, and its barycentric weights
@@ -211,7 +223,7 @@ mod tests {
         let mut far_roots = roots.clone();
         far_roots[7] = Vec3::new(0.0, 0.2, 0.0);
         let err = bind_roots(&far_roots, &mesh, 0.01).expect_err("too far");
-        assert!(err.to_string().contains("strand 7"), "{err}");
+        assert!(err.to_string().contains("strand 7, 0.1"), "{err}");
         far_roots[7] = Vec3::new(0.0, f32::NAN, 0.0);
         assert!(bind_roots(&far_roots, &mesh, 0.01).is_err());
         assert!(bind_roots(&roots, &mesh, 0.0).is_err());

@@ -135,6 +135,9 @@ pub struct FrameScheduler {
     slots: usize,
     frames: u64,
     sim_device: Option<GpuContext>,
+    /// Head and body colliders set, checked together against what a sub-step
+    /// holds before anything is sent to a worker.
+    colliders: (usize, usize),
 }
 
 impl std::fmt::Debug for FrameScheduler {
@@ -227,6 +230,7 @@ impl FrameScheduler {
             slots,
             frames: 0,
             sim_device: (mode == ScheduleMode::SecondDevice).then_some(sim_ctx),
+            colliders: (colliders.len(), 0),
         })
     }
 

@@ -11,7 +11,9 @@ use crate::gpu_types::ColliderShape;
 /// Most colliders a simulation may have.
 pub const MAX_COLLIDERS: usize = crate::limits::SIM_MAX_COLLIDERS as usize;
 
-/// A collision shape in the head's frame; it moves with the head transform.
+/// A collision shape: in the head's frame, moving with the head transform
+/// ([`super::HairSim::set_colliders`]), or in the world for a body that moves
+/// on its own ([`super::HairSim::set_body_colliders`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Collider {
     /// A sphere.

@@ -25,7 +25,7 @@ impl HairSim {
     /// barrier and the followers' dispatch. A step that starts with a teleport or
     /// reset ([`HairSim::teleport`], [`HairSim::reset`], a head moving a root
     /// farther than [`crate::sim::SimParams::teleport_distance`]) records the move's dispatch
-    /// and two barriers first (debug label [`MOVE_LABEL`](crate::sim::MOVE_LABEL), no timestamp scope).
+    /// and two barriers after the uploads, before the step (debug label [`MOVE_LABEL`](crate::sim::MOVE_LABEL), no timestamp scope).
     /// Leaves the step pipeline, the followers' or the volume stage's last kernel
     /// bound.
     ///

@@ -54,7 +54,22 @@ pub struct InputArgs {
 impl InputArgs {
     /// Options that need others and values out of range, as errors that say so.
     pub fn check(&self) -> Result<(), String> {
-        if self.input.is_none() {
+        if self.gltf.is_some() {
+            let given = [("--input", self.input.is_some()), ("--obj", self.obj.is_some())];
+            if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
+                return Err(format!("--gltf grows hair on its own character: {flag} cannot go with it"));
+            }
+            let given = [("--scale", self.scale.is_some()), ("--strict", self.strict)];
+            if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
+                return Err(format!("{flag} needs --input (a --gltf character is in meters and grown, not read)"));
+            }
+        } else if let Some(flag) =
+            [("--animation", self.animation.is_some()), ("--head-joint", self.head_joint.is_some())]
+                .iter()
+                .find_map(|(f, g)| g.then_some(f))
+        {
+            return Err(format!("{flag} needs --gltf"));
+        } else if self.input.is_none() {
             let given = [
                 ("--obj", self.obj.is_some()),
                 ("--scale", self.scale.is_some()),
@@ -66,18 +81,6 @@ impl InputArgs {
                     "{flag} needs --input (the thesis scene brings its own groom, head and colliders)"
                 ));
             }
-        }
-        if self.gltf.is_some() {
-            let given = [("--input", self.input.is_some()), ("--obj", self.obj.is_some())];
-            if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
-                return Err(format!("--gltf grows hair on its own character: {flag} cannot go with it"));
-            }
-        } else if let Some(flag) =
-            [("--animation", self.animation.is_some()), ("--head-joint", self.head_joint.is_some())]
-                .iter()
-                .find_map(|(f, g)| g.then_some(f))
-        {
-            return Err(format!("{flag} needs --gltf"));
         }
         if self.no_mesh_collider && self.obj.is_none() {
             return Err("--no-mesh-collider needs --obj (there is no mesh to collide with)".into());

@@ -49,6 +49,10 @@ pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let mut sim = HairSim::new(&ctx, &groom, &params, &ch.head_at(0.0))?;
     sim.set_mesh(Some(&head_mesh), &config.mesh_collider)?;
+    if let Some(count) = a.sim.simulated_count(groom.strand_count())? {
+        sim.set_simulated_hairs(count)?;
+        say!("simulated: {count} of {} key hairs (the others follow them)", groom.strand_count());
+    }
     let mut profiler = GpuProfiler::new(&ctx, 1, 1024)?;
     let (strands, points) = sim.size();
     say!(
