@@ -66,6 +66,23 @@ fn a_body_collider_sweeping_through_hair_pushes_it_at_every_sub_step() {
     assert!(appeared < 1e-4, "a ball appearing past the curtain moved it by {appeared} m");
 }
 
+/// On a teleport the body's colliders start where they are set (the body
+/// was cut to its new place with the head), not swept from where they were.
+#[test]
+fn a_teleport_places_the_body_without_sweeping_it() {
+    let gpu = Gpu::new();
+    let params = SimParams { substeps: 4, gravity_enabled: false, ..SimParams::default() };
+    let head = RigidTransform::default();
+    let mut sim = HairSim::new(gpu.ctx(), &curtain(), &params, &head).expect("sim");
+    sim.set_body_colliders(&[ball(-0.1)]).expect("body");
+    sim.run(1, |_| head, None).expect("step");
+    sim.teleport(&head).expect("teleport in place");
+    sim.set_body_colliders(&[ball(0.1)]).expect("body");
+    sim.run(1, |_| head, None).expect("step");
+    let moved = moved(&sim.read_state().expect("readback"));
+    assert!(moved < 1e-4, "the body swept through the curtain on a teleport: {moved} m");
+}
+
 /// Head and body colliders together are limited to what a sub-step holds.
 #[test]
 fn head_and_body_colliders_share_the_limit() {

@@ -313,6 +313,11 @@ fn teleports_and_resets_reach_the_simulation_in_every_mode() {
     expected.push(common::bits(&reference.read_state().expect("state")));
     let all = [
         single(Pipelining::Throughput),
+        SchedulerOptions {
+            async_on_graphics_queue: true,
+            mode: Some(ScheduleMode::AsyncCompute),
+            ..SchedulerOptions::default()
+        },
         second_device(&sim, HandOff::ExternalMemory, Pipelining::Throughput),
         second_device(&sim, HandOff::HostStaging, Pipelining::Latency),
     ];
