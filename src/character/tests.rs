@@ -350,3 +350,27 @@ fn hostile_parts_are_refused_or_harmless() {
     eprintln!("200,000 nodes child first ordered in {:?}", started.elapsed());
     assert_eq!(sk.node_transforms(None, 0.0, false).len(), 200_000);
 }
+
+/// A bone whose rings widen from 5 mm to 10 cm: its capsule takes the 90th
+/// percentile of its vertices' distances from the axis (ring 19 of 20: 9.5 cm),
+/// not their median (5.5 cm).
+#[test]
+fn a_capsule_takes_the_ninetieth_percentile_of_its_bone() {
+    let skeleton =
+        Skeleton::new(vec![node("bone", None, Vec3::ZERO)], vec![0], vec![Mat4::IDENTITY], vec![]).expect("skeleton");
+    let mut c = Character { skeleton, positions: vec![], weights: vec![], triangles: vec![] };
+    for ring in 0..20 {
+        let y = ring as f32 * 0.05;
+        let before = c.positions.len();
+        tube(&mut c, 0, 0.005 * (ring + 1) as f32, &[y, y + 0.01]);
+        // One ring of each tube: drop the second ring's vertices and triangles.
+        c.positions.truncate(before + 16);
+        c.weights.truncate(before + 16);
+        c.triangles.retain(|t| t.iter().all(|&v| (v as usize) < c.positions.len()));
+    }
+    c.triangles.push([0, 1, 2]);
+    let c = Character::new(c.skeleton, c.positions, c.weights, c.triangles).expect("character");
+    let capsules = c.fit_capsules(&[]);
+    assert_eq!(capsules.len(), 1);
+    assert!((capsules[0].radius - 0.095).abs() < 1e-4, "radius {}", capsules[0].radius);
+}
