@@ -127,6 +127,21 @@ fn second_device_of(sim: &GpuContext, hand_off: HandOff, pipelining: Pipelining)
     }
 }
 
+/// One of each mode: single queue, ASYNC COMPUTE (on the graphics queue, as
+/// lavapipe has no second one), and SECOND DEVICE with both hand-offs.
+fn every_mode(sim: &Gpu) -> [SchedulerOptions; 4] {
+    [
+        single(Pipelining::Throughput),
+        SchedulerOptions {
+            async_on_graphics_queue: true,
+            mode: Some(ScheduleMode::AsyncCompute),
+            ..SchedulerOptions::default()
+        },
+        second_device(sim, HandOff::ExternalMemory, Pipelining::Throughput),
+        second_device(sim, HandOff::HostStaging, Pipelining::Latency),
+    ]
+}
+
 fn single(pipelining: Pipelining) -> SchedulerOptions {
     SchedulerOptions { mode: Some(ScheduleMode::SingleQueue), pipelining, ..SchedulerOptions::default() }
 }
@@ -253,16 +268,7 @@ fn stopping_the_simulation_side_returns_errors() {
     let sim = Gpu::new();
     let g = groom(16, 4);
     let heads = frame_heads(12);
-    let all = [
-        single(Pipelining::Throughput),
-        SchedulerOptions {
-            async_on_graphics_queue: true,
-            mode: Some(ScheduleMode::AsyncCompute),
-            ..SchedulerOptions::default()
-        },
-        second_device(&sim, HandOff::ExternalMemory, Pipelining::Throughput),
-        second_device(&sim, HandOff::HostStaging, Pipelining::Latency),
-    ];
+    let all = every_mode(&sim);
     for options in all {
         let mut s = FrameScheduler::new(render.ctx(), &g, &params(), &RigidTransform::default(), &[], &options)
             .expect("scheduler");
@@ -311,16 +317,7 @@ fn teleports_and_resets_reach_the_simulation_in_every_mode() {
         reference.run(1, |_| *h, None).expect("step");
     }
     expected.push(common::bits(&reference.read_state().expect("state")));
-    let all = [
-        single(Pipelining::Throughput),
-        SchedulerOptions {
-            async_on_graphics_queue: true,
-            mode: Some(ScheduleMode::AsyncCompute),
-            ..SchedulerOptions::default()
-        },
-        second_device(&sim, HandOff::ExternalMemory, Pipelining::Throughput),
-        second_device(&sim, HandOff::HostStaging, Pipelining::Latency),
-    ];
+    let all = every_mode(&sim);
     for options in all {
         let mut s =
             FrameScheduler::new(render.ctx(), &g, &p, &RigidTransform::default(), &[], &options).expect("scheduler");

@@ -178,19 +178,25 @@ impl Character {
     /// average, ahead of the joints that move them); when the feet say
     /// nothing, glTF's +Z (−Y for a Z-up character).
     pub fn forward(&self) -> Vec3 {
-        let up = self.up_axis();
+        let (up, heights, lo, hi) = self.heights();
         let rest = self.bind_pose();
-        let skinned = &self.positions;
-        let heights: Vec<f32> = skinned.iter().map(|p| p.dot(up)).collect();
-        let (lo, hi) = heights.iter().fold((f32::MAX, f32::MIN), |(l, h), &y| (l.min(y), h.max(y)));
         let cut = lo + FEET_FRACTION * (hi - lo);
         let mut ahead = Vec3::ZERO;
-        for (v, p) in skinned.iter().enumerate().filter(|(v, _)| heights[*v] <= cut) {
+        for (v, p) in self.positions.iter().enumerate().filter(|(v, _)| heights[*v] <= cut) {
             ahead += *p - self.joint_transform(&rest, self.dominant_joint(v)).transform_point3(Vec3::ZERO);
         }
         let flat = ahead - up * ahead.dot(up);
         let fallback = if up == Vec3::Z { Vec3::NEG_Y } else { Vec3::Z };
         flat.try_normalize().unwrap_or(fallback)
+    }
+
+    /// The up axis, every bind-pose vertex's height along it, and the lowest
+    /// and highest.
+    fn heights(&self) -> (Vec3, Vec<f32>, f32, f32) {
+        let up = self.up_axis();
+        let heights: Vec<f32> = self.positions.iter().map(|p| p.dot(up)).collect();
+        let (lo, hi) = heights.iter().fold((f32::MAX, f32::MIN), |(l, h), &y| (l.min(y), h.max(y)));
+        (up, heights, lo, hi)
     }
 
     /// The skin joint named `name`.
@@ -204,9 +210,7 @@ impl Character {
     /// The head: the joint that dominates the most vertices of the top
     /// [`HEAD_TOP_FRACTION`] of the bind pose along [`Character::up_axis`].
     pub fn head_joint(&self) -> usize {
-        let up = self.up_axis();
-        let heights: Vec<f32> = self.positions.iter().map(|p| p.dot(up)).collect();
-        let (lo, hi) = heights.iter().fold((f32::MAX, f32::MIN), |(l, h), &y| (l.min(y), h.max(y)));
+        let (_, heights, lo, hi) = self.heights();
         let cut = hi - HEAD_TOP_FRACTION * (hi - lo);
         let mut votes = vec![0usize; self.skeleton.joints.len()];
         for (v, &y) in heights.iter().enumerate() {

@@ -33,7 +33,8 @@ impl FrameScheduler {
     /// Replaces the colliders (validated now) from the next step on.
     pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
         crate::sim::validate_colliders(colliders)?;
-        self.check_colliders(colliders.len(), self.colliders.1)?;
+        // Checked here, so that a second device's worker never fails on it.
+        crate::sim::validate_collider_total(colliders.len(), self.colliders.1)?;
         self.colliders.0 = colliders.len();
         match &mut self.backend {
             Backend::Local { sim, .. } => sim.set_colliders(colliders),
@@ -47,7 +48,7 @@ impl FrameScheduler {
     /// now; see [`crate::sim::HairSim::set_body_colliders`]).
     pub fn set_body_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
         crate::sim::validate_colliders(colliders)?;
-        self.check_colliders(self.colliders.0, colliders.len())?;
+        crate::sim::validate_collider_total(self.colliders.0, colliders.len())?;
         self.colliders.1 = colliders.len();
         match &mut self.backend {
             Backend::Local { sim, .. } => sim.set_body_colliders(colliders),
@@ -83,16 +84,6 @@ impl FrameScheduler {
             Backend::Remote { worker, .. } => worker.update(SimUpdate::Reset),
             Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
         }
-    }
-
-    /// Refuses more head and body colliders together than a sub-step holds
-    /// (checked here, so that a second device's worker never fails on it).
-    fn check_colliders(&self, head: usize, body: usize) -> Result<()> {
-        if head + body > crate::sim::MAX_COLLIDERS {
-            let allowed = format!("at most {} head and body colliders together", crate::sim::MAX_COLLIDERS);
-            return Err(Error::param("colliders", format!("{head} head + {body} body"), allowed));
-        }
-        Ok(())
     }
 
     /// Simulates only `count` key hairs from the next step on, the others

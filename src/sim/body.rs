@@ -34,6 +34,16 @@ pub enum Collider {
     },
 }
 
+/// Refuses more head and body colliders together than a sub-step holds
+/// ([`MAX_COLLIDERS`]).
+pub(crate) fn validate_collider_total(head: usize, body: usize) -> Result<()> {
+    if head + body > MAX_COLLIDERS {
+        let allowed = format!("at most {MAX_COLLIDERS} head and body colliders together");
+        return Err(Error::param("colliders", format!("{head} head + {body} body"), allowed));
+    }
+    Ok(())
+}
+
 /// Checks a collider list: at most [`MAX_COLLIDERS`], each valid.
 pub(crate) fn validate_colliders(colliders: &[Collider]) -> Result<()> {
     if colliders.len() > MAX_COLLIDERS {

@@ -69,7 +69,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-pub(crate) use body::validate_colliders;
+pub(crate) use body::{validate_collider_total, validate_colliders};
 pub use body::{Collider, RigidTransform, MAX_COLLIDERS};
 pub use cpu::{CpuHairSim, REFERENCE_STEP_TOLERANCE_M};
 pub use driver::{FixedStepDriver, StepPlan};

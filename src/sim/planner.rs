@@ -6,7 +6,7 @@
 
 use glam::Mat4;
 
-use super::body::{validate_colliders, Collider, RigidTransform};
+use super::body::{validate_collider_total, validate_colliders, Collider, RigidTransform};
 use super::mesh_collider::MeshGrid;
 use super::packing::{self, SimShape, SubstepPose};
 use super::params::SimParams;
@@ -73,15 +73,6 @@ pub(crate) struct SubstepPlanner {
     pub pending: Option<PendingMove>,
 }
 
-/// Refuses more head and body colliders together than a sub-step holds.
-fn check_total(head: usize, body: usize) -> Result<()> {
-    if head + body > super::body::MAX_COLLIDERS {
-        let allowed = format!("at most {} head and body colliders together", super::body::MAX_COLLIDERS);
-        return Err(crate::error::Error::param("colliders", format!("{head} head + {body} body"), allowed));
-    }
-    Ok(())
-}
-
 /// Says, through `log`, when the sag-free rest state is asked for but cannot be
 /// met: a shape stiffness under 1 % per sub-step leaves every particle
 /// uncompensated (see `sim_shape_target`), so the groom sags as without it.
@@ -132,7 +123,7 @@ impl SubstepPlanner {
 
     pub(crate) fn set_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
         validate_colliders(colliders)?;
-        check_total(colliders.len(), self.body.len())?;
+        validate_collider_total(colliders.len(), self.body.len())?;
         self.colliders = colliders.to_vec();
         Ok(())
     }
@@ -141,7 +132,7 @@ impl SubstepPlanner {
     /// sub-steps move each from where it was at the end of the previous step.
     pub(crate) fn set_body_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
         validate_colliders(colliders)?;
-        check_total(self.colliders.len(), colliders.len())?;
+        validate_collider_total(self.colliders.len(), colliders.len())?;
         self.body = colliders.to_vec();
         Ok(())
     }

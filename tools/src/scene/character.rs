@@ -106,7 +106,8 @@ impl CharacterScene {
         let local =
             TriMesh::new(region.positions.iter().map(|p| to_head.transform_point3(*p)).collect(), region.triangles)?;
         // No roots on the face: triangles facing forward below the crown are left out.
-        let forward = to_head.transform_vector3(self.character.forward()).normalize();
+        let facing = self.character.forward();
+        let forward = to_head.transform_vector3(facing).normalize();
         let up_local = to_head.transform_vector3(Vec3::Y).normalize();
         let (lo, hi) = local
             .positions
@@ -130,7 +131,7 @@ impl CharacterScene {
             length: HAIR_LENGTH,
             gravity: to_head.transform_vector3(Vec3::NEG_Y),
             droop: 5.0,
-            comb: to_head.transform_vector3(0.2 * Vec3::Y - 0.8 * self.character.forward()),
+            comb: to_head.transform_vector3(0.2 * Vec3::Y - 0.8 * facing),
             ..GrowParams::default()
         };
         Ok((grow(&scalp, &params)?, local))

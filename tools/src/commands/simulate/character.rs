@@ -14,7 +14,7 @@ use vkhair::sim::{HairSim, SimState};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
 use super::check::{tip_drift, write_final};
-use super::{simulate_params, SimulateArgs, TRACK};
+use super::{announce, apply_simulated, run_summary, simulate_params, SimulateArgs, TRACK};
 use crate::output::{progress, CliResult};
 use crate::profile::{host_now_ns, percentile, Profile};
 use crate::say;
@@ -49,19 +49,11 @@ pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let mut sim = HairSim::new(&ctx, &groom, &params, &ch.head_at(0.0))?;
     sim.set_mesh(Some(&head_mesh), &config.mesh_collider)?;
-    if let Some(count) = a.sim.simulated_count(groom.strand_count())? {
-        sim.set_simulated_hairs(count)?;
-        say!("simulated: {count} of {} key hairs (the others follow them)", groom.strand_count());
-    }
+    apply_simulated(&mut sim, a.sim.simulated_count(groom.strand_count())?, groom.strand_count())?;
     let mut profiler = GpuProfiler::new(&ctx, 1, 1024)?;
     let (strands, points) = sim.size();
-    say!(
-        "character: {strands} key hairs × {points} points on {}, {} steps of {:.4} s",
-        ctx.info().name,
-        a.steps,
-        params.dt
-    );
-    say!("{}", a.sim.describe(&params));
+    let label = a.input.gltf.as_ref().map_or_else(String::new, |p| p.display().to_string());
+    announce(a, &label, &ctx, &sim, &params);
     let bar = progress(a.steps, "steps");
     let mut profile = Profile::new("step");
     let (mut root_error, mut inside) = (0.0f32, 0.0f64);
@@ -104,20 +96,12 @@ pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
         say!("wrote {}: {strands} strands × {points} points", out.display());
     }
     a.profile_out.write(&profile, || {
-        serde_json::json!({
-            "command": "simulate",
-            "device": ctx.info().name,
-            "groom": a.input.gltf.as_ref().map(|p| p.display().to_string()),
-            "key_hairs": strands,
-            "points_per_key_hair": points,
-            "steps": a.steps,
-            "dt_s": params.dt,
-            "iterations": params.iterations,
-            "volume": format!("{:?}", params.volume.mode),
-            "root_error_max_m": root_error,
-            "inside_fraction_max": inside,
-        })
+        let mut run = run_summary(a, &ctx, &label, &sim, &params);
+        run["root_error_max_m"] = root_error.into();
+        run["inside_fraction_max"] = inside.into();
+        run
     })?;
+
     Ok(())
 }
 

@@ -75,6 +75,54 @@ fn load_mesh(obj: Option<&Path>, scale: f32) -> Result<Option<TriMesh>, vkhair::
     }
 }
 
+/// Says what runs: the groom's `label`, its size, the device, the steps and
+/// the parameters (with the file they came from).
+fn announce(a: &SimulateArgs, label: &str, ctx: &GpuContext, sim: &HairSim, params: &SimParams) {
+    let (strands, points) = sim.size();
+    say!(
+        "{label}: {strands} key hairs × {points} points on {}, {} steps of {:.4} s",
+        ctx.info().name,
+        a.steps,
+        params.dt
+    );
+    say!(
+        "{}{}",
+        a.sim.describe(params),
+        a.config.as_ref().map(|c| format!(" (from {} and the flags)", c.display())).unwrap_or_default()
+    );
+}
+
+/// The `run` object of the `--json` summary.
+fn run_summary(
+    a: &SimulateArgs,
+    ctx: &GpuContext,
+    label: &str,
+    sim: &HairSim,
+    params: &SimParams,
+) -> serde_json::Value {
+    let (strands, points) = sim.size();
+    serde_json::json!({
+        "command": "simulate",
+        "device": ctx.info().name,
+        "groom": label,
+        "key_hairs": strands,
+        "points_per_key_hair": points,
+        "steps": a.steps,
+        "dt_s": params.dt,
+        "iterations": params.iterations,
+        "volume": format!("{:?}", params.volume.mode),
+    })
+}
+
+/// Simulates only `count` of the `strands` key hairs (`--simulated`), if given.
+fn apply_simulated(sim: &mut HairSim, count: Option<usize>, strands: usize) -> CliResult {
+    if let Some(count) = count {
+        sim.set_simulated_hairs(count)?;
+        say!("simulated: {count} of {strands} key hairs (the others follow them)");
+    }
+    Ok(())
+}
+
 /// The profile's track: `simulate` records on the graphics queue.
 const TRACK: &str = "graphics queue";
 
@@ -124,10 +172,7 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     let head = |i: usize| a.sim.motion.head((i + 1) as f32 * params.dt, pivot, size);
     let mut sim = HairSim::new(&ctx, &groom, &params, &RigidTransform::default())?;
     sim.set_colliders(&colliders)?;
-    if let Some(count) = simulated {
-        sim.set_simulated_hairs(count)?;
-        say!("simulated: {count} of {} key hairs (the others follow them)", groom.strand_count());
-    }
+    apply_simulated(&mut sim, simulated, groom.strand_count())?;
     let field = match &mesh {
         Some(m) => {
             let collider = MeshCollider::new(&ctx, m, &config.mesh_collider)?;
@@ -148,17 +193,7 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     };
     let mut profiler = GpuProfiler::new(&ctx, 1, 1024)?;
     let (strands, points) = sim.size();
-    say!(
-        "{label}: {strands} key hairs × {points} points on {}, {} steps of {:.4} s",
-        ctx.info().name,
-        a.steps,
-        params.dt
-    );
-    say!(
-        "{}{}",
-        a.sim.describe(&params),
-        a.config.as_ref().map(|c| format!(" (from {} and the flags)", c.display())).unwrap_or_default()
-    );
+    announce(a, &label, &ctx, &sim, &params);
     say!(
         "style: global shape {:.2} over {:.2} of the strand, local shape {:.2}, rest-shape spring {}, sag-free {}",
         params.global_shape_stiffness,
@@ -254,19 +289,7 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
             grid.cell_size * 1e3,
         );
     }
-    a.profile_out.write(&profile, || {
-        serde_json::json!({
-            "command": "simulate",
-            "device": ctx.info().name,
-            "groom": label,
-            "key_hairs": strands,
-            "points_per_key_hair": points,
-            "steps": a.steps,
-            "dt_s": params.dt,
-            "iterations": params.iterations,
-            "volume": format!("{:?}", params.volume.mode),
-        })
-    })?;
+    a.profile_out.write(&profile, || run_summary(a, &ctx, &label, &sim, &params))?;
     if a.check {
         let whole_run = if params.volume.mode == VolumeMode::Flip {
             None
