@@ -18,6 +18,10 @@ pub enum FileFormat {
     Obj,
     /// glTF 2.0 (`.gltf`, `.glb`).
     Gltf,
+    /// Universal Scene Description (`.usd`, `.usda`, `.usdc`).
+    Usd,
+    /// Alembic (`.abc`, the Ogawa container).
+    Alembic,
 }
 
 impl std::fmt::Display for FileFormat {
@@ -27,6 +31,8 @@ impl std::fmt::Display for FileFormat {
             FileFormat::TressFx => ".tfx",
             FileFormat::Obj => ".obj",
             FileFormat::Gltf => "glTF",
+            FileFormat::Usd => "USD",
+            FileFormat::Alembic => "Alembic",
         })
     }
 }
@@ -142,6 +148,16 @@ pub enum Error {
         /// The file.
         path: PathBuf,
         /// What was wrong with it.
+        source: Box<Error>,
+    },
+    /// A curve object of a USD or Alembic file (a prim or object path) could
+    /// not be read: the object, and what was wrong with it (its strand and
+    /// point indices count within the object).
+    #[error("{object}: {source}")]
+    CurveObject {
+        /// The prim or object path.
+        object: String,
+        /// What was wrong.
         source: Box<Error>,
     },
     /// An input file is larger than what vkhair reads of such a file: its

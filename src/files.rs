@@ -80,6 +80,26 @@ pub fn read_capped(path: &Path, cap: u64, what: &'static str) -> Result<Vec<u8>>
     Ok(data)
 }
 
+/// Checks that `path` is a regular file, a `what` of at most `cap` bytes, for
+/// a reader that opens the file itself (a USD stage): a device or a FIFO is
+/// refused, since nothing bounds what such a reader would take from it.
+pub fn check_regular(path: &Path, cap: u64, what: &'static str) -> Result<()> {
+    let (_, len) = open_input(path)?;
+    match len {
+        None => Err(Error::Io {
+            path: path.into(),
+            source: std::io::Error::other(format!("not a regular file; {what} must be one")),
+        }),
+        Some(len) if len > cap => Err(Error::InputTooLarge {
+            path: path.into(),
+            what,
+            cap,
+            hint: " (set VKHAIR_MAX_INPUT_BYTES to read a larger one)",
+        }),
+        Some(_) => Ok(()),
+    }
+}
+
 /// Reads the `header_len`-byte header of `path`, then at most the length in
 /// bytes that `announced` computes from it (header included), which refuses a
 /// header that is not the format's or announces more than its limits allow.

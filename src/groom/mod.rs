@@ -23,6 +23,8 @@
 //! every strand the same point count (the GPU simulation wants it) and
 //! [`Groom::select`] picks key hairs.
 
+pub mod alembic;
+pub mod authored;
 pub mod binding;
 mod bytes;
 pub mod cyhair;
@@ -31,6 +33,7 @@ pub mod mesh;
 pub mod scenes;
 pub mod sdf;
 pub mod tfx;
+pub mod usd;
 
 mod repair;
 mod resample;

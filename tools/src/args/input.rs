@@ -1,20 +1,25 @@
-//! Reading the groom a user gives: `.hair` or `.tfx`, repaired unless `--strict`
-//! (with a warning that counts what was dropped), scaled and resampled.
+//! Reading the groom a user gives: `.hair`, `.tfx`, USD (`.usd`, `.usda`,
+//! `.usdc`) or Alembic (`.abc`), repaired unless `--strict` (with a warning
+//! that counts what was dropped), scaled and resampled.
 
 use std::path::{Path, PathBuf};
 
+use vkhair::groom::authored::{AuthoredGroom, CurveObject, UpAxis};
 use vkhair::groom::cyhair::HairFile;
 use vkhair::groom::tfx::TfxFile;
-use vkhair::groom::{Groom, Repairs};
+use vkhair::groom::{alembic, usd, Groom, Repairs};
 
 use crate::output::Error;
 
 /// The groom and character mesh a user gives `render` and `simulate`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct InputArgs {
-    /// Groom file (.hair or .tfx) instead of the `thesis` scene (its groom, head
-    /// and colliders); it holds its authored style (a shape constraint over the
-    /// whole strand and a sag-free rest state) unless --config says otherwise.
+    /// Groom file (.hair, .tfx, .usd/.usda/.usdc or .abc) instead of the
+    /// `thesis` scene (its groom, head and colliders); it holds its authored
+    /// style (a shape constraint over the whole strand and a sag-free rest
+    /// state) unless --config says otherwise. A USD stage's metersPerUnit and
+    /// upAxis are honoured (meters, Y up); Alembic states no unit and is taken
+    /// as meters.
     #[arg(long)]
     pub input: Option<PathBuf>,
     /// Character mesh (OBJ, the groom's units and frame): the strands collide with
@@ -124,7 +129,75 @@ impl InputArgs {
 /// repaired are (with a warning on stderr) unless `strict`; then the file is
 /// refused with the defect named.
 pub fn load(path: &Path, strict: bool) -> Result<(Groom, String), Error> {
-    load_with_defaults(path, strict).map(|(g, kind, _)| (g, kind))
+    load_with_defaults(path, strict).map(|l| (l.groom, l.kind))
+}
+
+/// A groom file read: the groom, what kind of file it was, and what a USD or
+/// Alembic file says beyond its strands.
+pub struct Loaded {
+    /// The groom (the file's units; USD and Alembic: meters, Y up).
+    pub groom: Groom,
+    /// The format, as `inspect` names it.
+    pub kind: String,
+    /// A cyHair header's thickness (see [`load_with_defaults`]).
+    header_thickness: Option<f32>,
+    /// What a USD or Alembic file says beyond its strands.
+    pub authored: Option<Authored>,
+}
+
+/// [`AuthoredGroom`] without its groom.
+pub struct Authored {
+    /// Per-strand guide marks, when the file has them.
+    pub guides: Option<Vec<bool>>,
+    /// Whether the strands have root UVs.
+    pub root_uvs: bool,
+    /// The curve objects read.
+    pub objects: Vec<CurveObject>,
+    /// Meters per file unit, and whether the file states it.
+    pub meters_per_unit: (f64, bool),
+    /// The file's up axis.
+    pub up_axis: UpAxis,
+    /// What was passed over.
+    pub skipped: Vec<String>,
+}
+
+/// The file's format by its extension.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Format {
+    CyHair,
+    TressFx,
+    Usd,
+    Alembic,
+}
+
+fn format_of(path: &Path) -> Format {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("tfx") => Format::TressFx,
+        Some("usd" | "usda" | "usdc") => Format::Usd,
+        Some("abc") => Format::Alembic,
+        _ => Format::CyHair,
+    }
+}
+
+/// Splits a USD or Alembic read into the groom and the rest.
+fn authored(g: AuthoredGroom, format: &str, path: &Path) -> (Groom, String, Authored) {
+    let objects: Vec<String> = g
+        .objects
+        .iter()
+        .map(|o| format!("{} ({} {} curve{})", o.path, o.curves, o.basis, if o.curves == 1 { "" } else { "s" }))
+        .collect();
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    let kind = format!("{format} (.{ext}), {} curve objects: {}", objects.len(), objects.join(", "));
+    let rest = Authored {
+        guides: g.guides,
+        root_uvs: g.root_uvs.is_some(),
+        objects: g.objects,
+        meters_per_unit: (g.meters_per_unit, g.units_stated),
+        up_axis: g.up_axis,
+        skipped: g.skipped,
+    };
+    (g.groom, kind, rest)
 }
 
 /// The cyHair format's default thickness: a file that leaves it unchanged and has
@@ -134,17 +207,19 @@ const CYHAIR_DEFAULT_THICKNESS: f32 = 1.0;
 /// [`load`], and the thickness a cyHair file gives every point in its header when
 /// it has no thickness array and the header says something other than the
 /// format's default.
-fn load_with_defaults(path: &Path, strict: bool) -> Result<(Groom, String, Option<f32>), Error> {
-    let tfx = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("tfx"));
+pub fn load_with_defaults(path: &Path, strict: bool) -> Result<Loaded, Error> {
+    let format = format_of(path);
     let refused = |e: vkhair::Error| -> Error {
         match e {
             vkhair::Error::Asset { .. } if strict => {
-                format!("{e} (--strict: without it, vkhair drops such segments and strands and says so)").into()
+                format!("{e} (--strict: without it, vkhair drops such segments, strands and curve objects and says so)")
+                    .into()
             }
             e => e.into(),
         }
     };
-    let (groom, kind, repairs, header_thickness) = if tfx {
+    let mut extra = None;
+    let (groom, kind, repairs, header_thickness) = if format == Format::TressFx {
         let (f, repairs) = if strict {
             (TfxFile::open(path).map_err(refused)?, Repairs::default())
         } else {
@@ -152,6 +227,20 @@ fn load_with_defaults(path: &Path, strict: bool) -> Result<(Groom, String, Optio
         };
         let kind = format!("TressFX {} (.tfx)", f.version);
         (f.groom, kind, repairs, None)
+    } else if matches!(format, Format::Usd | Format::Alembic) {
+        let (g, repairs) = match (format, strict) {
+            (Format::Usd, true) => (usd::open(path).map_err(refused)?, Repairs::default()),
+            (Format::Usd, false) => usd::open_repairing(path)?,
+            (_, true) => (alembic::open(path).map_err(refused)?, Repairs::default()),
+            (_, false) => alembic::open_repairing(path)?,
+        };
+        let name = if format == Format::Usd { "USD" } else { "Alembic" };
+        let (groom, kind, rest) = authored(g, name, path);
+        for note in &rest.skipped {
+            eprintln!("vkhair: warning: {}: not read: {note}", path.display());
+        }
+        extra = Some(rest);
+        (groom, kind, repairs, None)
     } else {
         let (f, repairs) = if strict {
             (HairFile::open(path).map_err(refused)?, Repairs::default())
@@ -172,7 +261,7 @@ fn load_with_defaults(path: &Path, strict: bool) -> Result<(Groom, String, Optio
             groom.strand_count()
         );
     }
-    Ok((groom, kind, header_thickness))
+    Ok(Loaded { groom, kind, header_thickness, authored: extra })
 }
 
 /// A groom read, scaled and resampled, with what it says about its strands' width.
@@ -188,7 +277,7 @@ pub struct Scaled {
 /// The groom in `path` (see [`load`]) with its lengths (positions and thickness)
 /// multiplied by `scale` and every strand resampled to `points` points.
 pub fn load_scaled(path: &Path, strict: bool, scale: f32, points: usize) -> Result<Scaled, Error> {
-    let (groom, _, header_thickness) = load_with_defaults(path, strict)?;
+    let Loaded { groom, header_thickness, .. } = load_with_defaults(path, strict)?;
     let groom = groom.scaled(scale)?;
     let thickness = groom.end_thickness().or(header_thickness.map(|t| (t * scale, t * scale)));
     Ok(Scaled { groom: groom.resampled(points)?, thickness })

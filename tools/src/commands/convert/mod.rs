@@ -1,8 +1,9 @@
 //! `vkhair convert`: a groom file resampled and/or thinned to key hairs,
-//! written as a .hair file.
+//! written as a .hair file or an Alembic .abc file.
 
 use std::path::{Path, PathBuf};
 
+use vkhair::groom::alembic::write::{to_bytes, CurvesObject};
 use vkhair::groom::cyhair::HairFile;
 
 use crate::args::input::load;
@@ -12,7 +13,7 @@ use crate::say;
 
 #[derive(clap::Args)]
 pub struct ConvertArgs {
-    /// Input groom (.hair or .tfx).
+    /// Input groom (.hair, .tfx, .usd/.usda/.usdc or .abc).
     input: PathBuf,
     /// Resample every strand to this many points by arc length.
     #[arg(long)]
@@ -20,7 +21,8 @@ pub struct ConvertArgs {
     /// Keep this many strands, spread evenly (key hairs).
     #[arg(long)]
     key_hairs: Option<usize>,
-    /// Output .hair file.
+    /// Output file: .hair, or .abc (Alembic: one linear curves object,
+    /// widths and colours when the groom has them).
     #[arg(long)]
     out: PathBuf,
     /// Refuse a file with defects instead of repairing it (see `render --strict`).
@@ -29,7 +31,7 @@ pub struct ConvertArgs {
 }
 
 pub fn convert(a: &ConvertArgs) -> CliResult {
-    destinations::check(&[&a.input], &[Output { flag: "--out", path: &a.out, kind: Kind::File(&["hair"]) }])?;
+    destinations::check(&[&a.input], &[Output { flag: "--out", path: &a.out, kind: Kind::File(&["hair", "abc"]) }])?;
     write_converted(&a.input, a.points, a.key_hairs, &a.out, a.strict)
 }
 
@@ -48,8 +50,13 @@ fn write_converted(
         groom = groom.resampled(n)?;
     }
     let s = groom.stats();
-    HairFile::new(groom, &format!("from {}", input.file_name().and_then(|n| n.to_str()).unwrap_or("input")))
-        .save(out)?;
+    if out.extension().is_some_and(|e| e.eq_ignore_ascii_case("abc")) {
+        let object = CurvesObject { name: "groom", groom: &groom, guides: None, root_uvs: None, transform: None };
+        vkhair::files::write_atomic(out, &to_bytes(&[object]))?;
+    } else {
+        HairFile::new(groom, &format!("from {}", input.file_name().and_then(|n| n.to_str()).unwrap_or("input")))
+            .save(out)?;
+    }
     say!("wrote {}: {} strands, {} points", out.display(), s.strands, s.points);
     Ok(())
 }

@@ -1,0 +1,228 @@
+//! Writing grooms as Alembic (Ogawa) files: one `AbcGeom_Curve_v2` object per
+//! [`CurvesObject`], under an `AbcGeom_Xform_v3` object when it has a
+//! transform. Linear, non-periodic curves; `P`, `nVertices`,
+//! `curveBasisAndType`, `width` (per point, when the groom has thickness) and,
+//! in `.arbGeomParams`, `groom_color` (per point), `groom_guide` and
+//! `groom_root_uv` (per curve) in Unreal's convention. One sample each, the
+//! layout [`super`] reads.
+
+use glam::{DMat4, Vec2};
+
+use crate::groom::Groom;
+
+/// One curves object to write.
+#[derive(Debug, Clone)]
+pub struct CurvesObject<'a> {
+    /// Its name (one path element: no `/`).
+    pub name: &'a str,
+    /// Its strands, in the object's own space.
+    pub groom: &'a Groom,
+    /// Per-strand guide marks (`groom_guide`).
+    pub guides: Option<&'a [bool]>,
+    /// Per-strand root UVs (`groom_root_uv`).
+    pub root_uvs: Option<&'a [Vec2]>,
+    /// A parent Xform object's matrix (column vectors), written as one matrix op.
+    pub transform: Option<DMat4>,
+}
+
+const DATA_BIT: u64 = 1 << 63;
+/// Alembic's POD codes used here.
+const BOOL: u32 = 0;
+const U8: u32 = 1;
+const I32: u32 = 6;
+const F32: u32 = 10;
+const F64: u32 = 11;
+
+/// A child of a group being written.
+#[derive(Clone, Copy)]
+enum Node {
+    Group(u64),
+    Data(u64),
+}
+
+struct Writer {
+    out: Vec<u8>,
+}
+
+impl Writer {
+    fn data(&mut self, bytes: &[u8]) -> Node {
+        if bytes.is_empty() {
+            return Node::Data(0);
+        }
+        let at = self.out.len() as u64;
+        self.out.extend_from_slice(&(bytes.len() as u64).to_le_bytes());
+        self.out.extend_from_slice(bytes);
+        Node::Data(at)
+    }
+
+    fn group(&mut self, children: &[Node]) -> Node {
+        if children.is_empty() {
+            return Node::Group(0);
+        }
+        let at = self.out.len() as u64;
+        self.out.extend_from_slice(&(children.len() as u64).to_le_bytes());
+        for c in children {
+            let v = match *c {
+                Node::Group(p) => p,
+                Node::Data(p) => p | DATA_BIT,
+            };
+            self.out.extend_from_slice(&v.to_le_bytes());
+        }
+        Node::Group(at)
+    }
+
+    /// A property's one sample: a 16-byte key, then the values.
+    fn sample(&mut self, values: &[u8]) -> Node {
+        let mut b = vec![0u8; 16];
+        b.extend_from_slice(values);
+        self.data(&b)
+    }
+}
+
+/// A property written: its header bytes and its group.
+struct Property {
+    header: Vec<u8>,
+    node: Node,
+}
+
+fn header(kind: u32, pod: u32, extent: u32, name: &str, metadata: &str) -> Vec<u8> {
+    // Numbers as 4 bytes (size hint 2), metadata inline (index 0xff), one
+    // sample the same throughout (0x800).
+    let mut info = kind | (2 << 2) | (0xff << 20);
+    if kind != 0 {
+        info |= (pod << 4) | 0x800 | ((extent & 0xff) << 12);
+    }
+    let mut h = info.to_le_bytes().to_vec();
+    if kind != 0 {
+        h.extend_from_slice(&1u32.to_le_bytes());
+    }
+    h.extend_from_slice(&(name.len() as u32).to_le_bytes());
+    h.extend_from_slice(name.as_bytes());
+    h.extend_from_slice(&(metadata.len() as u32).to_le_bytes());
+    h.extend_from_slice(metadata.as_bytes());
+    h
+}
+
+fn array(w: &mut Writer, name: &str, pod: u32, extent: u32, metadata: &str, values: &[u8]) -> Property {
+    let data = w.sample(values);
+    let node = w.group(&[data, Node::Data(0)]);
+    Property { header: header(2, pod, extent, name, metadata), node }
+}
+
+fn scalar(w: &mut Writer, name: &str, pod: u32, extent: u32, values: &[u8]) -> Property {
+    let data = w.sample(values);
+    let node = w.group(&[data]);
+    Property { header: header(1, pod, extent, name, ""), node }
+}
+
+fn compound(w: &mut Writer, name: &str, metadata: &str, props: Vec<Property>) -> Property {
+    let node = compound_group(w, props);
+    Property { header: header(0, 0, 0, name, metadata), node }
+}
+
+fn compound_group(w: &mut Writer, props: Vec<Property>) -> Node {
+    let mut children: Vec<Node> = props.iter().map(|p| p.node).collect();
+    let headers: Vec<u8> = props.into_iter().flat_map(|p| p.header).collect();
+    children.push(w.data(&headers));
+    w.group(&children)
+}
+
+fn f32s(v: impl IntoIterator<Item = f32>) -> Vec<u8> {
+    v.into_iter().flat_map(f32::to_le_bytes).collect()
+}
+
+/// An object group: its properties, its children, their headers (+ hashes).
+fn object(w: &mut Writer, props: Vec<Property>, children: &[(String, String, Node)]) -> Node {
+    let top = compound_group(w, props);
+    let mut nodes = vec![top];
+    let mut headers = Vec::new();
+    for (name, metadata, node) in children {
+        nodes.push(*node);
+        headers.extend_from_slice(&(name.len() as u32).to_le_bytes());
+        headers.extend_from_slice(name.as_bytes());
+        headers.push(0xff);
+        headers.extend_from_slice(&(metadata.len() as u32).to_le_bytes());
+        headers.extend_from_slice(metadata.as_bytes());
+    }
+    headers.extend_from_slice(&[0u8; 32]);
+    nodes.push(w.data(&headers));
+    w.group(&nodes)
+}
+
+fn curves(w: &mut Writer, o: &CurvesObject<'_>) -> Node {
+    let g = o.groom;
+    let p = f32s(g.positions().iter().flat_map(|p| p.to_array()));
+    let counts: Vec<u8> = (0..g.strand_count()).flat_map(|s| (g.strand_len(s) as i32).to_le_bytes()).collect();
+    let mut geom = vec![
+        array(w, "P", F32, 3, "geoScope=vtx;interpretation=point", &p),
+        array(w, "nVertices", I32, 1, "", &counts),
+        scalar(w, "curveBasisAndType", U8, 4, &[1, 0, 0, 0]),
+    ];
+    if let Some(t) = g.thickness() {
+        geom.push(array(w, "width", F32, 1, "geoScope=vtx", &f32s(t.iter().copied())));
+    }
+    let mut arb = Vec::new();
+    if let Some(c) = g.colors() {
+        let c = f32s(c.iter().flat_map(|c| c.to_array()));
+        arb.push(array(w, "groom_color", F32, 3, "geoScope=vtx;interpretation=rgb", &c));
+    }
+    if let Some(guides) = o.guides {
+        let v: Vec<u8> = guides.iter().flat_map(|&b| i32::from(b).to_le_bytes()).collect();
+        arb.push(array(w, "groom_guide", I32, 1, "geoScope=uni", &v));
+    }
+    if let Some(uvs) = o.root_uvs {
+        arb.push(array(w, "groom_root_uv", F32, 2, "geoScope=uni", &f32s(uvs.iter().flat_map(|u| u.to_array()))));
+    }
+    if !arb.is_empty() {
+        geom.push(compound(w, ".arbGeomParams", "", arb));
+    }
+    let geom = compound(w, ".geom", "schema=AbcGeom_Curve_v2", geom);
+    object(w, vec![geom], &[])
+}
+
+fn xform(w: &mut Writer, m: DMat4, child: (String, String, Node)) -> Node {
+    let vals: Vec<u8> = m.to_cols_array().iter().flat_map(|v| v.to_le_bytes()).collect();
+    let props = vec![
+        scalar(w, ".ops", U8, 1, &[3 << 4]),
+        scalar(w, ".vals", F64, 16, &vals),
+        scalar(w, ".inherits", BOOL, 1, &[1]),
+    ];
+    let x = compound(w, ".xform", "schema=AbcGeom_Xform_v3", props);
+    object(w, vec![x], &[child])
+}
+
+/// The bytes of an Alembic file holding `objects`.
+pub fn to_bytes(objects: &[CurvesObject<'_>]) -> Vec<u8> {
+    let mut w = Writer { out: b"Ogawa\xff\x00\x01".to_vec() };
+    w.out.extend_from_slice(&[0u8; 8]);
+    let curve_meta = "schema=AbcGeom_Curve_v2;schemaObjTitle=AbcGeom_Curve_v2:.geom".to_owned();
+    let mut children = Vec::new();
+    for o in objects {
+        let node = curves(&mut w, o);
+        let child = match o.transform {
+            None => (o.name.to_owned(), curve_meta.clone(), node),
+            Some(m) => {
+                let inner = (o.name.to_owned(), curve_meta.clone(), node);
+                let meta = "schema=AbcGeom_Xform_v3;schemaObjTitle=AbcGeom_Xform_v3:.xform".to_owned();
+                (format!("{}_xform", o.name), meta, xform(&mut w, m, inner))
+            }
+        };
+        children.push(child);
+    }
+    let top = object(&mut w, Vec::new(), &children);
+    let version = w.data(&1i32.to_le_bytes());
+    let library = w.data(&10709i32.to_le_bytes());
+    let meta = w.data(b"_ai_Application=vkhair");
+    // Time sampling 0: one sample a cycle of 1 s, at 0 (u32 max sample, f64
+    // time per cycle, u32 sample count, f64 times).
+    let mut sampling = 1u32.to_le_bytes().to_vec();
+    sampling.extend_from_slice(&1f64.to_le_bytes());
+    sampling.extend_from_slice(&1u32.to_le_bytes());
+    sampling.extend_from_slice(&0f64.to_le_bytes());
+    let samplings = w.data(&sampling);
+    let indexed = w.data(&[]);
+    let root = w.out.len() as u64;
+    w.group(&[version, library, top, meta, samplings, indexed]);
+    w.out[8..16].copy_from_slice(&root.to_le_bytes());
+    w.out
+}

@@ -1,0 +1,174 @@
+//! USD grooms (`vkhair::groom::usd`): fixtures written by Pixar's own library
+//! (`tools/usd_fixtures.py`, usd-core 26.11; every expected value below is the
+//! one that script wrote) and a real groom (arnold-usd's test 0184, its
+//! expected points computed by usd-core's `ComputeLocalToWorldTransform`).
+
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3};
+use vkhair::groom::authored::{Basis, UpAxis};
+use vkhair::groom::usd;
+use vkhair::Error;
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+}
+
+fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).length() < 1e-6
+}
+
+/// The small stage: centimetres, Z up, a translated parent, a linear and a
+/// cubic prim, and a mesh that is not read. Text and binary give the same.
+#[test]
+fn small_stage_reads_in_meters_y_up_with_its_attributes() {
+    for file in ["usd/small_cm_zup.usda", "usd/small_cm_zup.usdc"] {
+        let g = usd::open(data(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert_eq!((g.meters_per_unit, g.units_stated, g.up_axis), (0.01, true, UpAxis::Z), "{file}");
+        let objects: Vec<(&str, usize, Basis)> =
+            g.objects.iter().map(|o| (o.path.as_str(), o.curves, o.basis)).collect();
+        assert_eq!(objects, [("/groom/linear", 3, Basis::Linear), ("/groom/cubic", 1, Basis::Bspline)], "{file}");
+        let groom = &g.groom;
+        assert_eq!((groom.strand_count(), groom.point_count()), (4, 14), "{file}");
+        // Linear curve c, point i: (i, 10c, 0) cm under a (0, 0, 100) cm
+        // translate, Z up → (0.01 i, 1, -0.1 c) m, Y up.
+        for (c, n) in [2usize, 3, 4].into_iter().enumerate() {
+            let strand = groom.strand(c);
+            assert_eq!(strand.len(), n, "{file}");
+            for (i, &p) in strand.iter().enumerate() {
+                let want = Vec3::new(0.01 * i as f32, 1.0, -0.1 * c as f32);
+                assert!(close(p, want), "{file}: curve {c} point {i}: {p} against {want}");
+            }
+        }
+        // The cubic curve: (0, 50, 2i) cm → (0, 1 + 0.02 i, -0.5) m.
+        for (i, &p) in groom.strand(3).iter().enumerate() {
+            assert!(close(p, Vec3::new(0.0, 1.0 + 0.02 * i as f32, -0.5)), "{file}: cubic point {i}: {p}");
+        }
+        // Widths 0.2 - 0.05 i cm per vertex, then 0.1 cm constant, in meters.
+        let thickness = groom.thickness().expect("widths");
+        let want: Vec<f32> = [2usize, 3, 4]
+            .into_iter()
+            .flat_map(|n| (0..n).map(|i| 0.002 - 0.0005 * i as f32))
+            .chain([0.001; 5])
+            .collect();
+        for (t, w) in thickness.iter().zip(&want) {
+            assert!((t - w).abs() < 1e-9, "{file}: width {t} against {w}");
+        }
+        // displayColor per curve (red, green, blue), then constant grey.
+        let colors = groom.colors().expect("colours");
+        let per_strand = [Vec3::X, Vec3::Y, Vec3::Z, Vec3::splat(0.5)];
+        for (s, want) in per_strand.iter().enumerate() {
+            for i in groom.strand_range(s) {
+                assert_eq!(colors[i], *want, "{file}: strand {s}");
+            }
+        }
+        // groom_guide on the linear prim only: the cubic strand is no guide.
+        assert_eq!(g.guides.as_deref(), Some(&[true, false, true, false][..]), "{file}");
+        assert_eq!(g.guide_count(), 2);
+        // st on the linear prim only: dropped, and said.
+        assert_eq!(g.root_uvs, None, "{file}");
+        assert!(g.skipped.iter().any(|s| s.contains("root UVs") && s.contains("1 of 2")), "{file}: {:?}", g.skipped);
+    }
+}
+
+#[test]
+fn root_uvs_are_read_per_strand() {
+    // The linear prim alone (the cubic one has no st): through a stage that
+    // deactivates nothing but a copy without the cubic prim.
+    let text = std::fs::read_to_string(data("usd/small_cm_zup.usda")).expect("fixture");
+    let start = text.find("    def BasisCurves \"cubic\"").expect("cubic prim");
+    let end = text.find("    def Mesh").expect("mesh prim");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("linear.usda");
+    std::fs::write(&path, format!("{}{}", &text[..start], &text[end..])).expect("write");
+    let g = usd::open(&path).expect("read");
+    let uvs = g.root_uvs.expect("root UVs");
+    assert_eq!(uvs, vec![Vec2::new(0.1, 0.2), Vec2::new(0.3, 0.4), Vec2::new(0.5, 0.6)]);
+}
+
+#[test]
+fn a_real_groom_reads_with_its_transform_and_widths() {
+    let g = usd::open(data("curves/arnold-usd_test_0184_groom_sphere.usda")).expect("arnold-usd groom");
+    // 118 curves of 13 points, each pinned by three equal points at its root
+    // and its tip: 9 points a strand once those are kept once.
+    assert_eq!((g.groom.strand_count(), g.groom.point_count()), (118, 118 * 9));
+    assert_eq!(g.objects[0].basis, Basis::Bspline);
+    assert_eq!((g.meters_per_unit, g.up_axis), (1.0, UpAxis::Y));
+    // usd-core: the prim's xformOp:scale of 2 applied (its points 0, 12, 13).
+    let s0 = g.groom.strand(0);
+    assert!(close(s0[0], Vec3::new(-0.030084286, 1.992629, -0.14639603)), "{}", s0[0]);
+    assert!(close(s0[8], Vec3::new(-0.13392752, 2.0927486, -0.06023486)), "{}", s0[8]);
+    assert!(close(g.groom.strand(1)[0], Vec3::new(-0.0050448216, 1.991179, 0.17870373)));
+    // Widths per vertex, doubled by the scale: its fourth, 0.048067454 × 2, is
+    // the strand's second point now.
+    let t = g.groom.thickness().expect("widths");
+    assert!((t[1] - 2.0 * 0.048_067_454).abs() < 1e-7, "{}", t[1]);
+    assert_eq!(g.guides, None);
+}
+
+fn refused(name: &str) -> String {
+    let e = usd::open(data(name)).expect_err(name);
+    assert!(matches!(e, Error::Asset { .. }), "{name}: {e:?}");
+    let text = e.to_string();
+    assert!(text.contains(name.rsplit('/').next().unwrap_or(name)), "{name}: the file is not named: {text}");
+    text
+}
+
+#[test]
+fn defects_are_named_with_the_prim() {
+    let text = refused("usd/periodic.usda");
+    assert!(text.contains("/hair") && text.contains("periodic"), "{text}");
+    let text = refused("usd/no_points.usda");
+    assert!(text.contains("/hair") && text.contains("no points"), "{text}");
+    let text = refused("usd/counts_mismatch.usda");
+    assert!(text.contains("/hair") && text.contains("add up to 5 points but points holds 4"), "{text}");
+    let text = refused("usd/nan.usda");
+    assert!(text.contains("/hair") && text.contains("strand 0") && text.contains("point 1"), "{text}");
+    // Repairing passes over the loop, and then nothing is left to read.
+    let e = usd::open_repairing(data("usd/periodic.usda")).expect_err("only a loop");
+    assert!(e.to_string().contains("no BasisCurves prim") && e.to_string().contains("periodic"), "{e}");
+    // A file that is not USD at all, and one cut short.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let junk = dir.path().join("junk.usda");
+    std::fs::write(&junk, "this is not a stage {").expect("write");
+    let e = usd::open(&junk).expect_err("junk");
+    assert!(e.to_string().contains("junk.usda"), "{e}");
+    let bytes = std::fs::read(data("usd/small_cm_zup.usdc")).expect("fixture");
+    for cut in [8, 64, bytes.len() / 2, bytes.len() - 16] {
+        let short = dir.path().join(format!("cut{cut}.usdc"));
+        std::fs::write(&short, &bytes[..cut]).expect("write");
+        let e = usd::open(&short).expect_err("truncated");
+        assert!(e.to_string().contains(&format!("cut{cut}.usdc")), "{e}");
+    }
+    // A folder and a FIFO are not read.
+    assert!(usd::open(dir.path()).is_err());
+}
+
+/// Mutations of the text fixture: every one read or refused, never a panic.
+#[test]
+fn mutated_stages_never_panic() {
+    let text = std::fs::read_to_string(data("usd/small_cm_zup.usda")).expect("fixture");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("m.usda");
+    let mutations: Vec<String> = vec![
+        text.replace("[2, 3, 4]", "[2, 3, -4]"),
+        text.replace("[2, 3, 4]", "[2, 3, 40000000]"),
+        text.replace("[(0.1, 0.2), (0.3, 0.4), (0.5, 0.6)]", "[(0.1, 0.2)]"),
+        text.replace("[1, 0, 1]", "[1, 0]"),
+        text.replace("metersPerUnit = 0.01", "metersPerUnit = -1"),
+        text.replace("metersPerUnit = 0.01", "metersPerUnit = \"m\""),
+        text.replace("upAxis = \"Z\"", "upAxis = \"X\""),
+        text.replace("uniform token type = \"linear\"", "uniform token type = \"quintic\""),
+        text.replace("(0, 0, 100)", "(0, 0, inf)"),
+        text.replace("float[] widths = [0.2", "float[] widths = [nan"),
+        text.replace("point3f[] points", "float[] points"),
+    ];
+    for (i, m) in mutations.iter().enumerate() {
+        assert_ne!(m, &text, "mutation {i} changed nothing");
+        std::fs::write(&path, m).expect("write");
+        match usd::open(&path) {
+            Ok(g) => panic!("mutation {i} was read: {} strands", g.groom.strand_count()),
+            Err(e) => assert!(e.to_string().contains("m.usda"), "mutation {i}: {e}"),
+        }
+    }
+}

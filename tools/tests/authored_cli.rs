@@ -1,0 +1,117 @@
+//! USD and Alembic grooms through the tool: `inspect` (table and `--json`),
+//! `convert` to `.hair` and `.abc` and back, `render` and `simulate`.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use common::{run, run_line};
+
+const LIMIT: Duration = Duration::from_secs(300);
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data").join(name)
+}
+
+fn json(stdout: &str) -> serde_json::Value {
+    serde_json::from_str(stdout).unwrap_or_else(|e| panic!("not JSON ({e}):\n{stdout}"))
+}
+
+#[test]
+fn inspect_tells_guides_units_axes_and_objects() {
+    let usd = data("usd/small_cm_zup.usda");
+    let out = run(&["inspect", usd.to_str().expect("utf-8")], LIMIT);
+    out.assert_ok();
+    for line in [
+        "/groom/linear (3 linear curves), /groom/cubic (1 cubic B-spline curve)",
+        "guides             2 marked by the file (groom_guide), 2 followers",
+        "0.01 m per unit (stated)",
+        "Z up in the file, turned to Y up",
+        "root UVs no",
+    ] {
+        assert!(out.stdout.contains(line), "{line:?} missing from:\n{}", out.stdout);
+    }
+    let out = run(&["inspect", "--json", usd.to_str().expect("utf-8")], LIMIT);
+    out.assert_ok();
+    let j = json(&out.stdout);
+    assert_eq!((j["strands"].as_u64(), j["points"].as_u64()), (Some(4), Some(14)));
+    assert_eq!((j["guides_marked"].as_u64(), j["followers"].as_u64()), (Some(2), Some(2)));
+    assert_eq!(j["meters_per_unit"].as_f64(), Some(0.01));
+    assert_eq!(j["up_axis"].as_str(), Some("Z"));
+    assert_eq!(j["attributes"]["thickness"].as_bool(), Some(true));
+    assert_eq!(j["curve_objects"][1]["path"].as_str(), Some("/groom/cubic"));
+    // Alembic: no unit stated, a periodic object passed over and said.
+    let abc = data("curves/cortex_curves.abc");
+    let out = run(&["inspect", "--json", abc.to_str().expect("utf-8")], LIMIT);
+    out.assert_ok();
+    let j = json(&out.stdout);
+    assert_eq!((j["strands"].as_u64(), j["units_stated"].as_bool()), (Some(2), Some(false)));
+    assert!(out.stderr.contains("/nurbsCircle/object"), "{}", out.stderr);
+    run(&["inspect", "--strict", abc.to_str().expect("utf-8")], LIMIT).assert_error("/nurbsCircle/object");
+}
+
+#[test]
+fn convert_round_trips_through_alembic_and_hair() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let usd = data("curves/arnold-usd_test_0184_groom_sphere.usda");
+    let abc = dir.path().join("groom.abc");
+    let hair = dir.path().join("groom.hair");
+    let line = format!("convert {} --out {}", usd.display(), abc.display());
+    run_line(&line, LIMIT).assert_ok();
+    run_line(&format!("convert {} --out {}", abc.display(), hair.display()), LIMIT).assert_ok();
+    let counts = |path: &Path| {
+        let out = run(&["inspect", "--json", path.to_str().expect("utf-8")], LIMIT);
+        out.assert_ok();
+        let j = json(&out.stdout);
+        let b = &j["bounds"];
+        (j["strands"].as_u64(), j["points"].as_u64(), b["min"].to_string(), b["max"].to_string())
+    };
+    let want = counts(&usd);
+    assert_eq!(want.0, Some(118));
+    assert_eq!(counts(&abc), want);
+    assert_eq!(counts(&hair), want);
+    // Anything else is refused before reading.
+    let bad = dir.path().join("groom.usda");
+    run_line(&format!("convert {} --out {}", usd.display(), bad.display()), LIMIT).assert_error("--out");
+}
+
+#[test]
+fn render_and_simulate_take_usd_and_alembic() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let usd = data("curves/arnold-usd_test_0184_groom_sphere.usda");
+    let abc = dir.path().join("groom.abc");
+    run_line(&format!("convert {} --out {}", usd.display(), abc.display()), LIMIT).assert_ok();
+    for input in [usd, abc] {
+        let out = dir.path().join(format!("{}-frames", input.extension().and_then(|e| e.to_str()).unwrap_or("x")));
+        let line = format!(
+            "render --input {} --frames 1 --width 160 --height 120 --shadow-resolution 64 --out {}",
+            input.display(),
+            out.display()
+        );
+        run_line(&line, LIMIT).assert_ok();
+        let (_, _, rgba) = common::read_png(&out.join("frame_0000.png"));
+        let covered = common::coverage(&rgba);
+        assert!(covered > 0.02, "{}: the groom covers {:.2} % of the image", input.display(), 100.0 * covered);
+        let line = format!("simulate --input {} --steps 2", input.display());
+        run_line(&line, LIMIT).assert_ok();
+    }
+}
+
+#[test]
+fn usd_and_alembic_reads_are_bounded() {
+    for name in ["usd/small_cm_zup.usdc", "curves/cortex_curves.abc"] {
+        let path = data(name);
+        let mut command = common::vkhair();
+        command.env("VKHAIR_MAX_INPUT_BYTES", "1000").args(["inspect", path.to_str().expect("utf-8")]);
+        let out = common::run_command(&mut command, LIMIT);
+        out.assert_error("more than 1000 bytes");
+    }
+    // A FIFO: nothing bounds what the USD library would take from it.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let fifo = dir.path().join("pipe.usda");
+    let c = std::ffi::CString::new(fifo.to_str().expect("utf-8")).expect("path");
+    // SAFETY: mkfifo with a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    run(&["inspect", fifo.to_str().expect("utf-8")], LIMIT).assert_error("not a regular file");
+}
