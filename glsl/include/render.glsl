@@ -26,6 +26,13 @@ struct InterpolatePush {
     float tip_width;      // fraction of clump_width at the tip
 };
 
+// One follower's guides and weights (render::Followers). Twin:
+// gpu_types::FollowerBinding.
+struct FollowerBinding {
+    uvec4 guides;         // three guide indices (w unused)
+    vec4 weights;         // their weights, summing to 1 (w unused)
+};
+
 // Interpolated hair `first + i` of the isoline at tessellation coordinate y
 // among `lines` isolines (y = i / lines): the hair an evaluation of the
 // interpolation pass stores.

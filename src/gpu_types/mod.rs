@@ -28,7 +28,8 @@ mod volume;
 #[cfg(test)]
 pub(crate) use probe::{LayoutProbe, ScaleAddPush};
 pub(crate) use render::{
-    DrawParams, GpuLight, GpuShadowMap, GpuShadowParams, InterpolatePush, MarschnerPush, OitCounters, SmoothPush,
+    DrawParams, FollowerBinding, GpuLight, GpuShadowMap, GpuShadowParams, InterpolatePush, MarschnerPush, OitCounters,
+    SmoothPush,
 };
 pub(crate) use sim::{GpuCollider, MovePush, SdfPush, SimPush, SimStepParams};
 pub(crate) use volume::{GpuVolumeParams, PcgScalars, VolumePush};
@@ -194,6 +195,7 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<SdfPush>(reflection, &mut problems);
     check::<SmoothPush>(reflection, &mut problems);
     check::<InterpolatePush>(reflection, &mut problems);
+    check::<FollowerBinding>(reflection, &mut problems);
     check::<GpuLight>(reflection, &mut problems);
     check::<DrawParams>(reflection, &mut problems);
     check::<OitCounters>(reflection, &mut problems);

@@ -53,6 +53,18 @@ gpu_struct!(InterpolatePush => "InterpolatePush" {
     head_rotation, strands, points, level, stride, hairs, clump_width, root_width, tip_width
 });
 
+/// One follower's guides and weights (`FollowerBinding` in
+/// `glsl/include/render.glsl`; [`crate::render::Followers`]).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct FollowerBinding {
+    /// Three guide indices (the fourth unused).
+    pub guides: [u32; 4],
+    /// Their weights, summing to 1 (the fourth unused).
+    pub weights: [f32; 4],
+}
+gpu_struct!(FollowerBinding => "FollowerBinding" { guides, weights });
+
 /// One light of the draw pass (`Light` in `glsl/include/render.glsl`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]

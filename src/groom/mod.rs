@@ -29,6 +29,7 @@ pub mod binding;
 mod bytes;
 pub mod cyhair;
 pub mod grow;
+pub mod guides;
 pub mod mesh;
 pub mod scenes;
 pub mod sdf;

@@ -11,12 +11,17 @@
 //! In [`InterpolationMode::Barycentric`] the patches are triangles of key-hair
 //! roots instead ([`super::scalp`]), each hair blending three key hairs with
 //! stable random weights.
+//!
+//! With [`Followers`] (a dense authored groom) a third evaluation stage draws
+//! them instead: one patch per follower segment, each point the blend of its
+//! guides plus its rest offset in their frames (see [`super::followers`]).
 
 use std::sync::Arc;
 
 use ash::vk;
-use glam::{Vec3, Vec4};
+use glam::Vec4;
 
+use super::followers::Followers;
 use super::pass::{self, RenderPass};
 use super::smooth::SmoothPass;
 use super::InterpolationMode;
@@ -29,24 +34,13 @@ use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::pipeline::GraphicsPipeline;
 use crate::vk::shaders::{
-    ShaderSource, RENDER_INTERPOLATE_BARY_TESE, RENDER_INTERPOLATE_TESC, RENDER_INTERPOLATE_TESE,
-    RENDER_INTERPOLATE_VERT,
+    ShaderSource, RENDER_INTERPOLATE_BARY_TESE, RENDER_INTERPOLATE_FOLLOW_TESE, RENDER_INTERPOLATE_TESC,
+    RENDER_INTERPOLATE_TESE, RENDER_INTERPOLATE_VERT,
 };
 
-/// Per key hair, the normal of the plane its rest shape lies in (head frame):
-/// root tangent × (tip − root), or any perpendicular of the root tangent for a
-/// straight hair.
+/// Per key hair, its rest-plane normal ([`super::reference::rest_plane_normals`]).
 fn reference_vectors(rest: &SimState) -> Vec<Vec4> {
-    (0..rest.strands)
-        .map(|s| {
-            let base = s * rest.points;
-            let root = rest.rest[base].truncate();
-            let t0 = (rest.rest[base + 1].truncate() - root).normalize_or(Vec3::NEG_Y);
-            let tip = rest.rest[base + rest.points - 1].truncate();
-            let n = t0.cross(tip - root).try_normalize().unwrap_or_else(|| t0.any_orthonormal_vector());
-            n.extend(0.0)
-        })
-        .collect()
+    super::reference::rest_plane_normals(rest).into_iter().map(|n| n.extend(0.0)).collect()
 }
 
 /// Rejects `mode` when it cannot grow hairs from key hairs whose roots form
@@ -95,6 +89,15 @@ pub(super) struct InterpolatePass {
     positions: Buffer,
     /// Interpolated (tangent, t along the hair), as `positions`.
     tangents: Buffer,
+    /// The followers' pipeline and binding buffers, when drawing followers.
+    follow: Option<Follow>,
+}
+
+/// The followers' evaluation stage and what it reads.
+struct Follow {
+    pipeline: Pipeline,
+    _bindings: Buffer,
+    _offsets: Buffer,
 }
 
 struct Pipeline {
@@ -105,13 +108,14 @@ struct Pipeline {
 impl InterpolatePass {
     /// The pass growing hairs from `smooth`'s output for the key hairs of `rest`
     /// (or the scalp `triangles` between their roots), with room for
-    /// `hair_vertices` vertices.
+    /// `hair_vertices` vertices; with `followers`, their pipeline too.
     pub(super) fn new(
         device: &Arc<Device>,
         rest: &SimState,
         triangles: &[[u32; 3]],
         smooth: &SmoothPass,
         hair_vertices: u64,
+        followers: Option<&Followers>,
     ) -> Result<Self> {
         let storage = |name: &str, size: u64| Buffer::storage(device, name, size);
         let positions = storage("vkhair hair positions", hair_vertices * 16)?;
@@ -143,8 +147,36 @@ impl InterpolatePass {
             let set = pipeline.declared_buffer_set(0, &bindings)?;
             Ok(Pipeline { pipeline, set })
         };
+        let follow = match followers {
+            None => None,
+            Some(f) => {
+                let b = storage("vkhair follower bindings", std::mem::size_of_val(f.gpu_bindings()) as u64)?;
+                device.upload_pod(&b, f.gpu_bindings())?;
+                let o = storage("vkhair follower offsets", std::mem::size_of_val(f.gpu_offsets()) as u64)?;
+                device.upload_pod(&o, f.gpu_offsets())?;
+                let pipeline = pass::capture_pipeline(
+                    device,
+                    RENDER_INTERPOLATE_FOLLOW_TESE.name,
+                    &[&RENDER_INTERPOLATE_VERT, &RENDER_INTERPOLATE_TESC, &RENDER_INTERPOLATE_FOLLOW_TESE],
+                    1,
+                    1,
+                )?;
+                let all = [
+                    (0, smoothed_positions),
+                    (1, smoothed_tangents),
+                    (2, &reference),
+                    (3, &positions),
+                    (4, &tangents),
+                    (6, &b),
+                    (7, &o),
+                ];
+                let set = pipeline.declared_buffer_set(0, &all)?;
+                Some(Follow { pipeline: Pipeline { pipeline, set }, _bindings: b, _offsets: o })
+            }
+        };
         Ok(InterpolatePass {
             device: device.clone(),
+            follow,
             single_strand: pipeline(&RENDER_INTERPOLATE_TESE)?,
             barycentric: pipeline(&RENDER_INTERPOLATE_BARY_TESE)?,
             reference,
@@ -187,7 +219,9 @@ impl InterpolatePass {
     /// # Safety
     /// `cmd` is a recording command buffer of this device outside a render pass,
     /// after the smoothing pass. `push.strands` counts key hairs, or scalp
-    /// triangles in barycentric mode.
+    /// triangles in barycentric mode, or (with `push.hairs` 1 and
+    /// `push.points` the follower points) the followers drawn when the pass
+    /// was created with followers.
     pub(super) unsafe fn record(
         &self,
         cmd: vk::CommandBuffer,
@@ -196,11 +230,13 @@ impl InterpolatePass {
         timing: Timing<'_>,
     ) {
         let d = &self.device;
-        let p = match mode {
-            InterpolationMode::SingleStrand => &self.single_strand,
-            InterpolationMode::Barycentric => &self.barycentric,
+        let p = match (&self.follow, mode) {
+            (Some(f), _) => &f.pipeline,
+            (None, InterpolationMode::SingleStrand) => &self.single_strand,
+            (None, InterpolationMode::Barycentric) => &self.barycentric,
         };
-        // SAFETY: guaranteed by the caller: one patch per key segment of each unit.
+        // SAFETY: guaranteed by the caller: one patch per key segment of each
+        // unit (per follower segment, one line each, with followers).
         unsafe {
             pass::record_capture(d, cmd, RenderPass::Interpolate, timing, |cmd| {
                 p.pipeline.bind(cmd, &[p.set]);

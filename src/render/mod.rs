@@ -26,6 +26,8 @@
 //! [`Renderer::record_shadows`], 4–5 by [`Renderer::record_draw`].
 
 mod draw;
+pub mod followers;
+mod frame;
 mod interpolate;
 pub mod marschner;
 mod params;
@@ -40,6 +42,7 @@ mod smooth;
 mod target;
 
 pub use draw::{OitPool, OitStats};
+pub use followers::Followers;
 pub use marschner::MarschnerParams;
 pub use params::{
     Detail, InterpolationMode, LodParams, OitParams, Primitive, RenderParams, Transparency, MAX_HAIRS_PER_KEY,
@@ -57,7 +60,7 @@ use ash::vk;
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
-use crate::gpu_types::{GpuLight, InterpolatePush, SmoothPush};
+use crate::gpu_types::GpuLight;
 use crate::profiler::{GpuProfiler, Timing};
 use crate::sim::KeyHairs;
 use crate::vk::barrier::{self, AccessKind};
@@ -140,6 +143,16 @@ pub struct Renderer {
     source: [vk::Buffer; 4],
     /// The last frame index `record_draw` was given.
     last_frame: Option<u64>,
+    /// Followers drawn instead of grown hairs, when created with them.
+    followers: Option<FollowerCounts>,
+}
+
+/// What the renderer keeps of its [`Followers`].
+#[derive(Debug, Clone, Copy)]
+struct FollowerCounts {
+    count: u32,
+    points: u32,
+    root_spacing: f32,
 }
 
 /// Rejects key hairs that live on another device than the renderer's.
@@ -158,7 +171,31 @@ impl Renderer {
     /// ([`crate::schedule::FrameScheduler::key_hairs`]). Later frames must come from
     /// the same source.
     pub fn new<'a>(ctx: &GpuContext, sim: impl Into<KeyHairs<'a>>, params: &RenderParams) -> Result<Self> {
-        let sim: KeyHairs<'a> = sim.into();
+        Self::build(ctx, sim.into(), params, None)
+    }
+
+    /// Creates a renderer that draws `followers` — every strand of a dense
+    /// groom, bound to the guides `sim` simulates ([`Followers::bind`] with
+    /// `sim`'s rest state and `params.smoothing_level`) — instead of growing
+    /// hairs: the interpolation mode and `hairs_per_key` no longer grow hairs;
+    /// level of detail draws the share `detail.hairs_per_key / hairs_per_key`
+    /// of the followers (a prefix of their stable random order), as it thins
+    /// grown hairs.
+    pub fn with_followers<'a>(
+        ctx: &GpuContext,
+        sim: impl Into<KeyHairs<'a>>,
+        params: &RenderParams,
+        followers: &Followers,
+    ) -> Result<Self> {
+        Self::build(ctx, sim.into(), params, Some(followers))
+    }
+
+    fn build(
+        ctx: &GpuContext,
+        sim: KeyHairs<'_>,
+        params: &RenderParams,
+        followers: Option<&Followers>,
+    ) -> Result<Self> {
         params.validate()?;
         let device = ctx.device.clone();
         check_device(&device, &sim)?;
@@ -172,15 +209,23 @@ impl Renderer {
         // Sized for the level asked for at creation: level-of-detail only lowers it.
         let stride = (points as u64 - 1) * u64::from(params.smoothing_level) + 1;
         let triangles = scalp::root_triangles(sim.rest);
-        interpolate::check_mode(params.interpolation, triangles.len() as u32)?;
-        // Room for the hairs of either mode (key hairs or scalp triangles, each
-        // growing hairs) where the device's storage range holds them, else for
-        // the mode asked for.
-        let units = u64::from(interpolate::units(params.interpolation, strands as u32, triangles.len() as u32));
-        let both = (strands as u64).max(triangles.len() as u64) * u64::from(params.hairs_per_key);
-        let fits = |hairs: u64| hairs * stride * 16 <= u64::from(device.info.max_storage_buffer_range);
-        let capacity_hairs = if fits(both) { both } else { units * u64::from(params.hairs_per_key) };
-        let hair_vertices = capacity_hairs * stride;
+        let fits = |hairs: u64, stride: u64| hairs * stride * 16 <= u64::from(device.info.max_storage_buffer_range);
+        let (capacity_hairs, hair_vertices) = match followers {
+            Some(f) => {
+                followers::check(f, strands, params.smoothing_level)?;
+                (f.count() as u64, f.count() as u64 * f.points() as u64)
+            }
+            None => {
+                interpolate::check_mode(params.interpolation, triangles.len() as u32)?;
+                // Room for the hairs of either mode (key hairs or scalp
+                // triangles, each growing hairs) where the device's storage
+                // range holds them, else for the mode asked for.
+                let units = u64::from(interpolate::units(params.interpolation, strands as u32, triangles.len() as u32));
+                let both = (strands as u64).max(triangles.len() as u64) * u64::from(params.hairs_per_key);
+                let hairs = if fits(both, stride) { both } else { units * u64::from(params.hairs_per_key) };
+                (hairs, hairs * stride)
+            }
+        };
         if hair_vertices * 16 > u64::from(device.info.max_storage_buffer_range) {
             return Err(Error::device(
                 "the interpolated hairs",
@@ -191,7 +236,7 @@ impl Renderer {
             ));
         }
         let smooth = SmoothPass::new(&device, sim.halves, sim.before, strands as u64 * stride)?;
-        let interpolate = InterpolatePass::new(&device, sim.rest, &triangles, &smooth, hair_vertices)?;
+        let interpolate = InterpolatePass::new(&device, sim.rest, &triangles, &smooth, hair_vertices, followers)?;
         let draw = DrawPass::new(&device, hair_vertices)?;
         let shadows = Shadows::new(&device, interpolate.hairs().0)?;
         let detail = params.detail_at(0.0);
@@ -212,6 +257,11 @@ impl Renderer {
             detail,
             source: sim.bound_buffers(),
             last_frame: None,
+            followers: followers.map(|f| FollowerCounts {
+                count: f.count() as u32,
+                points: f.points() as u32,
+                root_spacing: f.root_spacing(),
+            }),
             device,
         })
     }
@@ -236,6 +286,16 @@ impl Renderer {
                 format!("at most {}, the level this renderer was created for", self.capacity_level),
             ));
         }
+        if self.followers.is_none() {
+            self.check_hairs(params)?;
+        }
+        self.params = params.clone();
+        self.detail = self.detail.min_with(params);
+        Ok(())
+    }
+
+    /// Rejects `params` whose grown hairs do not fit the renderer's buffers.
+    fn check_hairs(&self, params: &RenderParams) -> Result<()> {
         self.interpolate.check_mode(params.interpolation)?;
         let units = u64::from(self.units_of(params.interpolation));
         if units * u64::from(params.hairs_per_key) > self.capacity_hairs {
@@ -250,8 +310,6 @@ impl Renderer {
                 ),
             ));
         }
-        self.params = params.clone();
-        self.detail = self.detail.min_with(params);
         Ok(())
     }
 
@@ -302,108 +360,6 @@ impl Renderer {
             self.draw.forget();
         }
         changed.map(|_| ())
-    }
-}
-
-/// What the latest prepared frame holds.
-impl Renderer {
-    /// Smoothed vertices per key hair at the detail of the latest prepared frame.
-    pub fn smoothed_vertices_per_strand(&self) -> u32 {
-        (self.points - 1) * self.detail.smoothing_level + 1
-    }
-
-    /// The detail of the latest prepared frame.
-    pub fn detail(&self) -> Detail {
-        self.detail
-    }
-
-    /// Scalp triangles between key-hair roots (barycentric mode).
-    pub fn scalp_triangle_count(&self) -> u32 {
-        self.interpolate.triangles()
-    }
-
-    /// Key hairs, or scalp triangles in barycentric mode: what hairs are grown from.
-    fn interpolation_units(&self) -> u32 {
-        self.units_of(self.params.interpolation)
-    }
-
-    /// Key hairs, or scalp triangles: what `mode` grows hairs from.
-    fn units_of(&self, mode: InterpolationMode) -> u32 {
-        self.interpolate.units(mode, self.strands)
-    }
-
-    /// Real hairs each hair drawn in the latest prepared frame stands for:
-    /// [`HairMaterial::represented_hairs`] at full detail, more where level of
-    /// detail draws fewer hairs (× full `hairs_per_key` / the frame's).
-    pub fn strand_hairs(&self) -> f32 {
-        self.material.represented_hairs * self.params.hairs_per_key as f32 / self.detail.hairs_per_key.max(1) as f32
-    }
-
-    /// Spacing of the hairs drawn in the latest prepared frame at the root and
-    /// at the tip, meters: in single-strand mode the side of each one's share
-    /// of its clump's disk (clump radius × √(π / hairs_per_key) at the
-    /// frame's detail), in barycentric mode of its share of a mean scalp
-    /// triangle (√(area / hairs_per_key)). A transparent strand standing for
-    /// several hairs spreads over part of it ([`reference::strand_band`]).
-    pub fn strand_spacing(&self) -> (f32, f32) {
-        let hairs = self.detail.hairs_per_key.max(1) as f32;
-        let p = &self.params;
-        match p.interpolation {
-            InterpolationMode::SingleStrand => {
-                let share = (std::f32::consts::PI / hairs).sqrt() * p.clump_width;
-                (share * p.root_width, share * p.tip_width)
-            }
-            InterpolationMode::Barycentric => {
-                let side = (self.interpolate.mean_triangle_area() / hairs).sqrt();
-                (side, side)
-            }
-        }
-    }
-
-    /// Interpolated hairs and vertices per hair of the latest prepared frame.
-    pub fn hair_counts(&self) -> (u32, u32) {
-        (self.interpolation_units() * self.detail.hairs_per_key, self.smoothed_vertices_per_strand())
-    }
-
-    /// Vertices the draw of the latest prepared frame's hairs takes: six per
-    /// segment for ribbons (two triangles), two for lines.
-    fn draw_vertices(&self) -> u32 {
-        let (hairs, per_hair) = self.hair_counts();
-        let per_segment = match self.params.primitive {
-            Primitive::Ribbons => 6,
-            Primitive::Lines => 2,
-        };
-        hairs * (per_hair - 1) * per_segment
-    }
-
-    /// Radius around the rest bounds' centre that the hair can reach.
-    #[cfg(test)]
-    pub(crate) fn bounds_radius(&self) -> f32 {
-        self.placement.bound_radius
-    }
-
-    fn smooth_push(&self, alpha: f32) -> SmoothPush {
-        SmoothPush {
-            strands: self.strands,
-            points: self.points,
-            level: self.detail.smoothing_level,
-            stride: self.smoothed_vertices_per_strand(),
-            alpha,
-        }
-    }
-
-    fn interpolate_push(&self) -> InterpolatePush {
-        InterpolatePush {
-            head_rotation: self.placement.head_rotation.to_array(),
-            strands: self.interpolation_units(),
-            points: self.points,
-            level: self.detail.smoothing_level,
-            stride: self.smoothed_vertices_per_strand(),
-            hairs: self.detail.hairs_per_key,
-            clump_width: self.params.clump_width,
-            root_width: self.params.root_width,
-            tip_width: self.params.tip_width,
-        }
     }
 }
 

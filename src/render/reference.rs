@@ -72,6 +72,21 @@ pub fn barycentric_weights(tri: u32, hair: u32) -> Vec3 {
     Vec3::new(u, v, 1.0 - u - v)
 }
 
+/// Per key hair of `rest`, the normal of the plane its rest shape lies in
+/// (head frame), the reference vector of its offset frames: root tangent ×
+/// (tip − root), or any perpendicular of the root tangent for a straight hair.
+pub fn rest_plane_normals(rest: &crate::sim::SimState) -> Vec<Vec3> {
+    (0..rest.strands)
+        .map(|s| {
+            let base = s * rest.points;
+            let root = rest.rest[base].truncate();
+            let t0 = (rest.rest[base + 1].truncate() - root).normalize_or(Vec3::NEG_Y);
+            let tip = rest.rest[base + rest.points - 1].truncate();
+            t0.cross(tip - root).try_normalize().unwrap_or_else(|| t0.any_orthonormal_vector())
+        })
+        .collect()
+}
+
 /// The offset frame (B1, B2) of a key vertex with unit tangent `t` and reference
 /// vector `reference` (world), as `key_frame` in `render.glsl`.
 pub fn key_frame(t: Vec3, reference: Vec3) -> (Vec3, Vec3) {

@@ -115,3 +115,78 @@ fn usd_and_alembic_reads_are_bounded() {
     assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
     run(&["inspect", fifo.to_str().expect("utf-8")], LIMIT).assert_error("not a regular file");
 }
+
+/// A dense groom written by usd-core (`tools/usd_dense_groom.py`: 1,500 curly
+/// strands of 24 points, meters, Z up): rendered as followers of guides, and
+/// `simulate --drawn-out` writes every authored strand as drawn, in the file's
+/// order, close to the authored one after one still step.
+#[test]
+fn a_dense_groom_draws_its_authored_strands_as_followers() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let usd = data("usd/dense_curly.usdc");
+    let frames = dir.path().join("frames");
+    let line = format!(
+        "render --input {} --guides 0.1 --frames 1 --width 160 --height 120 --shadow-resolution 64 --out {}",
+        usd.display(),
+        frames.display()
+    );
+    let out = run_line(&line, LIMIT);
+    out.assert_ok();
+    assert!(out.stdout.contains("followers: 1500 strands drawn as followers of 150 guides"), "{}", out.stdout);
+    let (_, _, rgba) = common::read_png(&frames.join("frame_0000.png"));
+    assert!(common::coverage(&rgba) > 0.05, "the groom covers {:.2} % of the image", 100.0 * common::coverage(&rgba));
+    // The same through Alembic: converted, then read with its own reader.
+    let abc = dir.path().join("dense.abc");
+    run_line(&format!("convert {} --out {}", usd.display(), abc.display()), LIMIT).assert_ok();
+    let drawn = dir.path().join("drawn.hair");
+    let line = format!(
+        "simulate --input {} --guides 150 --steps 1 --motion still --drawn-out {}",
+        abc.display(),
+        drawn.display()
+    );
+    let out = run_line(&line, LIMIT);
+    out.assert_ok();
+    assert!(out.stdout.contains("guides: 150 of 1500 strands"), "{}", out.stdout);
+    let drawn = vkhair::groom::cyhair::HairFile::open(&drawn).expect("drawn strands").groom;
+    let authored = vkhair::groom::usd::open(&usd).expect("authored").groom;
+    assert_eq!(drawn.strand_count(), authored.strand_count());
+    let mut worst_root = 0.0f32;
+    let mut deviations = Vec::new();
+    for s in 0..authored.strand_count() {
+        let (a, d) = (authored.strand(s), drawn.strand(s));
+        worst_root = worst_root.max(a[0].distance(d[0]));
+        let length: f32 = a.windows(2).map(|w| w[0].distance(w[1])).sum();
+        for p in a {
+            let near = d
+                .windows(2)
+                .map(|w| {
+                    let e = w[1] - w[0];
+                    let t = ((*p - w[0]).dot(e) / e.length_squared()).clamp(0.0, 1.0);
+                    p.distance(w[0] + t * e)
+                })
+                .fold(f32::MAX, f32::min);
+            deviations.push(near / length);
+        }
+    }
+    deviations.sort_by(f32::total_cmp);
+    let p95 = deviations[deviations.len() * 95 / 100];
+    println!(
+        "drawn against authored after one still step: roots within {worst_root:e} m, p95 {:.3} % of the strand length",
+        100.0 * p95
+    );
+    assert!(worst_root < 1e-4, "a drawn root is {worst_root} m from its authored root: not the file's order?");
+    assert!(p95 < 0.01, "p95 deviation {:.3} % of the strand length", 100.0 * p95);
+}
+
+#[test]
+fn guides_options_are_checked() {
+    run_line("render --guides 10", LIMIT).assert_error("--guides needs --input");
+    let usd = data("usd/dense_curly.usdc");
+    for (bad, says) in [("0", "at least 1"), ("1.5", "a share between 0 and 1"), ("many", "`all`")] {
+        run_line(&format!("simulate --input {} --guides {bad} --steps 1", usd.display()), LIMIT).assert_error(says);
+    }
+    // `all`: every strand a key hair, no followers.
+    let out = run_line(&format!("simulate --input {} --guides all --steps 1", usd.display()), LIMIT);
+    out.assert_ok();
+    assert!(out.stdout.contains("1500 key hairs") && !out.stdout.contains("guides:"), "{}", out.stdout);
+}

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use vkhair::groom::authored::{AuthoredGroom, CurveObject, UpAxis};
 use vkhair::groom::cyhair::HairFile;
 use vkhair::groom::tfx::TfxFile;
-use vkhair::groom::{alembic, usd, Groom, Repairs};
+use vkhair::groom::{alembic, guides, usd, Groom, Repairs};
 
 use crate::output::Error;
 
@@ -54,6 +54,29 @@ pub struct InputArgs {
     /// The --gltf joint the hair grows on, by name [default: found by weights].
     #[arg(long)]
     pub head_joint: Option<String>,
+    /// Simulate this many strands of a dense --input groom as guides — a
+    /// count, or a share below 1 such as 0.05 — and draw every strand of the
+    /// file as a follower of them; `all` simulates every strand as a key hair.
+    /// [default: the strands the file marks as guides (groom_guide), else
+    /// every strand up to 4096 strands, else 5 % of them (at least 64)]
+    #[arg(long)]
+    pub guides: Option<String>,
+}
+
+/// A groom with more strands than this is dense: without --guides or guide
+/// marks, 5 % of its strands (at least 64) are simulated as guides.
+pub const DENSE_STRANDS: usize = 4096;
+
+/// A dense groom drawn as followers of some of its strands.
+pub struct Dense {
+    /// Every strand of the file, scaled, in the file's order (not resampled).
+    pub groom: Groom,
+    /// The strands simulated as guides (indices into `groom`, ascending).
+    pub guides: Vec<usize>,
+    /// How they were chosen, for the run's header.
+    pub chosen_by: &'static str,
+    /// Points per drawn follower: the file's median per strand, 4..=64.
+    pub points: usize,
 }
 
 impl InputArgs {
@@ -100,6 +123,12 @@ impl InputArgs {
                 return Err(format!("--points must be 2..=64 (got {points})"));
             }
         }
+        if let Some(g) = &self.guides {
+            if self.input.is_none() {
+                return Err("--guides needs --input (a dense groom to choose guides from)".into());
+            }
+            guide_request(g)?;
+        }
         Ok(())
     }
 
@@ -113,15 +142,60 @@ impl InputArgs {
         self.scale.unwrap_or(1.0)
     }
 
-    /// The --input groom, scaled and resampled, with the thickness it gives its
-    /// strands (see [`load_scaled`]).
-    pub fn groom(&self, path: &Path) -> Result<Scaled, Error> {
-        load_scaled(path, self.strict, self.scale(), self.points.unwrap_or(16))
+    /// The --input groom's key hairs (scaled, resampled to --points) and, for
+    /// a dense groom, the whole groom and the guides among it that the key
+    /// hairs are (see --guides).
+    pub fn groom_and_guides(&self, path: &Path) -> Result<(Scaled, Option<Dense>), Error> {
+        let loaded = load_with_defaults(path, self.strict)?;
+        let marks = loaded.authored.as_ref().and_then(|a| a.guides.clone());
+        let groom = loaded.groom.scaled(self.scale())?;
+        let thickness = groom.end_thickness().or(loaded.header_thickness.map(|t| (t * self.scale(), t * self.scale())));
+        let points = self.points.unwrap_or(16);
+        let n = groom.strand_count();
+        let request = self.guides.as_deref().map(guide_request).transpose()?;
+        let (guides, chosen_by) = match (request, marks) {
+            (Some(Guides::All), _) => return Ok((Scaled { groom: groom.resampled(points)?, thickness }, None)),
+            (Some(Guides::Count(c)), _) => (guides::spread(&groom, c.min(n))?, "--guides, spread over the roots"),
+            (Some(Guides::Share(f)), _) => {
+                let c = ((n as f64 * f).round() as usize).clamp(1, n);
+                (guides::spread(&groom, c)?, "--guides, spread over the roots")
+            }
+            (None, Some(marks)) => (guides::marked(&marks)?, "marked by the file (groom_guide)"),
+            (None, None) if n > DENSE_STRANDS => {
+                (guides::spread(&groom, (n / 20).max(64))?, "5 % of a dense groom, spread over the roots")
+            }
+            (None, None) => return Ok((Scaled { groom: groom.resampled(points)?, thickness }, None)),
+        };
+        let keys = groom.select(&guides)?.resampled(points)?;
+        let mut per_strand: Vec<usize> = (0..n).map(|s| groom.strand_len(s)).collect();
+        per_strand.sort_unstable();
+        let follower_points = per_strand[n / 2].clamp(4, 64);
+        Ok((Scaled { groom: keys, thickness }, Some(Dense { groom, guides, chosen_by, points: follower_points })))
     }
 
     /// Whether the strands collide with the --obj mesh.
     pub fn colliding(&self) -> bool {
         self.input.is_some() && self.obj.is_some() && !self.no_mesh_collider
+    }
+}
+
+/// What --guides asks for.
+enum Guides {
+    All,
+    Count(usize),
+    Share(f64),
+}
+
+fn guide_request(g: &str) -> Result<Guides, String> {
+    if g == "all" {
+        return Ok(Guides::All);
+    }
+    if let Ok(n) = g.parse::<usize>() {
+        return if n >= 1 { Ok(Guides::Count(n)) } else { Err("--guides must be at least 1".into()) };
+    }
+    match g.parse::<f64>() {
+        Ok(f) if f > 0.0 && f < 1.0 => Ok(Guides::Share(f)),
+        _ => Err(format!("--guides takes a count (1 or more), a share between 0 and 1, or `all` (got {g})")),
     }
 }
 

@@ -16,15 +16,18 @@ use vkhair::render::Camera;
 use vkhair::sim::{motion, Collider};
 
 pub use character::CharacterScene;
-pub use parameters::{make_renderer, parameters, FULL_HEAD_HAIRS};
+pub use parameters::{bind_followers, make_renderer, parameters, FULL_HEAD_HAIRS};
 
-use crate::args::input::Scaled;
+use crate::args::input::{Dense, Scaled};
 use crate::args::scene::SceneArgs;
 use crate::output::Error;
 
 /// A loaded scene.
 pub struct Scene {
+    /// The key hairs simulated (a dense groom's guides).
     pub groom: Groom,
+    /// A dense groom drawn as followers of the key hairs.
+    pub dense: Option<Dense>,
     pub colliders: Vec<Collider>,
     pub head_mesh: TriMesh,
     pub center: Vec3,
@@ -63,6 +66,7 @@ pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
     }
     let sintel =
         |p: &Option<PathBuf>| p.as_ref().is_some_and(|p| p.to_string_lossy().to_lowercase().contains("sintel"));
+    let mut dense = None;
     let (groom, thickness, colliders, head_mesh, pivot, credit) = match &a.input.input {
         None => {
             let head = TriMesh::uv_sphere(THESIS_HEAD_CENTER, THESIS_HEAD_RADIUS * 0.97, 24, 32)?;
@@ -70,7 +74,8 @@ pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
         }
         Some(path) => {
             let scale = a.input.scale();
-            let Scaled { groom, thickness } = a.input.groom(path)?;
+            let (Scaled { groom, thickness }, followers) = a.input.groom_and_guides(path)?;
+            dense = followers;
             let head_mesh = match &a.input.obj {
                 Some(obj) => {
                     let m = TriMesh::load_obj(obj)?;
@@ -79,7 +84,7 @@ pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
                 None => {
                     // A stand-in head under the roots, sized by the groom's largest
                     // extent (a flat groom has no extent along one axis).
-                    let (lo, hi) = groom.bounds();
+                    let (lo, hi) = dense.as_ref().map_or(&groom, |d| &d.groom).bounds();
                     let r = 0.25 * (hi - lo).max_element();
                     TriMesh::uv_sphere(0.5 * (lo + hi), r, 16, 24)?
                 }
@@ -89,16 +94,18 @@ pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
             (groom, thickness, Vec::new(), head_mesh, None, credit)
         }
     };
-    let (center, radius) = bounds_sphere(groom.positions().iter().chain(&head_mesh.positions).copied());
+    let drawn = dense.as_ref().map_or(&groom, |d| &d.groom);
+    let (center, radius) = bounds_sphere(drawn.positions().iter().chain(&head_mesh.positions).copied());
     if !(center.is_finite() && radius.is_finite() && radius > 0.0) {
         return Err(format!("the groom and mesh span no finite volume (bounding radius {radius})").into());
     }
-    let (lo, _) = groom.bounds();
+    let (lo, _) = drawn.bounds();
     let pivot = pivot.unwrap_or(Vec3::new(center.x, lo.y, center.z));
     let start_head = vkhair::sim::RigidTransform::default();
     let view_dir = Vec3::Z;
     Ok(Scene {
         groom,
+        dense,
         colliders,
         head_mesh,
         center,
@@ -128,6 +135,7 @@ fn character_scene(ch: CharacterScene, a: &SceneArgs) -> Result<Scene, Error> {
     let view_dir = ch.character.forward();
     Ok(Scene {
         groom,
+        dense: None,
         colliders,
         head_mesh,
         center,

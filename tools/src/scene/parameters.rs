@@ -2,13 +2,13 @@
 
 use vkhair::config::Config;
 use vkhair::render::{
-    InterpolationMode, Light, Primitive, Renderer, ShadingMode, ShadowCaster, ShadowParams, Transparency,
+    Followers, InterpolationMode, Light, Primitive, Renderer, ShadingMode, ShadowCaster, ShadowParams, Transparency,
 };
-use vkhair::sim::{KeyHairs, SimParams, VolumeMode, VolumeParams};
+use vkhair::sim::{KeyHairs, RigidTransform, SimParams, SimState, VolumeMode, VolumeParams};
 use vkhair::GpuContext;
 
 use super::{drawing_scale, Scene};
-use crate::args::input::strand_widths;
+use crate::args::input::{strand_widths, Dense};
 use crate::args::scene::SceneArgs;
 use crate::say;
 
@@ -99,9 +99,24 @@ pub fn make_renderer(
     ctx: &GpuContext,
     config: &Config,
     key_hairs: KeyHairs<'_>,
-    radius: f32,
+    s: &Scene,
 ) -> Result<Renderer, vkhair::Error> {
-    let mut renderer = Renderer::new(ctx, key_hairs, &config.render)?;
+    let radius = s.radius;
+    let mut renderer = match &s.dense {
+        None => Renderer::new(ctx, key_hairs, &config.render)?,
+        Some(d) => {
+            let followers = bind_followers(d, &s.groom, config)?;
+            say!(
+                "followers: {} strands drawn as followers of {} guides ({}), {} points each, {:.1} MiB of bindings",
+                followers.count(),
+                d.guides.len(),
+                d.chosen_by,
+                followers.points(),
+                followers.gpu_bytes() as f64 / (1 << 20) as f64
+            );
+            Renderer::with_followers(ctx, key_hairs, &config.render, &followers)?
+        }
+    };
     renderer.set_lights(&config.lights)?;
     if !a.no_shadows {
         // The thesis' setup: both spot lights cast shadows through their own maps.
@@ -143,6 +158,13 @@ pub fn make_renderer(
         );
     }
     Ok(renderer)
+}
+
+/// The strands of `dense` bound to its guides, the key hairs `keys` (the
+/// simulation's rest state), at the smoothing level of `config`.
+pub fn bind_followers(dense: &Dense, keys: &vkhair::Groom, config: &Config) -> Result<Followers, vkhair::Error> {
+    let rest = SimState::from_groom(keys, &config.sim, &RigidTransform::default())?;
+    Followers::bind(&dense.groom, &dense.guides, &rest, config.render.smoothing_level, dense.points)
 }
 
 /// Hairs on a full head of real hair, for the tool's default of

@@ -180,7 +180,7 @@ pub fn bench_frames(
     if let Some(count) = simulated {
         sim.set_simulated_hairs(count)?;
     }
-    let mut renderer = make_renderer(&a, ctx, &config, sim.key_hairs(), s.radius)?;
+    let mut renderer = make_renderer(&a, ctx, &config, sim.key_hairs(), &s)?;
     let offscreen = Offscreen::new(ctx, a.width, a.height)?;
     let camera = framing(&s, a.distance, a.width as f32 / a.height as f32)?;
     let mut profiler = GpuProfiler::new(ctx, 1, 64)?;

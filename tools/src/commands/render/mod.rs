@@ -114,7 +114,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
             config.mesh_collider.resolution
         );
     }
-    let renderer = make_renderer(sa, &ctx, &config, sim.key_hairs(), s.radius)?;
+    let renderer = make_renderer(sa, &ctx, &config, sim.key_hairs(), &s)?;
     let offscreen = Offscreen::new(&ctx, sa.width, sa.height)?;
     // The head mesh (lit along the key spot light's direction) takes that light's hair
     // shadow the way a host would, through glsl/include/shadow.glsl.

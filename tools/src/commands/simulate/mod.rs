@@ -20,6 +20,7 @@ use crate::say;
 
 mod character;
 mod check;
+mod drawn;
 
 use check::{share_inside, tip_drift, write_final, Reference, StepCheck};
 
@@ -45,6 +46,13 @@ pub struct SimulateArgs {
     /// strand per input strand with --points points each.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Write the strands as the renderer draws them after the last step as a
+    /// .hair file (world, meters, full detail): a dense groom's followers
+    /// evaluated from their guides, in the input's strand order, at their
+    /// follower points (before the tessellation smooths them); else the hairs
+    /// grown from the key hairs.
+    #[arg(long)]
+    drawn_out: Option<PathBuf>,
     #[command(flatten)]
     profile_out: ProfileArgs,
 }
@@ -145,19 +153,35 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     inputs.extend(a.config.as_deref());
     let mut outputs: Vec<Output> =
         a.out.as_deref().map(|path| Output { flag: "--out", path, kind: Kind::File(&["hair"]) }).into_iter().collect();
+    outputs.extend(a.drawn_out.as_deref().map(|path| Output {
+        flag: "--drawn-out",
+        path,
+        kind: Kind::File(&["hair"]),
+    }));
     outputs.extend(a.profile_out.outputs());
     destinations::check(&inputs, &outputs)?;
     if let Some(ch) = crate::scene::CharacterScene::load(&a.input)? {
         return character::simulate_character(a, ch);
     }
     let scale = a.input.scale();
+    let mut dense = None;
     let (groom, colliders, label, pivot) = match &a.input.input {
         None => (scenes::thesis()?, motion::thesis_colliders(), "thesis scene".to_owned(), motion::NECK_PIVOT),
         Some(path) => {
-            let groom = a.input.groom(path)?.groom;
+            let (scaled, followers) = a.input.groom_and_guides(path)?;
+            let groom = scaled.groom;
             // Turn about the centre of the roots' lowest level: roughly the neck.
-            let (lo, hi) = groom.bounds();
+            let (lo, hi) = followers.as_ref().map_or(&groom, |d| &d.groom).bounds();
             let pivot = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
+            if let Some(d) = &followers {
+                say!(
+                    "guides: {} of {} strands ({}); every strand drawn follows them",
+                    d.guides.len(),
+                    d.groom.strand_count(),
+                    d.chosen_by
+                );
+            }
+            dense = followers;
             (groom, Vec::new(), path.display().to_string(), pivot)
         }
     };
@@ -270,6 +294,9 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     if let Some(out) = &a.out {
         write_final(out, &state, &last_head, scale)?;
         say!("wrote {}: {strands} strands × {points} points", out.display());
+    }
+    if let Some(out) = &a.drawn_out {
+        drawn::write_drawn(out, &ctx, &sim, &groom, dense.as_ref(), &config)?;
     }
     if let (Some(grid), Some(stats)) = (sim.volume_grid(), sim.volume_stats()?) {
         let solve = match params.volume.mode {

@@ -1,0 +1,261 @@
+//! A dense, curly groom drawn as followers of simulated guides
+//! (`render::Followers`): at rest the drawn strands are the authored ones
+//! (measured against the authored polylines, not against the code's own
+//! resampling), in motion they follow their guides with roots on the scalp,
+//! the GPU evaluation matches the CPU reference, and level of detail draws a
+//! prefix that covers the scalp. Under validation.
+
+use glam::{Quat, Vec3, Vec4};
+use vkhair::groom::guides;
+use vkhair::render::reference::{rest_plane_normals, smooth_strand};
+use vkhair::render::{Camera, Followers, RenderParams, Renderer};
+use vkhair::sim::{HairSim, RigidTransform, SimParams, SimState};
+use vkhair::Groom;
+
+mod common;
+
+use common::Gpu;
+
+const LEVEL: u32 = 3;
+/// Points per drawn follower.
+const POINTS: usize = 48;
+/// GPU against CPU evaluation, meters (float rounding of a few products).
+const GPU_TOLERANCE_M: f32 = 2e-5;
+
+/// Grown strands of 48 points, each wound into a helix of 4 mm radius and six
+/// turns around its own root-to-tip line: curls a guide does not have.
+fn curly(strands: usize) -> Groom {
+    let grown = common::grown_groom(strands, 48, 11);
+    let curled: Vec<Vec<Vec3>> = (0..grown.strand_count())
+        .map(|s| {
+            let p = grown.strand(s);
+            let axis = (p[p.len() - 1] - p[0]).normalize();
+            let (u, v) = axis.any_orthonormal_pair();
+            let n = p.len();
+            p.iter()
+                .enumerate()
+                .map(|(i, &x)| {
+                    let t = i as f32 / (n - 1) as f32;
+                    let a = t * 6.0 * std::f32::consts::TAU + s as f32;
+                    // Grows from 0 at the root, so the root stays put.
+                    let r = 0.004 * (4.0 * t).min(1.0);
+                    x + r * (a.cos() * u + a.sin() * v)
+                })
+                .collect()
+        })
+        .collect();
+    Groom::from_strands(&curled).expect("curly groom")
+}
+
+struct Scene {
+    dense: Groom,
+    guides: Vec<usize>,
+    keys: Groom,
+    followers: Followers,
+}
+
+fn scene(strands: usize, guide_count: usize) -> Scene {
+    let dense = curly(strands);
+    let guides = guides::spread(&dense, guide_count).expect("guides");
+    let keys = dense.select(&guides).expect("guides").resampled(16).expect("resampled");
+    let rest = SimState::from_groom(&keys, &SimParams::default(), &RigidTransform::default()).expect("rest");
+    let followers = Followers::bind(&dense, &guides, &rest, LEVEL, POINTS).expect("bind");
+    Scene { dense, guides, keys, followers }
+}
+
+/// Distance from `p` to the polyline `line`.
+fn to_polyline(p: Vec3, line: &[Vec3]) -> f32 {
+    line.windows(2)
+        .map(|w| {
+            let d = w[1] - w[0];
+            let t = ((p - w[0]).dot(d) / d.length_squared().max(1e-20)).clamp(0.0, 1.0);
+            p.distance(w[0] + t * d)
+        })
+        .fold(f32::MAX, f32::min)
+}
+
+fn length(line: &[Vec3]) -> f32 {
+    line.windows(2).map(|w| w[0].distance(w[1])).sum()
+}
+
+/// The CPU evaluation of every follower for guides in `state` (world) under `head`.
+fn cpu_followers(s: &Scene, state: &SimState, head: Quat) -> Vec<Vec3> {
+    let guides: Vec<Vec<(Vec3, Vec3)>> =
+        (0..state.strands).map(|g| smooth_strand(&state.strand(g).collect::<Vec<_>>(), LEVEL)).collect();
+    s.followers.evaluate(&guides, &rest_plane_normals(state), head, s.followers.count())
+}
+
+/// The drawn followers the GPU evaluates, in the file's strand order.
+fn gpu_followers(renderer: &mut Renderer, sim: &HairSim, s: &Scene) -> Vec<Vec<Vec3>> {
+    renderer.prepare_now(sim, None).expect("prepare");
+    let (positions, _) = renderer.read_hairs().expect("hairs");
+    s.followers.to_input_order(&positions).into_iter().map(|(_, strand)| strand).collect()
+}
+
+fn drawing_order(cpu: &[Vec3], s: &Scene) -> Vec<Vec<Vec3>> {
+    let mut strands: Vec<(u32, Vec<Vec3>)> =
+        cpu.chunks_exact(POINTS).zip(s.followers.input_order()).map(|(c, &i)| (i, c.to_vec())).collect();
+    strands.sort_by_key(|(i, _)| *i);
+    strands.into_iter().map(|(_, c)| c).collect()
+}
+
+fn params() -> RenderParams {
+    RenderParams { smoothing_level: LEVEL, ..RenderParams::default() }
+}
+
+#[test]
+fn at_rest_the_drawn_followers_are_the_authored_strands() {
+    let gpu = Gpu::new();
+    let s = scene(600, 48);
+    assert_eq!(s.followers.count(), 600);
+    // Memory: 12 bytes a point, 32 a follower.
+    assert_eq!(s.followers.gpu_bytes(), (600 * POINTS * 12 + 600 * 32) as u64);
+    let sim = HairSim::new(gpu.ctx(), &s.keys, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    let mut renderer = Renderer::with_followers(gpu.ctx(), &sim, &params(), &s.followers).expect("renderer");
+    assert_eq!(renderer.hair_counts(), (600, POINTS as u32));
+    let drawn = gpu_followers(&mut renderer, &sim, &s);
+    // Deviation of every authored point from its drawn follower, as a share
+    // of the strand's length.
+    let mut deviations: Vec<f32> = (0..s.dense.strand_count())
+        .flat_map(|i| {
+            let authored = s.dense.strand(i);
+            let len = length(authored);
+            let line = &drawn[i];
+            authored.iter().map(move |&p| to_polyline(p, line) / len).collect::<Vec<_>>()
+        })
+        .collect();
+    deviations.sort_by(f32::total_cmp);
+    let q = |f: f64| deviations[((deviations.len() - 1) as f64 * f) as usize];
+    println!(
+        "rest deviation of {} authored points from the drawn followers, share of strand length: p50 {:.2e}, p95 {:.2e}, max {:.2e}",
+        deviations.len(),
+        q(0.5),
+        q(0.95),
+        q(1.0)
+    );
+    assert!(q(1.0) <= 0.005, "an authored point is {:.3} % of its strand's length from its follower", 100.0 * q(1.0));
+    // The GPU against the CPU reference.
+    let state = sim.read_state().expect("state");
+    let cpu = drawing_order(&cpu_followers(&s, &state, Quat::IDENTITY), &s);
+    let worst = drawn.iter().flatten().zip(cpu.iter().flatten()).map(|(a, b)| a.distance(*b)).fold(0.0, f32::max);
+    println!("rest: GPU against CPU {worst:e} m");
+    assert!(worst < GPU_TOLERANCE_M, "{worst} m");
+}
+
+#[test]
+fn in_motion_followers_follow_their_guides_with_roots_on_the_scalp() {
+    let gpu = Gpu::new();
+    let s = scene(300, 30);
+    let mut sim = HairSim::new(gpu.ctx(), &s.keys, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    let mut renderer = Renderer::with_followers(gpu.ctx(), &sim, &params(), &s.followers).expect("renderer");
+    let rest_drawn = gpu_followers(&mut renderer, &sim, &s);
+    let head = |k: usize| RigidTransform {
+        rotation: Quat::from_rotation_y(0.5 * (k as f32 / 10.0).min(1.0)),
+        translation: Vec3::new(0.05 * (k as f32 / 10.0).min(1.0), 0.0, 0.0),
+    };
+    sim.run(20, |k| head(k + 1), None).expect("steps");
+    let last = head(20);
+    let drawn = gpu_followers(&mut renderer, &sim, &s);
+    let state = sim.read_state().expect("state");
+    let cpu = drawing_order(&cpu_followers(&s, &state, last.rotation), &s);
+    let worst = drawn.iter().flatten().zip(cpu.iter().flatten()).map(|(a, b)| a.distance(*b)).fold(0.0, f32::max);
+    println!("motion: GPU against CPU {worst:e} m");
+    assert!(worst < GPU_TOLERANCE_M, "{worst} m");
+    // Roots: the authored roots carried by the head.
+    let m = last.matrix();
+    let root_error = (0..s.dense.strand_count())
+        .map(|i| drawn[i][0].distance(m.transform_point3(s.dense.strand(i)[0])))
+        .fold(0.0, f32::max);
+    println!("motion: roots {root_error:e} m from the scalp");
+    assert!(root_error < 1e-5, "a root is {root_error} m off the scalp");
+    // The hair moved (the test tests something), and each follower stayed
+    // with its guides: its tip no farther from the blend of its guides' tips
+    // than 1.5 × at rest plus 1 mm.
+    let blend = |i: usize, tips: &dyn Fn(usize) -> Vec3| -> Vec3 {
+        s.followers.guides_of(i).expect("bound").iter().map(|&(g, w)| w * tips(g as usize)).sum()
+    };
+    let (mut moved, mut worst) = (0.0f32, 0.0f32);
+    for i in 0..s.dense.strand_count() {
+        let (tip, rest_tip) = (*drawn[i].last().expect("tip"), *rest_drawn[i].last().expect("tip"));
+        moved = moved.max(tip.distance(rest_tip));
+        let now = tip.distance(blend(i, &|g| state.strand(g).last().expect("tip")));
+        let before = rest_tip.distance(blend(i, &|g| *s.keys.strand(g).last().expect("tip")));
+        worst = worst.max(now - 1.5 * before);
+    }
+    println!("motion: tips moved up to {moved:.3} m; a tip's distance to its guides' blend grew by at most {worst:.4} m over 1.5 × rest");
+    assert!(moved > 0.03, "the tips moved only {moved} m: the motion tests nothing");
+    assert!(worst < 1e-3, "a follower tip left its guides by {worst} m more than 1.5 × its rest distance");
+}
+
+#[test]
+fn a_rigid_move_moves_every_follower_rigidly() {
+    let gpu = Gpu::new();
+    let s = scene(200, 20);
+    let params = SimParams { gravity_enabled: false, ..SimParams::default() };
+    let mut sim = HairSim::new(gpu.ctx(), &s.keys, &params, &RigidTransform::default()).expect("sim");
+    let mut renderer = Renderer::with_followers(gpu.ctx(), &sim, &self::params(), &s.followers).expect("renderer");
+    let rest = gpu_followers(&mut renderer, &sim, &s);
+    let to = RigidTransform { rotation: Quat::from_rotation_y(1.2), translation: Vec3::new(0.3, -0.1, 2.0) };
+    sim.teleport(&to).expect("teleport");
+    sim.run(1, |_| to, None).expect("step");
+    let moved = gpu_followers(&mut renderer, &sim, &s);
+    let m = to.matrix();
+    let worst = moved
+        .iter()
+        .flatten()
+        .zip(rest.iter().flatten())
+        .map(|(a, b)| a.distance(m.transform_point3(*b)))
+        .fold(0.0, f32::max);
+    println!("rigid move: followers {worst:e} m from the rest followers moved");
+    assert!(worst < 1e-4, "a follower point is {worst} m from where the move takes it");
+}
+
+#[test]
+fn level_of_detail_draws_a_prefix_spread_over_the_scalp() {
+    let gpu = Gpu::new();
+    let s = scene(400, 40);
+    let sim = HairSim::new(gpu.ctx(), &s.keys, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    // The smoothing level held, so that the prefix is the same hairs to the bit.
+    let mut p = params();
+    p.lod.min_smoothing_level = LEVEL;
+    let mut renderer = Renderer::with_followers(gpu.ctx(), &sim, &p, &s.followers).expect("renderer");
+    renderer.prepare_now(&sim, None).expect("prepare");
+    let (full, _) = renderer.read_hairs().expect("hairs");
+    // Far away: the share of hairs level of detail keeps.
+    let far =
+        Camera::look_at(Vec3::new(0.0, 1.6, 6.0), Vec3::new(0.0, 1.6, 0.0), 0.8, 1.0, 0.01, 100.0).expect("camera");
+    renderer.prepare_now(&sim, Some(&far)).expect("prepare");
+    let detail = renderer.detail();
+    let (drawn, per) = renderer.hair_counts();
+    let want = (400.0 * detail.hairs_per_key as f32 / p.hairs_per_key as f32).round() as u32;
+    assert!(detail.hairs_per_key < p.hairs_per_key, "the camera is not far enough to thin the hair");
+    assert_eq!((drawn, per), (want, POINTS as u32));
+    let (near_prefix, _) = renderer.read_hairs().expect("hairs");
+    let same = near_prefix.iter().zip(&full).all(|(a, b): (&Vec4, &Vec4)| a == b);
+    assert!(same, "the thinned hairs are not the first of the full set");
+    // Spread: every guide has a drawn follower within 4 cm of its root.
+    let roots: Vec<Vec3> = near_prefix.chunks_exact(POINTS).map(|h| h[0].truncate()).collect();
+    for &g in &s.guides {
+        let r = s.dense.strand(g)[0];
+        let nearest = roots.iter().map(|x| x.distance(r)).fold(f32::MAX, f32::min);
+        assert!(nearest < 0.04, "guide {g}: the nearest drawn root is {nearest} m away");
+    }
+}
+
+#[test]
+fn bad_bindings_are_refused() {
+    let dense = curly(50);
+    let keys = dense.select(&[0, 10, 20]).expect("keys").resampled(16).expect("resampled");
+    let rest = SimState::from_groom(&keys, &SimParams::default(), &RigidTransform::default()).expect("rest");
+    assert!(Followers::bind(&dense, &[0, 10], &rest, LEVEL, POINTS).is_err(), "a guide count that is not the sim's");
+    assert!(Followers::bind(&dense, &[0, 10, 10], &rest, LEVEL, POINTS).is_err(), "a guide twice");
+    assert!(Followers::bind(&dense, &[0, 10, 99], &rest, LEVEL, POINTS).is_err(), "a guide past the groom");
+    assert!(Followers::bind(&dense, &[0, 10, 20], &rest, LEVEL, 1).is_err(), "one point");
+    assert!(Followers::bind(&dense, &[0, 10, 20], &rest, 0, POINTS).is_err(), "level 0");
+    // A renderer at another level than the binding's is refused.
+    let gpu = Gpu::new();
+    let f = Followers::bind(&dense, &[0, 10, 20], &rest, LEVEL, POINTS).expect("bind");
+    let sim = HairSim::new(gpu.ctx(), &keys, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    let other = RenderParams { smoothing_level: LEVEL + 1, ..RenderParams::default() };
+    assert!(Renderer::with_followers(gpu.ctx(), &sim, &other, &f).is_err());
+}
