@@ -213,3 +213,21 @@ proptest::proptest! {
         must_not_panic(&b);
     }
 }
+
+/// A groom of 20,000 strands (the size of an artist's) written and read
+/// back whole.
+#[test]
+fn twenty_thousand_strands_read_back() {
+    let strands: Vec<Vec<Vec3>> = (0..20_000)
+        .map(|s| {
+            let a = s as f32 * 2.399;
+            let root = Vec3::new(a.cos(), 1.0, a.sin()) * (0.05 + 0.04 * (s as f32 / 20_000.0));
+            (0..24).map(|i| root + Vec3::new(0.003 * (i as f32).sin(), -0.01 * i as f32, 0.0)).collect()
+        })
+        .collect();
+    let groom = Groom::from_strands(&strands).expect("groom");
+    let object = write::CurvesObject { name: "dense", groom: &groom, guides: None, root_uvs: None, transform: None };
+    let g = alembic::parse(&write::to_bytes(&[object])).expect("20,000 strands");
+    assert_eq!((g.groom.strand_count(), g.groom.point_count()), (20_000, 480_000));
+    assert_eq!(g.groom.positions(), groom.positions());
+}

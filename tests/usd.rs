@@ -172,3 +172,11 @@ fn mutated_stages_never_panic() {
         }
     }
 }
+
+#[test]
+fn an_animated_stage_gives_its_first_sample() {
+    // usd-core wrote points at times 5 (x = 0) and 10 (x = 1) only.
+    let g = usd::open(data("usd/animated.usda")).expect("animated");
+    let xs: Vec<f32> = g.groom.positions().iter().map(|p| p.x).collect();
+    assert_eq!(xs, vec![0.0; 3], "not the first sample: {:?}", g.groom.positions());
+}

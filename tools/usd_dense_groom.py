@@ -11,7 +11,9 @@ centred at (0, 0, 1.6) m — metersPerUnit 1, Z up, as Blender writes — each
 growing out from its root, bending down under a soft "gravity" to 22-30 cm,
 wound into a helix of 3 mm radius and 4-6 turns around its own path. Widths
 per vertex from 80 um at the root to 20 um at the tip; displayColor per curve,
-browns of varying lightness. No guide marks: vkhair chooses the guides.
+browns of varying lightness; primvars:st per curve, the root's direction
+from the head's centre (u around Z, v from the bottom up). No guide marks:
+vkhair chooses the guides.
 Deterministic (a fixed seed). Beside it, HEAD.obj: the head sphere as an OBJ
 in vkhair's frame (meters, Y up: centre (0, 1.6, 0)), for --obj.
 """
@@ -21,7 +23,7 @@ import os
 import random
 import sys
 
-from pxr import Gf, Usd, UsdGeom, Vt
+from pxr import Gf, Sdf, Usd, UsdGeom, Vt
 
 OUT = sys.argv[2] if len(sys.argv) > 2 else os.path.join(os.path.dirname(__file__), "..", "tests", "data", "usd", "dense_curly.usdc")
 STRANDS = int(sys.argv[1]) if len(sys.argv) > 1 else 1_500
@@ -65,7 +67,8 @@ def strand(rng, k):
         rad = 0.003 * min(1.0, 4.0 * t)
         ang = phase + turns * 2.0 * math.pi * t
         out.append(Gf.Vec3f(*[p[j] + rad * (math.cos(ang) * u[j] + math.sin(ang) * v[j]) for j in range(3)]))
-    return out
+    uv = Gf.Vec2f((a / (2.0 * math.pi)) % 1.0, 0.5 * (z + 1.0))
+    return out, uv
 
 
 def write_head(path, rings=24, segments=32):
@@ -99,9 +102,11 @@ def main():
     stage.SetDefaultPrim(root.GetPrim())
     curves = UsdGeom.BasisCurves.Define(stage, "/hair/curly")
     curves.CreateTypeAttr(UsdGeom.Tokens.linear)
-    points, widths, colors = [], [], []
+    points, widths, colors, uvs = [], [], [], []
     for k in range(STRANDS):
-        points.extend(strand(rng, k))
+        pts, uv = strand(rng, k)
+        points.extend(pts)
+        uvs.append(uv)
         widths.extend(8e-5 - 6e-5 * i / (POINTS - 1) for i in range(POINTS))
         light = rng.uniform(0.6, 1.0)
         colors.append(Gf.Vec3f(0.28 * light, 0.16 * light, 0.08 * light))
@@ -110,6 +115,8 @@ def main():
     curves.CreateWidthsAttr(Vt.FloatArray(widths))
     curves.SetWidthsInterpolation(UsdGeom.Tokens.vertex)
     curves.CreateDisplayColorPrimvar(UsdGeom.Tokens.uniform).Set(Vt.Vec3fArray(colors))
+    st = UsdGeom.PrimvarsAPI(curves).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.uniform)
+    st.Set(Vt.Vec2fArray(uvs))
     stage.GetRootLayer().Save()
     write_head(os.path.splitext(OUT)[0] + "_head.obj")
     print("wrote", OUT, os.path.getsize(OUT), "bytes with usd-core", ".".join(map(str, Usd.GetVersion())))

@@ -23,6 +23,8 @@ back through vkhair: nothing in the files is computed by vkhair.
 - no_points.usda: a BasisCurves prim without points.
 - counts_mismatch.usda: curveVertexCounts sum 5, 4 points.
 - nan.usda: one linear curve with a NaN point.
+- animated.usda: one linear curve whose points are time samples only, at
+  times 5 (x = 0) and 10 (x = 1): the first sample is read.
 """
 
 import math
@@ -93,10 +95,24 @@ def one_curve(path, points, counts=None, wrap=None, curve_type="linear"):
     stage.GetRootLayer().Save()
 
 
+def animated(path):
+    stage = Usd.Stage.CreateNew(path)
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    curves = UsdGeom.BasisCurves.Define(stage, "/hair")
+    curves.CreateTypeAttr(UsdGeom.Tokens.linear)
+    curves.CreateCurveVertexCountsAttr(Vt.IntArray([3]))
+    points = curves.CreatePointsAttr()
+    for time, x in ((5.0, 0.0), (10.0, 1.0)):
+        points.Set(Vt.Vec3fArray([Gf.Vec3f(x, -0.1 * i, 0.0) for i in range(3)]), Usd.TimeCode(time))
+    stage.GetRootLayer().Save()
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
-    for name in os.listdir(OUT):
-        if name.endswith((".usda", ".usdc")):
+    written = ["small_cm_zup.usda", "small_cm_zup.usdc", "periodic.usda", "no_points.usda",
+               "counts_mismatch.usda", "nan.usda", "animated.usda"]
+    for name in written:
+        if os.path.exists(os.path.join(OUT, name)):
             os.remove(os.path.join(OUT, name))
     small(os.path.join(OUT, "small_cm_zup.usda"))
     small(os.path.join(OUT, "small_cm_zup.usdc"))
@@ -105,7 +121,8 @@ def main():
     one_curve(os.path.join(OUT, "no_points.usda"), None, counts=[2])
     one_curve(os.path.join(OUT, "counts_mismatch.usda"), [(0, 0, 0), (0, 1, 0), (0, 2, 0), (0, 3, 0)], counts=[2, 3])
     one_curve(os.path.join(OUT, "nan.usda"), [(0, 0, 0), (0, float("nan"), 0), (0, 2, 0)])
-    print("wrote", sorted(os.listdir(OUT)), "with usd-core", ".".join(map(str, Usd.GetVersion())))
+    animated(os.path.join(OUT, "animated.usda"))
+    print("wrote", written, "with usd-core", ".".join(map(str, Usd.GetVersion())))
 
 
 if __name__ == "__main__":

@@ -100,7 +100,7 @@ struct DrawParams {
     vec4 primary;         // rgb primary highlight color, w exponent
     vec4 secondary;       // rgb secondary highlight color, w exponent
     vec4 shifts;          // x primary shift, y secondary shift, z shift jitter, w highlight breakup
-    vec4 widths;          // x root width (m), y tip width (m), z least width (pixels), w unused
+    vec4 widths;          // x root width (m), y tip width (m), z least width (pixels), w 1: hairs have their own albedo (hair_looks)
     vec4 coverage;        // x 1 for transparent strands (coverage, no least width), y opacity, z hairs a strand stands for, w unused
     vec4 band;            // x spacing of the drawn strands at the root (m), y at the tip (m), zw unused
     uvec4 counts;         // x hairs, y vertices per hair, z lights, w shading mode (0 Kajiya-Kay, 1 Marschner)

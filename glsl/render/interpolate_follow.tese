@@ -6,7 +6,7 @@
 // (pc.stride vertices each) plus its rest offset in the blend of their frames
 // (in the head's frame at the root).
 // Stored like the other evaluation stages: each vertex once, with its tangent
-// from its neighbours.
+// from its neighbours and its width factor in the position's w.
 #include "render.glsl"
 
 layout(isolines, equal_spacing) in;
@@ -18,6 +18,8 @@ layout(std430, set = 0, binding = 3) writeonly buffer HairPos { vec4 hair_pos[];
 layout(std430, set = 0, binding = 4) writeonly buffer HairTan { vec4 hair_tan[]; };
 layout(std430, set = 0, binding = 6) readonly buffer Bindings { FollowerBinding bindings[]; };
 layout(std430, set = 0, binding = 7) readonly buffer Offsets { float offsets[]; };
+// Per follower its albedo and width factor (a) at the root (2f) and tip (2f + 1).
+layout(std430, set = 0, binding = 8) readonly buffer Looks { vec4 looks[]; };
 
 layout(location = 0) patch in uint p_patch;
 layout(location = 1) patch in uint p_first_hair;  // 0: one follower a patch
@@ -67,7 +69,9 @@ void main() {
         vec3 t = after - before;
         float len = length(t);
         uint dst = f * pc.points + i;
-        hair_pos[dst] = vec4(p, 1.0);
+        // The width factor along the follower, for the draw's ribbons.
+        float s = float(i) / float(pc.points - 1u);
+        hair_pos[dst] = vec4(p, mix(looks[2u * f].a, looks[2u * f + 1u].a, s));
         hair_tan[dst] = vec4(len > 0.0 ? t / len : vec3(0.0, -1.0, 0.0), float(i) / float(pc.points - 1u));
     }
     gl_Position = vec4(0.0);

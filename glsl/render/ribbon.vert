@@ -73,7 +73,8 @@ void main() {
     vec3 side = cross(dir, to_camera);
     float side_len = length(side);
     side = side_len > 1e-12 ? side / side_len : vec3(1.0, 0.0, 0.0);
-    float width = mix(dp.widths.x, dp.widths.y, tan_t.w);
+    // A hair's own width factor rides in its positions' w (1 for grown hairs).
+    float width = mix(dp.widths.x, dp.widths.y, tan_t.w) * (e == 0u ? hair_pos[first].w : hair_pos[first + 1u].w);
 #ifdef VKHAIR_COVERAGE
     // A transparent strand standing for n hairs: its band (reference::strand_band).
     float hair_width = width;

@@ -119,7 +119,8 @@ pub(crate) struct DrawParams {
     pub secondary: [f32; 4],
     /// Primary shift, secondary shift, shift jitter, highlight breakup.
     pub shifts: [f32; 4],
-    /// Root width, tip width (m), least width (pixels).
+    /// Root width, tip width (m), least width (pixels), 1 when the hairs
+    /// have their own albedo (`hair_looks`).
     pub widths: [f32; 4],
     /// 1 for transparent strands (coverage, no least width), opacity, hairs a
     /// strand stands for.

@@ -19,6 +19,20 @@ impl Groom {
         Groom::with_attributes(self.positions.iter().map(|p| *p * factor).collect(), &counts, attributes)
     }
 
+    /// Each strand's colour at its root and at its tip (its first and last
+    /// point's), when the groom has per-point colours.
+    pub fn end_colors(&self) -> Option<Vec<[glam::Vec3; 2]>> {
+        let c = self.colors()?;
+        Some(
+            (0..self.strand_count())
+                .map(|s| {
+                    let r = self.strand_range(s);
+                    [c[r.start], c[r.end - 1]]
+                })
+                .collect(),
+        )
+    }
+
     /// The thickness at the root and at the tip when the groom has per-point
     /// thickness: the median over the strands of their first and of their last
     /// point's thickness (the groom's length unit; robust to a few odd strands).

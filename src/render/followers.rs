@@ -28,8 +28,10 @@
 //! over the scalp by drawing a prefix; [`Followers::input_order`] maps drawn
 //! hairs back to the file's strand order.
 //!
-//! GPU memory: 12 bytes per follower point (three f32 offsets) plus 32 bytes
-//! per follower (three guide indices and weights) — [`Followers::gpu_bytes`].
+//! GPU memory: 12 bytes per follower point (three f32 offsets) plus 64 bytes
+//! per follower (three guide indices and weights; its colours and width
+//! factors, [`Followers::with_colors`], [`Followers::with_width_factors`]) —
+//! [`Followers::gpu_bytes`].
 
 use glam::{Mat3, Quat, Vec3, Vec4};
 
@@ -42,6 +44,8 @@ use crate::groom::Groom;
 use crate::hash::hash_u32;
 use crate::sim::SimState;
 
+/// Largest factor of the material's width a follower may be drawn at.
+pub const MAX_WIDTH_FACTOR: f32 = 10.0;
 /// Most points per follower (the GPU draws a follower as one hair of this many).
 pub const MAX_FOLLOWER_POINTS: usize = 256;
 /// A blended frame whose determinant is below this is taken as singular.
@@ -59,6 +63,11 @@ pub struct Followers {
     offsets: Vec<f32>,
     order: Vec<u32>,
     root_spacing: f32,
+    /// Per follower (drawing order), its own albedo at the root and the tip.
+    colors: Option<Vec<[Vec3; 2]>>,
+    /// Per follower (drawing order), its width at the root and the tip as a
+    /// factor of the material's.
+    widths: Option<Vec<[f32; 2]>>,
 }
 
 /// The blend of guides `g` with weights `w` at parameter `s`: position and
@@ -93,8 +102,9 @@ fn blend(
 impl Followers {
     /// Binds every strand of `authored` (head frame, the frame of `rest`) to
     /// the guides `guides` (indices into `authored`; `rest` holds them as the
-    /// simulation does, in this order), resampling each strand to `points`
-    /// points, against the guides smoothed at `level` (the renderer's).
+    /// simulation does, in this order), each drawn with `points` points (its
+    /// own when it has that many, else resampled by arc length), against the
+    /// guides smoothed at `level` (the renderer's).
     pub fn bind(authored: &Groom, guides: &[usize], rest: &SimState, level: u32, points: usize) -> Result<Self> {
         if guides.len() != rest.strands {
             return Err(Error::incompatible(
@@ -130,13 +140,19 @@ impl Followers {
         let mesh = (!triangles.is_empty()).then(|| TriMesh::new(roots.clone(), triangles.clone())).transpose()?;
         let spacing = median_edge(&roots, &triangles).max(1e-6);
         let grid = mesh.as_ref().map(|m| TriangleGrid::new(m, 2.0 * spacing)).transpose()?;
-        let resampled = authored.resampled(points)?;
+        // A strand of `points` points keeps its own; others are resampled by
+        // arc length.
+        let uneven = (0..strands).any(|s| authored.strand_len(s) != points);
+        let resampled = uneven.then(|| authored.resampled(points)).transpose()?;
         let mut order: Vec<u32> = (0..strands as u32).collect();
         order.sort_by_key(|&s| (hash_u32(s ^ 0x6a09_e667), s));
         let mut bindings = Vec::with_capacity(strands);
         let mut offsets = Vec::with_capacity(strands * points * 3);
         for &s in &order {
-            let strand = resampled.strand(s as usize);
+            let strand = match &resampled {
+                Some(r) if authored.strand_len(s as usize) != points => r.strand(s as usize),
+                _ => authored.strand(s as usize),
+            };
             let root = authored.strand(s as usize)[0];
             let (mut g, mut w) = match guide_of[s as usize] {
                 u32::MAX => nearest_guides(root, &roots, grid.as_ref(), &triangles),
@@ -176,7 +192,76 @@ impl Followers {
         } else {
             spacing / (strands as f32 / guides.len() as f32).sqrt()
         };
-        Ok(Followers { points: points as u32, level, bindings, offsets, order, root_spacing })
+        Ok(Followers {
+            points: points as u32,
+            level,
+            bindings,
+            offsets,
+            order,
+            root_spacing,
+            colors: None,
+            widths: None,
+        })
+    }
+
+    /// The same followers drawn in their own colours: per strand of the groom
+    /// (the file's order) its linear RGB albedo at the root and at the tip
+    /// (each component 0..=1), blended along the strand instead of the
+    /// material's root and tip colours.
+    pub fn with_colors(mut self, colors: &[[Vec3; 2]]) -> Result<Self> {
+        if colors.len() != self.count() {
+            return Err(Error::param(
+                "follower colours",
+                colors.len(),
+                format!("one root and tip colour per strand ({})", self.count()),
+            ));
+        }
+        if let Some(s) = colors
+            .iter()
+            .position(|c| !c.iter().all(|c| c.is_finite() && c.cmpge(Vec3::ZERO).all() && c.cmple(Vec3::ONE).all()))
+        {
+            return Err(Error::param(
+                "follower colours",
+                format!("strand {s}: {:?}", colors[s]),
+                "components in 0..=1",
+            ));
+        }
+        self.colors = Some(self.order.iter().map(|&s| colors[s as usize]).collect());
+        Ok(self)
+    }
+
+    /// The same followers drawn at their own widths: per strand of the groom
+    /// (the file's order) its width at the root and at the tip as a factor of
+    /// the material's root and tip widths (0..=[`MAX_WIDTH_FACTOR`]; 1 draws
+    /// the material's), blended along the strand.
+    pub fn with_width_factors(mut self, factors: &[[f32; 2]]) -> Result<Self> {
+        if factors.len() != self.count() {
+            return Err(Error::param(
+                "follower width factors",
+                factors.len(),
+                format!("one root and tip factor per strand ({})", self.count()),
+            ));
+        }
+        let fits = |f: &[f32; 2]| f.iter().all(|f| (0.0..=MAX_WIDTH_FACTOR).contains(f));
+        if let Some(s) = factors.iter().position(|f| !fits(f)) {
+            return Err(Error::param(
+                "follower width factors",
+                format!("strand {s}: {:?}", factors[s]),
+                format!("0..={MAX_WIDTH_FACTOR}"),
+            ));
+        }
+        self.widths = Some(self.order.iter().map(|&s| factors[s as usize]).collect());
+        Ok(self)
+    }
+
+    /// Each follower's width factors at the root and the tip, in drawing order.
+    pub fn width_factors(&self) -> Option<&[[f32; 2]]> {
+        self.widths.as_deref()
+    }
+
+    /// Each follower's own albedo at the root and the tip, in drawing order.
+    pub fn colors(&self) -> Option<&[[Vec3; 2]]> {
+        self.colors.as_deref()
     }
 
     /// Followers (every strand of the groom bound).
@@ -199,9 +284,10 @@ impl Followers {
         self.root_spacing
     }
 
-    /// GPU bytes the binding takes: offsets and per-follower guides and weights.
+    /// GPU bytes the binding takes: offsets, per-follower guides and weights,
+    /// and per follower its colours and width factors (32 bytes).
     pub fn gpu_bytes(&self) -> u64 {
-        (self.offsets.len() * 4 + self.bindings.len() * std::mem::size_of::<FollowerBinding>()) as u64
+        (self.offsets.len() * 4 + self.bindings.len() * (std::mem::size_of::<FollowerBinding>() + 32)) as u64
     }
 
     pub(crate) fn gpu_bindings(&self) -> &[FollowerBinding] {

@@ -19,7 +19,7 @@
 use std::sync::Arc;
 
 use ash::vk;
-use glam::Vec4;
+use glam::{Vec3, Vec4};
 
 use super::followers::Followers;
 use super::pass::{self, RenderPass};
@@ -91,6 +91,11 @@ pub(super) struct InterpolatePass {
     tangents: Buffer,
     /// The followers' pipeline and binding buffers, when drawing followers.
     follow: Option<Follow>,
+    /// Per drawn follower its own albedo and width factor at the root and the
+    /// tip (two vec4); two zero vec4 never read without followers.
+    looks: Buffer,
+    /// Whether the hairs have their own albedo.
+    own_colors: bool,
 }
 
 /// The followers' evaluation stage and what it reads.
@@ -147,6 +152,22 @@ impl InterpolatePass {
             let set = pipeline.declared_buffer_set(0, &bindings)?;
             Ok(Pipeline { pipeline, set })
         };
+        let colors = followers.and_then(Followers::colors);
+        let widths = followers.and_then(Followers::width_factors);
+        // Every follower's entry: its colours (zero without) and width factors
+        // (1 without); the follower stage writes the factors into the hairs.
+        let look_data: Vec<Vec4> = match followers {
+            Some(f) => (0..f.count())
+                .flat_map(|i| {
+                    let [root, tip] = colors.map_or([Vec3::ZERO; 2], |c| c[i]);
+                    let [wr, wt] = widths.map_or([1.0; 2], |w| w[i]);
+                    [root.extend(wr), tip.extend(wt)]
+                })
+                .collect(),
+            None => vec![Vec4::ZERO; 2],
+        };
+        let looks = storage("vkhair hair colours", (look_data.len() * 16) as u64)?;
+        device.upload_pod(&looks, &look_data)?;
         let follow = match followers {
             None => None,
             Some(f) => {
@@ -169,6 +190,7 @@ impl InterpolatePass {
                     (4, &tangents),
                     (6, &b),
                     (7, &o),
+                    (8, &looks),
                 ];
                 let set = pipeline.declared_buffer_set(0, &all)?;
                 Some(Follow { pipeline: Pipeline { pipeline, set }, _bindings: b, _offsets: o })
@@ -177,6 +199,8 @@ impl InterpolatePass {
         Ok(InterpolatePass {
             device: device.clone(),
             follow,
+            own_colors: colors.is_some(),
+            looks,
             single_strand: pipeline(&RENDER_INTERPOLATE_TESE)?,
             barycentric: pipeline(&RENDER_INTERPOLATE_BARY_TESE)?,
             reference,
@@ -206,6 +230,13 @@ impl InterpolatePass {
     /// Key hairs (of `strands`), or scalp triangles: what `mode` grows hairs from.
     pub(super) fn units(&self, mode: InterpolationMode, strands: u32) -> u32 {
         units(mode, strands, self.triangles)
+    }
+
+    /// Per drawn hair its own albedo and width factor at the root and the
+    /// tip, and whether the hairs have their own albedo (their width factors
+    /// are in the hair positions' w).
+    pub(super) fn looks(&self) -> (&Buffer, bool) {
+        (&self.looks, self.own_colors)
     }
 
     /// The interpolated hairs: positions and (tangent, t).

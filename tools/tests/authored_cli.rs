@@ -117,7 +117,8 @@ fn usd_and_alembic_reads_are_bounded() {
 }
 
 /// A dense groom written by usd-core (`tools/usd_dense_groom.py`: 1,500 curly
-/// strands of 24 points, meters, Z up): rendered as followers of guides, and
+/// strands of 24 points, meters, Z up; its head sphere as an OBJ): rendered
+/// as followers of guides colliding with the head, and
 /// `simulate --drawn-out` writes every authored strand as drawn, in the file's
 /// order, close to the authored one after one still step.
 #[test]
@@ -126,13 +127,15 @@ fn a_dense_groom_draws_its_authored_strands_as_followers() {
     let usd = data("usd/dense_curly.usdc");
     let frames = dir.path().join("frames");
     let line = format!(
-        "render --input {} --guides 0.1 --frames 1 --width 160 --height 120 --shadow-resolution 64 --out {}",
+        "render --input {} --obj {} --guides 0.1 --frames 1 --width 160 --height 120 --shadow-resolution 64 --out {}",
         usd.display(),
+        data("usd/dense_curly_head.obj").display(),
         frames.display()
     );
     let out = run_line(&line, LIMIT);
     out.assert_ok();
     assert!(out.stdout.contains("followers: 1500 strands drawn as followers of 150 guides"), "{}", out.stdout);
+    assert!(out.stdout.contains("mesh collider"), "{}", out.stdout);
     let (_, _, rgba) = common::read_png(&frames.join("frame_0000.png"));
     assert!(common::coverage(&rgba) > 0.05, "the groom covers {:.2} % of the image", 100.0 * common::coverage(&rgba));
     // The same through Alembic: converted, then read with its own reader.
@@ -189,4 +192,60 @@ fn guides_options_are_checked() {
     let out = run_line(&format!("simulate --input {} --guides all --steps 1", usd.display()), LIMIT);
     out.assert_ok();
     assert!(out.stdout.contains("1500 key hairs") && !out.stdout.contains("guides:"), "{}", out.stdout);
+}
+
+/// Writes a `w` × `h` RGB PNG of `texel(x, y)`.
+fn write_png(path: &Path, (w, h): (u32, u32), texel: impl Fn(u32, u32) -> [u8; 3]) {
+    let file = std::fs::File::create(path).expect("png file");
+    let mut encoder = png::Encoder::new(file, w, h);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let data: Vec<u8> = (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).flat_map(|(x, y)| texel(x, y)).collect();
+    encoder.write_header().expect("header").write_image_data(&data).expect("pixels");
+}
+
+/// Mean RGB of the pixels that are not the background.
+fn hair_rgb(path: &Path) -> [f64; 3] {
+    let (_, _, rgba) = common::read_png(path);
+    let bg = [rgba[0], rgba[1], rgba[2]];
+    let hair: Vec<&[u8]> = rgba.chunks_exact(4).filter(|p| p[..3] != bg).collect();
+    let n = hair.len().max(1) as f64;
+    [0, 1, 2].map(|c| hair.iter().map(|p| f64::from(p[c])).sum::<f64>() / n)
+}
+
+#[test]
+fn followers_take_the_file_colours_or_a_scalp_texture() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let usd = data("usd/dense_curly.usdc");
+    let render = |extra: &str, out: &str| {
+        let frames = dir.path().join(out);
+        let line = format!(
+            "render --input {} --guides 0.1 --no-shadows --frames 1 --width 120 --height 120 --out {} {extra}",
+            usd.display(),
+            frames.display()
+        );
+        let run = run_line(&line, LIMIT);
+        run.assert_ok();
+        (run.stdout.clone(), hair_rgb(&frames.join("frame_0000.png")))
+    };
+    // The file's displayColor: browns, red over green over blue.
+    let (stdout, file) = render("", "file");
+    assert!(stdout.contains("the file's colours"), "{stdout}");
+    assert!(file[0] > file[1] && file[1] > file[2], "the file's browns drawn as {file:?}");
+    // A green scalp texture, sampled at the root UVs.
+    let texture = dir.path().join("green.png");
+    write_png(&texture, (2, 2), |_, _| [0, 200, 0]);
+    let (stdout, green) = render(&format!("--scalp-texture {}", texture.display()), "green");
+    assert!(stdout.contains("the scalp texture at the root UVs colours"), "{stdout}");
+    assert!(green[1] > 2.0 * green[0] && green[1] > 2.0 * green[2], "a green texture drawn as {green:?}");
+    // No root UVs, no dense groom, no image: said.
+    let arnold = data("curves/arnold-usd_test_0184_groom_sphere.usda");
+    let line = format!("render --input {} --guides 20 --scalp-texture {}", arnold.display(), texture.display());
+    run_line(&line, LIMIT).assert_error("has no root UVs");
+    let line = format!("render --input {} --scalp-texture {}", arnold.display(), texture.display());
+    run_line(&line, LIMIT).assert_error("give --guides");
+    let junk = dir.path().join("junk.png");
+    std::fs::write(&junk, b"not a png").expect("write");
+    let line = format!("render --input {} --guides 0.1 --scalp-texture {}", usd.display(), junk.display());
+    run_line(&line, LIMIT).assert_error("not a PNG image");
 }

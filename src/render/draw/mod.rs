@@ -94,6 +94,9 @@ pub(super) struct DrawInputs<'a> {
     pub atlas: (vk::ImageView, vk::Sampler),
     /// Per-cell transmittance of density-volume lights.
     pub transmittance: &'a Buffer,
+    /// Per hair its own albedo at the root and the tip (read when the draw
+    /// parameters say the hairs have them).
+    pub looks: &'a Buffer,
 }
 
 /// One frame of pass 4: everything its modes record with and into.
@@ -265,18 +268,21 @@ impl Renderer {
             cmd,
             frame,
             timing: Timing::of(profiler.as_deref()),
-            params: draw_params(
-                mode != Transparency::Off,
-                &self.material,
-                &self.lights,
-                StrandFootprint {
-                    width_scale: self.detail.width_scale,
-                    hairs: self.strand_hairs(),
-                    spacing: self.strand_spacing(),
-                },
-                self.hair_counts(),
-                camera,
-                drawn.extent,
+            params: own_looks(
+                draw_params(
+                    mode != Transparency::Off,
+                    &self.material,
+                    &self.lights,
+                    StrandFootprint {
+                        width_scale: self.detail.width_scale,
+                        hairs: self.strand_hairs(),
+                        spacing: self.strand_spacing(),
+                    },
+                    self.hair_counts(),
+                    camera,
+                    drawn.extent,
+                ),
+                self.interpolate.looks().1,
             ),
             vertices: self.draw_vertices(),
             target: drawn,
@@ -285,6 +291,7 @@ impl Renderer {
                 shadow_uniforms: self.shadows.uniforms(),
                 atlas: self.shadows.atlas(),
                 transmittance: self.shadows.transmittance(),
+                looks: self.interpolate.looks().0,
             },
             marschner: self.material.marschner,
         };
@@ -359,6 +366,12 @@ pub(super) struct StrandFootprint {
     pub hairs: f32,
     /// Spacing of the drawn strands at the root and at the tip, m.
     pub spacing: (f32, f32),
+}
+
+/// `params` for hairs drawn in their own albedo (`own`) or the material's.
+fn own_looks(mut params: DrawParams, own: bool) -> DrawParams {
+    params.widths[3] = if own { 1.0 } else { 0.0 };
+    params
 }
 
 /// The draw's uniform block for `hairs` hairs of `per_hair` vertices with

@@ -18,7 +18,7 @@ use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc, Sampler};
 
 /// The shading stages' buffers and (view, sampler) images, by binding.
-pub(super) type ShadingBindings<'a> = ([(u32, &'a Buffer); 5], [(u32, vk::ImageView, vk::Sampler); 4]);
+pub(super) type ShadingBindings<'a> = ([(u32, &'a Buffer); 6], [(u32, vk::ImageView, vk::Sampler); 4]);
 
 /// The uniform block, the noise texture and the Marschner tables.
 pub(super) struct ShadingResources {
@@ -63,6 +63,7 @@ impl ShadingResources {
                 (2, inputs.hairs.1),
                 (6, inputs.shadow_uniforms),
                 (8, inputs.transmittance),
+                (24, inputs.looks),
             ],
             [
                 (3, self.noise.view(), self.sampler.raw),

@@ -4,10 +4,13 @@
 
 use std::path::{Path, PathBuf};
 
+use glam::Vec3;
 use vkhair::groom::authored::{AuthoredGroom, CurveObject, UpAxis};
 use vkhair::groom::cyhair::HairFile;
 use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::{alembic, guides, usd, Groom, Repairs};
+
+use super::texture::Texture;
 
 use crate::output::Error;
 
@@ -61,6 +64,12 @@ pub struct InputArgs {
     /// every strand up to 4096 strands, else 5 % of them (at least 64)]
     #[arg(long)]
     pub guides: Option<String>,
+    /// Colour each strand of a dense groom drawn as followers from this PNG
+    /// (sRGB), sampled at the strand's root UV (the file's st, groom_root_uv
+    /// or uv) [default: the file's own colours (displayColor, groom_color),
+    /// else the material's]
+    #[arg(long)]
+    pub scalp_texture: Option<PathBuf>,
 }
 
 /// A groom with more strands than this is dense: without --guides or guide
@@ -77,6 +86,13 @@ pub struct Dense {
     pub chosen_by: &'static str,
     /// Points per drawn follower: the file's median per strand, 4..=64.
     pub points: usize,
+    /// Each strand's own albedo at the root and the tip (the file's order).
+    pub colors: Option<Vec<[Vec3; 2]>>,
+    /// Where the colours come from, for the run's header.
+    pub colors_from: &'static str,
+    /// Each strand's width at the root and the tip as a factor of the
+    /// groom's median there (the file's thickness), 0..=10.
+    pub width_factors: Option<Vec<[f32; 2]>>,
 }
 
 impl InputArgs {
@@ -129,12 +145,18 @@ impl InputArgs {
             }
             guide_request(g)?;
         }
+        if self.scalp_texture.is_some() && self.input.is_none() {
+            return Err("--scalp-texture needs --input (a dense groom with root UVs)".into());
+        }
         Ok(())
     }
 
     /// The files these flags read.
     pub fn files(&self) -> Vec<&Path> {
-        [self.input.as_deref(), self.obj.as_deref(), self.gltf.as_deref()].into_iter().flatten().collect()
+        [self.input.as_deref(), self.obj.as_deref(), self.gltf.as_deref(), self.scalp_texture.as_deref()]
+            .into_iter()
+            .flatten()
+            .collect()
     }
 
     /// The --scale factor.
@@ -148,13 +170,22 @@ impl InputArgs {
     pub fn groom_and_guides(&self, path: &Path) -> Result<(Scaled, Option<Dense>), Error> {
         let loaded = load_with_defaults(path, self.strict)?;
         let marks = loaded.authored.as_ref().and_then(|a| a.guides.clone());
+        let root_uvs = loaded.authored.as_ref().and_then(|a| a.root_uvs.clone());
         let groom = loaded.groom.scaled(self.scale())?;
         let thickness = groom.end_thickness().or(loaded.header_thickness.map(|t| (t * self.scale(), t * self.scale())));
         let points = self.points.unwrap_or(16);
         let n = groom.strand_count();
         let request = self.guides.as_deref().map(guide_request).transpose()?;
+        let key_hairs_only = |groom: Groom| -> Result<(Scaled, Option<Dense>), Error> {
+            if self.scalp_texture.is_some() {
+                return Err("--scalp-texture colours the strands of a dense groom drawn as followers of guides; this \
+                            one is simulated strand by strand (give --guides)"
+                    .into());
+            }
+            Ok((Scaled { groom: groom.resampled(points)?, thickness }, None))
+        };
         let (guides, chosen_by) = match (request, marks) {
-            (Some(Guides::All), _) => return Ok((Scaled { groom: groom.resampled(points)?, thickness }, None)),
+            (Some(Guides::All), _) => return key_hairs_only(groom),
             (Some(Guides::Count(c)), _) => (guides::spread(&groom, c.min(n))?, "--guides, spread over the roots"),
             (Some(Guides::Share(f)), _) => {
                 let c = ((n as f64 * f).round() as usize).clamp(1, n);
@@ -164,19 +195,57 @@ impl InputArgs {
             (None, None) if n > DENSE_STRANDS => {
                 (guides::spread(&groom, (n / 20).max(64))?, "5 % of a dense groom, spread over the roots")
             }
-            (None, None) => return Ok((Scaled { groom: groom.resampled(points)?, thickness }, None)),
+            (None, None) => return key_hairs_only(groom),
+        };
+        let (colors, colors_from) = match &self.scalp_texture {
+            Some(texture) => {
+                let uvs = root_uvs.ok_or_else(|| {
+                    format!(
+                        "--scalp-texture: {} has no root UVs (primvars:st or groom_root_uv in USD, uv or \
+                         groom_root_uv in Alembic)",
+                        path.display()
+                    )
+                })?;
+                let t = Texture::open(texture)?;
+                (Some(uvs.iter().map(|&uv| [t.sample(uv); 2]).collect()), "the scalp texture at the root UVs")
+            }
+            None => match groom.end_colors() {
+                Some(c) => {
+                    let clamp = |c: Vec3| c.clamp(Vec3::ZERO, Vec3::ONE);
+                    (Some(c.into_iter().map(|[r, t]| [clamp(r), clamp(t)]).collect()), "the file's")
+                }
+                None => (None, "the material's"),
+            },
         };
         let keys = groom.select(&guides)?.resampled(points)?;
         let mut per_strand: Vec<usize> = (0..n).map(|s| groom.strand_len(s)).collect();
         per_strand.sort_unstable();
         let follower_points = per_strand[n / 2].clamp(4, 64);
-        Ok((Scaled { groom: keys, thickness }, Some(Dense { groom, guides, chosen_by, points: follower_points })))
+        let width_factors = width_factors(&groom);
+        let dense = Dense { groom, guides, chosen_by, points: follower_points, colors, colors_from, width_factors };
+        Ok((Scaled { groom: keys, thickness }, Some(dense)))
     }
 
     /// Whether the strands collide with the --obj mesh.
     pub fn colliding(&self) -> bool {
         self.input.is_some() && self.obj.is_some() && !self.no_mesh_collider
     }
+}
+
+/// Each strand's thickness at its root and tip over the groom's median there
+/// (see [`Groom::end_thickness`]), 0..=10; 1 where the median is 0.
+fn width_factors(groom: &Groom) -> Option<Vec<[f32; 2]>> {
+    let t = groom.thickness()?;
+    let (root, tip) = groom.end_thickness()?;
+    let factor = |v: f32, median: f32| if median > 0.0 { (v / median).clamp(0.0, 10.0) } else { 1.0 };
+    Some(
+        (0..groom.strand_count())
+            .map(|s| {
+                let r = groom.strand_range(s);
+                [factor(t[r.start], root), factor(t[r.end - 1], tip)]
+            })
+            .collect(),
+    )
 }
 
 /// What --guides asks for.
@@ -223,8 +292,8 @@ pub struct Loaded {
 pub struct Authored {
     /// Per-strand guide marks, when the file has them.
     pub guides: Option<Vec<bool>>,
-    /// Whether the strands have root UVs.
-    pub root_uvs: bool,
+    /// Per-strand root UVs, when the file has them.
+    pub root_uvs: Option<Vec<glam::Vec2>>,
     /// The curve objects read.
     pub objects: Vec<CurveObject>,
     /// Meters per file unit, and whether the file states it.
@@ -265,7 +334,7 @@ fn authored(g: AuthoredGroom, format: &str, path: &Path) -> (Groom, String, Auth
     let kind = format!("{format} (.{ext}), {} curve objects: {}", objects.len(), objects.join(", "));
     let rest = Authored {
         guides: g.guides,
-        root_uvs: g.root_uvs.is_some(),
+        root_uvs: g.root_uvs,
         objects: g.objects,
         meters_per_unit: (g.meters_per_unit, g.units_stated),
         up_axis: g.up_axis,
@@ -382,4 +451,27 @@ pub fn strand_widths(thickness: Option<(f32, f32)>, k: f32) -> Option<(f32, f32)
         return None;
     }
     Some((root, tip))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn width_factors_are_each_strands_thickness_over_the_median() {
+        let strand = |x: f32| vec![Vec3::new(x, 0.0, 0.0), Vec3::new(x, -0.1, 0.0)];
+        let positions: Vec<Vec3> = [0.0, 0.01, 0.02].into_iter().flat_map(strand).collect();
+        // Roots 50, 100, 200 µm (median 100); tips 10, 20, 20 (median 20); a
+        // root 200 × the median is clamped to 10.
+        let thickness = vec![50e-6, 10e-6, 100e-6, 20e-6, 20e-3, 20e-6];
+        let attributes = vkhair::groom::Attributes { thickness: Some(thickness), ..Default::default() };
+        let groom = Groom::with_attributes(positions, &[2, 2, 2], attributes).expect("groom");
+        let f = width_factors(&groom).expect("factors");
+        let want = [[0.5, 0.5], [1.0, 1.0], [10.0, 1.0]];
+        for (got, want) in f.iter().zip(want) {
+            assert!((got[0] - want[0]).abs() < 1e-5 && (got[1] - want[1]).abs() < 1e-5, "{got:?} against {want:?}");
+        }
+        let bare = Groom::new(vec![Vec3::ZERO, Vec3::X], &[2]).expect("groom");
+        assert!(width_factors(&bare).is_none());
+    }
 }

@@ -5,3 +5,4 @@
 pub mod input;
 pub mod scene;
 pub mod sim;
+pub mod texture;

@@ -107,12 +107,14 @@ pub fn make_renderer(
         Some(d) => {
             let followers = bind_followers(d, &s.groom, config)?;
             say!(
-                "followers: {} strands drawn as followers of {} guides ({}), {} points each, {:.1} MiB of bindings",
+                "followers: {} strands drawn as followers of {} guides ({}), {} points each, {:.1} MiB of bindings, \
+                 {} colours",
                 followers.count(),
                 d.guides.len(),
                 d.chosen_by,
                 followers.points(),
-                followers.gpu_bytes() as f64 / (1 << 20) as f64
+                followers.gpu_bytes() as f64 / (1 << 20) as f64,
+                d.colors_from
             );
             Renderer::with_followers(ctx, key_hairs, &config.render, &followers)?
         }
@@ -164,7 +166,15 @@ pub fn make_renderer(
 /// simulation's rest state), at the smoothing level of `config`.
 pub fn bind_followers(dense: &Dense, keys: &vkhair::Groom, config: &Config) -> Result<Followers, vkhair::Error> {
     let rest = SimState::from_groom(keys, &config.sim, &RigidTransform::default())?;
-    Followers::bind(&dense.groom, &dense.guides, &rest, config.render.smoothing_level, dense.points)
+    let followers = Followers::bind(&dense.groom, &dense.guides, &rest, config.render.smoothing_level, dense.points)?;
+    let followers = match &dense.colors {
+        Some(c) => followers.with_colors(c)?,
+        None => followers,
+    };
+    match &dense.width_factors {
+        Some(w) => followers.with_width_factors(w),
+        None => Ok(followers),
+    }
 }
 
 /// Hairs on a full head of real hair, for the tool's default of

@@ -54,7 +54,7 @@ fn report(l: &Loaded) -> serde_json::Value {
             "thickness": s.has_thickness,
             "transparency": s.has_transparency,
             "colors": s.has_colors,
-            "root_uvs": a.is_some_and(|a| a.root_uvs),
+            "root_uvs": a.is_some_and(|a| a.root_uvs.is_some()),
             "guide_marks": guides.is_some(),
         },
         "curve_objects": a.map(|a| a.objects.iter().map(|o| json!({
@@ -101,7 +101,7 @@ fn print_table(path: &std::path::Path, l: &Loaded) {
     );
     say!("segment length     min {:.5}  max {:.5}", s.segment_length.0, s.segment_length.1);
     say!("bounds             {:.4} .. {:.4}  (size {:.4})", s.bounds.0, s.bounds.1, s.bounds.1 - s.bounds.0);
-    let uvs = l.authored.as_ref().is_some_and(|a| a.root_uvs);
+    let uvs = l.authored.as_ref().is_some_and(|a| a.root_uvs.is_some());
     say!(
         "attributes         thickness {}  transparency {}  colors {}  root UVs {}",
         yes(s.has_thickness),
