@@ -82,14 +82,14 @@ fn length(line: &[Vec3]) -> f32 {
 fn cpu_followers(s: &Scene, state: &SimState, head: Quat) -> Vec<Vec3> {
     let guides: Vec<Vec<(Vec3, Vec3)>> =
         (0..state.strands).map(|g| smooth_strand(&state.strand(g).collect::<Vec<_>>(), LEVEL)).collect();
-    s.followers.evaluate(&guides, &rest_plane_normals(state), head, s.followers.count())
+    s.followers.evaluate(&guides, &rest_plane_normals(state), head, s.followers.count()).expect("evaluate")
 }
 
 /// The drawn followers the GPU evaluates, in the file's strand order.
 fn gpu_followers(renderer: &mut Renderer, sim: &HairSim, s: &Scene) -> Vec<Vec<Vec3>> {
     renderer.prepare_now(sim, None).expect("prepare");
     let (positions, _) = renderer.read_hairs().expect("hairs");
-    s.followers.to_input_order(&positions).into_iter().map(|(_, strand)| strand).collect()
+    s.followers.to_input_order(&positions).expect("whole followers").into_iter().map(|(_, strand)| strand).collect()
 }
 
 fn drawing_order(cpu: &[Vec3], s: &Scene) -> Vec<Vec<Vec3>> {
@@ -157,7 +157,8 @@ fn resampled_followers_stay_within_half_a_percent_of_the_authored_strands() {
     let mut renderer = Renderer::with_followers(gpu.ctx(), &sim, &params(), &followers).expect("renderer");
     renderer.prepare_now(&sim, None).expect("prepare");
     let (positions, _) = renderer.read_hairs().expect("hairs");
-    let drawn: Vec<Vec<Vec3>> = followers.to_input_order(&positions).into_iter().map(|(_, s)| s).collect();
+    let drawn: Vec<Vec<Vec3>> =
+        followers.to_input_order(&positions).expect("whole followers").into_iter().map(|(_, s)| s).collect();
     let mut deviations: Vec<f32> = (0..dense.strand_count())
         .flat_map(|i| {
             let authored = dense.strand(i);
@@ -250,9 +251,7 @@ fn level_of_detail_draws_a_prefix_spread_over_the_scalp() {
     let gpu = Gpu::new();
     let s = scene(400, 40);
     let sim = HairSim::new(gpu.ctx(), &s.keys, &SimParams::default(), &RigidTransform::default()).expect("sim");
-    // The smoothing level held, so that the prefix is the same hairs to the bit.
-    let mut p = params();
-    p.lod.min_smoothing_level = LEVEL;
+    let p = params();
     let mut renderer = Renderer::with_followers(gpu.ctx(), &sim, &p, &s.followers).expect("renderer");
     renderer.prepare_now(&sim, None).expect("prepare");
     let (full, _) = renderer.read_hairs().expect("hairs");
@@ -261,6 +260,9 @@ fn level_of_detail_draws_a_prefix_spread_over_the_scalp() {
         Camera::look_at(Vec3::new(0.0, 1.6, 6.0), Vec3::new(0.0, 1.6, 0.0), 0.8, 1.0, 0.01, 100.0).expect("camera");
     renderer.prepare_now(&sim, Some(&far)).expect("prepare");
     let detail = renderer.detail();
+    // The followers stay at the smoothing level they were bound at, so the
+    // prefix is the same hairs to the bit.
+    assert_eq!(detail.smoothing_level, LEVEL);
     let (drawn, per) = renderer.hair_counts();
     let want = (400.0 * detail.hairs_per_key as f32 / p.hairs_per_key as f32).round() as u32;
     assert!(detail.hairs_per_key < p.hairs_per_key, "the camera is not far enough to thin the hair");
@@ -293,6 +295,12 @@ fn bad_bindings_are_refused() {
     let sim = HairSim::new(gpu.ctx(), &keys, &SimParams::default(), &RigidTransform::default()).expect("sim");
     let other = RenderParams { smoothing_level: LEVEL + 1, ..RenderParams::default() };
     assert!(Renderer::with_followers(gpu.ctx(), &sim, &other, &f).is_err());
+    let mut renderer = Renderer::with_followers(gpu.ctx(), &sim, &params(), &f).expect("renderer");
+    let lower = RenderParams { smoothing_level: LEVEL - 1, ..params() };
+    assert!(renderer.set_params(&lower).is_err(), "another smoothing level for bound followers");
+    // The CPU evaluation and the read-back order refuse what does not fit.
+    assert!(f.evaluate(&[], &[], Quat::IDENTITY, 1).is_err());
+    assert!(f.to_input_order(&[Vec4::ZERO; POINTS + 1]).is_err());
 }
 
 /// Mean linear-ish RGB of the pixels that are not background.
@@ -345,4 +353,20 @@ fn followers_are_drawn_in_their_own_colours() {
     assert!(s.followers.clone().with_colors(&bad).is_err());
     bad[7][1] = Vec3::NAN;
     assert!(s.followers.clone().with_colors(&bad).is_err());
+}
+
+/// Guides turned against each other (one growing up, two down) blend to a
+/// nearly singular frame: the follower between them takes its heaviest guide
+/// alone instead of an offset the blend's inverse would magnify.
+#[test]
+fn a_nearly_singular_blend_falls_back_to_the_heaviest_guide() {
+    let line = |x: f32, z: f32, dir: f32| (0..6).map(|i| Vec3::new(x, dir * 0.02 * i as f32, z)).collect::<Vec<_>>();
+    let strands = vec![line(0.0, 0.0, 1.0), line(0.02, 0.0, -1.0), line(0.01, 0.02, -1.0), line(0.008, 0.006, 1.0)];
+    let dense = Groom::from_strands(&strands).expect("groom");
+    let keys = dense.select(&[0, 1, 2]).expect("guides");
+    let rest = SimState::from_groom(&keys, &SimParams::default(), &RigidTransform::default()).expect("rest");
+    let f = Followers::bind(&dense, &[0, 1, 2], &rest, LEVEL, 6).expect("bind");
+    let bound = f.guides_of(3).expect("bound");
+    let weights: Vec<f32> = bound.iter().map(|&(_, w)| w).filter(|&w| w > 0.0).collect();
+    assert_eq!(weights, vec![1.0], "the follower blends {bound:?}");
 }

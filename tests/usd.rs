@@ -180,3 +180,13 @@ fn an_animated_stage_gives_its_first_sample() {
     let xs: Vec<f32> = g.groom.positions().iter().map(|p| p.x).collect();
     assert_eq!(xs, vec![0.0; 3], "not the first sample: {:?}", g.groom.positions());
 }
+
+#[test]
+fn nested_rotations_scales_and_translations_compose_as_usd_core_does() {
+    // usd-core's ComputeLocalToWorldTransform (tools/usd_fixtures.py prints them).
+    let g = usd::open(data("usd/rotated.usda")).expect("rotated");
+    let want = [Vec3::new(-0.1464466, 3.4783978, 3.7071068), Vec3::new(-0.3114437, 4.085_435, 3.3017896)];
+    for (p, w) in g.groom.positions().iter().zip(want) {
+        assert!((*p - w).length() < 1e-5, "{p} against usd-core's {w}");
+    }
+}

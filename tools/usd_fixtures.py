@@ -25,6 +25,11 @@ back through vkhair: nothing in the files is computed by vkhair.
 - nan.usda: one linear curve with a NaN point.
 - animated.usda: one linear curve whose points are time samples only, at
   times 5 (x = 0) and 10 (x = 1): the first sample is read.
+- rotated.usda: meters, Y up; /a translates (1, 2, 3), rotates XYZ (30, 45,
+  60) degrees and scales (2, 2, 2); /a/b rotates 90 degrees about Y then
+  translates (0, 1, 0); /a/b/c is a linear curve through (0, 0, 0) and
+  (0.1, 0.2, 0.3). The script prints the points usd-core's
+  ComputeLocalToWorldTransform gives them (the values tests/usd.rs states).
 """
 
 import math
@@ -107,10 +112,31 @@ def animated(path):
     stage.GetRootLayer().Save()
 
 
+def rotated(path):
+    stage = Usd.Stage.CreateNew(path)
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
+    a = UsdGeom.Xform.Define(stage, "/a")
+    a.AddTranslateOp().Set(Gf.Vec3d(1, 2, 3))
+    a.AddRotateXYZOp().Set(Gf.Vec3f(30, 45, 60))
+    a.AddScaleOp().Set(Gf.Vec3f(2, 2, 2))
+    b = UsdGeom.Xform.Define(stage, "/a/b")
+    b.AddRotateYOp().Set(90.0)
+    b.AddTranslateOp().Set(Gf.Vec3d(0, 1, 0))
+    c = UsdGeom.BasisCurves.Define(stage, "/a/b/c")
+    c.CreateTypeAttr(UsdGeom.Tokens.linear)
+    c.CreateCurveVertexCountsAttr(Vt.IntArray([2]))
+    pts = [Gf.Vec3f(0, 0, 0), Gf.Vec3f(0.1, 0.2, 0.3)]
+    c.CreatePointsAttr(Vt.Vec3fArray(pts))
+    stage.GetRootLayer().Save()
+    m = UsdGeom.Xformable(c).ComputeLocalToWorldTransform(Usd.TimeCode.Default())
+    print("rotated.usda world points:", [tuple(round(v, 7) for v in m.Transform(Gf.Vec3d(p))) for p in pts])
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
     written = ["small_cm_zup.usda", "small_cm_zup.usdc", "periodic.usda", "no_points.usda",
-               "counts_mismatch.usda", "nan.usda", "animated.usda"]
+               "counts_mismatch.usda", "nan.usda", "animated.usda", "rotated.usda"]
     for name in written:
         if os.path.exists(os.path.join(OUT, name)):
             os.remove(os.path.join(OUT, name))
@@ -122,6 +148,7 @@ def main():
     one_curve(os.path.join(OUT, "counts_mismatch.usda"), [(0, 0, 0), (0, 1, 0), (0, 2, 0), (0, 3, 0)], counts=[2, 3])
     one_curve(os.path.join(OUT, "nan.usda"), [(0, 0, 0), (0, float("nan"), 0), (0, 2, 0)])
     animated(os.path.join(OUT, "animated.usda"))
+    rotated(os.path.join(OUT, "rotated.usda"))
     print("wrote", written, "with usd-core", ".".join(map(str, Usd.GetVersion())))
 
 

@@ -9,8 +9,8 @@
 //!    linear, B-spline and Catmull-Rom strands keep their points (vkhair's
 //!    tessellation smooths every strand as a B-spline of its points), except
 //!    that a B-spline's end point repeated to pin the curve to it (as groom
-//!    exporters write them: three equal points at the root and the tip) is
-//!    kept once;
+//!    exporters write them: three or more equal points at the root or the
+//!    tip) is kept once;
 //! 2. lengths become meters (the file's unit) and a Z-up file turns to Y up
 //!    (`(x, y, z)` → `(x, z, −y)`), widths scaled like lengths;
 //! 3. the strands of every object are concatenated in file order, then checked
@@ -203,13 +203,21 @@ fn collapse_pinned_ends(o: &mut RawCurves) {
     let mut at = 0usize;
     for n in o.counts.iter_mut() {
         let p = &o.points[at..at + *n as usize];
+        // A run of three or more equal points at an end is the exporter's
+        // pinning; a shorter one is a zero-length segment for the checks.
         let mut first = 0;
         while first + 2 < p.len() && p[first + 1] == p[first] {
             first += 1;
         }
+        if first < 2 {
+            first = 0;
+        }
         let mut last = p.len().saturating_sub(1);
         while last > first + 1 && p[last - 1] == p[last] {
             last -= 1;
+        }
+        if p.len().saturating_sub(1) - last < 2 {
+            last = p.len().saturating_sub(1);
         }
         if p.len() < 2 {
             first = 0;
@@ -261,11 +269,25 @@ impl Topology<'_> {
     /// `varying` values on a curve of `n` points: one per segment end.
     pub(crate) fn varying(&self, n: u32) -> u32 {
         match self.basis {
-            _ if self.pinned => n,
+            Basis::Bspline | Basis::CatmullRom if self.pinned => n,
             Basis::Linear => n,
             Basis::Bspline | Basis::CatmullRom => n.saturating_sub(2),
             Basis::Bezier => n.saturating_sub(1) / 3 + 1,
         }
+    }
+}
+
+/// Refuses a curve that a primvar of `interp` gives no value of its own: one
+/// of no points, or a cubic curve too short for varying values.
+fn check_valued(name: &'static str, interp: Interpolation, topology: &Topology<'_>) -> Result<()> {
+    let empty = |n: u32| n == 0 || (interp == Interpolation::Varying && topology.varying(n) == 0);
+    match topology.counts.iter().position(|&n| empty(n)) {
+        Some(c) => Err(Error::param(
+            name,
+            format!("curve {c} of {} points", topology.counts[c]),
+            "curves with a value of their own (at least one point; a cubic curve's varying values need four)",
+        )),
+        None => Ok(()),
     }
 }
 
@@ -285,6 +307,7 @@ where
     if values.len() != expected {
         return Err(Error::AttributeLength { what: name, expected, actual: values.len() });
     }
+    check_valued(name, interp, topology)?;
     Ok(match interp {
         Interpolation::Constant => vec![values[0]; points],
         Interpolation::Uniform => per_point_from_curves(&values, counts),
@@ -319,6 +342,7 @@ pub(crate) fn per_curve<T: Copy>(
     if values.len() != expected {
         return Err(Error::AttributeLength { what: name, expected, actual: values.len() });
     }
+    check_valued(name, interp, topology)?;
     Ok(match interp {
         Interpolation::Constant => vec![values[0]; counts.len()],
         Interpolation::Uniform => values,
@@ -413,6 +437,13 @@ pub(crate) fn assemble(
     let guides: Option<Vec<bool>> = objects.iter().any(|o| o.guides.is_some()).then(|| {
         objects.iter().flat_map(|o| o.guides.clone().unwrap_or_else(|| vec![false; o.counts.len()])).collect()
     });
+    if let Some(uvs) = &root_uvs {
+        if let Some(s) = uvs.iter().position(|uv| !uv.is_finite()) {
+            let object = object_starts.partition_point(|&start| start <= s).saturating_sub(1);
+            let e = Error::NonFinite { strand: s - object_starts[object], point: 0, what: "root UV" };
+            return Err(in_object(&objects[object].path, e));
+        }
+    }
     let attributes = Attributes { thickness, transparency: None, colors };
     let (groom, repairs) =
         load.build(positions, &counts, attributes).map_err(|e| locate(e, &objects, &object_starts))?;
@@ -486,17 +517,18 @@ mod tests {
         let mut o = RawCurves {
             path: "/c".into(),
             basis: Basis::Bspline,
-            counts: vec![7, 3, 1],
-            points: vec![a, a, a, b, c, c, c, a, b, c, d],
-            widths: Some((0..11).map(|i| i as f32).collect()),
+            counts: vec![7, 3, 1, 4],
+            points: vec![a, a, a, b, c, c, c, a, b, c, d, a, a, b, c],
+            widths: Some((0..15).map(|i| i as f32).collect()),
             colors: None,
             guides: None,
             root_uvs: None,
         };
         collapse_pinned_ends(&mut o);
-        assert_eq!(o.counts, vec![3, 3, 1]);
-        assert_eq!(o.points, vec![a, b, c, a, b, c, d]);
-        assert_eq!(o.widths, Some(vec![2.0, 3.0, 4.0, 7.0, 8.0, 9.0, 10.0]));
+        // Two equal points are a zero-length segment, left for the checks.
+        assert_eq!(o.counts, vec![3, 3, 1, 4]);
+        assert_eq!(o.points, vec![a, b, c, a, b, c, d, a, a, b, c]);
+        assert_eq!(o.widths, Some(vec![2.0, 3.0, 4.0, 7.0, 8.0, 9.0, 10.0, 11.0, 12.0, 13.0, 14.0]));
     }
 
     #[test]

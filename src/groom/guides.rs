@@ -6,26 +6,44 @@ use glam::Vec3;
 use super::Groom;
 use crate::error::{Error, Result};
 
+/// The most strands × guides steps [`spread`] takes (about ten seconds).
+pub const MAX_WORK: u64 = 10_000_000_000;
+
 /// `count` strands of `groom` whose roots spread evenly over its roots:
 /// farthest-point sampling (each next guide the root farthest from every
 /// guide so far), from the root nearest the roots' centroid; ties go to the
-/// lower index, so the choice is the same every run. Indices in strand order.
+/// lower index, so the choice is the same every run; strands sharing a root
+/// are told apart. Indices in strand order. Refused beyond [`MAX_WORK`].
 pub fn spread(groom: &Groom, count: usize) -> Result<Vec<usize>> {
     let n = groom.strand_count();
     if !(1..=n).contains(&count) {
         return Err(Error::param("guides", count, format!("1..={n} (the groom's strands)")));
+    }
+    if (n as u64) * (count as u64) > MAX_WORK {
+        return Err(Error::param(
+            "guides",
+            count,
+            format!(
+                "at most {} for {n} strands (choosing them takes strands × guides steps; mark guides in the file or \
+                 ask for fewer)",
+                MAX_WORK / n as u64
+            ),
+        ));
     }
     let roots: Vec<Vec3> = (0..n).map(|s| groom.strand(s)[0]).collect();
     let centroid = roots.iter().copied().sum::<Vec3>() / n as f32;
     let first = nearest(&roots, centroid);
     let mut chosen = vec![first];
     let mut gap: Vec<f32> = roots.iter().map(|r| r.distance_squared(roots[first])).collect();
+    // A chosen root is never chosen again, even where roots coincide.
+    gap[first] = -1.0;
     while chosen.len() < count {
         let next = (0..n).fold(0, |best, s| if gap[s] > gap[best] { s } else { best });
         chosen.push(next);
         for (g, r) in gap.iter_mut().zip(&roots) {
             *g = g.min(r.distance_squared(roots[next]));
         }
+        gap[next] = -1.0;
     }
     chosen.sort_unstable();
     Ok(chosen)
@@ -79,6 +97,9 @@ mod tests {
             .fold(0.0f32, f32::max);
         assert!(worst < 0.025, "a root {worst} m from every guide");
         assert!(spread(&groom, 0).is_err() && spread(&groom, 101).is_err());
+        // Every root in one place: still distinct strands.
+        let same = Groom::from_strands(&vec![vec![Vec3::ZERO, Vec3::NEG_Y]; 10]).expect("groom");
+        assert_eq!(spread(&same, 4).expect("guides"), vec![0, 1, 2, 3]);
         assert_eq!(marked(&[false, true, true]).expect("marked"), vec![1, 2]);
         assert!(marked(&[false, false]).is_err());
     }

@@ -16,8 +16,10 @@
 //! | attribute arrays of the right length | [`Error::AttributeLength`] |
 //!
 //! Sources: [`cyhair`] (`.hair` read/write), [`tfx`] (TressFX `.tfx` read),
-//! [`grow`] (procedural growth on a sphere, ellipsoid or OBJ mesh) and
-//! [`scenes`] (the reference scenes of the design). [`Groom::repaired`] builds a
+//! [`usd`] (USD `BasisCurves`) and [`alembic`] (Alembic curves, read/write),
+//! both through [`authored`], [`grow`] (procedural growth on a sphere,
+//! ellipsoid or OBJ mesh) and [`scenes`] (the reference scenes of the
+//! design); [`guides`] chooses the strands of a dense groom to simulate. [`Groom::repaired`] builds a
 //! groom from real assets, dropping what the checks refuse and counting it in
 //! [`Repairs`]. [`Groom::resampled`] gives
 //! every strand the same point count (the GPU simulation wants it) and

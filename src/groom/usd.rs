@@ -14,8 +14,8 @@
 //! | `primvars:groom_guide` | per-strand guide mark (non-zero: a guide) |
 //!
 //! Primvars honour their `interpolation` (`constant`, `uniform`, `varying`,
-//! `vertex`) and `:indices`. A value is the attribute's default, or else its
-//! first time sample. The stage's `metersPerUnit` (USD's fallback 0.01 when not
+//! `vertex`) and `:indices`. Values and transforms are read at the earliest
+//! time: an attribute's first time sample, else its default. The stage's `metersPerUnit` (USD's fallback 0.01 when not
 //! authored) and `upAxis` (fallback Y) are honoured: the groom comes out in
 //! meters, +Y up.
 //!
@@ -206,13 +206,14 @@ fn world_transform(prim: &Prim) -> Result<DMat4> {
     Ok(world)
 }
 
-/// An attribute's value: its default, else its first time sample; a blocked
-/// value counts as none.
+/// An attribute's value at the stage's earliest time: its first time sample,
+/// else its default (USD's resolution at a time); a blocked value counts as
+/// none. The transforms are read at the same time.
 fn value(prim: &Prim, name: &str) -> Result<Option<sdf::Value>> {
     let attr = prim.attribute(name);
-    let v = match attr.get::<sdf::Value>().map_err(usd_error)? {
+    let v = match attr.get_at::<sdf::Value>(TimeCode::EARLIEST).map_err(usd_error)? {
         Some(v) => Some(v),
-        None => attr.get_at::<sdf::Value>(TimeCode::EARLIEST).map_err(usd_error)?,
+        None => attr.get::<sdf::Value>().map_err(usd_error)?,
     };
     Ok(v.filter(|v| !matches!(v, sdf::Value::ValueBlock | sdf::Value::None)))
 }
@@ -232,7 +233,8 @@ fn interpolation(prim: &Prim, name: &str, fallback: Interpolation) -> Result<Int
     match token(&v).as_deref() {
         Some("constant") => Ok(Interpolation::Constant),
         Some("uniform") => Ok(Interpolation::Uniform),
-        Some("varying") => Ok(Interpolation::Varying),
+        // Face-varying is varying on curves.
+        Some("varying" | "faceVarying") => Ok(Interpolation::Varying),
         Some("vertex") => Ok(Interpolation::Vertex),
         _ => {
             Err(malformed(format!("{name} has interpolation {v:?}; curves take constant, uniform, varying or vertex")))

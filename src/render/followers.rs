@@ -187,11 +187,9 @@ impl Followers {
                 0.5 * (b - a).cross(c - a).length()
             })
             .sum();
-        let root_spacing = if area > 0.0 {
-            (area / strands as f32).sqrt()
-        } else {
-            spacing / (strands as f32 / guides.len() as f32).sqrt()
-        };
+        // The scalp's area: the guide-root triangles', else the roots' bounds.
+        let area = if area > 0.0 { area } else { bounds_area(authored) };
+        let root_spacing = (area / strands as f32).sqrt().max(1e-6);
         Ok(Followers {
             points: points as u32,
             level,
@@ -316,7 +314,28 @@ impl Followers {
     /// (position, tangent) per guide at any level, `references` the guides'
     /// rest-plane normals ([`super::reference::rest_plane_normals`]) and the
     /// head's rotation `head`. Points follower after follower.
-    pub fn evaluate(&self, guides: &[Vec<(Vec3, Vec3)>], references: &[Vec3], head: Quat, drawn: usize) -> Vec<Vec3> {
+    /// Refused: fewer guides or references than the binding names, a guide of
+    /// fewer than two points, more followers than bound.
+    pub fn evaluate(
+        &self,
+        guides: &[Vec<(Vec3, Vec3)>],
+        references: &[Vec3],
+        head: Quat,
+        drawn: usize,
+    ) -> Result<Vec<Vec3>> {
+        let most = self.bindings.iter().flat_map(|b| &b.guides[..3]).copied().max().unwrap_or(0) as usize;
+        if guides.len() <= most || references.len() <= most {
+            return Err(Error::incompatible(
+                "guides",
+                format!("{} guides and {} references for followers of guide {most}", guides.len(), references.len()),
+            ));
+        }
+        if let Some(g) = guides.iter().position(|g| g.len() < 2) {
+            return Err(Error::param("guide points", format!("guide {g}: {}", guides[g].len()), "at least 2"));
+        }
+        if drawn > self.count() {
+            return Err(Error::param("drawn followers", drawn, format!("at most {}", self.count())));
+        }
         let shapes: Vec<&[(Vec3, Vec3)]> = guides.iter().map(Vec::as_slice).collect();
         let turned: Vec<Vec3> = references.iter().map(|r| head * *r).collect();
         let root = Mat3::from_quat(head);
@@ -331,21 +350,30 @@ impl Followers {
                 out.push(p + m * Vec3::new(o[0], o[1], o[2]));
             }
         }
-        out
+        Ok(out)
     }
 
     /// Drawn hair positions (`drawn × points`, drawing order, as the renderer
     /// reads them back) as strands in the file's order; strands not drawn are
     /// left out.
-    pub fn to_input_order(&self, hairs: &[Vec4]) -> Vec<(u32, Vec<Vec3>)> {
+    /// Refused: a count of vertices that is not whole followers or more than
+    /// all of them.
+    pub fn to_input_order(&self, hairs: &[Vec4]) -> Result<Vec<(u32, Vec<Vec3>)>> {
         let n = self.points as usize;
+        if !hairs.len().is_multiple_of(n) || hairs.len() > self.count() * n {
+            return Err(Error::param(
+                "drawn hair vertices",
+                hairs.len(),
+                format!("whole followers of {n} points, at most {}", self.count()),
+            ));
+        }
         let mut strands: Vec<(u32, Vec<Vec3>)> = hairs
             .chunks_exact(n)
             .zip(&self.order)
             .map(|(h, &s)| (s, h.iter().map(|p| p.truncate()).collect()))
             .collect();
         strands.sort_by_key(|(s, _)| *s);
-        strands
+        Ok(strands)
     }
 }
 
@@ -365,6 +393,14 @@ pub(super) fn check(followers: &Followers, strands: usize, level: u32) -> Result
         ));
     }
     Ok(())
+}
+
+/// The largest face of the box around `groom`'s roots (0 for one root).
+fn bounds_area(groom: &Groom) -> f32 {
+    let roots = (0..groom.strand_count()).map(|s| groom.strand(s)[0]);
+    let (lo, hi) = roots.fold((Vec3::MAX, Vec3::MIN), |(lo, hi), r| (lo.min(r), hi.max(r)));
+    let d = (hi - lo).max(Vec3::ZERO);
+    (d.x * d.y).max(d.y * d.z).max(d.z * d.x)
 }
 
 /// The median edge of `triangles` of `roots` (0 without triangles).

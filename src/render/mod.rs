@@ -153,6 +153,8 @@ struct FollowerCounts {
     count: u32,
     points: u32,
     root_spacing: f32,
+    /// The smoothing level the followers were bound at: they are drawn at it.
+    level: u32,
 }
 
 /// Rejects key hairs that live on another device than the renderer's.
@@ -180,7 +182,8 @@ impl Renderer {
     /// hairs: the interpolation mode and `hairs_per_key` no longer grow hairs;
     /// level of detail draws the share `detail.hairs_per_key / hairs_per_key`
     /// of the followers (a prefix of their stable random order), as it thins
-    /// grown hairs.
+    /// grown hairs (the smoothing level stays the one they were bound at:
+    /// [`Renderer::set_params`] refuses another).
     pub fn with_followers<'a>(
         ctx: &GpuContext,
         sim: impl Into<KeyHairs<'a>>,
@@ -261,6 +264,7 @@ impl Renderer {
                 count: f.count() as u32,
                 points: f.points() as u32,
                 root_spacing: f.root_spacing(),
+                level: f.level(),
             }),
             device,
         })
@@ -286,8 +290,16 @@ impl Renderer {
                 format!("at most {}, the level this renderer was created for", self.capacity_level),
             ));
         }
-        if self.followers.is_none() {
-            self.check_hairs(params)?;
+        match self.followers {
+            None => self.check_hairs(params)?,
+            Some(f) if params.smoothing_level != f.level => {
+                return Err(Error::param(
+                    "smoothing_level",
+                    params.smoothing_level,
+                    format!("{}, the level the followers were bound at", f.level),
+                ))
+            }
+            Some(_) => {}
         }
         self.params = params.clone();
         self.detail = self.detail.min_with(params);
@@ -393,6 +405,10 @@ impl Renderer {
         self.placement.head_center = head.matrix().transform_point3(self.placement.rest_center);
         let distance = camera.map_or(0.0, |c| (c.position() - self.placement.head_center).length());
         self.detail = self.params.detail_at(distance);
+        if let Some(f) = self.followers {
+            // Followers' offsets hold against guides smoothed at their level.
+            self.detail.smoothing_level = f.level;
+        }
         let entry = barrier::memory(
             &[AccessKind::AnyWrite],
             &[AccessKind::VertexRead, AccessKind::TessellationRead, AccessKind::TessellationWrite],

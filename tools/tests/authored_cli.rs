@@ -244,6 +244,15 @@ fn followers_take_the_file_colours_or_a_scalp_texture() {
     run_line(&line, LIMIT).assert_error("has no root UVs");
     let line = format!("render --input {} --scalp-texture {}", arnold.display(), texture.display());
     run_line(&line, LIMIT).assert_error("give --guides");
+    // An image that declares 9000 × 9000 texels is refused before decoding.
+    let huge = dir.path().join("huge.png");
+    let file = std::fs::File::create(&huge).expect("png file");
+    let mut encoder = png::Encoder::new(file, 9000, 9000);
+    encoder.set_color(png::ColorType::Grayscale);
+    encoder.set_depth(png::BitDepth::One);
+    encoder.write_header().expect("header").write_image_data(&vec![0u8; 1125 * 9000]).expect("pixels");
+    let line = format!("render --input {} --guides 0.1 --scalp-texture {}", usd.display(), huge.display());
+    run_line(&line, LIMIT).assert_error("at most 67108864 texels");
     let junk = dir.path().join("junk.png");
     std::fs::write(&junk, b"not a png").expect("write");
     let line = format!("render --input {} --guides 0.1 --scalp-texture {}", usd.display(), junk.display());

@@ -208,10 +208,14 @@ impl<'a> Archive<'a> {
         })
     }
 
-    /// The child objects of an object group: header and group each.
-    pub fn children(&self, object: &[Child]) -> Result<Vec<(ObjectHeader, Vec<Child>)>> {
+    /// The child objects of an object group: header, group position and
+    /// group each.
+    pub fn children(&self, object: &[Child]) -> Result<Vec<(ObjectHeader, u64, Vec<Child>)>> {
         let Some((&Child::Data(at), groups)) = object.split_last() else { return Ok(Vec::new()) };
         let block = self.file.data(at)?;
+        if !block.is_empty() && block.len() < 32 {
+            return Err(malformed(format!("object headers of {} bytes, shorter than their hashes", block.len())));
+        }
         // The last 32 bytes are the object's hashes.
         let headers = &block[..block.len().saturating_sub(32)];
         let mut c = Cursor { b: headers, at: 0, what: "object headers" };
@@ -230,10 +234,11 @@ impl<'a> Archive<'a> {
                 self.indexed(u32::from(index), &format!("object {name}"))?
             };
             // Child i is group i + 1 (group 0 holds the properties).
-            let group =
+            let child =
                 groups.get(out.len() + 1).copied().ok_or_else(|| malformed(format!("object {name} has no group")))?;
-            let group = self.file.group_of(group, &format!("object {name}"))?;
-            out.push((ObjectHeader { name, metadata }, group));
+            let group = self.file.group_of(child, &format!("object {name}"))?;
+            let (Child::Group(at) | Child::Data(at)) = child;
+            out.push((ObjectHeader { name, metadata }, at, group));
         }
         Ok(out)
     }

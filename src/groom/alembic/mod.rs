@@ -26,7 +26,8 @@
 //! when repairing, such an object is passed over and said), 16-bit floats and
 //! strings where numbers belong, counts that do not add up, any position or
 //! length outside the file, more than [`MAX_DEPTH`] levels of objects or
-//! [`MAX_OBJECTS`] objects. Objects of other geometry (points, meshes) are
+//! [`MAX_OBJECTS`] objects, an object group listed twice (a cycle), more
+//! curve points than a groom holds. Objects of other geometry (points, meshes) are
 //! passed over and listed in [`AuthoredGroom::skipped`]. The file is read
 //! whole, within [`MAX_ABC_BYTES`] (or `VKHAIR_MAX_INPUT_BYTES`).
 //!
@@ -46,7 +47,7 @@ use self::ogawa::{malformed, Child};
 use super::authored::{assemble, in_object, per_curve, per_point, AuthoredGroom, Basis, Frame, Interpolation};
 use super::authored::{RawCurves, Topology, UpAxis, Values};
 use super::repair::Load;
-use super::Repairs;
+use super::{Repairs, MAX_POINTS};
 use crate::error::{Error, FileFormat, Result};
 
 /// The largest Alembic file read by default (1 GiB).
@@ -85,7 +86,15 @@ fn read(path: &Path) -> Result<Vec<u8>> {
 
 fn parse_as(bytes: &[u8], load: Load) -> Result<(AuthoredGroom, Option<Repairs>)> {
     let archive = Archive::open(bytes)?;
-    let mut walk = Walk { archive: &archive, load, raw: Vec::new(), skipped: Vec::new(), objects: 0 };
+    let mut walk = Walk {
+        archive: &archive,
+        load,
+        raw: Vec::new(),
+        skipped: Vec::new(),
+        objects: 0,
+        seen: std::collections::HashSet::new(),
+        points: 0,
+    };
     walk.objects(&archive.top, "", DMat4::IDENTITY, 0)?;
     if walk.raw.is_empty() {
         let why = if walk.skipped.is_empty() { String::new() } else { format!(" ({})", walk.skipped.join("; ")) };
@@ -117,6 +126,10 @@ struct Walk<'w, 'a> {
     raw: Vec<RawCurves>,
     skipped: Vec<String>,
     objects: usize,
+    /// Object group positions read so far.
+    seen: std::collections::HashSet<u64>,
+    /// Curve points read so far.
+    points: usize,
 }
 
 impl Walk<'_, '_> {
@@ -124,17 +137,28 @@ impl Walk<'_, '_> {
         if depth >= MAX_DEPTH {
             return Err(malformed(format!("{path}: objects nest deeper than {MAX_DEPTH} levels")));
         }
-        for (header, child) in self.archive.children(group).map_err(|e| in_object(or_root(path), e))? {
+        for (header, at, child) in self.archive.children(group).map_err(|e| in_object(or_root(path), e))? {
             self.objects += 1;
             if self.objects > MAX_OBJECTS {
                 return Err(malformed(format!("more than {MAX_OBJECTS} objects")));
             }
             let here = format!("{path}/{}", header.name);
+            // Every object is written once: a group listed again is a cycle or
+            // a file made to read one object over and over.
+            if at != 0 && !self.seen.insert(at) {
+                return Err(malformed(format!("{here}: its group (byte {at}) belongs to another object too")));
+            }
             let mut world = parent;
             match meta(&header.metadata, "schema").unwrap_or("") {
                 "AbcGeom_Xform_v3" => world = xform(self.archive, &child, parent).map_err(|e| in_object(&here, e))?,
                 "AbcGeom_Curve_v2" => match curves(self.archive, &child, world, &here) {
-                    Ok(c) => self.raw.push(c),
+                    Ok(c) => {
+                        self.points += c.points.len();
+                        if self.points > MAX_POINTS {
+                            return Err(Error::TooManyPoints { count: self.points as u64, max: MAX_POINTS as u64 });
+                        }
+                        self.raw.push(c)
+                    }
                     Err(Outcome::Skip(why)) if self.load == Load::Repair => self.skipped.push(format!("{here}: {why}")),
                     Err(Outcome::Skip(why)) => return Err(in_object(&here, unsupported(why))),
                     Err(Outcome::Fail(e)) => return Err(in_object(&here, e)),

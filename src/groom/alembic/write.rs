@@ -8,6 +8,7 @@
 
 use glam::{DMat4, Vec2};
 
+use crate::error::{Error, Result};
 use crate::groom::Groom;
 
 /// One curves object to write.
@@ -45,6 +46,13 @@ struct Writer {
 }
 
 impl Writer {
+    /// An Ogawa header with its root position to be filled in.
+    fn new() -> Self {
+        let mut out = b"Ogawa\xff\x00\x01".to_vec();
+        out.extend_from_slice(&[0u8; 8]);
+        Writer { out }
+    }
+
     fn data(&mut self, bytes: &[u8]) -> Node {
         if bytes.is_empty() {
             return Node::Data(0);
@@ -180,36 +188,64 @@ fn curves(w: &mut Writer, o: &CurvesObject<'_>) -> Node {
     object(w, vec![geom], &[])
 }
 
+/// An Xform object of one matrix op over `child`.
 fn xform(w: &mut Writer, m: DMat4, child: (String, String, Node)) -> Node {
-    let vals: Vec<u8> = m.to_cols_array().iter().flat_map(|v| v.to_le_bytes()).collect();
+    xform_ops(w, &[3 << 4], &m.to_cols_array(), child)
+}
+
+/// An Xform object of encoded `ops` (type << 4) with their channel `vals`.
+fn xform_ops(w: &mut Writer, ops: &[u8], vals: &[f64], child: (String, String, Node)) -> Node {
+    let bytes: Vec<u8> = vals.iter().flat_map(|v| v.to_le_bytes()).collect();
     let props = vec![
-        scalar(w, ".ops", U8, 1, &[3 << 4]),
-        scalar(w, ".vals", F64, 16, &vals),
+        scalar(w, ".ops", U8, ops.len() as u32, ops),
+        scalar(w, ".vals", F64, vals.len() as u32, &bytes),
         scalar(w, ".inherits", BOOL, 1, &[1]),
     ];
     let x = compound(w, ".xform", "schema=AbcGeom_Xform_v3", props);
     object(w, vec![x], &[child])
 }
 
-/// The bytes of an Alembic file holding `objects`.
-pub fn to_bytes(objects: &[CurvesObject<'_>]) -> Vec<u8> {
-    let mut w = Writer { out: b"Ogawa\xff\x00\x01".to_vec() };
-    w.out.extend_from_slice(&[0u8; 8]);
-    let curve_meta = "schema=AbcGeom_Curve_v2;schemaObjTitle=AbcGeom_Curve_v2:.geom".to_owned();
+const CURVE_META: &str = "schema=AbcGeom_Curve_v2;schemaObjTitle=AbcGeom_Curve_v2:.geom";
+const XFORM_META: &str = "schema=AbcGeom_Xform_v3;schemaObjTitle=AbcGeom_Xform_v3:.xform";
+
+/// The bytes of an Alembic file holding `objects`. Refused: a name that is
+/// empty, has a `/` or is another object's; guide marks or root UVs not one
+/// per strand; a transform that is not finite.
+pub fn to_bytes(objects: &[CurvesObject<'_>]) -> Result<Vec<u8>> {
+    for (i, o) in objects.iter().enumerate() {
+        if o.name.is_empty() || o.name.contains('/') || objects[..i].iter().any(|p| p.name == o.name) {
+            return Err(Error::param("object name", format!("{:?}", o.name), "a unique name without '/'"));
+        }
+        let strands = o.groom.strand_count();
+        for (what, len) in [("guide marks", o.guides.map(<[bool]>::len)), ("root UVs", o.root_uvs.map(<[Vec2]>::len))] {
+            if let Some(len) = len.filter(|&l| l != strands) {
+                return Err(Error::AttributeLength { what, expected: strands, actual: len });
+            }
+        }
+        if o.root_uvs.is_some_and(|u| u.iter().any(|uv| !uv.is_finite())) || o.transform.is_some_and(|m| !m.is_finite())
+        {
+            return Err(Error::param("object", o.name, "finite root UVs and transform"));
+        }
+    }
+    let mut w = Writer::new();
     let mut children = Vec::new();
     for o in objects {
         let node = curves(&mut w, o);
         let child = match o.transform {
-            None => (o.name.to_owned(), curve_meta.clone(), node),
+            None => (o.name.to_owned(), CURVE_META.to_owned(), node),
             Some(m) => {
-                let inner = (o.name.to_owned(), curve_meta.clone(), node);
-                let meta = "schema=AbcGeom_Xform_v3;schemaObjTitle=AbcGeom_Xform_v3:.xform".to_owned();
-                (format!("{}_xform", o.name), meta, xform(&mut w, m, inner))
+                let inner = (o.name.to_owned(), CURVE_META.to_owned(), node);
+                (format!("{}_xform", o.name), XFORM_META.to_owned(), xform(&mut w, m, inner))
             }
         };
         children.push(child);
     }
-    let top = object(&mut w, Vec::new(), &children);
+    Ok(finish(w, &children))
+}
+
+/// The archive around the top object's `children`: the whole file.
+fn finish(mut w: Writer, children: &[(String, String, Node)]) -> Vec<u8> {
+    let top = object(&mut w, Vec::new(), children);
     let version = w.data(&1i32.to_le_bytes());
     let library = w.data(&10709i32.to_le_bytes());
     let meta = w.data(b"_ai_Application=vkhair");
@@ -225,4 +261,26 @@ pub fn to_bytes(objects: &[CurvesObject<'_>]) -> Vec<u8> {
     w.group(&[version, library, top, meta, samplings, indexed]);
     w.out[8..16].copy_from_slice(&root.to_le_bytes());
     w.out
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+
+    #[test]
+    fn xform_ops_compose_with_the_first_outermost() {
+        let groom = Groom::from_strands(&[vec![Vec3::X, Vec3::new(1.0, -1.0, 0.0)]]).expect("groom");
+        let mut w = Writer::new();
+        let o = CurvesObject { name: "c", groom: &groom, guides: None, root_uvs: None, transform: None };
+        let node = curves(&mut w, &o);
+        // Translate (1, 2, 3), rotate 90° about Y, scale 2.
+        let (ops, vals) = ([1 << 4, 5 << 4, 0], [1.0, 2.0, 3.0, 90.0, 2.0, 2.0, 2.0]);
+        let x = xform_ops(&mut w, &ops, &vals, ("c".into(), CURVE_META.into(), node));
+        let g = super::super::parse(&finish(w, &[("x".into(), XFORM_META.into(), x)])).expect("file");
+        // (1, 0, 0) scaled to (2, 0, 0), turned to (0, 0, −2), moved to (1, 2, 1).
+        let p = g.groom.strand(0)[0];
+        assert!((p - Vec3::new(1.0, 2.0, 1.0)).length() < 1e-5, "{p}");
+    }
 }

@@ -8,6 +8,9 @@ use crate::output::Error;
 
 /// The largest scalp texture read (64 MiB of file).
 const MAX_TEXTURE_BYTES: u64 = 64 << 20;
+/// The most texels a scalp texture may declare (8192 × 8192), checked before
+/// decoding.
+const MAX_TEXELS: u64 = 8192 * 8192;
 
 /// A decoded texture: linear RGB texels, rows from the top.
 pub struct Texture {
@@ -34,6 +37,14 @@ impl Texture {
         let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
         decoder.set_transformations(png::Transformations::normalize_to_color8());
         let mut reader = decoder.read_info().map_err(bad)?;
+        let (w, h) = (reader.info().width, reader.info().height);
+        if u64::from(w) * u64::from(h) > MAX_TEXELS {
+            return Err(format!(
+                "{}: a {w}×{h} image; a scalp texture has at most {MAX_TEXELS} texels",
+                path.display()
+            )
+            .into());
+        }
         let size = reader.output_buffer_size().ok_or_else(|| format!("{}: the image is too large", path.display()))?;
         let mut buf = vec![0u8; size];
         let info = reader.next_frame(&mut buf).map_err(bad)?;

@@ -52,7 +52,7 @@ fn write_converted(
     let s = groom.stats();
     if out.extension().is_some_and(|e| e.eq_ignore_ascii_case("abc")) {
         let object = CurvesObject { name: "groom", groom: &groom, guides: None, root_uvs: None, transform: None };
-        vkhair::files::write_atomic(out, &to_bytes(&[object]))?;
+        vkhair::files::write_atomic(out, &to_bytes(&[object])?)?;
     } else {
         HairFile::new(groom, &format!("from {}", input.file_name().and_then(|n| n.to_str()).unwrap_or("input")))
             .save(out)?;

@@ -36,7 +36,7 @@ pub fn write_drawn(
     let (positions, _) = renderer.read_hairs()?;
     let (hairs, per_hair) = renderer.hair_counts();
     let strands: Vec<Vec<Vec3>> = match &followers {
-        Some(f) => f.to_input_order(&positions).into_iter().map(|(_, strand)| strand).collect(),
+        Some(f) => f.to_input_order(&positions)?.into_iter().map(|(_, strand)| strand).collect(),
         None => positions.chunks_exact(per_hair as usize).map(|h| h.iter().map(|p| p.truncate()).collect()).collect(),
     };
     let groom = Groom::from_strands(&strands)?;
