@@ -78,6 +78,23 @@ fn length(line: &[Vec3]) -> f32 {
     line.windows(2).map(|w| w[0].distance(w[1])).sum()
 }
 
+/// The deviation of every authored point of `dense` from its drawn strand in
+/// `drawn` (the file's order), as a share of the strand's length: its
+/// quantile function (0: the least, 1: the largest), printed under `label`.
+fn deviations(dense: &Groom, drawn: &[Vec<Vec3>], label: &str) -> impl Fn(f64) -> f32 {
+    let mut d: Vec<f32> = (0..dense.strand_count())
+        .flat_map(|i| {
+            let authored = dense.strand(i);
+            let len = length(authored);
+            authored.iter().map(move |&p| to_polyline(p, &drawn[i]) / len).collect::<Vec<_>>()
+        })
+        .collect();
+    d.sort_by(f32::total_cmp);
+    let q = move |f: f64| d[((d.len() - 1) as f64 * f) as usize];
+    println!("{label}: deviation p50 {:.2e}, p95 {:.2e}, max {:.2e} of strand length", q(0.5), q(0.95), q(1.0));
+    q
+}
+
 /// The CPU evaluation of every follower for guides in `state` (world) under `head`.
 fn cpu_followers(s: &Scene, state: &SimState, head: Quat) -> Vec<Vec3> {
     let guides: Vec<Vec<(Vec3, Vec3)>> =
@@ -114,25 +131,7 @@ fn at_rest_the_drawn_followers_are_the_authored_strands() {
     let mut renderer = Renderer::with_followers(gpu.ctx(), &sim, &params(), &s.followers).expect("renderer");
     assert_eq!(renderer.hair_counts(), (600, POINTS as u32));
     let drawn = gpu_followers(&mut renderer, &sim, &s);
-    // Deviation of every authored point from its drawn follower, as a share
-    // of the strand's length.
-    let mut deviations: Vec<f32> = (0..s.dense.strand_count())
-        .flat_map(|i| {
-            let authored = s.dense.strand(i);
-            let len = length(authored);
-            let line = &drawn[i];
-            authored.iter().map(move |&p| to_polyline(p, line) / len).collect::<Vec<_>>()
-        })
-        .collect();
-    deviations.sort_by(f32::total_cmp);
-    let q = |f: f64| deviations[((deviations.len() - 1) as f64 * f) as usize];
-    println!(
-        "rest deviation of {} authored points from the drawn followers, share of strand length: p50 {:.2e}, p95 {:.2e}, max {:.2e}",
-        deviations.len(),
-        q(0.5),
-        q(0.95),
-        q(1.0)
-    );
+    let q = deviations(&s.dense, &drawn, "drawn with their own points");
     // The strands have POINTS points: drawn as authored, to float precision.
     assert!(q(1.0) <= 1e-5, "an authored point is {:.5} % of its strand's length from its follower", 100.0 * q(1.0));
     // The GPU against the CPU reference.
@@ -159,22 +158,7 @@ fn resampled_followers_stay_within_half_a_percent_of_the_authored_strands() {
     let (positions, _) = renderer.read_hairs().expect("hairs");
     let drawn: Vec<Vec<Vec3>> =
         followers.to_input_order(&positions).expect("whole followers").into_iter().map(|(_, s)| s).collect();
-    let mut deviations: Vec<f32> = (0..dense.strand_count())
-        .flat_map(|i| {
-            let authored = dense.strand(i);
-            let len = length(authored);
-            let line = &drawn[i];
-            authored.iter().map(move |&p| to_polyline(p, line) / len).collect::<Vec<_>>()
-        })
-        .collect();
-    deviations.sort_by(f32::total_cmp);
-    let q = |f: f64| deviations[((deviations.len() - 1) as f64 * f) as usize];
-    println!(
-        "48 authored points drawn with 40: deviation p50 {:.2e}, p95 {:.2e}, max {:.2e} of strand length",
-        q(0.5),
-        q(0.95),
-        q(1.0)
-    );
+    let q = deviations(&dense, &drawn, "48 authored points drawn with 40");
     assert!(q(1.0) <= 0.005, "an authored point is {:.3} % of its strand's length from its follower", 100.0 * q(1.0));
 }
 

@@ -269,6 +269,30 @@ mod tests {
 
     use super::*;
 
+    /// An animated object: P has two samples (x = 0, then x = 1); the
+    /// reader takes the first.
+    #[test]
+    fn an_animated_object_gives_its_first_sample() {
+        let mut w = Writer::new();
+        let p = |x: f32| f32s([x, 0.0, 0.0, x, -0.1, 0.0]);
+        let (first, second) = (w.sample(&p(0.0)), w.sample(&p(1.0)));
+        let node = w.group(&[first, Node::Data(0), second, Node::Data(0)]);
+        let mut h = header(2, F32, 3, "P", "geoScope=vtx");
+        // Two samples that differ: no "same throughout" bit, a count of 2.
+        let info = u32::from_le_bytes([h[0], h[1], h[2], h[3]]) & !0x800;
+        h[..4].copy_from_slice(&info.to_le_bytes());
+        h[4..8].copy_from_slice(&2u32.to_le_bytes());
+        let geom = vec![
+            Property { header: h, node },
+            array(&mut w, "nVertices", I32, 1, "", &2i32.to_le_bytes()),
+            scalar(&mut w, "curveBasisAndType", U8, 4, &[1, 0, 0, 0]),
+        ];
+        let geom = compound(&mut w, ".geom", CURVE_META, geom);
+        let c = object(&mut w, vec![geom], &[]);
+        let g = super::super::parse(&finish(w, &[("c".into(), CURVE_META.into(), c)])).expect("file");
+        assert_eq!(g.groom.positions(), [Vec3::ZERO, Vec3::new(0.0, -0.1, 0.0)]);
+    }
+
     #[test]
     fn xform_ops_compose_with_the_first_outermost() {
         let groom = Groom::from_strands(&[vec![Vec3::X, Vec3::new(1.0, -1.0, 0.0)]]).expect("groom");
