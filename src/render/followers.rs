@@ -158,26 +158,33 @@ impl Followers {
                 u32::MAX => nearest_guides(root, &roots, grid.as_ref(), &triangles),
                 g => ([g, g, g], [1.0, 0.0, 0.0]),
             };
-            // A frame blend that is nearly singular anywhere along the strand
-            // (its inverse would magnify the offset, and motion with it): the
-            // heaviest guide alone.
-            let at = |g, w, i: usize| {
-                blend(&guide_shapes, &references, (g, w), i as f32 / (points - 1) as f32, Mat3::IDENTITY)
+            // Each point's offset in the blend of guides `(g, w)`, or `None`
+            // where `strict` and the blend is nearly singular anywhere along
+            // the strand (its inverse would magnify the offset, and motion
+            // with it).
+            let offsets_in = |(g, w), strict: bool| -> Option<Vec<Vec3>> {
+                strand
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &x)| {
+                        let s = i as f32 / (points - 1) as f32;
+                        let (p, m) = blend(&guide_shapes, &references, (g, w), s, Mat3::IDENTITY);
+                        let (d, o) = (x - p, m.inverse() * (x - p));
+                        let singular = m.determinant().abs() < SINGULAR || o.length() > MAGNIFIED * d.length() + 1e-6;
+                        (!(strict && singular)).then_some(o)
+                    })
+                    .collect()
             };
-            let singular = (0..points).any(|i| {
-                let (p, m) = at(g, w, i);
-                let d = strand[i] - p;
-                m.determinant().abs() < SINGULAR || (m.inverse() * d).length() > MAGNIFIED * d.length() + 1e-6
-            });
-            if singular {
-                let k = (0..3).max_by(|&a, &b| w[a].total_cmp(&w[b])).unwrap_or(0);
-                (g, w) = ([g[k]; 3], [1.0, 0.0, 0.0]);
-            }
-            for (i, &x) in strand.iter().enumerate() {
-                let (p, m) = at(g, w, i);
-                let o = m.inverse() * (x - p);
-                offsets.extend_from_slice(&o.to_array());
-            }
+            let point_offsets = match offsets_in((g, w), true) {
+                Some(o) => o,
+                None => {
+                    // The heaviest guide alone (one guide's frame is a rotation).
+                    let k = (0..3).max_by(|&a, &b| w[a].total_cmp(&w[b])).unwrap_or(0);
+                    (g, w) = ([g[k]; 3], [1.0, 0.0, 0.0]);
+                    offsets_in((g, w), false).unwrap_or_default()
+                }
+            };
+            offsets.extend(point_offsets.iter().flat_map(|o| o.to_array()));
             bindings.push(FollowerBinding { guides: [g[0], g[1], g[2], 0], weights: [w[0], w[1], w[2], 0.0] });
         }
         let area: f32 = triangles
@@ -207,24 +214,10 @@ impl Followers {
     /// (each component 0..=1), blended along the strand instead of the
     /// material's root and tip colours.
     pub fn with_colors(mut self, colors: &[[Vec3; 2]]) -> Result<Self> {
-        if colors.len() != self.count() {
-            return Err(Error::param(
-                "follower colours",
-                colors.len(),
-                format!("one root and tip colour per strand ({})", self.count()),
-            ));
-        }
-        if let Some(s) = colors
-            .iter()
-            .position(|c| !c.iter().all(|c| c.is_finite() && c.cmpge(Vec3::ZERO).all() && c.cmple(Vec3::ONE).all()))
-        {
-            return Err(Error::param(
-                "follower colours",
-                format!("strand {s}: {:?}", colors[s]),
-                "components in 0..=1",
-            ));
-        }
-        self.colors = Some(self.order.iter().map(|&s| colors[s as usize]).collect());
+        let fits =
+            |c: &[Vec3; 2]| c.iter().all(|c| c.is_finite() && c.cmpge(Vec3::ZERO).all() && c.cmple(Vec3::ONE).all());
+        self.colors =
+            Some(self.in_drawing_order(("follower colours", "colour"), colors, fits, "components in 0..=1")?);
         Ok(self)
     }
 
@@ -233,23 +226,33 @@ impl Followers {
     /// the material's root and tip widths (0..=[`MAX_WIDTH_FACTOR`]; 1 draws
     /// the material's), blended along the strand.
     pub fn with_width_factors(mut self, factors: &[[f32; 2]]) -> Result<Self> {
-        if factors.len() != self.count() {
-            return Err(Error::param(
-                "follower width factors",
-                factors.len(),
-                format!("one root and tip factor per strand ({})", self.count()),
-            ));
-        }
         let fits = |f: &[f32; 2]| f.iter().all(|f| (0.0..=MAX_WIDTH_FACTOR).contains(f));
-        if let Some(s) = factors.iter().position(|f| !fits(f)) {
+        let allowed = format!("0..={MAX_WIDTH_FACTOR}");
+        self.widths = Some(self.in_drawing_order(("follower width factors", "factor"), factors, fits, &allowed)?);
+        Ok(self)
+    }
+
+    /// `values` (a root and a tip value per strand, the file's order) in
+    /// drawing order, refused unless one per strand and each `fits`; errors
+    /// name `what` (and `noun`, one of them) and what is `allowed`.
+    fn in_drawing_order<T: Copy + std::fmt::Debug>(
+        &self,
+        (what, noun): (&'static str, &str),
+        values: &[[T; 2]],
+        fits: impl Fn(&[T; 2]) -> bool,
+        allowed: &str,
+    ) -> Result<Vec<[T; 2]>> {
+        if values.len() != self.count() {
             return Err(Error::param(
-                "follower width factors",
-                format!("strand {s}: {:?}", factors[s]),
-                format!("0..={MAX_WIDTH_FACTOR}"),
+                what,
+                values.len(),
+                format!("one root and tip {noun} per strand ({})", self.count()),
             ));
         }
-        self.widths = Some(self.order.iter().map(|&s| factors[s as usize]).collect());
-        Ok(self)
+        if let Some(s) = values.iter().position(|v| !fits(v)) {
+            return Err(Error::param(what, format!("strand {s}: {:?}", values[s]), allowed));
+        }
+        Ok(self.order.iter().map(|&s| values[s as usize]).collect())
     }
 
     /// Each follower's width factors at the root and the tip, in drawing order.

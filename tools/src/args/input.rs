@@ -168,11 +168,9 @@ impl InputArgs {
     /// a dense groom, the whole groom and the guides among it that the key
     /// hairs are (see --guides).
     pub fn groom_and_guides(&self, path: &Path) -> Result<(Scaled, Option<Dense>), Error> {
-        let loaded = load_with_defaults(path, self.strict)?;
-        let marks = loaded.authored.as_ref().and_then(|a| a.guides.clone());
-        let root_uvs = loaded.authored.as_ref().and_then(|a| a.root_uvs.clone());
-        let groom = loaded.groom.scaled(self.scale())?;
-        let thickness = groom.end_thickness().or(loaded.header_thickness.map(|t| (t * self.scale(), t * self.scale())));
+        let mut loaded = load_with_defaults(path, self.strict)?;
+        let (marks, root_uvs) = loaded.authored.take().map(|a| (a.guides, a.root_uvs)).unwrap_or_default();
+        let (groom, thickness) = loaded.scaled(self.scale())?;
         let points = self.points.unwrap_or(16);
         let n = groom.strand_count();
         let request = self.guides.as_deref().map(guide_request).transpose()?;
@@ -286,6 +284,16 @@ pub struct Loaded {
     header_thickness: Option<f32>,
     /// What a USD or Alembic file says beyond its strands.
     pub authored: Option<Authored>,
+}
+
+impl Loaded {
+    /// The groom with its lengths multiplied by `scale`, and the root and tip
+    /// thickness it gives its strands (see [`Scaled::thickness`]).
+    fn scaled(self, scale: f32) -> Result<(Groom, Option<(f32, f32)>), Error> {
+        let groom = self.groom.scaled(scale)?;
+        let thickness = groom.end_thickness().or(self.header_thickness.map(|t| (t * scale, t * scale)));
+        Ok((groom, thickness))
+    }
 }
 
 /// [`AuthoredGroom`] without its groom.
@@ -420,9 +428,7 @@ pub struct Scaled {
 /// The groom in `path` (see [`load`]) with its lengths (positions and thickness)
 /// multiplied by `scale` and every strand resampled to `points` points.
 pub fn load_scaled(path: &Path, strict: bool, scale: f32, points: usize) -> Result<Scaled, Error> {
-    let Loaded { groom, header_thickness, .. } = load_with_defaults(path, strict)?;
-    let groom = groom.scaled(scale)?;
-    let thickness = groom.end_thickness().or(header_thickness.map(|t| (t * scale, t * scale)));
+    let (groom, thickness) = load_with_defaults(path, strict)?.scaled(scale)?;
     Ok(Scaled { groom: groom.resampled(points)?, thickness })
 }
 
