@@ -57,6 +57,9 @@ shader_codes! {
         LOCAL_SHAPE = 1 << 8,
         /// A mesh collider is set and collisions act.
         MESH = 1 << 9,
+        /// Each key hair's root follows its bound triangle of a skinned scalp
+        /// (`sim::scalp`): the rest pose is placed per hair by its root's frame.
+        SCALP = 1 << 10,
     }
 
     /// A collider's shape (`collider_kind(c)`, stored as a float).

@@ -28,6 +28,16 @@ struct SimStepParams {
     mat4 previous_head;
     vec4 mesh_grid;
     uvec4 mesh_dims;
+    vec4 scalp_lerp;
+    uvec4 scalp_source;
+};
+
+// A key hair's root on its scalp triangle (one per key hair). Twin:
+// gpu_types::GpuScalpRoot, view gpu_types::ScalpRootView.
+struct ScalpRoot {
+    uvec4 corners;
+    vec4 weights;
+    mat4 unbind;
 };
 
 // Push constants of the step kernel. Twin: gpu_types::SimPush, view gpu_types::StepRange.

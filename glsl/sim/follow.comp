@@ -19,7 +19,8 @@
 //   velocity:               v = (x − x_f⁻) / (dt · count)
 //
 // where ⁻ marks the positions, head and frames before the dispatch (the half
-// it reads). A follower bends and swings as its guide does (a neighbour with a
+// it reads). With SIM_SCALP the head is the follower's own root frame
+// (glsl/include/scalp.glsl). A follower bends and swings as its guide does (a neighbour with a
 // similar rest shape, sim/lod.rs) and keeps its own shape and segment lengths,
 // so it can rejoin the simulation where it is. The CPU reference
 // (sim::reference::follow) runs the same operations in the same order.
@@ -40,7 +41,11 @@ layout(std430, set = 0, binding = 12) readonly buffer SimOrder { uint sim_order[
 layout(std430, set = 0, binding = 13) readonly buffer SimGuides { uint sim_guide[]; };
 layout(std430, set = 0, binding = 7) readonly buffer Colliders { Collider colliders[]; };
 layout(std430, set = 0, binding = 10) readonly buffer MeshField { float mesh_field[]; };
+layout(std430, set = 0, binding = 14) readonly buffer ScalpRoots { ScalpRoot scalp_roots[]; };
+layout(std430, set = 0, binding = 15) buffer ScalpPrevious { vec4 scalp_previous[]; };
+layout(std430, set = 0, binding = 16) readonly buffer ScalpSource { float scalp_source[]; };
 #include "sim_bodies.glsl"
+#include "scalp.glsl"
 
 // A frame: three columns.
 struct Frame {
@@ -83,6 +88,11 @@ void main() {
     uint g = sim_guide[f];
     mat4 before_head = sim_previous_head(start);
     mat4 head = sim_head(end);
+    bool scalp = (sim_flags(end) & SIM_SCALP) != 0u;
+    if (scalp) {
+        before_head = scalp_frame(start, f, sim_scalp_from(start), before_head);
+        head = scalp_frame(end, f, sim_scalp_to(end), head);
+    }
     Frame q_old = Frame(before_head[0].xyz, before_head[1].xyz, before_head[2].xyz);
     Frame q_new = Frame(head[0].xyz, head[1].xyz, head[2].xyz);
     vec3 y_old = vec3(0.0);
@@ -133,5 +143,8 @@ void main() {
         precise vec3 v = (x.xyz - old.xyz) / span;
         pos_out[fi] = x;
         vel_out[fi] = vec4(v, 0.0);
+    }
+    if (scalp && sim_scalp_last(end) != 0u) {
+        scalp_keep_corners(end, f);
     }
 }

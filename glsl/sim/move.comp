@@ -4,7 +4,8 @@
 // the step reads, in place. Teleport: x = T·x and v = R·v with T the rigid
 // motion from the old head to the new one and R its rotation, so the hair
 // keeps its shape and motion relative to the head and gains no velocity.
-// Reset: x = head·rest (the rest pose placed by the head), v = 0. Inverse
+// Reset: x = head·rest (the rest pose placed by the head, or with a bound
+// scalp by each key hair's root frame), v = 0. Inverse
 // masses (x.w) and velocity w are kept. The CPU reference
 // (sim::reference::move_state) runs the same operations.
 #include "sim.glsl"
@@ -15,6 +16,13 @@ layout(push_constant) uniform Push { MovePush push; };
 layout(std430, set = 0, binding = 1) buffer PosIn { vec4 pos_in[]; };
 layout(std430, set = 0, binding = 2) buffer VelIn { vec4 vel_in[]; };
 layout(std430, set = 0, binding = 5) readonly buffer Rest { vec4 rest[]; };
+// With SIM_SCALP in the step's parameters, a reset places each key hair by its
+// root's frame on this step's scalp (glsl/include/scalp.glsl).
+layout(std430, set = 0, binding = 0) readonly buffer Steps { SimStepParams steps[]; };
+layout(std430, set = 0, binding = 14) readonly buffer ScalpRoots { ScalpRoot scalp_roots[]; };
+layout(std430, set = 0, binding = 15) buffer ScalpPrevious { vec4 scalp_previous[]; };
+layout(std430, set = 0, binding = 16) readonly buffer ScalpSource { float scalp_source[]; };
+#include "scalp.glsl"
 
 // A grid-stride loop: the dispatch stays within the 65,535 workgroups every
 // device offers however many points there are.
@@ -23,11 +31,15 @@ void main() {
     bool reset = state_move_reset(push) != 0u;
     uint total = state_move_points(push);
     uint stride = gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+    SimStepParams first = steps[0];
+    bool scalp = reset && (sim_flags(first) & SIM_SCALP) != 0u;
     for (uint i = gl_GlobalInvocationID.x; i < total; i += stride) {
         vec4 x = pos_in[i];
         vec4 v = vel_in[i];
         if (reset) {
-            pos_in[i] = vec4(sim_transform_point(m, rest[i].xyz), x.w);
+            // The step restarts from this scalp (sim_scalp_restart): its frame at 0.
+            mat4 placed = scalp ? scalp_frame(first, i / sim_points(first), 0.0, m) : m;
+            pos_in[i] = vec4(sim_transform_point(placed, rest[i].xyz), x.w);
             vel_in[i] = vec4(0.0, 0.0, 0.0, v.w);
         } else {
             pos_in[i] = vec4(sim_transform_point(m, x.xyz), x.w);

@@ -8,7 +8,9 @@
 //   1. forces and prediction (own point only):
 //        a  = gravity + wind·(1 + turbulence·noise) + spring·(rest_world − x)
 //        v* = v + dt·a,  x* = x + dt·v*
-//      pinned particles (inverse mass 0) follow the head: x* = head · rest;
+//      pinned particles (inverse mass 0) follow the head: x* = head · rest
+//      (with SIM_SCALP every "head" here is the key hair's root frame, see
+//      glsl/include/scalp.glsl);
 //   2. the constraint solve: N iterations with a barrier between the sets.
 //      The barrier's scope is the "sync group": the subgroup when every hair
 //      fits into one (hairs are packed so none straddles two), else the whole
@@ -78,7 +80,13 @@ layout(std430, set = 0, binding = 11) writeonly buffer PosBefore { vec4 pos_befo
 // The key hairs in level-of-detail order (sim/lod.rs): the dispatch simulates
 // the first step_range_simulated(push) of them; follow.comp moves the others.
 layout(std430, set = 0, binding = 12) readonly buffer SimOrder { uint sim_order[]; };
+// With SIM_SCALP: the roots' triangles, their corners after the previous step,
+// and the skinned scalp's vertices (glsl/include/scalp.glsl).
+layout(std430, set = 0, binding = 14) readonly buffer ScalpRoots { ScalpRoot scalp_roots[]; };
+layout(std430, set = 0, binding = 15) buffer ScalpPrevious { vec4 scalp_previous[]; };
+layout(std430, set = 0, binding = 16) readonly buffer ScalpSource { float scalp_source[]; };
 #include "sim_bodies.glsl"
+#include "scalp.glsl"
 
 shared vec4 s_pos[2][SIM_WORKGROUP];
 shared float s_length[SIM_WORKGROUP];
@@ -173,15 +181,24 @@ void local_shape_sweep(uint root, uint points, uint src) {
     }
 }
 
-// The rest offset of particle k from its parent, rotated into the world.
-vec3 local_rest_offset(uint k) {
-    return sim_rotate(sim_head(params), rest[k].xyz - rest[k - 1u].xyz);
+// Where the rest pose of key hair `strand` is placed at the end of the
+// sub-step being run: the head, or with SIM_SCALP its root's frame.
+mat4 hair_frame(uint strand) {
+    if ((step_flags() & SIM_SCALP) != 0u) {
+        return scalp_frame(params, strand, sim_scalp_to(params), sim_head(params));
+    }
+    return sim_head(params);
+}
+
+// The rest offset of particle k from its parent, rotated into the world by `frame`.
+vec3 local_rest_offset(mat4 frame, uint k) {
+    return sim_rotate(frame, rest[k].xyz - rest[k - 1u].xyz);
 }
 
 // The unit rest direction of the segment ending at particle k, in the world
 // (zero for a degenerate segment).
-vec3 local_rest_dir(uint k) {
-    vec3 d = local_rest_offset(k);
+vec3 local_rest_dir(mat4 frame, uint k) {
+    vec3 d = local_rest_offset(frame, k);
     precise float len = sqrt(sim_dot(d, d));
     return len > 0.0 ? d / len : vec3(0.0);
 }
@@ -195,11 +212,12 @@ vec2 bend_at(uint strand_base, uint c, uint points) {
 }
 
 // Stage 1 for the own point: its predicted position (w: inverse mass) from the
-// position `x` and velocity `v` at the start of the sub-step.
-vec4 predict(vec4 x, vec3 v, vec3 rest_head, uint strand) {
+// position `x` and velocity `v` at the start of the sub-step, its rest
+// position placed by `frame`.
+vec4 predict(vec4 x, vec3 v, vec3 rest_head, uint strand, mat4 frame) {
     uint flags = step_flags();
     float dt = sim_dt(params);
-    vec3 rest_world = sim_transform_point(sim_head(params), rest_head);
+    vec3 rest_world = sim_transform_point(frame, rest_head);
     if (x.w == 0.0) {
         return vec4(rest_world, 0.0);
     }
@@ -319,18 +337,19 @@ void main() {
         // 1. Prediction, and what the shape constraints need of this sub-step's head.
         vec4 own = vec4(0.0);
         if (live) {
-            own = predict(x, v, rest_head, strand);
+            mat4 frame = hair_frame(strand);
+            own = predict(x, v, rest_head, strand, frame);
             s_pos[0][lid] = own;
             if (global_shape) {
                 precise float t = float(i) / float(points - 1u);
                 precise float k = sim_global_shape(params) * sim_shape_weight(t, sim_global_shape_range(params));
                 shape_k = k;
-                vec3 at_rest = sim_transform_point(sim_head(params), rest_head);
+                vec3 at_rest = sim_transform_point(frame, rest_head);
                 shape_target = sim_shape_target(at_rest, k, sim_iterations(params), flags, sim_gravity(params), sim_dt(params));
             }
             if (local_shape && i >= 1u) {
-                s_local_offset[lid] = local_rest_offset(index);
-                s_local_dir[lid] = i >= 2u ? local_rest_dir(index - 1u) : vec3(0.0);
+                s_local_offset[lid] = local_rest_offset(frame, index);
+                s_local_dir[lid] = i >= 2u ? local_rest_dir(frame, index - 1u) : vec3(0.0);
             }
         }
         sync(group);
@@ -424,5 +443,9 @@ void main() {
     if (live) {
         pos_out[index] = x;
         vel_out[index] = vec4(v, 0.0);
+        // Every lane read the corners it needed before the last sub-step's barriers.
+        if (i == 0u && (step_flags() & SIM_SCALP) != 0u && sim_scalp_last(params) != 0u) {
+            scalp_keep_corners(params, strand);
+        }
     }
 }

@@ -31,7 +31,7 @@ pub(crate) use render::{
     DrawParams, FollowerBinding, GpuLight, GpuShadowMap, GpuShadowParams, InterpolatePush, MarschnerPush, OitCounters,
     SmoothPush,
 };
-pub(crate) use sim::{GpuCollider, MovePush, SdfPush, SimPush, SimStepParams};
+pub(crate) use sim::{GpuCollider, GpuScalpRoot, MovePush, SdfPush, SimPush, SimStepParams};
 pub(crate) use volume::{GpuVolumeParams, PcgScalars, VolumePush};
 
 /// The Rust type of a view field of a given kind.
@@ -192,6 +192,7 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<SimPush>(reflection, &mut problems);
     check::<MovePush>(reflection, &mut problems);
     check::<GpuCollider>(reflection, &mut problems);
+    check::<GpuScalpRoot>(reflection, &mut problems);
     check::<SdfPush>(reflection, &mut problems);
     check::<SmoothPush>(reflection, &mut problems);
     check::<InterpolatePush>(reflection, &mut problems);

@@ -23,9 +23,12 @@ pub(crate) struct SimStepParams {
     pub(super) previous_head: [[f32; 4]; 4],
     pub(super) mesh_grid: [f32; 4],
     pub(super) mesh_dims: [u32; 4],
+    pub(super) scalp_lerp: [f32; 4],
+    pub(super) scalp_source: [u32; 4],
 }
 gpu_struct!(SimStepParams => "SimStepParams" {
-    head, gravity_dt, wind, wind_noise, bending, counts, layout_info, shape, previous_head, mesh_grid, mesh_dims
+    head, gravity_dt, wind, wind_noise, bending, counts, layout_info, shape, previous_head, mesh_grid, mesh_dims,
+    scalp_lerp, scalp_source
 });
 
 /// Push constants of the simulation step kernel (`SimPush`); view: [`super::StepRange`].
@@ -54,6 +57,16 @@ pub(crate) struct SdfPush {
     pub(super) pass_info: [u32; 4],
 }
 gpu_struct!(SdfPush => "SdfPush" { origin_cell, dims, pass_info });
+
+/// A key hair's root bound to a scalp triangle (`ScalpRoot`); view: [`super::ScalpRootView`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct GpuScalpRoot {
+    pub(super) corners: [u32; 4],
+    pub(super) weights: [f32; 4],
+    pub(super) unbind: [[f32; 4]; 4],
+}
+gpu_struct!(GpuScalpRoot => "ScalpRoot" { corners, weights, unbind });
 
 /// A collider in world space (`Collider`); view: [`super::ColliderShape`].
 #[repr(C)]

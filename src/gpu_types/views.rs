@@ -93,6 +93,31 @@ shader_views! {
         mesh_dims: uvec3 = mesh_dims.xyz,
         /// 1 when a mesh collider is set.
         mesh_set: uint = mesh_dims.w,
+        /// Scalp (with `SIM_SCALP`): where the sub-step starts between the
+        /// previous step's scalp (0) and this step's (1).
+        scalp_from: float = scalp_lerp.x,
+        /// Scalp: where the sub-step ends, likewise.
+        scalp_to: float = scalp_lerp.y,
+        /// Scalp: the source buffer's float holding vertex 0's x this step.
+        scalp_first: uint = scalp_source.x,
+        /// Scalp: floats from one vertex to the next in the source buffer.
+        scalp_stride: uint = scalp_source.y,
+        /// Scalp: 1 when the step starts from this step's scalp (bound anew,
+        /// teleported or reset: no motion from the previous one).
+        scalp_restart: uint = scalp_source.z,
+        /// Scalp: 1 for the step's last sub-step (its dispatch keeps this
+        /// step's corners as the next step's previous ones).
+        scalp_last: uint = scalp_source.w,
+    }
+
+    /// A key hair's root on its scalp triangle (`ScalpRoot`, one per key hair).
+    ScalpRootView for GpuScalpRoot in "sim.glsl" as "ScalpRoot" prefix "scalp_root" {
+        /// The triangle's three vertices (indices into the scalp's vertices).
+        corners: uvec3 = corners.xyz,
+        /// Barycentric weights of the root on the triangle.
+        weights: vec3 = weights.xyz,
+        /// Bind-pose triangle frame's inverse: head frame → triangle frame.
+        unbind: mat4 = unbind,
     }
 
     /// Which sub-steps one dispatch of the step kernel runs (`SimPush`).

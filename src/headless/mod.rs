@@ -9,7 +9,9 @@
 //! - [`Offscreen`]: a colour + depth target in place of a swapchain image,
 //!   read back as RGBA8;
 //! - [`MeshDrawer`]: the head mesh drawn the way a host draws its geometry,
-//!   optionally shadowed by the hair.
+//!   optionally shadowed by the hair;
+//! - [`HostBuffer`]: a storage buffer filled from the CPU in place of a
+//!   host's GPU buffer (skinned scalp vertices).
 //!
 //! ```
 //! use vkhair::headless::{Offscreen, Submit};
@@ -31,11 +33,13 @@
 //! # Ok::<(), vkhair::Error>(())
 //! ```
 
+mod host_buffer;
 mod mesh;
 mod offscreen;
 
 use ash::vk;
 
+pub use host_buffer::HostBuffer;
 pub use mesh::MeshDrawer;
 pub use offscreen::{Offscreen, OFFSCREEN_COLOR, OFFSCREEN_DEPTH};
 

@@ -1,11 +1,14 @@
 //! The CPU reference simulation.
 
 use super::lod::SimLod;
+use super::packing::ScalpLanes;
 use super::planner::SubstepPlanner;
+use super::scalp::{check_vertices, CpuScalp, Scalp, ScalpBinding};
 use super::{reference, volume, Collider, RigidTransform, SimParams, SimState, VolumeGrid, VolumeMode, MAX_SIM_POINTS};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::groom::sdf::MeshSdf;
 use crate::groom::Groom;
+use glam::{Mat4, Vec3};
 
 /// How far one step of [`HairSim`](super::HairSim) and one of [`CpuHairSim`] from
 /// the same state may end apart, measured by [`SimState::step_difference`],
@@ -43,6 +46,8 @@ pub struct CpuHairSim {
     volume_time: std::time::Duration,
     /// Which key hairs are simulated, and whom the others follow.
     lod: SimLod,
+    /// The bound scalp, when set.
+    scalp: Option<CpuScalp>,
 }
 
 impl CpuHairSim {
@@ -58,7 +63,16 @@ impl CpuHairSim {
         let planner = SubstepPlanner::new(params, head, state.rest_roots(), state.points, MAX_SIM_POINTS as u32)?;
         let volume = cpu_volume_grid(params, &state)?;
         let lod = SimLod::new(&state);
-        Ok(CpuHairSim { planner, state, volume, last_volume: None, mesh: None, volume_time: Default::default(), lod })
+        Ok(CpuHairSim {
+            planner,
+            state,
+            volume,
+            last_volume: None,
+            mesh: None,
+            volume_time: Default::default(),
+            lod,
+            scalp: None,
+        })
     }
 
     /// See [`HairSim::set_params`](super::HairSim::set_params).
@@ -93,11 +107,45 @@ impl CpuHairSim {
         Ok(())
     }
 
+    /// Binds every key hair's root to `scalp` (see [`HairSim::bind_scalp_source`](super::HairSim::bind_scalp_source)),
+    /// its vertices now at `vertices` (world); the next step starts from them.
+    pub fn bind_scalp(&mut self, scalp: &Scalp, vertices: &[Vec3]) -> Result<()> {
+        let binding = ScalpBinding::new(scalp, &self.state.rest_roots())?;
+        check_vertices(vertices, binding.vertices)?;
+        self.scalp = Some(CpuScalp { binding, scalp: scalp.clone(), previous: Vec::new(), now: vertices.to_vec() });
+        self.planner.scalp = Some(ScalpLanes { first: 0, stride: 3, restart: true });
+        Ok(())
+    }
+
+    /// The bound scalp's vertices (world) at the end of the next step: the
+    /// CPU form of the host's skinned buffer.
+    pub fn set_scalp_vertices(&mut self, vertices: &[Vec3]) -> Result<()> {
+        self.bound_scalp()?.set_vertices(vertices)
+    }
+
+    /// See [`HairSim::set_scalp_bones`](super::HairSim::set_scalp_bones).
+    pub fn set_scalp_bones(&mut self, bones: &[Mat4]) -> Result<()> {
+        let scalp = self.bound_scalp()?;
+        let vertices = scalp.scalp.skin(bones)?;
+        scalp.set_vertices(&vertices)
+    }
+
+    /// Roots follow the head again.
+    pub fn unbind_scalp(&mut self) {
+        self.scalp = None;
+        self.planner.scalp = None;
+    }
+
+    fn bound_scalp(&mut self) -> Result<&mut CpuScalp> {
+        self.scalp.as_mut().ok_or_else(|| Error::incompatible("scalp vertices", "no scalp is bound"))
+    }
+
     /// Advances one step ending with the head at `head`.
     pub fn step(&mut self, head: &RigidTransform) -> Result<()> {
         let planned = self.planner.next(head)?;
+        let scalp = self.scalp.as_ref();
         if let Some(start) = &planned.start {
-            reference::move_state(&mut self.state, start);
+            reference::move_state(&mut self.state, start, scalp.zip(planned.substeps.first().map(|s| &s.params)));
         }
         let inputs = planned.substeps;
         self.volume_time = std::time::Duration::ZERO;
@@ -108,13 +156,14 @@ impl CpuHairSim {
         let mut before = active.map(|_| self.state.positions.clone());
         for (k, sub) in inputs.iter().enumerate() {
             let mesh = self.mesh.as_ref().map(reference::MeshField::new);
-            reference::step(&mut self.state, std::slice::from_ref(sub), mesh, active);
+            reference::step(&mut self.state, std::slice::from_ref(sub), mesh, active, scalp);
             if let Some(before) = &mut before {
                 if self.volume.is_some() {
-                    reference::follow(&mut self.state, before, &self.lod.guides, std::slice::from_ref(sub), mesh);
+                    let one = std::slice::from_ref(sub);
+                    reference::follow(&mut self.state, before, &self.lod.guides, one, mesh, scalp);
                     before.clone_from(&self.state.positions);
                 } else if k + 1 == inputs.len() {
-                    reference::follow(&mut self.state, before, &self.lod.guides, &inputs, mesh);
+                    reference::follow(&mut self.state, before, &self.lod.guides, &inputs, mesh, scalp);
                 }
             }
             if let Some(grid) = &self.volume {
@@ -132,6 +181,9 @@ impl CpuHairSim {
                 self.last_volume = Some(snapshot);
                 self.volume_time += started.elapsed();
             }
+        }
+        if let Some(scalp) = &mut self.scalp {
+            scalp.keep_corners();
         }
         Ok(())
     }

@@ -59,6 +59,8 @@ mod params;
 mod planner;
 mod record;
 pub(crate) mod reference;
+pub mod scalp;
+mod scalp_gpu;
 mod state;
 mod step;
 mod teleport;
@@ -208,6 +210,8 @@ pub struct HairSim {
     follow_sets: [vk::DescriptorSet; 2],
     /// The teleport and reset kernel.
     mover: teleport::MoveKernel,
+    /// The bound scalp, when set.
+    scalp: Option<scalp_gpu::GpuScalp>,
 }
 
 impl HairSim {
@@ -254,6 +258,7 @@ impl HairSim {
             follow,
             follow_sets,
             mover,
+            scalp: None,
         };
         sim.configure_volume(&params.volume)?;
         sim.prepare_step()?;
@@ -264,7 +269,8 @@ impl HairSim {
     /// parameters and mesh collider (the kernel specialised to the switches they
     /// turn on), so that recording a step does not compile it.
     fn prepare_step(&mut self) -> Result<()> {
-        self.pipeline.prepare_variant(packing::flags(&self.planner.params, self.mesh.is_some()))
+        let scalp = if self.planner.scalp.is_some() { crate::codes::sim_flags::SCALP } else { 0 };
+        self.pipeline.prepare_variant(packing::flags(&self.planner.params, self.mesh.is_some()) | scalp)
     }
 
     /// Creates, rebuilds or drops the volume stage for `params`. The grid is fitted
@@ -378,19 +384,9 @@ impl HairSim {
                 return Err(Error::incompatible("mesh collider", "it was built on another context's device"));
             }
         }
-        self.device.wait_idle()?;
-        let field = mesh.as_ref().map(|m| &m.field);
-        for (parity, &set) in self.sets.iter().enumerate() {
-            // SAFETY: the set was allocated by this pipeline for set 0, and the
-            // device is idle; recording happens only through `&mut self`.
-            unsafe { self.pipeline.rewrite_declared(set, 0, &self.gpu.bindings(parity, field))? };
-        }
-        for (parity, &set) in self.follow_sets.iter().enumerate() {
-            // SAFETY: as above, for the follower kernel's sets.
-            unsafe { self.follow.rewrite_declared(set, 0, &self.gpu.follow_bindings(parity, field))? };
-        }
         self.planner.mesh = mesh.as_ref().map(MeshCollider::grid);
         let previous = std::mem::replace(&mut self.mesh, mesh);
+        self.rewrite_sets()?;
         self.prepare_step()?;
         // The volume stage binds the field too: rebuild it around the new one.
         if self.volume.take().is_some() {

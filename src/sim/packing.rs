@@ -102,6 +102,38 @@ pub(crate) fn sim_step(
         mesh_cell: grid.cell,
         mesh_dims: grid.dims,
         mesh_set: u32::from(mesh.is_some()),
+        // Set by the planner when a scalp is bound (`ScalpLanes`).
+        scalp_from: 0.0,
+        scalp_to: 0.0,
+        scalp_first: 0,
+        scalp_stride: 0,
+        scalp_restart: 0,
+        scalp_last: 0,
+    }
+}
+
+/// With a bound scalp (`sim::scalp`): where a step's skinned vertices are, and
+/// whether it starts from them (no motion from the previous step's).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ScalpLanes {
+    /// The source's float holding vertex 0's x.
+    pub first: u32,
+    /// Floats from one vertex to the next.
+    pub stride: u32,
+    /// The scalp was bound or its source changed since the last step.
+    pub restart: bool,
+}
+
+impl ScalpLanes {
+    /// Sub-step `k` of `count` of a step, which starts anew when `restart`.
+    pub(crate) fn apply(&self, step: &mut SimStep, k: u32, count: u32, restart: bool) {
+        step.flags |= sim_flags::SCALP;
+        step.scalp_from = k as f32 / count as f32;
+        step.scalp_to = (k + 1) as f32 / count as f32;
+        step.scalp_first = self.first;
+        step.scalp_stride = self.stride;
+        step.scalp_restart = u32::from(restart);
+        step.scalp_last = u32::from(k + 1 == count);
     }
 }
 
@@ -181,9 +213,25 @@ mod tests {
             mesh_cell: 0.03125,
             mesh_dims: [21, 22, 23],
             mesh_set: 1,
+            scalp_from: 0.0,
+            scalp_to: 0.0,
+            scalp_first: 0,
+            scalp_stride: 0,
+            scalp_restart: 0,
+            scalp_last: 0,
         };
         assert_eq!(s, expected);
         assert_eq!(SimStep::from(&SimStepParams::from(&s)), s, "the packing loses or mixes fields");
+        // A bound scalp's lanes: sub-step 1 of 2 ends the step.
+        let mut scalped = s;
+        ScalpLanes { first: 9, stride: 4, restart: true }.apply(&mut scalped, 1, 2, true);
+        let lanes = (scalped.scalp_from, scalped.scalp_to, scalped.scalp_first, scalped.scalp_stride);
+        assert_eq!(lanes, (0.5, 1.0, 9, 4));
+        assert_eq!(
+            (scalped.scalp_restart, scalped.scalp_last, scalped.flags & sim_flags::SCALP),
+            (1, 1, sim_flags::SCALP)
+        );
+        assert_eq!(SimStep::from(&SimStepParams::from(&scalped)), scalped, "the scalp lanes are lost or mixed");
         let unset = sim_step(&p, &pose, shape, 0, None);
         assert_eq!((unset.mesh_set, unset.flags & sim_flags::MESH, unset.mesh_cell), (0, 0, 1.0));
     }

@@ -8,7 +8,7 @@ use glam::Mat4;
 
 use super::body::{validate_collider_total, validate_colliders, Collider, RigidTransform};
 use super::mesh_collider::MeshGrid;
-use super::packing::{self, SimShape, SubstepPose};
+use super::packing::{self, ScalpLanes, SimShape, SubstepPose};
 use super::params::SimParams;
 use super::teleport::{root_displacement, Move, PendingMove};
 use super::volume::VolumeParams;
@@ -71,6 +71,8 @@ pub(crate) struct SubstepPlanner {
     pub roots: Vec<glam::Vec3>,
     /// A teleport or reset asked for, applied at the start of the next step.
     pub pending: Option<PendingMove>,
+    /// With a bound scalp: where the next step's skinned vertices are.
+    pub scalp: Option<ScalpLanes>,
 }
 
 /// Says, through `log`, when the sag-free rest state is asked for but cannot be
@@ -111,6 +113,7 @@ impl SubstepPlanner {
             subgroup_size,
             roots,
             pending: None,
+            scalp: None,
         })
     }
 
@@ -194,6 +197,7 @@ impl SubstepPlanner {
         let p = &self.params;
         let dt = p.substep_dt();
         let shape = SimShape { strands: self.strands, points: self.points, packing: self.packing() };
+        let restart = start.is_some() || self.scalp.is_some_and(|s| s.restart);
         let inputs = (0..p.substeps)
             .map(|k| {
                 let at = |k: u32| self.head.lerp(head, k as f32 / p.substeps as f32).matrix();
@@ -207,12 +211,19 @@ impl SubstepPlanner {
                 let t = (k + 1) as f32 / p.substeps as f32;
                 let body =
                     self.body_before.iter().zip(&self.body).map(|(b0, b1)| b0.lerp(b1, t).in_world(&Mat4::IDENTITY));
+                let mut params = packing::sim_step(p, &pose, shape, colliders, self.mesh.as_ref());
+                if let Some(scalp) = &self.scalp {
+                    scalp.apply(&mut params, k, p.substeps, restart);
+                }
                 SubstepInputs {
-                    params: packing::sim_step(p, &pose, shape, colliders, self.mesh.as_ref()),
+                    params,
                     colliders: self.colliders.iter().map(|c| c.in_world(&pose.head)).chain(body).collect(),
                 }
             })
             .collect();
+        if let Some(scalp) = &mut self.scalp {
+            scalp.restart = false;
+        }
         self.head = *head;
         self.body_before.clone_from(&self.body);
         self.time += f64::from(p.dt);

@@ -3,6 +3,7 @@
 //! the volume stage on, its kernels after each sub-step.
 
 use ash::vk;
+use glam::Vec4;
 
 use super::planner::SubstepInputs;
 use super::{state, step, volume, HairSim, SimStage};
@@ -49,10 +50,11 @@ impl HairSim {
         // `new`, `set_params` and `set_mesh_collider`, so found here.
         let features = inputs.iter().fold(0, |f, sub| f | sub.params.flags);
         self.pipeline.prepare_variant(features)?;
+        let scalp = self.take_scalp_upload();
         // SAFETY (whole body): guaranteed by the caller; all buffers belong to this
         // device, and update sizes are multiples of 4 below 64 KiB (by construction).
         unsafe {
-            self.record_uploads(cmd, &inputs);
+            self.record_uploads(cmd, &inputs, scalp.as_deref());
             if let Some(start) = &planned.start {
                 let points = self.planner.strands * self.planner.points;
                 self.mover.record(cmd, self.current, start, points);
@@ -85,12 +87,13 @@ impl HairSim {
     }
 
     /// Records the uploads of a step between the entry and the uploaded barrier:
-    /// the sub-steps' parameters and colliders, pending rest data, and with the
-    /// volume stage its uploads for the first sub-step.
+    /// the sub-steps' parameters and colliders, pending rest data, a scalp's
+    /// vertices skinned from bone matrices, and with the volume stage its
+    /// uploads for the first sub-step.
     ///
     /// # Safety
     /// As [`HairSim::record_step`].
-    unsafe fn record_uploads(&self, cmd: vk::CommandBuffer, inputs: &[SubstepInputs]) {
+    unsafe fn record_uploads(&self, cmd: vk::CommandBuffer, inputs: &[SubstepInputs], scalp: Option<&[Vec4]>) {
         let d = &self.device;
         let params: Vec<SimStepParams> = inputs.iter().map(|sub| SimStepParams::from(&sub.params)).collect();
         // SAFETY: guaranteed by the caller; sizes are multiples of 4, each update
@@ -113,6 +116,9 @@ impl HairSim {
                 let lengths = bytemuck::cast_slice(&self.shape.rest_lengths[range.clone()]);
                 update_chunked(d, cmd, self.gpu.rest.raw(), range.start as u64 * 16, rest);
                 update_chunked(d, cmd, self.gpu.rest_lengths.raw(), range.start as u64 * 4, lengths);
+            }
+            if let Some(vertices) = scalp {
+                update_chunked(d, cmd, self.gpu.scalp_vertices.raw(), 0, bytemuck::cast_slice(vertices));
             }
             if let (Some(volume), Some(first)) = (&self.volume, inputs.first()) {
                 self.record_volume_uploads(cmd, volume, first);

@@ -10,26 +10,31 @@ use glam::{Mat4, Vec3, Vec4};
 
 use super::mesh_collider::MeshGrid;
 use super::planner::SubstepInputs;
+use super::scalp::CpuScalp;
 use super::state::SimState;
 use crate::codes::sim_flags as flags;
 use crate::gpu_types::{ColliderShape, SimStep};
 use crate::groom::sdf::MeshSdf;
 
-fn dot(a: Vec3, b: Vec3) -> f32 {
+pub(crate) fn dot(a: Vec3, b: Vec3) -> f32 {
     (a.x * b.x + a.y * b.y) + a.z * b.z
 }
 
-fn transform_point(m: &Mat4, p: Vec3) -> Vec3 {
+pub(crate) fn transform_point(m: &Mat4, p: Vec3) -> Vec3 {
     let c = |i: usize| m.col(i).truncate();
     ((c(0) * p.x + c(1) * p.y) + c(2) * p.z) + c(3)
 }
 
-/// A teleport or reset of the whole state (`glsl/sim/move.comp`).
-pub(crate) fn move_state(state: &mut SimState, mv: &super::teleport::Move) {
+/// A teleport or reset of the whole state (`glsl/sim/move.comp`); a reset with
+/// a bound scalp places each key hair by its root's frame at the start of
+/// `first`, the step's first sub-step.
+pub(crate) fn move_state(state: &mut SimState, mv: &super::teleport::Move, scalp: Option<(&CpuScalp, &SimStep)>) {
     let m = &mv.transform;
+    let frames = scalp.filter(|_| mv.reset).map(|(s, first)| s.frames(first, 0.0, m));
     for (i, (x, v)) in state.positions.iter_mut().zip(&mut state.velocities).enumerate() {
         if mv.reset {
-            *x = transform_point(m, state.rest[i].truncate()).extend(x.w);
+            let placed = frames.as_ref().map_or(m, |f| &f[i / state.points]);
+            *x = transform_point(placed, state.rest[i].truncate()).extend(x.w);
             *v = Vec4::new(0.0, 0.0, 0.0, v.w);
         } else {
             *x = transform_point(m, x.truncate()).extend(x.w);
@@ -46,12 +51,12 @@ fn to_head(m: &Mat4, p: Vec3) -> Vec3 {
 }
 
 /// `sim_rotate`: R · v.
-fn rotate(m: &Mat4, v: Vec3) -> Vec3 {
+pub(crate) fn rotate(m: &Mat4, v: Vec3) -> Vec3 {
     let c = |i: usize| m.col(i).truncate();
     (c(0) * v.x + c(1) * v.y) + c(2) * v.z
 }
 
-fn cross(a: Vec3, b: Vec3) -> Vec3 {
+pub(crate) fn cross(a: Vec3, b: Vec3) -> Vec3 {
     Vec3::new(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x)
 }
 
@@ -244,8 +249,14 @@ fn simulated(active: Option<&[bool]>, s: usize) -> bool {
     active.is_none_or(|a| a[s])
 }
 
+/// Where key hair `strand`'s rest pose is placed: its root's frame with a bound
+/// scalp (`frames`), else the head (`hair_frame` of glsl/sim/step.comp).
+fn hair_frame<'a>(p: &'a SimStep, frames: Option<&'a [Mat4]>, strand: usize) -> &'a Mat4 {
+    frames.map_or(&p.head, |f| &f[strand])
+}
+
 /// Stage 1: forces and prediction.
-fn predict(p: &SimStep, state: &SimState, active: Option<&[bool]>, predicted: &mut [Vec4]) {
+fn predict(p: &SimStep, frames: Option<&[Mat4]>, state: &SimState, active: Option<&[bool]>, predicted: &mut [Vec4]) {
     let points = p.points as usize;
     let (dt, flags, gravity, wind) = (p.dt, p.flags, p.gravity, p.wind);
     for (index, out) in predicted.iter_mut().enumerate() {
@@ -254,7 +265,7 @@ fn predict(p: &SimStep, state: &SimState, active: Option<&[bool]>, predicted: &m
         }
         let strand = (index / points) as u32;
         let x = state.positions[index];
-        let rest_world = transform_point(&p.head, state.rest[index].truncate());
+        let rest_world = transform_point(hair_frame(p, frames, index / points), state.rest[index].truncate());
         if x.w == 0.0 {
             *out = rest_world.extend(0.0);
             continue;
@@ -277,7 +288,7 @@ fn predict(p: &SimStep, state: &SimState, active: Option<&[bool]>, predicted: &m
 
 /// Stage 2: constraint solve, hair by hair.
 fn solve(
-    p: &SimStep,
+    (p, frames): (&SimStep, Option<&[Mat4]>),
     colliders: &[ColliderShape],
     mesh: Option<MeshField<'_>>,
     state: &SimState,
@@ -339,13 +350,14 @@ fn solve(
             for (i, slot) in shape.iter_mut().enumerate() {
                 let t = i as f32 / (points - 1) as f32;
                 let k = shape_stiffness * shape_weight(t, shape_range);
-                let at_rest = transform_point(&p.head, state.rest[base + i].truncate());
+                let at_rest = transform_point(hair_frame(p, frames, strand), state.rest[base + i].truncate());
                 *slot = (shape_target(at_rest, k, p.iterations, flags, p.gravity, p.dt), k);
             }
         }
         if local_shape {
+            let frame = hair_frame(p, frames, strand);
             let offset =
-                |j: usize| rotate(&p.head, state.rest[base + j].truncate() - state.rest[base + j - 1].truncate());
+                |j: usize| rotate(frame, state.rest[base + j].truncate() - state.rest[base + j - 1].truncate());
             for (i, slot) in local.iter_mut().enumerate().skip(1) {
                 let mut dir = Vec3::ZERO;
                 if i >= 2 {
@@ -442,19 +454,24 @@ fn integrate(p: &SimStep, state: &mut SimState, active: Option<&[bool]>, predict
 }
 
 /// Advances `state` by the given sub-steps, with the mesh collider's field when
-/// set; with `active`, only the strands it marks (the others are left as they are).
+/// set; with `active`, only the strands it marks (the others are left as they
+/// are); with `scalp`, the rest pose placed per key hair by its root's frame.
 pub(crate) fn step(
     state: &mut SimState,
     substeps: &[SubstepInputs],
     mesh: Option<MeshField<'_>>,
     active: Option<&[bool]>,
+    scalp: Option<&CpuScalp>,
 ) {
     let n = state.positions.len();
     let mut predicted = vec![Vec4::ZERO; n];
     let mut correction = vec![Vec4::ZERO; n];
     for sub in substeps {
-        predict(&sub.params, state, active, &mut predicted);
-        solve(&sub.params, &sub.colliders, mesh, state, active, &mut predicted, &mut correction);
+        let p = &sub.params;
+        let frames = scalp.map(|s| s.frames(p, p.scalp_to, &p.head));
+        let frames = frames.as_deref();
+        predict(p, frames, state, active, &mut predicted);
+        solve((p, frames), &sub.colliders, mesh, state, active, &mut predicted, &mut correction);
         integrate(&sub.params, state, active, &predicted, &correction);
     }
 }
@@ -494,6 +511,7 @@ pub(crate) fn follow(
     guides: &[u32],
     substeps: &[SubstepInputs],
     mesh: Option<MeshField<'_>>,
+    scalp: Option<&CpuScalp>,
 ) {
     let (Some(first), Some(last)) = (substeps.first(), substeps.last()) else {
         return;
@@ -505,12 +523,17 @@ pub(crate) fn follow(
     let points = state.points;
     let span = end.dt * substeps.len() as f32;
     let columns = |m: &Mat4| [m.col(0).truncate(), m.col(1).truncate(), m.col(2).truncate()];
+    // Each follower's own root frames with a bound scalp, else the head's.
+    let starts = scalp.map(|s| s.frames(start, start.scalp_from, &start.previous_head));
+    let ends = scalp.map(|s| s.frames(end, end.scalp_to, &end.head));
     for (f, &g) in guides.iter().enumerate() {
         let g = g as usize;
         if g == f {
             continue;
         }
-        let (mut q_old, mut q_new) = (columns(&start.previous_head), columns(&end.head));
+        let before_head = starts.as_ref().map_or(&start.previous_head, |frames| &frames[f]);
+        let head = ends.as_ref().map_or(&end.head, |frames| &frames[f]);
+        let (mut q_old, mut q_new) = (columns(before_head), columns(head));
         let (mut y_old, mut y_new) = (Vec3::ZERO, Vec3::ZERO);
         let (mut placed_before, mut rest_length) = (Vec3::ZERO, 0.0f32);
         for i in 0..points {
@@ -518,8 +541,8 @@ pub(crate) fn follow(
             let old = before[fi];
             let rest = state.rest[fi].truncate();
             if i == 0 {
-                y_old = transform_point(&start.previous_head, rest);
-                y_new = transform_point(&end.head, rest);
+                y_old = transform_point(before_head, rest);
+                y_new = transform_point(head, rest);
             } else {
                 let rest_segment = state.rest[gi].truncate() - state.rest[gi - 1].truncate();
                 let old_segment = before[gi].truncate() - before[gi - 1].truncate();

@@ -181,6 +181,12 @@ pub(crate) struct GpuState {
     /// The key hairs in level-of-detail order (`sim::lod`), and each one's guide.
     pub order: Buffer,
     pub guides: Buffer,
+    /// With a bound scalp (`sim::scalp`): each key hair's root on its triangle,
+    /// its triangle's corners after the previous step, and the scalp's vertices
+    /// when vkhair skins them (bone matrices); placeholders otherwise.
+    pub scalp_roots: Buffer,
+    pub scalp_previous: Buffer,
+    pub scalp_vertices: Buffer,
 }
 
 /// Byte offset of sub-step `k`'s colliders in [`GpuState::colliders`].
@@ -203,6 +209,9 @@ pub(crate) mod binding {
     pub const ORDER: u32 = 12;
     /// The follower kernel's (`glsl/sim/follow.comp`) only.
     pub const GUIDES: u32 = 13;
+    pub const SCALP_ROOTS: u32 = 14;
+    pub const SCALP_PREVIOUS: u32 = 15;
+    pub const SCALP_SOURCE: u32 = 16;
 }
 
 impl GpuState {
@@ -238,6 +247,9 @@ impl GpuState {
             no_mesh: storage("vkhair sim no mesh collider", 16)?,
             order: storage("vkhair sim level-of-detail order", 4 * state.strands as u64)?,
             guides: storage("vkhair sim followers' guides", 4 * state.strands as u64)?,
+            scalp_roots: storage("vkhair sim no scalp roots", 16)?,
+            scalp_previous: storage("vkhair sim no scalp corners", 16)?,
+            scalp_vertices: storage("vkhair sim no scalp vertices", 16)?,
         };
         gpu.upload(device, state, 0)?;
         device.upload_pod(&gpu.order, &lod.order.order)?;
@@ -258,9 +270,12 @@ impl GpuState {
 
     /// Buffers by binding number for half `parity` (reads `parity`, writes the other),
     /// with `mesh` as the mesh collider's field (none: the placeholder).
-    pub(crate) fn bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 11] {
+    pub(crate) fn bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 14] {
         use binding::*;
         [
+            (SCALP_ROOTS, &self.scalp_roots),
+            (SCALP_PREVIOUS, &self.scalp_previous),
+            (SCALP_SOURCE, &self.scalp_vertices),
             (PARAMS, &self.params),
             (POS_IN, &self.positions[parity]),
             (VEL_IN, &self.velocities[parity]),
@@ -276,9 +291,12 @@ impl GpuState {
     }
 
     /// The follower kernel's buffers for half `parity` (as [`GpuState::bindings`]).
-    pub(crate) fn follow_bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 10] {
+    pub(crate) fn follow_bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 13] {
         use binding::*;
         [
+            (SCALP_ROOTS, &self.scalp_roots),
+            (SCALP_PREVIOUS, &self.scalp_previous),
+            (SCALP_SOURCE, &self.scalp_vertices),
             (COLLIDERS, &self.colliders),
             (MESH_FIELD, mesh.unwrap_or(&self.no_mesh)),
             (PARAMS, &self.params),
@@ -289,6 +307,20 @@ impl GpuState {
             (POS_BEFORE, &self.before),
             (ORDER, &self.order),
             (GUIDES, &self.guides),
+        ]
+    }
+
+    /// The move kernel's buffers for half `parity` (it moves that half in place).
+    pub(crate) fn move_bindings(&self, parity: usize) -> [(u32, &Buffer); 7] {
+        use binding::*;
+        [
+            (PARAMS, &self.params),
+            (POS_IN, &self.positions[parity]),
+            (VEL_IN, &self.velocities[parity]),
+            (REST, &self.rest),
+            (SCALP_ROOTS, &self.scalp_roots),
+            (SCALP_PREVIOUS, &self.scalp_previous),
+            (SCALP_SOURCE, &self.scalp_vertices),
         ]
     }
 }

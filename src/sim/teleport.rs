@@ -16,7 +16,7 @@ use ash::vk;
 use glam::{Mat4, Vec3};
 
 use super::body::RigidTransform;
-use super::state::{binding, GpuState};
+use super::state::GpuState;
 use crate::error::Result;
 use crate::gpu_types::{MovePush, StateMove};
 use crate::profiler::{PassScope, Timing};
@@ -69,23 +69,14 @@ pub(crate) fn root_displacement(roots: &[Vec3], from: &RigidTransform, to: &Rigi
 /// The move kernel with its sets for both halves of the double buffer.
 pub(crate) struct MoveKernel {
     device: Arc<Device>,
-    pipeline: ComputePipeline,
-    sets: [vk::DescriptorSet; 2],
+    pub(crate) pipeline: ComputePipeline,
+    pub(crate) sets: [vk::DescriptorSet; 2],
 }
 
 impl MoveKernel {
     pub(crate) fn new(device: &Arc<Device>, gpu: &GpuState) -> Result<Self> {
         let pipeline = ComputePipeline::new(device, &SIM_MOVE_COMP, 2)?;
-        let set = |parity: usize| {
-            pipeline.declared_buffer_set(
-                0,
-                &[
-                    (binding::POS_IN, &gpu.positions[parity]),
-                    (binding::VEL_IN, &gpu.velocities[parity]),
-                    (binding::REST, &gpu.rest),
-                ],
-            )
-        };
+        let set = |parity: usize| pipeline.declared_buffer_set(0, &gpu.move_bindings(parity));
         let sets = [set(0)?, set(1)?];
         Ok(MoveKernel { device: device.clone(), pipeline, sets })
     }

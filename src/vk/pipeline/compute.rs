@@ -106,6 +106,24 @@ impl ComputePipeline {
         Ok(())
     }
 
+    /// Points storage buffer `binding` of set `set` in `target` at a range of a
+    /// host's buffer (not counted in the traffic estimate).
+    ///
+    /// # Safety
+    /// As [`ComputePipeline::rewrite_declared`], and `info` names a live buffer
+    /// of this device with storage usage, its range within the buffer and the
+    /// device's limits.
+    pub(crate) unsafe fn rewrite_raw_buffer(
+        &self,
+        target: vk::DescriptorSet,
+        set: u32,
+        binding: u32,
+        info: vk::DescriptorBufferInfo,
+    ) -> Result<()> {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.layout.write_raw_buffer(target, set, binding, info) }
+    }
+
     fn note_traffic(&self, target: vk::DescriptorSet, set: u32, buffers: &[(u32, &Buffer)]) {
         let traffic = self.layout.traffic(set, buffers);
         if let Ok(mut map) = self.traffic.lock() {

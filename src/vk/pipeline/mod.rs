@@ -234,6 +234,38 @@ impl Layout {
         traffic
     }
 
+    /// Points storage buffer binding `binding` of `set` at a range of a buffer
+    /// this crate does not own (a host's).
+    ///
+    /// # Safety
+    /// `target` was allocated for `set` and is not in use by pending GPU work;
+    /// `info` names a live buffer of this device with storage usage, its range
+    /// within the buffer and the device's limits.
+    unsafe fn write_raw_buffer(
+        &self,
+        target: vk::DescriptorSet,
+        set: u32,
+        binding: u32,
+        info: vk::DescriptorBufferInfo,
+    ) -> Result<()> {
+        let declared = self.bindings.iter().find(|(b, _)| b.set == set && b.binding == binding);
+        if declared.is_none_or(|(b, _)| b.ty != vk::DescriptorType::STORAGE_BUFFER) {
+            return Err(Error::incompatible(
+                "descriptor binding",
+                format!("set {set} binding {binding} is not a declared storage buffer"),
+            ));
+        }
+        let infos = [info];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(target)
+            .dst_binding(binding)
+            .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+            .buffer_info(&infos);
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.device.raw.update_descriptor_sets(&[write], &[]) };
+        Ok(())
+    }
+
     /// Points storage/uniform buffer bindings of `set` at whole buffers.
     fn write_buffers(&self, target: vk::DescriptorSet, set: u32, buffers: &[(u32, &Buffer)]) -> Result<()> {
         let infos: Vec<_> = buffers.iter().map(|(_, b)| [b.descriptor()]).collect();

@@ -1,0 +1,186 @@
+//! A bound scalp on the GPU ([`HairSim::bind_scalp_source`],
+//! [`HairSim::bind_scalp_bones`]; the rule is in [`super::scalp`]): the roots'
+//! triangles and their corners after the previous step live in this
+//! simulation's buffers; the skinned vertices are read from the host's buffer
+//! or, with bone matrices, from one of ours that each step's uploads refill.
+//! The frames are computed inside the step's, the followers' and the move's
+//! dispatches: binding a scalp adds no dispatch.
+
+use ash::vk;
+use glam::{Mat4, Vec4};
+
+use super::packing::ScalpLanes;
+use super::scalp::{as_vec4, check_vertices, Scalp, ScalpBinding, ScalpSource};
+use super::state::binding;
+use super::HairSim;
+use crate::error::{Error, Result};
+use crate::vk::buffer::Buffer;
+
+/// Where a bound scalp's skinned vertices come from.
+pub(crate) enum VertexSource {
+    /// The host's buffer.
+    Host(ScalpSource),
+    /// Bone matrices applied by vkhair; the vertices the next step uploads.
+    Bones { scalp: Scalp, pending: Option<Vec<Vec4>> },
+}
+
+/// See the module docs.
+pub(crate) struct GpuScalp {
+    pub binding: ScalpBinding,
+    pub source: VertexSource,
+}
+
+/// Binding a scalp.
+impl HairSim {
+    /// Binds every key hair's root to the nearest triangle of `scalp` (bind
+    /// pose, head frame; a root farther than `scalp.tolerance` is refused,
+    /// naming the strand) and from the next step on places each key hair's
+    /// rest pose by its root's frame on the skinned scalp that `source` holds
+    /// (see [`super::scalp`]): the shape constraints, the rest-shape spring, the
+    /// pinned roots, the followers and a reset all follow the skin, while the
+    /// head (the argument of [`HairSim::record_step`]) still places the head's
+    /// colliders, the mesh collider and the volume grid and decides teleports.
+    /// The next step starts from the source's vertices (no motion from before).
+    /// Waits for the device to be idle; nothing is recorded.
+    ///
+    /// Vertex `v` of `scalp.mesh` is read at byte `offset + v · stride` of
+    /// `source.buffer` (`offset` 0, or [`HairSim::set_scalp_offset`]'s), xyz in
+    /// the world, by every recorded step's dispatches (storage reads in the
+    /// compute stage, after the step's entry barrier, which orders any earlier
+    /// write in the same queue before them).
+    ///
+    /// # Safety
+    /// `source.buffer` is a buffer of this simulation's device created with
+    /// `STORAGE_BUFFER` usage, at least `source.size` bytes long and bound to
+    /// memory; it stays alive until another scalp is bound, the scalp is
+    /// unbound or this simulation is dropped, each after the last step that
+    /// reads it has completed. Writes to it reach the step through the same
+    /// queue before the step (or through the host's semaphores), and none
+    /// overlaps a step that reads it.
+    pub unsafe fn bind_scalp_source(&mut self, scalp: &Scalp, source: &ScalpSource) -> Result<()> {
+        let binding = ScalpBinding::new(scalp, &self.shape.rest_roots())?;
+        let stride = source.validate(binding.vertices, u64::from(self.device.info.max_storage_buffer_range))?;
+        let first = source.first_float(0)?;
+        self.install_scalp(GpuScalp { binding, source: VertexSource::Host(*source) }, None)?;
+        self.planner.scalp = Some(ScalpLanes { first, stride, restart: true });
+        self.prepare_step()
+    }
+
+    /// Where the host's skinned vertices start in its buffer from the next
+    /// step on, bytes (a host may keep a frame's vertices apart from the next
+    /// one's in one buffer). Checked against the bound [`ScalpSource`].
+    pub fn set_scalp_offset(&mut self, offset: u64) -> Result<()> {
+        let (Some(scalp), Some(lanes)) = (&self.scalp, &mut self.planner.scalp) else {
+            return Err(Error::incompatible("scalp offset", "no scalp is bound"));
+        };
+        let VertexSource::Host(source) = &scalp.source else {
+            return Err(Error::incompatible("scalp offset", "the scalp is skinned from bone matrices"));
+        };
+        lanes.first = source.first_float(offset)?;
+        Ok(())
+    }
+
+    /// As [`HairSim::bind_scalp_source`], for a host without GPU skinning:
+    /// vkhair skins `scalp`'s vertices itself with `scalp.skin` (up to four
+    /// bones per vertex) and `bones` (each maps the bind pose, head frame, to
+    /// the world) now, and with [`HairSim::set_scalp_bones`] before each step.
+    /// Uploads and waits.
+    pub fn bind_scalp_bones(&mut self, scalp: &Scalp, bones: &[Mat4]) -> Result<()> {
+        let binding = ScalpBinding::new(scalp, &self.shape.rest_roots())?;
+        if scalp.skin.is_empty() {
+            return Err(Error::incompatible("scalp bones", "the scalp has no vertex bones (Scalp::skin)"));
+        }
+        let vertices = as_vec4(&scalp.skin(bones)?);
+        let source = VertexSource::Bones { scalp: scalp.clone(), pending: None };
+        self.install_scalp(GpuScalp { binding, source }, Some(&vertices))?;
+        self.planner.scalp = Some(ScalpLanes { first: 0, stride: 4, restart: true });
+        self.prepare_step()
+    }
+
+    /// The bones at the end of the next step (see [`HairSim::bind_scalp_bones`]):
+    /// the scalp skinned now, uploaded by the next step's recording. Errors
+    /// name a bone that is not finite or a joint past `bones`.
+    pub fn set_scalp_bones(&mut self, bones: &[Mat4]) -> Result<()> {
+        let Some(GpuScalp { source: VertexSource::Bones { scalp, pending }, binding }) = &mut self.scalp else {
+            return Err(Error::incompatible("scalp bones", "no scalp skinned from bone matrices is bound"));
+        };
+        let vertices = scalp.skin(bones)?;
+        check_vertices(&vertices, binding.vertices)?;
+        *pending = Some(as_vec4(&vertices));
+        Ok(())
+    }
+
+    /// Roots follow the head again from the next step on (waits for the
+    /// device to be idle).
+    pub fn unbind_scalp(&mut self) -> Result<()> {
+        self.device.wait_idle()?;
+        self.scalp = None;
+        self.planner.scalp = None;
+        let placeholder = |name: &str| Buffer::storage(&self.device, name, 16);
+        self.gpu.scalp_roots = placeholder("vkhair sim no scalp roots")?;
+        self.gpu.scalp_previous = placeholder("vkhair sim no scalp corners")?;
+        self.gpu.scalp_vertices = placeholder("vkhair sim no scalp vertices")?;
+        self.rewrite_sets()?;
+        self.prepare_step()
+    }
+
+    /// The vertices the next step uploads (bone path), taken.
+    pub(crate) fn take_scalp_upload(&mut self) -> Option<Vec<Vec4>> {
+        match &mut self.scalp {
+            Some(GpuScalp { source: VertexSource::Bones { pending, .. }, .. }) => pending.take(),
+            _ => None,
+        }
+    }
+
+    /// Creates the scalp's buffers (with `vertices` uploaded into ours for the
+    /// bone path) and points every kernel's sets at them.
+    fn install_scalp(&mut self, scalp: GpuScalp, vertices: Option<&[Vec4]>) -> Result<()> {
+        self.device.wait_idle()?;
+        let strands = scalp.binding.roots.len() as u64;
+        let d = &self.device;
+        self.gpu.scalp_roots = Buffer::storage(d, "vkhair sim scalp roots", strands * 96)?;
+        d.upload_pod(&self.gpu.scalp_roots, &scalp.binding.roots)?;
+        self.gpu.scalp_previous = Buffer::storage(d, "vkhair sim scalp corners before the step", strands * 48)?;
+        self.gpu.scalp_vertices = match vertices {
+            Some(v) => {
+                let buffer = Buffer::storage(d, "vkhair sim scalp vertices", v.len() as u64 * 16)?;
+                d.upload_pod(&buffer, v)?;
+                buffer
+            }
+            None => Buffer::storage(d, "vkhair sim no scalp vertices", 16)?,
+        };
+        self.scalp = Some(scalp);
+        self.rewrite_sets()
+    }
+
+    /// Points every kernel's descriptor sets at the current buffers: the mesh
+    /// collider's field, the scalp's, and the host's vertex buffer when bound.
+    /// Waits for the device to be idle.
+    pub(crate) fn rewrite_sets(&self) -> Result<()> {
+        self.device.wait_idle()?;
+        let field = self.mesh.as_ref().map(|m| &m.field);
+        let host = match &self.scalp {
+            Some(GpuScalp { source: VertexSource::Host(s), .. }) => Some(s),
+            _ => None,
+        };
+        for parity in 0..2 {
+            let sets = [
+                (&self.pipeline, self.sets[parity], self.gpu.bindings(parity, field).to_vec()),
+                (&self.follow, self.follow_sets[parity], self.gpu.follow_bindings(parity, field).to_vec()),
+                (&self.mover.pipeline, self.mover.sets[parity], self.gpu.move_bindings(parity).to_vec()),
+            ];
+            for (pipeline, set, buffers) in sets {
+                // SAFETY: each set was allocated by its pipeline for set 0, and the
+                // device is idle; recording happens only through `&mut self`.
+                unsafe { pipeline.rewrite_declared(set, 0, &buffers)? };
+                if let Some(source) = host {
+                    let info = vk::DescriptorBufferInfo { buffer: source.buffer, offset: 0, range: source.size };
+                    // SAFETY: as above; the caller of `bind_scalp_source` vouched
+                    // for the buffer, its usage and size (checked against the range).
+                    unsafe { pipeline.rewrite_raw_buffer(set, 0, binding::SCALP_SOURCE, info)? };
+                }
+            }
+        }
+        Ok(())
+    }
+}
