@@ -7,6 +7,11 @@
 //! workgroup barriers with as many hairs as fit, and one hair per workgroup.
 //! ("auto" uses subgroup barriers when they keep as many lanes busy.)
 //!
+//! The summary adds the default packing with every root bound to a skinned
+//! scalp (`HairSim::bind_scalp_bones`; a small triangle around each root,
+//! skinned by one bone): the cost of placing each hair by its root's frame
+//! against the same row with the rigid head.
+//!
 //! Besides criterion's own report, a summary table (ms per step, particle-steps
 //! per second, per-stage share, ratio to the CPU reference) is printed and
 //! written to `target/vkhair-bench/sim.csv`.
@@ -15,8 +20,11 @@ use std::fmt::Write as _;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, Criterion};
+use glam::{Mat4, Vec3};
 use vkhair::groom::grow::{grow, GrowParams};
+use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::{scenes, Groom};
+use vkhair::sim::scalp::{Scalp, VertexSkin};
 use vkhair::sim::{motion, CpuHairSim, HairSim, RigidTransform, SimParams, SimStage};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
@@ -71,6 +79,22 @@ fn make_sim(ctx: &GpuContext, scene: &Scene, params: &SimParams) -> HairSim {
     let mut sim = HairSim::new(ctx, &scene.groom, params, &RigidTransform::default()).expect("sim");
     sim.set_colliders(&motion::thesis_colliders()).expect("colliders");
     sim
+}
+
+/// A scalp of one small triangle centred on each root, every vertex on one bone.
+fn scalp_under(groom: &Groom) -> Scalp {
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for s in 0..groom.strand_count() {
+        let root = groom.strand(s)[0];
+        let base = positions.len() as u32;
+        positions.extend(
+            [Vec3::new(2e-3, 0.0, 0.0), Vec3::new(-1e-3, 0.0, 2e-3), Vec3::new(-1e-3, 0.0, -2e-3)].map(|d| root + d),
+        );
+        triangles.push([base, base + 1, base + 2]);
+    }
+    let skin = vec![VertexSkin { joints: [0; 4], weights: [1.0, 0.0, 0.0, 0.0] }; positions.len()];
+    Scalp { skin, ..Scalp::new(TriMesh::new(positions, triangles).expect("scalp")) }
 }
 
 fn bench_sim(c: &mut Criterion) {
@@ -150,6 +174,11 @@ fn summary() {
             let shares = [share(SimStage::Step)];
             row(name, t.as_secs_f64() * 1e3 / steps as f64, shares, &mut csv);
         }
+        let mut sim = make_sim(&ctx, &scene, &scene.params);
+        sim.bind_scalp_bones(&scalp_under(&scene.groom), &[Mat4::IDENTITY]).expect("scalp");
+        gpu_time(&mut sim, &mut profiler, 0, 2);
+        let (t, _) = gpu_time(&mut sim, &mut profiler, 2, steps);
+        row("gpu auto, skinned scalp", t.as_secs_f64() * 1e3 / steps as f64, [100.0], &mut csv);
     }
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/vkhair-bench");
     if std::fs::create_dir_all(&dir).is_ok() && std::fs::write(dir.join("sim.csv"), csv).is_ok() {

@@ -327,3 +327,33 @@ fn bad_scalps_are_named_and_unbinding_restores_the_rigid_head() {
     assert_eq!(bits(&a), bits(&b), "an unbound scalp changed the rigid head's steps");
     drop((sim, plain, buffer));
 }
+
+/// A bound scalp adds no dispatch and no barrier: the frames are computed
+/// inside the step's own dispatch (one per step with the volume stage off).
+#[test]
+fn a_bound_scalp_adds_no_dispatch() {
+    let gpu_ctx = Gpu::new();
+    let ctx = gpu_ctx.ctx();
+    let scalp = scalp();
+    let groom = groom(&scalp);
+    let p = SimParams {
+        volume: vkhair::sim::VolumeParams { mode: vkhair::sim::VolumeMode::Off, ..Default::default() },
+        ..params()
+    };
+    let start = bones(0.0, 0.0, 0.0);
+    let mut work = Vec::new();
+    for bound in [false, true] {
+        let mut sim = HairSim::new(ctx, &groom, &p, &head_of(&start)).expect("gpu sim");
+        if bound {
+            sim.bind_scalp_bones(&scalp, &start).expect("bind");
+        }
+        sim.run(1, |_| head_of(&start), None).expect("warm-up step");
+        let before = ctx.recorded_work();
+        sim.set_scalp_bones(&start).ok();
+        sim.run(1, |_| head_of(&swinging(1, p.dt)), None).expect("step");
+        let w = ctx.recorded_work() - before;
+        work.push((w.dispatches, w.barriers));
+    }
+    assert_eq!(work[0].0, 1, "a step without a scalp: {:?}", work[0]);
+    assert_eq!(work[1], work[0], "a bound scalp changed the recorded work");
+}

@@ -541,3 +541,64 @@ fn profiles_of_both_devices_share_the_host_clock() {
         }
     }
 }
+
+/// A scalp skinned from bone matrices, bound to the scheduler and its bones
+/// set between frames, reaches the simulation in every mode: the state after
+/// the frames is, bit for bit, that of a `HairSim` bound and driven the same.
+/// Bones for a scalp bound nowhere, and bad bones, are named at the call.
+#[test]
+fn a_skinned_scalp_reaches_the_simulation_in_every_mode() {
+    use vkhair::sim::scalp::{Scalp, VertexSkin};
+    let render = Gpu::new();
+    let sim = Gpu::new();
+    let g = groom(16, 4);
+    let p = SimParams::default();
+    // A small triangle around each root, its corners on two bones.
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for s in 0..g.strand_count() {
+        let root = g.strand(s)[0];
+        let base = positions.len() as u32;
+        positions.extend(
+            [Vec3::new(4e-3, 0.0, 0.0), Vec3::new(-2e-3, 0.0, 4e-3), Vec3::new(-2e-3, 0.0, -4e-3)].map(|d| root + d),
+        );
+        triangles.push([base, base + 1, base + 2]);
+    }
+    let skin = (0..positions.len())
+        .map(|v| VertexSkin {
+            joints: [0, 1, 0, 0],
+            weights: if v % 2 == 0 { [1.0, 0.0, 0.0, 0.0] } else { [0.5, 0.5, 0.0, 0.0] },
+        })
+        .collect();
+    let mesh = vkhair::groom::mesh::TriMesh::new(positions, triangles).expect("scalp");
+    let scalp = Scalp { skin, ..Scalp::new(mesh) };
+    let head = |i: usize| motion::violent_motion((i + 1) as f32 / 60.0);
+    let bones = |i: usize| {
+        let m = head(i).matrix();
+        [m, m * glam::Mat4::from_rotation_z(0.3 * (i as f32 * 0.4).sin())]
+    };
+    let start = [glam::Mat4::IDENTITY; 2];
+    let mut reference = vkhair::sim::HairSim::new(sim.ctx(), &g, &p, &RigidTransform::default()).expect("sim");
+    reference.bind_scalp_bones(&scalp, &start).expect("bind");
+    for i in 0..8 {
+        reference.set_scalp_bones(&bones(i)).expect("bones");
+        reference.run(1, |_| head(i), None).expect("step");
+    }
+    let expected = common::bits(&reference.read_state().expect("state"));
+    for options in every_mode(&sim) {
+        let mut s =
+            FrameScheduler::new(render.ctx(), &g, &p, &RigidTransform::default(), &[], &options).expect("scheduler");
+        let e = s.set_scalp_bones(&start).expect_err("no scalp bound");
+        assert!(e.to_string().contains("no scalp"), "{:?}: {e}", s.mode());
+        s.bind_scalp_bones(&scalp, &start).expect("bind");
+        let e = s.set_scalp_bones(&[glam::Mat4::IDENTITY]).expect_err("bone 1 missing");
+        assert!(e.to_string().contains("scalp joint"), "{:?}: {e}", s.mode());
+        for i in 0..8 {
+            s.set_scalp_bones(&bones(i)).expect("bones");
+            let steps = [head(i)];
+            // SAFETY: recording command buffer of the rendering device, waited for.
+            render.ctx().run_frame("frame", |cmd| unsafe { s.record_frame(cmd, &steps, None) }).expect("frame");
+        }
+        assert!(common::bits(&s.read_state().expect("state")) == expected, "{:?}: not the HairSim's state", s.mode());
+    }
+}

@@ -1,11 +1,13 @@
 //! What a host changes on a running scheduler: parameters, colliders, the mesh
-//! collider, and stopping the simulation side.
+//! collider, a scalp skinned from bone matrices, and stopping the simulation side.
 
 use super::worker::SimUpdate;
 use super::{Backend, FrameScheduler};
 use crate::error::{Error, Result};
 use crate::groom::mesh::TriMesh;
+use crate::sim::scalp::{Scalp, ScalpBinding};
 use crate::sim::{Collider, MeshCollider, MeshColliderParams, RigidTransform, SimParams};
+use glam::Mat4;
 
 impl FrameScheduler {
     /// Changes simulation parameters from the next step on (validated now). The
@@ -116,6 +118,45 @@ impl FrameScheduler {
             Backend::Remote { worker, .. } => {
                 worker.update(SimUpdate::Mesh(mesh.map(|m| Box::new((m.clone(), params.clone())))))
             }
+            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
+        }
+    }
+
+    /// Binds the key hairs' roots to `scalp`, skinned by vkhair from `bones`
+    /// (see [`crate::sim::HairSim::bind_scalp_bones`]), in every mode; the
+    /// roots, weights and bones are checked now, so that a second device's
+    /// worker never fails on them.
+    pub fn bind_scalp_bones(&mut self, scalp: &Scalp, bones: &[Mat4]) -> Result<()> {
+        ScalpBinding::new(scalp, &self.key_hairs().rest.rest_roots())?;
+        if scalp.skin.is_empty() {
+            return Err(Error::incompatible("scalp bones", "the scalp has no vertex bones (Scalp::skin)"));
+        }
+        scalp.skin(bones)?;
+        match &mut self.backend {
+            Backend::Local { sim, .. } => sim.bind_scalp_bones(scalp, bones),
+            Backend::Async { sim, .. } => sim.sim.bind_scalp_bones(scalp, bones),
+            Backend::Remote { worker, .. } => {
+                worker.update(SimUpdate::ScalpBind(Box::new((scalp.clone(), bones.to_vec()))))
+            }
+            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
+        }?;
+        self.scalp = Some(scalp.clone());
+        Ok(())
+    }
+
+    /// The bones at the end of the next frame's steps (see
+    /// [`crate::sim::HairSim::set_scalp_bones`]; checked now). Like the body's
+    /// colliders they are taken per frame: with several steps a frame the
+    /// first step's sub-steps carry the scalp the whole frame's way.
+    pub fn set_scalp_bones(&mut self, bones: &[Mat4]) -> Result<()> {
+        let Some(scalp) = &self.scalp else {
+            return Err(Error::incompatible("scalp bones", "no scalp skinned from bone matrices is bound"));
+        };
+        scalp.skin(bones)?;
+        match &mut self.backend {
+            Backend::Local { sim, .. } => sim.set_scalp_bones(bones),
+            Backend::Async { sim, .. } => sim.sim.set_scalp_bones(bones),
+            Backend::Remote { worker, .. } => worker.update(SimUpdate::ScalpBones(bones.to_vec())),
             Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
         }
     }

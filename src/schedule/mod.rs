@@ -138,6 +138,8 @@ pub struct FrameScheduler {
     /// Head and body colliders set, checked together against what a sub-step
     /// holds before anything is sent to a worker.
     colliders: (usize, usize),
+    /// The scalp skinned from bone matrices, when bound (to check bones against).
+    scalp: Option<crate::sim::scalp::Scalp>,
 }
 
 impl std::fmt::Debug for FrameScheduler {
@@ -231,6 +233,7 @@ impl FrameScheduler {
             frames: 0,
             sim_device: (mode == ScheduleMode::SecondDevice).then_some(sim_ctx),
             colliders: (colliders.len(), 0),
+            scalp: None,
         })
     }
 

@@ -40,6 +40,8 @@ const SLICE: Duration = Duration::from_millis(20);
 /// A change to the simulation, applied before the next job.
 pub(crate) enum SimUpdate {
     Params(Box<SimParams>),
+    ScalpBind(Box<(crate::sim::scalp::Scalp, Vec<glam::Mat4>)>),
+    ScalpBones(Vec<glam::Mat4>),
     Colliders(Vec<Collider>),
     Body(Vec<Collider>),
     Teleport(RigidTransform),
@@ -283,6 +285,8 @@ fn run(mut side: SimSide, slots: usize, timeout: Duration, shared: &Shared) {
                 Ok(())
             }
             Request::Update(SimUpdate::Simulated(count)) => side.sim.set_simulated_hairs(count),
+            Request::Update(SimUpdate::ScalpBind(bound)) => side.sim.bind_scalp_bones(&bound.0, &bound.1),
+            Request::Update(SimUpdate::ScalpBones(bones)) => side.sim.set_scalp_bones(&bones),
             Request::Update(SimUpdate::Mesh(m)) => match m.as_deref() {
                 Some((mesh, params)) => side.sim.set_mesh(Some(mesh), params),
                 None => side.sim.set_mesh(None, &MeshColliderParams::default()),

@@ -171,9 +171,10 @@ fn render_puts_hair_on_an_animated_gltf_character() {
 }
 
 /// `simulate --gltf` follows the character's run and writes, in `--json`, how
-/// far the roots got from the skinned scalp points they were grown on (float
-/// precision: the mannequin's head is one bone) and the share of points inside
-/// the body.
+/// far the roots got from the skinned scalp points they were grown on (the
+/// roots ride their triangles of the skinned mesh, which the tool writes into a
+/// GPU buffer every step: a few micrometres, the bind pose's rounding at the
+/// character's scale) and the share of points inside the body.
 #[test]
 fn simulate_measures_roots_and_penetration_on_an_animated_character() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -186,7 +187,7 @@ fn simulate_measures_roots_and_penetration_on_an_animated_character() {
     let root = v["run"]["root_error_max_m"].as_f64().expect("root_error_max_m");
     let inside = v["run"]["inside_fraction_max"].as_f64().expect("inside_fraction_max");
     eprintln!("root error {root:e} m, inside {inside}");
-    assert!(root < 1e-3, "roots {root} m from their skinned scalp points");
+    assert!(root < 2e-5, "roots {root} m from their skinned scalp points");
     assert!((0.0..0.5).contains(&inside), "inside fraction {inside}");
 }
 

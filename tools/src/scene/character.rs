@@ -8,6 +8,7 @@ use vkhair::character::{BoneCapsule, Character, Pose};
 use vkhair::groom::grow::{grow, GrowParams, Scalp};
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::Groom;
+use vkhair::sim::scalp::VertexSkin;
 use vkhair::sim::{Collider, RigidTransform, MAX_COLLIDERS};
 
 use crate::args::input::InputArgs;
@@ -88,6 +89,31 @@ impl CharacterScene {
     pub fn colliders_at(&self, time: f32) -> Vec<Collider> {
         let pose = self.pose(time);
         self.capsules.iter().map(|c| c.in_world(&self.character, &pose)).collect()
+    }
+
+    /// The character's mesh in the bind pose, in the head's frame (the
+    /// groom's), with its skin: the scalp the roots are bound to.
+    pub fn scalp(&self) -> Result<vkhair::sim::scalp::Scalp, Error> {
+        let to_head = self.bind_frame().inverse();
+        let positions = self.character.positions.iter().map(|p| to_head.transform_point3(*p)).collect();
+        let skin =
+            self.character.weights.iter().map(|(j, w)| VertexSkin { joints: j.map(u32::from), weights: *w }).collect();
+        Ok(vkhair::sim::scalp::Scalp {
+            skin,
+            ..vkhair::sim::scalp::Scalp::new(TriMesh::new(positions, self.character.triangles.clone())?)
+        })
+    }
+
+    /// The scalp's bones at `time`: each joint's skinning matrix after the
+    /// head frame's bind placement (head frame, bind pose → world).
+    pub fn scalp_bones(&self, time: f32) -> Vec<Mat4> {
+        let bind = self.bind_frame();
+        self.pose(time).skin.iter().map(|m| *m * bind).collect()
+    }
+
+    /// The head's frame in the bind pose.
+    pub fn bind_frame(&self) -> Mat4 {
+        self.character.rigid_frame(&self.character.bind_pose(), self.head).matrix()
     }
 
     /// The whole character at `time`, in the world.

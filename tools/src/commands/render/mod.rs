@@ -100,6 +100,11 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     let sim_params = config.sim.clone();
     let options = schedule_options(a)?;
     let mut sim = FrameScheduler::new(&ctx, &s.groom, &sim_params, &s.start_head, &s.colliders, &options)?;
+    if let Some(ch) = &s.character {
+        // The roots ride the character's skinned mesh (skinned by vkhair from
+        // the joints' matrices, set every frame below).
+        sim.bind_scalp_bones(&ch.scalp()?, &ch.scalp_bones(0.0))?;
+    }
     say!("simulation: {} ({})", sim.mode().name(), sim.reason());
     if let Some(count) = simulated {
         sim.set_simulated_hairs(count)?;
@@ -164,6 +169,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
             // (the first step's sub-steps move them there from the previous
             // frame's; the scheduler takes them per frame, the head per step).
             sim.set_body_colliders(&ch.colliders_at(time(first_step + steps_per_frame)))?;
+            sim.set_scalp_bones(&ch.scalp_bones(time(first_step + steps_per_frame)))?;
         }
         let started = host_now_ns();
         ctx.run_frame("vkhair render frame", |cmd| {

@@ -1,15 +1,21 @@
-//! `simulate --gltf`: key hairs grown on an animated character's head, the
-//! head joint driving the simulation's head and the bones' capsules its body
-//! colliders every step, and two measures of how well the hair stays on and
+//! `simulate --gltf`: key hairs grown on an animated character's head, their
+//! roots bound to the character's mesh and riding it as the tool skins it
+//! every step into a GPU buffer the simulation reads (`HairSim::bind_scalp_source`,
+//! the way a host hands over its skinning pass's output), the head joint
+//! placing the head's colliders and the bones' capsules the body colliders
+//! every step, and two measures of how well the hair stays on and
 //! out of the character: the roots' distance from the scalp points they were
 //! grown on, skinned by the animation (`root_error_max_m`), and the share of
 //! free points inside the skinned body near the head (`inside_fraction_max`),
 //! both every 10 steps.
 
 use glam::Vec3;
+use vkhair::ash::vk;
 use vkhair::groom::binding::{bind_roots, RootBinding, TriangleGrid};
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::sdf::MeshSdf;
+use vkhair::headless::HostBuffer;
+use vkhair::sim::scalp::Scalp;
 use vkhair::sim::{HairSim, SimState};
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
 
@@ -48,6 +54,25 @@ pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
     )?;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let mut sim = HairSim::new(&ctx, &groom, &params, &ch.head_at(0.0))?;
+    // The roots ride the skinned mesh: the tool skins the character every step
+    // and writes the vertices into a GPU buffer, as a host's skinning pass
+    // would; the simulation reads them from there.
+    let scalp = Scalp { skin: Vec::new(), ..ch.scalp()? };
+    let vertices = ch.character.positions.len();
+    let skinned_buffer = HostBuffer::new(&ctx, "vkhair tool skinned character", vertices as u64 * 16)?;
+    let write_skinned = |time: f32| -> Result<Vec<Vec3>, vkhair::Error> {
+        let skinned = ch.character.skin(&ch.pose(time));
+        let packed: Vec<u8> =
+            skinned.iter().flat_map(|v| v.extend(1.0).to_array()).flat_map(f32::to_ne_bytes).collect();
+        skinned_buffer.write(0, &packed)?;
+        Ok(skinned)
+    };
+    write_skinned(0.0)?;
+    let source = skinned_buffer.scalp_source(16, vk::Format::R32G32B32A32_SFLOAT, vertices as u32);
+    // SAFETY: the buffer is the context's, with storage usage, and outlives
+    // `sim` (declared before it drops); each write completes before the step
+    // reading it is submitted.
+    unsafe { sim.bind_scalp_source(&scalp, &source)? };
     sim.set_mesh(Some(&head_mesh), &config.mesh_collider)?;
     apply_simulated(&mut sim, a.sim.simulated_count(groom.strand_count())?, groom.strand_count())?;
     let mut profiler = GpuProfiler::new(&ctx, 1, 1024)?;
@@ -59,6 +84,7 @@ pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
     let (mut root_error, mut inside) = (0.0f32, 0.0f64);
     for step in 0..a.steps {
         sim.set_body_colliders(&ch.colliders_at(time(step + 1)))?;
+        let skinned = write_skinned(time(step + 1))?;
         let started = host_now_ns();
         if let Some(report) = sim.run(1, |_| ch.head_at(time(step + 1)), Some(&mut profiler))? {
             profile.add(&report, TRACK, 1);
@@ -67,7 +93,6 @@ pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
         if (step + 1) % 10 == 0 || step + 1 == a.steps {
             let state = sim.read_state()?;
             let pose = ch.pose(time(step + 1));
-            let skinned = ch.character.skin(&pose);
             root_error = root_error.max(largest_root_error(&state, &bound, &ch.character.triangles, &skinned));
             let head = ch.character.joint_transform(&pose, ch.head).transform_point3(Vec3::ZERO);
             inside = inside.max(share_inside_body(&state, &ch.character.triangles, &skinned, head)?);
