@@ -29,6 +29,7 @@ const ACCEPTED: &[(&str, &str)] = &[
     ("sim.global_shape_range", "0"),
     ("sim.local_shape_stiffness", "0"),
     ("sim.mesh_friction", "0"),
+    ("sim.collider_friction", "0"),
     ("sim.damping", "0"),
     ("sim.dftl_damping", "0"),
     ("sim.pearl_radius_root", "0"),

@@ -70,6 +70,12 @@ fn viewer() -> PathBuf {
 
 /// Runs the viewer on `display` and returns its screenshot's size and RGBA pixels.
 fn run(display: &str, out: &Path, args: &[&str]) -> (u32, u32, Vec<u8>) {
+    let (w, h, pixels, _) = run_printing(display, out, args);
+    (w, h, pixels)
+}
+
+/// [`run`], with what the viewer printed.
+fn run_printing(display: &str, out: &Path, args: &[&str]) -> (u32, u32, Vec<u8>, String) {
     let output = Command::new(viewer())
         .env("DISPLAY", display)
         .args(["--validation", "--screenshot"])
@@ -86,7 +92,7 @@ fn run(display: &str, out: &Path, args: &[&str]) -> (u32, u32, Vec<u8>) {
     let mut pixels = vec![0; reader.output_buffer_size().expect("size")];
     let info = reader.next_frame(&mut pixels).expect("png data");
     pixels.truncate(info.buffer_size());
-    (info.width, info.height, pixels)
+    (info.width, info.height, pixels, stdout.into_owned())
 }
 
 /// Mean RGB over the rectangle `(x0, y0)..(x1, y1)` of an image `width` wide.
@@ -175,6 +181,63 @@ fn the_viewer_runs_clean_in_a_window_and_shows_hair_overlay_and_floor() {
     }
 }
 
+/// `--gltf`: the viewer, as a host with a skinned character, skins the mesh on
+/// the GPU every frame, draws it, and hands the skinned vertices to vkhair:
+/// after 40 frames of the run (fixed frame times, so that runs with and
+/// without hair see the same poses) the key hairs' roots are within 50 µm of
+/// their points on the mesh skinned on the CPU at the same time of the
+/// animation (GPU against CPU rounding at the character's scale), the body
+/// is drawn and the hair differs from the body alone; validation clean.
+#[test]
+fn the_viewer_puts_hair_on_a_skinned_character() {
+    let (display, _server) = match display() {
+        Ok(d) => d,
+        Err(why) => {
+            println!("SKIPPED the viewer character test: {why}");
+            eprintln!("SKIPPED the viewer character test: {why}");
+            return;
+        }
+    };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let glb = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
+    let args = [
+        "--gltf",
+        glb,
+        "--animation",
+        "run",
+        "--frames",
+        "40",
+        "--frame-time",
+        "0.02",
+        "--no-overlay",
+        "--width",
+        "320",
+        "--height",
+        "320",
+    ];
+    let (_, _, hair, printed) = run_printing(&display, &dir.path().join("hair.png"), &args);
+    let (_, _, bare) = run(&display, &dir.path().join("bare.png"), &[&args[..], &["--no-hair"]].concat());
+    let error: f64 = printed
+        .lines()
+        .find_map(|l| l.strip_prefix("viewer: roots within "))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no root error printed:\n{printed}"));
+    println!("roots from the CPU-skinned mesh: {error:e} m");
+    assert!(error < 5e-5, "the roots are {error} m from their points on the skinned mesh");
+    // The body: lit albedo (0.45, 0.30, 0.24), reddish, in the frame without hair.
+    let body = bare.chunks_exact(4).filter(|p| p[0] > 60 && u32::from(p[0]) > u32::from(p[2]) + 25).count();
+    let differs = hair
+        .chunks_exact(4)
+        .zip(bare.chunks_exact(4))
+        .filter(|(a, b)| a.iter().zip(b.iter()).take(3).any(|(x, y)| x.abs_diff(*y) > 24))
+        .count();
+    let share = |n: usize| n as f64 / f64::from(320 * 320);
+    println!("body {:.1} %, hair {:.1} % of the window", 100.0 * share(body), 100.0 * share(differs));
+    assert!(share(body) > 0.02, "the body covers {:.2} % of the window", 100.0 * share(body));
+    assert!(share(differs) > 0.01, "the hair covers {:.2} % of the window", 100.0 * share(differs));
+}
+
 /// Values out of range are refused before any window opens, naming the option.
 #[test]
 fn the_viewer_refuses_bad_options_by_name() {
@@ -183,6 +246,8 @@ fn the_viewer_refuses_bad_options_by_name() {
         (&["--scale", "nan"][..], "--scale"),
         (&["--frames", "0"][..], "--frames"),
         (&["--resize", "10x5000"][..], "--resize"),
+        (&["--frame-time", "0"][..], "--frame-time"),
+        (&["--animation", "run"][..], "--gltf"),
     ] {
         let output = Command::new(viewer()).args(args).env_remove("DISPLAY").output().expect("run the viewer");
         let stderr = String::from_utf8_lossy(&output.stderr);

@@ -21,6 +21,7 @@ use crate::hair::{Hair, Scene, FRAMES_IN_FLIGHT};
 use crate::host::{BoxError, Memory};
 use crate::overlay::{Changes, Overlay, Painted};
 use crate::scene::HostScene;
+use crate::skin::GpuSkin;
 use crate::swapchain::Swapchain;
 use crate::Args;
 
@@ -60,6 +61,8 @@ pub struct Running {
     // vkhair first: dropped (in `shut_down`) before the host's device.
     pub(crate) hair: Option<Hair>,
     pub(crate) ctx: Option<GpuContext>,
+    /// A `--gltf` character's skinning pass (destroyed after vkhair).
+    pub(crate) skin: Option<GpuSkin>,
     pub(crate) overlay: Option<Overlay>,
     pub(crate) scene: HostScene,
     pub(crate) swapchain: Swapchain,
@@ -82,8 +85,10 @@ pub struct Running {
 impl Running {
     pub fn new(args: &Args, window: &Window) -> Result<Running, BoxError> {
         let scene_data = Scene::load(args)?;
-        // An --input groom is held in its authored style (as `vkhair render` does).
-        let sim = if args.input.is_some() { SimParams::styled() } else { SimParams::default() };
+        // An --input groom, or one grown on a character, is held in its style
+        // (as `vkhair render` does).
+        let styled = args.input.is_some() || args.gltf.is_some();
+        let sim = if styled { SimParams::styled() } else { SimParams::default() };
         let base = Config { sim, ..Config::default() };
         let config = match &args.config {
             Some(path) => base.load_over(path)?,
@@ -108,12 +113,16 @@ impl Running {
                 enabled_extensions: Vec::new(),
             })
         }?;
-        let hair = Hair::new(&ctx, &scene_data, config)?;
+        // A character's skinning pass is the host's: vkhair reads the skinned
+        // vertices it writes.
+        let skin = match &scene_data.rig {
+            Some(rig) => Some(GpuSkin::new(&gpu.device, gpu.allocator(), &rig.character)?),
+            None => None,
+        };
+        let hair = Hair::new(&ctx, &scene_data, config, skin.as_ref())?;
         let size = window.inner_size();
         let swapchain = Swapchain::new(&gpu, (size.width.max(1), size.height.max(1)))?;
-        let floor_y =
-            scene_data.head.positions.iter().chain(scene_data.groom.positions()).map(|p| p.y).fold(f32::MAX, f32::min)
-                - 0.2 * scene_data.radius;
+        let floor_y = scene_data.floor_y;
         let scene = HostScene::new(
             &gpu.device,
             gpu.allocator(),
@@ -152,6 +161,7 @@ impl Running {
         Ok(Running {
             hair: Some(hair),
             ctx: Some(ctx),
+            skin,
             overlay,
             scene,
             swapchain,
@@ -303,6 +313,9 @@ impl Running {
                 self.write_screenshot(path)?;
             }
             let frames = self.frame;
+            if let Some((time, error)) = self.hair().root_error()? {
+                println!("viewer: roots within {error:.2e} m of the skinned mesh at {time:.3} s of the animation");
+            }
             if let Some(report) = self.hair().report.as_ref() {
                 println!("viewer: {frames} frames; GPU passes of frame {}:\n{report}", report.frame);
             }

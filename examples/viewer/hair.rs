@@ -7,7 +7,9 @@ use std::path::Path;
 
 use ash::vk;
 use glam::Vec3;
+use vkhair::character::{Character, HairRig};
 use vkhair::config::Config;
+use vkhair::groom::binding::RootBinding;
 use vkhair::groom::cyhair::HairFile;
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::scenes;
@@ -18,6 +20,7 @@ use vkhair::sim::{motion, Collider, FixedStepDriver, HairSim, RigidTransform, Si
 use vkhair::{ash, GpuContext, GpuProfiler, ProfileReport};
 
 use crate::host::BoxError;
+use crate::skin::{GpuSkin, MAX_STEPS, SKINNED_STRIDE};
 use crate::Args;
 
 /// Frames the host keeps in flight (vkhair's `RenderParams::frames_in_flight`
@@ -27,6 +30,8 @@ pub const FRAMES_IN_FLIGHT: u32 = 2;
 /// The groom, what it collides with and the head the host draws.
 pub struct Scene {
     pub groom: Groom,
+    /// The head the host draws and, with `mesh_collider`, the strands collide
+    /// with (a `--gltf` character's: its head's region, in its head's frame).
     pub head: TriMesh,
     /// Whether the strands collide with `head` (an --obj mesh).
     pub mesh_collider: bool,
@@ -34,12 +39,19 @@ pub struct Scene {
     pub colliders: Vec<Collider>,
     pub center: Vec3,
     pub radius: f32,
+    /// Height of the floor the host draws.
+    pub floor_y: f32,
+    /// The `--gltf` character, skinned by the host and carrying the hair.
+    pub rig: Option<HairRig>,
 }
 
 impl Scene {
     /// The thesis scene, or `--input` (`.hair` or `.tfx`, repaired when it has
     /// defects) with `--obj` scaled by `--scale`.
     pub fn load(args: &Args) -> Result<Scene, BoxError> {
+        if let Some(path) = &args.gltf {
+            return Scene::character(path, args);
+        }
         let (groom, head, mesh_collider, colliders) = match &args.input {
             None => {
                 let head = TriMesh::uv_sphere(scenes::THESIS_HEAD_CENTER, scenes::THESIS_HEAD_RADIUS * 0.97, 24, 32)?;
@@ -69,7 +81,31 @@ impl Scene {
         if !(center.is_finite() && radius.is_finite() && radius > 0.0) {
             return Err(format!("the groom and mesh span no finite volume (radius {radius})").into());
         }
-        Ok(Scene { groom, head, mesh_collider, colliders, center, radius })
+        let floor_y = lo.y - 0.2 * radius;
+        Ok(Scene { groom, head, mesh_collider, colliders, center, radius, floor_y, rig: None })
+    }
+
+    /// `--gltf`: key hairs grown on the character's head, its head's region
+    /// as the mesh collider, framed on the hair and the body near the head.
+    fn character(path: &Path, args: &Args) -> Result<Scene, BoxError> {
+        let character = Character::load(path)?;
+        let rig = HairRig::new(character, args.animation.as_deref(), args.head_joint.as_deref())
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        let (groom, head) = rig.grow(16)?;
+        let m = rig.head_at(0.0).matrix();
+        let body = rig.body_at(0.0)?;
+        let origin = m.transform_point3(Vec3::ZERO);
+        let near = body.positions.iter().copied().filter(|p| p.distance(origin) < 0.45);
+        let hair = groom.positions().iter().map(|p| m.transform_point3(*p));
+        let (lo, hi) = hair
+            .chain(near)
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        let (center, radius) = (0.5 * (lo + hi), 0.5 * (hi - lo).length());
+        if !(center.is_finite() && radius.is_finite() && radius > 0.0) {
+            return Err(format!("{}: the hair and head span no finite volume", path.display()).into());
+        }
+        let floor_y = body.positions.iter().map(|p| p.y).fold(f32::MAX, f32::min);
+        Ok(Scene { groom, head, mesh_collider: true, colliders: Vec::new(), center, radius, floor_y, rig: Some(rig) })
     }
 }
 
@@ -107,20 +143,43 @@ pub struct Hair {
     driver: FixedStepDriver,
     initial: SimState,
     alpha: f32,
+    /// The `--gltf` character, its animation's time (s), the bytes of one
+    /// step's slot of skinned vertices, and each root's point on its mesh.
+    rig: Option<(HairRig, f32, u64, Vec<RootBinding>)>,
 }
 
 impl Hair {
-    pub fn new(ctx: &GpuContext, scene: &Scene, config: Config) -> Result<Hair, BoxError> {
+    /// With a `--gltf` character, `skin` is the host's skinning pass whose
+    /// skinned vertices the key hairs' roots ride.
+    pub fn new(ctx: &GpuContext, scene: &Scene, config: Config, skin: Option<&GpuSkin>) -> Result<Hair, BoxError> {
         let mut config = config;
         config.render.frames_in_flight = FRAMES_IN_FLIGHT;
         if config.lights.is_empty() {
             config.lights = Light::thesis_rig(scene.center, scene.radius).to_vec();
         }
-        let head = RigidTransform::default();
+        let head = scene.rig.as_ref().map_or(RigidTransform::default(), |r| r.head_at(0.0));
         let mut sim = HairSim::new(ctx, &scene.groom, &config.sim, &head)?;
         sim.set_colliders(&scene.colliders)?;
         if scene.mesh_collider {
             sim.set_mesh(Some(&scene.head), &config.mesh_collider)?;
+        }
+        let mut rig = None;
+        if let (Some(r), Some(skin)) = (&scene.rig, skin) {
+            // The host's skinned vertices: slot k holds step k's of a frame.
+            let (buffer, size, slot) = skin.skinned();
+            let vertex_count = u32::try_from(r.character.positions.len())?;
+            let format = vk::Format::R32G32B32A32_SFLOAT;
+            let source = vkhair::sim::scalp::ScalpSource { buffer, size, stride: SKINNED_STRIDE, format, vertex_count };
+            let scalp = vkhair::sim::scalp::Scalp { skin: Vec::new(), ..r.scalp()? };
+            // SAFETY: the buffer is the host device's, with storage usage and
+            // `size` bytes bound to memory; the viewer destroys it after vkhair
+            // (`Running::shut_down`); the skinning pass writes it in the same
+            // queue before the steps that read it, behind a barrier after the
+            // previous frame's steps.
+            unsafe { sim.bind_scalp_source(&scalp, &source) }?;
+            sim.set_body_colliders(&r.colliders_at(0.0))?;
+            let bound = r.bind_roots(&scene.groom, 1e-3)?;
+            rig = Some((r.clone(), 0.0, slot, bound));
         }
         let initial = sim.read_state()?;
         let mut renderer = Renderer::new(ctx, &sim, &config.render)?;
@@ -142,11 +201,12 @@ impl Hair {
             report: None,
             paused: false,
             pending_steps: 0,
-            moving: false,
+            moving: scene.rig.is_some(),
             steps_done: 0,
             driver,
             initial,
             alpha: 1.0,
+            rig,
         })
     }
 
@@ -162,6 +222,7 @@ impl Hair {
         frame: u64,
         frame_time: f64,
         camera: &Camera,
+        skin: Option<&mut GpuSkin>,
     ) -> Result<(), BoxError> {
         // SAFETY: guaranteed by the caller.
         unsafe {
@@ -170,17 +231,62 @@ impl Hair {
             }
             let steps = if self.paused {
                 self.alpha = 1.0;
-                std::mem::take(&mut self.pending_steps)
+                let now = self.pending_steps.min(MAX_STEPS);
+                self.pending_steps -= now;
+                now
             } else {
                 let plan = self.driver.advance(frame_time);
                 self.alpha = plan.alpha;
                 plan.steps
             };
+            if let (Some(skin), Some(_)) = (skin, &self.rig) {
+                return self.record_character(cmd, frame, steps, camera, skin);
+            }
             for _ in 0..steps {
                 self.steps_done += 1;
                 let t = self.steps_done as f32 * self.config.sim.dt;
                 let head = if self.moving { motion::reference_motion(t) } else { RigidTransform::default() };
                 self.sim.record_step(cmd, &head, Some(&mut self.profiler))?;
+            }
+            let key_hairs = self.sim.key_hairs().blended(self.alpha)?;
+            self.renderer.record_prepare(cmd, key_hairs, Some(camera), Some(&mut self.profiler))?;
+            self.renderer.record_shadows(cmd, &self.sim, Some(&mut self.profiler))?;
+        }
+        Ok(())
+    }
+
+    /// [`Hair::record_simulation`] with a character: the host's skinning pass
+    /// for each step's pose and the frame's shown pose, then the steps, each
+    /// reading its slot of skinned vertices, with the character's capsules as
+    /// body colliders and its head joint as the head; the animation plays while
+    /// `moving`.
+    ///
+    /// # Safety
+    /// As for [`Hair::record_simulation`].
+    unsafe fn record_character(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: u64,
+        steps: u32,
+        camera: &Camera,
+        skin: &mut GpuSkin,
+    ) -> Result<(), BoxError> {
+        let Some((rig, time, slot, _)) = &mut self.rig else { return Ok(()) };
+        let dt = if self.moving { self.config.sim.dt } else { 0.0 };
+        let times: Vec<f32> = (1..=steps).map(|k| *time + dt * k as f32).collect();
+        *time += dt * steps as f32;
+        let shown = *time - dt * (1.0 - self.alpha);
+        let bones: Vec<Vec<glam::Mat4>> = times.iter().map(|&t| rig.pose(t).skin).collect();
+        let frame_slot = (frame % u64::from(FRAMES_IN_FLIGHT)) as u32;
+        skin.write_bones(frame_slot, &bones, &rig.pose(shown).skin)?;
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            skin.record(cmd, frame_slot, steps);
+            for (k, &t) in times.iter().enumerate() {
+                self.steps_done += 1;
+                self.sim.set_scalp_offset(k as u64 * *slot)?;
+                self.sim.set_body_colliders(&rig.colliders_at(t))?;
+                self.sim.record_step(cmd, &rig.head_at(t), Some(&mut self.profiler))?;
             }
             let key_hairs = self.sim.key_hairs().blended(self.alpha)?;
             self.renderer.record_prepare(cmd, key_hairs, Some(camera), Some(&mut self.profiler))?;
@@ -207,10 +313,28 @@ impl Hair {
 
     /// Back to the first state (the device must be idle: the state is uploaded).
     pub fn reset(&mut self) -> Result<(), BoxError> {
-        self.sim.write_state(&self.initial)?;
+        if let Some((rig, time, ..)) = &mut self.rig {
+            // The rest pose where the animation starts again: the hair and its
+            // skinned roots start there together (no sweep from the old pose).
+            *time = 0.0;
+            self.sim.teleport(&rig.head_at(0.0))?;
+            self.sim.set_body_colliders(&rig.colliders_at(0.0))?;
+            self.sim.reset();
+        } else {
+            self.sim.write_state(&self.initial)?;
+        }
         self.driver = FixedStepDriver::new(f64::from(self.config.sim.dt), 2)?;
         self.steps_done = 0;
         Ok(())
+    }
+
+    /// With a character: the animation's time of the latest step and the
+    /// largest distance of a key hair's root from its point on the character's
+    /// mesh skinned on the CPU at that time (the device must be idle).
+    pub fn root_error(&self) -> Result<Option<(f32, f32)>, BoxError> {
+        let Some((rig, time, _, bound)) = &self.rig else { return Ok(None) };
+        let skinned = rig.character.skin(&rig.pose(*time));
+        Ok(Some((*time, rig.root_error(&self.sim.read_state()?, bound, &skinned))))
     }
 
     /// Applies `config.sim`, `config.render` and `config.material` after a change.

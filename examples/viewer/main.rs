@@ -12,7 +12,14 @@
 //! ```text
 //! cargo run --release --example viewer
 //! cargo run --release --example viewer -- --input sintel_hair.tfx --obj sintel_bust.obj --scale 0.01
+//! cargo run --release --example viewer -- --gltf tests/data/mannequiny-0.3.0.glb --animation run
 //! ```
+//!
+//! With `--gltf` the viewer is a host with a skinned character: its own
+//! compute pass skins the mesh every frame (`skin.rs`), draws it, and hands
+//! the skinned vertices to vkhair, whose key hairs' roots ride them
+//! (`HairSim::bind_scalp_source`); the bones' capsules are the body's
+//! colliders and M pauses the animation.
 //!
 //! Mouse: drag to orbit, scroll to zoom. Keys: L level of detail, S shadows,
 //! A supersampling, K shading model, T transparency, M head motion, Space
@@ -41,6 +48,7 @@ mod hair;
 mod overlay;
 mod record;
 mod scene;
+mod skin;
 mod swapchain;
 
 use frame::Running;
@@ -56,6 +64,17 @@ pub struct Args {
     /// Character mesh (OBJ, the groom's units) the strands collide with and the viewer draws.
     #[arg(long)]
     pub obj: Option<PathBuf>,
+    /// Skinned, animated glTF character (.glb or .gltf, meters): key hairs
+    /// grown on its head ride its mesh as the viewer skins it on the GPU every
+    /// frame, its bones' capsules keep them off the body. Instead of --input.
+    #[arg(long, conflicts_with_all = ["input", "obj"])]
+    pub gltf: Option<PathBuf>,
+    /// The --gltf animation, by name or index [default: the first].
+    #[arg(long, requires = "gltf")]
+    pub animation: Option<String>,
+    /// The --gltf joint the hair grows on, by name [default: found by weights].
+    #[arg(long, requires = "gltf")]
+    pub head_joint: Option<String>,
     /// Multiply groom and mesh positions by this (0.01: centimetres to meters; > 0).
     #[arg(long, default_value_t = 1.0, value_parser = positive)]
     pub scale: f32,
@@ -71,6 +90,11 @@ pub struct Args {
     /// Render this many frames (at least 1), then exit.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub frames: Option<u64>,
+    /// Advance the simulation and animation by this many seconds each frame
+    /// instead of the wall clock's time (a repeatable run, e.g. for a capture;
+    /// 0.001..=1).
+    #[arg(long, value_parser = frame_time)]
+    pub frame_time: Option<f64>,
     /// Save the last presented image here (PNG), with --frames.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
@@ -96,6 +120,13 @@ fn positive(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
         _ => Err(format!("expected a finite number above 0, got {s:?}")),
+    }
+}
+
+fn frame_time(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if (0.001..=1.0).contains(&v) => Ok(v),
+        _ => Err(format!("expected seconds within 0.001..=1, got {s:?}")),
     }
 }
 
@@ -205,7 +236,7 @@ impl ApplicationHandler for App {
             }
             WindowEvent::RedrawRequested => {
                 let now = Instant::now();
-                let dt = now.duration_since(self.last_frame).as_secs_f64();
+                let dt = self.args.frame_time.unwrap_or(now.duration_since(self.last_frame).as_secs_f64());
                 self.last_frame = now;
                 running.draw(window, dt, &self.args).map(|done| {
                     if done {

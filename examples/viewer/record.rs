@@ -8,6 +8,7 @@ use vkhair::{ash, gpu_allocator};
 use crate::frame::Running;
 use crate::host::{allocate, cleared, transition, BoxError, Memory};
 use crate::overlay::Painted;
+use crate::skin::GpuSkin;
 use crate::swapchain::{range, DEPTH};
 
 impl Running {
@@ -40,7 +41,7 @@ impl Running {
             let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             d.begin_command_buffer(cmd, &begin)?;
             // 1. vkhair: simulation steps due, geometry between the last two states, shadows.
-            hair.record_simulation(cmd, frame, dt, &camera)?;
+            hair.record_simulation(cmd, frame, dt, &camera, self.skin.as_mut())?;
             // 2. The host: clear, floor and head.
             let attachment =
                 (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE);
@@ -77,7 +78,7 @@ impl Running {
                 .depth_attachment(&depth_attachment);
             let view_projection = camera.projection * camera.view;
             d.cmd_begin_rendering(cmd, &rendering);
-            self.scene.record_head(cmd, extent, view_projection);
+            self.scene.record_head(cmd, extent, view_projection, self.skin.as_ref().map(GpuSkin::drawn));
             d.cmd_end_rendering(cmd);
             // 3. vkhair: the hair over them, depth-tested against the head and floor.
             let target = RenderTarget {
@@ -263,6 +264,9 @@ impl Running {
         drop(self.overlay.take());
         drop(self.hair.take());
         drop(self.ctx.take());
+        if let Some(skin) = &mut self.skin {
+            skin.destroy(self.gpu.allocator());
+        }
         self.free_readback();
         self.scene.destroy(self.gpu.allocator());
         self.swapchain.destroy(d.clone(), self.gpu.allocator());

@@ -93,11 +93,21 @@ impl HostScene {
 
     /// Records the head inside the caller's rendering (color attachment of the
     /// format given at creation, depth [`DEPTH`]): binds the pipeline and the
-    /// vertex buffer, sets viewport and scissor to `extent`.
+    /// vertex buffer, sets viewport and scissor to `extent`. With `body` (a
+    /// vertex buffer of positions and normals and its vertex count: a skinned
+    /// character), draws that instead of the head, then binds its own buffer
+    /// again for the floor.
     ///
     /// # Safety
-    /// `cmd` is recording inside such a rendering.
-    pub unsafe fn record_head(&self, cmd: vk::CommandBuffer, extent: vk::Extent2D, view_projection: Mat4) {
+    /// `cmd` is recording inside such a rendering; `body`'s buffer is alive
+    /// and its vertices written before this draw (barrier included).
+    pub unsafe fn record_head(
+        &self,
+        cmd: vk::CommandBuffer,
+        extent: vk::Extent2D,
+        view_projection: Mat4,
+        body: Option<(vk::Buffer, u32)>,
+    ) {
         let d = &self.device;
         let viewport = vk::Viewport {
             x: 0.0,
@@ -111,8 +121,14 @@ impl HostScene {
         unsafe {
             d.cmd_set_viewport(cmd, 0, &[viewport]);
             d.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
+            if let Some((buffer, count)) = body {
+                d.cmd_bind_vertex_buffers(cmd, 0, &[buffer], &[0]);
+                self.draw(cmd, (0, count), HEAD_COLOR, view_projection);
+            }
             d.cmd_bind_vertex_buffers(cmd, 0, &[self.buffer], &[0]);
-            self.draw(cmd, self.head, HEAD_COLOR, view_projection);
+            if body.is_none() {
+                self.draw(cmd, self.head, HEAD_COLOR, view_projection);
+            }
         }
     }
 

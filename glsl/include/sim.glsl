@@ -56,6 +56,8 @@ struct MovePush {
 struct Collider {
     vec4 a_radius;
     vec4 b_kind;
+    vec4 moved_a_friction;
+    vec4 moved_b;
 };
 
 
@@ -119,6 +121,37 @@ vec3 sim_rotate(mat4 m, vec3 v) {
 float sim_dot(vec3 a, vec3 b) {
     precise float r = (a.x * b.x + a.y * b.y) + a.z * b.z;
     return r;
+}
+
+// Friction against one collider, on the velocity: a particle at p (its pearl
+// `radius`) within its own radius of touching the surface loses the fraction
+// collider_friction(c) of its velocity v along the surface relative to the
+// surface's own (collider_moved_a/b over the sub-step of `dt` seconds, blended
+// along a capsule), so a moving body carries the hair resting on it; the
+// positions, and so the constraints and the non-penetration the solve left,
+// are untouched. Twin: `collider_friction` in src/sim/reference.rs.
+vec3 sim_collider_friction(Collider c, vec3 p, vec3 v, float radius, float dt) {
+    precise float friction = collider_friction(c);
+    precise vec3 closest = collider_a(c);
+    precise vec3 surface = collider_moved_a(c);
+    if (collider_kind(c) == float(COLLIDER_CAPSULE)) {
+        precise vec3 ab = collider_b(c) - collider_a(c);
+        precise float len2 = sim_dot(ab, ab);
+        precise float t = len2 > 0.0 ? clamp(sim_dot(p - collider_a(c), ab) / len2, 0.0, 1.0) : 0.0;
+        closest = collider_a(c) + ab * t;
+        surface = collider_moved_a(c) + (collider_moved_b(c) - collider_moved_a(c)) * t;
+    }
+    precise vec3 d = p - closest;
+    precise float dist = sqrt(sim_dot(d, d));
+    precise float contact = (collider_radius(c) + radius) + radius;
+    if (!(dist < contact) || !(dist > 0.0) || !(friction > 0.0)) {
+        return v;
+    }
+    precise vec3 n = d / dist;
+    precise vec3 relative = v - surface / dt;
+    precise vec3 along = relative - n * sim_dot(n, relative);
+    precise vec3 held = v - along * friction;
+    return held;
 }
 
 // v rotated by the smallest rotation taking unit vector a onto unit vector b

@@ -26,4 +26,13 @@ vec3 sim_collide_bodies(SimStepParams p, uint flags, uint base, vec3 x, float ra
     return x;
 }
 
+// The velocity v of a particle at x after friction against every sphere and
+// capsule it touches (from entry `base`; see sim_collider_friction).
+vec3 sim_collider_friction_all(SimStepParams p, uint base, vec3 x, vec3 v, float radius) {
+    for (uint c = 0u; c < sim_colliders(p); c++) {
+        v = sim_collider_friction(colliders[base + c], x, v, radius, sim_dt(p));
+    }
+    return v;
+}
+
 #endif

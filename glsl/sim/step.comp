@@ -34,8 +34,11 @@
 //           body collisions (spheres, capsules and, with SIM_MESH, the mesh
 //           collider's field; each particle has its own radius),
 //      then, with the mesh collider, friction against it (once per sub-step);
-//   3. velocity from the position change, damping:
-//        v = (x_solved − x_old) / dt  [− s·d_{i+1} / dt in DFTL mode],  v *= 1 − damping.
+//   3. velocity from the position change, friction, damping:
+//        v = (x_solved − x_old) / dt  [− s·d_{i+1} / dt in DFTL mode],
+//        against each sphere and capsule touched: the velocity along its
+//        surface relative to the surface's own (its motion over the sub-step)
+//        loses the fraction collider_friction,  v *= 1 − damping.
 //
 // The final state goes to the other half of the double buffer.
 //
@@ -434,6 +437,9 @@ void main() {
             precise vec3 vel = (own.xyz - x.xyz) / dt;
             if ((flags & SIM_DFTL) != 0u && i + 1u < points) {
                 vel = vel - s_local_offset[lid + 1u] * (sim_dftl_damping(params) / dt);
+            }
+            if ((flags & SIM_COLLISIONS) != 0u && own.w > 0.0) {
+                vel = sim_collider_friction_all(params, collider_base, own.xyz, vel, radius);
             }
             vel = vel * (1.0 - sim_damping(params));
             x = own;

@@ -9,13 +9,16 @@
 //! inverse bind matrix, weighted); [`Character::head_joint`] finds the head by
 //! the weights of the mesh's top; [`Character::fit_capsules`] fits a capsule
 //! per bone to the vertices it dominates, so that colliders follow the body
-//! without hand placement.
+//! without hand placement. A [`HairRig`] puts hair on one: the animation
+//! played, the head joint, the capsules within the hair's reach, the scalp the
+//! roots are bound to and the bones that skin it, key hairs grown on the head.
 //!
 //! A host with its own characters does not need this module: it hands vkhair
 //! the head's transform and the colliders it keeps itself.
 
 mod fit;
 mod gltf_read;
+mod hair;
 pub mod skeleton;
 #[cfg(test)]
 mod tests;
@@ -26,6 +29,7 @@ use glam::{Mat4, Vec3};
 
 pub use fit::{BoneCapsule, MIN_CAPSULE_VERTICES};
 pub use gltf_read::{MAX_CHARACTER_VERTICES, MAX_GLTF_BYTES};
+pub use hair::{HairRig, RIG_CAPSULES, RIG_HAIR_LENGTH, RIG_KEY_HAIRS};
 use skeleton::Skeleton;
 
 use crate::error::{Error, FileFormat, Result};

@@ -74,5 +74,7 @@ gpu_struct!(GpuScalpRoot => "ScalpRoot" { corners, weights, unbind });
 pub(crate) struct GpuCollider {
     pub(super) a_radius: [f32; 4],
     pub(super) b_kind: [f32; 4],
+    pub(super) moved_a_friction: [f32; 4],
+    pub(super) moved_b: [f32; 4],
 }
-gpu_struct!(GpuCollider => "Collider" { a_radius, b_kind });
+gpu_struct!(GpuCollider => "Collider" { a_radius, b_kind, moved_a_friction, moved_b });

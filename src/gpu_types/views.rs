@@ -154,6 +154,12 @@ shader_views! {
         b: vec3 = b_kind.xyz,
         /// `COLLIDER_*` kind (`codes::collider_kind`), as a float.
         kind: float = b_kind.w,
+        /// How far the centre or first end moved during the sub-step, m.
+        moved_a: vec3 = moved_a_friction.xyz,
+        /// Friction against it (0..=1; `SimParams::collider_friction`).
+        friction: float = moved_a_friction.w,
+        /// How far the second end moved during the sub-step, m.
+        moved_b: vec3 = moved_b.xyz,
     }
 
     /// One pass of the mesh collider's field build (`SdfPush`).

@@ -19,6 +19,25 @@ impl Groom {
         Groom::with_attributes(self.positions.iter().map(|p| *p * factor).collect(), &counts, attributes)
     }
 
+    /// The groom moved rigidly by `m` (a rotation and a translation; thickness
+    /// kept). Refuses a matrix that is not finite or not rigid (a scale or
+    /// shear changes the strands' lengths: use [`Groom::scaled`]).
+    pub fn rigidly_moved(&self, m: &glam::Mat4) -> Result<Groom> {
+        let (scale, _, _) = m.to_scale_rotation_translation();
+        let rigid = m.is_finite()
+            && (scale - glam::Vec3::ONE).abs().max_element() < 1e-3
+            && (m.row(3) - glam::Vec4::W).abs().max_element() == 0.0;
+        if !rigid {
+            return Err(Error::param("groom transform", format!("{m:?}"), "finite, a rotation and a translation"));
+        }
+        let counts: Vec<u32> = self.offsets.windows(2).map(|w| w[1] - w[0]).collect();
+        Groom::with_attributes(
+            self.positions.iter().map(|p| m.transform_point3(*p)).collect(),
+            &counts,
+            self.attributes(),
+        )
+    }
+
     /// Each strand's colour at its root and at its tip (its first and last
     /// point's), when the groom has per-point colours.
     pub fn end_colors(&self) -> Option<Vec<[glam::Vec3; 2]>> {

@@ -81,18 +81,19 @@ impl Collider {
     }
 
     /// The collider in world space with the head at `head`, as the step kernel
-    /// (and the CPU reference) sees it.
+    /// (and the CPU reference) sees it, at rest (no motion, no friction).
     pub(crate) fn in_world(self, head: &Mat4) -> ColliderShape {
         match self {
             Collider::Sphere { center, radius } => {
                 let c = head.transform_point3(center);
-                ColliderShape { a: c, radius, b: c, kind: collider_kind::SPHERE as f32 }
+                ColliderShape { a: c, radius, b: c, kind: collider_kind::SPHERE as f32, ..ColliderShape::default() }
             }
             Collider::Capsule { a, b, radius } => ColliderShape {
                 a: head.transform_point3(a),
                 radius,
                 b: head.transform_point3(b),
                 kind: collider_kind::CAPSULE as f32,
+                ..ColliderShape::default()
             },
         }
     }

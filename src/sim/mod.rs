@@ -366,7 +366,10 @@ impl HairSim {
     /// the previous step (where it is now for the first step, after a change
     /// of their count, and on a teleport). Set them before every step; they
     /// keep their place when not set again. At most [`MAX_COLLIDERS`] together
-    /// with the head's; they push particles out as the head's do.
+    /// with the head's; they push particles out as the head's do, and hold
+    /// the hair touching them by [`SimParams::collider_friction`] against
+    /// their own motion across the sub-step (a moving shoulder carries the
+    /// hair resting on it).
     pub fn set_body_colliders(&mut self, colliders: &[Collider]) -> Result<()> {
         self.planner.set_body_colliders(colliders)
     }

@@ -98,6 +98,11 @@ pub struct SimParams {
     /// motion along the surface, relative to the mesh, removed per sub-step
     /// (0..=1). Default: 0.3.
     pub mesh_friction: f32,
+    /// Friction against spheres and capsules, head's and body's: the fraction
+    /// of a touching particle's motion along the surface, relative to the
+    /// surface's own motion during the sub-step (a moving shoulder carries the
+    /// hair resting on it), removed per sub-step (0..=1). Default: 0.3.
+    pub collider_friction: f32,
     /// Whether body collisions act (spheres, capsules and the mesh collider).
     /// Default: true.
     pub collisions_enabled: bool,
@@ -153,6 +158,7 @@ impl Default for SimParams {
             sag_free: true,
             local_shape_stiffness: 0.0,
             mesh_friction: 0.3,
+            collider_friction: 0.3,
             collisions_enabled: true,
             damping: 0.02,
             dftl_damping: 0.9,
@@ -224,6 +230,7 @@ impl SimParams {
         in_range("global_shape_range", self.global_shape_range, 0.0, 1.0)?;
         in_range("local_shape_stiffness", self.local_shape_stiffness, 0.0, 1.0)?;
         in_range("mesh_friction", self.mesh_friction, 0.0, 1.0)?;
+        in_range("collider_friction", self.collider_friction, 0.0, 1.0)?;
         in_range("damping", self.damping, 0.0, 0.999)?;
         in_range("dftl_damping", self.dftl_damping, 0.0, 1.0)?;
         in_range("pearl_radius_root", self.pearl_radius_root, 0.0, 1e6)?;

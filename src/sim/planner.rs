@@ -208,17 +208,21 @@ impl SubstepPlanner {
                     index: self.substep.wrapping_add(k),
                 };
                 let colliders = self.collider_count();
-                let t = (k + 1) as f32 / p.substeps as f32;
-                let body =
-                    self.body_before.iter().zip(&self.body).map(|(b0, b1)| b0.lerp(b1, t).in_world(&Mat4::IDENTITY));
+                let t = |k: u32| k as f32 / p.substeps as f32;
+                let friction = p.collider_friction;
+                let head_colliders = self
+                    .colliders
+                    .iter()
+                    .map(|c| moving(c.in_world(&pose.previous_head), c.in_world(&pose.head), friction));
+                let body = self.body_before.iter().zip(&self.body).map(|(b0, b1)| {
+                    let at = |k: u32| b0.lerp(b1, t(k)).in_world(&Mat4::IDENTITY);
+                    moving(at(k), at(k + 1), friction)
+                });
                 let mut params = packing::sim_step(p, &pose, shape, colliders, self.mesh.as_ref());
                 if let Some(scalp) = &self.scalp {
                     scalp.apply(&mut params, k, p.substeps, restart);
                 }
-                SubstepInputs {
-                    params,
-                    colliders: self.colliders.iter().map(|c| c.in_world(&pose.head)).chain(body).collect(),
-                }
+                SubstepInputs { params, colliders: head_colliders.chain(body).collect() }
             })
             .collect();
         if let Some(scalp) = &mut self.scalp {
@@ -230,4 +234,10 @@ impl SubstepPlanner {
         self.substep = self.substep.wrapping_add(p.substeps);
         Ok(PlannedStep { start, substeps: inputs })
     }
+}
+
+/// A collider where it ends a sub-step (`end`), with how far it moved from
+/// `start` and the friction against it.
+fn moving(start: ColliderShape, end: ColliderShape, friction: f32) -> ColliderShape {
+    ColliderShape { moved_a: end.a - start.a, moved_b: end.b - start.b, friction, ..end }
 }

@@ -178,6 +178,32 @@ fn collide(c: &ColliderShape, p: Vec3, radius: f32) -> Vec3 {
     }
 }
 
+/// `sim_collider_friction`.
+fn collider_friction(c: &ColliderShape, p: Vec3, v: Vec3, radius: f32, dt: f32) -> Vec3 {
+    let friction = c.friction;
+    let mut closest = c.a;
+    let mut surface = c.moved_a;
+    if c.is_capsule() {
+        let ab = c.b - c.a;
+        let len2 = dot(ab, ab);
+        let t = if len2 > 0.0 { (dot(p - c.a, ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+        closest = c.a + ab * t;
+        surface = c.moved_a + (c.moved_b - c.moved_a) * t;
+    }
+    let d = p - closest;
+    let dist = dot(d, d).sqrt();
+    let contact = (c.radius + radius) + radius;
+    // Written to treat NaN as the shader does: no contact.
+    let touching = dist < contact && dist > 0.0 && friction > 0.0;
+    if !touching {
+        return v;
+    }
+    let n = d / dist;
+    let relative = v - surface / dt;
+    let along = relative - n * dot(n, relative);
+    v - along * friction
+}
+
 /// The bodies a particle collides with: spheres and capsules, and the mesh
 /// collider when `SIM_MESH` is set.
 #[derive(Clone, Copy)]
@@ -432,11 +458,19 @@ fn solve(
     }
 }
 
-/// Stage 3: velocity update, damping, final state.
-fn integrate(p: &SimStep, state: &mut SimState, active: Option<&[bool]>, predicted: &[Vec4], correction: &[Vec4]) {
+/// Stage 3: velocity update, friction against the sub-step's `colliders`,
+/// damping, final state.
+fn integrate(
+    (p, colliders): (&SimStep, &[ColliderShape]),
+    state: &mut SimState,
+    active: Option<&[bool]>,
+    predicted: &[Vec4],
+    correction: &[Vec4],
+) {
     let points = p.points as usize;
     let dt = p.dt;
     let dftl = p.flags & flags::DFTL != 0;
+    let collisions = p.flags & flags::COLLISIONS != 0;
     for index in 0..predicted.len() {
         if !simulated(active, index / points) {
             continue;
@@ -446,6 +480,11 @@ fn integrate(p: &SimStep, state: &mut SimState, active: Option<&[bool]>, predict
         let mut v = (solved.truncate() - state.positions[index].truncate()) / dt;
         if dftl && i + 1 < points {
             v -= correction[index + 1].truncate() * (p.dftl_damping / dt);
+        }
+        if collisions && solved.w > 0.0 {
+            for c in colliders {
+                v = collider_friction(c, solved.truncate(), v, state.rest[index].w, dt);
+            }
         }
         v *= 1.0 - p.damping;
         state.positions[index] = solved;
@@ -472,7 +511,7 @@ pub(crate) fn step(
         let frames = frames.as_deref();
         predict(p, frames, state, active, &mut predicted);
         solve((p, frames), &sub.colliders, mesh, state, active, &mut predicted, &mut correction);
-        integrate(&sub.params, state, active, &predicted, &correction);
+        integrate((&sub.params, &sub.colliders), state, active, &predicted, &correction);
     }
 }
 

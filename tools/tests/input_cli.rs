@@ -131,7 +131,9 @@ fn options_that_need_others_say_so() {
         (&["simulate", "--no-mesh-collider"], "--no-mesh-collider needs --obj"),
         (&["render", "--animation", "run"], "--animation needs --gltf"),
         (&["render", "--head-joint", "head"], "--head-joint needs --gltf"),
-        (&["render", "--gltf", "a.glb", "--input", "g.hair"], "--input cannot go with it"),
+        (&["render", "--gltf", "a.glb", "--obj", "head.obj"], "--obj cannot go with it"),
+        (&["render", "--gltf", "a.glb", "--scale", "0.01"], "--scale needs --input"),
+        (&["grow", "--scalp", "gltf", "--out", "g.hair"], "--scalp gltf needs --gltf"),
         (&["simulate", "--gltf", "a.glb", "--check"], "not --gltf"),
     ];
     for (args, message) in cases {
@@ -189,6 +191,49 @@ fn simulate_measures_roots_and_penetration_on_an_animated_character() {
     eprintln!("root error {root:e} m, inside {inside}");
     assert!(root < 2e-5, "roots {root} m from their skinned scalp points");
     assert!((0.0..0.5).contains(&inside), "inside fraction {inside}");
+}
+
+/// `grow --scalp gltf` writes hair grown on the character's head in its bind
+/// pose, and `render`/`simulate --gltf --input` bind that groom's roots to the
+/// skinned mesh: the roots ride it as closely as the grown hair's do. A groom
+/// whose roots are not on the character is refused, naming a strand.
+#[test]
+fn a_groom_grown_on_a_gltf_character_is_loaded_and_bound() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let glb = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/mannequiny-0.3.0.glb");
+    let groom = dir.path().join("grown.hair");
+    let args = format!("grow --scalp gltf --gltf {glb} --strands 300 --points 12 --out {}", groom.display());
+    let grown = run_line(&args, LIMIT);
+    grown.assert_ok();
+    assert!(grown.stdout.contains("grown on joint \"head\""), "{}", grown.stdout);
+    let json = dir.path().join("run.json");
+    let args = format!(
+        "simulate --gltf {glb} --input {} --animation run --steps 20 --volume off --json {}",
+        groom.display(),
+        json.display()
+    );
+    let sim = run_line(&args, LIMIT);
+    sim.assert_ok();
+    assert!(sim.stdout.contains("300 key hairs"), "{}", sim.stdout);
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("parse");
+    let root = v["run"]["root_error_max_m"].as_f64().expect("root_error_max_m");
+    eprintln!("loaded groom: root error {root:e} m");
+    assert!(root < 2e-5, "roots {root} m from their skinned scalp points");
+    let out = dir.path().join("frames");
+    let args = format!(
+        "render --gltf {glb} --input {} --frames 2 --width 160 --height 160 --shadow-resolution 64 --out {}",
+        groom.display(),
+        out.display()
+    );
+    run_line(&args, LIMIT).assert_ok();
+    let (_, _, rgba) = common::read_png(&out.join("frame_0001.png"));
+    let brown = rgba.chunks_exact(4).filter(|p| p[0] > 40 && 3 * u32::from(p[2]) < 2 * u32::from(p[0])).count();
+    assert!(brown > 300, "{brown} hair pixels");
+    // A groom of the thesis head, nowhere near the character's scalp.
+    let far = dir.path().join("far.hair");
+    common::write_groom(&far, &common::cap_groom(20, 6, 0.1));
+    let args = format!("render --gltf {glb} --input {} --frames 1 --out {}", far.display(), out.display());
+    run_line(&args, LIMIT).assert_error("strand");
 }
 
 /// Values out of range name their option; library functions are never suggested.

@@ -41,7 +41,7 @@ fn run_gpu(
         d,
         &BufferDesc {
             name: "test colliders",
-            size: (MAX_COLLIDERS * 32) as u64,
+            size: (MAX_COLLIDERS * std::mem::size_of::<GpuCollider>()) as u64,
             usage: ash::vk::BufferUsageFlags::UNIFORM_BUFFER | ash::vk::BufferUsageFlags::TRANSFER_DST,
             location: gpu_allocator::MemoryLocation::GpuOnly,
         },
@@ -98,7 +98,7 @@ fn block(grid: &GridLayout, params: &VolumeParams, previous: Mat4, colliders: u3
 
 /// A sphere collider as the volume stage sees it.
 fn sphere(center: Vec3, radius: f32) -> ColliderShape {
-    ColliderShape { a: center, radius, b: center, kind: SPHERE as f32 }
+    ColliderShape { a: center, radius, b: center, kind: SPHERE as f32, ..ColliderShape::default() }
 }
 
 fn random_particles(rng: &mut Pcg32, n: usize, lo: Vec3, hi: Vec3, speed: f32) -> (Vec<Vec4>, Vec<Vec4>) {

@@ -47,8 +47,10 @@ pub struct InputArgs {
     pub strict: bool,
     /// Skinned, animated glTF character (.glb or .gltf, meters): key hairs are
     /// grown on its head (the joint that dominates the top of the mesh, or
-    /// --head-joint) and move with it through the animation; a capsule per bone
-    /// and the head's distance field keep them out of the body. Instead of --input.
+    /// --head-joint), or read from --input (in the character's bind pose, as
+    /// `vkhair grow --scalp gltf` writes them, each root on its mesh), their
+    /// roots bound to the skinned mesh; a capsule per bone and the head's
+    /// distance field keep them out of the body.
     #[arg(long)]
     pub gltf: Option<PathBuf>,
     /// The --gltf animation, by name or index [default: the first].
@@ -99,13 +101,12 @@ impl InputArgs {
     /// Options that need others and values out of range, as errors that say so.
     pub fn check(&self) -> Result<(), String> {
         if self.gltf.is_some() {
-            let given = [("--input", self.input.is_some()), ("--obj", self.obj.is_some())];
-            if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
-                return Err(format!("--gltf grows hair on its own character: {flag} cannot go with it"));
+            if self.obj.is_some() {
+                return Err("--gltf brings its own mesh: --obj cannot go with it".into());
             }
             let given = [("--scale", self.scale.is_some()), ("--strict", self.strict)];
-            if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
-                return Err(format!("{flag} needs --input (a --gltf character is in meters and grown, not read)"));
+            if let Some((flag, _)) = given.iter().find(|(_, g)| *g).filter(|_| self.input.is_none()) {
+                return Err(format!("{flag} needs --input (without it the hair is grown on the --gltf character)"));
             }
         } else if let Some(flag) =
             [("--animation", self.animation.is_some()), ("--head-joint", self.head_joint.is_some())]

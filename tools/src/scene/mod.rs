@@ -15,10 +15,10 @@ use vkhair::groom::Groom;
 use vkhair::render::Camera;
 use vkhair::sim::{motion, Collider};
 
-pub use character::CharacterScene;
+pub use character::{load as load_character, CharacterScene};
 pub use parameters::{bind_followers, make_renderer, parameters, FULL_HEAD_HAIRS};
 
-use crate::args::input::{Dense, Scaled};
+use crate::args::input::{Dense, InputArgs, Scaled};
 use crate::args::scene::SceneArgs;
 use crate::output::Error;
 
@@ -61,7 +61,7 @@ fn bounds_sphere(points: impl Iterator<Item = Vec3>) -> (Vec3, f32) {
 
 /// The scene of `a`'s flags.
 pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
-    if let Some(ch) = CharacterScene::load(&a.input)? {
+    if let Some(ch) = character::load(&a.input)? {
         return character_scene(ch, a);
     }
     let sintel =
@@ -121,7 +121,7 @@ pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
 
 /// The `--gltf` scene: framed on the hair and the body around the head.
 fn character_scene(ch: CharacterScene, a: &SceneArgs) -> Result<Scene, Error> {
-    let (groom, head_mesh) = ch.groom(a.input.points.unwrap_or(16))?;
+    let (Scaled { groom, thickness }, dense, head_mesh) = character_groom(&ch, &a.input)?;
     let start_head = ch.head_at(0.0);
     let m = start_head.matrix();
     let body = ch.body_at(0.0)?;
@@ -135,18 +135,34 @@ fn character_scene(ch: CharacterScene, a: &SceneArgs) -> Result<Scene, Error> {
     let view_dir = ch.character.forward();
     Ok(Scene {
         groom,
-        dense: None,
+        dense,
         colliders,
         head_mesh,
         center,
         radius,
-        thickness: None,
+        thickness,
         pivot: head,
         credit,
         character: Some(ch),
         start_head,
         view_dir,
     })
+}
+
+/// The key hairs on a `--gltf` character, in its head's frame (grown on the
+/// head, or the --input groom moved there from the character's bind pose),
+/// a dense --input groom's followers likewise, and the head's region (the mesh
+/// collider).
+pub fn character_groom(ch: &CharacterScene, a: &InputArgs) -> Result<(Scaled, Option<Dense>, TriMesh), Error> {
+    let Some(path) = &a.input else {
+        let (groom, head_mesh) = ch.grow(a.points.unwrap_or(16))?;
+        return Ok((Scaled { groom, thickness: None }, None, head_mesh));
+    };
+    let to_head = ch.bind_frame().inverse();
+    let (Scaled { groom, thickness }, dense) = a.groom_and_guides(path)?;
+    let groom = groom.rigidly_moved(&to_head)?;
+    let dense = dense.map(|d| d.groom.rigidly_moved(&to_head).map(|groom| Dense { groom, ..d })).transpose()?;
+    Ok((Scaled { groom, thickness }, dense, ch.head_region()?))
 }
 
 /// How much wider than given the render's lengths are drawn for a scene of

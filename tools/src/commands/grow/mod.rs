@@ -23,6 +23,11 @@ pub enum ScalpKind {
     Ellipsoid,
     /// Upward-facing triangles in the top part of an OBJ mesh (--obj).
     Obj,
+    /// The head of a skinned glTF character (--gltf; the joint that dominates
+    /// the top of the mesh, or --head-joint), the face left free, combed back;
+    /// written in the character's bind pose (meters), its roots on the mesh,
+    /// for `render`/`simulate --gltf FILE --input OUT`.
+    Gltf,
 }
 
 #[derive(clap::Args)]
@@ -33,6 +38,12 @@ pub struct GrowArgs {
     /// OBJ mesh for --scalp obj.
     #[arg(long)]
     obj: Option<PathBuf>,
+    /// glTF character (.glb or .gltf) for --scalp gltf.
+    #[arg(long)]
+    gltf: Option<PathBuf>,
+    /// --scalp gltf: the joint the hair grows on, by name [default: found by weights].
+    #[arg(long)]
+    head_joint: Option<String>,
     /// Sphere radius / ellipsoid semi-axes "x,y,z" (scalp units).
     #[arg(long, default_value = "0.1")]
     radius: String,
@@ -54,7 +65,8 @@ pub struct GrowArgs {
     /// Points per strand.
     #[arg(long, default_value_t = 16)]
     points: usize,
-    /// Strand length (scalp units); default 0.3, or 35 % of the mesh height for OBJ.
+    /// Strand length (scalp units); default 0.3, 35 % of the mesh height for
+    /// OBJ, 0.28 m for glTF.
     #[arg(long)]
     length: Option<f32>,
     /// Bend toward gravity, radians over the strand.
@@ -85,10 +97,28 @@ pub fn grow_groom(a: &GrowArgs) -> CliResult {
     if !(a.max_angle.is_finite() && a.max_angle > 0.0 && a.max_angle <= 180.0) {
         return Err(format!("--max-angle must be within (0, 180] degrees (got {})", a.max_angle).into());
     }
-    let inputs: Vec<&std::path::Path> = a.obj.iter().map(|p| p.as_path()).collect();
+    let inputs: Vec<&std::path::Path> = a.obj.iter().chain(&a.gltf).map(|p| p.as_path()).collect();
     destinations::check(&inputs, &[Output { flag: "--out", path: &a.out, kind: Kind::File(&["hair"]) }])?;
     let groom = match a.scalp {
         ScalpKind::Thesis => scenes::thesis()?,
+        ScalpKind::Gltf => {
+            let path = a.gltf.as_ref().ok_or("--scalp gltf needs --gltf FILE.glb")?;
+            let character = vkhair::character::Character::load(path)?;
+            // The rig's animation is not used: the groom is grown in the bind pose.
+            let rig = vkhair::character::HairRig::new(character, None, a.head_joint.as_deref())
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            let params = GrowParams {
+                strands: a.strands,
+                points_per_strand: a.points,
+                length: a.length.unwrap_or(vkhair::character::RIG_HAIR_LENGTH),
+                droop: a.droop,
+                seed: a.seed,
+                ..GrowParams::default()
+            };
+            let (groom, _) = rig.grow_with(&params)?;
+            say!("grown on joint {:?} of {}", rig.joint_name(rig.head), path.display());
+            groom.rigidly_moved(&rig.bind_frame())?
+        }
         kind => {
             let mut length = a.length.unwrap_or(0.3);
             let scalp = match kind {

@@ -11,7 +11,7 @@
 
 use glam::Vec3;
 use vkhair::ash::vk;
-use vkhair::groom::binding::{bind_roots, RootBinding, TriangleGrid};
+use vkhair::groom::binding::TriangleGrid;
 use vkhair::groom::mesh::TriMesh;
 use vkhair::groom::sdf::MeshSdf;
 use vkhair::headless::HostBuffer;
@@ -39,19 +39,10 @@ const BODY_FIELD_RESOLUTION: u32 = 64;
 pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
     let config = simulate_params(a)?;
     let params = config.sim.clone();
-    let (groom, head_mesh) = ch.groom(a.input.points.unwrap_or(16))?;
+    let (crate::args::input::Scaled { groom, .. }, _, head_mesh) = crate::scene::character_groom(&ch, &a.input)?;
     let time = |step: usize| step as f32 * params.dt;
     // Roots bound to the character's triangles in the bind pose (world).
-    let bind = ch.character.bind_pose();
-    let bind_frame = ch.character.rigid_frame(&bind, ch.head).matrix();
-    let roots: Vec<Vec3> = (0..groom.strand_count())
-        .filter_map(|s| groom.strand(s).first().map(|r| bind_frame.transform_point3(*r)))
-        .collect();
-    let bound = bind_roots(
-        &roots,
-        &TriMesh::new(ch.character.positions.clone(), ch.character.triangles.clone())?,
-        ROOT_TOLERANCE,
-    )?;
+    let bound = ch.bind_roots(&groom, ROOT_TOLERANCE)?;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let mut sim = HairSim::new(&ctx, &groom, &params, &ch.head_at(0.0))?;
     // The roots ride the skinned mesh: the tool skins the character every step
@@ -93,7 +84,7 @@ pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
         if (step + 1) % 10 == 0 || step + 1 == a.steps {
             let state = sim.read_state()?;
             let pose = ch.pose(time(step + 1));
-            root_error = root_error.max(largest_root_error(&state, &bound, &ch.character.triangles, &skinned));
+            root_error = root_error.max(ch.root_error(&state, &bound, &skinned));
             let head = ch.character.joint_transform(&pose, ch.head).transform_point3(Vec3::ZERO);
             inside = inside.max(share_inside_body(&state, &ch.character.triangles, &skinned, head)?);
         }
@@ -128,16 +119,6 @@ pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
     })?;
 
     Ok(())
-}
-
-/// The largest distance of a simulated root from its bound point on the
-/// skinned mesh.
-fn largest_root_error(state: &SimState, bound: &[RootBinding], triangles: &[[u32; 3]], skinned: &[Vec3]) -> f32 {
-    bound
-        .iter()
-        .enumerate()
-        .map(|(s, b)| state.positions[s * state.points].truncate().distance(b.point(triangles, skinned)))
-        .fold(0.0, f32::max)
 }
 
 /// The share of free points inside the skinned body's triangles near `head`:

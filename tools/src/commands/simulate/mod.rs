@@ -160,7 +160,7 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     }));
     outputs.extend(a.profile_out.outputs());
     destinations::check(&inputs, &outputs)?;
-    if let Some(ch) = crate::scene::CharacterScene::load(&a.input)? {
+    if let Some(ch) = crate::scene::load_character(&a.input)? {
         return character::simulate_character(a, ch);
     }
     let scale = a.input.scale();

@@ -1,0 +1,209 @@
+//! Hair on a character, the host side: which animation plays, which joint is
+//! the head, the capsules that keep hair out of the body near it, the scalp the
+//! key hairs' roots are bound to with the bones that skin it, and key hairs
+//! grown on the head. What `vkhair render --gltf`, `simulate --gltf` and the
+//! viewer share.
+
+use glam::{Mat4, Vec3};
+
+use super::{BoneCapsule, Character, Pose};
+use crate::error::{Error, Result};
+use crate::groom::binding::{bind_roots, RootBinding};
+use crate::groom::grow::{grow, GrowParams, Scalp as GrowScalp};
+use crate::groom::mesh::TriMesh;
+use crate::groom::Groom;
+use crate::sim::scalp::{Scalp, VertexSkin};
+use crate::sim::{Collider, RigidTransform, SimState, MAX_COLLIDERS};
+
+/// Key hairs [`HairRig::grow`] grows on the head: 600.
+pub const RIG_KEY_HAIRS: usize = 600;
+/// Their length: 0.28 m.
+pub const RIG_HAIR_LENGTH: f32 = 0.28;
+/// Capsules a rig keeps: the nearest the head, up to half the simulation's
+/// collider limit (the rest is left to a host's own colliders).
+pub const RIG_CAPSULES: usize = MAX_COLLIDERS / 2;
+
+/// A character with hair on its head (see the module docs).
+#[derive(Debug, Clone)]
+pub struct HairRig {
+    /// The character.
+    pub character: Character,
+    /// The animation played (index into the skeleton's animations).
+    pub animation: usize,
+    /// The skin joint the hair grows on.
+    pub head: usize,
+    /// A capsule per bone within reach of the hair, the nearest first (at
+    /// most [`RIG_CAPSULES`]).
+    pub capsules: Vec<BoneCapsule>,
+}
+
+impl HairRig {
+    /// The rig of `character` playing `animation` (by name or index; the first
+    /// when `None`) with the head at `head_joint` (by name; found by the
+    /// weights of the mesh's top when `None`). Refuses a character without an
+    /// animation.
+    pub fn new(character: Character, animation: Option<&str>, head_joint: Option<&str>) -> Result<Self> {
+        let sk = &character.skeleton;
+        if sk.animations.is_empty() {
+            return Err(Error::incompatible("character", "it has no animation"));
+        }
+        let animation = match animation {
+            Some(name) => sk.animation_index(name)?,
+            None => 0,
+        };
+        let head = match head_joint {
+            Some(name) => character.joint_named(name)?,
+            None => character.head_joint(),
+        };
+        let rest = character.bind_pose();
+        let origin = character.joint_transform(&rest, head).transform_point3(Vec3::ZERO);
+        let mut capsules = character.fit_capsules(&[head]);
+        let distance = |c: &BoneCapsule| {
+            let m = character.joint_transform(&rest, c.joint);
+            let (a, b) = (m.transform_point3(c.a), m.transform_point3(c.b));
+            segment_distance(origin, a, b) - c.radius
+        };
+        // Only what the hair can reach: bones within one and a half hair lengths
+        // of the head joint, the nearest first.
+        capsules.retain(|c| distance(c) < 1.5 * RIG_HAIR_LENGTH);
+        capsules.sort_by(|x, y| distance(x).total_cmp(&distance(y)));
+        capsules.truncate(RIG_CAPSULES);
+        Ok(HairRig { character, animation, head, capsules })
+    }
+
+    /// A joint's node name (empty when it has none).
+    pub fn joint_name(&self, joint: usize) -> &str {
+        let sk = &self.character.skeleton;
+        &sk.nodes[sk.joints[joint]].name
+    }
+
+    /// The pose at `time` seconds into the animation (looping).
+    pub fn pose(&self, time: f32) -> Pose {
+        self.character.pose(Some(self.animation), time)
+    }
+
+    /// The head's frame at `time`.
+    pub fn head_at(&self, time: f32) -> RigidTransform {
+        self.character.rigid_frame(&self.pose(time), self.head)
+    }
+
+    /// The capsules at `time`, in the world (the simulation's body colliders).
+    pub fn colliders_at(&self, time: f32) -> Vec<Collider> {
+        let pose = self.pose(time);
+        self.capsules.iter().map(|c| c.in_world(&self.character, &pose)).collect()
+    }
+
+    /// The character's mesh in the bind pose, in the head's frame (the
+    /// groom's), with its skin: the scalp the roots are bound to. Vertex `v` is
+    /// the character's vertex `v`, so a host's skinned copy of the character
+    /// is its source.
+    pub fn scalp(&self) -> Result<Scalp> {
+        let to_head = self.bind_frame().inverse();
+        let positions = self.character.positions.iter().map(|p| to_head.transform_point3(*p)).collect();
+        let skin =
+            self.character.weights.iter().map(|(j, w)| VertexSkin { joints: j.map(u32::from), weights: *w }).collect();
+        Ok(Scalp { skin, ..Scalp::new(TriMesh::new(positions, self.character.triangles.clone())?) })
+    }
+
+    /// The scalp's bones at `time`: each joint's skinning matrix after the
+    /// head frame's bind placement (head frame, bind pose → world).
+    pub fn scalp_bones(&self, time: f32) -> Vec<Mat4> {
+        let bind = self.bind_frame();
+        self.pose(time).skin.iter().map(|m| *m * bind).collect()
+    }
+
+    /// Each key hair's root of `groom` (in the head's frame) bound to the
+    /// character's mesh in the bind pose: its triangle and weights. A root
+    /// farther than `tolerance` (m) from the mesh is refused, naming the strand.
+    pub fn bind_roots(&self, groom: &Groom, tolerance: f32) -> Result<Vec<RootBinding>> {
+        let bind = self.bind_frame();
+        let roots: Vec<Vec3> = (0..groom.strand_count())
+            .filter_map(|s| groom.strand(s).first().map(|r| bind.transform_point3(*r)))
+            .collect();
+        let mesh = TriMesh::new(self.character.positions.clone(), self.character.triangles.clone())?;
+        bind_roots(&roots, &mesh, tolerance)
+    }
+
+    /// The largest distance of a root of `state` (the first point of each
+    /// strand) from its point `bound` on the mesh as `skinned` (the
+    /// character's vertices deformed, [`Character::skin`]) places it.
+    pub fn root_error(&self, state: &SimState, bound: &[RootBinding], skinned: &[Vec3]) -> f32 {
+        bound
+            .iter()
+            .enumerate()
+            .map(|(s, b)| {
+                state.positions[s * state.points].truncate().distance(b.point(&self.character.triangles, skinned))
+            })
+            .fold(0.0, f32::max)
+    }
+
+    /// The head's frame in the bind pose.
+    pub fn bind_frame(&self) -> Mat4 {
+        self.character.rigid_frame(&self.character.bind_pose(), self.head).matrix()
+    }
+
+    /// The whole character at `time`, in the world.
+    pub fn body_at(&self, time: f32) -> Result<TriMesh> {
+        self.character.mesh(&self.pose(time))
+    }
+
+    /// The head's region at rest, in the head's frame: the mesh collider.
+    pub fn head_region(&self) -> Result<TriMesh> {
+        let to_head: Mat4 = self.bind_frame().inverse();
+        let region = self.character.region_mesh(self.head, &self.character.bind_pose())?;
+        TriMesh::new(region.positions.iter().map(|p| to_head.transform_point3(*p)).collect(), region.triangles)
+    }
+
+    /// The head's region at rest, in the head's frame (the mesh collider), and
+    /// [`RIG_KEY_HAIRS`] key hairs of `points` points, [`RIG_HAIR_LENGTH`]
+    /// long, grown on its upper part (see [`HairRig::grow_with`]).
+    pub fn grow(&self, points: usize) -> Result<(Groom, TriMesh)> {
+        let params = GrowParams {
+            strands: RIG_KEY_HAIRS,
+            points_per_strand: points,
+            length: RIG_HAIR_LENGTH,
+            droop: 5.0,
+            ..GrowParams::default()
+        };
+        self.grow_with(&params)
+    }
+
+    /// Hair grown on the upper part of the head's region by `params`, in the
+    /// head's frame, combed back (away from where the character faces, the
+    /// given comb replaced) under the character's gravity; no roots on the
+    /// face. With the head's region at rest (the mesh collider).
+    pub fn grow_with(&self, params: &GrowParams) -> Result<(Groom, TriMesh)> {
+        let to_head: Mat4 = self.bind_frame().inverse();
+        let local = self.head_region()?;
+        // No roots on the face: triangles facing forward below the crown are left out.
+        let facing = self.character.forward();
+        let forward = to_head.transform_vector3(facing).normalize();
+        let up = to_head.transform_vector3(Vec3::Y).normalize();
+        let (lo, hi) =
+            local.positions.iter().fold((f32::MAX, f32::MIN), |(l, h), p| (l.min(p.dot(up)), h.max(p.dot(up))));
+        let crown = hi - 0.2 * (hi - lo);
+        let scalp_triangles: Vec<[u32; 3]> = (0..local.triangles.len())
+            .filter(|&i| {
+                let n = local.scaled_normal(i).normalize_or_zero();
+                let centroid = local.corners(i).iter().copied().sum::<Vec3>() / 3.0;
+                n.dot(forward) < 0.25 || centroid.dot(up) > crown
+            })
+            .map(|i| local.triangles[i])
+            .collect();
+        let scalp_mesh = TriMesh::new(local.positions.clone(), scalp_triangles)?;
+        let scalp = GrowScalp::Mesh { mesh: scalp_mesh, up, min_height: 0.45, min_up_dot: -0.2 };
+        let params = GrowParams {
+            gravity: to_head.transform_vector3(Vec3::NEG_Y),
+            comb: to_head.transform_vector3(0.2 * Vec3::Y - 0.8 * facing),
+            ..params.clone()
+        };
+        Ok((grow(&scalp, &params)?, local))
+    }
+}
+
+/// Distance from `p` to the segment `a`–`b`.
+fn segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f32 {
+    let ab = b - a;
+    let t = if ab.length_squared() > 0.0 { ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0) } else { 0.0 };
+    p.distance(a + ab * t)
+}
