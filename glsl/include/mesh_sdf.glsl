@@ -1,7 +1,7 @@
 // Sampling the mesh collider's field (src/sim/mesh_collider.rs) in a
 // simulation stage. The including shader declares, before the #include,
 //     layout(std430, ...) readonly buffer MeshField { float mesh_field[]; };
-// The CPU twins are `mesh_sample` and `mesh_collide` in src/sim/reference.rs.
+// The CPU twins are `mesh_sample` and `mesh_collide` in src/sim/reference/bodies.rs.
 #ifndef VKHAIR_MESH_SDF_GLSL
 #define VKHAIR_MESH_SDF_GLSL
 

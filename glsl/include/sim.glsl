@@ -1,5 +1,5 @@
 // Declarations shared by the simulation kernels (glsl/sim/step.comp and the volume stage).
-// The CPU reference (src/sim/reference.rs) mirrors every function here with
+// The CPU reference (src/sim/reference/) mirrors every function here with
 // the same operation order; `precise` keeps the compiler from fusing or
 // reordering float operations so both sides round the same way.
 #ifndef VKHAIR_SIM_GLSL
@@ -129,7 +129,7 @@ float sim_dot(vec3 a, vec3 b) {
 // surface's own (collider_moved_a/b over the sub-step of `dt` seconds, blended
 // along a capsule), so a moving body carries the hair resting on it; the
 // positions, and so the constraints and the non-penetration the solve left,
-// are untouched. Twin: `collider_friction` in src/sim/reference.rs.
+// are untouched. Twin: `collider_friction` in src/sim/reference/bodies.rs.
 vec3 sim_collider_friction(Collider c, vec3 p, vec3 v, float radius, float dt) {
     precise float friction = collider_friction(c);
     precise vec3 closest = collider_a(c);

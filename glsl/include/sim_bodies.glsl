@@ -3,7 +3,7 @@
 // sub-steps' colliders and the mesh collider's field:
 //     layout(std430, ...) readonly buffer Colliders { Collider colliders[]; };
 //     layout(std430, ...) readonly buffer MeshField { float mesh_field[]; };
-// The CPU twin is `Bodies::collide` in src/sim/reference.rs.
+// The CPU twin is `Bodies::collide` in src/sim/reference/bodies.rs.
 #ifndef VKHAIR_SIM_BODIES_GLSL
 #define VKHAIR_SIM_BODIES_GLSL
 #include "mesh_sdf.glsl"

@@ -1,0 +1,165 @@
+//! The bodies of the CPU reference: the mesh collider's field, spheres and
+//! capsules, and friction against them, each as its shader twin computes it
+//! (`glsl/include/mesh_sdf.glsl`, `sim.glsl`, `sim_bodies.glsl`).
+
+use glam::{Mat4, Vec3};
+
+use super::{dot, transform_point};
+use crate::gpu_types::ColliderShape;
+use crate::groom::sdf::MeshSdf;
+use crate::sim::mesh_collider::MeshGrid;
+
+/// `sim_to_head`: Rᵀ(p − t) for a rigid `m`.
+fn to_head(m: &Mat4, p: Vec3) -> Vec3 {
+    let d = p - m.col(3).truncate();
+    let row = |i: usize| (m.col(i).x * d.x + m.col(i).y * d.y) + m.col(i).z * d.z;
+    Vec3::new(row(0), row(1), row(2))
+}
+
+/// The mesh collider's field as the solver sees it.
+#[derive(Clone, Copy)]
+pub(crate) struct MeshField<'a> {
+    pub grid: MeshGrid,
+    pub values: &'a [f32],
+}
+
+impl<'a> MeshField<'a> {
+    pub(crate) fn new(sdf: &'a MeshSdf) -> Self {
+        MeshField { grid: MeshGrid { origin: sdf.origin, cell: sdf.cell, dims: sdf.dims }, values: &sdf.values }
+    }
+
+    /// `mesh_sample`: trilinear value and its gradient (per cell) at q, head frame.
+    pub(crate) fn sample(&self, q: Vec3) -> (Vec3, f32) {
+        let dims = self.grid.dims;
+        let g = (q - self.grid.origin) / self.grid.cell;
+        let top = Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32) - 1.0;
+        if g.cmplt(Vec3::ZERO).any() || g.cmpgt(top).any() {
+            return (Vec3::ZERO, 1e30);
+        }
+        let base = g.floor().min(top - 1.0);
+        let f = g - base;
+        let (sx, sy, sz) = (1usize, dims[0] as usize, (dims[0] * dims[1]) as usize);
+        let k = ((base.z as usize * dims[1] as usize) + base.y as usize) * dims[0] as usize + base.x as usize;
+        let v = |o: usize| self.values[k + o];
+        let (c000, c100, c010, c110) = (v(0), v(sx), v(sy), v(sx + sy));
+        let (c001, c101, c011, c111) = (v(sz), v(sx + sz), v(sy + sz), v(sx + sy + sz));
+        let x00 = c000 + (c100 - c000) * f.x;
+        let x10 = c010 + (c110 - c010) * f.x;
+        let x01 = c001 + (c101 - c001) * f.x;
+        let x11 = c011 + (c111 - c011) * f.x;
+        let y0 = x00 + (x10 - x00) * f.y;
+        let y1 = x01 + (x11 - x01) * f.y;
+        let value = y0 + (y1 - y0) * f.z;
+        let gx0 = (c100 - c000) + ((c110 - c010) - (c100 - c000)) * f.y;
+        let gx1 = (c101 - c001) + ((c111 - c011) - (c101 - c001)) * f.y;
+        let gx = gx0 + (gx1 - gx0) * f.z;
+        let gy = (x10 - x00) + ((x11 - x01) - (x10 - x00)) * f.z;
+        let gz = y1 - y0;
+        (Vec3::new(gx, gy, gz), value)
+    }
+
+    /// `mesh_collide`.
+    fn collide(&self, head: &Mat4, p: Vec3, radius: f32) -> Vec3 {
+        let q = to_head(head, p);
+        let (gradient, value) = self.sample(q);
+        if value < radius {
+            let len = dot(gradient, gradient).sqrt();
+            if len > 0.0 {
+                return transform_point(head, q + gradient * ((radius - value) / len));
+            }
+        }
+        p
+    }
+
+    /// `mesh_friction`.
+    #[allow(clippy::too_many_arguments, reason = "mirrors the shader function")]
+    pub(super) fn friction(
+        &self,
+        head: &Mat4,
+        previous_head: &Mat4,
+        p: Vec3,
+        from: Vec3,
+        radius: f32,
+        friction: f32,
+    ) -> Vec3 {
+        let q = to_head(head, p);
+        let (gradient, value) = self.sample(q);
+        let contact = radius + 0.1 * self.grid.cell;
+        let len = dot(gradient, gradient).sqrt();
+        // Written to treat NaN as the shader does: no contact.
+        let touching = value < contact && len > 0.0;
+        if !touching || friction <= 0.0 {
+            return p;
+        }
+        let n = gradient / len;
+        let moved = q - to_head(previous_head, from);
+        let along = moved - n * dot(n, moved);
+        transform_point(head, q - along * friction)
+    }
+}
+
+fn collide(c: &ColliderShape, p: Vec3, radius: f32) -> Vec3 {
+    let a = c.a;
+    let mut closest = a;
+    if c.is_capsule() {
+        let ab = c.b - a;
+        let len2 = dot(ab, ab);
+        let t = if len2 > 0.0 { (dot(p - a, ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+        closest = a + ab * t;
+    }
+    let d = p - closest;
+    let dist = dot(d, d).sqrt();
+    let reach = c.radius + radius;
+    if dist < reach && dist > 0.0 {
+        closest + d * (reach / dist)
+    } else {
+        p
+    }
+}
+
+/// `sim_collider_friction`.
+pub(super) fn collider_friction(c: &ColliderShape, p: Vec3, v: Vec3, radius: f32, dt: f32) -> Vec3 {
+    let friction = c.friction;
+    let mut closest = c.a;
+    let mut surface = c.moved_a;
+    if c.is_capsule() {
+        let ab = c.b - c.a;
+        let len2 = dot(ab, ab);
+        let t = if len2 > 0.0 { (dot(p - c.a, ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+        closest = c.a + ab * t;
+        surface = c.moved_a + (c.moved_b - c.moved_a) * t;
+    }
+    let d = p - closest;
+    let dist = dot(d, d).sqrt();
+    let contact = (c.radius + radius) + radius;
+    // Written to treat NaN as the shader does: no contact.
+    let touching = dist < contact && dist > 0.0 && friction > 0.0;
+    if !touching {
+        return v;
+    }
+    let n = d / dist;
+    let relative = v - surface / dt;
+    let along = relative - n * dot(n, relative);
+    v - along * friction
+}
+
+/// The bodies a particle collides with: spheres and capsules, and the mesh
+/// collider when `SIM_MESH` is set.
+#[derive(Clone, Copy)]
+pub(super) struct Bodies<'a> {
+    pub colliders: &'a [ColliderShape],
+    pub mesh: Option<MeshField<'a>>,
+    pub head: &'a Mat4,
+}
+
+impl Bodies<'_> {
+    pub(super) fn collide(&self, mut p: Vec3, radius: f32) -> Vec3 {
+        for c in self.colliders {
+            p = collide(c, p, radius);
+        }
+        if let Some(mesh) = &self.mesh {
+            p = mesh.collide(self.head, p, radius);
+        }
+        p
+    }
+}
