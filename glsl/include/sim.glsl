@@ -84,17 +84,38 @@ float sim_noise(float t, uint strand) {
     return n;
 }
 
+// a · b, in the CPU reference's order.
+float sim_dot(vec3 a, vec3 b) {
+    precise float r = (a.x * b.x + a.y * b.y) + a.z * b.z;
+    return r;
+}
+
+// Where along collider c's core the point nearest p lies: 0 for a sphere, the
+// parameter along a capsule's segment (0 at a, 1 at b).
+float sim_collider_t(Collider c, vec3 p) {
+    if (collider_kind(c) != float(COLLIDER_CAPSULE)) {
+        return 0.0;
+    }
+    precise vec3 ab = collider_b(c) - collider_a(c);
+    precise float len2 = sim_dot(ab, ab);
+    precise float t = len2 > 0.0 ? clamp(sim_dot(p - collider_a(c), ab) / len2, 0.0, 1.0) : 0.0;
+    return t;
+}
+
+// The point of collider c's core (its centre or segment) at parameter t.
+vec3 sim_collider_point(Collider c, float t) {
+    if (collider_kind(c) != float(COLLIDER_CAPSULE)) {
+        return collider_a(c);
+    }
+    precise vec3 point = collider_a(c) + (collider_b(c) - collider_a(c)) * t;
+    return point;
+}
+
 // Projects p out of one collider, keeping a gap of `radius` (the particle's pearl).
 vec3 sim_collide(Collider c, vec3 p, float radius) {
-    precise vec3 closest = collider_a(c);
-    if (collider_kind(c) == float(COLLIDER_CAPSULE)) {
-        precise vec3 ab = collider_b(c) - collider_a(c);
-        precise float len2 = dot(ab, ab);
-        precise float t = len2 > 0.0 ? clamp(dot(p - collider_a(c), ab) / len2, 0.0, 1.0) : 0.0;
-        closest = collider_a(c) + ab * t;
-    }
+    precise vec3 closest = sim_collider_point(c, sim_collider_t(c, p));
     precise vec3 d = p - closest;
-    precise float dist = sqrt(dot(d, d));
+    precise float dist = sqrt(sim_dot(d, d));
     precise float reach = collider_radius(c) + radius;
     if (dist < reach && dist > 0.0) {
         precise vec3 out_p = closest + d * (reach / dist);
@@ -118,11 +139,6 @@ vec3 sim_rotate(mat4 m, vec3 v) {
     return r;
 }
 
-float sim_dot(vec3 a, vec3 b) {
-    precise float r = (a.x * b.x + a.y * b.y) + a.z * b.z;
-    return r;
-}
-
 // Friction against one collider, on the velocity: a particle at p (its pearl
 // `radius`) within its own radius of touching the surface loses the fraction
 // collider_friction(c) of its velocity v along the surface relative to the
@@ -132,15 +148,9 @@ float sim_dot(vec3 a, vec3 b) {
 // are untouched. Twin: `collider_friction` in src/sim/reference/bodies.rs.
 vec3 sim_collider_friction(Collider c, vec3 p, vec3 v, float radius, float dt) {
     precise float friction = collider_friction(c);
-    precise vec3 closest = collider_a(c);
-    precise vec3 surface = collider_moved_a(c);
-    if (collider_kind(c) == float(COLLIDER_CAPSULE)) {
-        precise vec3 ab = collider_b(c) - collider_a(c);
-        precise float len2 = sim_dot(ab, ab);
-        precise float t = len2 > 0.0 ? clamp(sim_dot(p - collider_a(c), ab) / len2, 0.0, 1.0) : 0.0;
-        closest = collider_a(c) + ab * t;
-        surface = collider_moved_a(c) + (collider_moved_b(c) - collider_moved_a(c)) * t;
-    }
+    precise float t = sim_collider_t(c, p);
+    precise vec3 closest = sim_collider_point(c, t);
+    precise vec3 surface = collider_moved_a(c) + (collider_moved_b(c) - collider_moved_a(c)) * t;
     precise vec3 d = p - closest;
     precise float dist = sqrt(sim_dot(d, d));
     precise float contact = (collider_radius(c) + radius) + radius;

@@ -98,15 +98,32 @@ impl<'a> MeshField<'a> {
     }
 }
 
-fn collide(c: &ColliderShape, p: Vec3, radius: f32) -> Vec3 {
-    let a = c.a;
-    let mut closest = a;
-    if c.is_capsule() {
-        let ab = c.b - a;
-        let len2 = dot(ab, ab);
-        let t = if len2 > 0.0 { (dot(p - a, ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
-        closest = a + ab * t;
+/// `sim_collider_t`.
+fn collider_t(c: &ColliderShape, p: Vec3) -> f32 {
+    if !c.is_capsule() {
+        return 0.0;
     }
+    let ab = c.b - c.a;
+    let len2 = dot(ab, ab);
+    if len2 > 0.0 {
+        (dot(p - c.a, ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+/// `sim_collider_point`.
+fn collider_point(c: &ColliderShape, t: f32) -> Vec3 {
+    if c.is_capsule() {
+        c.a + (c.b - c.a) * t
+    } else {
+        c.a
+    }
+}
+
+/// `sim_collide`.
+fn collide(c: &ColliderShape, p: Vec3, radius: f32) -> Vec3 {
+    let closest = collider_point(c, collider_t(c, p));
     let d = p - closest;
     let dist = dot(d, d).sqrt();
     let reach = c.radius + radius;
@@ -120,15 +137,9 @@ fn collide(c: &ColliderShape, p: Vec3, radius: f32) -> Vec3 {
 /// `sim_collider_friction`.
 pub(super) fn collider_friction(c: &ColliderShape, p: Vec3, v: Vec3, radius: f32, dt: f32) -> Vec3 {
     let friction = c.friction;
-    let mut closest = c.a;
-    let mut surface = c.moved_a;
-    if c.is_capsule() {
-        let ab = c.b - c.a;
-        let len2 = dot(ab, ab);
-        let t = if len2 > 0.0 { (dot(p - c.a, ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
-        closest = c.a + ab * t;
-        surface = c.moved_a + (c.moved_b - c.moved_a) * t;
-    }
+    let t = collider_t(c, p);
+    let closest = collider_point(c, t);
+    let surface = c.moved_a + (c.moved_b - c.moved_a) * t;
     let d = p - closest;
     let dist = dot(d, d).sqrt();
     let contact = (c.radius + radius) + radius;
