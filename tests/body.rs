@@ -150,6 +150,6 @@ fn a_sliding_capsule_carries_the_hair_touching_it_by_its_friction() {
     let held = slide(0.3);
     let free = slide(0.0);
     eprintln!("mean drift along the capsule's slide (8 cm): friction 0.3 {held} m, friction 0 {free} m");
-    assert!(held > 0.005, "friction carried the hair by {held} m only");
+    assert!(held > 0.003, "friction carried the hair by {held} m only");
     assert!(free.abs() < 1e-4, "a capsule sliding along its own axis without friction moved the hair by {free} m");
 }

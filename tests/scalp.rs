@@ -109,9 +109,10 @@ fn params() -> SimParams {
 
 /// Steps the GPU through the bone path and the CPU reference side by side,
 /// with a level of detail, a teleport and a reset, and checks that they agree
-/// bit for bit after every step.
+/// after every step (bit for bit on lavapipe; elsewhere within one step's
+/// reference tolerance, `common::agree`).
 #[test]
-fn gpu_and_cpu_agree_bit_for_bit_on_a_skinned_scalp() {
+fn gpu_and_cpu_agree_on_a_skinned_scalp() {
     let gpu_ctx = Gpu::new();
     let ctx = gpu_ctx.ctx();
     let (scalp, p) = (scalp(), params());
@@ -143,7 +144,7 @@ fn gpu_and_cpu_agree_bit_for_bit_on_a_skinned_scalp() {
         cpu.step(&head_of(&b)).expect("cpu step");
         let state = gpu.read_state().expect("readback");
         assert!(state.positions.iter().all(|x| x.is_finite()), "step {step}: non-finite state");
-        assert_eq!(bits(&state), bits(cpu.state()), "step {step}: GPU and CPU apart");
+        common::agree(ctx, &state, &mut cpu, p.dt, &format!("step {step}"));
     }
 }
 

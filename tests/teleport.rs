@@ -32,10 +32,7 @@ fn swung(ctx: &GpuContext, params: &SimParams) -> (HairSim, CpuHairSim, RigidTra
     let colliders = motion::thesis_colliders();
     gpu.set_colliders(&colliders).expect("colliders");
     cpu.set_colliders(&colliders).expect("colliders");
-    gpu.run(SWING, |i| shaking(i, params), None).expect("swing");
-    for i in 0..SWING {
-        cpu.step(&shaking(i, params)).expect("cpu swing");
-    }
+    common::run_both(ctx, (&mut gpu, &mut cpu), 0..SWING, |i| shaking(i, params), "swing");
     (gpu, cpu, shaking(SWING - 1, params))
 }
 
@@ -47,11 +44,7 @@ fn hold(ctx: &GpuContext, gpu: &mut HairSim, cpu: &mut CpuHairSim, head: &RigidT
         gpu.run(1, |_| *head, None).expect("step");
         cpu.step(head).expect("cpu step");
         let state = gpu.read_state().expect("readback");
-        let apart = state.step_difference(cpu.state(), gpu.params().dt);
-        assert!(apart <= REFERENCE_STEP_TOLERANCE_M, "GPU and CPU apart by {apart} m after the cut");
-        if common::on_lavapipe(ctx) {
-            assert!(common::bits(&state) == common::bits(cpu.state()), "not bit for bit on lavapipe");
-        }
+        common::agree(ctx, &state, cpu, gpu.params().dt, "after the cut");
         energy.push(state.kinetic_energy());
     }
     (energy, gpu.read_state().expect("readback"))

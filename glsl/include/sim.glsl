@@ -140,10 +140,11 @@ vec3 sim_rotate(mat4 m, vec3 v) {
 }
 
 // Friction against one collider, on the velocity: a particle at p (its pearl
-// `radius`) within its own radius of touching the surface loses the fraction
-// collider_friction(c) of its velocity v along the surface relative to the
+// `radius`) touching the surface loses the fraction collider_friction(c) of
+// its velocity v along the surface relative to the
 // surface's own (collider_moved_a/b over the sub-step of `dt` seconds, blended
-// along a capsule), so a moving body carries the hair resting on it; the
+// along a capsule), less in proportion up to a pearl radius off the surface
+// and none beyond, so a moving body carries the hair resting on it; the
 // positions, and so the constraints and the non-penetration the solve left,
 // are untouched. Twin: `collider_friction` in src/sim/reference/bodies.rs.
 vec3 sim_collider_friction(Collider c, vec3 p, vec3 v, float radius, float dt) {
@@ -153,14 +154,18 @@ vec3 sim_collider_friction(Collider c, vec3 p, vec3 v, float radius, float dt) {
     precise vec3 surface = collider_moved_a(c) + (collider_moved_b(c) - collider_moved_a(c)) * t;
     precise vec3 d = p - closest;
     precise float dist = sqrt(sim_dot(d, d));
-    precise float contact = (collider_radius(c) + radius) + radius;
+    precise float reach = collider_radius(c) + radius;
+    precise float contact = reach + radius;
     if (!(dist < contact) || !(dist > 0.0) || !(friction > 0.0)) {
         return v;
     }
+    // Whole at the surface, fading to none a pearl radius off it: the velocity
+    // does not jump where contact begins.
+    precise float share = dist > reach ? (contact - dist) / radius : 1.0;
     precise vec3 n = d / dist;
     precise vec3 relative = v - surface / dt;
     precise vec3 along = relative - n * sim_dot(n, relative);
-    precise vec3 held = v - along * friction;
+    precise vec3 held = v - along * (friction * share);
     return held;
 }
 

@@ -219,6 +219,21 @@ impl CpuHairSim {
         &self.state
     }
 
+    /// Replaces the positions and velocities (as [`HairSim::write_state`](super::HairSim::write_state)):
+    /// the reference then continues from another simulation's state, e.g. the
+    /// GPU's, to compare one step at a time. Refuses a state of another size.
+    pub fn write_state(&mut self, state: &SimState) -> Result<()> {
+        if (state.strands, state.points) != (self.state.strands, self.state.points)
+            || state.positions.len() != self.state.positions.len()
+            || state.velocities.len() != self.state.velocities.len()
+        {
+            return Err(crate::error::Error::incompatible("state", "its size differs from the simulation's"));
+        }
+        self.state.positions.clone_from(&state.positions);
+        self.state.velocities.clone_from(&state.velocities);
+        Ok(())
+    }
+
     /// As [`HairSim::set_simulated_hairs`](super::HairSim::set_simulated_hairs).
     pub fn set_simulated_hairs(&mut self, count: usize) -> Result<()> {
         self.lod.set(count)

@@ -142,16 +142,18 @@ pub(super) fn collider_friction(c: &ColliderShape, p: Vec3, v: Vec3, radius: f32
     let surface = c.moved_a + (c.moved_b - c.moved_a) * t;
     let d = p - closest;
     let dist = dot(d, d).sqrt();
-    let contact = (c.radius + radius) + radius;
+    let reach = c.radius + radius;
+    let contact = reach + radius;
     // Written to treat NaN as the shader does: no contact.
     let touching = dist < contact && dist > 0.0 && friction > 0.0;
     if !touching {
         return v;
     }
+    let share = if dist > reach { (contact - dist) / radius } else { 1.0 };
     let n = d / dist;
     let relative = v - surface / dt;
     let along = relative - n * dot(n, relative);
-    v - along * friction
+    v - along * (friction * share)
 }
 
 /// The bodies a particle collides with: spheres and capsules, and the mesh
