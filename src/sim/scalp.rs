@@ -1,4 +1,5 @@
-//! Roots bound to a skinned scalp ([`HairSim::bind_scalp`](super::HairSim::bind_scalp)):
+//! Roots bound to a skinned scalp ([`HairSim::bind_scalp_source`](super::HairSim::bind_scalp_source),
+//! [`HairSim::bind_scalp_bones`](super::HairSim::bind_scalp_bones)):
 //! each key hair's root is bound to a triangle of a scalp mesh (the triangle
 //! and the root's barycentric weights, found in the bind pose), and every step
 //! places the hair's rest pose by that triangle's frame where the host's
@@ -18,7 +19,7 @@
 //! GPU skinning, from bone matrices that vkhair applies to the scalp's
 //! vertices itself ([`Scalp::skin`], [`HairSim::set_scalp_bones`](super::HairSim::set_scalp_bones)).
 //! `glsl/include/scalp.glsl` runs the frames on the GPU; the CPU reference
-//! ([`scalp_frame`]) runs the same operations.
+//! (`scalp_frame`) runs the same operations.
 
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
@@ -67,7 +68,7 @@ impl Scalp {
         Scalp { mesh, skin: Vec::new(), tolerance: DEFAULT_ROOT_TOLERANCE }
     }
 
-    /// Linear blend skinning of every vertex: Σ wₖ · bones[jₖ] · p (the bone
+    /// Linear blend skinning of every vertex: Σ wₖ · bones\[jₖ\] · p (the bone
     /// matrices map the bind pose, head frame, to the world). Errors name a
     /// bone that is not finite or a joint index past `bones`.
     pub fn skin(&self, bones: &[Mat4]) -> Result<Vec<Vec3>> {
