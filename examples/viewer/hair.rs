@@ -92,15 +92,8 @@ impl Scene {
         let rig = HairRig::new(character, args.animation.as_deref(), args.head_joint.as_deref())
             .map_err(|e| format!("{}: {e}", path.display()))?;
         let (groom, head) = rig.grow(16)?;
-        let m = rig.head_at(0.0).matrix();
         let body = rig.body_at(0.0)?;
-        let origin = m.transform_point3(Vec3::ZERO);
-        let near = body.positions.iter().copied().filter(|p| p.distance(origin) < 0.45);
-        let hair = groom.positions().iter().map(|p| m.transform_point3(*p));
-        let (lo, hi) = hair
-            .chain(near)
-            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
-        let (center, radius) = (0.5 * (lo + hi), 0.5 * (hi - lo).length());
+        let (center, radius) = rig.framing(&groom, &body);
         if !(center.is_finite() && radius.is_finite() && radius > 0.0) {
             return Err(format!("{}: the hair and head span no finite volume", path.display()).into());
         }
@@ -143,9 +136,19 @@ pub struct Hair {
     driver: FixedStepDriver,
     initial: SimState,
     alpha: f32,
-    /// The `--gltf` character, its animation's time (s), the bytes of one
-    /// step's slot of skinned vertices, and each root's point on its mesh.
-    rig: Option<(HairRig, f32, u64, Vec<RootBinding>)>,
+    /// The `--gltf` character the hair rides.
+    rig: Option<Riding>,
+}
+
+/// A `--gltf` character in the simulation.
+struct Riding {
+    rig: HairRig,
+    /// The animation's time at the latest step, seconds.
+    time: f32,
+    /// Bytes of one step's slot of the host's skinned vertices.
+    slot_bytes: u64,
+    /// Each key hair's root on the character's mesh (bind pose).
+    bound: Vec<RootBinding>,
 }
 
 impl Hair {
@@ -179,7 +182,7 @@ impl Hair {
             unsafe { sim.bind_scalp_source(&scalp, &source) }?;
             sim.set_body_colliders(&r.colliders_at(0.0))?;
             let bound = r.bind_roots(&scene.groom, 1e-3)?;
-            rig = Some((r.clone(), 0.0, slot, bound));
+            rig = Some(Riding { rig: r.clone(), time: 0.0, slot_bytes: slot, bound });
         }
         let initial = sim.read_state()?;
         let mut renderer = Renderer::new(ctx, &sim, &config.render)?;
@@ -239,14 +242,16 @@ impl Hair {
                 self.alpha = plan.alpha;
                 plan.steps
             };
-            if let (Some(skin), Some(_)) = (skin, &self.rig) {
-                return self.record_character(cmd, frame, steps, camera, skin);
-            }
-            for _ in 0..steps {
-                self.steps_done += 1;
-                let t = self.steps_done as f32 * self.config.sim.dt;
-                let head = if self.moving { motion::reference_motion(t) } else { RigidTransform::default() };
-                self.sim.record_step(cmd, &head, Some(&mut self.profiler))?;
+            match skin {
+                Some(skin) if self.rig.is_some() => self.record_character_steps(cmd, frame, steps, skin)?,
+                _ => {
+                    for _ in 0..steps {
+                        self.steps_done += 1;
+                        let t = self.steps_done as f32 * self.config.sim.dt;
+                        let head = if self.moving { motion::reference_motion(t) } else { RigidTransform::default() };
+                        self.sim.record_step(cmd, &head, Some(&mut self.profiler))?;
+                    }
+                }
             }
             let key_hairs = self.sim.key_hairs().blended(self.alpha)?;
             self.renderer.record_prepare(cmd, key_hairs, Some(camera), Some(&mut self.profiler))?;
@@ -255,23 +260,22 @@ impl Hair {
         Ok(())
     }
 
-    /// [`Hair::record_simulation`] with a character: the host's skinning pass
-    /// for each step's pose and the frame's shown pose, then the steps, each
-    /// reading its slot of skinned vertices, with the character's capsules as
-    /// body colliders and its head joint as the head; the animation plays while
-    /// `moving`.
+    /// The steps of [`Hair::record_simulation`] with a character: the host's
+    /// skinning pass for each step's pose and the frame's shown pose, then the
+    /// steps, each reading its slot of skinned vertices, with the character's
+    /// capsules as body colliders and its head joint as the head; the
+    /// animation plays while `moving`.
     ///
     /// # Safety
     /// As for [`Hair::record_simulation`].
-    unsafe fn record_character(
+    unsafe fn record_character_steps(
         &mut self,
         cmd: vk::CommandBuffer,
         frame: u64,
         steps: u32,
-        camera: &Camera,
         skin: &mut GpuSkin,
     ) -> Result<(), BoxError> {
-        let Some((rig, time, slot, _)) = &mut self.rig else { return Ok(()) };
+        let Some(Riding { rig, time, slot_bytes, .. }) = &mut self.rig else { return Ok(()) };
         let dt = if self.moving { self.config.sim.dt } else { 0.0 };
         let times: Vec<f32> = (1..=steps).map(|k| *time + dt * k as f32).collect();
         *time += dt * steps as f32;
@@ -284,13 +288,10 @@ impl Hair {
             skin.record(cmd, frame_slot, steps);
             for (k, &t) in times.iter().enumerate() {
                 self.steps_done += 1;
-                self.sim.set_scalp_offset(k as u64 * *slot)?;
+                self.sim.set_scalp_offset(k as u64 * *slot_bytes)?;
                 self.sim.set_body_colliders(&rig.colliders_at(t))?;
                 self.sim.record_step(cmd, &rig.head_at(t), Some(&mut self.profiler))?;
             }
-            let key_hairs = self.sim.key_hairs().blended(self.alpha)?;
-            self.renderer.record_prepare(cmd, key_hairs, Some(camera), Some(&mut self.profiler))?;
-            self.renderer.record_shadows(cmd, &self.sim, Some(&mut self.profiler))?;
         }
         Ok(())
     }
@@ -313,7 +314,7 @@ impl Hair {
 
     /// Back to the first state (the device must be idle: the state is uploaded).
     pub fn reset(&mut self) -> Result<(), BoxError> {
-        if let Some((rig, time, ..)) = &mut self.rig {
+        if let Some(Riding { rig, time, .. }) = &mut self.rig {
             // The rest pose where the animation starts again: the hair and its
             // skinned roots start there together (no sweep from the old pose).
             *time = 0.0;
@@ -332,7 +333,7 @@ impl Hair {
     /// largest distance of a key hair's root from its point on the character's
     /// mesh skinned on the CPU at that time (the device must be idle).
     pub fn root_error(&self) -> Result<Option<(f32, f32)>, BoxError> {
-        let Some((rig, time, _, bound)) = &self.rig else { return Ok(None) };
+        let Some(Riding { rig, time, bound, .. }) = &self.rig else { return Ok(None) };
         let skinned = rig.character.skin(&rig.pose(*time));
         Ok(Some((*time, rig.root_error(&self.sim.read_state()?, bound, &skinned))))
     }

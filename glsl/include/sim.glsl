@@ -149,16 +149,18 @@ vec3 sim_rotate(mat4 m, vec3 v) {
 // are untouched. Twin: `collider_friction` in src/sim/reference/bodies.rs.
 vec3 sim_collider_friction(Collider c, vec3 p, vec3 v, float radius, float dt) {
     precise float friction = collider_friction(c);
+    if (!(friction > 0.0)) {
+        return v;
+    }
     precise float t = sim_collider_t(c, p);
-    precise vec3 closest = sim_collider_point(c, t);
-    precise vec3 surface = collider_moved_a(c) + (collider_moved_b(c) - collider_moved_a(c)) * t;
-    precise vec3 d = p - closest;
+    precise vec3 d = p - sim_collider_point(c, t);
     precise float dist = sqrt(sim_dot(d, d));
     precise float reach = collider_radius(c) + radius;
     precise float contact = reach + radius;
-    if (!(dist < contact) || !(dist > 0.0) || !(friction > 0.0)) {
+    if (!(dist < contact) || !(dist > 0.0)) {
         return v;
     }
+    precise vec3 surface = collider_moved_a(c) + (collider_moved_b(c) - collider_moved_a(c)) * t;
     // Whole at the surface, fading to none a pearl radius off it: the velocity
     // does not jump where contact begins.
     precise float share = dist > reach ? (contact - dist) / radius : 1.0;

@@ -93,6 +93,21 @@ impl HairRig {
         self.capsules.iter().map(|c| c.in_world(&self.character, &pose)).collect()
     }
 
+    /// The sphere (centre, radius) a camera frames at the animation's start:
+    /// around `groom` (key hairs in the head's frame) placed by the head then,
+    /// and the vertices of `body` (the character at that time,
+    /// [`HairRig::body_at`]`(0.0)`) within 0.45 m of the head joint.
+    pub fn framing(&self, groom: &Groom, body: &TriMesh) -> (Vec3, f32) {
+        let m = self.head_at(0.0).matrix();
+        let origin = m.transform_point3(Vec3::ZERO);
+        let near = body.positions.iter().copied().filter(|p| p.distance(origin) < 0.45);
+        let hair = groom.positions().iter().map(|p| m.transform_point3(*p));
+        let (lo, hi) = hair
+            .chain(near)
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        (0.5 * (lo + hi), 0.5 * (hi - lo).length())
+    }
+
     /// The character's mesh in the bind pose, in the head's frame (the
     /// groom's), with its skin: the scalp the roots are bound to. Vertex `v` is
     /// the character's vertex `v`, so a host's skinned copy of the character

@@ -99,9 +99,10 @@ pub struct SimParams {
     /// (0..=1). Default: 0.3.
     pub mesh_friction: f32,
     /// Friction against spheres and capsules, head's and body's: the fraction
-    /// of a touching particle's motion along the surface, relative to the
-    /// surface's own motion during the sub-step (a moving shoulder carries the
-    /// hair resting on it), removed per sub-step (0..=1). Default: 0.3.
+    /// of a touching particle's velocity along the surface, relative to the
+    /// surface's own velocity over the sub-step (a moving shoulder carries the
+    /// hair resting on it), removed per sub-step, fading to none a pearl
+    /// radius off the surface (0..=1). Default: 0.3.
     pub collider_friction: f32,
     /// Whether body collisions act (spheres, capsules and the mesh collider).
     /// Default: true.

@@ -137,18 +137,21 @@ fn collide(c: &ColliderShape, p: Vec3, radius: f32) -> Vec3 {
 /// `sim_collider_friction`.
 pub(super) fn collider_friction(c: &ColliderShape, p: Vec3, v: Vec3, radius: f32, dt: f32) -> Vec3 {
     let friction = c.friction;
+    // Written to treat NaN as the shader does: no friction, no contact.
+    let rubs = friction > 0.0;
+    if !rubs {
+        return v;
+    }
     let t = collider_t(c, p);
-    let closest = collider_point(c, t);
-    let surface = c.moved_a + (c.moved_b - c.moved_a) * t;
-    let d = p - closest;
+    let d = p - collider_point(c, t);
     let dist = dot(d, d).sqrt();
     let reach = c.radius + radius;
     let contact = reach + radius;
-    // Written to treat NaN as the shader does: no contact.
-    let touching = dist < contact && dist > 0.0 && friction > 0.0;
+    let touching = dist < contact && dist > 0.0;
     if !touching {
         return v;
     }
+    let surface = c.moved_a + (c.moved_b - c.moved_a) * t;
     let share = if dist > reach { (contact - dist) / radius } else { 1.0 };
     let n = d / dist;
     let relative = v - surface / dt;

@@ -123,12 +123,8 @@ pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
 fn character_scene(ch: CharacterScene, a: &SceneArgs) -> Result<Scene, Error> {
     let (Scaled { groom, thickness }, dense, head_mesh) = character_groom(&ch, &a.input)?;
     let start_head = ch.head_at(0.0);
-    let m = start_head.matrix();
-    let body = ch.body_at(0.0)?;
-    let head = m.transform_point3(Vec3::ZERO);
-    let near: Vec<Vec3> = body.positions.iter().copied().filter(|p| p.distance(head) < 0.45).collect();
-    let hair = groom.positions().iter().map(|p| m.transform_point3(*p));
-    let (center, radius) = bounds_sphere(hair.chain(near.iter().copied()));
+    let head = start_head.matrix().transform_point3(Vec3::ZERO);
+    let (center, radius) = ch.framing(&groom, &ch.body_at(0.0)?);
     let credit =
         a.input.gltf.as_ref().is_some_and(|p| p.to_string_lossy().contains("mannequiny")).then_some(MANNEQUIN_CREDIT);
     let colliders = Vec::new();
