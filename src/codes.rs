@@ -142,6 +142,18 @@ shader_codes! {
         MARSCHNER = 1,
     }
 
+    /// Optional parts of the hair shading (`hair_shading.glsl`) that the
+    /// pipelines which shade are specialised to, as the bits of their
+    /// `SHADING_FEATURES` constant: a CPU device runs both sides of every branch
+    /// it cannot prove uniform, so a frame without them does not pay for them.
+    shading_features = "SHADE_" {
+        /// Marschner shading (else Kajiya-Kay only).
+        MARSCHNER = 1,
+        /// A light whose shadow comes from the density volume (else deep
+        /// opacity maps, or none, only).
+        DENSITY_VOLUME = 1 << 1,
+    }
+
     /// How the interpolation pass lays out its isolines.
     interpolate = "INTERPOLATE_" {
         /// Hairs (isolines) grown per patch instance (at most 64, the least

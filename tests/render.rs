@@ -239,7 +239,7 @@ fn hairs_beyond_one_patch_take_instances() {
 // ---- Drawing -----------------------------------------------------------------
 
 use vkhair::groom::mesh::TriMesh;
-use vkhair::render::{Camera, HairMaterial, Light};
+use vkhair::render::{Camera, HairMaterial, Light, Transparency};
 
 const W: u32 = 160;
 const H: u32 = 120;
@@ -574,25 +574,70 @@ fn marschner_tables_match_the_cpu_and_follow_parameters() {
         eprintln!("{params:?}: largest relative table error {worst:e}");
     }
     // Marschner shading draws, and a new cuticle shift changes what it draws: the
-    // tables are rebuilt (unchanged tables would give the same image).
+    // tables are rebuilt (unchanged tables would give the same image). In the
+    // opaque mode (shaded per fragment) and in the exact one (shaded per vertex
+    // by shade_points.comp): both pipelines are specialised to the frame's
+    // shading features, and one that left Marschner out would draw Kajiya-Kay,
+    // which does not follow the shift.
     s.renderer
         .set_lights(&[Light::Directional { direction: Vec3::new(0.0, -0.4, -1.0), color: Vec3::ONE }])
         .expect("lights");
-    let mut brightness = |alpha: f32| {
-        let material = HairMaterial {
-            shading: vkhair::render::ShadingMode::Marschner,
-            root_color: Vec3::ZERO,
-            tip_color: Vec3::ZERO,
-            marschner: MarschnerParams { alpha, beta: 0.12, ..MarschnerParams::default() },
-            ..HairMaterial::default()
+    for transparency in [Transparency::Off, Transparency::Exact] {
+        let params = RenderParams { transparency, ..s.renderer.params().clone() };
+        s.renderer.set_params(&params).expect("params");
+        let mut brightness = |alpha: f32| {
+            let material = HairMaterial {
+                shading: vkhair::render::ShadingMode::Marschner,
+                root_color: Vec3::ZERO,
+                tip_color: Vec3::ZERO,
+                marschner: MarschnerParams { alpha, beta: 0.12, ..MarschnerParams::default() },
+                ..HairMaterial::default()
+            };
+            s.renderer.set_material(&material).expect("material");
+            hair_pixels(&draw(&gpu, &mut s, None)).iter().map(|p| p.2).sum::<f32>()
         };
-        s.renderer.set_material(&material).expect("material");
-        hair_pixels(&draw(&gpu, &mut s, None)).iter().map(|p| p.2).sum::<f32>()
-    };
-    let (a, b) = (brightness(-0.25), brightness(-0.05));
-    eprintln!("Marschner R-only image brightness: alpha −0.25 → {a:.1}, −0.05 → {b:.1}");
-    assert!(a > 10.0 && b > 1.0, "Marschner shading drew nothing: {a}, {b}");
-    assert!(a > 2.0 * b || b > 2.0 * a, "the R lobe did not follow its shift: {a} vs {b}");
+        let (a, b) = (brightness(-0.25), brightness(-0.05));
+        eprintln!("{transparency:?}: Marschner R-only image brightness: alpha −0.25 → {a:.1}, −0.05 → {b:.1}");
+        assert!(a > 10.0 && b > 1.0, "{transparency:?}: Marschner shading drew nothing: {a}, {b}");
+        assert!(a > 2.0 * b || b > 2.0 * a, "{transparency:?}: the R lobe did not follow its shift: {a} vs {b}");
+    }
+}
+
+/// Hair lit through the simulation's density volume is darker than the same
+/// hair unshadowed, in the opaque mode (shaded per fragment) and the exact one
+/// (shaded per vertex): the draw's pipelines are specialised to the frame's
+/// shadow kinds, and one without the volume lookup would read that light's
+/// shadow from an opacity map that was never drawn.
+#[test]
+fn density_volume_shadows_darken_the_drawn_hair() {
+    use vkhair::render::ShadowCaster;
+    use vkhair::sim::{VolumeMode, VolumeParams};
+    let gpu = Gpu::new();
+    let groom = scenes::thesis().expect("thesis");
+    let volume = VolumeParams { mode: VolumeMode::Friction, friction: 0.0, repulsion: 0.0, ..VolumeParams::default() };
+    let params = SimParams { volume, ..SimParams::default() };
+    let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
+    sim.run(1, |_| RigidTransform::default(), None).expect("step");
+    let renderer = Renderer::new(gpu.ctx(), &sim, &RenderParams::default()).expect("renderer");
+    let offscreen = Offscreen::new(gpu.ctx(), W, H).expect("offscreen");
+    let mut s = Scene { sim, renderer, offscreen, camera: common::front_camera(1.0, (W, H)) };
+    // Light from above and behind the camera: the hair lower down lies under the
+    // hair above it.
+    let light = Light::Directional { direction: Vec3::new(0.0, -1.0, -0.3), color: Vec3::ONE };
+    s.renderer.set_lights(&[light]).expect("lights");
+    for transparency in [Transparency::Off, Transparency::Exact] {
+        let params = RenderParams { transparency, ..s.renderer.params().clone() };
+        s.renderer.set_params(&params).expect("params");
+        let mut brightness = |casters: Vec<ShadowCaster>| {
+            let shadows = ShadowParams { casters, volume_cross_section: 0.01, ..ShadowParams::default() };
+            s.renderer.set_shadows(&s.sim, &shadows).expect("shadows");
+            hair_pixels(&draw(&gpu, &mut s, None)).iter().map(|p| p.2).sum::<f32>()
+        };
+        let (lit, shadowed) = (brightness(vec![]), brightness(vec![ShadowCaster::density_volume(0)]));
+        eprintln!("{transparency:?}: hair brightness unshadowed {lit:.1}, through the density volume {shadowed:.1}");
+        assert!(lit > 10.0, "{transparency:?}: nothing lit: {lit}");
+        assert!(shadowed < 0.8 * lit, "{transparency:?}: the density volume did not shadow: {shadowed} vs {lit}");
+    }
 }
 
 #[test]

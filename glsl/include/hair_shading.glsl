@@ -15,6 +15,17 @@ layout(std430, set = 0, binding = 8) readonly buffer Transmittance { float volum
 #include "shadow.glsl"
 
 layout(std140, set = 0, binding = 0) uniform Draw { DrawParams dp; };
+
+// The optional parts of the shading this pipeline runs (codes::shading_features,
+// SHADE_* bits; all by default): a CPU device runs both sides of every branch
+// it cannot prove uniform, so a pipeline is specialised to the frame's model
+// and shadow kinds (DrawFrame::features). Specialisation constant
+// SHADING_FEATURES_ID, 0 unless the including shader uses 0 for another
+// constant and defines it first.
+#ifndef SHADING_FEATURES_ID
+#define SHADING_FEATURES_ID 0
+#endif
+layout(constant_id = SHADING_FEATURES_ID) const uint SHADING_FEATURES = 0xFFFFFFFFu;
 // Per hair its own albedo at the root (2·hair) and the tip (2·hair + 1), read
 // when dp.widths.w is 1 (render::Followers' colours).
 layout(std430, set = 0, binding = 24) readonly buffer HairLooks { vec4 hair_looks[]; };
@@ -34,7 +45,7 @@ float shadow(vec3 p, uint light) {
     if (map >= sp.counts.z) {
         return 1.0;
     }
-    if (uint(sp.maps[map].params.z) == SHADOW_DENSITY_VOLUME) {
+    if ((SHADING_FEATURES & SHADE_DENSITY_VOLUME) != 0u && uint(sp.maps[map].params.z) == SHADOW_DENSITY_VOLUME) {
         return shadow_volume_lookup(sp, sp.maps[map], p);
     }
     return shadow_transmittance(shadow_atlas, sp.maps[map], p);
@@ -81,7 +92,7 @@ vec3 shade_hair(vec3 pos, vec3 tangent, float t_along, uint hair) {
             }
         }
         vec3 radiance = light.color_range.rgb * falloff * shadow(pos, i);
-        if (dp.counts.w == SHADING_MARSCHNER) {
+        if ((SHADING_FEATURES & SHADE_MARSCHNER) != 0u && dp.counts.w == SHADING_MARSCHNER) {
             // Marschner: S = M_R N_R + (M_TT N_TT + M_TRT N_TRT), the transmitted
             // paths tinted by the hair's albedo, times cos θi.
             float sin_i = dot(l, t);

@@ -6,6 +6,8 @@
 // premultiplied, alpha, absorbance −ln(1 − alpha); additive blending), which the
 // resolve folds into the order-independent tail: nothing is lost. Early tests:
 // the depth test runs before the stores.
+// Constant 0 is the pool's buffer count (oit.glsl); this stage shades nothing.
+#define SHADING_FEATURES_ID 1
 #include "hair_shading.glsl"
 #include "oit.glsl"
 

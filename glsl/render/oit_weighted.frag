@@ -3,6 +3,8 @@
 // every hair fragment adds its weighted premultiplied colour and weight to
 // attachment 0 and its absorbance −ln(1 − alpha) to attachment 1; the resolve
 // turns the sums into colour and total opacity. Nearer fragments weigh more.
+// Constant 0 is the pool's buffer count (oit.glsl); this stage shades nothing.
+#define SHADING_FEATURES_ID 1
 #include "hair_shading.glsl"
 #include "oit.glsl"
 

@@ -33,7 +33,8 @@ pub use exact::OitPool;
 pub use transparent::OitStats;
 
 use super::marschner::MarschnerParams;
-use super::shading::{Camera, HairMaterial, MAX_LIGHTS};
+use super::shading::{Camera, HairMaterial, ShadingMode, MAX_LIGHTS};
+use super::shadow::ShadowParams;
 use super::{OitParams, Primitive, RenderTarget, Renderer, Transparency};
 use crate::error::{Error, Result};
 use crate::gpu_types::{DrawParams, GpuLight};
@@ -118,6 +119,10 @@ pub(super) struct DrawFrame<'a> {
     /// Vertices of the frame's hairs: six per segment (two triangles) for
     /// ribbons, two for lines.
     pub vertices: u32,
+    /// The optional parts of the shading the frame needs
+    /// ([`crate::codes::shading_features`]): the shading pipelines are
+    /// specialised to them.
+    pub features: u32,
 }
 
 /// Pass 4: the shading every mode shares, the opaque pipelines and the
@@ -285,6 +290,7 @@ impl Renderer {
                 self.interpolate.looks().1,
             ),
             vertices: self.draw_vertices(),
+            features: shading_features(&self.material, self.shadows.params()),
             target: drawn,
             inputs: DrawInputs {
                 hairs: self.interpolate.hairs(),
@@ -366,6 +372,15 @@ pub(super) struct StrandFootprint {
     pub hairs: f32,
     /// Spacing of the drawn strands at the root and at the tip, m.
     pub spacing: (f32, f32),
+}
+
+/// The optional parts of the shading ([`crate::codes::shading_features`]) a
+/// frame with `material` and `shadows` runs.
+fn shading_features(material: &HairMaterial, shadows: &ShadowParams) -> u32 {
+    use crate::codes::shading_features::{DENSITY_VOLUME, MARSCHNER};
+    let marschner = if material.shading == ShadingMode::Marschner { MARSCHNER } else { 0 };
+    let volume = if shadows.volume_casters() > 0 { DENSITY_VOLUME } else { 0 };
+    marschner | volume
 }
 
 /// `params` for hairs drawn in their own albedo (`own`) or the material's.

@@ -6,7 +6,9 @@
 //! ribbons are drawn twice in one rendering instance: first depth only (no
 //! fragment stage), then shaded with depth writes off and the depth test
 //! passing only fragments at the nearest depth, so that hidden layers of hair
-//! are not shaded. Pipelines are made on first use for each [`TargetKey`].
+//! are not shaded. Pipelines are made on first use for each [`TargetKey`] and
+//! set of shading features (the shading stage is specialised to them,
+//! [`DrawFrame::features`]).
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -32,7 +34,7 @@ struct Pipelines {
 /// The opaque draw's pipelines per target.
 pub(super) struct OpaquePipelines {
     device: Arc<Device>,
-    pipelines: HashMap<TargetKey, Pipelines>,
+    pipelines: HashMap<(TargetKey, u32), Pipelines>,
 }
 
 impl OpaquePipelines {
@@ -46,10 +48,11 @@ impl OpaquePipelines {
         self.pipelines.clear();
     }
 
-    /// Makes the pipelines and descriptor sets for `frame`'s target on first use.
+    /// Makes the pipelines and descriptor sets for `frame`'s target and shading
+    /// features on first use.
     fn make(&mut self, frame: &DrawFrame<'_>, shading: &ShadingResources) -> Result<()> {
         let key = frame.target.key;
-        if self.pipelines.contains_key(&key) {
+        if self.pipelines.contains_key(&(key, frame.features)) {
             return Ok(());
         }
         let (buffers, images) = shading.bindings(&frame.inputs);
@@ -87,9 +90,10 @@ impl OpaquePipelines {
         } else {
             None
         };
-        let pipeline = GraphicsPipeline::new(&self.device, &desc("vkhair hair draw", stages, false, Blend::None), 1)?;
+        let shade_desc = desc("vkhair hair draw", stages, false, Blend::None);
+        let pipeline = GraphicsPipeline::specialised(&self.device, &shade_desc, 1, Some(frame.features))?;
         let set = pipeline.resource_set(0, &buffers, &images)?;
-        self.pipelines.insert(key, Pipelines { depth, shade: (pipeline, set) });
+        self.pipelines.insert((key, frame.features), Pipelines { depth, shade: (pipeline, set) });
         Ok(())
     }
 
@@ -110,7 +114,7 @@ impl OpaquePipelines {
         unsafe {
             let scope = RenderPass::Draw.open(d, cmd, frame.timing);
             shading.record_updates(cmd, &target.before, &frame.params, &frame.marschner);
-            let pipelines = &self.pipelines[&target.key];
+            let pipelines = &self.pipelines[&(target.key, frame.features)];
             d.raw.cmd_begin_rendering(cmd, &info);
             d.cmd_set_full_viewport(cmd, target.extent);
             // Within one rendering instance, rasterization order puts the depth

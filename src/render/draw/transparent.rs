@@ -240,7 +240,8 @@ impl TransparentPass {
     }
 
     /// Makes the pipelines for `frame`'s target on first use, bound to the
-    /// shading inputs and the current resources.
+    /// shading inputs and the current resources, and the vertex shading's
+    /// variant for the frame's shading features.
     fn make_pipelines(
         &mut self,
         frame: &DrawFrame<'_>,
@@ -251,8 +252,8 @@ impl TransparentPass {
             return Err(Error::incompatible("transparency", "pipelines requested before the resources"));
         };
         let key = frame.target.key;
-        if res.pipelines.contains_key(&(key, shaders.composite.name)) {
-            return Ok(());
+        if let Some(made) = res.pipelines.get_mut(&(key, shaders.composite.name)) {
+            return made.points.0.prepare_variant(frame.features);
         }
         let d = &self.device;
         let has_depth = key.depth != vk::Format::UNDEFINED;
@@ -281,7 +282,8 @@ impl TransparentPass {
 
         // The pool's buffer count specialises the list shaders (oit.glsl).
         let pool_buffers = res.lists.as_ref().map(|lists| lists.pool.buffers);
-        let points = ComputePipeline::new(d, &RENDER_SHADE_POINTS_COMP, 1)?;
+        let mut points = ComputePipeline::new(d, &RENDER_SHADE_POINTS_COMP, 1)?;
+        points.prepare_variant(frame.features)?;
         let points_set = points.declared_resource_set(0, &buffers, &shading_images)?;
         let build_stages = [&RENDER_RIBBON_VERT_COVERAGE, shaders.build];
         let build = GraphicsPipeline::specialised(
@@ -415,7 +417,7 @@ impl TransparentPass {
             let scope = RenderPass::Draw.open(d, cmd, timing);
             shading.record_updates(cmd, &target.before, &frame.params, &frame.marschner);
             d.cmd_barrier(cmd, &[to_clear, to_shade], &[], &to_sums);
-            pipelines.points.0.bind(cmd, &[pipelines.points.1]);
+            pipelines.points.0.bind_variant(cmd, frame.features, &[pipelines.points.1]);
             // At most 65,535 workgroups (every device's limit); the shader loops over the rest.
             let per_group = pipelines.points.0.workgroup_size()[0];
             let threads = hairs.saturating_mul(per_hair).min(MAX_WORKGROUPS.saturating_mul(per_group));
