@@ -585,6 +585,10 @@ fn marschner_tables_match_the_cpu_and_follow_parameters() {
     for transparency in [Transparency::Off, Transparency::Exact] {
         let params = RenderParams { transparency, ..s.renderer.params().clone() };
         s.renderer.set_params(&params).expect("params");
+        // A Kajiya-Kay frame first: its pipelines exist when the material turns
+        // to Marschner, which must not reuse them.
+        s.renderer.set_material(&HairMaterial::default()).expect("material");
+        draw(&gpu, &mut s, None);
         let mut brightness = |alpha: f32| {
             let material = HairMaterial {
                 shading: vkhair::render::ShadingMode::Marschner,

@@ -1,5 +1,7 @@
-// The draw pass's shading, shared by the opaque draw (draw.frag) and the
-// transparent fragment store (oit_build.frag): Kajiya-Kay diffuse (wrapped
+// The draw pass's shading, shared by the opaque draw (draw.frag, per fragment)
+// and the transparent modes' vertex shading (shade_points.comp); the list and
+// weighted stages include it for the uniform block and strand_alpha only.
+// Kajiya-Kay diffuse (wrapped
 // toward the viewer's side so the unlit side of the head is darker) and two
 // specular highlights from tangents shifted along the strand normal
 // (Scheuermann): the primary one in the light's color, the secondary one tinted
