@@ -72,12 +72,9 @@ impl Scene {
                 (groom, head, args.obj.is_some(), Vec::new())
             }
         };
-        let (lo, hi) = groom
-            .positions()
-            .iter()
-            .chain(&head.positions)
-            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-        let (center, radius) = (0.5 * (lo + hi), 0.5 * (hi - lo).length());
+        let bounds = vkhair::groom::bounding_box(groom.positions().iter().chain(&head.positions).copied());
+        let (center, radius) = vkhair::groom::bounding_sphere(bounds);
+        let lo = bounds.0;
         if !(center.is_finite() && radius.is_finite() && radius > 0.0) {
             return Err(format!("the groom and mesh span no finite volume (radius {radius})").into());
         }

@@ -102,10 +102,7 @@ impl HairRig {
         let origin = m.transform_point3(Vec3::ZERO);
         let near = body.positions.iter().copied().filter(|p| p.distance(origin) < 0.45);
         let hair = groom.positions().iter().map(|p| m.transform_point3(*p));
-        let (lo, hi) = hair
-            .chain(near)
-            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
-        (0.5 * (lo + hi), 0.5 * (hi - lo).length())
+        crate::groom::bounding_sphere(crate::groom::bounding_box(hair.chain(near)))
     }
 
     /// The character's mesh in the bind pose, in the head's frame (the

@@ -118,9 +118,7 @@ impl TriMesh {
 
     /// Axis-aligned bounding box (min, max).
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.positions
-            .iter()
-            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+        super::bounding_box(self.positions.iter().copied())
     }
 
     /// Corners of triangle `i`.

@@ -58,6 +58,20 @@ pub const MAX_POINTS_PER_STRAND: usize = 1 << 16;
 /// as zero-length (scale-free, so it works for meters and for Blender units alike).
 pub const MIN_SEGMENT_FRACTION: f32 = 1e-6;
 
+/// The axis-aligned bounding box (min, max) of `points`; (+∞, −∞) for none.
+pub fn bounding_box(points: impl IntoIterator<Item = Vec3>) -> (Vec3, Vec3) {
+    points
+        .into_iter()
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)))
+}
+
+/// The sphere around the bounding box (min, max) `bounds` ([`bounding_box`]),
+/// which the tools and the viewer frame a camera by: its centre and half its
+/// diagonal.
+pub fn bounding_sphere((lo, hi): (Vec3, Vec3)) -> (Vec3, f32) {
+    (0.5 * (lo + hi), 0.5 * (hi - lo).length())
+}
+
 /// The bounding box `lo..hi` of finite points: its diagonal must be finite for
 /// lengths relative to it (zero-length segments) to mean anything.
 fn check_extent(lo: Vec3, hi: Vec3) -> Result<()> {
@@ -288,9 +302,7 @@ impl Groom {
 
     /// Axis-aligned bounding box (min, max).
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.positions
-            .iter()
-            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+        bounding_box(self.positions.iter().copied())
     }
 
     /// Length of strand `i` along its segments.

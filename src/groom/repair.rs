@@ -148,10 +148,7 @@ impl Groom {
         if strands.is_empty() {
             return Err(Error::NothingLeft { repairs: repairs.to_string() });
         }
-        let (lo, hi) = strands
-            .iter()
-            .flat_map(|(_, r)| positions[r.clone()].iter())
-            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let (lo, hi) = super::bounding_box(strands.iter().flat_map(|(_, r)| positions[r.clone()].iter().copied()));
         super::check_extent(lo, hi)?;
         let min_segment = (hi - lo).length() * MIN_SEGMENT_FRACTION;
         let mut counts = Vec::with_capacity(strands.len());

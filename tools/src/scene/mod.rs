@@ -52,13 +52,6 @@ pub struct Scene {
 /// The credit line of the shared character.
 const MANNEQUIN_CREDIT: &str = "\"Mannequiny\" by Luciano Muñoz / GDQuest and contributors (CC BY 4.0)";
 
-/// The sphere around a set of points: centre of the box and half its diagonal.
-fn bounds_sphere(points: impl Iterator<Item = Vec3>) -> (Vec3, f32) {
-    let (lo, hi) =
-        points.fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
-    (0.5 * (lo + hi), 0.5 * (hi - lo).length())
-}
-
 /// The scene of `a`'s flags.
 pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
     if let Some(ch) = character::load(&a.input)? {
@@ -95,7 +88,9 @@ pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
         }
     };
     let drawn = dense.as_ref().map_or(&groom, |d| &d.groom);
-    let (center, radius) = bounds_sphere(drawn.positions().iter().chain(&head_mesh.positions).copied());
+    let (center, radius) = vkhair::groom::bounding_sphere(vkhair::groom::bounding_box(
+        drawn.positions().iter().chain(&head_mesh.positions).copied(),
+    ));
     if !(center.is_finite() && radius.is_finite() && radius > 0.0) {
         return Err(format!("the groom and mesh span no finite volume (bounding radius {radius})").into());
     }
