@@ -10,6 +10,7 @@
 //! set of shading features (the shading stage is specialised to them,
 //! [`DrawFrame::features`]).
 
+use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -25,16 +26,17 @@ use crate::vk::shaders::{ShaderSource, RENDER_DRAW_FRAG, RENDER_DRAW_VERT, RENDE
 use ash::vk;
 
 /// The pipelines of one target: the depth pre-pass (targets with a depth image)
-/// and the shading draw, each with its descriptor set.
+/// and the shading draw per set of shading features (only the fragment stage
+/// differs), each with its descriptor set.
 struct Pipelines {
     depth: Option<(GraphicsPipeline, vk::DescriptorSet)>,
-    shade: (GraphicsPipeline, vk::DescriptorSet),
+    shade: HashMap<u32, (GraphicsPipeline, vk::DescriptorSet)>,
 }
 
 /// The opaque draw's pipelines per target.
 pub(super) struct OpaquePipelines {
     device: Arc<Device>,
-    pipelines: HashMap<(TargetKey, u32), Pipelines>,
+    pipelines: HashMap<TargetKey, Pipelines>,
 }
 
 impl OpaquePipelines {
@@ -52,7 +54,7 @@ impl OpaquePipelines {
     /// features on first use.
     fn make(&mut self, frame: &DrawFrame<'_>, shading: &ShadingResources) -> Result<()> {
         let key = frame.target.key;
-        if self.pipelines.contains_key(&(key, frame.features)) {
+        if self.pipelines.get(&key).is_some_and(|p| p.shade.contains_key(&frame.features)) {
             return Ok(());
         }
         let (buffers, images) = shading.bindings(&frame.inputs);
@@ -81,19 +83,25 @@ impl OpaquePipelines {
         };
         // The geometry is the same in both: only the hair positions (bindings 1
         // and 2) and the uniform block.
-        let depth = if has_depth {
-            let geometry = &stages[..stages.len() - 1];
-            let pipeline =
-                GraphicsPipeline::new(&self.device, &desc("vkhair hair depth", geometry, true, Blend::NoColor), 1)?;
-            let set = pipeline.resource_set(0, &buffers[..3], &[])?;
-            Some((pipeline, set))
-        } else {
-            None
+        let made = match self.pipelines.entry(key) {
+            Entry::Occupied(made) => made.into_mut(),
+            Entry::Vacant(slot) => {
+                let depth = if has_depth {
+                    let geometry = &stages[..stages.len() - 1];
+                    let depth_desc = desc("vkhair hair depth", geometry, true, Blend::NoColor);
+                    let pipeline = GraphicsPipeline::new(&self.device, &depth_desc, 1)?;
+                    let set = pipeline.resource_set(0, &buffers[..3], &[])?;
+                    Some((pipeline, set))
+                } else {
+                    None
+                };
+                slot.insert(Pipelines { depth, shade: HashMap::new() })
+            }
         };
         let shade_desc = desc("vkhair hair draw", stages, false, Blend::None);
         let pipeline = GraphicsPipeline::specialised(&self.device, &shade_desc, 1, Some(frame.features))?;
         let set = pipeline.resource_set(0, &buffers, &images)?;
-        self.pipelines.insert((key, frame.features), Pipelines { depth, shade: (pipeline, set) });
+        made.shade.insert(frame.features, (pipeline, set));
         Ok(())
     }
 
@@ -114,12 +122,13 @@ impl OpaquePipelines {
         unsafe {
             let scope = RenderPass::Draw.open(d, cmd, frame.timing);
             shading.record_updates(cmd, &target.before, &frame.params, &frame.marschner);
-            let pipelines = &self.pipelines[&(target.key, frame.features)];
+            let pipelines = &self.pipelines[&target.key];
+            let shade = &pipelines.shade[&frame.features];
             d.raw.cmd_begin_rendering(cmd, &info);
             d.cmd_set_full_viewport(cmd, target.extent);
             // Within one rendering instance, rasterization order puts the depth
             // pre-pass's writes before the shading draw's tests.
-            for (pipeline, set) in pipelines.depth.iter().chain([&pipelines.shade]) {
+            for (pipeline, set) in pipelines.depth.iter().chain([shade]) {
                 pipeline.bind(cmd, &[*set]);
                 d.raw.cmd_draw(cmd, frame.vertices, 1, 0, 0);
             }
