@@ -11,14 +11,7 @@ const float OIT_OPAQUE_ALPHA = 0.5;
 // Fragments fainter than this are not stored (1/1024: below an 8-bit step).
 const float OIT_LEAST_ALPHA = 1.0 / 1024.0;
 
-// Per-frame words. Twin: gpu_types::OitCounters.
-layout(std430, set = 0, binding = 9) buffer OitCounters {
-    uint used;       // fragments offered this frame (stored = min(used, capacity))
-    uint capacity;   // nodes in the pool
-    uint width;      // pixels per row of the lists' image
-    uint sorted;     // K: fragments sorted exactly per pixel in the exact mode
-    uint pool_nodes; // nodes per buffer of the pool
-} oit;
+#include "oit_counters.glsl"
 // Per pixel: the newest node of its list (exact mode), OIT_END for none.
 layout(std430, set = 0, binding = 10) buffer OitHeads { uint oit_heads[]; };
 // The node pool, split over up to eight buffers (one binding's range is

@@ -107,6 +107,22 @@ struct DrawParams {
     Light lights[MAX_LIGHTS];
 };
 
+// A transparent strand's band at one of its vertices (reference::strand_band):
+// from the width of one hair there (m), the hairs the strand stands for, the
+// drawn strands' spacing there (m) and the world size of a pixel there (m):
+// x half the drawn ribbon's width (m; the band at least a pixel wide, plus half
+// a pixel each side), y half the band's true width (pixels), z its density, the
+// fraction of the band its hairs at random across it cover. Shared by the
+// ribbons (ribbon.vert) and the rectangle they reach (hair_rect.comp).
+vec3 coverage_band(float hair_width, float hairs, float spacing, float pixel) {
+    float n = max(hairs, 1.0);
+    float spread = (1.0 - 1.0 / n) * spacing;
+    float width = max(n * hair_width, min(spread, float(BAND_MAX_SPREAD) * n * hair_width));
+    float density = width > 0.0 ? 1.0 - pow(max(1.0 - hair_width / width, 0.0), n) : 0.0;
+    float half_true = 0.5 * width / pixel;
+    return vec3((max(half_true, 0.5) + 0.5) * pixel, half_true, density);
+}
+
 // Uniform cubic B-spline basis at u and its derivative (weights of p0..p3).
 void bspline_basis(float u, out vec4 b, out vec4 db) {
     float u2 = u * u;

@@ -1,11 +1,12 @@
 #version 460
-// Exact transparency, resolve (one full-screen triangle): walks the pixel's
-// list, keeps its K nearest fragments sorted by depth (insertion), folds every
-// farther one into an order-independent tail (sum of premultiplied colour, sum
-// of alpha, product of transmittance) together with the fragments the full
-// pool could not store (the build's overflow sums), composites the K front to
-// back and the tail behind them, and blends the result over the target as
-// premultiplied colour. Pixels without hair are discarded.
+// Exact transparency, resolve (over the rectangle the ribbons reach,
+// hair_rect.vert): walks the pixel's list, keeps its K nearest fragments sorted
+// by depth (insertion), folds every farther one into an order-independent tail
+// (sum of premultiplied colour, sum of alpha, product of transmittance)
+// together with the fragments the full pool could not store (the build's
+// overflow sums), composites the K front to back and the tail behind them, and
+// blends the result over the target as premultiplied colour. Pixels without
+// hair are discarded.
 //
 // The kept fragments live in local arrays of SORT_CAPACITY entries (depth and
 // packed half-float colour): the smallest variant that holds K is chosen

@@ -1,7 +1,8 @@
 #version 460
-// Fast transparency, resolve (one full-screen triangle): the weighted average
-// colour of the pixel's hair fragments times their total opacity
-// 1 − exp(−Σ absorbance), blended over the target as premultiplied colour.
+// Fast transparency, resolve (over the rectangle the ribbons reach,
+// hair_rect.vert): the weighted average colour of the pixel's hair fragments
+// times their total opacity 1 − exp(−Σ absorbance), blended over the target as
+// premultiplied colour.
 layout(set = 0, binding = 0) uniform sampler2D weighted_sum;
 layout(set = 0, binding = 1) uniform sampler2D absorbance;
 

@@ -77,14 +77,9 @@ void main() {
     float width = mix(dp.widths.x, dp.widths.y, tan_t.w) * (e == 0u ? hair_pos[first].w : hair_pos[first + 1u].w);
 #ifdef VKHAIR_COVERAGE
     // A transparent strand standing for n hairs: its band (reference::strand_band).
-    float hair_width = width;
-    float n = max(dp.coverage.z, 1.0);
-    float spread = (1.0 - 1.0 / n) * mix(dp.band.x, dp.band.y, tan_t.w);
-    width = max(n * hair_width, min(spread, float(BAND_MAX_SPREAD) * n * hair_width));
-    float density = width > 0.0 ? 1.0 - pow(max(1.0 - hair_width / width, 0.0), n) : 0.0;
     float pixel = max(dp.camera.w * distance_to_camera, 1e-12);
-    float half_true = 0.5 * width / pixel;
-    float half_drawn = (max(half_true, 0.5) + 0.5) * pixel;
+    vec3 band = coverage_band(width, dp.coverage.z, mix(dp.band.x, dp.band.y, tan_t.w), pixel);
+    float half_drawn = band.x;
 #else
     float half_drawn = 0.5 * max(width, dp.widths.z * dp.camera.w * distance_to_camera);
 #endif
@@ -92,7 +87,7 @@ void main() {
     vec3 corner_pos = pos + side * (half_drawn * s);
 #ifdef VKHAIR_COVERAGE
     g_color = point_color[first + e].rgb;
-    g_cover = vec3(half_drawn / pixel * s, half_true, density);
+    g_cover = vec3(half_drawn / pixel * s, band.y, band.z);
 #else
     g_pos = corner_pos;
     g_tan = tan_t.xyz;

@@ -151,8 +151,22 @@ pub(crate) struct OitCounters {
     pub sorted: u32,
     /// Nodes per buffer of the pool (node n is entry n mod this of buffer n / this).
     pub pool_nodes: u32,
+    /// Pixel rows of the target.
+    pub height: u32,
+    /// The pixels the frame's ribbons can reach (`hair_rect.comp`): first
+    /// column, first row (from NDC y = −1), and the column and row past the
+    /// last; `u32::MAX, u32::MAX, 0, 0` before the vertex shading.
+    pub hair_x0: u32,
+    /// See `hair_x0`.
+    pub hair_y0: u32,
+    /// See `hair_x0`.
+    pub hair_x1: u32,
+    /// See `hair_x0`.
+    pub hair_y1: u32,
 }
-gpu_struct!(OitCounters => "OitCounters" { used, capacity, width, sorted, pool_nodes });
+gpu_struct!(OitCounters => "OitCounters" {
+    used, capacity, width, sorted, pool_nodes, height, hair_x0, hair_y0, hair_x1, hair_y1
+});
 
 /// Push constants of the Marschner table builder (`MarschnerPush` in `glsl/include/marschner.glsl`).
 #[repr(C)]

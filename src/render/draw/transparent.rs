@@ -12,10 +12,12 @@
 //!    (exact; beyond the pool, counted and added to the weighted sums instead)
 //!    or added to the weighted sums (fast). Both keep the nearest depth of a
 //!    fragment at least half opaque.
-//! 2. **Composite** ([`RenderPass::Composite`]): one full-screen triangle blends
-//!    each pixel's hair over the target as premultiplied colour, then a second
-//!    one writes that nearest half-opaque depth into the target's depth where
-//!    it is nearer, so later host passes see the hair.
+//!    A second dispatch (`hair_rect.comp`) finds the rectangle of pixels the
+//!    ribbons can reach.
+//! 2. **Composite** ([`RenderPass::Composite`]): over that rectangle (two
+//!    triangles, `hair_rect.vert`), blends each pixel's hair over the target as
+//!    premultiplied colour, then writes that nearest half-opaque depth into the
+//!    target's depth where it is nearer, so later host passes see the hair.
 //!
 //! The pass owns the lists, the accumulation images and their pipelines for the
 //! current extent and mode; when either changes, the old ones are retired and
@@ -43,8 +45,15 @@ use crate::vk::image::Sampler;
 use crate::vk::pipeline::{Blend, ComputePipeline, GraphicsDesc, GraphicsPipeline};
 use crate::vk::rendering;
 use crate::vk::shaders::{
-    ShaderSource, RENDER_OIT_DEPTH_FRAG, RENDER_RESOLVE_VERT, RENDER_RIBBON_VERT_COVERAGE, RENDER_SHADE_POINTS_COMP,
+    ShaderSource, RENDER_HAIR_RECT_COMP, RENDER_HAIR_RECT_VERT, RENDER_OIT_DEPTH_FRAG, RENDER_RIBBON_VERT_COVERAGE,
+    RENDER_SHADE_POINTS_COMP,
 };
+
+/// Reads of the pass's buffers by its stages (the ribbons, the vertex shading,
+/// the build and the composite).
+const READ_BY_ANY: &[AccessKind] = &[AccessKind::VertexRead, AccessKind::ComputeRead, AccessKind::FragmentRead];
+/// Writes to the pass's buffers by its stages.
+const WRITTEN_BY_ANY: &[AccessKind] = &[AccessKind::ComputeWrite, AccessKind::FragmentWrite];
 
 /// Workgroups of a dispatch that every device runs (`maxComputeWorkGroupCount`'s minimum).
 const MAX_WORKGROUPS: u32 = 65_535;
@@ -72,11 +81,17 @@ pub struct OitStats {
     /// more than `capacity` where the device's buffers could not hold them
     /// (see [`OitPool`]).
     pub requested: u64,
+    /// The pixels the composite ran over, `[x0, y0, x1, y1]` (the last column
+    /// and row excluded; rows from the top; pixels of the drawn target, twice
+    /// each side with supersampling): a rectangle holding every pixel the
+    /// hair's ribbons can reach. `None` when no hair was drawn.
+    pub composited: Option<[u32; 4]>,
 }
 
 /// The pipelines of one target and their descriptor sets.
 struct Pipelines {
     points: (ComputePipeline, vk::DescriptorSet),
+    rect: (ComputePipeline, vk::DescriptorSet),
     build: (GraphicsPipeline, vk::DescriptorSet),
     composite: (GraphicsPipeline, vk::DescriptorSet),
     depth: Option<(GraphicsPipeline, vk::DescriptorSet)>,
@@ -185,12 +200,14 @@ impl TransparentPass {
         let bytes = self.counters.mapped()?;
         let counters: OitCounters = bytemuck::pod_read_unaligned(bytes.get(..std::mem::size_of::<OitCounters>())?);
         let stored = counters.used.min(counters.capacity);
+        let rect = [counters.hair_x0, counters.hair_y0, counters.hair_x1, counters.hair_y1];
         Some(OitStats {
             fragments: u64::from(counters.used),
             stored: u64::from(stored),
             overflowed: u64::from(counters.used - stored),
             capacity: u64::from(counters.capacity),
             requested: pool.requested,
+            composited: (rect[0] < rect[2] && rect[1] < rect[3]).then_some(rect),
         })
     }
 }
@@ -285,6 +302,8 @@ impl TransparentPass {
         let mut points = ComputePipeline::new(d, &RENDER_SHADE_POINTS_COMP, 1)?;
         points.prepare_variant(frame.features)?;
         let points_set = points.declared_resource_set(0, &buffers, &shading_images)?;
+        let rect = ComputePipeline::new(d, &RENDER_HAIR_RECT_COMP, 1)?;
+        let rect_set = rect.declared_resource_set(0, &buffers, &[])?;
         let build_stages = [&RENDER_RIBBON_VERT_COVERAGE, shaders.build];
         let build = GraphicsPipeline::specialised(
             d,
@@ -301,7 +320,7 @@ impl TransparentPass {
         )?;
         let build_set = build.declared_resource_set(0, &buffers, &shading_images)?;
 
-        let composite_stages = [&RENDER_RESOLVE_VERT, shaders.composite];
+        let composite_stages = [&RENDER_HAIR_RECT_VERT, shaders.composite];
         let composite = GraphicsPipeline::specialised(
             d,
             &desc(
@@ -323,7 +342,7 @@ impl TransparentPass {
                 d,
                 &desc(
                     "vkhair hair transparency depth",
-                    &[&RENDER_RESOLVE_VERT, &RENDER_OIT_DEPTH_FRAG],
+                    &[&RENDER_HAIR_RECT_VERT, &RENDER_OIT_DEPTH_FRAG],
                     &target_formats,
                     true,
                     true,
@@ -340,6 +359,7 @@ impl TransparentPass {
             (key, shaders.composite.name),
             Pipelines {
                 points: (points, points_set),
+                rect: (rect, rect_set),
                 build: (build, build_set),
                 composite: (composite, composite_set),
                 depth,
@@ -393,18 +413,29 @@ impl TransparentPass {
             width: target.extent.width,
             sorted: params.sorted_fragments,
             pool_nodes: pool.map_or(1, |p| p.nodes_per_buffer as u32),
+            height: target.extent.height,
+            hair_x0: u32::MAX,
+            hair_y0: u32::MAX,
+            hair_x1: 0,
+            hair_y1: 0,
         };
         let storage = &[AccessKind::FragmentRead, AccessKind::FragmentWrite];
-        // The previous frame's composite read the lists (and the host read the counters).
-        let to_clear = barrier::memory(storage, &[AccessKind::TransferWrite]);
+        // The previous frame's passes used the lists and counters (and the host read them).
+        let to_clear = barrier::memory(&[READ_BY_ANY, WRITTEN_BY_ANY].concat(), &[AccessKind::TransferWrite]);
+        let counters_ready =
+            barrier::memory(&[AccessKind::TransferWrite], &[AccessKind::ComputeRead, AccessKind::ComputeWrite]);
         let cleared = barrier::memory(&[AccessKind::TransferWrite], storage);
         let built = barrier::memory(&[AccessKind::FragmentWrite], &[AccessKind::FragmentRead]);
         // The previous frame's ribbons read the colours this frame's dispatch writes.
         let to_shade = barrier::memory(&[AccessKind::VertexRead], &[AccessKind::ComputeWrite]);
-        let shaded = barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::VertexRead]);
+        // The colours and the rectangle to the ribbons, the build and the composite.
+        let shaded = barrier::memory(
+            &[AccessKind::ComputeWrite],
+            &[AccessKind::VertexRead, AccessKind::FragmentRead, AccessKind::FragmentWrite],
+        );
         let (hairs, per_hair) = (frame.params.counts[0], frame.params.counts[1]);
         let depth_order = barrier::memory(barrier::ATTACHMENTS, barrier::ATTACHMENTS);
-        let to_host = barrier::memory(&[AccessKind::FragmentWrite], &[AccessKind::HostRead]);
+        let to_host = barrier::memory(WRITTEN_BY_ANY, &[AccessKind::HostRead]);
         let (to_sums, from_sums) = res.sums.barriers();
         let sums = res.sums.attachments();
         let depth_first = target.depth_attachment();
@@ -417,16 +448,21 @@ impl TransparentPass {
             let scope = RenderPass::Draw.open(d, cmd, timing);
             shading.record_updates(cmd, &target.before, &frame.params, &frame.marschner);
             d.cmd_barrier(cmd, &[to_clear, to_shade], &[], &to_sums);
+            d.raw.cmd_update_buffer(cmd, self.counters.raw(), 0, bytemuck::bytes_of(&counters));
+            d.cmd_barrier(cmd, &[counters_ready], &[], &[]);
             pipelines.points.0.bind_variant(cmd, frame.features, &[pipelines.points.1]);
             // At most 65,535 workgroups (every device's limit); the shader loops over the rest.
             let per_group = pipelines.points.0.workgroup_size()[0];
             let threads = hairs.saturating_mul(per_hair).min(MAX_WORKGROUPS.saturating_mul(per_group));
             pipelines.points.0.dispatch_threads(cmd, [threads, 1, 1]);
+            // The rectangle the ribbons reach: a dispatch of its own (folded into the
+            // shading above, lavapipe's resident memory grew by ~0.4 MB a frame).
+            pipelines.rect.0.bind(cmd, &[pipelines.rect.1]);
+            pipelines.rect.0.dispatch_threads(cmd, [threads, 1, 1]);
             if let Some(lists) = &res.lists {
                 lists.record_clear(d, cmd);
             }
             d.raw.cmd_fill_buffer(cmd, res.opaque.raw(), 0, vk::WHOLE_SIZE, OIT_END);
-            d.raw.cmd_update_buffer(cmd, self.counters.raw(), 0, bytemuck::bytes_of(&counters));
             d.cmd_barrier(cmd, &[cleared, shaded], &[], &[]);
             d.raw.cmd_begin_rendering(cmd, &build_rendering);
             d.cmd_set_full_viewport(cmd, target.extent);
@@ -441,7 +477,7 @@ impl TransparentPass {
             d.cmd_set_full_viewport(cmd, target.extent);
             for (pipeline, set) in [&pipelines.composite].into_iter().chain(&pipelines.depth) {
                 pipeline.bind(cmd, &[*set]);
-                d.raw.cmd_draw(cmd, 3, 1, 0, 0);
+                d.raw.cmd_draw(cmd, 6, 1, 0, 0);
             }
             d.raw.cmd_end_rendering(cmd);
             d.cmd_barrier(cmd, &[to_host], &[], &[]);

@@ -241,6 +241,9 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
             stats.capacity,
             if stats.capacity < stats.requested { format!(" of the {} asked for", stats.requested) } else { String::new() }
         );
+        if let Some([x0, y0, x1, y1]) = stats.composited {
+            say!("composited over {}×{} pixels from ({x0}, {y0}), where the ribbons reach", x1 - x0, y1 - y0);
+        }
     }
     say!("wrote {} frames and contact_sheet.png to {}", a.frames, a.out.display());
     a.profile_out.write(&profile, || {
