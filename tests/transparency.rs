@@ -74,20 +74,31 @@ fn draw(gpu: &Gpu, s: &mut Scene) -> Vec<Vec3> {
 
 /// The exact image of the hairs the renderer drew (read back), by the CPU reference.
 fn reference(s: &Scene, width: f32, opacity: f32) -> Vec<Vec3> {
+    rgb(&reference_bands(s, width, 1.0, s.renderer.strand_spacing(), opacity))
+}
+
+/// The CPU reference's image of the hairs the renderer drew (read back), each
+/// a band standing for `n` hairs `width` m wide whose drawn strands lie
+/// `band_spacing` apart (root, tip): linear RGB over BACKGROUND and hair alpha.
+fn reference_bands(s: &Scene, width: f32, n: f32, band_spacing: (f32, f32), opacity: f32) -> Vec<glam::Vec4> {
     let strands = s.renderer.read_strands().expect("hairs");
     let color = |t: f32| ROOT.lerp(TIP, t);
-    let image = composite_strands(&CompositeScene {
+    composite_strands(&CompositeScene {
         hairs: &strands,
         view_proj: s.camera.projection * s.camera.view,
         camera: s.camera.position(),
         extent: (W, H),
         widths: (width, width),
-        represented_hairs: 1.0,
-        band_spacing: s.renderer.strand_spacing(),
+        represented_hairs: n,
+        band_spacing,
         opacity,
         color: &color,
         background: BACKGROUND,
-    });
+    })
+}
+
+/// The colour of each pixel of a reference image, without its alpha.
+fn rgb(image: &[glam::Vec4]) -> Vec<Vec3> {
     image.iter().map(|p| p.truncate()).collect()
 }
 
@@ -148,25 +159,7 @@ fn sparse_strands_are_drawn_as_bands_spread_to_their_neighbours() {
     let (band, density) = vkhair::render::reference::strand_band(width, n, spacing.0);
     assert!(band > n * width, "the spread is wider than the hairs side by side: {band} vs {}", n * width);
     assert!((density - (1.0 - (1.0 - width / band).powf(n))).abs() < 1e-6);
-    let strands = s.renderer.read_strands().expect("hairs");
-    let color = |t: f32| ROOT.lerp(TIP, t);
-    let reference_with = |band_spacing: (f32, f32)| -> Vec<Vec3> {
-        composite_strands(&CompositeScene {
-            hairs: &strands,
-            view_proj: s.camera.projection * s.camera.view,
-            camera: s.camera.position(),
-            extent: (W, H),
-            widths: (width, width),
-            represented_hairs: n,
-            band_spacing,
-            opacity: OPACITY,
-            color: &color,
-            background: BACKGROUND,
-        })
-        .iter()
-        .map(|p| p.truncate())
-        .collect()
-    };
+    let reference_with = |band_spacing: (f32, f32)| rgb(&reference_bands(&s, width, n, band_spacing, OPACITY));
     let spread = mae(&image, &reference_with(spacing));
     let unspread = mae(&image, &reference_with((0.0, 0.0)));
     println!("error against the spread bands {spread:.2}, against bands n hairs wide {unspread:.2} (8-bit sRGB steps)");
@@ -673,20 +666,7 @@ fn the_composite_covers_every_ribbon_pixel_and_little_more() {
     let image = draw(&gpu, &mut s);
     let stats = s.renderer.transparency_stats().expect("stats of an exact frame");
     let [x0, y0, x1, y1] = stats.composited.expect("a rectangle: hair was drawn");
-    let strands = s.renderer.read_strands().expect("hairs");
-    let color = |t: f32| ROOT.lerp(TIP, t);
-    let truth = composite_strands(&CompositeScene {
-        hairs: &strands,
-        view_proj: s.camera.projection * s.camera.view,
-        camera: s.camera.position(),
-        extent: (W, H),
-        widths: (width, width),
-        represented_hairs: n,
-        band_spacing: s.renderer.strand_spacing(),
-        opacity: OPACITY,
-        color: &color,
-        background: BACKGROUND,
-    });
+    let truth = reference_bands(&s, width, n, s.renderer.strand_spacing(), OPACITY);
     // The reference's hair pixels and their bounds.
     let hair: Vec<(u32, u32)> = (0..W * H).filter(|&i| truth[i as usize].w > 0.0).map(|i| (i % W, i / W)).collect();
     assert!(hair.len() > 500, "only {} hair pixels", hair.len());
@@ -709,8 +689,7 @@ fn the_composite_covers_every_ribbon_pixel_and_little_more() {
     let beyond = [lo.0 - x0, lo.1 - y0, x1 - hi.0, y1 - hi.1];
     assert!(beyond.iter().all(|&b| b <= 8), "the composite reaches {beyond:?} pixels beyond the hair");
     assert!(u64::from((x1 - x0) * (y1 - y0)) < u64::from(W * H) * 3 / 4, "the composite covers most of the target");
-    let truth: Vec<Vec3> = truth.iter().map(|p| p.truncate()).collect();
-    let error = mae(&image, &truth);
+    let error = mae(&image, &rgb(&truth));
     println!("error against the reference {error:.2} (8-bit sRGB steps)");
     // lavapipe: 5.0 to 5.2, as when the composite ran over the whole target
     // (bands this wide overlap at the ribbons' joints, where the reference's

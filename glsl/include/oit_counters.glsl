@@ -1,8 +1,8 @@
 // The transparency passes' per-frame words (render/draw/transparent.rs), in a
 // header of their own for the stages that use no list: hair_rect.comp finds
 // the hair's rectangle, the composite's vertex stage (hair_rect.vert) draws
-// it. Define OIT_COUNTERS_READONLY before including it
-// in a stage that only reads them.
+// it. Define OIT_COUNTERS_READONLY before including it in a stage that only
+// reads them.
 #ifndef VKHAIR_OIT_COUNTERS_GLSL
 #define VKHAIR_OIT_COUNTERS_GLSL
 
