@@ -605,9 +605,10 @@ fn lit_transparent_hair_takes_the_shading_of_opaque_hair() {
 
 /// The composite keeps K fragments in arrays sized by the smallest variant that
 /// holds K (4, 8, 16 or 32): each K just past a variant's size sorts one more
-/// fragment than the one before it (pixels more than an 8-bit step apart where
-/// pixels hold that many), and the error against the reference falls from K = 4
-/// to K = 32.
+/// fragment than the one before it, and a K below its variant's size sorts K,
+/// not the variant's size (pixels more than an 8-bit step apart where pixels
+/// hold that many), and the error against the reference falls from K = 4 to
+/// K = 32, starting low: the order-independent tail keeps the rest.
 #[test]
 fn every_k_sorts_its_k_nearest_fragments() {
     let gpu = Gpu::new();
@@ -637,12 +638,15 @@ fn every_k_sorts_its_k_nearest_fragments() {
         let step = |p: Vec3, q: Vec3| (0..3).map(|i| (to8(p)[i] - to8(q)[i]).abs()).fold(0.0f32, f32::max);
         let differing = x.iter().zip(y).filter(|(p, q)| step(**p, **q) > 1.0).count();
         println!("K {a} → {b}: {differing} pixels differ; error {:.3} → {:.3}", mae(x, &truth), mae(y, &truth));
-        if b - a == 1 {
-            assert!(differing > 20, "K = {b} drew what K = {a} drew: its composite keeps fewer than {b}");
-        }
+        // K just past a variant's size keeps one more than the variant below;
+        // K below a variant's size keeps K, not the variant's size.
+        assert!(differing > 20, "K = {b} drew what K = {a} drew: one of them keeps other than its K");
     }
     let (first, last) = (mae(&images[0].1, &truth), mae(&images[images.len() - 1].1, &truth));
     assert!(last < first, "K = 32 is no nearer the reference than K = 4: {last:.3} against {first:.3}");
+    // The tail stands in for the fragments beyond K: on lavapipe K = 4 is 4.3
+    // steps from the reference (34 with the fragments beyond K dropped).
+    assert!(first < 6.0, "K = 4 is {first:.3} steps from the reference: the tail lost fragments");
 }
 
 /// The composite runs over the rectangle of pixels the ribbons can reach

@@ -1,21 +1,22 @@
 #version 460
 // Exact transparency, resolve (over the rectangle the ribbons reach,
-// hair_rect.vert): walks the pixel's list, keeps its K nearest fragments sorted
-// by depth (insertion), folds every farther one into an order-independent tail
-// (sum of premultiplied colour, sum of alpha, product of transmittance)
-// together with the fragments the full pool could not store (the build's
-// overflow sums), composites the K front to back and the tail behind them, and
-// blends the result over the target as premultiplied colour. Pixels without
-// hair are discarded.
+// hair_rect.vert): walks the pixel's list, keeps its K nearest fragments
+// sorted by depth (one compare-and-swap pass over the kept ones per
+// fragment), folds every farther one into an order-independent tail (sum of
+// premultiplied colour, sum of alpha, product of transmittance) together with
+// the fragments the full pool could not store (the build's overflow sums),
+// composites the K front to back and the tail behind them, and blends the
+// result over the target as premultiplied colour. Pixels without hair are
+// discarded.
 //
 // The kept fragments live in local arrays of SORT_CAPACITY entries (depth and
-// packed half-float colour): the smallest variant that holds K is chosen
-// (exact.rs), since arrays larger than needed cost registers and scratch
-// memory on every pixel (on lavapipe a 32-entry array made the thesis frame
-// 40 % slower at K = 8).
+// packed half-float colour), every pass over them unrolled: the smallest
+// variant that holds K is chosen (exact.rs), since each fragment costs
+// SORT_CAPACITY compare-and-swaps whatever K is.
 // vkhair variant: VKHAIR_SORT_4
 // vkhair variant: VKHAIR_SORT_8
 // vkhair variant: VKHAIR_SORT_16
+#extension GL_EXT_control_flow_attributes : require
 #include "oit.glsl"
 
 #if defined(VKHAIR_SORT_4)
@@ -35,16 +36,27 @@ layout(set = 0, binding = 1) uniform sampler2D overflow_absorbance;
 
 layout(location = 0) out vec4 out_color;
 
+// The depth of an empty slot: beyond every fragment's (depths lie in 0..1).
+const float EMPTY = 2.0;
+
 void main() {
     uint node = oit_heads[oit_pixel(gl_FragCoord)];
     vec4 overflow = texelFetch(overflow_sum, ivec2(gl_FragCoord.xy), 0);
     if (node == OIT_END && overflow.a <= 0.0) {
         discard;
     }
+    // Slot i holds the i-th nearest kept fragment; an empty slot holds depth
+    // EMPTY, beyond every fragment's. Every index below is a constant once the
+    // loops are unrolled: the arrays stay in registers (a dynamically indexed
+    // local array is scratch memory, gathered and scattered per lane on a CPU
+    // device, and cost the resolve about a third of its time on lavapipe).
     float depth[SORT_CAPACITY];
     uvec2 color[SORT_CAPACITY];
+    [[unroll]] for (uint i = 0u; i < SORT_CAPACITY; i++) {
+        depth[i] = EMPTY;
+        color[i] = uvec2(0u);
+    }
     uint k = min(oit.sorted, SORT_CAPACITY);
-    uint n = 0u;
     vec3 tail_sum = overflow.rgb;
     float tail_alpha = overflow.a;
     float tail_transmittance = exp(-texelFetch(overflow_absorbance, ivec2(gl_FragCoord.xy), 0).r);
@@ -53,36 +65,31 @@ void main() {
     for (uint step = 0u; node != OIT_END && step < steps; step++) {
         uvec4 record = oit_load(node);
         node = record.w;
+        // Insertion by one pass over the k slots: the fragment in hand swaps
+        // places with every kept one farther than it, so the slots stay sorted
+        // (fragments at one depth in no set order, as they reach the list in
+        // none) and what is left in hand is the farthest of the k + 1 — the
+        // new fragment or one pushed out — bound for the tail.
         float z = uintBitsToFloat(record.z);
-        if (n == k) {
-            // Full: the farther of this fragment and the farthest kept one goes to the tail.
-            if (k == 0u || z >= depth[n - 1u]) {
-                vec4 c = vec4(unpackHalf2x16(record.x), unpackHalf2x16(record.y));
-                tail_sum += c.rgb * c.a;
-                tail_alpha += c.a;
-                tail_transmittance *= 1.0 - c.a;
-                continue;
-            }
-            uvec2 out_p = color[n - 1u];
-            vec4 out_c = vec4(unpackHalf2x16(out_p.x), unpackHalf2x16(out_p.y));
-            tail_sum += out_c.rgb * out_c.a;
-            tail_alpha += out_c.a;
-            tail_transmittance *= 1.0 - out_c.a;
-            n -= 1u;
+        uvec2 c = record.xy;
+        [[unroll]] for (uint i = 0u; i < SORT_CAPACITY; i++) {
+            bool swap = i < k && z < depth[i];
+            float kept_z = depth[i];
+            uvec2 kept_c = color[i];
+            depth[i] = swap ? z : kept_z;
+            color[i] = swap ? c : kept_c;
+            z = swap ? kept_z : z;
+            c = swap ? kept_c : c;
         }
-        uint i = n;
-        while (i > 0u && depth[i - 1u] > z) {
-            depth[i] = depth[i - 1u];
-            color[i] = color[i - 1u];
-            i -= 1u;
-        }
-        depth[i] = z;
-        color[i] = record.xy;
-        n += 1u;
+        // An empty slot's colour is zero: handed out, it adds nothing.
+        vec4 out_c = vec4(unpackHalf2x16(c.x), unpackHalf2x16(c.y));
+        tail_sum += out_c.rgb * out_c.a;
+        tail_alpha += out_c.a;
+        tail_transmittance *= 1.0 - out_c.a;
     }
     vec3 sum = vec3(0.0);
     float transmittance = 1.0;
-    for (uint i = 0u; i < n; i++) {
+    [[unroll]] for (uint i = 0u; i < SORT_CAPACITY; i++) {
         vec4 c = vec4(unpackHalf2x16(color[i].x), unpackHalf2x16(color[i].y));
         sum += transmittance * c.a * c.rgb;
         transmittance *= 1.0 - c.a;
