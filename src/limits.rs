@@ -39,6 +39,11 @@ pub const SDF_MAX_RESOLUTION: u32 = 256;
 /// Most fragments per pixel the exact transparency mode sorts (its K).
 pub const OIT_MAX_SORTED: u32 = 32;
 
+/// Ribbon segments per instance of the indexed ribbon draw
+/// (`render/draw/ribbons.rs`): their four corners each are numbered within
+/// 16-bit indices.
+pub const RIBBON_CHUNK: u32 = 16_384;
+
 /// Every constant above with the name the shaders see it by.
 #[cfg_attr(not(test), allow(dead_code))] // used by build.rs and the tests
 pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
@@ -53,6 +58,7 @@ pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
     ("ITEM_GROUP", ITEM_GROUP),
     ("SDF_MAX_RESOLUTION", SDF_MAX_RESOLUTION),
     ("OIT_MAX_SORTED", OIT_MAX_SORTED),
+    ("RIBBON_CHUNK", RIBBON_CHUNK),
 ];
 
 /// The lines (1-based) of a shader source that declare a name of `table`

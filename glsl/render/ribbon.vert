@@ -1,7 +1,8 @@
 #version 460
 // Draw pass, vertex stage of ribbons (no vertex buffer, no geometry stage):
-// vertices 6s..6s+5 are the two triangles of segment s of the interpolated
-// hairs (hair-major), a camera-facing ribbon of mix(root width, tip width)
+// vertex 4s + c of instance i is corner c of segment RIBBON_CHUNK × i + s of
+// the interpolated hairs (hair-major), indexed twice by the segment's two
+// triangles (render/draw/ribbons.rs), a camera-facing ribbon of mix(root width, tip width)
 // world units, at least `least width` pixels wide. Each vertex reads both
 // ends of its segment (for the ribbon's direction) and places its corner.
 //
@@ -42,25 +43,16 @@ layout(location = 2) out float g_t;
 layout(location = 3) flat out uint g_hair;
 #endif
 
-// The two triangles of a ribbon, corners 0..5: (end 0, −), (end 0, +),
-// (end 1, −) and (end 0, +), (end 1, +), (end 1, −) — the end of the segment
-// (0 the first, 1 the second) and the side of its centre line.
-uint corner_end(uint c) {
-    return (c == 2u || c >= 4u) ? 1u : 0u;
-}
-
-float corner_side(uint c) {
-    return (c == 1u || c == 3u || c == 4u) ? 1.0 : -1.0;
-}
-
 void main() {
     uint per_hair = dp.counts.y;
     uint segs = per_hair - 1u;
-    uint seg = uint(gl_VertexIndex) / 6u;
-    uint corner = uint(gl_VertexIndex) - seg * 6u;
+    // Corner c = 2 × end + side: the end of the segment (0 the first, 1 the
+    // second) and the side of its centre line (0 −, 1 +).
+    uint corner = uint(gl_VertexIndex) & 3u;
+    uint seg = uint(gl_InstanceIndex) * RIBBON_CHUNK + uint(gl_VertexIndex) / 4u;
     uint hair = seg / segs;
     uint first = hair * per_hair + (seg - hair * segs);
-    uint e = corner_end(corner);
+    uint e = corner >> 1u;
     vec3 p0 = hair_pos[first].xyz;
     vec3 p1 = hair_pos[first + 1u].xyz;
     vec3 pos = e == 0u ? p0 : p1;
@@ -83,7 +75,7 @@ void main() {
 #else
     float half_drawn = 0.5 * max(width, dp.widths.z * dp.camera.w * distance_to_camera);
 #endif
-    float s = corner_side(corner);
+    float s = (corner & 1u) != 0u ? 1.0 : -1.0;
     vec3 corner_pos = pos + side * (half_drawn * s);
 #ifdef VKHAIR_COVERAGE
     g_color = point_color[first + e].rgb;

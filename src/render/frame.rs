@@ -1,7 +1,7 @@
 //! What the latest prepared frame holds: its detail, hair counts and
 //! spacing, and the push constants of the geometry passes.
 
-use super::{Detail, InterpolationMode, Primitive, Renderer};
+use super::{Detail, InterpolationMode, Renderer};
 use crate::gpu_types::{InterpolatePush, SmoothPush};
 
 /// What the latest prepared frame holds.
@@ -82,15 +82,11 @@ impl Renderer {
         self.followers.map_or(0, |f| f.count)
     }
 
-    /// Vertices the draw of the latest prepared frame's hairs takes: six per
-    /// segment for ribbons (two triangles), two for lines.
-    pub(super) fn draw_vertices(&self) -> u32 {
+    /// Segments of the latest prepared frame's hairs: a ribbon (two
+    /// triangles) or a line each.
+    pub(super) fn draw_segments(&self) -> u32 {
         let (hairs, per_hair) = self.hair_counts();
-        let per_segment = match self.params.primitive {
-            Primitive::Ribbons => 6,
-            Primitive::Lines => 2,
-        };
-        hairs * (per_hair - 1) * per_segment
+        hairs * (per_hair - 1)
     }
 
     /// Radius around the rest bounds' centre that the hair can reach.

@@ -22,6 +22,7 @@
 mod exact;
 mod fast;
 mod opaque;
+mod ribbons;
 mod shading;
 mod transparent;
 
@@ -44,6 +45,7 @@ use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::rendering::{self, Load};
 use opaque::OpaquePipelines;
+use ribbons::RibbonIndices;
 use shading::ShadingResources;
 use transparent::TransparentPass;
 
@@ -116,9 +118,8 @@ pub(super) struct DrawFrame<'a> {
     pub params: DrawParams,
     /// The Marschner tables' parameters (rebuilt when they change).
     pub marschner: MarschnerParams,
-    /// Vertices of the frame's hairs: six per segment (two triangles) for
-    /// ribbons, two for lines.
-    pub vertices: u32,
+    /// Segments of the frame's hairs: a ribbon or a line each.
+    pub segments: u32,
     /// The optional parts of the shading the frame needs
     /// ([`crate::codes::shading_features`]): the shading pipelines are
     /// specialised to them.
@@ -129,6 +130,7 @@ pub(super) struct DrawFrame<'a> {
 /// transparency modes' resources.
 pub(super) struct DrawPass {
     shading: ShadingResources,
+    ribbons: RibbonIndices,
     opaque: OpaquePipelines,
     transparent: TransparentPass,
 }
@@ -138,6 +140,7 @@ impl DrawPass {
     pub(super) fn new(device: &Arc<Device>, hair_vertices: u64) -> Result<Self> {
         Ok(DrawPass {
             shading: ShadingResources::new(device)?,
+            ribbons: RibbonIndices::new(device)?,
             opaque: OpaquePipelines::new(device),
             transparent: TransparentPass::new(device, hair_vertices)?,
         })
@@ -163,8 +166,8 @@ impl DrawPass {
         // SAFETY: guaranteed by the caller.
         unsafe {
             match mode {
-                Transparency::Off => self.opaque.record(frame, &mut self.shading),
-                _ => self.transparent.record(frame, mode, oit, &mut self.shading),
+                Transparency::Off => self.opaque.record(frame, &mut self.shading, &self.ribbons),
+                _ => self.transparent.record(frame, mode, oit, &mut self.shading, &self.ribbons),
             }
         }
     }
@@ -289,7 +292,7 @@ impl Renderer {
                 ),
                 self.interpolate.looks().1,
             ),
-            vertices: self.draw_vertices(),
+            segments: self.draw_segments(),
             features: shading_features(&self.material, self.shadows.params()),
             target: drawn,
             inputs: DrawInputs {

@@ -14,6 +14,7 @@ use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 use std::sync::Arc;
 
+use super::ribbons::RibbonIndices;
 use super::shading::ShadingResources;
 use super::{DrawFrame, TargetKey};
 use crate::error::Result;
@@ -106,12 +107,17 @@ impl OpaquePipelines {
     }
 
     /// Records `frame` in the draw's scope: the target's barriers, the shading
-    /// updates and one draw of the frame's line vertices (twice with a depth
-    /// pre-pass).
+    /// updates and one draw of the frame's ribbons or lines (twice with a depth
+    /// pre-pass). Leaves the ribbons' index buffer bound.
     ///
     /// # Safety
     /// As for `DrawPass::record`.
-    pub(super) unsafe fn record(&mut self, frame: &DrawFrame<'_>, shading: &mut ShadingResources) -> Result<()> {
+    pub(super) unsafe fn record(
+        &mut self,
+        frame: &DrawFrame<'_>,
+        shading: &mut ShadingResources,
+        ribbons: &RibbonIndices,
+    ) -> Result<()> {
         // Made (or found) before anything is recorded: a failure leaves `cmd` as it was.
         self.make(frame, shading)?;
         let (d, cmd, target) = (&*self.device, frame.cmd, &frame.target);
@@ -130,7 +136,10 @@ impl OpaquePipelines {
             // pre-pass's writes before the shading draw's tests.
             for (pipeline, set) in pipelines.depth.iter().chain([shade]) {
                 pipeline.bind(cmd, &[*set]);
-                d.raw.cmd_draw(cmd, frame.vertices, 1, 0, 0);
+                match target.key.primitive {
+                    Primitive::Lines => d.raw.cmd_draw(cmd, 2 * frame.segments, 1, 0, 0),
+                    Primitive::Ribbons => ribbons.draw(d, cmd, frame.segments),
+                }
             }
             d.raw.cmd_end_rendering(cmd);
             scope.close(d, cmd, frame.timing);

@@ -31,6 +31,7 @@ use gpu_allocator::MemoryLocation;
 
 use super::exact::{self, Lists, OitPool};
 use super::fast::{self, WeightedSums, ABSORBANCE, WEIGHTED_SUM};
+use super::ribbons::RibbonIndices;
 use super::shading::ShadingResources;
 use super::{DrawFrame, TargetKey};
 use crate::codes::sentinel::OIT_END;
@@ -382,6 +383,7 @@ impl TransparentPass {
         mode: Transparency,
         params: &OitParams,
         shading: &mut ShadingResources,
+        ribbons: &RibbonIndices,
     ) -> Result<()> {
         let target = &frame.target;
         if target.key.samples != vk::SampleCountFlags::TYPE_1 {
@@ -467,7 +469,7 @@ impl TransparentPass {
             d.raw.cmd_begin_rendering(cmd, &build_rendering);
             d.cmd_set_full_viewport(cmd, target.extent);
             pipelines.build.0.bind(cmd, &[pipelines.build.1]);
-            d.raw.cmd_draw(cmd, frame.vertices, 1, 0, 0);
+            ribbons.draw(d, cmd, frame.segments);
             d.raw.cmd_end_rendering(cmd);
             scope.close(d, cmd, timing);
 
