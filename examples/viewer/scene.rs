@@ -135,7 +135,7 @@ impl HostScene {
     /// Records the floor after vkhair's hair, inside the caller's rendering of
     /// the same attachments, relying on what vkhair documents about the state it
     /// leaves: the vertex buffer bound by [`HostScene::record_head`] is still
-    /// bound (vkhair binds none), and the viewport and scissor are the full
+    /// bound (vkhair binds no vertex buffer), and the viewport and scissor are the full
     /// target (`Renderer::record_draw` leaves them so). Only the pipeline and
     /// the push constants are the host's to set again.
     ///

@@ -1,8 +1,8 @@
 #version 460
 // Exact transparency, resolve (over the rectangle the ribbons reach,
 // hair_rect.vert): walks the pixel's list, keeps its K nearest fragments
-// sorted by depth (one compare-and-swap pass over the kept ones per
-// fragment), folds every farther one into an order-independent tail (sum of
+// sorted by depth (one compare-and-swap pass over the first K of the
+// SORT_CAPACITY slots per fragment), folds every farther one into an order-independent tail (sum of
 // premultiplied colour, sum of alpha, product of transmittance) together with
 // the fragments the full pool could not store (the build's overflow sums),
 // composites the K front to back and the tail behind them, and blends the

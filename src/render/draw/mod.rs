@@ -192,10 +192,12 @@ impl Renderer {
     /// resolved into `target` (depth tested, not written). When the target's size
     /// changes, the images of the old size are kept until `frame` is
     /// [`super::RenderParams::frames_in_flight`] frames later. Viewport and scissor are
-    /// left set to the full target and one of vkhair's pipelines bound; vkhair
-    /// binds no vertex or index buffers, so the host's stay bound, and the host
-    /// binds its own pipeline and pushes its constants again afterwards
-    /// (`tests/viewer.rs` draws after the hair relying on exactly this).
+    /// left set to the full target and one of vkhair's pipelines bound, and,
+    /// when ribbons were drawn, vkhair's 16-bit index buffer of their corners;
+    /// vkhair binds no vertex buffers, so the host's stay bound, and the host
+    /// binds its own pipeline and index buffer and pushes its constants again
+    /// afterwards (`tests/viewer.rs` draws from its vertex buffers after the
+    /// hair relying on this).
     ///
     /// With [`super::RenderParams::transparency`] on, the hair is composited over
     /// the target's colour instead (see `render/draw/transparent.rs`): each

@@ -1,6 +1,7 @@
 //! The ribbons' index buffer: each hair segment's ribbon is a quad of four
-//! corners (`ribbon.vert`), its two triangles indexing them, so the vertex
-//! stage runs four times a segment where six unindexed vertices ran it six
+//! corners (`ribbon.vert`), its two triangles indexing them, so a device with
+//! a vertex cache (lavapipe's) shades the two corners they share once: four
+//! vertices a segment where six unindexed vertices ran the vertex stage six
 //! times (the rasterized triangles are the same, vertex for vertex). The
 //! indices number [`RIBBON_CHUNK`] segments in 16 bits; a draw takes as many
 //! instances of them as it needs, the shader offsetting each by its instance.
@@ -20,6 +21,11 @@ use crate::vk::device::Device;
 /// order the corners were drawn before they were indexed: (0, −), (0, +),
 /// (1, −) and (0, +), (1, +), (1, −).
 const QUAD: [u16; 6] = [0, 1, 2, 1, 3, 2];
+
+// Every corner of a chunk is numbered in 16 bits. The last is 0xFFFF, which a
+// pipeline with primitive restart would read as a restart: the ribbon
+// pipelines draw triangle lists, which restart never applies to.
+const _: () = assert!(4 * RIBBON_CHUNK <= 1 << 16);
 
 /// Indices of the first [`RIBBON_CHUNK`] segments' ribbons.
 pub(super) struct RibbonIndices {
@@ -76,18 +82,20 @@ fn chunk_indices() -> Vec<u16> {
 mod tests {
     use super::*;
 
-    /// Every corner of the chunk is indexed, by two triangles of its own
-    /// segment, and the last fits 16 bits.
+    /// Each segment's six indices are its own corners in the order the
+    /// unindexed draw gave its vertices — (end, side): (0, −), (0, +),
+    /// (1, −) and (0, +), (1, +), (1, −) — corner 2 × end + side; the last
+    /// index is the chunk's last corner.
     #[test]
-    fn the_chunk_indexes_four_corners_a_segment() {
+    fn the_chunk_indexes_each_segments_corners_in_the_drawn_order() {
+        let drawn = [(0, 0), (0, 1), (1, 0), (0, 1), (1, 1), (1, 0)];
         let indices = chunk_indices();
         assert_eq!(indices.len(), 6 * RIBBON_CHUNK as usize);
         for (segment, triangles) in indices.chunks(6).enumerate() {
-            let base = 4 * segment as u32;
-            let mut corners: Vec<u32> = triangles.iter().map(|&i| u32::from(i) - base).collect();
-            corners.sort_unstable();
-            assert_eq!(corners, [0, 1, 1, 2, 2, 3], "segment {segment}");
+            let expected = drawn.map(|(end, side)| 4 * segment as u32 + 2 * end + side);
+            let got: Vec<u32> = triangles.iter().map(|&i| u32::from(i)).collect();
+            assert_eq!(got, expected, "segment {segment}");
         }
-        assert_eq!(indices.iter().max().copied(), Some(u16::MAX));
+        assert_eq!(indices.last().copied().map(u32::from), Some(4 * RIBBON_CHUNK - 2));
     }
 }
