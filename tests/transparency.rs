@@ -97,6 +97,20 @@ fn reference_bands(s: &Scene, width: f32, n: f32, band_spacing: (f32, f32), opac
     })
 }
 
+/// Real hairs each strand of [`sparse_band_scene`] stands for.
+const SPARSE_HAIRS: f32 = 6.0;
+
+/// Sparse strands standing for [`SPARSE_HAIRS`] hairs `width` wide each: 300
+/// key hairs grown on the thesis scalp, 4 strands a key hair in clumps 0.1
+/// wide, in the exact mode with K = 32; the scene and its parameters.
+fn sparse_band_scene(gpu: &Gpu, width: f32) -> (Scene, RenderParams) {
+    let groom = common::grown_groom(300, 8, 5);
+    let m = HairMaterial { represented_hairs: SPARSE_HAIRS, ..material(width, OPACITY) };
+    let mut p = RenderParams { hairs_per_key: 4, clump_width: 0.1, ..params(Transparency::Exact) };
+    p.oit.sorted_fragments = 32;
+    (scene(gpu, &groom, &p, &m), p)
+}
+
 /// The colour of each pixel of a reference image, without its alpha.
 fn rgb(image: &[glam::Vec4]) -> Vec<Vec3> {
     image.iter().map(|p| p.truncate()).collect()
@@ -142,14 +156,10 @@ fn each_mode_against_the_exact_reference() {
 #[test]
 fn sparse_strands_are_drawn_as_bands_spread_to_their_neighbours() {
     let gpu = Gpu::new();
-    let groom = common::grown_groom(300, 8, 5);
     // Bands over two pixels wide (a pixel is about 5.5 mm here), so that the
     // exact mode's coverage is exact.
-    let (width, n) = (0.001, 6.0);
-    let m = HairMaterial { represented_hairs: n, ..material(width, OPACITY) };
-    let mut p = RenderParams { hairs_per_key: 4, clump_width: 0.1, ..params(Transparency::Exact) };
-    p.oit.sorted_fragments = 32;
-    let mut s = scene(&gpu, &groom, &p, &m);
+    let (width, n) = (0.001, SPARSE_HAIRS);
+    let (mut s, p) = sparse_band_scene(&gpu, width);
     let image = draw(&gpu, &mut s);
     let spacing = s.renderer.strand_spacing();
     let root_share = (std::f32::consts::PI / 4.0).sqrt() * 0.1;
@@ -659,12 +669,8 @@ fn every_k_sorts_its_k_nearest_fragments() {
 #[test]
 fn the_composite_covers_every_ribbon_pixel_and_little_more() {
     let gpu = Gpu::new();
-    let groom = common::grown_groom(300, 8, 5);
-    let (width, n) = (0.01, 6.0);
-    let m = HairMaterial { represented_hairs: n, ..material(width, OPACITY) };
-    let mut p = RenderParams { hairs_per_key: 4, clump_width: 0.1, ..params(Transparency::Exact) };
-    p.oit.sorted_fragments = 32;
-    let mut s = scene(&gpu, &groom, &p, &m);
+    let (width, n) = (0.01, SPARSE_HAIRS);
+    let (mut s, p) = sparse_band_scene(&gpu, width);
     // About 11 mm a pixel: the bands are over five pixels wide, the head half the target.
     s.camera = common::front_camera(1.8, (W, H));
     let image = draw(&gpu, &mut s);

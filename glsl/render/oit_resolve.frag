@@ -2,12 +2,12 @@
 // Exact transparency, resolve (over the rectangle the ribbons reach,
 // hair_rect.vert): walks the pixel's list, keeps its K nearest fragments
 // sorted by depth (one compare-and-swap pass over the first K of the
-// SORT_CAPACITY slots per fragment), folds every farther one into an order-independent tail (sum of
-// premultiplied colour, sum of alpha, product of transmittance) together with
-// the fragments the full pool could not store (the build's overflow sums),
-// composites the K front to back and the tail behind them, and blends the
-// result over the target as premultiplied colour. Pixels without hair are
-// discarded.
+// SORT_CAPACITY slots per fragment), folds every farther one into an
+// order-independent tail (sum of premultiplied colour, sum of alpha, product
+// of transmittance) together with the fragments the full pool could not store
+// (the build's overflow sums), composites the K front to back and the tail
+// behind them, and blends the result over the target as premultiplied colour.
+// Pixels without hair are discarded.
 //
 // The kept fragments live in local arrays of SORT_CAPACITY entries (depth and
 // packed half-float colour), every pass over them unrolled: the smallest
@@ -38,6 +38,11 @@ layout(location = 0) out vec4 out_color;
 
 // The depth of an empty slot: beyond every fragment's (depths lie in 0..1).
 const float EMPTY = 2.0;
+
+// A node's colour and alpha from their half floats (oit_build.frag packs them).
+vec4 unpack_color(uvec2 packed) {
+    return vec4(unpackHalf2x16(packed.x), unpackHalf2x16(packed.y));
+}
 
 void main() {
     uint node = oit_heads[oit_pixel(gl_FragCoord)];
@@ -82,7 +87,7 @@ void main() {
             c = swap ? kept_c : c;
         }
         // An empty slot's colour is zero: handed out, it adds nothing.
-        vec4 out_c = vec4(unpackHalf2x16(c.x), unpackHalf2x16(c.y));
+        vec4 out_c = unpack_color(c);
         tail_sum += out_c.rgb * out_c.a;
         tail_alpha += out_c.a;
         tail_transmittance *= 1.0 - out_c.a;
@@ -90,7 +95,7 @@ void main() {
     vec3 sum = vec3(0.0);
     float transmittance = 1.0;
     [[unroll]] for (uint i = 0u; i < SORT_CAPACITY; i++) {
-        vec4 c = vec4(unpackHalf2x16(color[i].x), unpackHalf2x16(color[i].y));
+        vec4 c = unpack_color(color[i]);
         sum += transmittance * c.a * c.rgb;
         transmittance *= 1.0 - c.a;
     }

@@ -2,9 +2,10 @@
 // Draw pass, vertex stage of ribbons (no vertex buffer, no geometry stage):
 // vertex 4s + c of instance i is corner c of segment RIBBON_CHUNK × i + s of
 // the interpolated hairs (hair-major; corners 1 and 2 shared by the segment's
-// two triangles, render/draw/ribbons.rs), a camera-facing ribbon of mix(root width, tip width)
-// world units, at least `least width` pixels wide. Each vertex reads both
-// ends of its segment (for the ribbon's direction) and places its corner.
+// two triangles, render/draw/ribbons.rs), a camera-facing ribbon of
+// mix(root width, tip width) world units, at least `least width` pixels wide.
+// Each vertex reads both ends of its segment (for the ribbon's direction) and
+// places its corner.
 //
 // Transparent strands (the VKHAIR_COVERAGE variant, drawn with dp.coverage.x = 1) have no
 // least width: their ribbon is at least one pixel wide plus half a pixel each
