@@ -10,7 +10,8 @@
 //! - Files under `glsl/include/` are headers and are not compiled alone.
 //! - A line `// vkhair variant: NAME` in a shader compiles it once more with
 //!   `NAME` defined, as `<IDENT>_<NAME less VKHAIR_>` (e.g. the pressure solve's
-//!   reductions through shared memory, `…_SHARED_REDUCE`).
+//!   reductions through shared memory, `…_SHARED_REDUCE`); a line naming
+//!   several (`// vkhair variant: A B`) defines them all, as `<IDENT>_A_B`.
 //! - Every constant of `src/limits.rs` and every code of `src/codes.rs` is
 //!   defined for every shader as a macro (`-DNAME=VALUEu`); a shader or header
 //!   that declares one of those names itself fails the build, so the Rust side
@@ -100,7 +101,10 @@ fn main() {
         let variants = text.lines().filter_map(|l| l.trim().strip_prefix("// vkhair variant:")).map(str::trim);
         for variant in std::iter::once(None).chain(variants.map(Some)) {
             let name = match variant {
-                Some(v) => format!("{rel_name}#{}", v.trim_start_matches("VKHAIR_")),
+                Some(v) => {
+                    let names: Vec<_> = v.split_whitespace().map(|n| n.trim_start_matches("VKHAIR_")).collect();
+                    format!("{rel_name}#{}", names.join("+"))
+                }
                 None => rel_name.clone(),
             };
             match compile(&compiler, path, &name, kind, &include_dirs, &out_dir, variant) {
@@ -187,7 +191,7 @@ fn compile(
     for (name, value) in SHADER_CONSTANTS.iter().chain(SHADER_CODES) {
         options.add_macro_definition(name, Some(&format!("{value}u")));
     }
-    if let Some(name) = variant {
+    for name in variant.into_iter().flat_map(str::split_whitespace) {
         options.add_macro_definition(name, None);
     }
     // Unoptimised SPIR-V keeps every OpName/OpMemberName (reflection checks
@@ -221,7 +225,7 @@ fn compile(
         return Err(format!("{rel_name}: {}", artifact.get_warning_messages()));
     }
     let words = artifact.as_binary().to_vec();
-    let spv_path = out_dir.join(format!("{}.spv", rel_name.replace(['/', '#'], "__")));
+    let spv_path = out_dir.join(format!("{}.spv", rel_name.replace(['/', '#', '+'], "__")));
     std::fs::write(&spv_path, artifact.as_binary_u8()).map_err(|e| format!("{rel_name}: {e}"))?;
     let status = Command::new("spirv-val")
         .arg("--target-env")

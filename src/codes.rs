@@ -142,6 +142,20 @@ shader_codes! {
         MARSCHNER = 1,
     }
 
+    /// How the host's depth copied for the compute rasteriser is encoded
+    /// (`OitCounters::scene_depth`).
+    scene_depth = "SCENE_DEPTH_" {
+        /// No depth to test against (no depth attachment, or one cleared by vkhair).
+        NONE = 0,
+        /// 32-bit floats (`D32_SFLOAT`, the depth aspect of `D32_SFLOAT_S8_UINT`).
+        FLOAT32 = 1,
+        /// 24-bit unsigned normalised in the low bits of a word
+        /// (`X8_D24_UNORM_PACK32`, the depth aspect of `D24_UNORM_S8_UINT`).
+        UNORM24 = 2,
+        /// 16-bit unsigned normalised, two a word, the first in the low half (`D16_UNORM`).
+        UNORM16 = 3,
+    }
+
     /// Optional parts of the hair shading (`hair_shading.glsl`) that the
     /// pipelines which shade are specialised to, as the bits of their
     /// `SHADING_FEATURES` constant: a CPU device runs both sides of every branch

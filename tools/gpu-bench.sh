@@ -10,7 +10,18 @@
 #        c. 1,001,000 drawn strands (the thesis' 1,750 key hairs × 572, level of
 #           detail off) with transparency (the default exact mode) at
 #           1920×1080 (strands_frame.json);
-#   2. `vkhair bench --require-gpu` (bench.json, scaling.csv, scaling.png):
+#   2. the frame's goals (frame/), each figure beside its bound and whether it
+#      is met, for both rasterisers of the exact mode (--raster hardware and
+#      compute): the hair passes' GPU ms (the per-pass table's top-level
+#      `vkhair render:` rows, the host's head mesh and the simulation left out)
+#      of the thesis at 1920×1080 (≤ 1.5 ms, and exact ≤ 1.2 × opaque on the
+#      same frame), 1,001,000 strands with both shadowed lights (≤ 20 ms),
+#      20,000 followers of 300 guides (≤ 2 ms), Sintel at the peer's geometry
+#      (≤ 1.25 ms) and its 171,000-segment close-up, draw and composite
+#      (≤ 0.7 ms; Sintel from VKHAIR_SINTEL, default ../shared/data/sintel,
+#      skipped with the reason when absent), and the transparency memory at
+#      3840×2160 (≤ 512 MiB);
+#   3. `vkhair bench --require-gpu` (bench.json, scaling.csv, scaling.png):
 #      every stage beside its CPU reference, recorded work, the bound at the
 #      memory bandwidth of named GPUs, scaling curves; extra `vkhair bench`
 #      flags go after the script's name (e.g. --samples 50).
@@ -38,9 +49,9 @@ out=${VKHAIR_OUT:-out/gpu-bench}
 goals="$out/goals"
 mkdir -p "$goals"
 if [ "$smoke" = 1 ]; then
-  width=160 height=120 frames=2 steps=3 guides=300 grid=16 per_key=4
+  width=160 height=120 frames=2 steps=3 guides=300 grid=16 per_key=4 peer_width=160 peer_height=120
 else
-  width=1920 height=1080 frames=120 steps=120 guides=100000 grid=64 per_key=572
+  width=1920 height=1080 frames=120 steps=120 guides=100000 grid=64 per_key=572 peer_width=1280 peer_height=720
 fi
 report="$out/report.txt"
 log="$goals/log.txt"
@@ -84,6 +95,79 @@ run_goal "c. $((1750 * per_key)) drawn strands with transparency, ${width}×${he
   render --width "$width" --height "$height" --frames "$frames" --hairs-per-key "$per_key" --no-lod \
   --out "$goals/strands" --json "$goals/strands_frame.json"
 rm -f "$log.last"
+
+# The frame's goals. hair_ms FILE [ROWS]: the sum of the mean GPU ms of the
+# first per-pass table's top-level `vkhair render:` rows in FILE (a `vkhair
+# render` output), or of those whose pass matches ROWS (a regex; .* for every pass).
+hair_ms() {
+  awk -v rows="${2:-.*}" '
+    /^total/ { exit }
+    /^vkhair render: / {
+      pass = $0; sub(/^vkhair render: /, "", pass); sub(/ +[0-9.]+ +[0-9.]+ +[0-9.]+%$/, "", pass)
+      if (pass ~ "^(" rows ")$") sum += $(NF - 2)
+    }
+    END { printf "%.3f", sum }' "$1"
+}
+# verdict FIGURE BOUND: "met" when FIGURE ≤ BOUND, else "missed".
+verdict() {
+  awk -v f="$1" -v b="$2" 'BEGIN { print (f + 0 <= b + 0) ? "met" : "missed" }'
+}
+frame="$out/frame"
+mkdir -p "$frame"
+# frame_goal KEY NAME BOUND ROWS FLAGS...: `vkhair render FLAGS` into
+# $frame/KEY.txt, its hair passes' ms (ROWS: every pass, or a regex of passes)
+# into $frame/KEY.ms and the report, beside BOUND.
+frame_goal() {
+  local key=$1 name=$2 bound=$3 rows=$4
+  shift 4
+  local file="$frame/$key.txt"
+  "$vkhair" render "$@" --out "$frame/$key" >"$file" 2>&1 || {
+    cat "$file" >&2
+    echo "gpu-bench: $name failed: vkhair render $*" >&2
+    exit 1
+  }
+  hair_ms "$file" "$rows" >"$frame/$key.ms"
+  printf '  %-62s %9s ms   goal ≤ %s ms: %s\n' "$name" "$(cat "$frame/$key.ms")" "$bound" \
+    "$(verdict "$(cat "$frame/$key.ms")" "$bound")" >>"$report"
+}
+sintel=${VKHAIR_SINTEL:-../shared/data/sintel}
+echo "d. the frame's goals, hair passes (GPU timestamps, mean ms a frame)" >>"$report"
+"$vkhair" grow --scalp sphere --strands "$((smoke == 1 ? 2000 : 20000))" --points 24 --out "$frame/dense.hair" \
+  >>"$log" 2>&1
+size=(--width "$width" --height "$height" --frames "$frames")
+for raster in hardware compute; do
+  echo " --raster $raster" >>"$report"
+  # The opaque frame's strands always go through the hardware; its maps by --raster.
+  frame_goal "thesis_off_$raster" "thesis ${width}×${height}, opaque" 1.5 ".*" "${size[@]}" --raster "$raster" \
+    --transparency off
+  frame_goal "thesis_$raster" "thesis ${width}×${height}, exact" 1.5 ".*" "${size[@]}" --raster "$raster"
+  ratio=$(awk -v e="$(cat "$frame/thesis_$raster.ms")" -v o="$(cat "$frame/thesis_off_$raster.ms")" \
+    'BEGIN { printf "%.2f", (o > 0) ? e / o : 0 }')
+  printf '  %-62s %9s ×    goal ≤ 1.2 ×: %s\n' "exact / opaque, the thesis frame above" "$ratio" \
+    "$(verdict "$ratio" 1.2)" >>"$report"
+  frame_goal "strands_$raster" "$((1750 * per_key)) strands, both shadowed lights" 20 ".*" "${size[@]}" \
+    --raster "$raster" --hairs-per-key "$per_key" --no-lod
+  frame_goal "dense_$raster" "dense groom: $((smoke == 1 ? 2000 : 20000)) followers of 300 guides" 2 ".*" \
+    "${size[@]}" --raster "$raster" --input "$frame/dense.hair" --guides 300
+  if [ -f "$sintel/sintel_hair.tfx" ]; then
+    peer=(--input "$sintel/sintel_hair.tfx" --obj "$sintel/sintel_bust.obj" --scale 0.01 --width "$peer_width"
+      --height "$peer_height" --frames "$frames" --raster "$raster")
+    frame_goal "sintel_$raster" "Sintel at the peer's geometry, ${peer_width}×${peer_height}" 1.25 ".*" "${peer[@]}" \
+      --points 32 --level 1 --hairs-per-key 15 --no-lod
+    frame_goal "closeup_$raster" "Sintel close-up, 171,000 segments: draw + composite" 0.7 "draw|composite" \
+      "${peer[@]}" --hairs-per-key 50 --level 1 --no-lod --distance 0.5
+  else
+    echo "  Sintel: skipped, no $sintel/sintel_hair.tfx (set VKHAIR_SINTEL)" >>"$report"
+  fi
+  big=(--width "$((smoke == 1 ? 320 : 3840))" --height "$((smoke == 1 ? 180 : 2160))")
+  "$vkhair" render "${big[@]}" --frames 2 --raster "$raster" --out "$frame/memory_$raster" \
+    >"$frame/memory_$raster.txt" 2>&1
+  mib=$(sed -n 's/^transparency: .*, \([0-9.]*\) MiB of .*/\1/p' "$frame/memory_$raster.txt")
+  printf '  %-62s %9s MiB  goal ≤ 512 MiB: %s\n' "transparency memory at ${big[1]}×${big[3]}" "${mib:-?}" \
+    "$(verdict "${mib:-1e9}" 512)" >>"$report"
+done
+echo "  (per-pass tables: $frame/*.txt)" >>"$report"
+
 if [ "$smoke" = 0 ]; then
   "$vkhair" bench --require-gpu --out "$out" --json "$out/bench.json" "$@"
   echo "bench: $out/bench.json" >>"$report"

@@ -214,8 +214,9 @@ fn frames_with(
         vk::ImageAspectFlags::COLOR,
         "host color",
     )?;
-    let (depth, depth_view) =
-        make_image(DEPTH, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT, vk::ImageAspectFlags::DEPTH, "host depth")?;
+    // Transfer source: vkhair's compute rasteriser copies the depth out.
+    let depth_usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+    let (depth, depth_view) = make_image(DEPTH, depth_usage, vk::ImageAspectFlags::DEPTH, "host depth")?;
     let make_buffer = |size: u64,
                        usage: vk::BufferUsageFlags,
                        location: MemoryLocation,
@@ -423,6 +424,7 @@ fn frames_with(
                 color_format: COLOR,
                 depth: depth_view,
                 depth_format: DEPTH,
+                depth_image: depth,
                 extent: scissor.extent,
                 samples: vk::SampleCountFlags::TYPE_1,
             };

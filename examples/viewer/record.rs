@@ -86,6 +86,7 @@ impl Running {
                 color_format: self.swapchain.format,
                 depth: self.swapchain.depth_view,
                 depth_format: DEPTH,
+                depth_image: self.swapchain.depth,
                 extent,
                 samples: vk::SampleCountFlags::TYPE_1,
             };

@@ -107,7 +107,8 @@ impl Swapchain {
             .mip_levels(1)
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
-            .usage(vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT);
+            // Transfer source: vkhair's compute rasteriser copies the depth out.
+            .usage(vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC);
         // SAFETY: valid create info; destroyed in `destroy`.
         let depth = unsafe { device.create_image(&depth_info, None) }?;
         // SAFETY: the image is alive.

@@ -27,6 +27,9 @@ layout(std430, set = 0, binding = 9) OIT_COUNTERS_ACCESS buffer OitCounters {
     uint hair_y0;
     uint hair_x1;
     uint hair_y1;
+    // How the compute rasteriser's copy of the target's depth is encoded
+    // (SCENE_DEPTH_*; NONE: no depth test).
+    uint scene_depth;
 } oit;
 
 #endif

@@ -16,6 +16,14 @@
 // vkhair variant: VKHAIR_SORT_4
 // vkhair variant: VKHAIR_SORT_8
 // vkhair variant: VKHAIR_SORT_16
+// vkhair variant: VKHAIR_OVERFLOW_BUFFER
+// vkhair variant: VKHAIR_SORT_4 VKHAIR_OVERFLOW_BUFFER
+// vkhair variant: VKHAIR_SORT_8 VKHAIR_OVERFLOW_BUFFER
+// vkhair variant: VKHAIR_SORT_16 VKHAIR_OVERFLOW_BUFFER
+//
+// The VKHAIR_OVERFLOW_BUFFER variants composite what the compute rasteriser
+// built: its overflow is the fixed-point sums of oit_overflow.glsl instead of
+// the hardware build's blended images.
 #extension GL_EXT_control_flow_attributes : require
 #include "oit.glsl"
 
@@ -29,10 +37,14 @@
 #define SORT_CAPACITY OIT_MAX_SORTED
 #endif
 
+#ifdef VKHAIR_OVERFLOW_BUFFER
+#include "oit_overflow.glsl"
+#else
 // The build's sums of the fragments beyond the pool: Σ premultiplied colour and
 // Σ alpha; Σ absorbance −ln(1 − alpha).
 layout(set = 0, binding = 0) uniform sampler2D overflow_sum;
 layout(set = 0, binding = 1) uniform sampler2D overflow_absorbance;
+#endif
 
 layout(location = 0) out vec4 out_color;
 
@@ -46,7 +58,13 @@ vec4 unpack_color(uvec2 packed) {
 
 void main() {
     uint node = oit_heads[oit_pixel(gl_FragCoord)];
+#ifdef VKHAIR_OVERFLOW_BUFFER
+    vec4 overflow = oit_overflow_sum(oit_pixel(gl_FragCoord));
+    float absorbance_sum = oit_overflow_absorbance(oit_pixel(gl_FragCoord));
+#else
     vec4 overflow = texelFetch(overflow_sum, ivec2(gl_FragCoord.xy), 0);
+    float absorbance_sum = texelFetch(overflow_absorbance, ivec2(gl_FragCoord.xy), 0).r;
+#endif
     if (node == OIT_END && overflow.a <= 0.0) {
         discard;
     }
@@ -64,7 +82,7 @@ void main() {
     uint k = min(oit.sorted, SORT_CAPACITY);
     vec3 tail_sum = overflow.rgb;
     float tail_alpha = overflow.a;
-    float tail_transmittance = exp(-texelFetch(overflow_absorbance, ivec2(gl_FragCoord.xy), 0).r);
+    float tail_transmittance = exp(-absorbance_sum);
     // Each stored node is on exactly one list: at most min(used, capacity) steps.
     uint steps = min(oit.used, oit.capacity);
     for (uint step = 0u; node != OIT_END && step < steps; step++) {

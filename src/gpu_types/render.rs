@@ -163,9 +163,12 @@ pub(crate) struct OitCounters {
     pub hair_x1: u32,
     /// See `hair_x0`.
     pub hair_y1: u32,
+    /// How the compute rasteriser's copy of the target's depth is encoded
+    /// (`codes::scene_depth`; `NONE` for no depth test).
+    pub scene_depth: u32,
 }
 gpu_struct!(OitCounters => "OitCounters" {
-    used, capacity, width, sorted, pool_nodes, height, hair_x0, hair_y0, hair_x1, hair_y1
+    used, capacity, width, sorted, pool_nodes, height, hair_x0, hair_y0, hair_x1, hair_y1, scene_depth
 });
 
 /// Push constants of the Marschner table builder (`MarschnerPush` in `glsl/include/marschner.glsl`).

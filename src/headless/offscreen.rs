@@ -55,7 +55,8 @@ impl Offscreen {
                 name: "offscreen depth",
                 extent,
                 format: OFFSCREEN_DEPTH,
-                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+                // Transfer source: the compute rasteriser copies the depth out.
+                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
                 samples: vk::SampleCountFlags::TYPE_1,
                 aspect: vk::ImageAspectFlags::DEPTH,
             },
@@ -71,6 +72,7 @@ impl Offscreen {
             color_format: OFFSCREEN_COLOR,
             depth: self.depth.view(),
             depth_format: OFFSCREEN_DEPTH,
+            depth_image: self.depth.raw(),
             extent: self.color.extent,
             samples: vk::SampleCountFlags::TYPE_1,
         }

@@ -45,7 +45,7 @@ pub use draw::{OitPool, OitStats};
 pub use followers::Followers;
 pub use marschner::MarschnerParams;
 pub use params::{
-    Detail, InterpolationMode, LodParams, OitParams, Primitive, RenderParams, Transparency, MAX_HAIRS_PER_KEY,
+    Detail, InterpolationMode, LodParams, OitParams, Primitive, Raster, RenderParams, Transparency, MAX_HAIRS_PER_KEY,
     MAX_SMOOTHING_LEVEL,
 };
 pub use pass::RenderPass;
@@ -446,10 +446,12 @@ impl Renderer {
     /// uniforms without casters). Call it every frame after `record_prepare` and
     /// before [`Renderer::record_draw`]; the draw then attenuates those lights.
     /// Afterwards the atlas ([`Renderer::shadow_atlas`]) is in
-    /// `SHADER_READ_ONLY_OPTIMAL`, written by `COLOR_ATTACHMENT_OUTPUT` and made
-    /// visible to fragment shaders, for a host that shades its own surfaces with it.
-    /// When a map was drawn, the viewport and scissor are left set to its tile and
-    /// a shadow pipeline stays bound.
+    /// `SHADER_READ_ONLY_OPTIMAL`, written by `COLOR_ATTACHMENT_OUTPUT` (or by
+    /// `COMPUTE_SHADER`, [`Renderer::shadow_raster`]) and made visible to
+    /// fragment and compute shaders, for a host that shades its own surfaces with it.
+    /// When a map was drawn through the hardware raster pipeline, the viewport and
+    /// scissor are left set to its tile and a shadow pipeline stays bound; through
+    /// the compute rasteriser, a compute pipeline stays bound.
     ///
     /// # Safety
     /// As for [`Renderer::record_prepare`], recorded after it (and after `sim`'s step)
@@ -468,8 +470,16 @@ impl Renderer {
         let (root, tip) = self.strand_spacing();
         let footprint = ShadowFootprint { hairs: self.strand_hairs(), spacing: 0.5 * (root + tip) };
         let drawn = DrawnHairs { counts: self.hair_counts(), footprint };
+        let raster = (self.shadow_raster(), self.interpolate.hairs().0);
         // SAFETY: guaranteed by the caller.
-        unsafe { self.shadows.record(cmd, &sim, &self.lights, bounds, drawn, timing) }
+        unsafe { self.shadows.record(cmd, &sim, &self.lights, bounds, drawn, raster, timing) }
+    }
+
+    /// The rasteriser the current parameters draw the deep opacity maps with on
+    /// this device: [`RenderParams::raster`] resolved for the device's type
+    /// ([`Raster::resolve_shadows`]), whatever the transparency mode.
+    pub fn shadow_raster(&self) -> Raster {
+        self.params.raster.resolve_shadows(self.device.info.device_type)
     }
 
     /// The opacity atlas (format [`SHADOW_ATLAS_FORMAT`], one tile per caster, two tiles

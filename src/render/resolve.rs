@@ -129,6 +129,7 @@ impl Supersampling {
             extent: self.extent(),
             color: (self.color.view(), Load::color([0.0; 4])),
             depth: Some((self.depth.view(), Load::depth(1.0))),
+            depth_image: None,
             before: Barriers { images: self.to_attachments().to_vec(), ..Barriers::default() },
         }
     }

@@ -17,6 +17,14 @@ pub struct RenderTarget {
     pub depth: vk::ImageView,
     /// Its format (`UNDEFINED` for none).
     pub depth_format: vk::Format,
+    /// The image behind `depth` (its mip level 0 and array layer 0 are the ones
+    /// the view shows), created with `TRANSFER_SRC` usage, or null. The compute
+    /// rasteriser ([`super::Raster::Compute`]) copies the host's depth out of
+    /// it to test each hair fragment against (its depth aspect passes through
+    /// `TRANSFER_SRC_OPTIMAL` and is back in `DEPTH_ATTACHMENT_OPTIMAL` before
+    /// the draw returns); with a depth view and a null image, that rasteriser
+    /// refuses the target. The hardware raster pipeline never reads it.
+    pub depth_image: vk::Image,
     /// Extent of both.
     pub extent: vk::Extent2D,
     /// Sample count of both.

@@ -173,6 +173,19 @@ pub(crate) fn image(
     old: vk::ImageLayout,
     new: vk::ImageLayout,
 ) -> vk::ImageMemoryBarrier2<'static> {
+    subresources(image.raw(), image.full_range(), src, dst, old, new)
+}
+
+/// A barrier and layout transition on `range` of an image this crate may not
+/// own (a host's).
+pub(crate) fn subresources(
+    image: vk::Image,
+    range: vk::ImageSubresourceRange,
+    src: &[AccessKind],
+    dst: &[AccessKind],
+    old: vk::ImageLayout,
+    new: vk::ImageLayout,
+) -> vk::ImageMemoryBarrier2<'static> {
     let ((src_stage, src_access), (dst_stage, dst_access)) = (AccessKind::mask(src), AccessKind::mask(dst));
     vk::ImageMemoryBarrier2::default()
         .src_stage_mask(src_stage)
@@ -183,8 +196,8 @@ pub(crate) fn image(
         .new_layout(new)
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image.raw())
-        .subresource_range(image.full_range())
+        .image(image)
+        .subresource_range(range)
 }
 
 /// A global memory barrier.

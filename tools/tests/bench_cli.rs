@@ -135,8 +135,10 @@ fn require_gpu_refuses_a_cpu_device() {
 }
 
 /// `tools/gpu-bench.sh --smoke` runs every goal of the GPU report (the thesis
-/// frame, the guides' FLIP step, the drawn strands with transparency) at toy
-/// sizes and writes one report naming each with the device and a GPU figure.
+/// frame, the guides' FLIP step, the drawn strands with transparency, and the
+/// frame's goals for both rasterisers) at toy sizes and writes one report
+/// naming each with the device and a GPU figure, each frame goal's figure
+/// beside its bound.
 #[test]
 fn the_gpu_bench_script_runs_every_goal_and_writes_one_report() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -170,5 +172,35 @@ fn the_gpu_bench_script_runs_every_goal_and_writes_one_report() {
     }
     let log = std::fs::read_to_string(dir.path().join("goals/log.txt")).expect("log");
     assert!(!log.contains("vulkan: ") && !log.contains("panicked"), "{log}");
+    // The frame's goals: per rasteriser, the thesis (opaque, exact, and their
+    // ratio), the strands, the dense groom, the memory, and Sintel's two where
+    // its files are here; each a number beside its bound.
+    assert!(report.contains("d. the frame's goals"), "{report}");
+    let sintel = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/sintel/sintel_hair.tfx");
+    let per_raster = if sintel.exists() { 8 } else { 6 };
+    for raster in ["hardware", "compute"] {
+        let section = report.split(&format!(" --raster {raster}\n")).nth(1).expect("the rasteriser's section");
+        let lines: Vec<&str> = section.lines().take_while(|l| !l.starts_with(" --raster")).collect();
+        let goals: Vec<&str> = lines.iter().copied().filter(|l| l.contains("goal ≤")).collect();
+        assert_eq!(goals.len(), per_raster, "{raster}: {goals:#?}\n{report}");
+        for line in goals {
+            // "name   figure unit   goal ≤ bound unit: met"
+            let before_goal: Vec<&str> = line.split("goal ≤").next().unwrap_or("").split_whitespace().collect();
+            let figure: f64 = before_goal
+                .len()
+                .checked_sub(2)
+                .and_then(|i| before_goal[i].parse().ok())
+                .unwrap_or_else(|| panic!("no figure in {line:?}"));
+            assert!(figure > 0.0, "{line}");
+            assert!(line.ends_with(": met") || line.ends_with(": missed"), "{line}");
+        }
+    }
+    for entry in std::fs::read_dir(dir.path().join("frame")).expect("frame/") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_some_and(|e| e == "txt") {
+            let text = std::fs::read_to_string(&path).expect("a frame goal's output");
+            assert!(!text.contains("vulkan: ") && !text.contains("panicked"), "{}: {text}", path.display());
+        }
+    }
     assert!(report.contains("smoke sizes") && !report.contains("bench:"), "the smoke run skips the bench:\n{report}");
 }

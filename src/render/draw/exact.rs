@@ -14,21 +14,41 @@ use super::transparent::ModeShaders;
 use crate::codes::sentinel::OIT_END;
 use crate::error::Result;
 use crate::render::OitParams;
+use crate::render::Raster;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::{Device, DeviceInfo};
 use crate::vk::shaders::{
-    RENDER_OIT_BUILD_FRAG, RENDER_OIT_RESOLVE_FRAG, RENDER_OIT_RESOLVE_FRAG_SORT_16, RENDER_OIT_RESOLVE_FRAG_SORT_4,
-    RENDER_OIT_RESOLVE_FRAG_SORT_8,
+    RENDER_OIT_BUILD_FRAG, RENDER_OIT_RESOLVE_FRAG, RENDER_OIT_RESOLVE_FRAG_OVERFLOW_BUFFER,
+    RENDER_OIT_RESOLVE_FRAG_SORT_16, RENDER_OIT_RESOLVE_FRAG_SORT_16_OVERFLOW_BUFFER, RENDER_OIT_RESOLVE_FRAG_SORT_4,
+    RENDER_OIT_RESOLVE_FRAG_SORT_4_OVERFLOW_BUFFER, RENDER_OIT_RESOLVE_FRAG_SORT_8,
+    RENDER_OIT_RESOLVE_FRAG_SORT_8_OVERFLOW_BUFFER,
 };
 
 /// The build's and the composite's fragment stages for `sorted` (K) fragments
-/// sorted per pixel: the composite variant with the smallest arrays that hold K.
-pub(super) fn shaders(sorted: u32) -> ModeShaders {
+/// sorted per pixel: the composite variant with the smallest arrays that hold
+/// K, reading the overflow from the hardware build's images or, after the
+/// compute rasteriser (`raster.rs`, whose build is a compute pipeline of its
+/// own), from its sums.
+pub(super) fn shaders(sorted: u32, raster: Raster) -> ModeShaders {
+    let variants = match raster {
+        Raster::Compute => [
+            &RENDER_OIT_RESOLVE_FRAG_SORT_4_OVERFLOW_BUFFER,
+            &RENDER_OIT_RESOLVE_FRAG_SORT_8_OVERFLOW_BUFFER,
+            &RENDER_OIT_RESOLVE_FRAG_SORT_16_OVERFLOW_BUFFER,
+            &RENDER_OIT_RESOLVE_FRAG_OVERFLOW_BUFFER,
+        ],
+        _ => [
+            &RENDER_OIT_RESOLVE_FRAG_SORT_4,
+            &RENDER_OIT_RESOLVE_FRAG_SORT_8,
+            &RENDER_OIT_RESOLVE_FRAG_SORT_16,
+            &RENDER_OIT_RESOLVE_FRAG,
+        ],
+    };
     let composite = match sorted {
-        0..=4 => &RENDER_OIT_RESOLVE_FRAG_SORT_4,
-        5..=8 => &RENDER_OIT_RESOLVE_FRAG_SORT_8,
-        9..=16 => &RENDER_OIT_RESOLVE_FRAG_SORT_16,
-        _ => &RENDER_OIT_RESOLVE_FRAG,
+        0..=4 => variants[0],
+        5..=8 => variants[1],
+        9..=16 => variants[2],
+        _ => variants[3],
     };
     ModeShaders { build: &RENDER_OIT_BUILD_FRAG, composite }
 }

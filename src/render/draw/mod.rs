@@ -22,6 +22,7 @@
 mod exact;
 mod fast;
 mod opaque;
+mod raster;
 mod ribbons;
 mod shading;
 mod transparent;
@@ -36,7 +37,7 @@ pub use transparent::OitStats;
 use super::marschner::MarschnerParams;
 use super::shading::{Camera, HairMaterial, ShadingMode, MAX_LIGHTS};
 use super::shadow::ShadowParams;
-use super::{OitParams, Primitive, RenderTarget, Renderer, Transparency};
+use super::{OitParams, Primitive, Raster, RenderTarget, Renderer, Transparency};
 use crate::error::{Error, Result};
 use crate::gpu_types::{DrawParams, GpuLight};
 use crate::profiler::{GpuProfiler, Timing};
@@ -67,6 +68,9 @@ pub(super) struct DrawTarget {
     pub extent: vk::Extent2D,
     pub color: (vk::ImageView, Load),
     pub depth: Option<(vk::ImageView, Load)>,
+    /// The image behind a kept depth attachment, for the compute rasteriser's
+    /// copy ([`RenderTarget::depth_image`]); `None` when not given.
+    pub depth_image: Option<vk::Image>,
     pub before: Barriers,
 }
 
@@ -162,12 +166,18 @@ impl DrawPass {
     /// earlier in submission order with barriers to the draw's stages (the
     /// capture and shadow passes leave them so); the frames `frames_in_flight`
     /// before `frame.frame` completed.
-    unsafe fn record(&mut self, frame: &DrawFrame<'_>, mode: Transparency, oit: &OitParams) -> Result<()> {
+    unsafe fn record(
+        &mut self,
+        frame: &DrawFrame<'_>,
+        mode: Transparency,
+        oit: &OitParams,
+        raster: Raster,
+    ) -> Result<()> {
         // SAFETY: guaranteed by the caller.
         unsafe {
             match mode {
                 Transparency::Off => self.opaque.record(frame, &mut self.shading, &self.ribbons),
-                _ => self.transparent.record(frame, mode, oit, &mut self.shading, &self.ribbons),
+                _ => self.transparent.record(frame, mode, oit, raster, &mut self.shading, &self.ribbons),
             }
         }
     }
@@ -262,6 +272,7 @@ impl Renderer {
             extent: target.extent,
             color: (target.color, Load::Keep),
             depth: has_depth.then_some((target.depth, Load::Keep)),
+            depth_image: (has_depth && target.depth_image != vk::Image::null()).then_some(target.depth_image),
             before: host_writes,
         };
         // With supersampling, the hair goes into the renderer's own images first.
@@ -309,7 +320,7 @@ impl Renderer {
         // SAFETY: guaranteed by the caller; the supersampling images are this
         // renderer's and earlier resolves that sampled them are ordered by the barriers.
         let result = unsafe {
-            let drawn = self.draw.record(&frame, mode, &self.params.oit);
+            let drawn = self.draw.record(&frame, mode, &self.params.oit, self.raster());
             match &mut images {
                 Some(images) => drawn.and_then(|_| self.resolve.record(cmd, images, &host, frame.timing)),
                 None => drawn,
@@ -319,6 +330,18 @@ impl Renderer {
             self.resolve.restore(images);
         }
         result
+    }
+
+    /// The rasteriser the current parameters draw with on this device:
+    /// [`RenderParams::raster`](super::RenderParams::raster) resolved for the
+    /// device's type in the exact mode ([`Raster::resolve`]), and
+    /// [`Raster::Hardware`] in the other modes, which draw only through the
+    /// hardware raster pipeline.
+    pub fn raster(&self) -> Raster {
+        match self.params.transparency {
+            Transparency::Exact => self.params.raster.resolve(self.device.info.device_type),
+            _ => Raster::Hardware,
+        }
     }
 
     /// Sets of size-dependent images waiting for their frames to complete
@@ -348,7 +371,8 @@ impl Renderer {
     /// target of `extent` (the supersampled extent where supersampling is on), bytes.
     pub fn transparency_memory(&self, extent: vk::Extent2D) -> u64 {
         let drawn = self.drawn_extent(extent);
-        self.draw.transparent.memory_bytes(&self.device.info, self.params.transparency, &self.params.oit, drawn)
+        let raster = self.raster();
+        self.draw.transparent.memory_bytes(&self.device.info, self.params.transparency, &self.params.oit, raster, drawn)
     }
 
     /// The exact mode's fragment pool for a target of `extent` (the

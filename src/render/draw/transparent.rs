@@ -31,6 +31,7 @@ use gpu_allocator::MemoryLocation;
 
 use super::exact::{self, Lists, OitPool};
 use super::fast::{self, WeightedSums, ABSORBANCE, WEIGHTED_SUM};
+use super::raster::{DepthSource, RasterBuffers};
 use super::ribbons::RibbonIndices;
 use super::shading::ShadingResources;
 use super::{DrawFrame, TargetKey};
@@ -38,7 +39,7 @@ use crate::codes::sentinel::OIT_END;
 use crate::error::{Error, Result};
 use crate::gpu_types::OitCounters;
 use crate::render::pass::RenderPass;
-use crate::render::{OitParams, Transparency};
+use crate::render::{OitParams, Raster, Transparency};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::device::{Device, DeviceInfo};
@@ -47,7 +48,7 @@ use crate::vk::pipeline::{Blend, ComputePipeline, GraphicsDesc, GraphicsPipeline
 use crate::vk::rendering;
 use crate::vk::shaders::{
     ShaderSource, RENDER_HAIR_RECT_COMP, RENDER_HAIR_RECT_VERT, RENDER_OIT_DEPTH_FRAG, RENDER_RIBBON_VERT_COVERAGE,
-    RENDER_SHADE_POINTS_COMP,
+    RENDER_SHADE_POINTS_COMP, RENDER_STRAND_RASTER_COMP,
 };
 
 /// Reads of the pass's buffers by its stages (the ribbons, the vertex shading,
@@ -89,11 +90,20 @@ pub struct OitStats {
     pub composited: Option<[u32; 4]>,
 }
 
+/// How the build makes fragments.
+enum Build {
+    /// The ribbons through the hardware raster pipeline (`ribbon.vert`'s
+    /// coverage variant and the mode's fragment stage).
+    Ribbons(GraphicsPipeline, vk::DescriptorSet),
+    /// The compute rasteriser (`strand_raster.comp`, `raster.rs`).
+    Compute(ComputePipeline, vk::DescriptorSet),
+}
+
 /// The pipelines of one target and their descriptor sets.
 struct Pipelines {
     points: (ComputePipeline, vk::DescriptorSet),
     rect: (ComputePipeline, vk::DescriptorSet),
-    build: (GraphicsPipeline, vk::DescriptorSet),
+    build: Build,
     composite: (GraphicsPipeline, vk::DescriptorSet),
     depth: Option<(GraphicsPipeline, vk::DescriptorSet)>,
 }
@@ -102,12 +112,16 @@ struct Pipelines {
 struct Resources {
     extent: vk::Extent2D,
     mode: Transparency,
+    /// Who makes the fragments ([`Raster::Hardware`] or [`Raster::Compute`]).
+    raster: Raster,
     /// Per pixel: the nearest half-opaque depth.
     opaque: Buffer,
     /// Exact mode: the lists.
     lists: Option<Lists>,
-    /// Weighted sums and absorbance (fast mode; the exact mode's overflow).
-    sums: WeightedSums,
+    /// Weighted sums and absorbance (fast mode; the hardware build's overflow).
+    sums: Option<WeightedSums>,
+    /// The compute rasteriser's copy of the target's depth and its overflow sums.
+    raster_buffers: Option<RasterBuffers>,
     /// By target and composite shader (the exact mode's depends on K).
     pipelines: HashMap<(TargetKey, &'static str), Pipelines>,
 }
@@ -161,12 +175,17 @@ impl TransparentPass {
         info: &DeviceInfo,
         mode: Transparency,
         params: &OitParams,
+        raster: Raster,
         extent: vk::Extent2D,
     ) -> u64 {
         let pixels = u64::from(extent.width) * u64::from(extent.height);
-        // Both: the counters, the vertex colours, a depth word per pixel and the weighted sums.
-        let shared =
-            std::mem::size_of::<OitCounters>() as u64 + self.colors.size() + (4 + fast::BYTES_PER_PIXEL) * pixels;
+        // Both: the counters, the vertex colours, a depth word per pixel and
+        // the overflow: the weighted sums, or the compute rasteriser's buffers.
+        let overflow = match raster {
+            Raster::Compute => RasterBuffers::memory_bytes(extent),
+            _ => fast::BYTES_PER_PIXEL * pixels,
+        };
+        let shared = std::mem::size_of::<OitCounters>() as u64 + self.colors.size() + 4 * pixels + overflow;
         match mode {
             Transparency::Off => 0,
             Transparency::Exact => shared + Lists::memory_bytes(&OitPool::plan(info, params, extent)),
@@ -215,13 +234,21 @@ impl TransparentPass {
 
 /// Resources: made for an extent and mode, kept while they stay.
 impl TransparentPass {
-    /// Makes the resources for `mode` at `extent` the current ones (retiring others).
-    fn prepare(&mut self, frame: u64, mode: Transparency, params: &OitParams, extent: vk::Extent2D) -> Result<()> {
+    /// Makes the resources for `mode` drawn by `raster` at `extent` the current
+    /// ones (retiring others).
+    fn prepare(
+        &mut self,
+        frame: u64,
+        mode: Transparency,
+        params: &OitParams,
+        raster: Raster,
+        extent: vk::Extent2D,
+    ) -> Result<()> {
         let pool = match mode {
             Transparency::Exact => Some(OitPool::plan(&self.device.info, params, extent)),
             _ => None,
         };
-        let fits = |r: &Resources| r.extent == extent && r.mode == mode && r.pool() == pool;
+        let fits = |r: &Resources| r.extent == extent && r.mode == mode && r.pool() == pool && r.raster == raster;
         if let Some(old) = self.current.take_if(|r| !fits(r)) {
             // Frames up to the previous one may still be using them.
             self.retired.push((frame.saturating_sub(1), old));
@@ -246,12 +273,15 @@ impl TransparentPass {
             None => None,
         };
         let pixels = u64::from(extent.width) * u64::from(extent.height);
+        let compute = raster == Raster::Compute;
         self.current = Some(Resources {
             extent,
             mode,
+            raster,
             opaque: Buffer::storage(d, "vkhair transparency opaque depth", 4 * pixels)?,
             lists,
-            sums: WeightedSums::new(d, extent)?,
+            sums: if compute { None } else { Some(WeightedSums::new(d, extent)?) },
+            raster_buffers: if compute { Some(RasterBuffers::new(d, extent)?) } else { None },
             pipelines: HashMap::new(),
         });
         Ok(())
@@ -294,6 +324,9 @@ impl TransparentPass {
         if let Some(lists) = &res.lists {
             ours.extend(lists.bindings());
         }
+        if let Some(raster) = &res.raster_buffers {
+            ours.extend(raster.bindings());
+        }
         let (shading_buffers, shading_images) = shading.bindings(&frame.inputs);
         let mut buffers = shading_buffers.to_vec();
         buffers.extend_from_slice(&ours);
@@ -306,20 +339,32 @@ impl TransparentPass {
         let rect = ComputePipeline::new(d, &RENDER_HAIR_RECT_COMP, 1)?;
         let rect_set = rect.declared_resource_set(0, &buffers, &[])?;
         let build_stages = [&RENDER_RIBBON_VERT_COVERAGE, shaders.build];
-        let build = GraphicsPipeline::specialised(
-            d,
-            &desc(
-                "vkhair hair transparency build",
-                &build_stages,
-                &weighted_formats,
-                has_depth,
-                false,
-                Blend::Additive,
-            ),
-            1,
-            pool_buffers,
-        )?;
-        let build_set = build.declared_resource_set(0, &buffers, &shading_images)?;
+        let build = match res.raster {
+            Raster::Compute => {
+                // Constant 0: the pool's buffers (oit.glsl), as the hardware build's.
+                let mut pipeline = ComputePipeline::new(d, &RENDER_STRAND_RASTER_COMP, 1)?;
+                pipeline.prepare_variant(pool_buffers.unwrap_or(1))?;
+                let set = pipeline.declared_resource_set(0, &buffers, &shading_images)?;
+                Build::Compute(pipeline, set)
+            }
+            _ => {
+                let pipeline = GraphicsPipeline::specialised(
+                    d,
+                    &desc(
+                        "vkhair hair transparency build",
+                        &build_stages,
+                        &weighted_formats,
+                        has_depth,
+                        false,
+                        Blend::Additive,
+                    ),
+                    1,
+                    pool_buffers,
+                )?;
+                let set = pipeline.declared_resource_set(0, &buffers, &shading_images)?;
+                Build::Ribbons(pipeline, set)
+            }
+        };
 
         let composite_stages = [&RENDER_HAIR_RECT_VERT, shaders.composite];
         let composite = GraphicsPipeline::specialised(
@@ -335,7 +380,11 @@ impl TransparentPass {
             1,
             pool_buffers,
         )?;
-        let sums = [(0, res.sums.sum.view(), self.nearest.raw), (1, res.sums.absorbance.view(), self.nearest.raw)];
+        let sums: Vec<_> = res
+            .sums
+            .iter()
+            .flat_map(|s| [(0, s.sum.view(), self.nearest.raw), (1, s.absorbance.view(), self.nearest.raw)])
+            .collect();
         let composite_set = composite.declared_resource_set(0, &ours, &sums)?;
 
         let depth = if has_depth {
@@ -361,7 +410,7 @@ impl TransparentPass {
             Pipelines {
                 points: (points, points_set),
                 rect: (rect, rect_set),
-                build: (build, build_set),
+                build,
                 composite: (composite, composite_set),
                 depth,
             },
@@ -372,8 +421,8 @@ impl TransparentPass {
 
 /// Recording.
 impl TransparentPass {
-    /// Records `frame` in `mode`: the build in the draw's scope and the
-    /// composite in its own.
+    /// Records `frame` in `mode` with fragments made by `raster`: the build in
+    /// the draw's scope and the composite in its own.
     ///
     /// # Safety
     /// As for `DrawPass::record`.
@@ -382,6 +431,7 @@ impl TransparentPass {
         frame: &DrawFrame<'_>,
         mode: Transparency,
         params: &OitParams,
+        raster: Raster,
         shading: &mut ShadingResources,
         ribbons: &RibbonIndices,
     ) -> Result<()> {
@@ -392,10 +442,12 @@ impl TransparentPass {
                 "transparent hair needs a single-sample target (use supersampling for more samples)",
             ));
         }
-        // Made (or found) before anything is recorded: a failure leaves `cmd` as it was.
-        self.prepare(frame.frame, mode, params, target.extent)?;
+        let compute = raster == Raster::Compute;
+        // Checked, made (or found) before anything is recorded: a failure leaves `cmd` as it was.
+        let depth_source = if compute { DepthSource::of(target)? } else { DepthSource::None };
+        self.prepare(frame.frame, mode, params, raster, target.extent)?;
         let shaders = match mode {
-            Transparency::Exact => exact::shaders(params.sorted_fragments),
+            Transparency::Exact => exact::shaders(params.sorted_fragments, raster),
             _ => fast::SHADERS,
         };
         self.make_pipelines(frame, &shaders, shading)?;
@@ -420,31 +472,44 @@ impl TransparentPass {
             hair_y0: u32::MAX,
             hair_x1: 0,
             hair_y1: 0,
+            scene_depth: depth_source.code(),
         };
-        let storage = &[AccessKind::FragmentRead, AccessKind::FragmentWrite];
+        // Where the build's fragments are made and stored.
+        let storage: &[AccessKind] = match compute {
+            true => &[AccessKind::ComputeRead, AccessKind::ComputeWrite],
+            false => &[AccessKind::FragmentRead, AccessKind::FragmentWrite],
+        };
+        let build_write = storage[1];
         // The previous frame's passes used the lists and counters (and the host read them).
         let to_clear = barrier::memory(&[READ_BY_ANY, WRITTEN_BY_ANY].concat(), &[AccessKind::TransferWrite]);
         let counters_ready =
             barrier::memory(&[AccessKind::TransferWrite], &[AccessKind::ComputeRead, AccessKind::ComputeWrite]);
         let cleared = barrier::memory(&[AccessKind::TransferWrite], storage);
-        let built = barrier::memory(&[AccessKind::FragmentWrite], &[AccessKind::FragmentRead]);
+        // The lists, the counters and the overflow to the composite (its rectangle's vertex stage reads the counters).
+        let built = barrier::memory(&[build_write], &[AccessKind::VertexRead, AccessKind::FragmentRead]);
         // The previous frame's ribbons read the colours this frame's dispatch writes.
         let to_shade = barrier::memory(&[AccessKind::VertexRead], &[AccessKind::ComputeWrite]);
-        // The colours and the rectangle to the ribbons, the build and the composite.
+        // The colours and the rectangle to the ribbons (or the rasteriser), the build and the composite.
         let shaded = barrier::memory(
             &[AccessKind::ComputeWrite],
-            &[AccessKind::VertexRead, AccessKind::FragmentRead, AccessKind::FragmentWrite],
+            &[AccessKind::VertexRead, AccessKind::FragmentRead, AccessKind::FragmentWrite, AccessKind::ComputeRead],
         );
         let (hairs, per_hair) = (frame.params.counts[0], frame.params.counts[1]);
         let depth_order = barrier::memory(barrier::ATTACHMENTS, barrier::ATTACHMENTS);
         let to_host = barrier::memory(WRITTEN_BY_ANY, &[AccessKind::HostRead]);
-        let (to_sums, from_sums) = res.sums.barriers();
-        let sums = res.sums.attachments();
+        let (to_sums, from_sums) = match &res.sums {
+            Some(sums) => {
+                let (to, from) = sums.barriers();
+                (to.to_vec(), from.to_vec())
+            }
+            None => (Vec::new(), Vec::new()),
+        };
         let depth_first = target.depth_attachment();
         let depth_again = target.depth_kept();
-        let build_rendering = rendering::info(target.extent, &sums, depth_first.as_ref());
         let color = target.color_attachment();
-        let composite_rendering = rendering::info(target.extent, &color, depth_again.as_ref());
+        // The composite is the compute path's first use of the attachments.
+        let composite_depth = if compute { depth_first.as_ref() } else { depth_again.as_ref() };
+        let composite_rendering = rendering::info(target.extent, &color, composite_depth);
         // SAFETY: guaranteed by the caller; every object belongs to this device.
         unsafe {
             let scope = RenderPass::Draw.open(d, cmd, timing);
@@ -465,12 +530,28 @@ impl TransparentPass {
                 lists.record_clear(d, cmd);
             }
             d.raw.cmd_fill_buffer(cmd, res.opaque.raw(), 0, vk::WHOLE_SIZE, OIT_END);
+            if let Some(buffers) = &res.raster_buffers {
+                buffers.record_inputs(d, cmd, depth_source, target.extent);
+            }
             d.cmd_barrier(cmd, &[cleared, shaded], &[], &[]);
-            d.raw.cmd_begin_rendering(cmd, &build_rendering);
-            d.cmd_set_full_viewport(cmd, target.extent);
-            pipelines.build.0.bind(cmd, &[pipelines.build.1]);
-            ribbons.draw(d, cmd, frame.segments);
-            d.raw.cmd_end_rendering(cmd);
+            match &pipelines.build {
+                Build::Ribbons(pipeline, set) => {
+                    let sums = res.sums.as_ref().map(WeightedSums::attachments);
+                    let sums = sums.as_ref().map_or(&[][..], |s| &s[..]);
+                    let build_rendering = rendering::info(target.extent, sums, depth_first.as_ref());
+                    d.raw.cmd_begin_rendering(cmd, &build_rendering);
+                    d.cmd_set_full_viewport(cmd, target.extent);
+                    pipeline.bind(cmd, &[*set]);
+                    ribbons.draw(d, cmd, frame.segments);
+                    d.raw.cmd_end_rendering(cmd);
+                }
+                Build::Compute(pipeline, set) => {
+                    pipeline.bind_variant(cmd, pool.map_or(1, |p| p.buffers), &[*set]);
+                    let per_group = pipeline.workgroup_size()[0];
+                    let segments = frame.segments.min(MAX_WORKGROUPS.saturating_mul(per_group));
+                    pipeline.dispatch_threads(cmd, [segments, 1, 1]);
+                }
+            }
             scope.close(d, cmd, timing);
 
             let scope = RenderPass::Composite.open(d, cmd, timing);

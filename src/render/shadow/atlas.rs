@@ -72,7 +72,11 @@ impl ShadowAtlas {
         let atlas = image(
             "vkhair shadow opacity atlas",
             SHADOW_ATLAS_FORMAT,
-            color | vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::TRANSFER_SRC,
+            // Storage: the compute rasteriser's last dispatch writes it.
+            color
+                | vk::ImageUsageFlags::TRANSFER_DST
+                | vk::ImageUsageFlags::TRANSFER_SRC
+                | vk::ImageUsageFlags::STORAGE,
             vk::ImageAspectFlags::COLOR,
         )?;
         let sampler = Sampler::nearest(device, "vkhair shadow atlas sampler")?;
@@ -84,6 +88,36 @@ impl ShadowAtlas {
     /// The opacity atlas's view and the nearest sampler.
     pub(super) fn sampled(&self) -> (vk::ImageView, vk::Sampler) {
         (self.atlas.view(), self.sampler.raw)
+    }
+
+    /// The opacity atlas's view, for the compute rasteriser's storage writes (in GENERAL).
+    pub(super) fn storage_view(&self) -> vk::ImageView {
+        self.atlas.view()
+    }
+
+    /// Barrier before the compute rasteriser writes the opacity atlas: from the
+    /// last frame's sampling to GENERAL for compute-shader writes (contents
+    /// discarded).
+    pub(super) fn to_storage(&self) -> vk::ImageMemoryBarrier2<'static> {
+        barrier::image(
+            &self.atlas,
+            FRAGMENT_SAMPLED,
+            &[AccessKind::ComputeWrite],
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::GENERAL,
+        )
+    }
+
+    /// Barrier after the compute rasteriser wrote the opacity atlas: to
+    /// fragment- and compute-shader sampling.
+    pub(super) fn storage_to_sampled(&self) -> vk::ImageMemoryBarrier2<'static> {
+        barrier::image(
+            &self.atlas,
+            &[AccessKind::ComputeWrite],
+            FRAGMENT_SAMPLED,
+            vk::ImageLayout::GENERAL,
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        )
     }
 
     /// The z0 atlas's view and the nearest sampler (what the opacity pass reads).

@@ -13,6 +13,7 @@
 //! interpolation pass captured, at the frame's level of detail.
 
 mod atlas;
+mod compute_maps;
 mod opacity_maps;
 #[cfg(test)]
 mod tests;
@@ -24,6 +25,7 @@ use ash::vk;
 use glam::Vec3;
 
 use super::shading::MAX_LIGHTS;
+use super::Raster;
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuLight, GpuShadowParams};
 use crate::profiler::Timing;
@@ -326,13 +328,15 @@ impl Shadows {
     /// # Safety
     /// `cmd` is a recording command buffer of this device outside a render pass,
     /// after the interpolation pass (and `sim`'s step) in submission order.
+    #[allow(clippy::too_many_arguments)]
     pub(super) unsafe fn record(
-        &self,
+        &mut self,
         cmd: vk::CommandBuffer,
         sim: &KeyHairs<'_>,
         lights: &[GpuLight],
         bounds: Bounds,
         drawn: DrawnHairs,
+        (raster, hair_positions): (Raster, &Buffer),
         timing: Timing<'_>,
     ) -> Result<()> {
         let DrawnHairs { counts: (hairs, per_hair), footprint } = drawn;
@@ -388,7 +392,9 @@ impl Shadows {
             d.cmd_barrier(cmd, &[before_update], &[], &[]);
             d.raw.cmd_update_buffer(cmd, self.uniforms.raw(), 0, bytemuck::bytes_of(&uniforms));
             if any_map {
-                self.maps.record(cmd, updated, &uniforms, hairs * (per_hair - 1) * 2, timing);
+                let vertices = hairs * (per_hair - 1) * 2;
+                let inputs = (raster, (&self.uniforms, hair_positions));
+                self.maps.record_with(cmd, updated, &uniforms, vertices, inputs, timing)?;
             } else {
                 d.cmd_barrier(cmd, &[updated], &[], &[]);
             }

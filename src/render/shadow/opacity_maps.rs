@@ -18,12 +18,14 @@ use ash::vk;
 use glam::{Vec3, Vec4};
 
 use super::atlas::{ShadowAtlas, DEPTH_FORMAT, Z0_FORMAT};
+use super::compute_maps::ComputeMaps;
 use super::{Bounds, ShadowParams, SHADOW_ATLAS_FORMAT};
 use crate::codes::shadow_kind;
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuLight, GpuShadowMap, GpuShadowParams};
 use crate::profiler::{PassScope, Timing};
 use crate::render::pass::RenderPass;
+use crate::render::Raster;
 use crate::vk::buffer::Buffer;
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
@@ -31,12 +33,14 @@ use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
 use crate::vk::rendering;
 use crate::vk::shaders::{ShaderSource, RENDER_SHADOW_DEPTH_FRAG, RENDER_SHADOW_OPACITY_FRAG, RENDER_SHADOW_VERT};
 
-/// The two passes' pipelines over one atlas.
+/// The two passes' pipelines over one atlas, and the compute rasteriser's
+/// (`compute_maps.rs`), made on its first frame.
 pub(super) struct OpacityMaps {
     device: Arc<Device>,
     pub(super) atlas: ShadowAtlas,
     depth_pass: (GraphicsPipeline, vk::DescriptorSet),
     opacity_pass: (GraphicsPipeline, vk::DescriptorSet),
+    compute: Option<ComputeMaps>,
 }
 
 impl OpacityMaps {
@@ -89,7 +93,39 @@ impl OpacityMaps {
             atlas,
             depth_pass: (depth_pipeline, depth_set),
             opacity_pass: (opacity_pipeline, opacity_set),
+            compute: None,
         })
+    }
+
+    /// Records the maps of `uniforms` drawn by `raster`: see
+    /// [`OpacityMaps::record`] and `ComputeMaps::record`, which leave the atlas
+    /// alike. The compute passes are made on the first compute frame, reading
+    /// `inputs` (the uniform buffer and the hair positions this was made with).
+    ///
+    /// # Safety
+    /// As [`OpacityMaps::record`].
+    pub(super) unsafe fn record_with(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        before: vk::MemoryBarrier2<'_>,
+        uniforms: &GpuShadowParams,
+        vertices: u32,
+        (raster, inputs): (Raster, (&Buffer, &Buffer)),
+        timing: Timing<'_>,
+    ) -> Result<()> {
+        if raster != Raster::Compute {
+            // SAFETY: guaranteed by the caller.
+            unsafe { self.record(cmd, before, uniforms, vertices, timing) };
+            return Ok(());
+        }
+        if self.compute.is_none() {
+            self.compute = Some(ComputeMaps::new(&self.device, &self.atlas, inputs.0, inputs.1)?);
+        }
+        if let Some(compute) = &self.compute {
+            // SAFETY: guaranteed by the caller; the passes were made for this atlas.
+            unsafe { compute.record(cmd, before, uniforms, &self.atlas, timing) };
+        }
+        Ok(())
     }
 
     /// Records both passes for the maps of `uniforms` over `vertices` line

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use vkhair::render::Transparency;
+use vkhair::render::{Raster, Transparency};
 
 use super::input::InputArgs;
 use super::sim::SimArgs;
@@ -55,6 +55,11 @@ pub struct SceneArgs {
     /// per-pixel sorted lists [default: the --config file's, else exact].
     #[arg(long, value_enum)]
     pub transparency: Option<Transparency>,
+    /// Who rasterises the strands of --transparency exact: the compute
+    /// rasteriser or the hardware raster pipeline [default: the --config
+    /// file's, else auto: compute on GPUs, on a CPU device the faster one there].
+    #[arg(long, value_enum)]
+    pub raster: Option<Raster>,
     /// Fragments sorted exactly per pixel by --transparency exact (1..=32) [default: 8].
     #[arg(long)]
     pub sorted_fragments: Option<u32>,

@@ -59,6 +59,9 @@ pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
     if let Some(t) = a.transparency {
         r.transparency = t;
     }
+    if let Some(raster) = a.raster {
+        r.raster = raster;
+    }
     if a.marschner {
         config.material.shading = ShadingMode::Marschner;
     }

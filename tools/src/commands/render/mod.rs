@@ -226,11 +226,17 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     bar.finish_and_clear();
     sink.finish()?;
     profile.print_table();
+    if !sa.no_shadows && !sa.volume_shadows {
+        say!("shadows: deep opacity maps drawn by {}", rasteriser(renderer.shadow_raster()));
+    }
     let mode = renderer.params().transparency;
     if mode != Transparency::Off {
         let extent = vkhair::ash::vk::Extent2D { width: sa.width, height: sa.height };
         let mib = renderer.transparency_memory(extent) as f64 / (1024.0 * 1024.0);
-        say!("transparency: {mode:?}, {mib:.1} MiB of lists, accumulation images and vertex colours");
+        say!(
+            "transparency: {mode:?}, strands drawn by {}, {mib:.1} MiB of lists, accumulation buffers and vertex colours",
+            rasteriser(renderer.raster())
+        );
     }
     if let Some(stats) = renderer.transparency_stats() {
         say!(
@@ -268,4 +274,12 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
         say!("{credit}");
     }
     Ok(())
+}
+
+/// How the tool names a rasteriser.
+fn rasteriser(raster: vkhair::render::Raster) -> &'static str {
+    match raster {
+        vkhair::render::Raster::Compute => "the compute rasteriser",
+        _ => "the hardware raster pipeline",
+    }
 }

@@ -1,0 +1,216 @@
+//! Pass 4 with [`Transparency::Exact`](crate::render::Transparency::Exact) and
+//! [`Raster::Compute`](crate::render::Raster::Compute): the fragments made by
+//! vkhair's compute rasteriser (`glsl/render/strand_raster.comp`, one
+//! invocation a segment, analytic coverage) instead of the ribbons' hardware
+//! draw, into the same per-pixel lists (`exact.rs`), composited by the same
+//! resolve reading the overflow from a buffer.
+//!
+//! What the rasteriser adds to the transparency pass's resources, per extent:
+//!
+//! - **the target's depth**, copied each frame out of the host's depth image
+//!   ([`crate::render::RenderTarget::depth_image`]) into a buffer the
+//!   rasteriser tests each fragment against: a compute shader cannot read a
+//!   depth attachment, and a copy asks of the host only `TRANSFER_SRC` usage
+//!   (no sampled view, no layout of its own); none where the frame's depth
+//!   was cleared by vkhair (supersampling's own images);
+//! - **the overflow sums**, five words a pixel of fixed-point sums added with
+//!   integer atomics (`glsl/include/oit_overflow.glsl`) in two planes, where
+//!   the hardware build blends the overflow into two float images.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::DrawTarget;
+use crate::codes::scene_depth;
+use crate::error::{Error, Result};
+use crate::vk::barrier::{self, AccessKind};
+use crate::vk::buffer::Buffer;
+use crate::vk::device::Device;
+use crate::vk::rendering::Load;
+
+/// Binding of the target's depth copy (`SceneDepth` in `strand_raster.comp`).
+const SCENE_DEPTH_BINDING: u32 = 25;
+/// Bindings of the overflow sums' planes (`oit_overflow.glsl`).
+const OVERFLOW_BINDINGS: [u32; 2] = [26, 27];
+/// Bytes a pixel of the overflow planes: premultiplied rgb, then alpha and absorbance.
+const OVERFLOW_PLANE_BYTES: [u64; 2] = [12, 8];
+
+/// The rasteriser's buffers of one extent.
+pub(super) struct RasterBuffers {
+    /// The target's depth, a 32-bit word a pixel (16-bit depths two a word).
+    scene_depth: Buffer,
+    /// Fixed-point overflow sums, in two planes.
+    overflow: [Buffer; 2],
+}
+
+impl RasterBuffers {
+    /// The buffers for a target of `extent` on `device`: an error where a
+    /// plane would exceed one binding's range.
+    pub(super) fn new(device: &Arc<Device>, extent: vk::Extent2D) -> Result<Self> {
+        let pixels = pixels(extent);
+        let largest = OVERFLOW_PLANE_BYTES[0] * pixels;
+        if largest > u64::from(device.info.max_storage_buffer_range) {
+            return Err(Error::incompatible(
+                "render target",
+                format!(
+                    "the compute rasteriser at {}×{} needs {largest} bytes of per-pixel sums in one buffer, more \
+                     than this device's storage buffer range ({} bytes): draw smaller, without supersampling, or \
+                     with Raster::Hardware",
+                    extent.width, extent.height, device.info.max_storage_buffer_range
+                ),
+            ));
+        }
+        let plane = |name, bytes: u64| Buffer::storage(device, name, bytes * pixels);
+        Ok(RasterBuffers {
+            scene_depth: Buffer::storage(device, "vkhair compute raster scene depth", 4 * pixels)?,
+            overflow: [
+                plane("vkhair compute raster overflow colour", OVERFLOW_PLANE_BYTES[0])?,
+                plane("vkhair compute raster overflow alpha", OVERFLOW_PLANE_BYTES[1])?,
+            ],
+        })
+    }
+
+    /// Bytes of the buffers at `extent`.
+    pub(super) fn memory_bytes(extent: vk::Extent2D) -> u64 {
+        (4 + OVERFLOW_PLANE_BYTES[0] + OVERFLOW_PLANE_BYTES[1]) * pixels(extent)
+    }
+
+    /// The buffers by binding.
+    pub(super) fn bindings(&self) -> [(u32, &Buffer); 3] {
+        [
+            (SCENE_DEPTH_BINDING, &self.scene_depth),
+            (OVERFLOW_BINDINGS[0], &self.overflow[0]),
+            (OVERFLOW_BINDINGS[1], &self.overflow[1]),
+        ]
+    }
+}
+
+fn pixels(extent: vk::Extent2D) -> u64 {
+    u64::from(extent.width) * u64::from(extent.height)
+}
+
+/// Where the rasteriser's depth test reads the target's depth.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum DepthSource {
+    /// Nothing to test against: no depth attachment, or one vkhair clears.
+    None,
+    /// The host's depth image (`image`, its depth aspect in `format`), copied
+    /// each frame; `code` is its encoding (`codes::scene_depth`).
+    Copy { image: vk::Image, code: u32 },
+}
+
+impl DepthSource {
+    /// The source for `target`: the error names what the host must give.
+    pub(super) fn of(target: &DrawTarget) -> Result<Self> {
+        let Some((_, Load::Keep)) = target.depth else {
+            return Ok(DepthSource::None);
+        };
+        let Some(image) = target.depth_image else {
+            return Err(Error::incompatible(
+                "render target",
+                "the compute rasteriser tests hair against the target's depth and needs its image: set \
+                 RenderTarget::depth_image (created with TRANSFER_SRC usage), or draw with Raster::Hardware",
+            ));
+        };
+        let code = match target.key.depth {
+            vk::Format::D32_SFLOAT | vk::Format::D32_SFLOAT_S8_UINT => scene_depth::FLOAT32,
+            vk::Format::D24_UNORM_S8_UINT | vk::Format::X8_D24_UNORM_PACK32 => scene_depth::UNORM24,
+            vk::Format::D16_UNORM | vk::Format::D16_UNORM_S8_UINT => scene_depth::UNORM16,
+            other => {
+                return Err(Error::incompatible(
+                    "render target",
+                    format!("the compute rasteriser cannot read depth format {other:?}"),
+                ))
+            }
+        };
+        Ok(DepthSource::Copy { image, code })
+    }
+
+    /// The encoding the rasteriser reads (`OitCounters::scene_depth`).
+    pub(super) fn code(self) -> u32 {
+        match self {
+            DepthSource::None => scene_depth::NONE,
+            DepthSource::Copy { code, .. } => code,
+        }
+    }
+}
+
+impl RasterBuffers {
+    /// Records the copy of the target's depth (if any) into the buffer the
+    /// rasteriser reads: the host's image from `DEPTH_ATTACHMENT_OPTIMAL` to
+    /// `TRANSFER_SRC_OPTIMAL`, copied, and back for the composite's depth test
+    /// and write; then the overflow sums zeroed. Transfer writes: the caller's
+    /// barrier makes them visible to the rasteriser.
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of `device` outside a render pass;
+    /// `source`'s image is `extent` large (or larger), in
+    /// `DEPTH_ATTACHMENT_OPTIMAL` with the host's writes before it; earlier
+    /// reads of the buffers are ordered before by the caller's barrier.
+    pub(super) unsafe fn record_inputs(
+        &self,
+        device: &Device,
+        cmd: vk::CommandBuffer,
+        source: DepthSource,
+        extent: vk::Extent2D,
+    ) {
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            for plane in &self.overflow {
+                device.raw.cmd_fill_buffer(cmd, plane.raw(), 0, vk::WHOLE_SIZE, 0);
+            }
+        }
+        let DepthSource::Copy { image, .. } = source else {
+            return;
+        };
+        let range = vk::ImageSubresourceRange {
+            aspect_mask: vk::ImageAspectFlags::DEPTH,
+            base_mip_level: 0,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        let to_copy = barrier::subresources(
+            image,
+            range,
+            barrier::DEPTH_ATTACHMENT,
+            &[AccessKind::TransferRead],
+            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+        );
+        let back = barrier::subresources(
+            image,
+            range,
+            &[AccessKind::TransferRead],
+            barrier::DEPTH_ATTACHMENT,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+        );
+        let region = vk::BufferImageCopy {
+            buffer_offset: 0,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::DEPTH,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            },
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D { width: extent.width, height: extent.height, depth: 1 },
+        };
+        // SAFETY: guaranteed by the caller; the buffer holds a word a pixel.
+        unsafe {
+            device.cmd_barrier(cmd, &[], &[], &[to_copy]);
+            device.raw.cmd_copy_image_to_buffer(
+                cmd,
+                image,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                self.scene_depth.raw(),
+                &[region],
+            );
+            device.cmd_barrier(cmd, &[], &[], &[back]);
+        }
+    }
+}

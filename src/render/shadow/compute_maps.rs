@@ -1,0 +1,154 @@
+//! Deep opacity maps by the compute rasteriser ([`Raster::Compute`](crate::render::Raster::Compute);
+//! `glsl/render/shadow_raster.comp`, `shadow_resolve.comp`): the same two
+//! passes as `opacity_maps.rs`, the hairs walked as one-texel lines by one
+//! invocation a segment, into sums the last dispatch turns into the same atlas.
+//!
+//! 1. **Shadow depth** ([`RenderPass::ShadowDepth`]): per map, each segment's
+//!    texels keep the nearest light-space depth z0 (an atomic minimum of its
+//!    bits: depths in the map's range are positive);
+//! 2. **Shadow opacity** ([`RenderPass::ShadowOpacity`]): per map, each
+//!    segment's texels add its opacity to the layer its depth behind z0 falls in
+//!    and to every layer behind it, in fixed point (integer atomics: the sums do
+//!    not depend on the order the segments arrive in); then one dispatch writes
+//!    every atlas texel from its sums, layers in RGB and z0 in A (zero where no
+//!    strand reaches it), as the hardware passes leave it.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::atlas::ShadowAtlas;
+use crate::error::Result;
+use crate::gpu_types::GpuShadowParams;
+use crate::profiler::{PassScope, Timing};
+use crate::render::pass::RenderPass;
+use crate::vk::barrier::{self, AccessKind};
+use crate::vk::buffer::Buffer;
+use crate::vk::debug::LabelColor;
+use crate::vk::device::Device;
+use crate::vk::pipeline::ComputePipeline;
+use crate::vk::shaders::{RENDER_SHADOW_RASTER_COMP, RENDER_SHADOW_RASTER_COMP_SHADOW_Z0, RENDER_SHADOW_RESOLVE_COMP};
+
+/// Workgroups of a dispatch every device runs (`maxComputeWorkGroupCount`'s minimum).
+const MAX_WORKGROUPS: u32 = 65_535;
+/// `SHADOW_NO_HAIR` of `glsl/include/shadow_sums.glsl`: z0's key where no strand is.
+const NO_HAIR: u32 = u32::MAX;
+
+/// The passes' push constants (`Push` in `shadow_raster.comp`).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct RasterPush {
+    map: u32,
+    atlas_width: u32,
+}
+
+/// The compute passes over one atlas: its sums and pipelines.
+pub(super) struct ComputeMaps {
+    device: Arc<Device>,
+    /// Per atlas texel: z0's key.
+    z0: Buffer,
+    /// Per atlas texel: three layer sums.
+    layers: Buffer,
+    depth_pass: (ComputePipeline, vk::DescriptorSet),
+    opacity_pass: (ComputePipeline, vk::DescriptorSet),
+    resolve: (ComputePipeline, [vk::DescriptorSet; 2]),
+}
+
+impl ComputeMaps {
+    /// The passes into `atlas`, reading the frame's `uniforms` and hairs from `hair_positions`.
+    pub(super) fn new(
+        device: &Arc<Device>,
+        atlas: &ShadowAtlas,
+        uniforms: &Buffer,
+        hair_positions: &Buffer,
+    ) -> Result<Self> {
+        let extent = atlas.extent();
+        let texels = u64::from(extent.width) * u64::from(extent.height);
+        let z0 = Buffer::storage(device, "vkhair shadow z0 keys", 4 * texels)?;
+        let layers = Buffer::storage(device, "vkhair shadow layer sums", 12 * texels)?;
+        let buffers = [(0, uniforms), (1, hair_positions), (3, &z0), (4, &layers)];
+        let pass = |shader| -> Result<(ComputePipeline, vk::DescriptorSet)> {
+            let pipeline = ComputePipeline::new(device, shader, 1)?;
+            let set = pipeline.declared_buffer_set(0, &buffers)?;
+            Ok((pipeline, set))
+        };
+        let depth_pass = pass(&RENDER_SHADOW_RASTER_COMP_SHADOW_Z0)?;
+        let opacity_pass = pass(&RENDER_SHADOW_RASTER_COMP)?;
+        let resolve = ComputePipeline::new(device, &RENDER_SHADOW_RESOLVE_COMP, 1)?;
+        let sums = resolve.declared_buffer_set(0, &buffers)?;
+        let image = resolve.storage_image_set(1, &[(0, atlas.storage_view())])?;
+        Ok(ComputeMaps {
+            device: device.clone(),
+            z0,
+            layers,
+            depth_pass,
+            opacity_pass,
+            resolve: (resolve, [sums, image]),
+        })
+    }
+
+    /// Records both passes for the maps of `uniforms` into `atlas`, each in its
+    /// scope, leaving the atlas in SHADER_READ_ONLY_OPTIMAL for fragment and
+    /// compute shaders. `before` (the uniform update's barrier) is recorded
+    /// first, together with the atlas's own transition.
+    ///
+    /// # Safety
+    /// As `OpacityMaps::record`; `atlas` is the one the passes were made for.
+    pub(super) unsafe fn record(
+        &self,
+        cmd: vk::CommandBuffer,
+        before: vk::MemoryBarrier2<'_>,
+        uniforms: &GpuShadowParams,
+        atlas: &ShadowAtlas,
+        timing: Timing<'_>,
+    ) {
+        let d = &self.device;
+        let maps = uniforms.map_count();
+        let extent = atlas.extent();
+        let push = |map: usize| RasterPush { map: map as u32, atlas_width: extent.width };
+        let segments = uniforms.counts[0].saturating_mul(uniforms.counts[1].saturating_sub(1));
+        let light_of = |map: usize| (0..8).find(|&i| uniforms.light_map[i / 4][i % 4] == map as u32).unwrap_or(map);
+        let storage = &[AccessKind::ComputeRead, AccessKind::ComputeWrite];
+        // The previous frame's passes and resolve read and wrote the sums.
+        let to_clear = barrier::memory(storage, &[AccessKind::TransferWrite]);
+        let cleared = barrier::memory(&[AccessKind::TransferWrite], storage);
+        let between = barrier::memory(&[AccessKind::ComputeWrite], storage);
+        let run = |pass: &(ComputePipeline, vk::DescriptorSet), stage: RenderPass| {
+            // SAFETY: guaranteed by the caller.
+            unsafe {
+                pass.0.bind(cmd, &[pass.1]);
+                let per_group = pass.0.workgroup_size()[0];
+                let threads = segments.min(MAX_WORKGROUPS.saturating_mul(per_group));
+                for (k, map) in uniforms.maps.iter().enumerate().take(maps) {
+                    if map.is_density_volume() {
+                        continue; // density volume: no map
+                    }
+                    let label = format!("{}, light {}", stage.label(), light_of(k));
+                    let scope = PassScope::open(d, cmd, timing, &label, LabelColor::Compute);
+                    pass.0.push(cmd, &push(k));
+                    pass.0.dispatch_threads(cmd, [threads, 1, 1]);
+                    scope.close(d, cmd, timing);
+                }
+            }
+        };
+        // SAFETY: guaranteed by the caller; every object belongs to this device.
+        unsafe {
+            d.cmd_barrier(cmd, &[before, to_clear], &[], &[atlas.to_storage()]);
+            d.raw.cmd_fill_buffer(cmd, self.z0.raw(), 0, vk::WHOLE_SIZE, NO_HAIR);
+            d.raw.cmd_fill_buffer(cmd, self.layers.raw(), 0, vk::WHOLE_SIZE, 0);
+            d.cmd_barrier(cmd, &[cleared], &[], &[]);
+            let scope = RenderPass::ShadowDepth.open(d, cmd, timing);
+            run(&self.depth_pass, RenderPass::ShadowDepth);
+            d.cmd_barrier(cmd, &[between], &[], &[]);
+            scope.close(d, cmd, timing);
+            let scope = RenderPass::ShadowOpacity.open(d, cmd, timing);
+            run(&self.opacity_pass, RenderPass::ShadowOpacity);
+            d.cmd_barrier(cmd, &[between], &[], &[]);
+            let (resolve, sets) = &self.resolve;
+            resolve.bind(cmd, sets);
+            resolve.dispatch_threads(cmd, [extent.width, extent.height, 1]);
+            d.cmd_barrier(cmd, &[], &[], &[atlas.storage_to_sampled()]);
+            scope.close(d, cmd, timing);
+        }
+    }
+}
