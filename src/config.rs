@@ -8,6 +8,7 @@
 //! | `[[lights]]` | [`Light`], with `kind = "directional"`, `"point"` or `"spot"` |
 //! | `[material]`, `[material.marschner]` | [`HairMaterial`], [`crate::render::MarschnerParams`] |
 //! | `[mesh_collider]` | [`MeshColliderParams`] |
+//! | `[scalp]` | [`ScalpHairParams`] |
 //!
 //! Every key is optional: a file sets what it names and keeps everything else
 //! from the configuration it is applied to ([`Config::default`], or a tool's
@@ -36,7 +37,7 @@
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::render::{HairMaterial, Light, RenderParams, MAX_LIGHTS};
+use crate::render::{HairMaterial, Light, RenderParams, ScalpHairParams, MAX_LIGHTS};
 use crate::sim::{MeshColliderParams, SimParams};
 
 /// The most vkhair reads of a parameter file unless
@@ -60,6 +61,9 @@ pub struct Config {
     pub material: HairMaterial,
     /// How the mesh collider's field is built (`[mesh_collider]`).
     pub mesh_collider: MeshColliderParams,
+    /// How drawn hairs are rooted over the scalp (`[scalp]`;
+    /// [`crate::render::Followers::over_scalp`]).
+    pub scalp: ScalpHairParams,
 }
 
 impl Config {
@@ -112,6 +116,7 @@ impl Config {
         self.render.validate()?;
         self.material.validate()?;
         self.mesh_collider.validate()?;
+        self.scalp.validate()?;
         if self.lights.len() > MAX_LIGHTS {
             return Err(Error::param("lights", self.lights.len(), format!("at most {MAX_LIGHTS}")));
         }
@@ -127,8 +132,8 @@ impl Config {
             "# vkhair parameters. Uncomment and change the keys you need; every key is\n\
              # optional and keeps the value shown when left out. Units and ranges are\n\
              # documented on the fields of SimParams ([sim]), VolumeParams ([sim.volume]),\n\
-             # RenderParams ([render]), Light ([[lights]]), HairMaterial ([material]) and\n\
-             # MeshColliderParams ([mesh_collider]).\n",
+             # RenderParams ([render]), Light ([[lights]]), HairMaterial ([material]),\n\
+             # MeshColliderParams ([mesh_collider]) and ScalpHairParams ([scalp]).\n",
         );
         for line in body.lines() {
             let header = line.starts_with('[') && !line.starts_with("[[");

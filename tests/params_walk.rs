@@ -58,6 +58,10 @@ const ACCEPTED: &[(&str, &str)] = &[
     // Config: [render.oit]: 0 is the device's limit; any size from 64 KiB
     ("render.oit.max_buffer_bytes", "0"),
     ("render.oit.max_buffer_bytes", "4000000000"),
+    // Config: [scalp]: 0° blends only guides combed alike; no clumping; no length variation
+    ("scalp.parting_angle", "0"),
+    ("scalp.clumping", "0"),
+    ("scalp.length_variation", "0"),
     // Config: [material]
     ("material.ambient", "0"),
     ("material.diffuse_wrap", "0"),

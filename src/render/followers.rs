@@ -73,7 +73,7 @@ pub struct Followers {
 /// The blend of guides `g` with weights `w` at parameter `s`: position and
 /// frame (`root`, the head's rotation, at the root).
 fn blend(
-    guides: &[&[(Vec3, Vec3)]],
+    guides: &[Vec<(Vec3, Vec3)>],
     references: &[Vec3],
     (g, w): ([u32; 3], [f32; 3]),
     s: f32,
@@ -85,7 +85,7 @@ fn blend(
         if w[k] == 0.0 {
             continue;
         }
-        let guide = guides[g[k] as usize];
+        let guide = &guides[g[k] as usize];
         let u = s * (guide.len() - 1) as f32;
         let k0 = (u.floor() as usize).min(guide.len().saturating_sub(2));
         let a = u - k0 as f32;
@@ -126,15 +126,7 @@ impl Followers {
             }
             guide_of[s] = g as u32;
         }
-        let references = super::reference::rest_plane_normals(rest);
-        let smoothed: Vec<Vec<(Vec3, Vec3)>> = (0..rest.strands)
-            .map(|g| {
-                let keys: Vec<Vec3> =
-                    rest.rest[g * rest.points..(g + 1) * rest.points].iter().map(|p| p.truncate()).collect();
-                smooth_strand(&keys, level)
-            })
-            .collect();
-        let guide_shapes: Vec<&[(Vec3, Vec3)]> = smoothed.iter().map(Vec::as_slice).collect();
+        let shapes = GuideShapes::of(rest, level);
         let roots = rest.rest_roots();
         let triangles = super::scalp::root_triangles(rest);
         let mesh = (!triangles.is_empty()).then(|| TriMesh::new(roots.clone(), triangles.clone())).transpose()?;
@@ -154,36 +146,11 @@ impl Followers {
                 _ => authored.strand(s as usize),
             };
             let root = authored.strand(s as usize)[0];
-            let (mut g, mut w) = match guide_of[s as usize] {
+            let gw = match guide_of[s as usize] {
                 u32::MAX => nearest_guides(root, &roots, grid.as_ref(), &triangles),
                 g => ([g, g, g], [1.0, 0.0, 0.0]),
             };
-            // Each point's offset in the blend of guides `(g, w)`, or `None`
-            // where `strict` and the blend is nearly singular anywhere along
-            // the strand (its inverse would magnify the offset, and motion
-            // with it).
-            let offsets_in = |(g, w), strict: bool| -> Option<Vec<Vec3>> {
-                strand
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &x)| {
-                        let s = i as f32 / (points - 1) as f32;
-                        let (p, m) = blend(&guide_shapes, &references, (g, w), s, Mat3::IDENTITY);
-                        let (d, o) = (x - p, m.inverse() * (x - p));
-                        let singular = m.determinant().abs() < SINGULAR || o.length() > MAGNIFIED * d.length() + 1e-6;
-                        (!(strict && singular)).then_some(o)
-                    })
-                    .collect()
-            };
-            let point_offsets = match offsets_in((g, w), true) {
-                Some(o) => o,
-                None => {
-                    // The heaviest guide alone (one guide's frame is a rotation).
-                    let k = (0..3).max_by(|&a, &b| w[a].total_cmp(&w[b])).unwrap_or(0);
-                    (g, w) = ([g[k]; 3], [1.0, 0.0, 0.0]);
-                    offsets_in((g, w), false).unwrap_or_default()
-                }
-            };
+            let ((g, w), point_offsets) = shapes.bind_strand(strand, gw);
             offsets.extend(point_offsets.iter().flat_map(|o| o.to_array()));
             bindings.push(FollowerBinding { guides: [g[0], g[1], g[2], 0], weights: [w[0], w[1], w[2], 0.0] });
         }
@@ -197,16 +164,20 @@ impl Followers {
         // The scalp's area: the guide-root triangles', else the roots' bounds.
         let area = if area > 0.0 { area } else { bounds_area(authored) };
         let root_spacing = (area / strands as f32).sqrt().max(1e-6);
-        Ok(Followers {
-            points: points as u32,
-            level,
-            bindings,
-            offsets,
-            order,
-            root_spacing,
-            colors: None,
-            widths: None,
-        })
+        Ok(Followers::from_parts(points, level, (bindings, offsets), order, root_spacing))
+    }
+
+    /// Followers of `points` points bound at smoothing `level`: per follower
+    /// (drawing order) its guides and weights and its points' offsets, the
+    /// strand index each stands for, and the mean spacing of their roots (m).
+    pub(super) fn from_parts(
+        points: usize,
+        level: u32,
+        (bindings, offsets): (Vec<FollowerBinding>, Vec<f32>),
+        order: Vec<u32>,
+        root_spacing: f32,
+    ) -> Followers {
+        Followers { points: points as u32, level, bindings, offsets, order, root_spacing, colors: None, widths: None }
     }
 
     /// The same followers drawn in their own colours: per strand of the groom
@@ -339,7 +310,6 @@ impl Followers {
         if drawn > self.count() {
             return Err(Error::param("drawn followers", drawn, format!("at most {}", self.count())));
         }
-        let shapes: Vec<&[(Vec3, Vec3)]> = guides.iter().map(Vec::as_slice).collect();
         let turned: Vec<Vec3> = references.iter().map(|r| head * *r).collect();
         let root = Mat3::from_quat(head);
         let n = self.points as usize;
@@ -348,7 +318,7 @@ impl Followers {
             let g = [b.guides[0], b.guides[1], b.guides[2]];
             let w = [b.weights[0], b.weights[1], b.weights[2]];
             for i in 0..n {
-                let (p, m) = blend(&shapes, &turned, (g, w), i as f32 / (n - 1) as f32, root);
+                let (p, m) = blend(guides, &turned, (g, w), i as f32 / (n - 1) as f32, root);
                 let o = &self.offsets[(f * n + i) * 3..(f * n + i) * 3 + 3];
                 out.push(p + m * Vec3::new(o[0], o[1], o[2]));
             }
@@ -377,6 +347,76 @@ impl Followers {
             .collect();
         strands.sort_by_key(|(s, _)| *s);
         Ok(strands)
+    }
+}
+
+/// The guides at rest, smoothed as the renderer smooths them, and their
+/// rest-plane normals: what a strand is bound against.
+pub(super) struct GuideShapes {
+    smoothed: Vec<Vec<(Vec3, Vec3)>>,
+    references: Vec<Vec3>,
+}
+
+impl GuideShapes {
+    /// The guides of `rest` smoothed at `level`.
+    pub(super) fn of(rest: &SimState, level: u32) -> Self {
+        let smoothed = (0..rest.strands)
+            .map(|g| {
+                let keys: Vec<Vec3> =
+                    rest.rest[g * rest.points..(g + 1) * rest.points].iter().map(|p| p.truncate()).collect();
+                smooth_strand(&keys, level)
+            })
+            .collect();
+        GuideShapes { smoothed, references: super::reference::rest_plane_normals(rest) }
+    }
+
+    /// The blend of guides `g` with weights `w` at parameter `s` along them,
+    /// at rest: its position (as [`blend`] places it).
+    pub(super) fn position_at(&self, (g, w): ([u32; 3], [f32; 3]), s: f32) -> Vec3 {
+        let mut p = Vec3::ZERO;
+        for k in 0..3 {
+            if w[k] == 0.0 {
+                continue;
+            }
+            let guide = &self.smoothed[g[k] as usize];
+            let u = s * (guide.len() - 1) as f32;
+            let k0 = (u.floor() as usize).min(guide.len().saturating_sub(2));
+            let k1 = (k0 + 1).min(guide.len() - 1);
+            p += w[k] * guide[k0].0.lerp(guide[k1].0, u - k0 as f32);
+        }
+        p
+    }
+
+    /// `strand` (point `i` of `n` at parameter `i / (n − 1)`) bound to guides
+    /// `g` with weights `w`: the guides and weights it keeps and each point's
+    /// offset in their blend. Where the blend is nearly singular anywhere
+    /// along the strand (its inverse would magnify the offset, and motion with
+    /// it), the heaviest guide alone (one guide's frame is a rotation).
+    pub(super) fn bind_strand(
+        &self,
+        strand: &[Vec3],
+        (g, w): ([u32; 3], [f32; 3]),
+    ) -> (([u32; 3], [f32; 3]), Vec<Vec3>) {
+        let n = strand.len().max(2);
+        let offsets_in = |(g, w), strict: bool| -> Option<Vec<Vec3>> {
+            strand
+                .iter()
+                .enumerate()
+                .map(|(i, &x)| {
+                    let s = i as f32 / (n - 1) as f32;
+                    let (p, m) = blend(&self.smoothed, &self.references, (g, w), s, Mat3::IDENTITY);
+                    let (d, o) = (x - p, m.inverse() * (x - p));
+                    let singular = m.determinant().abs() < SINGULAR || o.length() > MAGNIFIED * d.length() + 1e-6;
+                    (!(strict && singular)).then_some(o)
+                })
+                .collect()
+        };
+        if let Some(o) = offsets_in((g, w), true) {
+            return ((g, w), o);
+        }
+        let k = (0..3).max_by(|&a, &b| w[a].total_cmp(&w[b])).unwrap_or(0);
+        let alone = ([g[k]; 3], [1.0, 0.0, 0.0]);
+        (alone, offsets_in(alone, false).unwrap_or_default())
     }
 }
 

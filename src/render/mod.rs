@@ -36,6 +36,7 @@ mod readback;
 pub mod reference;
 mod resolve;
 pub mod scalp;
+mod scalp_hair;
 mod shading;
 mod shadow;
 mod smooth;
@@ -49,6 +50,7 @@ pub use params::{
     MAX_SMOOTHING_LEVEL,
 };
 pub use pass::RenderPass;
+pub use scalp_hair::{scalp_area_cm2, ScalpHairParams};
 pub use shading::{Camera, HairMaterial, Light, ShadingMode, MAX_LIGHTS};
 pub use shadow::{
     layer_of, layer_opacity, ShadowCaster, ShadowMethod, ShadowParams, MAX_SHADOW_MAPS, SHADOW_ATLAS_FORMAT,

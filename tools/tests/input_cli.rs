@@ -77,10 +77,12 @@ fn strand_width_comes_from_the_groom_thickness() {
     let absurd = write("absurd.hair", Some(5.0)); // 5 cm
     let config = dir.path().join("widths.toml");
     std::fs::write(&config, "[material]\nroot_width = 0.0002\ntip_width = 0.0001\n").expect("write config");
+    // Clumps: pictures compared byte for byte want no pool overflow, whose
+    // order follows the atomics (a full head over the scalp overflows here).
     let render = |name: &str, groom: &std::path::Path, extra: &str| {
         let out = dir.path().join(name);
         let args = format!(
-            "render --input {} --scale 0.01 --frames 1 --width 160 --height 120 --shadow-resolution 64 --out {} {extra}",
+            "render --input {} --scale 0.01 --frames 1 --width 160 --height 120 --shadow-resolution 64 --clumps --out {} {extra}",
             groom.display(),
             out.display()
         );

@@ -40,10 +40,19 @@ pub struct SceneArgs {
     /// Turn level of detail off (always full detail).
     #[arg(long)]
     pub no_lod: bool,
-    /// Grow hairs inside triangles of key-hair roots (barycentric) instead of
-    /// around each key hair.
-    #[arg(long)]
+    /// Grow hairs inside triangles of key-hair roots (barycentric, a set count
+    /// per triangle) instead of rooting them over the scalp.
+    #[arg(long, conflicts_with = "clumps")]
     pub barycentric: bool,
+    /// Grow hairs in clumps around each key hair (single-strand interpolation,
+    /// --hairs-per-key a key hair) instead of rooting them over the scalp.
+    #[arg(long)]
+    pub clumps: bool,
+    /// Drawn hairs per cm² of the scalp the key hairs' roots cover, each
+    /// blended from its nearest key hairs [default: the --config file's
+    /// [scalp] density, else 150].
+    #[arg(long)]
+    pub density: Option<f32>,
     /// Shade with Marschner lookup tables instead of Kajiya-Kay.
     #[arg(long)]
     pub marschner: bool,

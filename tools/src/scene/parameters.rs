@@ -59,6 +59,9 @@ pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
     if let Some(t) = a.transparency {
         r.transparency = t;
     }
+    if let Some(d) = a.density {
+        config.scalp.density = d;
+    }
     if let Some(raster) = a.raster {
         r.raster = raster;
     }
@@ -90,6 +93,9 @@ pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
         config.render.lod.full_detail_distance *= k;
         config.material.root_width *= k;
         config.material.tip_width *= k;
+        // Hairs per cm² of a head in meters: the groom's own units count k² as
+        // many (kept within the parameter's range).
+        config.scalp.density = (config.scalp.density / (k * k)).clamp(0.01, 1000.0);
     }
     config.validate()?;
     Ok(config)
@@ -105,9 +111,27 @@ pub fn make_renderer(
     s: &Scene,
 ) -> Result<Renderer, vkhair::Error> {
     let radius = s.radius;
-    let mut renderer = match &s.dense {
-        None => Renderer::new(ctx, key_hairs, &config.render)?,
-        Some(d) => {
+    let over_scalp = !a.clumps && config.render.interpolation == InterpolationMode::SingleStrand;
+    let scalp = match (&s.dense, over_scalp) {
+        (None, true) => scalp_followers(&s.groom, config, ctx)?,
+        _ => None,
+    };
+    let mut renderer = match (&s.dense, scalp) {
+        (None, Some(followers)) => {
+            let mut render = config.render.clone();
+            // Full detail while the roots lie at least SCALP_LOD_PIXELS apart on
+            // screen; farther, fewer hairs, each standing for more (level of detail).
+            let pixel_at_1m = 2.0 * (0.5 * super::FOV_Y).tan() / a.height as f32;
+            let apart = followers.root_spacing() / (SCALP_LOD_PIXELS * pixel_at_1m);
+            let lod = &mut render.lod;
+            lod.full_detail_distance = lod.full_detail_distance.min(apart).max(1e-4);
+            // Followers are drawn in shares of hairs_per_key: the finest steps,
+            // down to 1/64 of the hairs (a small or distant head).
+            (render.hairs_per_key, lod.min_hairs_per_key) = (SCALP_LOD_STEPS, 1);
+            Renderer::with_followers(ctx, key_hairs, &render, &followers)?
+        }
+        (None, None) => Renderer::new(ctx, key_hairs, &config.render)?,
+        (Some(d), _) => {
             let followers = bind_followers(d, &s.groom, config)?;
             say!(
                 "followers: {} strands drawn as followers of {} guides ({}), {} points each, {:.1} MiB of bindings, \
@@ -178,6 +202,67 @@ pub fn bind_followers(dense: &Dense, keys: &vkhair::Groom, config: &Config) -> R
         Some(w) => followers.with_width_factors(w),
         None => Ok(followers),
     }
+}
+
+/// The fewest pixels between the roots of the hairs the tool draws over the
+/// scalp: nearer than that, level of detail drops hairs (each survivor
+/// standing for more, its band spread over the gap).
+const SCALP_LOD_PIXELS: f32 = 2.0;
+
+/// The steps of level of detail over the scalp's hairs: a frame draws k / 64
+/// of them (k in 1..=64; `hairs_per_key` only sets the share followers draw).
+const SCALP_LOD_STEPS: u32 = 64;
+
+/// Most points the tool draws a hair rooted over the scalp with.
+const SCALP_HAIR_POINTS: u32 = 32;
+
+/// Hairs rooted over the scalp the key hairs `keys` cover
+/// ([`Followers::over_scalp`], `config.scalp`), each drawn with the smoothed
+/// key hair's points (at most [`SCALP_HAIR_POINTS`]); `None`, saying why,
+/// where the key hairs' roots make no scalp (too few, or in a line): those
+/// hairs grow in clumps around each key hair instead.
+pub fn scalp_followers(
+    keys: &vkhair::Groom,
+    config: &Config,
+    ctx: &GpuContext,
+) -> Result<Option<Followers>, vkhair::Error> {
+    let rest = SimState::from_groom(keys, &config.sim, &RigidTransform::default())?;
+    let level = config.render.smoothing_level;
+    let points = ((rest.points as u32 - 1) * level + 1).clamp(2, SCALP_HAIR_POINTS) as usize;
+    // The most hairs of `points` points the device's storage range holds.
+    let most = (u64::from(ctx.info().max_storage_buffer_range) / (16 * points as u64)).min(u64::from(u32::MAX)) as u32;
+    let mut params = config.scalp.clone();
+    params.max_hairs = params.max_hairs.min(most);
+    let area = vkhair::render::scalp_area_cm2(&rest);
+    if area.is_nan() || area <= 0.0 {
+        say!(
+            "scalp: the {} key hairs' roots make no scalp to root hairs over (too few, or in a line); growing \
+             hairs in clumps around each key hair instead",
+            rest.strands
+        );
+        return Ok(None);
+    }
+    if f64::from(area) * f64::from(params.density) > f64::from(params.max_hairs) {
+        let density = 0.999 * params.max_hairs as f32 / area;
+        eprintln!(
+            "vkhair: warning: {} hairs per cm² over the {area:.0} cm² the key hairs' roots cover would be more \
+             than the {} hairs of {points} points this device holds; drawing {density:.2} per cm²",
+            params.density, params.max_hairs
+        );
+        params.density = density;
+    }
+    let followers = Followers::over_scalp(&rest, &params, level, points)?;
+    say!(
+        "scalp: {} hairs rooted over the scalp the {} key hairs' roots cover ({} per cm², a root every {:.2} mm), \
+         each blended from its nearest key hairs, {} points each, {:.1} MiB of bindings",
+        followers.count(),
+        rest.strands,
+        params.density,
+        followers.root_spacing() * 1e3,
+        points,
+        followers.gpu_bytes() as f64 / (1 << 20) as f64
+    );
+    Ok(Some(followers))
 }
 
 /// Hairs on a full head of real hair, for the tool's default of
