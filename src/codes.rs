@@ -147,10 +147,9 @@ shader_codes! {
     scene_depth = "SCENE_DEPTH_" {
         /// No depth to test against (no depth attachment, or one cleared by vkhair).
         NONE = 0,
-        /// 32-bit floats (`D32_SFLOAT`, the depth aspect of `D32_SFLOAT_S8_UINT`).
+        /// 32-bit floats (`D32_SFLOAT`).
         FLOAT32 = 1,
-        /// 24-bit unsigned normalised in the low bits of a word
-        /// (`X8_D24_UNORM_PACK32`, the depth aspect of `D24_UNORM_S8_UINT`).
+        /// 24-bit unsigned normalised in the low bits of a word (`X8_D24_UNORM_PACK32`).
         UNORM24 = 2,
         /// 16-bit unsigned normalised, two a word, the first in the low half (`D16_UNORM`).
         UNORM16 = 3,

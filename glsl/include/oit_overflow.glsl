@@ -31,7 +31,9 @@ const uint OIT_OVERFLOW_SATURATED = 0x80000000u;
 // Adds a fragment of colour `color` (linear, not premultiplied) and `alpha` to
 // pixel `pixel`'s sums.
 void oit_overflow_add(uint pixel, vec3 color, float alpha) {
-    vec3 premultiplied = max(color, vec3(0.0)) * alpha;
+    // Radiance above 64 (far past any display's white) is counted as 64, so
+    // that one add stays within a word.
+    vec3 premultiplied = clamp(color, vec3(0.0), vec3(64.0)) * alpha;
     uint c = 3u * pixel;
     OIT_SATURATING_ADD(oit_overflow_color[c], uint(premultiplied.r * OIT_OVERFLOW_COLOR_UNIT + 0.5))
     OIT_SATURATING_ADD(oit_overflow_color[c + 1u], uint(premultiplied.g * OIT_OVERFLOW_COLOR_UNIT + 0.5))

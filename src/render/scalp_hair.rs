@@ -36,6 +36,9 @@ use crate::sim::SimState;
 
 /// Square centimetres per square metre.
 const CM2_PER_M2: f32 = 1e4;
+/// Most points over all hairs [`Followers::over_scalp`] binds (2^26: 768 MiB
+/// of offsets on the host), whatever `max_hairs` allows.
+const MAX_SCALP_POINTS: u64 = 1 << 26;
 
 /// How drawn hairs are rooted over the scalp and shaped from their guides
 /// ([`Followers::over_scalp`]; the `[scalp]` table of a parameter file).
@@ -184,7 +187,8 @@ impl Followers {
     ///
     /// Refused: bad parameters (naming the field), fewer than three guides or
     /// guide roots that make no triangle, a count beyond
-    /// [`ScalpHairParams::max_hairs`], `points` outside 2..=256.
+    /// [`ScalpHairParams::max_hairs`] or beyond 2^26 points over all hairs,
+    /// `points` outside 2..=256.
     pub fn over_scalp(rest: &SimState, params: &ScalpHairParams, level: u32, points: usize) -> Result<Self> {
         params.validate()?;
         if !(2..=super::followers::MAX_FOLLOWER_POINTS).contains(&points) {
@@ -205,7 +209,8 @@ impl Followers {
                 format!("{} guide roots make no scalp triangle to root hairs in (at least 3 needed)", roots.len()),
             ));
         }
-        let scalp = scalp_roots(&roots, &triangles, params)?;
+        let most = (MAX_SCALP_POINTS / points as u64).min(u64::from(params.max_hairs)) as u32;
+        let scalp = scalp_roots(&roots, &triangles, &ScalpHairParams { max_hairs: most, ..params.clone() })?;
         if scalp.hairs.is_empty() {
             return Err(Error::param(
                 "scalp.density",
@@ -220,7 +225,9 @@ impl Followers {
                 (strand[rest.points - 1] - strand[0]).truncate().normalize_or(Vec3::Y)
             })
             .collect();
-        let cos_parting = params.parting_angle.to_radians().cos();
+        // At 180° every guide blends (a dot product of opposite directions may
+        // round below −1).
+        let cos_parting = if params.parting_angle >= 180.0 { -2.0 } else { params.parting_angle.to_radians().cos() };
         let mut order: Vec<u32> = (0..scalp.hairs.len() as u32).collect();
         order.sort_by_key(|&h| (hash_u32(h ^ 0x6a09_e667), h));
         // Each hair is bound on its own: chunks of the drawing order on every

@@ -18,7 +18,8 @@ pub struct RenderTarget {
     /// Its format (`UNDEFINED` for none).
     pub depth_format: vk::Format,
     /// The image behind `depth` (its mip level 0 and array layer 0 are the ones
-    /// the view shows), created with `TRANSFER_SRC` usage, or null. The compute
+    /// the view shows; a depth-only format: `D32_SFLOAT`, `X8_D24_UNORM_PACK32`
+    /// or `D16_UNORM`), created with `TRANSFER_SRC` usage, or null. The compute
     /// rasteriser ([`super::Raster::Compute`]) copies the host's depth out of
     /// it to test each hair fragment against (its depth aspect passes through
     /// `TRANSFER_SRC_OPTIMAL` and is back in `DEPTH_ATTACHMENT_OPTIMAL` before

@@ -113,14 +113,20 @@ impl DepthSource {
                  RenderTarget::depth_image (created with TRANSFER_SRC usage), or draw with Raster::Hardware",
             ));
         };
+        // Depth-only formats: the copy moves the image's one aspect to
+        // TRANSFER_SRC_OPTIMAL and back (a stencil aspect would need its own
+        // layouts, separateDepthStencilLayouts).
         let code = match target.key.depth {
-            vk::Format::D32_SFLOAT | vk::Format::D32_SFLOAT_S8_UINT => scene_depth::FLOAT32,
-            vk::Format::D24_UNORM_S8_UINT | vk::Format::X8_D24_UNORM_PACK32 => scene_depth::UNORM24,
-            vk::Format::D16_UNORM | vk::Format::D16_UNORM_S8_UINT => scene_depth::UNORM16,
+            vk::Format::D32_SFLOAT => scene_depth::FLOAT32,
+            vk::Format::X8_D24_UNORM_PACK32 => scene_depth::UNORM24,
+            vk::Format::D16_UNORM => scene_depth::UNORM16,
             other => {
                 return Err(Error::incompatible(
                     "render target",
-                    format!("the compute rasteriser cannot read depth format {other:?}"),
+                    format!(
+                        "the compute rasteriser reads depth-only targets (D32_SFLOAT, X8_D24_UNORM_PACK32, \
+                         D16_UNORM), not {other:?}: draw with Raster::Hardware"
+                    ),
                 ))
             }
         };

@@ -481,18 +481,27 @@ impl TransparentPass {
         };
         let build_write = storage[1];
         // The previous frame's passes used the lists and counters (and the host read them).
-        let to_clear = barrier::memory(&[READ_BY_ANY, WRITTEN_BY_ANY].concat(), &[AccessKind::TransferWrite]);
+        // Fills and the depth copy: any transfer write (fills run in the clear stage).
+        let to_clear = barrier::memory(&[READ_BY_ANY, WRITTEN_BY_ANY].concat(), &[AccessKind::AnyTransferWrite]);
         let counters_ready =
-            barrier::memory(&[AccessKind::TransferWrite], &[AccessKind::ComputeRead, AccessKind::ComputeWrite]);
-        let cleared = barrier::memory(&[AccessKind::TransferWrite], storage);
+            barrier::memory(&[AccessKind::AnyTransferWrite], &[AccessKind::ComputeRead, AccessKind::ComputeWrite]);
+        let cleared = barrier::memory(&[AccessKind::AnyTransferWrite], storage);
         // The lists, the counters and the overflow to the composite (its rectangle's vertex stage reads the counters).
         let built = barrier::memory(&[build_write], &[AccessKind::VertexRead, AccessKind::FragmentRead]);
-        // The previous frame's ribbons read the colours this frame's dispatch writes.
-        let to_shade = barrier::memory(&[AccessKind::VertexRead], &[AccessKind::ComputeWrite]);
-        // The colours and the rectangle to the ribbons (or the rasteriser), the build and the composite.
+        // The previous frame's ribbons (or rasteriser) read the colours this frame's dispatch writes.
+        let to_shade = barrier::memory(&[AccessKind::VertexRead, AccessKind::ComputeRead], &[AccessKind::ComputeWrite]);
+        // The colours and the rectangle (its atomics on the counters) to the
+        // ribbons or the rasteriser (which add to the counters too), the build
+        // and the composite.
         let shaded = barrier::memory(
             &[AccessKind::ComputeWrite],
-            &[AccessKind::VertexRead, AccessKind::FragmentRead, AccessKind::FragmentWrite, AccessKind::ComputeRead],
+            &[
+                AccessKind::VertexRead,
+                AccessKind::FragmentRead,
+                AccessKind::FragmentWrite,
+                AccessKind::ComputeRead,
+                AccessKind::ComputeWrite,
+            ],
         );
         let (hairs, per_hair) = (frame.params.counts[0], frame.params.counts[1]);
         let depth_order = barrier::memory(barrier::ATTACHMENTS, barrier::ATTACHMENTS);

@@ -18,7 +18,7 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::atlas::ShadowAtlas;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gpu_types::GpuShadowParams;
 use crate::profiler::{PassScope, Timing};
 use crate::render::pass::RenderPass;
@@ -64,6 +64,20 @@ impl ComputeMaps {
     ) -> Result<Self> {
         let extent = atlas.extent();
         let texels = u64::from(extent.width) * u64::from(extent.height);
+        if 12 * texels > u64::from(device.info.max_storage_buffer_range) {
+            return Err(Error::incompatible(
+                "shadow resolution",
+                format!(
+                    "the compute rasteriser's layer sums of a {}×{} atlas take {} bytes in one buffer, more than \
+                     this device's storage buffer range ({} bytes): lower ShadowParams::resolution, or draw the \
+                     maps with Raster::Hardware",
+                    extent.width,
+                    extent.height,
+                    12 * texels,
+                    device.info.max_storage_buffer_range
+                ),
+            ));
+        }
         let z0 = Buffer::storage(device, "vkhair shadow z0 keys", 4 * texels)?;
         let layers = Buffer::storage(device, "vkhair shadow layer sums", 12 * texels)?;
         let buffers = [(0, uniforms), (1, hair_positions), (3, &z0), (4, &layers)];
@@ -103,34 +117,13 @@ impl ComputeMaps {
         timing: Timing<'_>,
     ) {
         let d = &self.device;
-        let maps = uniforms.map_count();
         let extent = atlas.extent();
-        let push = |map: usize| RasterPush { map: map as u32, atlas_width: extent.width };
-        let segments = uniforms.counts[0].saturating_mul(uniforms.counts[1].saturating_sub(1));
-        let light_of = |map: usize| (0..8).find(|&i| uniforms.light_map[i / 4][i % 4] == map as u32).unwrap_or(map);
         let storage = &[AccessKind::ComputeRead, AccessKind::ComputeWrite];
-        // The previous frame's passes and resolve read and wrote the sums.
-        let to_clear = barrier::memory(storage, &[AccessKind::TransferWrite]);
-        let cleared = barrier::memory(&[AccessKind::TransferWrite], storage);
+        // The previous frame's passes and resolve read and wrote the sums; the
+        // fills run in the clear stage (any transfer write).
+        let to_clear = barrier::memory(storage, &[AccessKind::AnyTransferWrite]);
+        let cleared = barrier::memory(&[AccessKind::AnyTransferWrite], storage);
         let between = barrier::memory(&[AccessKind::ComputeWrite], storage);
-        let run = |pass: &(ComputePipeline, vk::DescriptorSet), stage: RenderPass| {
-            // SAFETY: guaranteed by the caller.
-            unsafe {
-                pass.0.bind(cmd, &[pass.1]);
-                let per_group = pass.0.workgroup_size()[0];
-                let threads = segments.min(MAX_WORKGROUPS.saturating_mul(per_group));
-                for (k, map) in uniforms.maps.iter().enumerate().take(maps) {
-                    if map.is_density_volume() {
-                        continue; // density volume: no map
-                    }
-                    let label = format!("{}, light {}", stage.label(), light_of(k));
-                    let scope = PassScope::open(d, cmd, timing, &label, LabelColor::Compute);
-                    pass.0.push(cmd, &push(k));
-                    pass.0.dispatch_threads(cmd, [threads, 1, 1]);
-                    scope.close(d, cmd, timing);
-                }
-            }
-        };
         // SAFETY: guaranteed by the caller; every object belongs to this device.
         unsafe {
             d.cmd_barrier(cmd, &[before, to_clear], &[], &[atlas.to_storage()]);
@@ -138,17 +131,54 @@ impl ComputeMaps {
             d.raw.cmd_fill_buffer(cmd, self.layers.raw(), 0, vk::WHOLE_SIZE, 0);
             d.cmd_barrier(cmd, &[cleared], &[], &[]);
             let scope = RenderPass::ShadowDepth.open(d, cmd, timing);
-            run(&self.depth_pass, RenderPass::ShadowDepth);
+            self.run(cmd, &self.depth_pass, RenderPass::ShadowDepth, uniforms, extent.width, timing);
             d.cmd_barrier(cmd, &[between], &[], &[]);
             scope.close(d, cmd, timing);
             let scope = RenderPass::ShadowOpacity.open(d, cmd, timing);
-            run(&self.opacity_pass, RenderPass::ShadowOpacity);
+            self.run(cmd, &self.opacity_pass, RenderPass::ShadowOpacity, uniforms, extent.width, timing);
             d.cmd_barrier(cmd, &[between], &[], &[]);
             let (resolve, sets) = &self.resolve;
             resolve.bind(cmd, sets);
             resolve.dispatch_threads(cmd, [extent.width, extent.height, 1]);
             d.cmd_barrier(cmd, &[], &[], &[atlas.storage_to_sampled()]);
             scope.close(d, cmd, timing);
+        }
+    }
+
+    /// Records `pass` over every opacity map of `uniforms` (an atlas
+    /// `atlas_width` texels wide), each map in a nested scope named by `stage`
+    /// and the map's light.
+    ///
+    /// # Safety
+    /// As [`ComputeMaps::record`], within it: the pass's inputs were made
+    /// visible to compute shaders before.
+    unsafe fn run(
+        &self,
+        cmd: vk::CommandBuffer,
+        pass: &(ComputePipeline, vk::DescriptorSet),
+        stage: RenderPass,
+        uniforms: &GpuShadowParams,
+        atlas_width: u32,
+        timing: Timing<'_>,
+    ) {
+        let d = &self.device;
+        let segments = uniforms.counts[0].saturating_mul(uniforms.counts[1].saturating_sub(1));
+        let light_of = |map: usize| (0..8).find(|&i| uniforms.light_map[i / 4][i % 4] == map as u32).unwrap_or(map);
+        let per_group = pass.0.workgroup_size()[0];
+        let threads = segments.min(MAX_WORKGROUPS.saturating_mul(per_group));
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            pass.0.bind(cmd, &[pass.1]);
+            for (k, map) in uniforms.maps.iter().enumerate().take(uniforms.map_count()) {
+                if map.is_density_volume() {
+                    continue; // density volume: no map
+                }
+                let label = format!("{}, light {}", stage.label(), light_of(k));
+                let scope = PassScope::open(d, cmd, timing, &label, LabelColor::Compute);
+                pass.0.push(cmd, &RasterPush { map: k as u32, atlas_width });
+                pass.0.dispatch_threads(cmd, [threads, 1, 1]);
+                scope.close(d, cmd, timing);
+            }
         }
     }
 }

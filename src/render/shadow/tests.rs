@@ -524,8 +524,7 @@ fn point_lights_are_refused_as_map_casters() {
 /// directional and by a spot light, every texel has hair in one atlas where
 /// it has hair in the other, the same z0 (within 1e-5 m), and the same layer
 /// sums within the compute sums' rounding (half of 1/65,536 per fragment, up
-/// to 50 fragments a texel here); and the directional map matches the CPU count of
-/// the slab as the hardware's does.
+/// to 50 fragments a texel here).
 #[test]
 fn the_compute_rasteriser_draws_the_maps_the_hardware_draws() {
     for light in [ALONG_Z, SPOT] {

@@ -94,8 +94,17 @@ pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
         config.material.root_width *= k;
         config.material.tip_width *= k;
         // Hairs per cm² of a head in meters: the groom's own units count k² as
-        // many (kept within the parameter's range).
-        config.scalp.density = (config.scalp.density / (k * k)).clamp(0.01, 1000.0);
+        // many, within the parameter's range (checked as given first).
+        config.scalp.validate()?;
+        let scaled = config.scalp.density / (k * k);
+        config.scalp.density = scaled.clamp(0.01, 1000.0);
+        if config.scalp.density != scaled {
+            eprintln!(
+                "vkhair: warning: {scaled} hairs per cm² of the groom's units is outside 0.01..=1000; rooting {} \
+                 per cm² (give --scale to convert the groom to meters)",
+                config.scalp.density
+            );
+        }
     }
     config.validate()?;
     Ok(config)
@@ -242,8 +251,16 @@ pub fn scalp_followers(
         );
         return Ok(None);
     }
+    if f64::from(area) * f64::from(params.density) < 1.0 {
+        say!(
+            "scalp: {} per cm² over the {area:.3} cm² the key hairs' roots cover roots no hair; growing hairs in \
+             clumps around each key hair instead",
+            params.density
+        );
+        return Ok(None);
+    }
     if f64::from(area) * f64::from(params.density) > f64::from(params.max_hairs) {
-        let density = 0.999 * params.max_hairs as f32 / area;
+        let density = (0.999 * params.max_hairs as f32 / area).max(0.01);
         eprintln!(
             "vkhair: warning: {} hairs per cm² over the {area:.0} cm² the key hairs' roots cover would be more \
              than the {} hairs of {points} points this device holds; drawing {density:.2} per cm²",
