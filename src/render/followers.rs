@@ -154,13 +154,7 @@ impl Followers {
             offsets.extend(point_offsets.iter().flat_map(|o| o.to_array()));
             bindings.push(FollowerBinding { guides: [g[0], g[1], g[2], 0], weights: [w[0], w[1], w[2], 0.0] });
         }
-        let area: f32 = triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| roots[i as usize]);
-                0.5 * (b - a).cross(c - a).length()
-            })
-            .sum();
+        let area: f32 = triangles.iter().map(|t| super::scalp::triangle_area(&roots, t)).sum();
         // The scalp's area: the guide-root triangles', else the roots' bounds.
         let area = if area > 0.0 { area } else { bounds_area(authored) };
         let root_spacing = (area / strands as f32).sqrt().max(1e-6);

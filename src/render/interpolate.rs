@@ -66,9 +66,8 @@ pub(super) fn units(mode: InterpolationMode, strands: u32, triangles: u32) -> u3
 
 /// Mean area of `triangles` of key-hair roots of `rest`, m² (0 for none).
 fn mean_area(rest: &SimState, triangles: &[[u32; 3]]) -> f32 {
-    let root = |k: u32| rest.rest[k as usize * rest.points].truncate();
-    let sum: f32 =
-        triangles.iter().map(|t| 0.5 * (root(t[1]) - root(t[0])).cross(root(t[2]) - root(t[0])).length()).sum();
+    let roots = rest.rest_roots();
+    let sum: f32 = triangles.iter().map(|t| super::scalp::triangle_area(&roots, t)).sum();
     sum / triangles.len().max(1) as f32
 }
 

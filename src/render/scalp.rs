@@ -10,6 +10,12 @@ use glam::Vec3;
 
 use crate::sim::SimState;
 
+/// The area of triangle `t` of `roots` (their units squared).
+pub fn triangle_area(roots: &[Vec3], t: &[u32; 3]) -> f32 {
+    let [a, b, c] = t.map(|i| roots[i as usize]);
+    0.5 * (b - a).cross(c - a).length()
+}
+
 /// Triangles of key-hair indices (at most 2 per key hair).
 pub fn root_triangles(rest: &SimState) -> Vec<[u32; 3]> {
     let roots: Vec<Vec3> = (0..rest.strands).map(|s| rest.rest[s * rest.points].truncate()).collect();

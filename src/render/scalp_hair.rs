@@ -28,6 +28,7 @@
 use glam::Vec3;
 
 use super::followers::GuideShapes;
+use super::scalp::triangle_area;
 use super::Followers;
 use crate::error::{Error, Result};
 use crate::gpu_types::FollowerBinding;
@@ -102,13 +103,7 @@ impl ScalpHairParams {
 /// [`Followers::over_scalp`] roots (0 where the roots make no triangle).
 pub fn scalp_area_cm2(rest: &SimState) -> f32 {
     let roots = rest.rest_roots();
-    let area: f32 = super::scalp::root_triangles(rest)
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| roots[i as usize]);
-            0.5 * (b - a).cross(c - a).length()
-        })
-        .sum();
+    let area: f32 = super::scalp::root_triangles(rest).iter().map(|t| triangle_area(&roots, t)).sum();
     area * CM2_PER_M2
 }
 
@@ -123,10 +118,7 @@ struct Roots {
 
 /// The roots of `params.density` hairs per cm² over `triangles` of `roots`.
 fn scalp_roots(roots: &[Vec3], triangles: &[[u32; 3]], params: &ScalpHairParams) -> Result<Roots> {
-    let area_of = |t: &[u32; 3]| {
-        let [a, b, c] = t.map(|i| roots[i as usize]);
-        0.5 * (b - a).cross(c - a).length()
-    };
+    let area_of = |t: &[u32; 3]| triangle_area(roots, t);
     let area: f32 = triangles.iter().map(area_of).sum();
     let wanted = f64::from(area) * f64::from(CM2_PER_M2) * f64::from(params.density);
     if wanted > f64::from(params.max_hairs) {

@@ -112,8 +112,6 @@ struct Pipelines {
 struct Resources {
     extent: vk::Extent2D,
     mode: Transparency,
-    /// Who makes the fragments ([`Raster::Hardware`] or [`Raster::Compute`]).
-    raster: Raster,
     /// Per pixel: the nearest half-opaque depth.
     opaque: Buffer,
     /// Exact mode: the lists.
@@ -130,6 +128,14 @@ impl Resources {
     /// The exact mode's pool (fast mode: none).
     fn pool(&self) -> Option<OitPool> {
         self.lists.as_ref().map(|l| l.pool)
+    }
+
+    /// Who makes the fragments: the compute rasteriser where its buffers are.
+    fn raster(&self) -> Raster {
+        match self.raster_buffers {
+            Some(_) => Raster::Compute,
+            None => Raster::Hardware,
+        }
     }
 }
 
@@ -248,7 +254,7 @@ impl TransparentPass {
             Transparency::Exact => Some(OitPool::plan(&self.device.info, params, extent)),
             _ => None,
         };
-        let fits = |r: &Resources| r.extent == extent && r.mode == mode && r.pool() == pool && r.raster == raster;
+        let fits = |r: &Resources| r.extent == extent && r.mode == mode && r.pool() == pool && r.raster() == raster;
         if let Some(old) = self.current.take_if(|r| !fits(r)) {
             // Frames up to the previous one may still be using them.
             self.retired.push((frame.saturating_sub(1), old));
@@ -277,7 +283,6 @@ impl TransparentPass {
         self.current = Some(Resources {
             extent,
             mode,
-            raster,
             opaque: Buffer::storage(d, "vkhair transparency opaque depth", 4 * pixels)?,
             lists,
             sums: if compute { None } else { Some(WeightedSums::new(d, extent)?) },
@@ -339,7 +344,7 @@ impl TransparentPass {
         let rect = ComputePipeline::new(d, &RENDER_HAIR_RECT_COMP, 1)?;
         let rect_set = rect.declared_resource_set(0, &buffers, &[])?;
         let build_stages = [&RENDER_RIBBON_VERT_COVERAGE, shaders.build];
-        let build = match res.raster {
+        let build = match res.raster() {
             Raster::Compute => {
                 // Constant 0: the pool's buffers (oit.glsl), as the hardware build's.
                 let mut pipeline = ComputePipeline::new(d, &RENDER_STRAND_RASTER_COMP, 1)?;
