@@ -47,6 +47,47 @@ fn ellipsoid_roots_lie_on_the_cap_and_avoid_the_face() {
     }
 }
 
+/// With the face given, hair frames it: no strand leaves its root toward the
+/// face, each strand rooted in front of the scalp's middle goes to its own
+/// side of the parting (never across it), and no strand's tip hangs in front
+/// of the face; without it the same roots grow strands that do (the test's
+/// scene makes them: roots all over a sphere's upper half).
+#[test]
+fn a_given_face_is_framed_parted_at_the_middle() {
+    let scalp = Scalp::sphere_cap(Vec3::ZERO, 0.1, 1.4);
+    let face = Vec3::Z;
+    let p = GrowParams { strands: 800, length: 0.3, droop: 5.0, direction_jitter: 0.3, ..GrowParams::default() };
+    let framed = grow(&scalp, &GrowParams { face, ..p.clone() }).expect("grow");
+    let mut front = 0;
+    for s in 0..framed.strand_count() {
+        let pts = framed.strand(s);
+        let (root, first) = (pts[0], pts[1] - pts[0]);
+        assert!(first.dot(face) <= 1e-6, "strand {s} leaves its root toward the face: {first}");
+        if root.normalize().dot(face) > 0.3 {
+            front += 1;
+            // Parted at the roots' middle, x ≈ 0: a strand rooted a centimetre
+            // or more off it stays on its root's side, and every tip lies off
+            // the face's width.
+            let side = root.x.signum();
+            if root.x.abs() > 0.01 {
+                assert!(pts.iter().all(|q| q.x * side >= 0.0), "strand {s} crosses the parting: {pts:?}");
+            }
+            let tip = pts[pts.len() - 1];
+            assert!(tip.z < 0.0 || tip.x.abs() > 0.06, "strand {s}'s tip hangs in front of the face: {tip}");
+        }
+    }
+    assert!(front > 20, "{front} strands rooted in front");
+    let unframed = grow(&scalp, &p).expect("grow");
+    let over_face = (0..unframed.strand_count())
+        .filter(|&s| {
+            let pts = unframed.strand(s);
+            let tip = pts[pts.len() - 1];
+            pts[0].normalize().dot(face) > 0.3 && tip.z > 0.0 && tip.x.abs() <= 0.06
+        })
+        .count();
+    assert!(over_face > 10, "without the face, {over_face} tips hang in front of it: the test shows nothing");
+}
+
 #[test]
 fn strands_droop_and_segments_lengthen_toward_the_tip() {
     let scalp = Scalp::sphere_cap(Vec3::ZERO, 0.1, 0.3); // crown only: roots point up
@@ -138,6 +179,8 @@ fn invalid_growth_parameters_are_rejected() {
         GrowParams { gravity: Vec3::ZERO, ..GrowParams::default() },
         GrowParams { segment_growth: 0.0, ..GrowParams::default() },
         GrowParams { direction_jitter: 3.0, ..GrowParams::default() },
+        GrowParams { face: Vec3::new(f32::NAN, 0.0, 1.0), ..GrowParams::default() },
+        GrowParams { face: Vec3::new(0.0, 0.0, 1e30), ..GrowParams::default() },
     ];
     for p in bad {
         assert!(matches!(grow(&scalp, &p), Err(Error::InvalidParameter { .. })), "{p:?} accepted");

@@ -943,3 +943,50 @@ fn fast_shows_what_exact_shows(gpu: &Gpu, s: &mut Scene, p: &RenderParams, image
     let stats = s.renderer.transparency_stats().expect("stats of an exact frame");
     assert_eq!(stats.composited, Some([0, 0, W, H]), "hair behind the camera composites the whole target");
 }
+
+/// Level of detail over hairs rooted over the scalp keeps the head's optical
+/// density: drawing a quarter and a sixteenth of the hairs (each standing for
+/// 4× and 16× as many, spread over the gap to its neighbours), black hair over
+/// white darkens the picture within 10 % of what every hair darkens, with
+/// either rasteriser. (Were the survivors to stand for no more hairs than at
+/// full detail, a quarter of the hairs would darken 0.62 as much.)
+#[test]
+fn level_of_detail_keeps_the_optical_density_of_hair_over_the_scalp() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(300, 8, 5);
+    let sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    let rest =
+        vkhair::sim::SimState::from_groom(&groom, &SimParams::default(), &RigidTransform::default()).expect("rest");
+    let density = 20.0;
+    let scalp = vkhair::render::ScalpHairParams { density, ..Default::default() };
+    let followers = vkhair::render::Followers::over_scalp(&rest, &scalp, 2, 15).expect("hairs over the scalp");
+    // A head of 150 hairs per cm²: each drawn hair stands for 7.5 at full detail.
+    let m = HairMaterial {
+        root_color: Vec3::ZERO,
+        tip_color: Vec3::ZERO,
+        represented_hairs: 150.0 / density,
+        ..material(70e-6, 0.8)
+    };
+    let offscreen = Offscreen::new(gpu.ctx(), W, H).expect("offscreen");
+    let camera = camera();
+    let darkening = |raster: Raster, lod: LodParams| -> (f32, u32) {
+        let p = RenderParams { hairs_per_key: 64, lod, raster, ..params(Transparency::Exact) };
+        let mut renderer = Renderer::with_followers(gpu.ctx(), &sim, &p, &followers).expect("renderer");
+        renderer.set_material(&m).expect("material");
+        let host = common::HostFrame { clear: Vec3::ONE, before: None, after: None };
+        let rgba = common::draw_frame(&gpu, (&sim, &mut renderer), &offscreen, &camera, &host);
+        (linear_rgb(&rgba).iter().map(|c| 1.0 - c.y).sum(), renderer.hair_counts().0)
+    };
+    for raster in RASTERS {
+        let (full, all) = darkening(raster, LodParams { enabled: false, ..LodParams::default() });
+        assert!(full > 200.0, "{raster:?}: every hair darkens only {full}");
+        for (step, share) in [(2.0, 0.25), (4.0, 0.0625)] {
+            let lod = LodParams { full_detail_distance: 0.9 / step, min_hairs_per_key: 1, ..LodParams::default() };
+            let (fewer, drawn) = darkening(raster, lod);
+            let (kept, ratio) = (drawn as f32 / all as f32, fewer / full);
+            println!("{raster:?}: {drawn} of {all} hairs ({kept:.3}) darken {ratio:.3} of what all darken");
+            assert!((kept - share).abs() < 0.25 * share, "{raster:?}: level of detail kept {kept} of the hairs");
+            assert!((ratio - 1.0).abs() <= 0.1, "{raster:?}: {kept:.3} of the hairs darken {ratio:.3} as much");
+        }
+    }
+}

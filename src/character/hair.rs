@@ -19,6 +19,15 @@ use crate::sim::{Collider, RigidTransform, SimState, MAX_COLLIDERS};
 pub const RIG_KEY_HAIRS: usize = 600;
 /// Their length: 0.28 m.
 pub const RIG_HAIR_LENGTH: f32 = 0.28;
+/// The face [`HairRig::face_region`] measures: triangles whose normal · the
+/// character's forward is at least this (within 60°).
+pub const FACE_FACING: f32 = 0.5;
+/// The face [`HairRig::face_region`] measures lies within this share of the
+/// head's half width of its middle (the ears, at the sides, are not face).
+pub const FACE_HALF_WIDTH: f32 = 0.6;
+/// Where [`HairRig::grow_with`] roots no hair: triangles below the crown whose
+/// normal · the character's forward is at least this (within 75.5°).
+pub const NO_ROOT_FACING: f32 = 0.25;
 /// Capsules a rig keeps: the nearest the head, up to half the simulation's
 /// collider limit (the rest is left to a host's own colliders).
 pub const RIG_CAPSULES: usize = MAX_COLLIDERS / 2;
@@ -181,35 +190,74 @@ impl HairRig {
     }
 
     /// Hair grown on the upper part of the head's region by `params`, in the
-    /// head's frame, combed back (away from where the character faces, the
-    /// given comb replaced) under the character's gravity; no roots on the
-    /// face. With the head's region at rest (the mesh collider).
+    /// head's frame, framing the face: combed back (away from where the
+    /// character faces, the given comb and face replaced), parted at the middle
+    /// with the front hair turned to its side ([`GrowParams::face`]), under the
+    /// character's gravity; no roots on the face. With the head's region at rest (the mesh collider).
     pub fn grow_with(&self, params: &GrowParams) -> Result<(Groom, TriMesh)> {
         let to_head: Mat4 = self.bind_frame().inverse();
         let local = self.head_region()?;
-        // No roots on the face: triangles facing forward below the crown are left out.
         let facing = self.character.forward();
         let forward = to_head.transform_vector3(facing).normalize();
         let up = to_head.transform_vector3(Vec3::Y).normalize();
-        let (lo, hi) =
-            local.positions.iter().fold((f32::MAX, f32::MIN), |(l, h), p| (l.min(p.dot(up)), h.max(p.dot(up))));
-        let crown = hi - 0.2 * (hi - lo);
-        let scalp_triangles: Vec<[u32; 3]> = (0..local.triangles.len())
-            .filter(|&i| {
-                let n = local.scaled_normal(i).normalize_or_zero();
-                let centroid = local.corners(i).iter().copied().sum::<Vec3>() / 3.0;
-                n.dot(forward) < 0.25 || centroid.dot(up) > crown
-            })
-            .map(|i| local.triangles[i])
-            .collect();
+        let face = self.face_triangles(&local, NO_ROOT_FACING);
+        let scalp_triangles: Vec<[u32; 3]> =
+            local.triangles.iter().zip(&face).filter(|(_, &f)| !f).map(|(t, _)| *t).collect();
         let scalp_mesh = TriMesh::new(local.positions.clone(), scalp_triangles)?;
         let scalp = GrowScalp::Mesh { mesh: scalp_mesh, up, min_height: 0.45, min_up_dot: -0.2 };
         let params = GrowParams {
             gravity: to_head.transform_vector3(Vec3::NEG_Y),
             comb: to_head.transform_vector3(0.2 * Vec3::Y - 0.8 * facing),
+            face: forward,
             ..params.clone()
         };
         Ok((grow(&scalp, &params)?, local))
+    }
+}
+
+impl HairRig {
+    /// The face: the triangles of the head's region at rest (head frame)
+    /// below the crown (the top fifth of the region's height) that face
+    /// forward, within 60° of the character's forward ([`FACE_FACING`]),
+    /// between the ears (their corners within [`FACE_HALF_WIDTH`] of the
+    /// region's half width of the middle): what hair should leave visible. [`HairRig::grow_with`] roots no hair on a
+    /// wider band, within 75° ([`NO_ROOT_FACING`]).
+    pub fn face_region(&self) -> Result<TriMesh> {
+        let local = self.head_region()?;
+        let face = self.face_triangles(&local, FACE_FACING);
+        let to_head: Mat4 = self.bind_frame().inverse();
+        let forward = to_head.transform_vector3(self.character.forward()).normalize();
+        let up = to_head.transform_vector3(Vec3::Y).normalize();
+        let across = forward.cross(up).normalize_or_zero();
+        let sides = local.positions.iter().map(|p| p.dot(across));
+        let (lo, hi) = sides.fold((f32::MAX, f32::MIN), |(l, h), x| (l.min(x), h.max(x)));
+        let (middle, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+        let triangles = (0..local.triangles.len())
+            .filter(|&i| {
+                face[i] && local.corners(i).iter().all(|p| (p.dot(across) - middle).abs() <= FACE_HALF_WIDTH * half)
+            })
+            .map(|i| local.triangles[i])
+            .collect();
+        TriMesh::new(local.positions, triangles)
+    }
+
+    /// Per triangle of `local` (the head's region at rest, head frame):
+    /// whether it lies below the crown facing forward by at least
+    /// `min_facing` (its normal · the character's forward).
+    fn face_triangles(&self, local: &TriMesh, min_facing: f32) -> Vec<bool> {
+        let to_head: Mat4 = self.bind_frame().inverse();
+        let forward = to_head.transform_vector3(self.character.forward()).normalize();
+        let up = to_head.transform_vector3(Vec3::Y).normalize();
+        let (lo, hi) =
+            local.positions.iter().fold((f32::MAX, f32::MIN), |(l, h), p| (l.min(p.dot(up)), h.max(p.dot(up))));
+        let crown = hi - 0.2 * (hi - lo);
+        (0..local.triangles.len())
+            .map(|i| {
+                let n = local.scaled_normal(i).normalize_or_zero();
+                let centroid = local.corners(i).iter().copied().sum::<Vec3>() / 3.0;
+                n.dot(forward) >= min_facing && centroid.dot(up) <= crown
+            })
+            .collect()
     }
 }
 

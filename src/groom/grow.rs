@@ -7,6 +7,11 @@
 //! is added to its root direction), by `droop` radians per unit of
 //! normalised length, never past the gravity direction itself. Segments get
 //! longer toward the tip: the last is `segment_growth` times the first.
+//!
+//! Given the direction the face looks ([`GrowParams::face`]), hair frames the
+//! face: no strand leaves its root toward the face, and the strands rooted in
+//! front of the scalp's middle are parted there and turned toward their own
+//! side, the more the nearer the face, so they fall beside it, not over it.
 
 use glam::{Quat, Vec3};
 use rand::{Rng, SeedableRng};
@@ -78,9 +83,23 @@ pub struct GrowParams {
     /// gravity (combing: e.g. backward to keep hair off the face; length ≈ strength).
     /// Default: zero.
     pub comb: Vec3,
+    /// Direction the face looks, in the scalp's frame (its length does not
+    /// matter; each component within ±1e6), or zero for none. Hair is combed
+    /// away from it: no strand leaves its root toward the face, and those
+    /// rooted in front of the scalp's middle are parted at the middle (the
+    /// plane of the face direction and gravity) and turned toward their side
+    /// and back by up to [`PART_STRENGTH`], the more the nearer the face.
+    /// Default: zero.
+    pub face: Vec3,
     /// Seed of the random generator. Default: 1.
     pub seed: u64,
 }
+
+/// How far a strand rooted straight in front of the scalp's middle is turned
+/// toward its side of the parting and back: the sideways direction and the
+/// backward one, each at this length, are added to its root direction (unit
+/// length).
+pub const PART_STRENGTH: f32 = 1.5;
 
 impl Default for GrowParams {
     fn default() -> Self {
@@ -94,6 +113,7 @@ impl Default for GrowParams {
             direction_jitter: 0.15,
             segment_growth: 2.0,
             comb: Vec3::ZERO,
+            face: Vec3::ZERO,
             seed: 1,
         }
     }
@@ -139,6 +159,9 @@ impl GrowParams {
         }
         if !self.comb.is_finite() || self.comb.length() > 100.0 {
             return Err(Error::param("comb", self.comb, "finite and at most 100 long"));
+        }
+        if !self.face.is_finite() || self.face.abs().max_element() > 1e6 {
+            return Err(Error::param("face", self.face, "finite, each component within ±1e6 (zero for none)"));
         }
         if !self.gravity.is_finite() || self.gravity.abs().max_element() > 1e6 || self.gravity.length_squared() < 1e-12
         {
@@ -240,6 +263,38 @@ fn roots(scalp: &Scalp, count: usize, rng: &mut Pcg64Mcg) -> Result<Vec<(Vec3, V
     }
 }
 
+/// The face a groom frames ([`GrowParams::face`]).
+struct FaceFraming {
+    /// Unit direction the face looks.
+    face: Vec3,
+    /// Unit direction across the parting (face × up).
+    across: Vec3,
+    /// The roots' mean.
+    middle: Vec3,
+}
+
+impl FaceFraming {
+    /// The framing of `face` (none for zero) over `roots` under `gravity` (unit).
+    fn new(face: Vec3, gravity: Vec3, roots: &[(Vec3, Vec3)]) -> Option<Self> {
+        let face = face.try_normalize()?;
+        let middle = roots.iter().map(|r| r.0).sum::<Vec3>() / roots.len().max(1) as f32;
+        // A face looking along gravity has no sides: no parting then.
+        let across = face.cross(-gravity).try_normalize().unwrap_or(Vec3::ZERO);
+        Some(FaceFraming { face, across, middle })
+    }
+
+    /// The root direction `start` (unit) of a strand rooted at `root`, combed
+    /// away from the face (unit).
+    fn comb(&self, root: Vec3, start: Vec3) -> Vec3 {
+        let from_middle = (root - self.middle).normalize_or_zero();
+        let front = from_middle.dot(self.face).max(0.0);
+        let side = if from_middle.dot(self.across) < 0.0 { -1.0 } else { 1.0 };
+        let parted = start + (self.across * side - self.face) * (PART_STRENGTH * front);
+        let toward_face = parted.dot(self.face).max(0.0);
+        (parted - self.face * toward_face).try_normalize().unwrap_or(start)
+    }
+}
+
 /// Grows strands on `scalp`.
 pub fn grow(scalp: &Scalp, params: &GrowParams) -> Result<Groom> {
     params.validate()?;
@@ -250,6 +305,7 @@ pub fn grow(scalp: &Scalp, params: &GrowParams) -> Result<Groom> {
     let ratio = if segments > 1 { params.segment_growth.powf(1.0 / (segments - 1) as f32) } else { 1.0 };
     let weights: Vec<f32> = (0..segments).map(|i| ratio.powi(i as i32)).collect();
     let weight_sum: f32 = weights.iter().sum();
+    let framing = FaceFraming::new(params.face, gravity, &roots);
     let mut positions = Vec::with_capacity(params.strands * params.points_per_strand);
     for (root, normal) in roots {
         // Tilt the growth direction a little, around a random axis perpendicular to the normal.
@@ -258,6 +314,7 @@ pub fn grow(scalp: &Scalp, params: &GrowParams) -> Result<Groom> {
         let tilt = params.direction_jitter * rng.random::<f32>();
         let tilted = Quat::from_axis_angle(tilt_axis, tilt) * normal;
         let start = (tilted + params.comb).try_normalize().unwrap_or(tilted);
+        let start = framing.as_ref().map_or(start, |f| f.comb(root, start));
         // Bend in the plane of start and gravity; straight up/down uses the tilt axis.
         let axis = start.cross(gravity).try_normalize().unwrap_or(tilt_axis);
         let max_bend = start.angle_between(gravity);

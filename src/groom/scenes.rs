@@ -35,6 +35,8 @@ pub fn thesis() -> Result<Groom> {
             direction_jitter: 0.15,
             segment_growth: 1.5,
             comb: Vec3::new(0.0, 0.2, -0.8),
+            // The thesis' own groom: combed back, not parted.
+            face: Vec3::ZERO,
             seed: 2011,
         },
     )

@@ -11,7 +11,9 @@
 //! - [`MeshDrawer`]: the head mesh drawn the way a host draws its geometry,
 //!   optionally shadowed by the hair;
 //! - [`HostBuffer`]: a storage buffer filled from the CPU in place of a
-//!   host's GPU buffer (skinned scalp vertices).
+//!   host's GPU buffer (skinned scalp vertices);
+//! - [`coverage`]: how much of a region of the picture (a character's face)
+//!   the hair hides.
 //!
 //! ```
 //! use vkhair::headless::{Offscreen, Submit};
@@ -33,6 +35,7 @@
 //! # Ok::<(), vkhair::Error>(())
 //! ```
 
+pub mod coverage;
 mod host_buffer;
 mod mesh;
 mod offscreen;

@@ -8,7 +8,7 @@ use glam::Vec3;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::render::RenderTarget;
-use crate::vk::barrier;
+use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc};
@@ -26,6 +26,9 @@ pub struct Offscreen {
     depth: Image,
     /// Host-visible copy target of `color`, kept between reads.
     readback: Buffer,
+    /// Host-visible copy of `color` taken mid-frame ([`Offscreen::record_snapshot`]),
+    /// made by [`Offscreen::keep_snapshots`].
+    snapshot: Option<Buffer>,
 }
 
 impl Offscreen {
@@ -62,7 +65,80 @@ impl Offscreen {
             },
         )?;
         let readback = device.readback_staging("offscreen readback", u64::from(width) * u64::from(height) * 4)?;
-        Ok(Offscreen { device, color, depth, readback })
+        Ok(Offscreen { device, color, depth, readback, snapshot: None })
+    }
+
+    /// Makes the buffer [`Offscreen::record_snapshot`] copies into (as large
+    /// as the colour image; once).
+    pub fn keep_snapshots(&mut self) -> Result<()> {
+        if self.snapshot.is_none() {
+            let (w, h) = self.size();
+            let bytes = u64::from(w) * u64::from(h) * 4;
+            self.snapshot = Some(self.device.readback_staging("offscreen snapshot", bytes)?);
+        }
+        Ok(())
+    }
+
+    /// Records a copy of the colour image as it is at this point of the frame
+    /// (after [`Offscreen::record_clear`], between passes) into the snapshot
+    /// buffer, read after the submission by [`Offscreen::read_snapshot_into`];
+    /// the image is left in `COLOR_ATTACHMENT_OPTIMAL`, its copy ordered before
+    /// later attachment reads and writes. Refused without
+    /// [`Offscreen::keep_snapshots`].
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of the context's device, outside a
+    /// render pass, after this target's clear in the same frame.
+    pub unsafe fn record_snapshot(&self, cmd: vk::CommandBuffer) -> Result<()> {
+        let snapshot = self
+            .snapshot
+            .as_ref()
+            .ok_or_else(|| Error::incompatible("offscreen snapshot", "record_snapshot before keep_snapshots"))?;
+        let d = &self.device;
+        let region = crate::vk::staging::whole_image_region(&self.color);
+        let attachment = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+        let source = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+        // SAFETY: guaranteed by the caller; both resources belong to this device.
+        unsafe {
+            d.cmd_transition(
+                cmd,
+                &self.color,
+                barrier::COLOR_ATTACHMENT,
+                &[AccessKind::TransferRead],
+                (attachment, source),
+            );
+            d.raw.cmd_copy_image_to_buffer(cmd, self.color.raw(), source, snapshot.raw(), &[region]);
+            d.cmd_barrier(
+                cmd,
+                &[],
+                &[barrier::buffer(snapshot, &[AccessKind::TransferWrite], &[AccessKind::HostRead])],
+                &[barrier::image(
+                    &self.color,
+                    &[AccessKind::TransferRead],
+                    barrier::COLOR_ATTACHMENT,
+                    source,
+                    attachment,
+                )],
+            );
+        }
+        Ok(())
+    }
+
+    /// The colour image as [`Offscreen::record_snapshot`] copied it, sRGB
+    /// RGBA8 rows top to bottom, into `out` (its memory reused). Call after
+    /// the frame that recorded the snapshot has completed.
+    pub fn read_snapshot_into(&self, out: &mut Vec<u8>) -> Result<()> {
+        let snapshot = self
+            .snapshot
+            .as_ref()
+            .ok_or_else(|| Error::incompatible("offscreen snapshot", "read_snapshot_into before keep_snapshots"))?;
+        let bytes = snapshot
+            .mapped()
+            .and_then(|b| b.get(..snapshot.size() as usize))
+            .ok_or_else(|| Error::device("staging memory", "the snapshot buffer could not be mapped whole"))?;
+        out.clear();
+        out.extend_from_slice(bytes);
+        Ok(())
     }
 
     /// The target for [`crate::render::Renderer::record_draw`] and [`super::MeshDrawer::record`].

@@ -36,6 +36,7 @@ mod readback;
 pub mod reference;
 mod resolve;
 pub mod scalp;
+mod scalp_coverage;
 mod scalp_hair;
 mod shading;
 mod shadow;
@@ -50,6 +51,7 @@ pub use params::{
     MAX_SMOOTHING_LEVEL,
 };
 pub use pass::RenderPass;
+pub use scalp_coverage::{scalp_coverage, ScalpCoverage, MAX_COVERAGE_PROBES};
 pub use scalp_hair::{scalp_area_cm2, ScalpHairParams};
 pub use shading::{Camera, HairMaterial, Light, ShadingMode, MAX_LIGHTS};
 pub use shadow::{

@@ -156,6 +156,25 @@ fn scalp_roots(roots: &[Vec3], triangles: &[[u32; 3]], params: &ScalpHairParams)
     Ok(Roots { hairs, area })
 }
 
+/// The order hairs are drawn in: a stable pseudo-random permutation of
+/// `0..count`, so a prefix (level of detail) spreads over the scalp.
+fn drawing_order(count: usize) -> Vec<u32> {
+    let mut order: Vec<u32> = (0..count as u32).collect();
+    order.sort_by_key(|&h| (hash_u32(h ^ 0x6a09_e667), h));
+    order
+}
+
+/// The roots (head frame, at rest) of the hairs [`Followers::over_scalp`]
+/// roots over the scalp of `rest` by `params`, in drawing order (the first
+/// k are those a frame drawing k hairs draws), and the scalp region's area, m².
+pub(super) fn drawn_roots(rest: &SimState, params: &ScalpHairParams) -> Result<(Vec<Vec3>, f32)> {
+    params.validate()?;
+    let roots = rest.rest_roots();
+    let triangles = super::scalp::root_triangles(rest);
+    let scalp = scalp_roots(&roots, &triangles, params)?;
+    Ok((drawing_order(scalp.hairs.len()).iter().map(|&h| scalp.hairs[h as usize].0).collect(), scalp.area))
+}
+
 /// The weights `w` of guides `g` with the guides across a parting from the
 /// heaviest one (rest directions `dirs` more than `cos_parting` apart) weighing
 /// nothing and the others sharing their weight.
@@ -220,8 +239,7 @@ impl Followers {
         // At 180° every guide blends (a dot product of opposite directions may
         // round below −1).
         let cos_parting = if params.parting_angle >= 180.0 { -2.0 } else { params.parting_angle.to_radians().cos() };
-        let mut order: Vec<u32> = (0..scalp.hairs.len() as u32).collect();
-        order.sort_by_key(|&h| (hash_u32(h ^ 0x6a09_e667), h));
+        let order = drawing_order(scalp.hairs.len());
         // Each hair is bound on its own: chunks of the drawing order on every
         // core, joined in order (the result does not depend on the threads).
         let bind = |hairs: &[u32]| -> (Vec<FollowerBinding>, Vec<f32>) {
@@ -295,49 +313,6 @@ mod tests {
         points.chunks(f.points()).map(|h| h[0]).collect()
     }
 
-    /// The radius of the largest disk on the guide-root triangles with no
-    /// drawn root in it, probed on a grid of `step` over each triangle.
-    fn largest_gap(rest: &SimState, drawn: &[Vec3], step: f32) -> f32 {
-        let cell = 4.0 * step;
-        let mut grid: std::collections::HashMap<[i32; 3], Vec<Vec3>> = std::collections::HashMap::new();
-        let key = |p: Vec3| (p / cell).floor().to_array().map(|x| x as i32);
-        for &r in drawn {
-            grid.entry(key(r)).or_default().push(r);
-        }
-        let nearest = |p: Vec3| {
-            let [x, y, z] = key(p);
-            let mut best = f32::MAX;
-            for reach in 1..64 {
-                for dx in -reach..=reach {
-                    for dy in -reach..=reach {
-                        for dz in -reach..=reach {
-                            for r in grid.get(&[x + dx, y + dy, z + dz]).into_iter().flatten() {
-                                best = best.min(r.distance(p));
-                            }
-                        }
-                    }
-                }
-                if best <= (reach - 1) as f32 * cell {
-                    return best;
-                }
-            }
-            best
-        };
-        let roots = rest.rest_roots();
-        let mut worst = 0.0f32;
-        for t in crate::render::scalp::root_triangles(rest) {
-            let [a, b, c] = t.map(|i| roots[i as usize]);
-            let n = ((b - a).length().max((c - a).length()) / step).ceil().max(1.0) as usize;
-            for i in 0..=n {
-                for j in 0..=n - i {
-                    let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
-                    worst = worst.max(nearest(a + u * (b - a) + v * (c - a)));
-                }
-            }
-        }
-        worst
-    }
-
     /// The count is the density times the scalp's area (to one hair), the
     /// roots cover the scalp evenly (no root-free disk wider than 3 × the
     /// mean root spacing), and binding is the same on every run.
@@ -352,10 +327,24 @@ mod tests {
         assert!((f.count() as f32 - expected).abs() <= 1.0, "{} hairs for {expected}", f.count());
         let spacing = (area / CM2_PER_M2 / f.count() as f32).sqrt();
         assert!((f.root_spacing() - spacing).abs() < 1e-6 * spacing.max(1.0));
+        // The roots the coverage measures are those the followers are drawn from.
         let roots = roots_of(&f, &rest, f.count());
-        let gap = largest_gap(&rest, &roots, 0.5 * spacing);
-        println!("largest root-free disk: radius {:.2} mm, {:.2} × the mean spacing", gap * 1e3, gap / spacing);
+        let (measured, _) = drawn_roots(&rest, &params).expect("roots");
+        assert_eq!(roots.len(), measured.len());
+        for (drawn, measured) in roots.iter().zip(&measured) {
+            assert!(drawn.distance(*measured) < 1e-5, "a follower rooted at {drawn}, measured at {measured}");
+        }
+        let cov = crate::render::scalp_coverage(&rest, &params, 1.0).expect("coverage");
+        assert_eq!(cov.hairs as usize, f.count());
+        assert!((cov.spacing - spacing).abs() < 1e-6);
+        let gap = cov.largest_gap;
+        println!("largest root-free disk: radius {:.2} mm, {:.2} × the mean spacing", gap * 1e3, cov.gap_ratio());
         assert!(gap <= 3.0 * spacing, "a root-free disk of radius {gap} against a spacing of {spacing}");
+        // The measure sees a hole: without the hairs of one region, the
+        // largest gap grows past 3 × the spacing.
+        let holed: Vec<Vec3> = measured.iter().copied().filter(|r| r.distance(measured[0]) > 8.0 * spacing).collect();
+        let hole = super::super::scalp_coverage::largest_gap(&rest, &holed, 0.5 * spacing);
+        assert!(hole > 3.0 * spacing, "a hole of radius 8 spacings measured as {hole}");
         assert_eq!(Followers::over_scalp(&rest, &params, 2, 8).expect("again"), f, "not the same on a second run");
     }
 
@@ -369,12 +358,12 @@ mod tests {
         let params = ScalpHairParams { density: 20.0, ..ScalpHairParams::default() };
         let f = Followers::over_scalp(&rest, &params, 2, 8).expect("followers");
         let all = roots_of(&f, &rest, f.count());
-        let tenth = roots_of(&f, &rest, f.count() / 10);
+        let tenth = roots_of(&f, &rest, (f.count() as f32 * 0.1).round() as usize);
         assert_eq!(&all[..tenth.len()], &tenth[..], "a hair moved when fewer were drawn");
-        let spacing = (scalp_area_cm2(&rest) / CM2_PER_M2 / tenth.len() as f32).sqrt();
-        let gap = largest_gap(&rest, &tenth, 0.5 * spacing);
-        println!("a tenth: largest root-free disk {:.2} × its mean spacing", gap / spacing);
-        assert!(gap <= 3.0 * spacing, "a tenth of the hairs leaves a gap of {gap} against a spacing of {spacing}");
+        let cov = crate::render::scalp_coverage(&rest, &params, 0.1).expect("coverage");
+        assert_eq!(cov.hairs as usize, tenth.len());
+        println!("a tenth: largest root-free disk {:.2} × its mean spacing", cov.gap_ratio());
+        assert!(cov.gap_ratio() <= 3.0, "a tenth of the hairs leaves a gap {:.2} × its spacing", cov.gap_ratio());
     }
 
     /// Two groups of guides combed apart (a parting down the middle: the left

@@ -288,7 +288,7 @@ impl Device {
 }
 
 /// A buffer ↔ image copy of a whole single-layer, single-mip image, tightly packed.
-fn whole_image_region(image: &Image) -> vk::BufferImageCopy {
+pub(crate) fn whole_image_region(image: &Image) -> vk::BufferImageCopy {
     vk::BufferImageCopy::default()
         .image_subresource(vk::ImageSubresourceLayers {
             aspect_mask: image.aspect,

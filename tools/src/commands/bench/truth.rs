@@ -1,7 +1,10 @@
-//! Sintel's default frame against its ground truth: a full head of thin
-//! strands, one hair each (single-strand interpolation, `hairs_per_key` such
-//! that key hairs × it ≈ 100,000, level of detail off, K = 32 and a pool of 24
-//! fragments per pixel), the same simulated state and camera. The figure is the error of
+//! Sintel's default frame against its ground truth: every hair of the
+//! full-density scalp distribution (the tool's default, `[scalp]` density
+//! over the scalp the key hairs' roots cover: about 107,000 hairs for Sintel),
+//! each one hair at its physical width, level of detail off, K = 32 and a pool
+//! of 24 fragments per pixel, the same simulated state and camera. (Where the
+//! key hairs make no scalp and hairs grow in clumps, the truth is those clumps
+//! at `hairs_per_key` such that key hairs × it ≈ 100,000.) The figure is the error of
 //! the default frame over hair pixels, as `render::reference::srgb_error_stats`.
 
 use vkhair::render::reference::{srgb_error_stats, ImageError};

@@ -72,6 +72,11 @@ pub struct GrowArgs {
     /// Bend toward gravity, radians over the strand.
     #[arg(long, default_value_t = 2.5)]
     droop: f32,
+    /// Sphere, ellipsoid and OBJ: the direction the face looks, "x,y,z", or
+    /// "0" for none. Hair frames it: combed back from it, parted at the middle
+    /// and, in front, turned to its side (glTF: the character's own forward).
+    #[arg(long, default_value = "0,0,1")]
+    face: String,
     /// Random seed.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -141,12 +146,22 @@ pub fn grow_groom(a: &GrowArgs) -> CliResult {
                     scalp
                 }
             };
+            let face = parse_vec3("face", &a.face)?;
+            if face.abs().max_element() > 1e6 {
+                return Err(format!("--face {:?}: each component within ±1e6", a.face).into());
+            }
             let params = GrowParams {
                 strands: a.strands,
                 points_per_strand: a.points,
                 length,
                 droop: a.droop,
                 seed: a.seed,
+                face,
+                // Back from the face, a little up: the crown's hair lies over the head.
+                comb: match face.try_normalize() {
+                    Some(f) => 0.2 * Vec3::Y - 0.8 * f,
+                    None => Vec3::ZERO,
+                },
                 ..GrowParams::default()
             };
             grow(&scalp, &params)?

@@ -1,13 +1,18 @@
 //! `vkhair inspect`: counts, lengths, bounds and point statistics of a groom
-//! file; for USD and Alembic also its curve objects, guides, units and axis.
+//! file; for USD and Alembic also its curve objects, guides, units and axis;
+//! with `--drawn`, the hairs `render` roots over the scalp its strands' roots
+//! cover and how evenly they cover it.
 
 use std::path::PathBuf;
 
 use serde_json::json;
 use vkhair::groom::authored::UpAxis;
 
+use vkhair::render::{scalp_coverage, ScalpCoverage, ScalpHairParams};
+use vkhair::sim::{RigidTransform, SimParams, SimState};
+
 use crate::args::input::{load_with_defaults, Loaded};
-use crate::output::CliResult;
+use crate::output::{CliResult, Error};
 use crate::say;
 
 #[derive(clap::Args)]
@@ -20,16 +25,109 @@ pub struct InspectArgs {
     /// Print the numbers as one JSON object instead of a table (for scripts).
     #[arg(long)]
     json: bool,
+    /// Also report the hairs `render` draws over the scalp the strands' roots
+    /// cover (each strand a key hair): their count at the density, the mean
+    /// spacing of their roots and the largest disk of the scalp with no root
+    /// in it, at full detail and at a quarter of the hairs (level of detail).
+    #[arg(long)]
+    drawn: bool,
+    /// With --drawn: multiply positions by this to make meters (0.01: Blender
+    /// units → m) [default: 1].
+    #[arg(long)]
+    scale: Option<f32>,
+    /// With --drawn: drawn hairs per cm² [default: 150, `[scalp] density`'s default].
+    #[arg(long)]
+    density: Option<f32>,
 }
 
+/// Most strands `--drawn` takes as key hairs (`render`'s: a larger file is
+/// drawn as followers of its guides, not over the scalp).
+const MOST_KEY_HAIRS: usize = 4096;
+
+/// Points each key hair is resampled to for `--drawn` (only roots matter).
+const DRAWN_POINTS: usize = 4;
+
 pub fn inspect(a: &InspectArgs) -> CliResult {
+    for (flag, given) in [("--scale", a.scale.is_some()), ("--density", a.density.is_some())] {
+        if given && !a.drawn {
+            return Err(format!("{flag} needs --drawn (it sets how the hairs over the scalp are counted)").into());
+        }
+    }
     let loaded = load_with_defaults(&a.file, a.strict)?;
+    let drawn = if a.drawn { Some(drawn(a, &loaded.groom)?) } else { None };
     if a.json {
-        say!("{}", report(&loaded));
+        let mut r = report(&loaded);
+        r["drawn"] = drawn.as_ref().map_or(serde_json::Value::Null, Drawn::json);
+        say!("{r}");
     } else {
         print_table(&a.file, &loaded);
+        if let Some(d) = &drawn {
+            d.print();
+        }
     }
     Ok(())
+}
+
+/// What `--drawn` reports: the hairs over the scalp at full detail and at a
+/// quarter of them.
+struct Drawn {
+    density: f32,
+    full: ScalpCoverage,
+    quarter: ScalpCoverage,
+}
+
+/// The hairs `render` roots over the scalp `groom`'s roots cover.
+fn drawn(a: &InspectArgs, groom: &vkhair::Groom) -> Result<Drawn, Error> {
+    let scale = a.scale.unwrap_or(1.0);
+    if !(scale.is_finite() && scale > 0.0) {
+        return Err(format!("--scale must be a finite number above 0 (got {scale})").into());
+    }
+    let params =
+        ScalpHairParams { density: a.density.unwrap_or(ScalpHairParams::default().density), ..Default::default() };
+    params.validate().map_err(|e| format!("--density: {e}"))?;
+    if groom.strand_count() > MOST_KEY_HAIRS {
+        return Err(format!(
+            "--drawn: {} strands are more than the {MOST_KEY_HAIRS} key hairs `render` roots hairs over the scalp \
+             from; it draws such a file's strands as followers of its guides",
+            groom.strand_count()
+        )
+        .into());
+    }
+    let keys = groom.scaled(scale)?.resampled(DRAWN_POINTS)?;
+    let rest = SimState::from_groom(&keys, &SimParams::default(), &RigidTransform::default())?;
+    let full = scalp_coverage(&rest, &params, 1.0)?;
+    let quarter = scalp_coverage(&rest, &params, 0.25)?;
+    Ok(Drawn { density: params.density, full, quarter })
+}
+
+impl Drawn {
+    fn print(&self) {
+        let (f, q) = (&self.full, &self.quarter);
+        say!(
+            "drawn hairs        {} over the scalp the strands' roots cover: {} per cm² over {:.1} cm², a root every {:.2} mm",
+            f.hairs,
+            self.density,
+            f.area_cm2,
+            f.spacing * 1e3
+        );
+        say!(
+            "scalp coverage     largest root-free disk {:.2} mm, {:.2} × the spacing; a quarter of the hairs (level of \
+             detail): {:.2} × theirs",
+            f.largest_gap * 1e3,
+            f.gap_ratio(),
+            q.gap_ratio()
+        );
+    }
+
+    fn json(&self) -> serde_json::Value {
+        let one = |c: &ScalpCoverage| json!({ "hairs": c.hairs, "spacing_m": c.spacing, "largest_gap_m": c.largest_gap, "gap_ratio": c.gap_ratio() });
+        json!({
+            "density_per_cm2": self.density,
+            "scalp_area_cm2": self.full.area_cm2,
+            "full": one(&self.full),
+            "quarter": one(&self.quarter),
+        })
+    }
 }
 
 /// Guides and followers: the file's own guide marks, else none marked.

@@ -3,8 +3,9 @@
 use std::path::PathBuf;
 
 use glam::Vec3;
-use vkhair::headless::{MeshDrawer, Offscreen, Submit};
-use vkhair::render::Transparency;
+use vkhair::groom::mesh::TriMesh;
+use vkhair::headless::{coverage, MeshDrawer, Offscreen, Submit};
+use vkhair::render::{Camera, Transparency};
 use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, SchedulerOptions};
 use vkhair::sim::RigidTransform;
 use vkhair::{ContextOptions, GpuContext, GpuProfiler};
@@ -120,7 +121,16 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
         );
     }
     let renderer = make_renderer(sa, &ctx, &config, sim.key_hairs(), &s)?;
-    let offscreen = Offscreen::new(&ctx, sa.width, sa.height)?;
+    let mut offscreen = Offscreen::new(&ctx, sa.width, sa.height)?;
+    // A character's face, measured every frame: how much of it the hair hides.
+    let mut face = match &s.character {
+        Some(ch) => {
+            offscreen.keep_snapshots()?;
+            Some(FaceCover::new(ch.face_region()?))
+        }
+        None => None,
+    };
+    let offscreen = offscreen;
     // The head mesh (lit along the key spot light's direction) takes that light's hair
     // shadow the way a host would, through glsl/include/shadow.glsl.
     // A character's whole body is drawn, deformed every frame (in the world).
@@ -172,6 +182,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
             sim.set_scalp_bones(&ch.scalp_bones(time(first_step + steps_per_frame)))?;
         }
         let started = host_now_ns();
+        let mut shown_time = 0.0;
         ctx.run_frame("vkhair render frame", |cmd| {
             // SAFETY: run_frame hands over a recording command buffer of the
             // context's device, submits it with the returned waits and waits for it;
@@ -182,7 +193,8 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
                 if let Some(ch) = &s.character {
                     // The body where the shown hair state is (uploaded before this
                     // frame is submitted; the previous frame has completed).
-                    head.update(&ch.character.mesh(&ch.pose(time(sim.shown_steps() as usize)))?)?;
+                    shown_time = time(sim.shown_steps() as usize);
+                    head.update(&ch.character.mesh(&ch.pose(shown_time))?)?;
                 }
                 renderer.record_prepare(cmd, sim.key_hairs(), Some(&camera), Some(&mut profiler))?;
                 renderer.record_shadows(cmd, sim.key_hairs(), Some(&mut profiler))?;
@@ -202,6 +214,9 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
                     Vec3::new(0.6, -0.5, -0.8),
                 );
                 profiler.end_scope(cmd, scope);
+                if face.is_some() {
+                    offscreen.record_snapshot(cmd)?;
+                }
                 renderer.record_draw(cmd, frame as u64, &offscreen.target(), &camera, Some(&mut profiler))?;
                 Ok(sync)
             }
@@ -219,6 +234,11 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
         let read = host_now_ns();
         let mut rgba = sink.buffer();
         offscreen.read_rgba8_into(&mut rgba)?;
+        if let (Some(face), Some(ch)) = (&mut face, &s.character) {
+            offscreen.read_snapshot_into(&mut face.before)?;
+            let head = ch.head_at(shown_time).matrix();
+            face.add(&rgba, head, &camera, (sa.width, sa.height));
+        }
         sink.push(frame, rgba)?;
         profile.add_cpu_span("frame: read back, hand to the PNG writer", read, host_now_ns());
         bar.inc(1);
@@ -251,12 +271,15 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
             say!("composited over {}×{} pixels from ({x0}, {y0}), where the ribbons reach", x1 - x0, y1 - y0);
         }
     }
+    if let Some(face) = &face {
+        face.report();
+    }
     say!("wrote {} frames and contact_sheet.png to {}", a.frames, a.out.display());
     a.profile_out.write(&profile, || {
         serde_json::json!({
             "command": "render",
             "device": ctx.info().name,
-            "scene": sa.input.input.as_ref().map_or("thesis".to_owned(), |p| p.display().to_string()),
+            "scene": sa.input.input.as_ref().or(sa.input.gltf.as_ref()).map_or("thesis".to_owned(), |p| p.display().to_string()),
             "simulation": sim.mode().name(),
             "key_hairs": strands,
             "points_per_key_hair": points,
@@ -268,12 +291,65 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
             "iterations": sim_params.iterations,
             "substeps": sim_params.substeps,
             "volume": format!("{:?}", sim_params.volume.mode),
+            "face_covered": face.as_ref().map(FaceCover::json),
         })
     })?;
     if let Some(credit) = s.credit {
         say!("{credit}");
     }
     Ok(())
+}
+
+/// How much of a character's face the hair hides, frame after frame
+/// ([`vkhair::headless::coverage`]).
+struct FaceCover {
+    /// The face, in the head's frame ([`vkhair::character::HairRig::face_region`]).
+    region: TriMesh,
+    /// The frame before the hair was drawn (the snapshot's copy).
+    before: Vec<u8>,
+    /// Per frame: face pixels covered by hair, face pixels.
+    frames: Vec<(usize, usize)>,
+}
+
+impl FaceCover {
+    fn new(region: TriMesh) -> Self {
+        FaceCover { region, before: Vec::new(), frames: Vec::new() }
+    }
+
+    /// Adds a frame: `after` with the hair, `self.before` without, the head
+    /// placed by `head`.
+    fn add(&mut self, after: &[u8], head: glam::Mat4, camera: &Camera, extent: (u32, u32)) {
+        let eye = camera.view.inverse().transform_point3(Vec3::ZERO);
+        let mask = coverage::front_facing_pixels(&self.region, head, camera.projection * camera.view, eye, extent);
+        if let Some(counts) = coverage::covered_pixels(&self.before, after, &mask) {
+            self.frames.push(counts);
+        }
+    }
+
+    /// The share of the face's pixels covered over all frames, and in the worst.
+    fn shares(&self) -> (f64, f64) {
+        let share = |(c, n): (usize, usize)| if n == 0 { 0.0 } else { c as f64 / n as f64 };
+        let (c, n) = self.frames.iter().fold((0, 0), |(c, n), f| (c + f.0, n + f.1));
+        (share((c, n)), self.frames.iter().copied().map(share).fold(0.0, f64::max))
+    }
+
+    fn report(&self) {
+        let (all, worst) = self.shares();
+        let pixels = self.frames.iter().map(|f| f.1).sum::<usize>() / self.frames.len().max(1);
+        say!(
+            "face: hair covers {:.2} % of the face's pixels over {} frames (the worst frame {:.2} %; about {pixels} face \
+             pixels a frame; covered: changed by more than {} sRGB steps)",
+            100.0 * all,
+            self.frames.len(),
+            100.0 * worst,
+            coverage::COVERED_STEPS
+        );
+    }
+
+    fn json(&self) -> serde_json::Value {
+        let (all, worst) = self.shares();
+        serde_json::json!({ "share": all, "worst_frame_share": worst, "frames": self.frames.len() })
+    }
 }
 
 /// How the tool names a rasteriser.
