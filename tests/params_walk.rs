@@ -62,6 +62,8 @@ const ACCEPTED: &[(&str, &str)] = &[
     ("scalp.parting_angle", "0"),
     ("scalp.clumping", "0"),
     ("scalp.length_variation", "0"),
+    ("scalp.curl_radius", "0"),
+    ("scalp.curl_variation", "0"),
     // Config: [material]
     ("material.ambient", "0"),
     ("material.diffuse_wrap", "0"),

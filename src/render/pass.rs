@@ -4,7 +4,7 @@
 //! ## The pass convention
 //!
 //! Every pass is a plain struct in its own file ([`super::smooth`],
-//! [`super::interpolate`], [`super::shadow`], [`super::draw`], [`super::oit`], [`super::resolve`])
+//! [`super::interpolate`], [`super::shadow`], [`super::draw`], [`super::resolve`])
 //! that
 //!
 //! - makes its pipelines, descriptor sets and the buffers and images it writes

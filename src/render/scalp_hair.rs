@@ -60,6 +60,16 @@ pub struct ScalpHairParams {
     /// Each hair is shorter than its guides' blend by up to this fraction of
     /// its length, stable per hair (0..=0.9). Default: 0.1.
     pub length_variation: f32,
+    /// Radius of each hair's own curl about its guides' blend, meters, reached
+    /// a fifth of the way from the root (0..=0.05; 0 for straight). Default: 0.
+    pub curl_radius: f32,
+    /// Length of hair one turn of the curl takes, meters (1e-4..=10).
+    /// Default: 0.02.
+    pub curl_period: f32,
+    /// How much each hair's curl radius and period differ from the set ones,
+    /// as a fraction, stable per hair (0..=0.9; the phase is each hair's own
+    /// always). Default: 0.3.
+    pub curl_variation: f32,
     /// Most drawn hairs: a density over an area that asks for more is refused
     /// (1..=4,000,000). Default: 1,000,000.
     pub max_hairs: u32,
@@ -72,6 +82,9 @@ impl Default for ScalpHairParams {
             parting_angle: 60.0,
             clumping: 0.0,
             length_variation: 0.1,
+            curl_radius: 0.0,
+            curl_period: 0.02,
+            curl_variation: 0.3,
             max_hairs: 1_000_000,
         }
     }
@@ -85,6 +98,9 @@ impl ScalpHairParams {
             ("scalp.parting_angle", self.parting_angle, 0.0, 180.0),
             ("scalp.clumping", self.clumping, 0.0, 1.0),
             ("scalp.length_variation", self.length_variation, 0.0, 0.9),
+            ("scalp.curl_radius", self.curl_radius, 0.0, 0.05),
+            ("scalp.curl_period", self.curl_period, 1e-4, 10.0),
+            ("scalp.curl_variation", self.curl_variation, 0.0, 0.9),
         ];
         for (name, v, lo, hi) in ranges {
             if !(v.is_finite() && (lo..=hi).contains(&v)) {
@@ -154,6 +170,50 @@ fn scalp_roots(roots: &[Vec3], triangles: &[[u32; 3]], params: &ScalpHairParams)
         }
     }
     Ok(Roots { hairs, area })
+}
+
+/// A hair's own curl ([`ScalpHairParams::curl_radius`]): a helix about its
+/// guides' blend, its frame carried along the blend (parallel transport) so
+/// that it turns smoothly.
+struct Curl {
+    /// Radius, meters (0: none).
+    radius: f32,
+    /// Radians of the turn per meter of hair.
+    turn: f32,
+    /// Phase at the root, radians.
+    phase: f32,
+    /// The frame's first axis at the previous point (unit, across the blend).
+    across: Option<Vec3>,
+}
+
+impl Curl {
+    /// The curl of hair `h` by `params` (radius and period varied per hair).
+    fn of(params: &ScalpHairParams, h: u32) -> Curl {
+        let unit = |salt: u32| hash_u32(h ^ salt) as f32 / u32::MAX as f32;
+        let vary = |salt: u32| 1.0 + params.curl_variation * (2.0 * unit(salt) - 1.0);
+        Curl {
+            radius: params.curl_radius * vary(0x243f_6a88),
+            turn: std::f32::consts::TAU / (params.curl_period * vary(0x85a3_08d3)),
+            phase: std::f32::consts::TAU * unit(0x1319_8a2e),
+            across: None,
+        }
+    }
+
+    /// The offset at the next point, `along` (0..=1) of the hair and `length`
+    /// meters along its blend, where the blend runs along `tangent` (unit):
+    /// around it, growing from nothing at the root to the full radius a fifth
+    /// of the way along. Points are visited root to tip.
+    fn next(&mut self, tangent: Vec3, along: f32, length: f32) -> Vec3 {
+        if self.radius == 0.0 {
+            return Vec3::ZERO;
+        }
+        let previous = self.across.unwrap_or_else(|| tangent.any_orthonormal_vector());
+        let across = (previous - tangent * previous.dot(tangent)).try_normalize().unwrap_or(previous);
+        self.across = Some(across);
+        let angle = self.phase + self.turn * length;
+        let ramp = (5.0 * along).min(1.0);
+        self.radius * ramp * (angle.cos() * across + angle.sin() * tangent.cross(across))
+    }
 }
 
 /// The order hairs are drawn in: a stable pseudo-random permutation of
@@ -254,10 +314,17 @@ impl Followers {
                 let seed = hash_u32(h ^ 0x1b87_3593);
                 let length = 1.0 - params.length_variation * (seed as f32 / u32::MAX as f32);
                 let origin = shapes.position_at((g, w), 0.0);
+                let mut curl = Curl::of(params, h);
+                let (mut previous, mut run) = (origin, 0.0);
                 for (i, x) in strand.iter_mut().enumerate() {
                     let along = i as f32 / (points - 1) as f32;
                     let s = length * along;
-                    let own = root + (shapes.position_at((g, w), s) - origin);
+                    let blend = shapes.position_at((g, w), s);
+                    let ahead = shapes.position_at((g, w), (s + 1.0 / (points - 1) as f32).min(1.0));
+                    let tangent = (ahead - blend).try_normalize().or((blend - previous).try_normalize());
+                    run += blend.distance(previous);
+                    previous = blend;
+                    let own = root + (blend - origin) + tangent.map_or(Vec3::ZERO, |t| curl.next(t, along, run));
                     *x = own.lerp(shapes.position_at(alone, s), params.clumping * along);
                 }
                 let ((g, w), point_offsets) = shapes.bind_strand(&strand, (g, w));
@@ -346,6 +413,43 @@ mod tests {
         let hole = super::super::scalp_coverage::largest_gap(&rest, &holed, 0.5 * spacing);
         assert!(hole > 3.0 * spacing, "a hole of radius 8 spacings measured as {hole}");
         assert_eq!(Followers::over_scalp(&rest, &params, 2, 8).expect("again"), f, "not the same on a second run");
+    }
+
+    /// Curl: each hair winds about where it would lie straight, at its own
+    /// radius (the set one ± the variation), its own phase, none at the root;
+    /// the roots stay where they were.
+    #[test]
+    fn curled_hairs_wind_about_their_straight_selves() {
+        let rest = guides(300);
+        let straight = ScalpHairParams { density: 5.0, ..ScalpHairParams::default() };
+        let radius = 0.004;
+        let curled = ScalpHairParams { curl_radius: radius, curl_period: 0.03, ..straight.clone() };
+        let points = |p: &ScalpHairParams| {
+            let f = Followers::over_scalp(&rest, p, 2, 24).expect("followers");
+            let smoothed: Vec<Vec<(Vec3, Vec3)>> = (0..rest.strands)
+                .map(|g| {
+                    let keys: Vec<Vec3> = (0..rest.points).map(|i| rest.rest[g * rest.points + i].truncate()).collect();
+                    smooth_strand(&keys, 2)
+                })
+                .collect();
+            f.evaluate(&smoothed, &rest_plane_normals(&rest), Quat::IDENTITY, f.count()).expect("evaluate")
+        };
+        let (a, b) = (points(&straight), points(&curled));
+        assert_eq!(a.len(), b.len());
+        let (lo, hi) = (radius * (1.0 - curled.curl_variation), radius * (1.0 + curled.curl_variation));
+        let mut directions = Vec::new();
+        for (h, (x, y)) in a.chunks(24).zip(b.chunks(24)).enumerate() {
+            assert!(x[0].distance(y[0]) < 1e-6, "hair {h}'s root moved");
+            for (i, (p, q)) in x.iter().zip(y).enumerate().skip(6) {
+                let d = p.distance(*q);
+                assert!(d >= 0.9 * lo && d <= 1.1 * hi, "hair {h} point {i}: {d} m from straight, not {lo}..{hi}");
+            }
+            directions.push((y[12] - x[12]).normalize());
+        }
+        // Phases differ: the offsets at the same point of the hairs point every way.
+        let mean = directions.iter().copied().sum::<Vec3>() / directions.len() as f32;
+        println!("{} hairs; mean offset direction {mean}", directions.len());
+        assert!(mean.length() < 0.2, "the hairs curl in step: mean direction {mean}");
     }
 
     /// Level of detail draws a prefix of the drawing order: a hair drawn at a

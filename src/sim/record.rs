@@ -15,6 +15,11 @@ use crate::vk::barrier::{self, AccessKind};
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 
+// vkCmdUpdateBuffer takes at most 64 KiB: the sub-steps' parameter blocks
+// and the colliders each fit one update.
+const _: () = assert!(super::MAX_SUBSTEPS as usize * std::mem::size_of::<SimStepParams>() <= 65_536);
+const _: () = assert!(super::MAX_COLLIDERS * std::mem::size_of::<GpuCollider>() <= 65_536);
+
 /// Recording.
 impl HairSim {
     /// Records one step that ends with the head at `head` into `cmd`, with a debug
@@ -97,8 +102,9 @@ impl HairSim {
         let d = &self.device;
         let params: Vec<SimStepParams> = inputs.iter().map(|sub| SimStepParams::from(&sub.params)).collect();
         // SAFETY: guaranteed by the caller; sizes are multiples of 4, each update
-        // below 64 KiB (at most MAX_SUBSTEPS parameter blocks of 256 bytes, at
-        // most MAX_COLLIDERS colliders of 32 bytes).
+        // below 64 KiB (at most MAX_SUBSTEPS parameter blocks of
+        // size_of::<SimStepParams>() bytes, at most MAX_COLLIDERS colliders of
+        // 32 bytes).
         unsafe {
             d.cmd_barrier(cmd, &[entry_barrier()], &[], &[]);
             d.raw.cmd_update_buffer(cmd, self.gpu.params.raw(), 0, bytemuck::cast_slice(&params));
