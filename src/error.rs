@@ -305,6 +305,23 @@ pub enum Error {
         /// Segment index within the strand.
         segment: usize,
     },
+    /// A point lies far from where its strand runs: a segment to it is over
+    /// [`crate::groom::OUTLIER_SEGMENT_RATIO`] times the strand's median.
+    #[error(
+        "strand {strand} point {point} at ({}, {}, {}) is an outlier: a segment to it is over 10,000 times its \
+         strand's median segment",
+        position[0],
+        position[1],
+        position[2]
+    )]
+    OutlierPoint {
+        /// Strand index.
+        strand: usize,
+        /// Point index within the strand.
+        point: usize,
+        /// Its position, in the groom's units.
+        position: [f32; 3],
+    },
     /// A per-point or per-strand attribute array has the wrong length.
     #[error("{what} has {actual} entries but the groom needs {expected}")]
     AttributeLength {

@@ -137,6 +137,65 @@ pub fn remove_partial_files_then<R>(then: impl FnOnce(usize) -> R) -> R {
     then(n)
 }
 
+/// Outputs opened before their write ([`hold_fifo_output`]): path and file.
+static HELD: std::sync::Mutex<Vec<(std::path::PathBuf, File)>> = std::sync::Mutex::new(Vec::new());
+
+/// The file [`hold_fifo_output`] opened for `path`, if any (taken: the write
+/// closes it).
+fn take_held(path: &Path) -> Option<File> {
+    let mut held = HELD.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let k = held.iter().position(|(p, _)| p == path)?;
+    Some(held.swap_remove(k).1)
+}
+
+fn is_fifo(path: &Path) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    std::fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo())
+}
+
+/// `path`, a FIFO, opened for writing without waiting for a reader: refused
+/// ([`Error::OutputRefused`]) when no process reads it, which would block the
+/// write forever; the file returned blocks on a full pipe as any write does.
+fn open_fifo_for_writing(path: &Path) -> Result<File> {
+    use std::os::fd::AsRawFd;
+    use std::os::unix::fs::OpenOptionsExt;
+    let file = std::fs::OpenOptions::new().write(true).custom_flags(libc::O_NONBLOCK).open(path).map_err(|e| {
+        match e.raw_os_error() {
+            Some(libc::ENXIO) => {
+                Error::OutputRefused { path: path.into(), reason: "no process reads this FIFO".into() }
+            }
+            _ => Error::Io { path: path.into(), source: e },
+        }
+    })?;
+    let fd = file.as_raw_fd();
+    // SAFETY: fcntl on a descriptor this function owns, reading then clearing
+    // one status flag.
+    let cleared = unsafe {
+        let flags = libc::fcntl(fd, libc::F_GETFL);
+        flags >= 0 && libc::fcntl(fd, libc::F_SETFL, flags & !libc::O_NONBLOCK) == 0
+    };
+    if !cleared {
+        return Err(Error::Io { path: path.into(), source: std::io::Error::last_os_error() });
+    }
+    Ok(file)
+}
+
+/// Opens the FIFO at `path` for writing now and keeps it open until
+/// [`write_atomic`] writes to it: a run checks at its start that a process
+/// reads its output, and that reader, holding the other end, does not see
+/// the stream end before the write (a reader that reads once would otherwise
+/// take a probe's open and close for the whole output, and the real write
+/// would wait for a reader forever). Refused ([`Error::OutputRefused`]) where
+/// no process reads it; a `path` that is not a FIFO is left alone.
+pub fn hold_fifo_output(path: &Path) -> Result<()> {
+    if !is_fifo(path) {
+        return Ok(());
+    }
+    let file = open_fifo_for_writing(path)?;
+    HELD.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).push((path.to_path_buf(), file));
+    Ok(())
+}
+
 /// Writes `bytes` to `path` through a temporary file in the same folder that then
 /// replaces `path`: a failed write, a full disk or a killed process leaves either
 /// the old file or none, never a truncated one (a process that handles its
@@ -163,7 +222,12 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
             });
         }
         Ok(_) if special(path) => {
-            let mut file = std::fs::OpenOptions::new().write(true).open(path).map_err(io)?;
+            let held = take_held(path);
+            let mut file = match held {
+                Some(file) => file,
+                None if is_fifo(path) => open_fifo_for_writing(path)?,
+                None => std::fs::OpenOptions::new().write(true).open(path).map_err(io)?,
+            };
             file.write_all(bytes).map_err(io)?;
             return file.flush().map_err(io);
         }

@@ -26,6 +26,7 @@ fn is_file_error(e: &Error) -> bool {
             | Error::StrandPointCount { .. }
             | Error::NonFinite { .. }
             | Error::ZeroLengthSegment { .. }
+            | Error::OutlierPoint { .. }
             | Error::AttributeLength { .. }
             | Error::GroomExtent { .. }
             | Error::BadScalp(_)

@@ -481,6 +481,7 @@ fn locate(e: Error, objects: &[RawCurves], starts: &[usize]) -> Error {
     let strand = match &e {
         Error::NonFinite { strand, .. }
         | Error::ZeroLengthSegment { strand, .. }
+        | Error::OutlierPoint { strand, .. }
         | Error::StrandPointCount { strand, .. } => *strand,
         _ => return e,
     };
@@ -489,6 +490,7 @@ fn locate(e: Error, objects: &[RawCurves], starts: &[usize]) -> Error {
     let e = match e {
         Error::NonFinite { point, what, .. } => Error::NonFinite { strand: local, point, what },
         Error::ZeroLengthSegment { segment, .. } => Error::ZeroLengthSegment { strand: local, segment },
+        Error::OutlierPoint { point, position, .. } => Error::OutlierPoint { strand: local, point, position },
         Error::StrandPointCount { points, max, .. } => Error::StrandPointCount { strand: local, points, max },
         e => e,
     };

@@ -12,7 +12,8 @@
 //! | 2..=[`MAX_POINTS_PER_STRAND`] points per strand | [`Error::StrandPointCount`] |
 //! | finite positions and attributes | [`Error::NonFinite`] |
 //! | a bounding-box diagonal that f32 can hold | [`Error::GroomExtent`] |
-//! | no segment shorter than [`MIN_SEGMENT_FRACTION`] × the bounding-box diagonal | [`Error::ZeroLengthSegment`] |
+//! | no outlier point: no segment over [`OUTLIER_SEGMENT_RATIO`] × its strand's median | [`Error::OutlierPoint`] |
+//! | no segment shorter than [`MIN_SEGMENT_FRACTION`] × its strand's bounding-box diagonal | [`Error::ZeroLengthSegment`] |
 //! | attribute arrays of the right length | [`Error::AttributeLength`] |
 //!
 //! Sources: [`cyhair`] (`.hair` read/write), [`tfx`] (TressFX `.tfx` read),
@@ -54,9 +55,39 @@ pub const MAX_STRANDS: usize = 1 << 22;
 pub const MAX_POINTS: usize = 1 << 24;
 /// Most points one strand may have (65,536: a `.hair` file stores segment counts as u16).
 pub const MAX_POINTS_PER_STRAND: usize = 1 << 16;
-/// A segment shorter than this fraction of the groom's bounding-box diagonal counts
-/// as zero-length (scale-free, so it works for meters and for Blender units alike).
+/// A segment shorter than this fraction of its strand's bounding-box diagonal
+/// counts as zero-length (scale-free, so it works for meters and for Blender
+/// units alike; judged per strand, so a far point elsewhere in the groom
+/// changes nothing).
 pub const MIN_SEGMENT_FRACTION: f32 = 1e-6;
+/// A segment longer than this many times its strand's median segment marks an
+/// outlier point (a strand of three segments or more): a point far from where
+/// its strand runs, which no zero-length judgement should be scaled by.
+pub const OUTLIER_SEGMENT_RATIO: f32 = 1e4;
+
+/// The first outlier point of the strand `points` ([`OUTLIER_SEGMENT_RATIO`]):
+/// its index and position. Of a too-long segment, the point it leads to is
+/// the outlier, or the root where only the first segment is too long.
+pub(crate) fn outlier_point(points: &[Vec3]) -> Option<(usize, Vec3)> {
+    if points.len() < 4 {
+        return None;
+    }
+    let lengths: Vec<f32> = points.windows(2).map(|p| (p[1] - p[0]).length()).collect();
+    let mut sorted = lengths.clone();
+    sorted.sort_by(f32::total_cmp);
+    let most = sorted[sorted.len() / 2] * OUTLIER_SEGMENT_RATIO;
+    let long = |i: usize| lengths.get(i).is_some_and(|&l| l > most);
+    let first = (0..lengths.len()).find(|&i| long(i))?;
+    let point = if first == 0 && !long(1) { 0 } else { first + 1 };
+    Some((point, points[point]))
+}
+
+/// The shortest segment of the strand `points` that is not zero-length
+/// ([`MIN_SEGMENT_FRACTION`] of its bounding-box diagonal).
+pub(crate) fn min_segment(points: &[Vec3]) -> f32 {
+    let (lo, hi) = bounding_box(points.iter().copied());
+    (hi - lo).length() * MIN_SEGMENT_FRACTION
+}
 
 /// The axis-aligned bounding box (min, max) of `points`; (+∞, −∞) for none.
 pub fn bounding_box(points: impl IntoIterator<Item = Vec3>) -> (Vec3, Vec3) {
@@ -222,9 +253,12 @@ impl Groom {
         }
         let (lo, hi) = self.bounds();
         check_extent(lo, hi)?;
-        let min_segment = (hi - lo).length() * MIN_SEGMENT_FRACTION;
         for strand in 0..self.strand_count() {
             let points = self.strand(strand);
+            if let Some((point, position)) = outlier_point(points) {
+                return Err(Error::OutlierPoint { strand, point, position: position.to_array() });
+            }
+            let min_segment = min_segment(points);
             for (segment, pair) in points.windows(2).enumerate() {
                 let length = (pair[1] - pair[0]).length();
                 if length <= min_segment || length == 0.0 {

@@ -3,20 +3,26 @@
 //! Exported grooms carry defects that the strict constructor refuses (TressFX's
 //! own `mohawk.tfx` has one zero-length segment among 2,228 strands).
 //! [`Groom::repaired`] drops, in this order: strands with a NaN or infinite value
-//! (position or attribute), then every point that coincides with the strand's
-//! previous kept point (a zero-length segment, as [`Groom::new`] judges it), then
-//! strands left with fewer than two points. [`Repairs`] counts what went.
+//! (position or attribute), then strands with an outlier point (far from where
+//! the strand runs, as [`Groom::new`] judges it; the first is named), then
+//! every point that coincides with the strand's previous kept point (a
+//! zero-length segment, judged against its own strand), then strands left with
+//! fewer than two points. [`Repairs`] counts what went.
 
 use glam::Vec3;
 
-use super::{Attributes, Groom, MIN_SEGMENT_FRACTION};
+use super::{Attributes, Groom};
 use crate::error::{Error, Result};
 
 /// What [`Groom::repaired`] dropped (all zero: nothing needed repair).
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct Repairs {
     /// Strands dropped for a NaN or infinite position or attribute.
     pub non_finite_strands: usize,
+    /// Strands dropped for an outlier point.
+    pub outlier_strands: usize,
+    /// The first outlier dropped: strand (in the input), point and position.
+    pub first_outlier: Option<(usize, usize, [f32; 3])>,
     /// Points dropped because they coincided with the previous kept point.
     pub zero_length_segments: usize,
     /// Strands dropped for having fewer than two points (left or given).
@@ -30,7 +36,10 @@ pub struct Repairs {
 impl Repairs {
     /// Whether nothing was dropped.
     pub fn is_empty(&self) -> bool {
-        self.non_finite_strands == 0 && self.zero_length_segments == 0 && self.short_strands == 0
+        self.non_finite_strands == 0
+            && self.outlier_strands == 0
+            && self.zero_length_segments == 0
+            && self.short_strands == 0
     }
 
     /// Original index of every kept point, in order.
@@ -51,6 +60,14 @@ impl std::fmt::Display for Repairs {
             (
                 self.non_finite_strands,
                 plural(self.non_finite_strands, "strand", "strands") + " with NaN or infinite values",
+            ),
+            (
+                self.outlier_strands,
+                plural(self.outlier_strands, "strand", "strands")
+                    + " with an outlier point"
+                    + &self.first_outlier.map_or(String::new(), |(s, p, [x, y, z])| {
+                        format!(" (the first: strand {s} point {p} at ({x}, {y}, {z}))")
+                    }),
             ),
             (
                 self.zero_length_segments,
@@ -150,9 +167,14 @@ impl Groom {
         }
         let (lo, hi) = super::bounding_box(strands.iter().flat_map(|(_, r)| positions[r.clone()].iter().copied()));
         super::check_extent(lo, hi)?;
-        let min_segment = (hi - lo).length() * MIN_SEGMENT_FRACTION;
         let mut counts = Vec::with_capacity(strands.len());
         for (strand, range) in strands {
+            if let Some((point, at)) = super::outlier_point(&positions[range.clone()]) {
+                repairs.outlier_strands += 1;
+                repairs.first_outlier.get_or_insert((strand, point, at.to_array()));
+                continue;
+            }
+            let min_segment = super::min_segment(&positions[range.clone()]);
             let first = range.start;
             let mut kept = vec![first];
             for i in range.skip(1) {
@@ -220,6 +242,43 @@ mod tests {
             repairs.to_string(),
             "dropped 1 strand with NaN or infinite values, 3 zero-length segments, 2 strands with fewer than two points"
         );
+    }
+
+    /// One far point in one strand is an outlier of that strand: the strict
+    /// constructor names it (strand, point, position), repairing drops that
+    /// strand alone and says so, and every other strand keeps every segment
+    /// (judged against the whole groom's extent, 1e5 wide, their 1 cm
+    /// segments had been "zero-length").
+    #[test]
+    fn a_far_point_is_an_outlier_of_its_strand_not_a_new_scale_for_zero() {
+        let mut broken = line(6, 0.2);
+        broken[3] = Vec3::new(1e5, 0.0, 0.0);
+        let strands = [line(6, 0.0), line(6, 0.1), broken, line(6, 0.3)];
+        let counts = [6u32; 4];
+        match Groom::new(strands.concat(), &counts) {
+            Err(e @ Error::OutlierPoint { strand: 2, point: 3, .. }) => {
+                assert!(e.to_string().contains("(100000, 0, 0)"), "{e}")
+            }
+            other => panic!("expected the outlier named, got {other:?}"),
+        }
+        let (groom, repairs) = Groom::repaired(strands.concat(), &counts, Attributes::default()).expect("repaired");
+        assert_eq!((repairs.outlier_strands, repairs.zero_length_segments, repairs.short_strands), (1, 0, 0));
+        assert_eq!(repairs.kept_strands(), &[0, 1, 3]);
+        for (kept, original) in [(0, 0), (1, 1), (2, 3)] {
+            assert_eq!(groom.strand(kept), &strands[original][..], "strand {original} lost points");
+        }
+        assert_eq!(
+            repairs.to_string(),
+            "dropped 1 strand with an outlier point (the first: strand 2 point 3 at (100000, 0, 0))"
+        );
+        // The tip and the root are named as the outlier where they are the far point.
+        let mut tip = line(5, 0.0);
+        tip[4] = Vec3::splat(1e4);
+        let mut root = line(5, 0.0);
+        root[0] = Vec3::splat(-1e4);
+        assert_eq!(crate::groom::outlier_point(&tip).map(|o| o.0), Some(4));
+        assert_eq!(crate::groom::outlier_point(&root).map(|o| o.0), Some(0));
+        assert_eq!(crate::groom::outlier_point(&line(5, 0.0)), None);
     }
 
     #[test]

@@ -118,13 +118,10 @@ fn writable_device(out: &Output<'_>, meta: &std::fs::Metadata) -> Result<(), Err
     let (flag, path) = (out.flag, out.path.display());
     let kind = meta.file_type();
     if kind.is_fifo() {
-        // Non-blocking: a FIFO no process reads would block the write forever.
-        use std::os::unix::fs::OpenOptionsExt;
-        return std::fs::OpenOptions::new()
-            .write(true)
-            .custom_flags(libc::O_NONBLOCK)
-            .open(out.path)
-            .map(drop)
+        // Opened now and held until the write: a FIFO no process reads would
+        // block the write forever, and opening and closing it would end a
+        // reader that reads once before the output reaches it.
+        return vkhair::files::hold_fifo_output(out.path)
             .map_err(|_| format!("{flag} {path}: no process reads this FIFO").into());
     }
     if kind.is_socket() {

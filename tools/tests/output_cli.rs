@@ -172,3 +172,31 @@ fn plot_refuses_absurd_figures_quickly_and_writes_nothing() {
     run(&["plot", csv.to_str().expect("utf-8")], Duration::from_secs(60)).assert_ok();
     assert_eq!(common::read_png(&csv.with_extension("png")).0, 1100);
 }
+
+/// A FIFO as the output, read by a process that reads once (as `cat` or a
+/// shell's `$(< fifo)` does): the run checks at its start that the FIFO has a
+/// reader and keeps it open, so the reader gets the whole output, not the
+/// end of an empty stream; a FIFO nobody reads is refused at the start.
+#[test]
+fn a_fifo_read_once_gets_the_whole_output() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let groom = dir.path().join("g.hair");
+    common::write_groom(&groom, &common::cap_groom(20, 6, 0.1));
+    let fifo = dir.path().join("out.hair");
+    let c = std::ffi::CString::new(fifo.to_str().expect("utf-8")).expect("path");
+    // SAFETY: mkfifo with a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    let (g, f) = (groom.to_str().expect("utf-8"), fifo.to_str().expect("utf-8"));
+    run(&["convert", g, "--out", f], LIMIT).assert_error("no process reads this FIFO");
+    let path = fifo.clone();
+    // One open, one read to the end of the stream.
+    let reader = std::thread::spawn(move || std::fs::read(&path).expect("read the FIFO"));
+    let started = Instant::now();
+    run(&["convert", g, "--out", f], Duration::from_secs(60)).assert_ok();
+    let bytes = reader.join().expect("reader");
+    println!("{} bytes through the FIFO in {:?}", bytes.len(), started.elapsed());
+    assert!(bytes.starts_with(b"HAIR"), "the reader got {} bytes, not the .hair file", bytes.len());
+    let copy = dir.path().join("copy.hair");
+    std::fs::write(&copy, &bytes).expect("write the copy");
+    run(&["inspect", copy.to_str().expect("utf-8")], LIMIT).assert_ok();
+}
