@@ -159,14 +159,15 @@ fn is_fifo(path: &Path) -> bool {
 fn open_fifo_for_writing(path: &Path) -> Result<File> {
     use std::os::fd::AsRawFd;
     use std::os::unix::fs::OpenOptionsExt;
-    let file = std::fs::OpenOptions::new().write(true).custom_flags(libc::O_NONBLOCK).open(path).map_err(|e| {
-        match e.raw_os_error() {
-            Some(libc::ENXIO) => {
-                Error::OutputRefused { path: path.into(), reason: "no process reads this FIFO".into() }
+    let file =
+        std::fs::OpenOptions::new().write(true).custom_flags(libc::O_NONBLOCK).open(path).map_err(|e| {
+            match e.raw_os_error() {
+                Some(libc::ENXIO) => {
+                    Error::OutputRefused { path: path.into(), reason: "no process reads this FIFO".into() }
+                }
+                _ => Error::Io { path: path.into(), source: e },
             }
-            _ => Error::Io { path: path.into(), source: e },
-        }
-    })?;
+        })?;
     let fd = file.as_raw_fd();
     // SAFETY: fcntl on a descriptor this function owns, reading then clearing
     // one status flag.

@@ -71,7 +71,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("vkhair: {e}");
+            say_err!("vkhair: {e}");
             ExitCode::FAILURE
         }
     }

@@ -20,10 +20,35 @@ pub type CliResult = Result<(), Error>;
 macro_rules! say {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        if let Err(e) = writeln!(std::io::stdout(), $($arg)*) {
+        let text = format!($($arg)*);
+        if let Err(e) = writeln!(std::io::stdout(), "{}", $crate::output::printable(&text)) {
             $crate::output::stdout_failed(e);
         }
     }};
+}
+
+/// `eprintln!` of text that may hold names from files: control characters
+/// other than line breaks and tabs are written escaped ([`printable`]).
+#[macro_export]
+macro_rules! say_err {
+    ($($arg:tt)*) => {{
+        let text = format!($($arg)*);
+        eprintln!("{}", $crate::output::printable(&text));
+    }};
+}
+
+/// `text` with every control character but line feeds and tabs written as an
+/// escape (`\u{1b}`): a name read from a file (a USD prim, an Alembic object,
+/// a path) cannot move the terminal's cursor, recolour it or retitle it.
+pub fn printable(text: &str) -> std::borrow::Cow<'_, str> {
+    let unsafe_char = |c: char| c.is_control() && c != '\n' && c != '\t';
+    if !text.chars().any(unsafe_char) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    text.chars()
+        .map(|c| if unsafe_char(c) { c.escape_unicode().to_string() } else { c.to_string() })
+        .collect::<String>()
+        .into()
 }
 
 /// Ends the program after a failed write to standard output.
@@ -77,7 +102,7 @@ pub fn exit_cleanly_on_signals() {
     let mut signals = match signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) {
         Ok(signals) => signals,
         Err(e) => {
-            eprintln!("vkhair: warning: signals are not handled ({e}); an interrupted write may leave a .partial file");
+            say_err!("vkhair: warning: signals are not handled ({e}); an interrupted write may leave a .partial file");
             return;
         }
     };

@@ -200,3 +200,22 @@ fn a_fifo_read_once_gets_the_whole_output() {
     std::fs::write(&copy, &bytes).expect("write the copy");
     run(&["inspect", copy.to_str().expect("utf-8")], LIMIT).assert_ok();
 }
+
+/// Names from files and paths reach the terminal escaped: a control character
+/// (here the escape that starts a terminal sequence) is printed as `\u{1b}`,
+/// on standard output and in errors alike.
+#[test]
+fn control_characters_in_names_are_printed_escaped() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let groom = dir.path().join("clear\u{1b}[2J\u{7}.hair");
+    common::write_groom(&groom, &common::cap_groom(20, 6, 0.1));
+    let out = run(&["inspect", groom.to_str().expect("utf-8")], LIMIT);
+    out.assert_ok();
+    assert!(!out.stdout.contains('\u{1b}') && !out.stdout.contains('\u{7}'), "raw control characters:\n{:?}", out.stdout);
+    assert!(out.stdout.contains("clear\\u{1b}[2J\\u{7}.hair"), "{}", out.stdout);
+    let missing = dir.path().join("gone\u{1b}]0;title\u{7}.hair");
+    let out = run(&["inspect", missing.to_str().expect("utf-8")], LIMIT);
+    assert_eq!(out.status.code(), Some(1), "{}", out.stderr);
+    assert!(!out.stderr.contains('\u{1b}') && !out.stderr.contains('\u{7}'), "raw control characters:\n{:?}", out.stderr);
+    assert!(out.stderr.contains("gone\\u{1b}]0;title\\u{7}.hair"), "{}", out.stderr);
+}

@@ -13,6 +13,7 @@ use vkhair::groom::{alembic, guides, usd, Groom, Repairs};
 use super::texture::Texture;
 
 use crate::output::Error;
+use crate::say_err;
 
 /// The groom and character mesh a user gives `render` and `simulate`.
 #[derive(clap::Args, Clone, Debug)]
@@ -389,7 +390,7 @@ pub fn load_with_defaults(path: &Path, strict: bool) -> Result<Loaded, Error> {
         let name = if format == Format::Usd { "USD" } else { "Alembic" };
         let (groom, kind, rest) = authored(g, name, path);
         for note in &rest.skipped {
-            eprintln!("vkhair: warning: {}: not read: {note}", path.display());
+            say_err!("vkhair: warning: {}: not read: {note}", path.display());
         }
         extra = Some(rest);
         (groom, kind, repairs, None)
@@ -407,7 +408,7 @@ pub fn load_with_defaults(path: &Path, strict: bool) -> Result<Loaded, Error> {
         (f.groom, kind, repairs, header_thickness)
     };
     if !repairs.is_empty() {
-        eprintln!(
+        say_err!(
             "vkhair: warning: {}: {repairs}; {} strands remain (--strict refuses such a file instead)",
             path.display(),
             groom.strand_count()
@@ -448,7 +449,7 @@ pub fn strand_widths(thickness: Option<(f32, f32)>, k: f32) -> Option<(f32, f32)
     let (root_m, tip_m) = (root / k, tip / k);
     let fits = PLAUSIBLE_WIDTH.contains(&root_m) && (0.0..=*PLAUSIBLE_WIDTH.end()).contains(&tip_m);
     if !fits {
-        eprintln!(
+        say_err!(
             "vkhair: warning: the groom's thickness ({root_m:e} m at the root, {tip_m:e} m at the tip after --scale) \
              is not a hair's ({:e}..={:e} m); drawing vkhair's default widths instead (set material.root_width \
              and tip_width in --config, or fix --scale)",

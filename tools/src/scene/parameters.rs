@@ -11,6 +11,7 @@ use super::{drawing_scale, Scene};
 use crate::args::input::{strand_widths, Dense};
 use crate::args::scene::SceneArgs;
 use crate::say;
+use crate::say_err;
 
 /// The parameters: vkhair's defaults (an `--input` groom held in its authored
 /// style, [`SimParams::styled`]; strands as wide as the groom file says when it
@@ -83,7 +84,7 @@ pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
     };
     say!("strand width: {:.1} µm at the root, {:.1} µm at the tip ({source})", m.root_width * 1e6, m.tip_width * 1e6);
     if k != 1.0 {
-        eprintln!(
+        say_err!(
             "vkhair: warning: the groom and mesh span {:.3} units around their centre, not the size of a \
              head of hair in meters (vkhair's unit); drawing clumps, hair widths and shadow layers {k:.3}× as wide to match \
              (give --scale to convert the groom itself: the simulation stays in meters)",
@@ -99,7 +100,7 @@ pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
         let scaled = config.scalp.density / (k * k);
         config.scalp.density = scaled.clamp(0.01, 1000.0);
         if config.scalp.density != scaled {
-            eprintln!(
+            say_err!(
                 "vkhair: warning: {scaled} hairs per cm² of the groom's units is outside 0.01..=1000; rooting {} \
                  per cm² (give --scale to convert the groom to meters)",
                 config.scalp.density
@@ -183,7 +184,7 @@ pub fn make_renderer(
     renderer.set_material(&material)?;
     let extent = vkhair::ash::vk::Extent2D { width: a.width, height: a.height };
     if let Some(pool) = renderer.transparency_pool(extent).filter(|p| p.is_capped()) {
-        eprintln!(
+        say_err!(
             "vkhair: warning: at {}×{} this device holds {:.2} of the {} fragments per pixel oit.fragments_per_pixel \
              asks for ({} of {} MiB in {} buffers); the fragments beyond the pool join the order-independent tail",
             a.width,
@@ -261,10 +262,11 @@ pub fn scalp_followers(
     }
     if f64::from(area) * f64::from(params.density) > f64::from(params.max_hairs) {
         let density = (0.999 * params.max_hairs as f32 / area).max(0.01);
-        eprintln!(
+        say_err!(
             "vkhair: warning: {} hairs per cm² over the {area:.0} cm² the key hairs' roots cover would be more \
              than the {} hairs of {points} points this device holds; drawing {density:.2} per cm²",
-            params.density, params.max_hairs
+            params.density,
+            params.max_hairs
         );
         params.density = density;
     }

@@ -27,6 +27,7 @@ use crate::chart::plot_file;
 use crate::destinations::{self, Kind, Output};
 use crate::output::Error;
 use crate::say;
+use crate::say_err;
 use measure::{measure_sim, Samples, SimCase, SimFigures};
 use modes::{default_exact, frame_ms, render_rows, write_modes, OFF};
 
@@ -514,6 +515,6 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
 /// report hold the figures.
 fn chart(csv: &std::path::Path) {
     if let Err(e) = plot_file(csv, &csv.with_extension("png")) {
-        eprintln!("vkhair: warning: no chart of {}: {e}", csv.display());
+        say_err!("vkhair: warning: no chart of {}: {e}", csv.display());
     }
 }
