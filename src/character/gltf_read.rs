@@ -72,10 +72,61 @@ pub(super) fn load(path: &Path) -> Result<Character> {
     parse(&bytes, Some(dir)).map_err(|e| e.in_asset(path))
 }
 
+/// The indices the `gltf` crate's validation indexes with before checking
+/// them, or its readers index with unchecked (a mesh attribute's or morph target's accessor, an
+/// animation channel's target node): each must name an object of the
+/// document, else the file is malformed, named by where the index is.
+fn check_indices(root: &gltf::json::Root) -> Result<()> {
+    let (accessors, nodes) = (root.accessors.len(), root.nodes.len());
+    let past = |what: String, index: usize, count: usize, of: &str| {
+        malformed(format!("{what} names {of} {index}, past the {count} the file has"))
+    };
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &primitive.attributes {
+                if index.value() >= accessors {
+                    let name = match semantic {
+                        gltf::json::validation::Checked::Valid(s) => s.to_string(),
+                        gltf::json::validation::Checked::Invalid => "an attribute".into(),
+                    };
+                    return Err(past(
+                        format!("meshes[{m}].primitives[{p}] {name}"),
+                        index.value(),
+                        accessors,
+                        "accessor",
+                    ));
+                }
+            }
+            for (t, target) in primitive.targets.iter().flatten().enumerate() {
+                for index in [&target.positions, &target.normals, &target.tangents].into_iter().flatten() {
+                    if index.value() >= accessors {
+                        let what = format!("meshes[{m}].primitives[{p}].targets[{t}]");
+                        return Err(past(what, index.value(), accessors, "accessor"));
+                    }
+                }
+            }
+        }
+    }
+    for (a, animation) in root.animations.iter().enumerate() {
+        for (c, channel) in animation.channels.iter().enumerate() {
+            let node = channel.target.node.value();
+            if node >= nodes {
+                return Err(past(format!("animations[{a}].channels[{c}].target"), node, nodes, "node"));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Parses a glTF document held in memory; external buffers are read from `dir`
 /// (refused without one).
 pub(super) fn parse(bytes: &[u8], dir: Option<&Path>) -> Result<Character> {
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| malformed(e.to_string()))?;
+    // The crate's own validation indexes with some indices before checking
+    // them: those are checked first.
+    let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| malformed(e.to_string()))?;
+    check_indices(raw.document.as_json())?;
+    let document = gltf::Document::from_json(raw.document.into_json()).map_err(|e| malformed(e.to_string()))?;
+    let gltf = gltf::Gltf { document, blob: raw.blob };
     let buffers = buffers(&gltf, dir)?;
     let get = |b: gltf::Buffer<'_>| buffers.get(b.index()).map(Vec::as_slice);
     let doc = &gltf.document;

@@ -314,6 +314,39 @@ fn malformed_accessors_and_keys_are_refused_not_read() {
     }
 }
 
+/// Indices past the end that the `gltf` crate's own checks index with (a
+/// mesh attribute's or a morph target's accessor) or its readers do (an
+/// animation channel's target node) are refused naming where they are: no
+/// panic; the indices it checks itself stay refused.
+#[test]
+fn indices_past_the_end_are_refused_not_followed() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
+    let bytes = std::fs::read(path).expect("read");
+    type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+    let cases: Vec<(&str, Edit)> = vec![
+        (
+            "meshes[0].primitives[0] POSITION names accessor 9999",
+            Box::new(|j| j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 9999.into()),
+        ),
+        (
+            "meshes[0].primitives[0].targets[0] names accessor 70000",
+            Box::new(|j| j["meshes"][0]["primitives"][0]["targets"] = serde_json::json!([{"POSITION": 70000}])),
+        ),
+        (
+            "animations[0].channels[0].target names node 9999",
+            Box::new(|j| j["animations"][0]["channels"][0]["target"]["node"] = 9999.into()),
+        ),
+        ("skins[0].joints[0]", Box::new(|j| j["skins"][0]["joints"][0] = 9999.into())),
+        ("meshes[0].primitives[0].indices", Box::new(|j| j["meshes"][0]["primitives"][0]["indices"] = 9999.into())),
+    ];
+    for (what, edit) in cases {
+        let document = mutated(&bytes, edit);
+        let result = std::panic::catch_unwind(|| Character::parse(&document));
+        let err = result.unwrap_or_else(|_| panic!("{what}: the reader panicked")).expect_err("refused");
+        assert!(err.to_string().contains(what), "{what}: {err}");
+    }
+}
+
 /// Hostile parts given through the public constructors: a NaN or infinite time
 /// samples the first keys; a zero rotation key, zero weights and a skin without
 /// joints are refused; a long chain of nodes listed child first is ordered in

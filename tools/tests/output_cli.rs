@@ -211,11 +211,19 @@ fn control_characters_in_names_are_printed_escaped() {
     common::write_groom(&groom, &common::cap_groom(20, 6, 0.1));
     let out = run(&["inspect", groom.to_str().expect("utf-8")], LIMIT);
     out.assert_ok();
-    assert!(!out.stdout.contains('\u{1b}') && !out.stdout.contains('\u{7}'), "raw control characters:\n{:?}", out.stdout);
+    assert!(
+        !out.stdout.contains('\u{1b}') && !out.stdout.contains('\u{7}'),
+        "raw control characters:\n{:?}",
+        out.stdout
+    );
     assert!(out.stdout.contains("clear\\u{1b}[2J\\u{7}.hair"), "{}", out.stdout);
     let missing = dir.path().join("gone\u{1b}]0;title\u{7}.hair");
     let out = run(&["inspect", missing.to_str().expect("utf-8")], LIMIT);
     assert_eq!(out.status.code(), Some(1), "{}", out.stderr);
-    assert!(!out.stderr.contains('\u{1b}') && !out.stderr.contains('\u{7}'), "raw control characters:\n{:?}", out.stderr);
+    assert!(
+        !out.stderr.contains('\u{1b}') && !out.stderr.contains('\u{7}'),
+        "raw control characters:\n{:?}",
+        out.stderr
+    );
     assert!(out.stderr.contains("gone\\u{1b}]0;title\\u{7}.hair"), "{}", out.stderr);
 }
