@@ -137,6 +137,52 @@ pub fn remove_partial_files_then<R>(then: impl FnOnce(usize) -> R) -> R {
     then(n)
 }
 
+/// Stack of the thread a third-party reader runs on ([`read_guarded`]): 256
+/// MiB, reserved, not committed; deep enough for any nesting the readers'
+/// own depth checks let through.
+pub const READER_STACK_BYTES: usize = 256 << 20;
+
+thread_local! {
+    /// Whether this thread runs a guarded reader, whose panics are reported
+    /// as errors rather than printed.
+    static GUARDED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `read` — a third-party reader that may panic on a malformed file —
+/// on its own thread with a [`READER_STACK_BYTES`] stack; a panic becomes
+/// `Err` with its message, printed nowhere (the process's panic hook is
+/// wrapped once so that it stays silent for guarded threads and prints as
+/// before for every other thread).
+pub fn read_guarded<T: Send>(read: impl FnOnce() -> T + Send) -> std::result::Result<T, String> {
+    static HOOK: std::sync::Once = std::sync::Once::new();
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !GUARDED.with(std::cell::Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+    let message = |panic: Box<dyn std::any::Any + Send>| {
+        panic
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "a panic without a message".into())
+    };
+    std::thread::scope(|scope| {
+        let worker = std::thread::Builder::new()
+            .name("vkhair reader".into())
+            .stack_size(READER_STACK_BYTES)
+            .spawn_scoped(scope, || {
+                GUARDED.with(|g| g.set(true));
+                read()
+            })
+            .map_err(|e| format!("the reader's thread could not start: {e}"))?;
+        worker.join().map_err(message)
+    })
+}
+
 /// Outputs opened before their write ([`hold_fifo_output`]): path and file.
 static HELD: std::sync::Mutex<Vec<(std::path::PathBuf, File)>> = std::sync::Mutex::new(Vec::new());
 

@@ -69,7 +69,12 @@ fn unsupported(reason: impl Into<String>) -> Error {
 pub(super) fn load(path: &Path) -> Result<Character> {
     let bytes = files::read_capped(path, MAX_GLTF_BYTES, "a glTF document")?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    parse(&bytes, Some(dir)).map_err(|e| e.in_asset(path))
+    // The gltf crate indexes some of the file's indices unchecked: those
+    // known are checked before (check_indices); a panic on one not yet known
+    // is the file's defect, reported, not printed.
+    crate::files::read_guarded(|| parse(&bytes, Some(dir)))
+        .unwrap_or_else(|what| Err(malformed(format!("the glTF reader stopped: {what}"))))
+        .map_err(|e| e.in_asset(path))
 }
 
 /// The indices the `gltf` crate's validation indexes with before checking

@@ -65,16 +65,9 @@ fn open_as(path: &Path, load: Load) -> Result<(AuthoredGroom, Option<Repairs>)> 
         source: Box::new(unsupported("the path is not UTF-8 text".into())),
     })?;
     // The crate is young: a panic inside it on a malformed file is reported as
-    // the file's defect rather than taking the host down.
-    let read = std::panic::catch_unwind(|| read_stage(text, load));
-    let read = read.unwrap_or_else(|panic| {
-        let what = panic
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| panic.downcast_ref::<String>().cloned())
-            .unwrap_or_default();
-        Err(malformed(format!("the USD reader stopped: {what}")))
-    });
+    // the file's defect, silently, rather than taking the host down.
+    let read = crate::files::read_guarded(|| read_stage(text, load))
+        .unwrap_or_else(|what| Err(malformed(format!("the USD reader stopped: {what}"))));
     let (raw, frame, skipped) = read.map_err(|e| e.in_asset(path))?;
     assemble(raw, frame, skipped, load).map_err(|e| e.in_asset(path))
 }

@@ -258,3 +258,29 @@ fn followers_take_the_file_colours_or_a_scalp_texture() {
     let line = format!("render --input {} --guides 0.1 --scalp-texture {}", usd.display(), junk.display());
     run_line(&line, LIMIT).assert_error("not a PNG image");
 }
+
+/// A `.usdc` file the USD library panics on (a `todo!()` for chunked LZ4,
+/// indices past the end of its tables) is an error naming the file and what
+/// stopped the reader, with no panic message or backtrace on stderr; the
+/// files are the test's own byte edits of the shared fixture.
+#[test]
+fn a_usdc_the_usd_library_panics_on_is_an_error_without_a_panic_message() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let original = std::fs::read(data("usd/small_cm_zup.usdc")).expect("read the fixture");
+    let edits: [(&str, &[(usize, u8)]); 3] =
+        [("lz4", &[(1689, 219)]), ("index out of bounds", &[(1350, 33)]), ("index out of bounds", &[(203, 36)])];
+    for (k, (what, bytes)) in edits.iter().enumerate() {
+        let mut edited = original.clone();
+        for &(at, value) in bytes.iter() {
+            edited[at] = value;
+        }
+        let path = dir.path().join(format!("edited_{k}.usdc"));
+        std::fs::write(&path, &edited).expect("write");
+        let out = run(&["inspect", path.to_str().expect("utf-8")], LIMIT);
+        out.assert_error("the USD reader stopped");
+        assert!(out.stderr.contains(what), "case {k}: {}", out.stderr);
+        assert!(out.stderr.contains(&format!("edited_{k}.usdc")), "case {k} names no file: {}", out.stderr);
+        assert!(!out.stderr.contains("stack backtrace") && !out.stderr.contains("thread '"), "{}", out.stderr);
+        assert_eq!(out.stderr.lines().count(), 1, "case {k}: one line, the error:\n{}", out.stderr);
+    }
+}
