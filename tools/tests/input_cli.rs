@@ -439,3 +439,22 @@ fn inspect_drawn_reports_how_the_hairs_cover_the_scalp() {
     run(&["inspect", g, "--drawn", "--density", "5000"], LIMIT).assert_error("scalp.density");
     run(&["inspect", g, "--density", "20"], LIMIT).assert_error("--drawn");
 }
+
+/// A groom whose size is absurd for the tool's scene (a nanometre across, or
+/// 10⁸ units) is refused at load naming the file, its size and `--scale`,
+/// not by an internal parameter derived from it.
+#[test]
+fn an_absurdly_sized_groom_is_refused_naming_the_file_and_its_size() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for (name, radius) in [("tiny.hair", 1e-9f32), ("huge.hair", 1e8)] {
+        let groom = dir.path().join(name);
+        common::write_groom(&groom, &common::cap_groom(20, 6, radius));
+        let args = format!("render --input {} --frames 1 --out {}", groom.display(), dir.path().join("f").display());
+        let out = run_line(&args, LIMIT);
+        out.assert_error(name);
+        for words in ["spans", "--scale"] {
+            assert!(out.stderr.contains(words), "{name}: {}", out.stderr);
+        }
+        assert!(!out.stderr.contains("invalid parameter"), "{name}: an internal parameter named: {}", out.stderr);
+    }
+}

@@ -52,6 +52,15 @@ pub struct Scene {
 /// The credit line of the shared character.
 const MANNEQUIN_CREDIT: &str = "\"Mannequiny\" by Luciano Muñoz / GDQuest and contributors (CC BY 4.0)";
 
+/// The smallest bounding radius of a scene the tool draws, in the groom's
+/// units after `--scale` (a hair's width is a thousandth of a head's size: a
+/// smaller scene puts it below f32's reach in the derived widths and
+/// distances).
+const MIN_SCENE_RADIUS: f32 = 1e-4;
+/// The largest bounding radius of a scene the tool draws (1e4 units: a head of
+/// hair in millimetres is 300).
+const MAX_SCENE_RADIUS: f32 = 1e4;
+
 /// The scene of `a`'s flags.
 pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
     if let Some(ch) = character::load(&a.input)? {
@@ -93,6 +102,19 @@ pub fn load(a: &SceneArgs) -> Result<Scene, Error> {
     ));
     if !(center.is_finite() && radius.is_finite() && radius > 0.0) {
         return Err(format!("the groom and mesh span no finite volume (bounding radius {radius})").into());
+    }
+    if !(MIN_SCENE_RADIUS..=MAX_SCENE_RADIUS).contains(&radius) {
+        let files: Vec<String> =
+            [&a.input.input, &a.input.obj].into_iter().flatten().map(|p| p.display().to_string()).collect();
+        return Err(format!(
+            "{}: the groom{} spans {radius:e} units from its centre (after --scale {}); vkhair draws scenes of \
+             {MIN_SCENE_RADIUS:e} to {MAX_SCENE_RADIUS:e} (a head of hair in meters: about 0.3): give --scale to \
+             bring it there",
+            files.join(" and "),
+            if a.input.obj.is_some() { " and mesh" } else { "" },
+            a.input.scale()
+        )
+        .into());
     }
     let (lo, _) = drawn.bounds();
     let pivot = pivot.unwrap_or(Vec3::new(center.x, lo.y, center.z));
