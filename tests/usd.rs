@@ -190,3 +190,42 @@ fn nested_rotations_scales_and_translations_compose_as_usd_core_does() {
         assert!((*p - w).length() < 1e-5, "{p} against usd-core's {w}");
     }
 }
+
+/// Text layers the USD library would recurse through without end or for
+/// seconds — a class inheriting itself, two classes inheriting each other,
+/// prims nested 5,000 deep, dictionaries nested 20,000 deep — are refused
+/// before it reads them, each with the file, the line and what is wrong
+/// (`groom::usda_check`).
+#[test]
+fn text_layers_that_recurse_without_bound_are_refused_before_reading() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let deep_prims = format!(
+        "{}{curves}{}",
+        (0..5000).map(|i| format!("def Xform \"p{i}\" {{\n")).collect::<String>(),
+        "}\n".repeat(5000)
+    );
+    let deep_dictionaries =
+        format!("(\n customLayerData = {}{{}}{}\n)\n{curves}", "{ dictionary a = ".repeat(20_000), " }".repeat(20_000));
+    let cases = [
+        ("self.usda", format!("class \"A\" (\n    inherits = </A>\n)\n{{\n}}\n{curves}"), "line 3, column 5", "itself"),
+        (
+            "cycle.usda",
+            format!("class \"A\" (\n inherits = </B>\n) {{ }}\nclass \"B\" (\n inherits = </A>\n) {{ }}\n{curves}"),
+            "line 6",
+            "a cycle",
+        ),
+        ("deep.usda", deep_prims, "line 130", "nesting deeper than 128"),
+        ("dictionaries.usda", deep_dictionaries, "line 3", "nesting deeper than 128"),
+    ];
+    for (name, body, line, what) in cases {
+        let path = dir.path().join(name);
+        std::fs::write(&path, format!("#usda 1.0\n{body}")).expect("write");
+        let started = std::time::Instant::now();
+        let err = usd::open(&path).expect_err(name).to_string();
+        println!("{name}: {err} ({:?})", started.elapsed());
+        for part in [name, line, what] {
+            assert!(err.contains(part), "{name}: {part:?} missing from {err}");
+        }
+    }
+}

@@ -38,6 +38,7 @@ pub mod scenes;
 pub mod sdf;
 pub mod tfx;
 pub mod usd;
+pub mod usda_check;
 
 mod repair;
 mod resample;

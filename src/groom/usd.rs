@@ -59,7 +59,16 @@ pub fn open_repairing(path: impl AsRef<Path>) -> Result<(AuthoredGroom, Repairs)
 }
 
 fn open_as(path: &Path, load: Load) -> Result<(AuthoredGroom, Option<Repairs>)> {
-    crate::files::check_regular(path, crate::files::input_cap(MAX_USD_BYTES)?, "a USD file")?;
+    let cap = crate::files::input_cap(MAX_USD_BYTES)?;
+    crate::files::check_regular(path, cap, "a USD file")?;
+    // A text layer is checked before the USD library reads it: its nesting
+    // depth and its composition arcs (super::usda_check).
+    let bytes = crate::files::read_capped(path, cap, "a USD file")?;
+    if bytes.starts_with(b"#usda") {
+        let text = std::str::from_utf8(&bytes)
+            .map_err(|e| malformed(format!("the text is not UTF-8 ({e})")).in_asset(path))?;
+        super::usda_check::check(text).map_err(|e| e.in_asset(path))?;
+    }
     let text = path.to_str().ok_or_else(|| Error::Asset {
         path: path.into(),
         source: Box::new(unsupported("the path is not UTF-8 text".into())),

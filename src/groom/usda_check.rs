@@ -1,0 +1,390 @@
+//! What a USD text layer must satisfy before the `openusd` crate reads it: the
+//! crate recurses once per level of nesting (its time grows with the cube of
+//! the depth: 8 s at 1,000 levels) and follows composition arcs without
+//! looking for cycles (a class inheriting itself overflows its stack and
+//! aborts the process). [`check`] scans the text once, without the crate:
+//!
+//! - nesting of `{`, `(` and `[` (prims, metadata, dictionaries, lists) at
+//!   most [`MAX_USDA_DEPTH`] deep;
+//! - the composition arcs between the layer's own prims (`inherits`,
+//!   `specializes`, and `references`/`payload` without an asset path) form no
+//!   cycle, and none targets its own prim, an ancestor or a descendant.
+//!
+//! Strings, comments and path literals are skipped as USD text writes them;
+//! errors carry the line and column.
+
+use std::collections::HashMap;
+
+use crate::error::{Error, FileFormat, Result};
+
+/// Deepest nesting of brackets a USD text layer may have (prims inside prims,
+/// dictionaries inside dictionaries): far beyond a real stage's, small enough
+/// that the reader's recursion and time stay bounded.
+pub const MAX_USDA_DEPTH: usize = 128;
+
+/// Metadata keys whose path values are composition arcs.
+const ARCS: [&str; 4] = ["inherits", "specializes", "references", "payload"];
+
+fn malformed(reason: String) -> Error {
+    Error::Malformed { format: FileFormat::Usd, reason }
+}
+
+/// One token of USD text that the check looks at.
+#[derive(Debug, PartialEq)]
+enum Token<'a> {
+    Open(u8),
+    Close(u8),
+    Word(&'a str),
+    Text(&'a str),
+    Path(&'a str),
+    /// An asset path `@…@`.
+    Asset,
+    Equals,
+}
+
+/// The tokens of `text` with their byte offsets (strings, comments and paths
+/// skipped as units); an unterminated string or path is an error.
+fn tokens(text: &str) -> Result<Vec<(usize, Token<'_>)>> {
+    let b = text.as_bytes();
+    let mut out = Vec::new();
+    let mut i = 0;
+    let unterminated = |at: usize, what: &str| malformed(format!("{} {what} that never ends", place(text, at)));
+    while i < b.len() {
+        let c = b[i];
+        match c {
+            b'#' => i = b[i..].iter().position(|&c| c == b'\n').map_or(b.len(), |n| i + n),
+            b'"' | b'\'' => {
+                let triple = b[i..].starts_with(&[c, c, c]);
+                let (start, quote) = if triple { (i + 3, 3) } else { (i + 1, 1) };
+                let mut j = start;
+                loop {
+                    if j >= b.len() {
+                        return Err(unterminated(i, "a string"));
+                    }
+                    if b[j] == b'\\' {
+                        j += 2;
+                        continue;
+                    }
+                    if b[j] == c && (!triple || b[j..].starts_with(&[c, c, c])) {
+                        break;
+                    }
+                    if !triple && b[j] == b'\n' {
+                        return Err(unterminated(i, "a string"));
+                    }
+                    j += 1;
+                }
+                out.push((i, Token::Text(&text[start..j])));
+                i = j + quote;
+            }
+            b'<' => {
+                let end = b[i..].iter().position(|&c| c == b'>').ok_or_else(|| unterminated(i, "a path"))?;
+                out.push((i, Token::Path(&text[i + 1..i + end])));
+                i += end + 1;
+            }
+            b'@' => {
+                let triple = b[i..].starts_with(b"@@@");
+                let skip = if triple { 3 } else { 1 };
+                let rest = &b[i + skip..];
+                let end = if triple {
+                    rest.windows(3).position(|w| w == b"@@@")
+                } else {
+                    rest.iter().position(|&c| c == b'@')
+                }
+                .ok_or_else(|| unterminated(i, "an asset path"))?;
+                out.push((i, Token::Asset));
+                i += skip + end + skip;
+            }
+            b'{' | b'(' | b'[' => {
+                out.push((i, Token::Open(c)));
+                i += 1;
+            }
+            b'}' | b')' | b']' => {
+                out.push((i, Token::Close(c)));
+                i += 1;
+            }
+            b'=' => {
+                out.push((i, Token::Equals));
+                i += 1;
+            }
+            c if c.is_ascii_alphabetic() || c == b'_' => {
+                let end =
+                    b[i..].iter().position(|&c| !(c.is_ascii_alphanumeric() || c == b'_' || c == b':' || c == b'.'));
+                let end = end.map_or(b.len(), |n| i + n);
+                out.push((i, Token::Word(&text[i..end])));
+                i = end;
+            }
+            _ => i += 1,
+        }
+    }
+    Ok(out)
+}
+
+/// "line L, column C" of byte `at` of `text`.
+fn place(text: &str, at: usize) -> String {
+    let before = &text[..at.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.len() - before.rfind('\n').map_or(0, |n| n + 1) + 1;
+    format!("line {line}, column {column}:")
+}
+
+/// `target` (a path literal's text, without its property part) as an
+/// absolute prim path, from the prim at `at`.
+fn absolute(target: &str, at: &str) -> String {
+    let target = target.split('.').next().unwrap_or_default().trim();
+    if target.starts_with('/') {
+        return target.trim_end_matches('/').to_owned();
+    }
+    let mut parts: Vec<&str> = at.split('/').filter(|p| !p.is_empty()).collect();
+    for part in target.split('/').filter(|p| !p.is_empty()) {
+        match part {
+            ".." => {
+                parts.pop();
+            }
+            "." => {}
+            p => parts.push(p),
+        }
+    }
+    format!("/{}", parts.join("/"))
+}
+
+/// Whether `a` is `b` or one of its ancestors.
+fn contains(a: &str, b: &str) -> bool {
+    a == b || (b.starts_with(a) && (a == "/" || b[a.len()..].starts_with('/')))
+}
+
+/// Most composition arcs between a layer's own prims [`check`] follows.
+pub const MAX_USDA_ARCS: usize = 10_000;
+
+/// Checks the USD text `text` (see the module docs).
+pub fn check(text: &str) -> Result<()> {
+    let tokens = tokens(text)?;
+    // Brackets open; for each whether it opened a prim's body.
+    let mut open: Vec<(u8, bool)> = Vec::new();
+    // The prims whose bodies are open, outermost first.
+    let mut prims: Vec<String> = Vec::new();
+    // A prim declared (`def`/`class`/`over` … "name") whose body is not open yet.
+    let mut pending: Option<String> = None;
+    let mut declaring = false;
+    let mut arcs: HashMap<String, Vec<(String, usize)>> = HashMap::new();
+    let mut count = 0usize;
+    for (k, (at, token)) in tokens.iter().enumerate() {
+        match token {
+            Token::Open(c) => {
+                if open.len() >= MAX_USDA_DEPTH {
+                    return Err(malformed(format!(
+                        "{} nesting deeper than {MAX_USDA_DEPTH} levels (prims, metadata or dictionaries)",
+                        place(text, *at)
+                    )));
+                }
+                let body = *c == b'{' && pending.is_some() && !prims_metadata_open(&open);
+                if body {
+                    let name = pending.take().unwrap_or_default();
+                    let parent = prims.last().map_or("", String::as_str);
+                    prims.push(format!("{parent}/{name}"));
+                    declaring = false;
+                }
+                open.push((*c, body));
+            }
+            Token::Close(c) => {
+                let expected = match c {
+                    b'}' => b'{',
+                    b')' => b'(',
+                    _ => b'[',
+                };
+                match open.pop() {
+                    Some((o, body)) if o == expected => {
+                        if body {
+                            prims.pop();
+                        }
+                    }
+                    _ => return Err(malformed(format!("{} '{}' closes nothing open", place(text, *at), *c as char))),
+                }
+            }
+            Token::Word(w) => {
+                let in_metadata = pending.is_some() && open.last().is_some_and(|(c, _)| *c == b'(');
+                if matches!(*w, "def" | "class" | "over") && !prims_metadata_open(&open) {
+                    declaring = true;
+                    pending = None;
+                } else if ARCS.contains(w) && in_metadata && matches!(tokens.get(k + 1), Some((_, Token::Equals))) {
+                    let from =
+                        format!("{}/{}", prims.last().map_or("", String::as_str), pending.as_deref().unwrap_or(""));
+                    for target in arc_targets(&tokens[k + 2..]) {
+                        count += 1;
+                        if count > MAX_USDA_ARCS {
+                            return Err(malformed(format!(
+                                "{} more than {MAX_USDA_ARCS} composition arcs between the layer's prims",
+                                place(text, *at)
+                            )));
+                        }
+                        arcs.entry(from.clone()).or_default().push((absolute(target, &from), *at));
+                    }
+                }
+            }
+            Token::Text(name) => {
+                if declaring && pending.is_none() {
+                    pending = Some((*name).to_owned());
+                }
+            }
+            Token::Path(_) | Token::Asset | Token::Equals => {}
+        }
+    }
+    if let Some((c, _)) = open.last() {
+        return Err(malformed(format!("a '{}' is never closed", *c as char)));
+    }
+    check_arcs(text, &arcs)
+}
+
+/// The prim paths of an arc's value (`tokens` start after its `=`): one path,
+/// or a list of them; a path right after an asset path (`@a.usda@</P>`)
+/// names a prim of another layer and is left out.
+fn arc_targets<'a>(tokens: &[(usize, Token<'a>)]) -> Vec<&'a str> {
+    let internal = |i: usize| i == 0 || !matches!(tokens.get(i - 1), Some((_, Token::Asset)));
+    match tokens.first() {
+        Some((_, Token::Path(p))) => vec![*p],
+        Some((_, Token::Open(b'['))) => tokens
+            .iter()
+            .enumerate()
+            .skip(1)
+            .take_while(|(_, (_, t))| !matches!(t, Token::Close(_) | Token::Open(_)))
+            .filter_map(|(i, (_, t))| match t {
+                Token::Path(p) if internal(i) => Some(*p),
+                _ => None,
+            })
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// Whether the innermost open bracket is a prim's metadata `(`…`)` or a
+/// list/dictionary inside it (not a prim body).
+fn prims_metadata_open(open: &[(u8, bool)]) -> bool {
+    open.last().is_some_and(|(c, _)| *c != b'{')
+        || open.iter().rev().take_while(|(_, body)| !body).any(|(c, _)| *c == b'(')
+}
+
+/// No arc targets its own prim, an ancestor or a descendant, and the arcs
+/// between prims form no cycle.
+fn check_arcs(text: &str, arcs: &HashMap<String, Vec<(String, usize)>>) -> Result<()> {
+    for (from, targets) in arcs {
+        for (to, at) in targets {
+            if contains(to, from) || contains(from, to) {
+                return Err(malformed(format!(
+                    "{} prim {from} has a composition arc to {to}, {}",
+                    place(text, *at),
+                    if to == from { "itself" } else { "its own namespace" }
+                )));
+            }
+        }
+    }
+    // Depth-first search for a cycle; a prim also composes what arcs of its
+    // ancestors bring, so an arc into a prim that (or whose descendant) leads
+    // back counts.
+    let mut state: HashMap<&str, u8> = HashMap::new();
+    let mut keys: Vec<&String> = arcs.keys().collect();
+    keys.sort();
+    for start in keys {
+        let mut stack: Vec<(&str, usize)> = vec![(start.as_str(), 0)];
+        if state.get(start.as_str()).copied().unwrap_or(0) != 0 {
+            continue;
+        }
+        state.insert(start, 1);
+        while let Some((node, next)) = stack.pop() {
+            let out: Vec<&(String, usize)> =
+                arcs.iter().filter(|(from, _)| contains(node, from)).flat_map(|(_, t)| t.iter()).collect();
+            if let Some((to, at)) = out.get(next) {
+                stack.push((node, next + 1));
+                match state.get(to.as_str()).copied().unwrap_or(0) {
+                    1 => {
+                        return Err(malformed(format!(
+                            "{} the composition arcs from {start} come back to {to}: a cycle",
+                            place(text, *at)
+                        )))
+                    }
+                    0 => {
+                        state.insert(to, 1);
+                        stack.push((to, 0));
+                    }
+                    _ => {}
+                }
+            } else {
+                state.insert(node, 2);
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CURVES: &str =
+        "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+
+    #[test]
+    fn a_plain_stage_with_arcs_between_prims_passes() {
+        let text = format!(
+            "#usda 1.0\n(\n  metersPerUnit = 0.01\n  customLayerData = {{ string note = \"a ) in a string {{\" }}\n)\n\
+             class \"Base\" {{ }}\ndef Xform \"groom\" (\n  inherits = </Base>\n  references = @other.usda@</Thing>\n) {{\n  \
+             {CURVES} }}\n# a comment with {{ ( [\n"
+        );
+        check(&text).expect("passes");
+    }
+
+    #[test]
+    fn nesting_past_the_limit_is_refused_with_its_line() {
+        let deep = |n: usize| {
+            let mut t = String::from("#usda 1.0\n");
+            for i in 0..n {
+                t += &format!("def Xform \"p{i}\" {{\n");
+            }
+            t += CURVES;
+            t += &"}\n".repeat(n);
+            t
+        };
+        // The curves prim adds three levels (its body, a list and a tuple).
+        check(&deep(MAX_USDA_DEPTH - 3)).expect("within the limit");
+        let err = check(&deep(MAX_USDA_DEPTH + 5)).expect_err("too deep").to_string();
+        assert!(
+            err.contains("nesting deeper than 128") && err.contains(&format!("line {}", MAX_USDA_DEPTH + 2)),
+            "{err}"
+        );
+        let dictionaries = format!(
+            "#usda 1.0\n(\n customLayerData = {}{{}}{}\n)\n",
+            "{ dictionary a = ".repeat(500),
+            " }".repeat(500)
+        );
+        assert!(check(&dictionaries).expect_err("too deep").to_string().contains("nesting deeper"));
+    }
+
+    #[test]
+    fn arcs_to_themselves_their_namespace_or_round_a_cycle_are_refused() {
+        let cases = [
+            ("class \"A\" (\n inherits = </A>\n) { }\n", "prim /A has a composition arc to /A, itself"),
+            ("def Xform \"A\" { def Xform \"B\" (\n specializes = </A>\n) { } }\n", "its own namespace"),
+            ("class \"A\" (\n inherits = </B>\n) { }\nclass \"B\" (\n inherits = [</C>]\n) { }\nclass \"C\" (\n prepend references = </A>\n) { }\n", "a cycle"),
+            ("class \"A\" { class \"Child\" (\n inherits = </B>\n) { } }\nclass \"B\" (\n inherits = </A>\n) { }\n", "a cycle"),
+        ];
+        for (body, what) in cases {
+            let text = format!("#usda 1.0\n{body}{CURVES}");
+            let err = check(&text).expect_err(what).to_string();
+            assert!(err.contains(what) && err.contains("line "), "{what}: {err}");
+        }
+        // A chain without a cycle, and an arc into another layer, pass.
+        let chain = "class \"A\" (\n inherits = </B>\n) { }\nclass \"B\" { }\ndef Xform \"C\" (\n references = @a.usda@</C>\n) { }\n";
+        check(&format!("#usda 1.0\n{chain}{CURVES}")).expect("no cycle");
+    }
+
+    #[test]
+    fn unbalanced_or_unterminated_text_is_refused() {
+        for (text, what) in [
+            ("#usda 1.0\ndef Xform \"a\" { ]\n", "closes nothing"),
+            ("#usda 1.0\ndef Xform \"a\" {\n", "never closed"),
+            ("#usda 1.0\ndef Xform \"a { }\n", "a string that never ends"),
+            ("#usda 1.0\ndef Xform \"a\" (inherits = </A) { }\n", "a path that never ends"),
+        ] {
+            let err = check(text).expect_err(what).to_string();
+            assert!(err.contains(what), "{what}: {err}");
+        }
+    }
+}
