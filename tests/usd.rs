@@ -229,3 +229,39 @@ fn text_layers_that_recurse_without_bound_are_refused_before_reading() {
         }
     }
 }
+
+/// Every layer a stage's text layers name is checked before the USD library
+/// opens any: a sublayer that is there loads; a missing one, a FIFO in a
+/// referenced layer's place (which the library would block on forever) and a
+/// sublayer with a cycle of its own are errors naming the layer, and the root
+/// layer and line that named it — never a stage read without them.
+#[test]
+fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
+    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    write("curves.usda", &format!("#usda 1.0\n{curves}"));
+    write("root.usda", "#usda 1.0\n(\n    subLayers = [\n        @./curves.usda@\n    ]\n)\n");
+    let g = usd::open(dir.path().join("root.usda")).expect("a stage of a sublayer");
+    assert_eq!(g.groom.strand_count(), 1);
+
+    write("missing.usda", "#usda 1.0\n(\n    subLayers = [@./curves.usda@, @./gone.usda@]\n)\n");
+    let c = std::ffi::CString::new(dir.path().join("pipe.usda").to_str().expect("utf-8")).expect("path");
+    // SAFETY: mkfifo with a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    write("fifo.usda", &format!("#usda 1.0\ndef Xform \"x\" (\n    references = @pipe.usda@</x>\n) {{ }}\n{curves}"));
+    write("cyclic.usda", &format!("#usda 1.0\nclass \"A\" (\n    inherits = </A>\n) {{ }}\n{curves}"));
+    write("names_cyclic.usda", "#usda 1.0\n(\n    subLayers = [@cyclic.usda@]\n)\n");
+    for (root, parts) in [
+        ("missing.usda", &["missing.usda", "line 3", "gone.usda"][..]),
+        ("fifo.usda", &["fifo.usda", "line 3", "pipe.usda", "not a regular file"][..]),
+        ("names_cyclic.usda", &["names_cyclic.usda", "line 3", "cyclic.usda", "line 3, column 5", "itself"][..]),
+    ] {
+        let started = std::time::Instant::now();
+        let err = usd::open(dir.path().join(root)).expect_err(root).to_string();
+        println!("{root}: {err} ({:?})", started.elapsed());
+        for part in parts {
+            assert!(err.contains(part), "{root}: {part:?} missing from {err}");
+        }
+    }
+}

@@ -60,15 +60,7 @@ pub fn open_repairing(path: impl AsRef<Path>) -> Result<(AuthoredGroom, Repairs)
 
 fn open_as(path: &Path, load: Load) -> Result<(AuthoredGroom, Option<Repairs>)> {
     let cap = crate::files::input_cap(MAX_USD_BYTES)?;
-    crate::files::check_regular(path, cap, "a USD file")?;
-    // A text layer is checked before the USD library reads it: its nesting
-    // depth and its composition arcs (super::usda_check).
-    let bytes = crate::files::read_capped(path, cap, "a USD file")?;
-    if bytes.starts_with(b"#usda") {
-        let text = std::str::from_utf8(&bytes)
-            .map_err(|e| malformed(format!("the text is not UTF-8 ({e})")).in_asset(path))?;
-        super::usda_check::check(text).map_err(|e| e.in_asset(path))?;
-    }
+    check_layers(path, cap)?;
     let text = path.to_str().ok_or_else(|| Error::Asset {
         path: path.into(),
         source: Box::new(unsupported("the path is not UTF-8 text".into())),
@@ -79,6 +71,56 @@ fn open_as(path: &Path, load: Load) -> Result<(AuthoredGroom, Option<Repairs>)> 
         .unwrap_or_else(|what| Err(malformed(format!("the USD reader stopped: {what}"))));
     let (raw, frame, skipped) = read.map_err(|e| e.in_asset(path))?;
     assemble(raw, frame, skipped, load).map_err(|e| e.in_asset(path))
+}
+
+/// Most layers a stage may pull in through its text layers' `subLayers`,
+/// `references` and `payload`, the root included.
+pub const MAX_USD_LAYERS: usize = 256;
+
+/// Checks the root layer at `path` and, transitively, every layer its text
+/// layers name, before the USD library opens any: each a regular file, all
+/// of them together within `cap` bytes, text layers checked by
+/// [`super::usda_check`]. A layer that cannot be read is an error naming it
+/// and the layer and line that named it, never a layer the stage goes
+/// without. (Binary layers are bounded in size; the layers they name are
+/// not followed here.)
+fn check_layers(path: &Path, cap: u64) -> Result<()> {
+    let mut queue = vec![(path.to_path_buf(), None::<(std::path::PathBuf, String)>)];
+    let mut seen = std::collections::HashSet::new();
+    let mut total = 0u64;
+    while let Some((layer, named_by)) = queue.pop() {
+        let named = |e: Error| match &named_by {
+            None => e,
+            Some((by, line)) => malformed(format!("{line} a layer it names cannot be used: {e}")).in_asset(by),
+        };
+        crate::files::check_regular(&layer, cap, "a USD layer").map_err(named)?;
+        if !seen.insert(std::fs::canonicalize(&layer).unwrap_or_else(|_| layer.clone())) {
+            continue;
+        }
+        if seen.len() > MAX_USD_LAYERS {
+            return Err(malformed(format!("the stage pulls in more than {MAX_USD_LAYERS} layers")).in_asset(path));
+        }
+        let bytes = crate::files::read_capped(&layer, cap, "a USD layer").map_err(named)?;
+        total += bytes.len() as u64;
+        if total > cap {
+            return Err(malformed(format!(
+                "the stage's layers add up to more than {cap} bytes (set VKHAIR_MAX_INPUT_BYTES to read more)"
+            ))
+            .in_asset(path));
+        }
+        if !bytes.starts_with(b"#usda") {
+            continue;
+        }
+        let text = std::str::from_utf8(&bytes)
+            .map_err(|e| named(malformed(format!("the text is not UTF-8 ({e})")).in_asset(&layer)))?;
+        let assets = super::usda_check::check(text).map_err(|e| named(e.in_asset(&layer)))?;
+        let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
+        for (asset, at) in assets {
+            let line = super::usda_check::position(text, at);
+            queue.push((dir.join(&asset), Some((layer.clone(), line))));
+        }
+    }
+    Ok(())
 }
 
 fn malformed(reason: String) -> Error {

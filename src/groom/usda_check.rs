@@ -37,8 +37,8 @@ enum Token<'a> {
     Word(&'a str),
     Text(&'a str),
     Path(&'a str),
-    /// An asset path `@…@`.
-    Asset,
+    /// An asset path `@…@` (its text).
+    Asset(&'a str),
     Equals,
 }
 
@@ -91,7 +91,7 @@ fn tokens(text: &str) -> Result<Vec<(usize, Token<'_>)>> {
                     rest.iter().position(|&c| c == b'@')
                 }
                 .ok_or_else(|| unterminated(i, "an asset path"))?;
-                out.push((i, Token::Asset));
+                out.push((i, Token::Asset(&text[i + skip..i + skip + end])));
                 i += skip + end + skip;
             }
             b'{' | b'(' | b'[' => {
@@ -155,8 +155,13 @@ fn contains(a: &str, b: &str) -> bool {
 /// Most composition arcs between a layer's own prims [`check`] follows.
 pub const MAX_USDA_ARCS: usize = 10_000;
 
-/// Checks the USD text `text` (see the module docs).
-pub fn check(text: &str) -> Result<()> {
+/// The other layers a text layer composes: each asset path of its
+/// `subLayers`, `references` and `payload`, with its byte offset.
+pub type LayerAssets = Vec<(String, usize)>;
+
+/// Checks the USD text `text` (see the module docs) and returns the other
+/// layers it names ([`LayerAssets`]).
+pub fn check(text: &str) -> Result<LayerAssets> {
     let tokens = tokens(text)?;
     // Brackets open; for each whether it opened a prim's body.
     let mut open: Vec<(u8, bool)> = Vec::new();
@@ -167,6 +172,7 @@ pub fn check(text: &str) -> Result<()> {
     let mut declaring = false;
     let mut arcs: HashMap<String, Vec<(String, usize)>> = HashMap::new();
     let mut count = 0usize;
+    let mut assets = LayerAssets::new();
     for (k, (at, token)) in tokens.iter().enumerate() {
         match token {
             Token::Open(c) => {
@@ -205,7 +211,10 @@ pub fn check(text: &str) -> Result<()> {
                 if matches!(*w, "def" | "class" | "over") && !prims_metadata_open(&open) {
                     declaring = true;
                     pending = None;
+                } else if *w == "subLayers" && open.len() == 1 && prims.is_empty() && pending.is_none() {
+                    assets.extend(asset_paths(&tokens[k + 1..]));
                 } else if ARCS.contains(w) && in_metadata && matches!(tokens.get(k + 1), Some((_, Token::Equals))) {
+                    assets.extend(asset_paths(&tokens[k + 2..]));
                     let from =
                         format!("{}/{}", prims.last().map_or("", String::as_str), pending.as_deref().unwrap_or(""));
                     for target in arc_targets(&tokens[k + 2..]) {
@@ -225,20 +234,60 @@ pub fn check(text: &str) -> Result<()> {
                     pending = Some((*name).to_owned());
                 }
             }
-            Token::Path(_) | Token::Asset | Token::Equals => {}
+            Token::Path(_) | Token::Asset(_) | Token::Equals => {}
         }
     }
     if let Some((c, _)) = open.last() {
         return Err(malformed(format!("a '{}' is never closed", *c as char)));
     }
-    check_arcs(text, &arcs)
+    check_arcs(text, &arcs)?;
+    Ok(assets)
+}
+
+/// The asset paths of a value (`tokens` start after its key, at `=` or at
+/// the value): one, or those of a list, to the list's end.
+fn asset_paths<'a>(tokens: &[(usize, Token<'a>)]) -> Vec<(String, usize)> {
+    let tokens = match tokens.first() {
+        Some((_, Token::Equals)) => &tokens[1..],
+        _ => tokens,
+    };
+    match tokens.first() {
+        Some((at, Token::Asset(a))) => vec![((*a).to_owned(), *at)],
+        Some((_, Token::Open(b'['))) => {
+            let mut depth = 0usize;
+            let mut out = Vec::new();
+            for (at, t) in tokens {
+                match t {
+                    Token::Open(_) => depth += 1,
+                    Token::Close(_) => {
+                        depth -= 1;
+                        if depth == 0 {
+                            break;
+                        }
+                    }
+                    // Only the list's own entries: not an asset inside a
+                    // reference's metadata.
+                    Token::Asset(a) if depth == 1 => out.push(((*a).to_owned(), *at)),
+                    _ => {}
+                }
+            }
+            out
+        }
+        _ => Vec::new(),
+    }
+}
+
+/// "line L, column C:" of byte `at` of `text`, for messages about a layer's
+/// asset paths.
+pub fn position(text: &str, at: usize) -> String {
+    place(text, at)
 }
 
 /// The prim paths of an arc's value (`tokens` start after its `=`): one path,
 /// or a list of them; a path right after an asset path (`@a.usda@</P>`)
 /// names a prim of another layer and is left out.
 fn arc_targets<'a>(tokens: &[(usize, Token<'a>)]) -> Vec<&'a str> {
-    let internal = |i: usize| i == 0 || !matches!(tokens.get(i - 1), Some((_, Token::Asset)));
+    let internal = |i: usize| i == 0 || !matches!(tokens.get(i - 1), Some((_, Token::Asset(_))));
     match tokens.first() {
         Some((_, Token::Path(p))) => vec![*p],
         Some((_, Token::Open(b'['))) => tokens
