@@ -24,6 +24,9 @@ pub const MAX_CHARACTER_VERTICES: usize = 4 << 20;
 const MAX_INDICES: usize = 3 << 22;
 /// The most keys of one animation channel.
 const MAX_KEYS: usize = 1 << 20;
+/// Most animation keys a document may decode over all its channels (4 Mi:
+/// under 100 MiB of times and values).
+pub const MAX_DOCUMENT_KEYS: usize = 1 << 22;
 
 use gltf::accessor::{DataType, Dimensions};
 
@@ -253,8 +256,33 @@ pub(super) fn parse(bytes: &[u8], dir: Option<&Path>) -> Result<Character> {
 
 /// Every buffer's bytes, checked against its declared length.
 fn buffers(gltf: &gltf::Gltf, dir: Option<&Path>) -> Result<Vec<Vec<u8>>> {
-    let mut out = Vec::new();
+    let mut out: Vec<Vec<u8>> = Vec::new();
+    // What the buffers hold together, each counted as often as it is named
+    // (fifty buffers naming one file read it fifty times).
+    let declared = gltf.document.buffers().map(|b| b.length() as u64).fold(0u64, u64::saturating_add);
+    if declared > MAX_GLTF_BYTES {
+        return Err(unsupported(format!(
+            "the document's {} buffers declare {declared} bytes together, more than {MAX_GLTF_BYTES} (each counted \
+             as often as it is named)",
+            gltf.document.buffers().len()
+        )));
+    }
+    let mut total = 0u64;
     for buffer in gltf.document.buffers() {
+        let budget = MAX_GLTF_BYTES.saturating_sub(total);
+        let too_much = || {
+            unsupported(format!(
+                "buffer {}: the document's buffers add up to more than {MAX_GLTF_BYTES} bytes (each counted as \
+                 often as it is named)",
+                buffer.index()
+            ))
+        };
+        if buffer.length() as u64 > budget
+            || (matches!(buffer.source(), gltf::buffer::Source::Bin)
+                && gltf.blob.as_ref().is_some_and(|b| b.len() as u64 > budget))
+        {
+            return Err(too_much());
+        }
         let data = match buffer.source() {
             gltf::buffer::Source::Bin => gltf
                 .blob
@@ -271,9 +299,13 @@ fn buffers(gltf: &gltf::Gltf, dir: Option<&Path>) -> Result<Vec<Vec<u8>>> {
                         buffer.index()
                     )));
                 }
-                files::read_capped(&dir.join(uri), MAX_GLTF_BYTES, "a glTF buffer")?
+                files::read_capped(&dir.join(uri), budget, "a glTF buffer").map_err(|e| match e {
+                    Error::InputTooLarge { .. } if budget < MAX_GLTF_BYTES => too_much(),
+                    e => e,
+                })?
             }
         };
+        total += data.len() as u64;
         if data.len() < buffer.length() {
             return Err(Error::Truncated {
                 format: FileFormat::Gltf,
@@ -324,6 +356,9 @@ fn animations<'s>(
     get: &(impl Clone + Fn(gltf::Buffer<'_>) -> Option<&'s [u8]>),
 ) -> Result<Vec<Animation>> {
     let mut out = Vec::new();
+    // Keys decoded over the whole document: channels sharing a sampler each
+    // decode its keys, so a small file could ask for many copies.
+    let mut decoded = 0usize;
     for a in doc.animations() {
         let name = a.name().map_or_else(|| format!("animation {}", a.index()), str::to_owned);
         let mut channels = Vec::new();
@@ -331,6 +366,14 @@ fn animations<'s>(
             let what = |part: &str| format!("{name:?} channel {}: {part}", c.index());
             let (input, output) = (c.sampler().input(), c.sampler().output());
             check_accessor(&input, &[DataType::F32], Dimensions::Scalar, MAX_KEYS, &what("input"))?;
+            decoded = decoded.saturating_add(input.count());
+            if decoded > MAX_DOCUMENT_KEYS {
+                return Err(malformed(format!(
+                    "{}: the animations decode to more than {MAX_DOCUMENT_KEYS} keys over all channels (a sampler \
+                     shared by several channels counts once for each)",
+                    what("keys")
+                )));
+            }
             let (types, dims): (&[DataType], _) = match c.target().property() {
                 Property::Translation | Property::Scale => (&[DataType::F32], Dimensions::Vec3),
                 Property::Rotation => {

@@ -225,6 +225,63 @@ fn buffers_that_cannot_be_read_safely_are_refused() {
     assert!(err.to_string().contains("truncated glTF file"), "{err}");
 }
 
+/// Amplification is bounded over the whole document: buffers naming one file
+/// fifty times declare more than the cap together and are refused before any
+/// is read; channels sharing one sampler of a million keys decode it once
+/// each, and past [`super::gltf_read::MAX_DOCUMENT_KEYS`] keys the document
+/// is refused (where it decoded them all).
+#[test]
+fn a_small_document_cannot_ask_for_copies_without_bound() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(dir.path().join("data.bin"), [0u8; 16]).expect("write");
+    let length = 25 << 20; // 50 × 25 MiB: 1.22 GiB
+    let buffers: Vec<String> = (0..50).map(|_| format!(r#"{{"uri":"data.bin","byteLength":{length}}}"#)).collect();
+    let doc = format!(r#"{{"asset":{{"version":"2.0"}},"buffers":[{}]}}"#, buffers.join(","));
+    let err = gltf_read::parse(doc.as_bytes(), Some(dir.path())).expect_err("too much").to_string();
+    assert!(err.contains("50 buffers declare 1310720000 bytes together"), "{err}");
+
+    let keys = 1 << 20;
+    let mut bin = Vec::with_capacity(16 * keys);
+    for i in 0..keys {
+        bin.extend_from_slice(&(i as f32 / keys as f32).to_le_bytes());
+    }
+    bin.resize(16 * keys, 0);
+    std::fs::write(dir.path().join("keys.bin"), &bin).expect("write");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
+    let bytes = std::fs::read(path).expect("read");
+    let shared = |channels: usize| {
+        mutated(&bytes, |j| {
+            let buffer = j["buffers"].as_array().map_or(0, Vec::len);
+            j["buffers"]
+                .as_array_mut()
+                .expect("buffers")
+                .push(serde_json::json!({"uri": "keys.bin", "byteLength": 16 * keys}));
+            let views = j["bufferViews"].as_array_mut().expect("views");
+            let view = views.len();
+            views.push(serde_json::json!({"buffer": buffer, "byteOffset": 0, "byteLength": 4 * keys}));
+            views.push(serde_json::json!({"buffer": buffer, "byteOffset": 4 * keys, "byteLength": 12 * keys}));
+            let accessors = j["accessors"].as_array_mut().expect("accessors");
+            let accessor = accessors.len();
+            accessors.push(serde_json::json!({"bufferView": view, "componentType": 5126, "count": keys,
+                "type": "SCALAR", "min": [0.0], "max": [1.0]}));
+            accessors.push(
+                serde_json::json!({"bufferView": view + 1, "componentType": 5126, "count": keys, "type": "VEC3"}),
+            );
+            let samplers = j["animations"][0]["samplers"].as_array_mut().expect("samplers");
+            let sampler = samplers.len();
+            samplers.push(serde_json::json!({"input": accessor, "output": accessor + 1}));
+            let channels_of = j["animations"][0]["channels"].as_array_mut().expect("channels");
+            for _ in 0..channels {
+                channels_of.push(serde_json::json!({"sampler": sampler, "target": {"node": 0, "path": "translation"}}));
+            }
+        })
+    };
+    let character = gltf_read::parse(&shared(2), Some(dir.path())).expect("two channels of a million keys");
+    assert!(!character.skeleton.animations.is_empty());
+    let err = gltf_read::parse(&shared(5), Some(dir.path())).expect_err("five").to_string();
+    assert!(err.contains("decode to more than 4194304 keys"), "{err}");
+}
+
 /// The mannequin's GLB with its JSON chunk changed by `edit`.
 fn mutated(bytes: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
     let json_len = u32::from_le_bytes(bytes[12..16].try_into().expect("length")) as usize;
