@@ -133,11 +133,13 @@ struct Walk<'w, 'a> {
 }
 
 impl Walk<'_, '_> {
+    /// Reads the objects of `group`, which lie `depth + 1` levels down (the
+    /// top object's children at level 1).
     fn objects(&mut self, group: &[Child], path: &str, parent: DMat4, depth: usize) -> Result<()> {
-        if depth >= MAX_DEPTH {
-            return Err(malformed(format!("{path}: objects nest deeper than {MAX_DEPTH} levels")));
-        }
         for (header, at, child) in self.archive.children(group).map_err(|e| in_object(or_root(path), e))? {
+            if depth >= MAX_DEPTH {
+                return Err(malformed(format!("{path}/{}: objects nest deeper than {MAX_DEPTH} levels", header.name)));
+            }
             self.objects += 1;
             if self.objects > MAX_OBJECTS {
                 return Err(malformed(format!("more than {MAX_OBJECTS} objects")));

@@ -293,6 +293,28 @@ mod tests {
         assert_eq!(g.groom.positions(), [Vec3::ZERO, Vec3::new(0.0, -0.1, 0.0)]);
     }
 
+    /// Objects nest up to [`super::super::MAX_DEPTH`] levels: a curves object
+    /// that deep (under 255 Xforms) is read, one level deeper is refused
+    /// naming it.
+    #[test]
+    fn objects_nest_as_deep_as_the_limit_and_no_deeper() {
+        let groom = Groom::from_strands(&[vec![Vec3::X, Vec3::new(1.0, -1.0, 0.0)]]).expect("groom");
+        let nested = |levels: usize| {
+            let mut w = Writer::new();
+            let o = CurvesObject { name: "c", groom: &groom, guides: None, root_uvs: None, transform: None };
+            let mut child = ("c".to_owned(), CURVE_META.to_owned(), curves(&mut w, &o));
+            for level in 1..levels {
+                child = (format!("x{level}"), XFORM_META.to_owned(), xform(&mut w, DMat4::IDENTITY, child));
+            }
+            finish(w, &[child])
+        };
+        let limit = super::super::MAX_DEPTH;
+        let g = super::super::parse(&nested(limit)).expect("as deep as the limit");
+        assert_eq!(g.groom.strand_count(), 1);
+        let err = super::super::parse(&nested(limit + 1)).expect_err("one deeper").to_string();
+        assert!(err.contains("/c: objects nest deeper than 256 levels"), "{err}");
+    }
+
     #[test]
     fn xform_ops_compose_with_the_first_outermost() {
         let groom = Groom::from_strands(&[vec![Vec3::X, Vec3::new(1.0, -1.0, 0.0)]]).expect("groom");
