@@ -265,3 +265,25 @@ fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
         }
     }
 }
+
+/// A negative width (a diameter) is a defect: refused strictly, naming the
+/// prim and strand; when repairing, the widths are passed over and said, the
+/// strands kept.
+#[test]
+fn a_negative_width_is_refused_strictly_and_passed_over_when_repairing() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("widths.usda");
+    std::fs::write(
+        &path,
+        "#usda 1.0\n(\n    metersPerUnit = 1\n)\ndef BasisCurves \"hair\"\n{\n    uniform token type = \"linear\"\n    \
+         int[] curveVertexCounts = [2, 2]\n    point3f[] points = [(0,0,0), (0,-0.1,0), (0.1,0,0), (0.1,-0.1,0)]\n    \
+         float[] widths = [0.001, 0.001, 0.001, -0.0005] (\n        interpolation = \"vertex\"\n    )\n}\n",
+    )
+    .expect("write");
+    let err = usd::open(&path).expect_err("strict").to_string();
+    assert!(err.contains("/hair") && err.contains("strand 1 has a negative width (-0.0005)"), "{err}");
+    let (g, _) = usd::open_repairing(&path).expect("repairing");
+    assert_eq!(g.groom.strand_count(), 2);
+    assert!(g.groom.end_thickness().is_none(), "the widths were read");
+    assert!(g.skipped.iter().any(|s| s.contains("negative width")), "{:?}", g.skipped);
+}

@@ -428,8 +428,33 @@ pub(crate) fn assemble(
         }
         n == objects.len()
     };
-    let thickness = all("widths", &|o| o.widths.is_some(), &mut skipped)
+    let mut thickness: Option<Vec<f32>> = all("widths", &|o| o.widths.is_some(), &mut skipped)
         .then(|| objects.iter().flat_map(|o| o.widths.iter().flatten().map(|&w| (f64::from(w) * k) as f32)).collect());
+    // A width is a diameter: a negative one is a defect, refused (strict) or
+    // the widths passed over, with the first named (repairing).
+    let negative = objects.iter().find_map(|o| {
+        let widths = o.widths.as_ref()?;
+        let at = widths.iter().position(|&w| w < 0.0)?;
+        let strand = o
+            .counts
+            .iter()
+            .scan(0usize, |end, &c| {
+                *end += c as usize;
+                Some(*end)
+            })
+            .position(|end| at < end)?;
+        Some((o.path.as_str(), strand, widths[at]))
+    });
+    if let Some((path, strand, width)) = negative {
+        let what = format!("strand {strand} has a negative width ({width})");
+        match load {
+            Load::Strict => return Err(in_object(path, Error::Malformed { format: frame.format, reason: what })),
+            Load::Repair => {
+                skipped.push(format!("widths: {path}: {what}; the widths are not read"));
+                thickness = None;
+            }
+        }
+    }
     let colors = all("colours", &|o| o.colors.is_some(), &mut skipped)
         .then(|| objects.iter().flat_map(|o| o.colors.iter().flatten().copied()).collect());
     let root_uvs: Option<Vec<Vec2>> = all("root UVs", &|o| o.root_uvs.is_some(), &mut skipped)
