@@ -200,7 +200,8 @@ fn owned_name(name: &str) -> Option<Option<usize>> {
 }
 
 /// Prepares `dir` for a run of `frames` frames: refuses when a file the run
-/// writes (`frame_NNNN.png`, `contact_sheet.png`) is a symbolic link, and
+/// writes (`frame_NNNN.png`, `contact_sheet.png`) is a symbolic link or not a
+/// regular file (a folder in a frame's place is found before rendering), and
 /// removes the frames of an earlier run that this one will not overwrite
 /// (their index is `frames` or more), so that the folder holds one run. Only
 /// those names are touched. Returns how many frames were removed.
@@ -219,7 +220,16 @@ pub fn clear_stale_frames(dir: &Path, frames: usize) -> Result<usize, Error> {
             )
             .into());
         }
-        if index.is_some_and(|i| i >= frames) {
+        let written = index.is_none_or(|i| i < frames);
+        if written && std::fs::metadata(&path).is_ok_and(|m| !m.is_file()) {
+            return Err(format!(
+                "--out {}: {name} is in the place of a file this run writes but is not a file (a folder or a \
+                 device); remove it or choose another folder",
+                dir.display()
+            )
+            .into());
+        }
+        if !written {
             stale.push(path);
         }
     }

@@ -227,3 +227,17 @@ fn control_characters_in_names_are_printed_escaped() {
     );
     assert!(out.stderr.contains("gone\\u{1b}]0;title\\u{7}.hair"), "{}", out.stderr);
 }
+
+/// A folder in the place of a frame the run writes is found before rendering:
+/// the run stops at once naming it, with no GPU work done.
+#[test]
+fn a_folder_in_a_frames_place_is_refused_before_rendering() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("frames");
+    std::fs::create_dir_all(out.join("frame_0001.png")).expect("a folder named like a frame");
+    let o = out.to_str().expect("utf-8");
+    let run = run(&["render", "--frames", "3", "--width", "32", "--height", "24", "--out", o], LIMIT);
+    run.assert_error("frame_0001.png is in the place of a file this run writes");
+    assert!(!run.stdout.contains("key hairs"), "GPU work started: {}", run.stdout);
+    assert!(!out.join("frame_0000.png").exists(), "a frame was written");
+}
