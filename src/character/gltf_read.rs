@@ -346,8 +346,25 @@ fn nodes(doc: &gltf::Document) -> Result<Vec<Node>> {
         if !finite || n.rotation.length_squared() < 1e-12 {
             return Err(malformed(format!("node {i} ({:?}) has a transform that is not finite", n.name)));
         }
+        if let Some(why) = absurd(n.translation, n.scale) {
+            return Err(malformed(format!("node {i} ({:?}): {why}", n.name)));
+        }
     }
     Ok(nodes)
+}
+
+/// Largest translation or scale component a node or an animation key may
+/// have (meters for translations): a character is metres across, and a
+/// value past this is a broken file, not a pose.
+pub const MAX_TRANSFORM_COMPONENT: f32 = 1e4;
+
+/// Why a translation `t` or scale `s` is beyond any character's, if it is.
+fn absurd(t: Vec3, s: Vec3) -> Option<String> {
+    let most = MAX_TRANSFORM_COMPONENT;
+    if t.abs().max_element() > most {
+        return Some(format!("translation {t} is beyond ±{most} m"));
+    }
+    (s.abs().max_element() > most).then(|| format!("scale {s} is beyond ±{most}"))
 }
 
 /// Every animation's transform channels.
@@ -398,6 +415,14 @@ fn animations<'s>(
                 Interpolation::Step => Sampling::Step,
                 Interpolation::CubicSpline => Sampling::CubicSpline,
             };
+            let beyond = match &keys {
+                Keys::Translation(v) => v.iter().find_map(|&t| absurd(t, Vec3::ONE)),
+                Keys::Scale(v) => v.iter().find_map(|&sc| absurd(Vec3::ZERO, sc)),
+                Keys::Rotation(_) => None,
+            };
+            if let Some(why) = beyond {
+                return Err(malformed(what(&format!("a key's {why}"))));
+            }
             let channel = Channel { node: c.target().node().index(), times, keys, sampling };
             channel.validate().map_err(|reason| malformed(what(&reason)))?;
             channels.push(channel);

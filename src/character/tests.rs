@@ -282,6 +282,52 @@ fn a_small_document_cannot_ask_for_copies_without_bound() {
     assert!(err.contains("decode to more than 4194304 keys"), "{err}");
 }
 
+/// A translation or scale no character has (10³⁰ m, a node scaled 10⁶×),
+/// on a node or in an animation key, is refused naming where it is.
+#[test]
+fn absurd_transforms_are_refused_naming_the_node_or_channel() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
+    let bytes = std::fs::read(path).expect("read");
+    let err = Character::parse(&mutated(&bytes, |j| j["nodes"][0]["translation"] = serde_json::json!([1e30, 0, 0])))
+        .expect_err("far")
+        .to_string();
+    assert!(err.contains("node 0") && err.contains("is beyond ±10000 m"), "{err}");
+    let err = Character::parse(&mutated(&bytes, |j| j["nodes"][0]["scale"] = serde_json::json!([1e6, 1, 1])))
+        .expect_err("huge")
+        .to_string();
+    assert!(err.contains("node 0") && err.contains("scale"), "{err}");
+    // An animation key 10³⁰ m away, from a buffer of its own.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut bin = Vec::new();
+    for t in [0.0f32, 1.0] {
+        bin.extend_from_slice(&t.to_le_bytes());
+    }
+    for v in [0.0f32, 0.0, 0.0, 1e30, 0.0, 0.0] {
+        bin.extend_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(dir.path().join("keys.bin"), &bin).expect("write");
+    let doc = mutated(&bytes, |j| {
+        let buffer = j["buffers"].as_array().map_or(0, Vec::len);
+        j["buffers"].as_array_mut().expect("buffers").push(serde_json::json!({"uri": "keys.bin", "byteLength": 32}));
+        let views = j["bufferViews"].as_array_mut().expect("views");
+        let view = views.len();
+        views.push(serde_json::json!({"buffer": buffer, "byteOffset": 0, "byteLength": 8}));
+        views.push(serde_json::json!({"buffer": buffer, "byteOffset": 8, "byteLength": 24}));
+        let accessors = j["accessors"].as_array_mut().expect("accessors");
+        let accessor = accessors.len();
+        accessors.push(serde_json::json!({"bufferView": view, "componentType": 5126, "count": 2, "type": "SCALAR",
+            "min": [0.0], "max": [1.0]}));
+        accessors.push(serde_json::json!({"bufferView": view + 1, "componentType": 5126, "count": 2, "type": "VEC3"}));
+        let samplers = j["animations"][0]["samplers"].as_array_mut().expect("samplers");
+        let sampler = samplers.len();
+        samplers.push(serde_json::json!({"input": accessor, "output": accessor + 1}));
+        let channels = j["animations"][0]["channels"].as_array_mut().expect("channels");
+        channels.push(serde_json::json!({"sampler": sampler, "target": {"node": 0, "path": "translation"}}));
+    });
+    let err = gltf_read::parse(&doc, Some(dir.path())).expect_err("a far key").to_string();
+    assert!(err.contains("channel") && err.contains("a key's translation") && err.contains("beyond"), "{err}");
+}
+
 /// The mannequin's GLB with its JSON chunk changed by `edit`.
 fn mutated(bytes: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
     let json_len = u32::from_le_bytes(bytes[12..16].try_into().expect("length")) as usize;
