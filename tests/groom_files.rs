@@ -354,6 +354,18 @@ fn a_binary_obj_says_it_is_not_text() {
     assert!(err.to_string().contains("line 3 is not UTF-8"), "{err}");
 }
 
+/// A glTF document given where an OBJ mesh belongs (binary or JSON) is named
+/// as a glTF document, not as a malformed OBJ; the shared character is one.
+#[test]
+fn a_gltf_document_given_as_a_mesh_is_named_as_one() {
+    let glb = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb")).expect("read");
+    let json = br#"  {"asset": {"version": "2.0"}, "nodes": []}"#;
+    for bytes in [&glb[..], &json[..]] {
+        let err = TriMesh::parse_obj(bytes).expect_err("a glTF document").to_string();
+        assert!(err.contains("this is a glTF document, not an OBJ mesh"), "{err}");
+    }
+}
+
 #[test]
 fn obj_parsing_and_errors() {
     let quad = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";

@@ -55,6 +55,15 @@ impl TriMesh {
     /// points or polylines) is refused, and a vertex that is not finite is
     /// named by its number in the file (counting from 1, as faces do) and line.
     pub fn parse_obj(data: &[u8]) -> Result<Self> {
+        // A glTF document given as a mesh is named as what it is, not as a
+        // malformed OBJ.
+        let json_gltf = data.trim_ascii_start().starts_with(b"{") && data.windows(7).any(|w| w == b"\"asset\"");
+        if data.starts_with(b"glTF") || json_gltf {
+            return Err(Error::Unsupported {
+                format: FileFormat::Obj,
+                reason: "this is a glTF document, not an OBJ mesh: read it as a character (glTF)".into(),
+            });
+        }
         let text = match std::str::from_utf8(data) {
             Ok(text) => text,
             Err(e) => {
