@@ -193,14 +193,14 @@ impl HairRig {
     /// head's frame, framing the face: combed back (away from where the
     /// character faces, the given comb and face replaced), parted at the middle
     /// with the front hair turned to its side ([`GrowParams::face`]), under the
-    /// character's gravity; no roots on the face. With the head's region at rest (the mesh collider).
+    /// character's gravity; no roots on the face. With the head's region at
+    /// rest (the mesh collider).
     pub fn grow_with(&self, params: &GrowParams) -> Result<(Groom, TriMesh)> {
         let to_head: Mat4 = self.bind_frame().inverse();
         let local = self.head_region()?;
         let facing = self.character.forward();
-        let forward = to_head.transform_vector3(facing).normalize();
-        let up = to_head.transform_vector3(Vec3::Y).normalize();
-        let face = self.face_triangles(&local, NO_ROOT_FACING);
+        let (forward, up) = self.head_axes();
+        let face = face_triangles(&local, (forward, up), NO_ROOT_FACING);
         let scalp_triangles: Vec<[u32; 3]> =
             local.triangles.iter().zip(&face).filter(|(_, &f)| !f).map(|(t, _)| *t).collect();
         let scalp_mesh = TriMesh::new(local.positions.clone(), scalp_triangles)?;
@@ -220,14 +220,13 @@ impl HairRig {
     /// below the crown (the top fifth of the region's height) that face
     /// forward, within 60° of the character's forward ([`FACE_FACING`]),
     /// between the ears (their corners within [`FACE_HALF_WIDTH`] of the
-    /// region's half width of the middle): what hair should leave visible. [`HairRig::grow_with`] roots no hair on a
-    /// wider band, within 75° ([`NO_ROOT_FACING`]).
+    /// region's half width of the middle): what hair should leave visible.
+    /// [`HairRig::grow_with`] roots no hair on a wider band, within 75°
+    /// ([`NO_ROOT_FACING`]).
     pub fn face_region(&self) -> Result<TriMesh> {
         let local = self.head_region()?;
-        let face = self.face_triangles(&local, FACE_FACING);
-        let to_head: Mat4 = self.bind_frame().inverse();
-        let forward = to_head.transform_vector3(self.character.forward()).normalize();
-        let up = to_head.transform_vector3(Vec3::Y).normalize();
+        let (forward, up) = self.head_axes();
+        let face = face_triangles(&local, (forward, up), FACE_FACING);
         let across = forward.cross(up).normalize_or_zero();
         let sides = local.positions.iter().map(|p| p.dot(across));
         let (lo, hi) = sides.fold((f32::MAX, f32::MIN), |(l, h), x| (l.min(x), h.max(x)));
@@ -241,24 +240,28 @@ impl HairRig {
         TriMesh::new(local.positions, triangles)
     }
 
-    /// Per triangle of `local` (the head's region at rest, head frame):
-    /// whether it lies below the crown facing forward by at least
-    /// `min_facing` (its normal · the character's forward).
-    fn face_triangles(&self, local: &TriMesh, min_facing: f32) -> Vec<bool> {
+    /// The character's forward and the world's up, unit, in the head's frame
+    /// in the bind pose.
+    fn head_axes(&self) -> (Vec3, Vec3) {
         let to_head: Mat4 = self.bind_frame().inverse();
-        let forward = to_head.transform_vector3(self.character.forward()).normalize();
-        let up = to_head.transform_vector3(Vec3::Y).normalize();
-        let (lo, hi) =
-            local.positions.iter().fold((f32::MAX, f32::MIN), |(l, h), p| (l.min(p.dot(up)), h.max(p.dot(up))));
-        let crown = hi - 0.2 * (hi - lo);
-        (0..local.triangles.len())
-            .map(|i| {
-                let n = local.scaled_normal(i).normalize_or_zero();
-                let centroid = local.corners(i).iter().copied().sum::<Vec3>() / 3.0;
-                n.dot(forward) >= min_facing && centroid.dot(up) <= crown
-            })
-            .collect()
+        let along = |v: Vec3| to_head.transform_vector3(v).normalize();
+        (along(self.character.forward()), along(Vec3::Y))
     }
+}
+
+/// Per triangle of `local` (the head's region at rest, head frame): whether
+/// it lies below the crown (the top fifth of its height along `up`) facing
+/// `forward` by at least `min_facing` (its normal · forward).
+fn face_triangles(local: &TriMesh, (forward, up): (Vec3, Vec3), min_facing: f32) -> Vec<bool> {
+    let (lo, hi) = local.positions.iter().fold((f32::MAX, f32::MIN), |(l, h), p| (l.min(p.dot(up)), h.max(p.dot(up))));
+    let crown = hi - 0.2 * (hi - lo);
+    (0..local.triangles.len())
+        .map(|i| {
+            let n = local.scaled_normal(i).normalize_or_zero();
+            let centroid = local.corners(i).iter().copied().sum::<Vec3>() / 3.0;
+            n.dot(forward) >= min_facing && centroid.dot(up) <= crown
+        })
+        .collect()
 }
 
 /// Distance from `p` to the segment `a`–`b`.

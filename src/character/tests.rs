@@ -241,41 +241,11 @@ fn a_small_document_cannot_ask_for_copies_without_bound() {
     assert!(err.contains("50 buffers declare 1310720000 bytes together"), "{err}");
 
     let keys = 1 << 20;
-    let mut bin = Vec::with_capacity(16 * keys);
-    for i in 0..keys {
-        bin.extend_from_slice(&(i as f32 / keys as f32).to_le_bytes());
-    }
-    bin.resize(16 * keys, 0);
-    std::fs::write(dir.path().join("keys.bin"), &bin).expect("write");
+    let times: Vec<f32> = (0..keys).map(|i| i as f32 / keys as f32).collect();
+    let values = vec![0.0f32; 3 * keys];
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
     let bytes = std::fs::read(path).expect("read");
-    let shared = |channels: usize| {
-        mutated(&bytes, |j| {
-            let buffer = j["buffers"].as_array().map_or(0, Vec::len);
-            j["buffers"]
-                .as_array_mut()
-                .expect("buffers")
-                .push(serde_json::json!({"uri": "keys.bin", "byteLength": 16 * keys}));
-            let views = j["bufferViews"].as_array_mut().expect("views");
-            let view = views.len();
-            views.push(serde_json::json!({"buffer": buffer, "byteOffset": 0, "byteLength": 4 * keys}));
-            views.push(serde_json::json!({"buffer": buffer, "byteOffset": 4 * keys, "byteLength": 12 * keys}));
-            let accessors = j["accessors"].as_array_mut().expect("accessors");
-            let accessor = accessors.len();
-            accessors.push(serde_json::json!({"bufferView": view, "componentType": 5126, "count": keys,
-                "type": "SCALAR", "min": [0.0], "max": [1.0]}));
-            accessors.push(
-                serde_json::json!({"bufferView": view + 1, "componentType": 5126, "count": keys, "type": "VEC3"}),
-            );
-            let samplers = j["animations"][0]["samplers"].as_array_mut().expect("samplers");
-            let sampler = samplers.len();
-            samplers.push(serde_json::json!({"input": accessor, "output": accessor + 1}));
-            let channels_of = j["animations"][0]["channels"].as_array_mut().expect("channels");
-            for _ in 0..channels {
-                channels_of.push(serde_json::json!({"sampler": sampler, "target": {"node": 0, "path": "translation"}}));
-            }
-        })
-    };
+    let shared = |channels: usize| with_translation_keys(&bytes, dir.path(), "keys.bin", &times, &values, channels);
     let character = gltf_read::parse(&shared(2), Some(dir.path())).expect("two channels of a million keys");
     assert!(!character.skeleton.animations.is_empty());
     let err = gltf_read::parse(&shared(5), Some(dir.path())).expect_err("five").to_string();
@@ -298,34 +268,50 @@ fn absurd_transforms_are_refused_naming_the_node_or_channel() {
     assert!(err.contains("node 0") && err.contains("scale"), "{err}");
     // An animation key 10³⁰ m away, from a buffer of its own.
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut bin = Vec::new();
-    for t in [0.0f32, 1.0] {
-        bin.extend_from_slice(&t.to_le_bytes());
-    }
-    for v in [0.0f32, 0.0, 0.0, 1e30, 0.0, 0.0] {
-        bin.extend_from_slice(&v.to_le_bytes());
-    }
-    std::fs::write(dir.path().join("keys.bin"), &bin).expect("write");
-    let doc = mutated(&bytes, |j| {
+    let far = [0.0, 0.0, 0.0, 1e30, 0.0, 0.0];
+    let doc = with_translation_keys(&bytes, dir.path(), "keys.bin", &[0.0, 1.0], &far, 1);
+    let err = gltf_read::parse(&doc, Some(dir.path())).expect_err("a far key").to_string();
+    assert!(err.contains("channel") && err.contains("a key's translation") && err.contains("beyond"), "{err}");
+}
+
+/// The mannequin's GLB (`bytes`) with an animation sampler of its own added
+/// to its first animation: `times` and translation `values` (three a key)
+/// written to `dir`/`name`, a buffer naming that file, and `channels`
+/// channels sharing the sampler, translating node 0. Parse it with
+/// `gltf_read::parse(…, Some(dir))`.
+fn with_translation_keys(
+    bytes: &[u8],
+    dir: &Path,
+    name: &str,
+    times: &[f32],
+    values: &[f32],
+    channels: usize,
+) -> Vec<u8> {
+    let keys = times.len();
+    let bin: Vec<u8> = times.iter().chain(values).flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(dir.join(name), &bin).expect("write the keys");
+    mutated(bytes, |j| {
         let buffer = j["buffers"].as_array().map_or(0, Vec::len);
-        j["buffers"].as_array_mut().expect("buffers").push(serde_json::json!({"uri": "keys.bin", "byteLength": 32}));
+        j["buffers"].as_array_mut().expect("buffers").push(serde_json::json!({"uri": name, "byteLength": bin.len()}));
         let views = j["bufferViews"].as_array_mut().expect("views");
         let view = views.len();
-        views.push(serde_json::json!({"buffer": buffer, "byteOffset": 0, "byteLength": 8}));
-        views.push(serde_json::json!({"buffer": buffer, "byteOffset": 8, "byteLength": 24}));
+        views.push(serde_json::json!({"buffer": buffer, "byteOffset": 0, "byteLength": 4 * keys}));
+        views.push(serde_json::json!({"buffer": buffer, "byteOffset": 4 * keys, "byteLength": 4 * values.len()}));
         let accessors = j["accessors"].as_array_mut().expect("accessors");
         let accessor = accessors.len();
-        accessors.push(serde_json::json!({"bufferView": view, "componentType": 5126, "count": 2, "type": "SCALAR",
-            "min": [0.0], "max": [1.0]}));
-        accessors.push(serde_json::json!({"bufferView": view + 1, "componentType": 5126, "count": 2, "type": "VEC3"}));
+        let (first, last) = (times.first().copied().unwrap_or(0.0), times.last().copied().unwrap_or(0.0));
+        accessors.push(serde_json::json!({"bufferView": view, "componentType": 5126, "count": keys,
+            "type": "SCALAR", "min": [first], "max": [last]}));
+        accessors
+            .push(serde_json::json!({"bufferView": view + 1, "componentType": 5126, "count": keys, "type": "VEC3"}));
         let samplers = j["animations"][0]["samplers"].as_array_mut().expect("samplers");
         let sampler = samplers.len();
         samplers.push(serde_json::json!({"input": accessor, "output": accessor + 1}));
-        let channels = j["animations"][0]["channels"].as_array_mut().expect("channels");
-        channels.push(serde_json::json!({"sampler": sampler, "target": {"node": 0, "path": "translation"}}));
-    });
-    let err = gltf_read::parse(&doc, Some(dir.path())).expect_err("a far key").to_string();
-    assert!(err.contains("channel") && err.contains("a key's translation") && err.contains("beyond"), "{err}");
+        let channels_of = j["animations"][0]["channels"].as_array_mut().expect("channels");
+        for _ in 0..channels {
+            channels_of.push(serde_json::json!({"sampler": sampler, "target": {"node": 0, "path": "translation"}}));
+        }
+    })
 }
 
 /// The mannequin's GLB with its JSON chunk changed by `edit`.

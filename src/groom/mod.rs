@@ -69,16 +69,18 @@ pub const OUTLIER_SEGMENT_RATIO: f32 = 1e4;
 /// The first outlier point of the strand `points` ([`OUTLIER_SEGMENT_RATIO`]):
 /// its index and position. Of a too-long segment, the point it leads to is
 /// the outlier, or the root where only the first segment is too long.
-pub(crate) fn outlier_point(points: &[Vec3]) -> Option<(usize, Vec3)> {
+/// `scratch` is reused memory for the segments' lengths.
+pub(crate) fn outlier_point(points: &[Vec3], scratch: &mut Vec<f32>) -> Option<(usize, Vec3)> {
     if points.len() < 4 {
         return None;
     }
-    let lengths: Vec<f32> = points.windows(2).map(|p| (p[1] - p[0]).length()).collect();
-    let mut sorted = lengths.clone();
-    sorted.sort_by(f32::total_cmp);
-    let most = sorted[sorted.len() / 2] * OUTLIER_SEGMENT_RATIO;
-    let long = |i: usize| lengths.get(i).is_some_and(|&l| l > most);
-    let first = (0..lengths.len()).find(|&i| long(i))?;
+    let length = |i: usize| (points[i + 1] - points[i]).length();
+    scratch.clear();
+    scratch.extend((0..points.len() - 1).map(length));
+    let middle = scratch.len() / 2;
+    let most = *scratch.select_nth_unstable_by(middle, f32::total_cmp).1 * OUTLIER_SEGMENT_RATIO;
+    let long = |i: usize| i + 1 < points.len() && length(i) > most;
+    let first = (0..points.len() - 1).find(|&i| long(i))?;
     let point = if first == 0 && !long(1) { 0 } else { first + 1 };
     Some((point, points[point]))
 }
@@ -254,9 +256,10 @@ impl Groom {
         }
         let (lo, hi) = self.bounds();
         check_extent(lo, hi)?;
+        let mut scratch = Vec::new();
         for strand in 0..self.strand_count() {
             let points = self.strand(strand);
-            if let Some((point, position)) = outlier_point(points) {
+            if let Some((point, position)) = outlier_point(points, &mut scratch) {
                 return Err(Error::OutlierPoint { strand, point, position: position.to_array() });
             }
             let min_segment = min_segment(points);

@@ -168,8 +168,9 @@ impl Groom {
         let (lo, hi) = super::bounding_box(strands.iter().flat_map(|(_, r)| positions[r.clone()].iter().copied()));
         super::check_extent(lo, hi)?;
         let mut counts = Vec::with_capacity(strands.len());
+        let mut scratch = Vec::new();
         for (strand, range) in strands {
-            if let Some((point, at)) = super::outlier_point(&positions[range.clone()]) {
+            if let Some((point, at)) = super::outlier_point(&positions[range.clone()], &mut scratch) {
                 repairs.outlier_strands += 1;
                 repairs.first_outlier.get_or_insert((strand, point, at.to_array()));
                 continue;
@@ -276,9 +277,10 @@ mod tests {
         tip[4] = Vec3::splat(1e4);
         let mut root = line(5, 0.0);
         root[0] = Vec3::splat(-1e4);
-        assert_eq!(crate::groom::outlier_point(&tip).map(|o| o.0), Some(4));
-        assert_eq!(crate::groom::outlier_point(&root).map(|o| o.0), Some(0));
-        assert_eq!(crate::groom::outlier_point(&line(5, 0.0)), None);
+        let outlier = |points: &[Vec3]| crate::groom::outlier_point(points, &mut Vec::new());
+        assert_eq!(outlier(&tip).map(|o| o.0), Some(4));
+        assert_eq!(outlier(&root).map(|o| o.0), Some(0));
+        assert_eq!(outlier(&line(5, 0.0)), None);
     }
 
     #[test]

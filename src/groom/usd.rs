@@ -28,6 +28,7 @@
 //! without any `BasisCurves` prim is refused. The root file must be a regular
 //! file within [`MAX_USD_BYTES`] (or `VKHAIR_MAX_INPUT_BYTES`).
 
+use std::io::Read as _;
 use std::path::Path;
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
@@ -100,17 +101,22 @@ fn check_layers(path: &Path, cap: u64) -> Result<()> {
         if seen.len() > MAX_USD_LAYERS {
             return Err(malformed(format!("the stage pulls in more than {MAX_USD_LAYERS} layers")).in_asset(path));
         }
-        let bytes = crate::files::read_capped(&layer, cap, "a USD layer").map_err(named)?;
-        total += bytes.len() as u64;
+        // A regular file (checked above): its length bounds the stage, and only
+        // a text layer is read here (the library reads the binary ones).
+        let io = |source| named(Error::Io { path: layer.clone(), source });
+        total += std::fs::metadata(&layer).map_err(io)?.len();
         if total > cap {
             return Err(malformed(format!(
                 "the stage's layers add up to more than {cap} bytes (set VKHAIR_MAX_INPUT_BYTES to read more)"
             ))
             .in_asset(path));
         }
-        if !bytes.starts_with(b"#usda") {
+        let mut magic = Vec::with_capacity(5);
+        std::fs::File::open(&layer).and_then(|f| f.take(5).read_to_end(&mut magic)).map_err(io)?;
+        if magic != b"#usda" {
             continue;
         }
+        let bytes = crate::files::read_capped(&layer, cap, "a USD layer").map_err(named)?;
         let text = std::str::from_utf8(&bytes)
             .map_err(|e| named(malformed(format!("the text is not UTF-8 ({e})")).in_asset(&layer)))?;
         let assets = super::usda_check::check(text).map_err(|e| named(e.in_asset(&layer)))?;

@@ -48,7 +48,7 @@ fn tokens(text: &str) -> Result<Vec<(usize, Token<'_>)>> {
     let b = text.as_bytes();
     let mut out = Vec::new();
     let mut i = 0;
-    let unterminated = |at: usize, what: &str| malformed(format!("{} {what} that never ends", place(text, at)));
+    let unterminated = |at: usize, what: &str| malformed(format!("{} {what} that never ends", position(text, at)));
     while i < b.len() {
         let c = b[i];
         match c {
@@ -119,8 +119,8 @@ fn tokens(text: &str) -> Result<Vec<(usize, Token<'_>)>> {
     Ok(out)
 }
 
-/// "line L, column C" of byte `at` of `text`.
-fn place(text: &str, at: usize) -> String {
+/// "line L, column C:" of byte `at` of `text`.
+pub fn position(text: &str, at: usize) -> String {
     let before = &text[..at.min(text.len())];
     let line = before.matches('\n').count() + 1;
     let column = before.len() - before.rfind('\n').map_or(0, |n| n + 1) + 1;
@@ -179,7 +179,7 @@ pub fn check(text: &str) -> Result<LayerAssets> {
                 if open.len() >= MAX_USDA_DEPTH {
                     return Err(malformed(format!(
                         "{} nesting deeper than {MAX_USDA_DEPTH} levels (prims, metadata or dictionaries)",
-                        place(text, *at)
+                        position(text, *at)
                     )));
                 }
                 let body = *c == b'{' && pending.is_some() && !prims_metadata_open(&open);
@@ -203,7 +203,9 @@ pub fn check(text: &str) -> Result<LayerAssets> {
                             prims.pop();
                         }
                     }
-                    _ => return Err(malformed(format!("{} '{}' closes nothing open", place(text, *at), *c as char))),
+                    _ => {
+                        return Err(malformed(format!("{} '{}' closes nothing open", position(text, *at), *c as char)))
+                    }
                 }
             }
             Token::Word(w) => {
@@ -222,7 +224,7 @@ pub fn check(text: &str) -> Result<LayerAssets> {
                         if count > MAX_USDA_ARCS {
                             return Err(malformed(format!(
                                 "{} more than {MAX_USDA_ARCS} composition arcs between the layer's prims",
-                                place(text, *at)
+                                position(text, *at)
                             )));
                         }
                         arcs.entry(from.clone()).or_default().push((absolute(target, &from), *at));
@@ -277,12 +279,6 @@ fn asset_paths<'a>(tokens: &[(usize, Token<'a>)]) -> Vec<(String, usize)> {
     }
 }
 
-/// "line L, column C:" of byte `at` of `text`, for messages about a layer's
-/// asset paths.
-pub fn position(text: &str, at: usize) -> String {
-    place(text, at)
-}
-
 /// The prim paths of an arc's value (`tokens` start after its `=`): one path,
 /// or a list of them; a path right after an asset path (`@a.usda@</P>`)
 /// names a prim of another layer and is left out.
@@ -319,7 +315,7 @@ fn check_arcs(text: &str, arcs: &HashMap<String, Vec<(String, usize)>>) -> Resul
             if contains(to, from) || contains(from, to) {
                 return Err(malformed(format!(
                     "{} prim {from} has a composition arc to {to}, {}",
-                    place(text, *at),
+                    position(text, *at),
                     if to == from { "itself" } else { "its own namespace" }
                 )));
             }
@@ -329,34 +325,38 @@ fn check_arcs(text: &str, arcs: &HashMap<String, Vec<(String, usize)>>) -> Resul
     // ancestors bring, so an arc into a prim that (or whose descendant) leads
     // back counts.
     let mut state: HashMap<&str, u8> = HashMap::new();
+    // The arcs leaving `node`: its own and its descendants' (found once per
+    // node visited).
+    let out_of = |node: &str| -> Vec<&(String, usize)> {
+        arcs.iter().filter(|(from, _)| contains(node, from)).flat_map(|(_, t)| t.iter()).collect()
+    };
     let mut keys: Vec<&String> = arcs.keys().collect();
     keys.sort();
     for start in keys {
-        let mut stack: Vec<(&str, usize)> = vec![(start.as_str(), 0)];
         if state.get(start.as_str()).copied().unwrap_or(0) != 0 {
             continue;
         }
         state.insert(start, 1);
-        while let Some((node, next)) = stack.pop() {
-            let out: Vec<&(String, usize)> =
-                arcs.iter().filter(|(from, _)| contains(node, from)).flat_map(|(_, t)| t.iter()).collect();
-            if let Some((to, at)) = out.get(next) {
-                stack.push((node, next + 1));
-                match state.get(to.as_str()).copied().unwrap_or(0) {
-                    1 => {
-                        return Err(malformed(format!(
-                            "{} the composition arcs from {start} come back to {to}: a cycle",
-                            place(text, *at)
-                        )))
-                    }
-                    0 => {
-                        state.insert(to, 1);
-                        stack.push((to, 0));
-                    }
-                    _ => {}
-                }
-            } else {
+        let mut stack = vec![(start.as_str(), out_of(start), 0usize)];
+        while let Some((node, out, next)) = stack.last_mut() {
+            let Some((to, at)) = out.get(*next).copied() else {
                 state.insert(node, 2);
+                stack.pop();
+                continue;
+            };
+            *next += 1;
+            match state.get(to.as_str()).copied().unwrap_or(0) {
+                1 => {
+                    return Err(malformed(format!(
+                        "{} the composition arcs from {start} come back to {to}: a cycle",
+                        position(text, *at)
+                    )))
+                }
+                0 => {
+                    state.insert(to, 1);
+                    stack.push((to, out_of(to), 0));
+                }
+                _ => {}
             }
         }
     }

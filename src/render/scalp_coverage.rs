@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
-use super::scalp_hair::{drawn_roots, ScalpHairParams};
+use super::scalp_hair::{drawn_roots, ScalpHairParams, CM2_PER_M2};
 use crate::error::{Error, Result};
 use crate::sim::SimState;
 
@@ -46,7 +46,8 @@ pub fn scalp_coverage(rest: &SimState, params: &ScalpHairParams, share: f32) -> 
     if !(share.is_finite() && share > 0.0 && share <= 1.0) {
         return Err(Error::param("drawn share", share, "(0, 1]"));
     }
-    let (roots, area) = drawn_roots(rest, params)?;
+    let scalp = drawn_roots(rest, params)?;
+    let (roots, area) = (&scalp.roots, scalp.area);
     let full_hairs = roots.len() as u32;
     let drawn = ((roots.len() as f32 * share).round() as usize).clamp(1, roots.len().max(1));
     let roots = roots.get(..drawn).ok_or_else(|| Error::incompatible("scalp", "no hair is rooted over it"))?;
@@ -62,15 +63,15 @@ pub fn scalp_coverage(rest: &SimState, params: &ScalpHairParams, share: f32) -> 
     Ok(ScalpCoverage {
         hairs: drawn as u32,
         full_hairs,
-        area_cm2: area * 1e4,
+        area_cm2: area * CM2_PER_M2,
         spacing,
-        largest_gap: largest_gap(rest, roots, 0.5 * spacing),
+        largest_gap: largest_gap(&scalp.guide_roots, &scalp.triangles, roots, 0.5 * spacing),
     })
 }
 
-/// The radius of the largest disk on the guide-root triangles of `rest` with
-/// no point of `drawn` in it, probed on a grid of `step` over each triangle.
-pub(super) fn largest_gap(rest: &SimState, drawn: &[Vec3], step: f32) -> f32 {
+/// The radius of the largest disk on `triangles` of `guide_roots` with no
+/// point of `drawn` in it, probed on a grid of `step` over each triangle.
+pub(super) fn largest_gap(guide_roots: &[Vec3], triangles: &[[u32; 3]], drawn: &[Vec3], step: f32) -> f32 {
     let cell = 4.0 * step;
     let mut grid: HashMap<[i32; 3], Vec<Vec3>> = HashMap::new();
     let key = |p: Vec3| (p / cell).floor().to_array().map(|x| x as i32);
@@ -101,10 +102,9 @@ pub(super) fn largest_gap(rest: &SimState, drawn: &[Vec3], step: f32) -> f32 {
         }
         best
     };
-    let roots = rest.rest_roots();
     let mut worst = 0.0f32;
-    for t in super::scalp::root_triangles(rest) {
-        let [a, b, c] = t.map(|i| roots[i as usize]);
+    for t in triangles {
+        let [a, b, c] = t.map(|i| guide_roots[i as usize]);
         let n = ((b - a).length().max((c - a).length()) / step).ceil().max(1.0) as usize;
         for i in 0..=n {
             for j in 0..=n - i {

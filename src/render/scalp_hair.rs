@@ -36,7 +36,7 @@ use crate::hash::hash_u32;
 use crate::sim::SimState;
 
 /// Square centimetres per square metre.
-const CM2_PER_M2: f32 = 1e4;
+pub(super) const CM2_PER_M2: f32 = 1e4;
 /// Most points over all hairs [`Followers::over_scalp`] binds (2^26: 768 MiB
 /// of offsets on the host), whatever `max_hairs` allows.
 const MAX_SCALP_POINTS: u64 = 1 << 26;
@@ -176,7 +176,7 @@ fn scalp_roots(roots: &[Vec3], triangles: &[[u32; 3]], params: &ScalpHairParams)
 /// guides' blend, its frame carried along the blend (parallel transport) so
 /// that it turns smoothly.
 struct Curl {
-    /// Radius, meters (0: none).
+    /// Radius, meters.
     radius: f32,
     /// Radians of the turn per meter of hair.
     turn: f32,
@@ -184,33 +184,45 @@ struct Curl {
     phase: f32,
     /// The frame's first axis at the previous point (unit, across the blend).
     across: Option<Vec3>,
+    /// The blend at the previous point.
+    previous: Option<Vec3>,
+    /// Meters along the blend so far.
+    run: f32,
 }
 
 impl Curl {
-    /// The curl of hair `h` by `params` (radius and period varied per hair).
-    fn of(params: &ScalpHairParams, h: u32) -> Curl {
+    /// The curl of hair `h` by `params` (radius and period varied per hair);
+    /// none for straight hair.
+    fn of(params: &ScalpHairParams, h: u32) -> Option<Curl> {
+        if params.curl_radius == 0.0 {
+            return None;
+        }
         let unit = |salt: u32| hash_u32(h ^ salt) as f32 / u32::MAX as f32;
         let vary = |salt: u32| 1.0 + params.curl_variation * (2.0 * unit(salt) - 1.0);
-        Curl {
+        Some(Curl {
             radius: params.curl_radius * vary(0x243f_6a88),
             turn: std::f32::consts::TAU / (params.curl_period * vary(0x85a3_08d3)),
             phase: std::f32::consts::TAU * unit(0x1319_8a2e),
             across: None,
-        }
+            previous: None,
+            run: 0.0,
+        })
     }
 
-    /// The offset at the next point, `along` (0..=1) of the hair and `length`
-    /// meters along its blend, where the blend runs along `tangent` (unit):
-    /// around it, growing from nothing at the root to the full radius a fifth
-    /// of the way along. Points are visited root to tip.
-    fn next(&mut self, tangent: Vec3, along: f32, length: f32) -> Vec3 {
-        if self.radius == 0.0 {
+    /// The offset at the next point, `along` (0..=1) of the hair, where the
+    /// blend is at `blend` and, a point further, at `ahead`: around the
+    /// blend's direction, growing from nothing at the root to the full radius
+    /// a fifth of the way along. Points are visited root to tip.
+    fn next(&mut self, blend: Vec3, ahead: Vec3, along: f32) -> Vec3 {
+        let previous = self.previous.replace(blend).unwrap_or(blend);
+        self.run += blend.distance(previous);
+        let Some(tangent) = (ahead - blend).try_normalize().or((blend - previous).try_normalize()) else {
             return Vec3::ZERO;
-        }
+        };
         let previous = self.across.unwrap_or_else(|| tangent.any_orthonormal_vector());
         let across = (previous - tangent * previous.dot(tangent)).try_normalize().unwrap_or(previous);
         self.across = Some(across);
-        let angle = self.phase + self.turn * length;
+        let angle = self.phase + self.turn * self.run;
         let ramp = (5.0 * along).min(1.0);
         self.radius * ramp * (angle.cos() * across + angle.sin() * tangent.cross(across))
     }
@@ -224,15 +236,29 @@ fn drawing_order(count: usize) -> Vec<u32> {
     order
 }
 
-/// The roots (head frame, at rest) of the hairs [`Followers::over_scalp`]
-/// roots over the scalp of `rest` by `params`, in drawing order (the first
-/// k are those a frame drawing k hairs draws), and the scalp region's area, m².
-pub(super) fn drawn_roots(rest: &SimState, params: &ScalpHairParams) -> Result<(Vec<Vec3>, f32)> {
+/// The hairs [`Followers::over_scalp`] roots over the scalp, as
+/// [`drawn_roots`] finds them.
+pub(super) struct DrawnRoots {
+    /// Their roots (head frame, at rest), in drawing order: the first k are
+    /// those a frame drawing k hairs draws.
+    pub roots: Vec<Vec3>,
+    /// The scalp region's area, m².
+    pub area: f32,
+    /// The guides' roots.
+    pub guide_roots: Vec<Vec3>,
+    /// The scalp region: triangles of guide roots.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// The hairs [`Followers::over_scalp`] roots over the scalp of `rest` by
+/// `params` ([`DrawnRoots`]).
+pub(super) fn drawn_roots(rest: &SimState, params: &ScalpHairParams) -> Result<DrawnRoots> {
     params.validate()?;
-    let roots = rest.rest_roots();
+    let guide_roots = rest.rest_roots();
     let triangles = super::scalp::root_triangles(rest);
-    let scalp = scalp_roots(&roots, &triangles, params)?;
-    Ok((drawing_order(scalp.hairs.len()).iter().map(|&h| scalp.hairs[h as usize].0).collect(), scalp.area))
+    let scalp = scalp_roots(&guide_roots, &triangles, params)?;
+    let roots = drawing_order(scalp.hairs.len()).iter().map(|&h| scalp.hairs[h as usize].0).collect();
+    Ok(DrawnRoots { roots, area: scalp.area, guide_roots, triangles })
 }
 
 /// The weights `w` of guides `g` with the guides across a parting from the
@@ -315,16 +341,15 @@ impl Followers {
                 let length = 1.0 - params.length_variation * (seed as f32 / u32::MAX as f32);
                 let origin = shapes.position_at((g, w), 0.0);
                 let mut curl = Curl::of(params, h);
-                let (mut previous, mut run) = (origin, 0.0);
                 for (i, x) in strand.iter_mut().enumerate() {
                     let along = i as f32 / (points - 1) as f32;
                     let s = length * along;
                     let blend = shapes.position_at((g, w), s);
-                    let ahead = shapes.position_at((g, w), (s + 1.0 / (points - 1) as f32).min(1.0));
-                    let tangent = (ahead - blend).try_normalize().or((blend - previous).try_normalize());
-                    run += blend.distance(previous);
-                    previous = blend;
-                    let own = root + (blend - origin) + tangent.map_or(Vec3::ZERO, |t| curl.next(t, along, run));
+                    let mut own = root + (blend - origin);
+                    if let Some(curl) = &mut curl {
+                        let ahead = shapes.position_at((g, w), (s + 1.0 / (points - 1) as f32).min(1.0));
+                        own += curl.next(blend, ahead, along);
+                    }
                     *x = own.lerp(shapes.position_at(alone, s), params.clumping * along);
                 }
                 let ((g, w), point_offsets) = shapes.bind_strand(&strand, (g, w));
@@ -396,9 +421,10 @@ mod tests {
         assert!((f.root_spacing() - spacing).abs() < 1e-6 * spacing.max(1.0));
         // The roots the coverage measures are those the followers are drawn from.
         let roots = roots_of(&f, &rest, f.count());
-        let (measured, _) = drawn_roots(&rest, &params).expect("roots");
+        let scalp = drawn_roots(&rest, &params).expect("roots");
+        let measured = &scalp.roots;
         assert_eq!(roots.len(), measured.len());
-        for (drawn, measured) in roots.iter().zip(&measured) {
+        for (drawn, measured) in roots.iter().zip(measured) {
             assert!(drawn.distance(*measured) < 1e-5, "a follower rooted at {drawn}, measured at {measured}");
         }
         let cov = crate::render::scalp_coverage(&rest, &params, 1.0).expect("coverage");
@@ -410,7 +436,8 @@ mod tests {
         // The measure sees a hole: without the hairs of one region, the
         // largest gap grows past 3 × the spacing.
         let holed: Vec<Vec3> = measured.iter().copied().filter(|r| r.distance(measured[0]) > 8.0 * spacing).collect();
-        let hole = super::super::scalp_coverage::largest_gap(&rest, &holed, 0.5 * spacing);
+        let hole =
+            super::super::scalp_coverage::largest_gap(&scalp.guide_roots, &scalp.triangles, &holed, 0.5 * spacing);
         assert!(hole > 3.0 * spacing, "a hole of radius 8 spacings measured as {hole}");
         assert_eq!(Followers::over_scalp(&rest, &params, 2, 8).expect("again"), f, "not the same on a second run");
     }

@@ -132,9 +132,7 @@ impl InputArgs {
             return Err("--no-mesh-collider needs --obj (there is no mesh to collide with)".into());
         }
         if let Some(scale) = self.scale {
-            if !(scale.is_finite() && scale > 0.0) {
-                return Err(format!("--scale must be a finite number above 0 (got {scale})"));
-            }
+            check_scale(scale)?;
         }
         if let Some(points) = self.points {
             if !(2..=64).contains(&points) {
@@ -356,6 +354,15 @@ fn authored(g: AuthoredGroom, format: &str, path: &Path) -> (Groom, String, Auth
 /// The cyHair format's default thickness: a file that leaves it unchanged and has
 /// no thickness array says nothing about its strands' thickness.
 const CYHAIR_DEFAULT_THICKNESS: f32 = 1.0;
+
+/// `--scale`'s value checked: a finite number above 0.
+pub fn check_scale(scale: f32) -> Result<(), String> {
+    if scale.is_finite() && scale > 0.0 {
+        Ok(())
+    } else {
+        Err(format!("--scale must be a finite number above 0 (got {scale})"))
+    }
+}
 
 /// [`load`], and the thickness a cyHair file gives every point in its header when
 /// it has no thickness array and the header says something other than the

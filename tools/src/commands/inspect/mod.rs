@@ -11,7 +11,7 @@ use vkhair::groom::authored::UpAxis;
 use vkhair::render::{scalp_coverage, ScalpCoverage, ScalpHairParams};
 use vkhair::sim::{RigidTransform, SimParams, SimState};
 
-use crate::args::input::{load_with_defaults, Loaded};
+use crate::args::input::{check_scale, load_with_defaults, Loaded};
 use crate::output::{CliResult, Error};
 use crate::say;
 
@@ -79,9 +79,7 @@ struct Drawn {
 /// The hairs `render` roots over the scalp `groom`'s roots cover.
 fn drawn(a: &InspectArgs, groom: &vkhair::Groom) -> Result<Drawn, Error> {
     let scale = a.scale.unwrap_or(1.0);
-    if !(scale.is_finite() && scale > 0.0) {
-        return Err(format!("--scale must be a finite number above 0 (got {scale})").into());
-    }
+    check_scale(scale)?;
     let params =
         ScalpHairParams { density: a.density.unwrap_or(ScalpHairParams::default().density), ..Default::default() };
     params.validate().map_err(|e| format!("--density: {e}"))?;

@@ -319,8 +319,8 @@ impl FaceCover {
     /// Adds a frame: `after` with the hair, `self.before` without, the head
     /// placed by `head`.
     fn add(&mut self, after: &[u8], head: glam::Mat4, camera: &Camera, extent: (u32, u32)) {
-        let eye = camera.view.inverse().transform_point3(Vec3::ZERO);
-        let mask = coverage::front_facing_pixels(&self.region, head, camera.projection * camera.view, eye, extent);
+        let view_proj = camera.projection * camera.view;
+        let mask = coverage::front_facing_pixels(&self.region, head, view_proj, camera.position(), extent);
         if let Some(counts) = coverage::covered_pixels(&self.before, after, &mask) {
             self.frames.push(counts);
         }
