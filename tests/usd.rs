@@ -287,3 +287,25 @@ fn a_negative_width_is_refused_strictly_and_passed_over_when_repairing() {
     assert!(g.groom.end_thickness().is_none(), "the widths were read");
     assert!(g.skipped.iter().any(|s| s.contains("negative width")), "{:?}", g.skipped);
 }
+
+/// A stage pulls in at most `usd::MAX_USD_LAYERS` layers: a chain of
+/// sublayers one longer is refused naming the limit.
+#[test]
+fn a_stage_of_too_many_layers_is_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let chain = |n: usize| {
+        for i in 0..n {
+            let text = if i + 1 < n {
+                format!("#usda 1.0\n(\n    subLayers = [@l{}.usda@]\n)\n", i + 1)
+            } else {
+                format!("#usda 1.0\n{curves}")
+            };
+            std::fs::write(dir.path().join(format!("l{i}.usda")), text).expect("write");
+        }
+        usd::open(dir.path().join("l0.usda"))
+    };
+    chain(usd::MAX_USD_LAYERS).expect("as many layers as the limit");
+    let err = chain(usd::MAX_USD_LAYERS + 1).expect_err("one more").to_string();
+    assert!(err.contains("more than 256 layers"), "{err}");
+}

@@ -425,6 +425,20 @@ mod tests {
     }
 
     #[test]
+    fn more_arcs_than_the_limit_are_refused() {
+        let arcs = |n: usize| {
+            let mut t = String::from("#usda 1.0\nclass \"Base\" { }\n");
+            for i in 0..n {
+                t += &format!("def Xform \"p{i}\" (\n inherits = </Base>\n) {{ }}\n");
+            }
+            t + CURVES
+        };
+        check(&arcs(MAX_USDA_ARCS)).expect("at the limit");
+        let err = check(&arcs(MAX_USDA_ARCS + 1)).expect_err("past it").to_string();
+        assert!(err.contains("more than 10000 composition arcs"), "{err}");
+    }
+
+    #[test]
     fn unbalanced_or_unterminated_text_is_refused() {
         for (text, what) in [
             ("#usda 1.0\ndef Xform \"a\" { ]\n", "closes nothing"),

@@ -284,3 +284,22 @@ fn a_usdc_the_usd_library_panics_on_is_an_error_without_a_panic_message() {
         assert_eq!(out.stderr.lines().count(), 1, "case {k}: one line, the error:\n{}", out.stderr);
     }
 }
+
+/// The USD cap bounds a stage's layers together: a root and a sublayer each
+/// within it but over it together are refused, naming the bound.
+#[test]
+fn a_stage_whose_layers_add_up_past_the_cap_is_refused() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let pad = format!("# {}\n", "x".repeat(600));
+    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    std::fs::write(dir.path().join("curves.usda"), format!("#usda 1.0\n{pad}{curves}")).expect("write");
+    let root = dir.path().join("root.usda");
+    std::fs::write(&root, format!("#usda 1.0\n{pad}(\n    subLayers = [@curves.usda@]\n)\n")).expect("write");
+    let inspect = |cap: &str| {
+        let mut c = common::vkhair();
+        c.env("VKHAIR_MAX_INPUT_BYTES", cap).args(["inspect", root.to_str().expect("utf-8")]);
+        common::run_command(&mut c, LIMIT)
+    };
+    inspect("4000").assert_ok();
+    inspect("1000").assert_error("the stage's layers add up to more than 1000 bytes");
+}
