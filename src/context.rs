@@ -8,8 +8,8 @@ use gpu_allocator::vulkan::Allocator;
 
 use crate::error::{Error, Result};
 use crate::requirements::{self, requirements, Support};
-use crate::vk::debug::{self, ValidationLog};
 use crate::vk::device::{Device, DeviceInfo, DeviceParts, Owned, Queue};
+use crate::vk::validation::{self, ValidationLog};
 
 /// Environment variable that forces a device by (case-insensitive) name substring.
 pub const DEVICE_ENV: &str = "VKHAIR_DEVICE";
@@ -299,7 +299,7 @@ fn create_instance(entry: &ash::Entry, options: &ContextOptions) -> Result<Insta
     let mut validation_features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_validation);
     let fallback_log = ValidationLog::new();
     let log = options.validation_log.as_ref().unwrap_or(&fallback_log);
-    let mut messenger_info = debug::messenger_info(log);
+    let mut messenger_info = validation::messenger_info(log);
     let mut info = vk::InstanceCreateInfo::default()
         .application_info(&app)
         .enabled_layer_names(&layer_names)
@@ -316,7 +316,7 @@ fn create_instance(entry: &ash::Entry, options: &ContextOptions) -> Result<Insta
     let mut messenger = None;
     if debug_utils && options.validation_log.is_some() {
         let utils = ash::ext::debug_utils::Instance::new(entry, &instance);
-        let info = debug::messenger_info(log);
+        let info = validation::messenger_info(log);
         // SAFETY: the log's user data outlives the messenger (the device record keeps
         // a clone until after the instance is destroyed).
         match unsafe { utils.create_debug_utils_messenger(&info, None) } {

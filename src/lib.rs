@@ -104,8 +104,8 @@ pub use groom::Groom;
 pub use profiler::{Clock, GpuProfiler, PassTiming, ProfileReport, ScopeId};
 pub use requirements::{requirements, RequiredFeatures, Requirements, API_VERSION};
 pub use vk::counters::RecordedWork;
-pub use vk::debug::{Severity, ValidationLog, ValidationMessage};
 pub use vk::device::DeviceInfo;
+pub use vk::validation::{Severity, ValidationLog, ValidationMessage};
 
 /// Re-export of the `ash` crate vkhair's public API is written against.
 pub use ash;

@@ -276,3 +276,279 @@ fn the_command_check_sees_an_import() {
     let names: Vec<String> = commands_named(source).into_iter().collect();
     assert_eq!(names, ["bench", "plot", "render", "simulate"]);
 }
+
+/// The module path of a source file under `src/` (`sim/lod.rs` → `sim::lod`,
+/// `sim/mod.rs` → `sim`).
+fn module_of(relative: &Path) -> Vec<String> {
+    let mut parts: Vec<String> = relative.iter().map(|c| c.to_string_lossy().into_owned()).collect();
+    let last = parts.pop().unwrap_or_default();
+    if last != "mod.rs" {
+        parts.push(last.trim_end_matches(".rs").to_owned());
+    }
+    parts
+}
+
+/// The source file of module `path` under `src`, if it has one of its own.
+fn file_of(src: &Path, path: &[String]) -> Option<PathBuf> {
+    if path.is_empty() {
+        return None;
+    }
+    let base: PathBuf = path.iter().collect();
+    [src.join(&base).with_extension("rs"), src.join(&base).join("mod.rs")].into_iter().find(|f| f.is_file())
+}
+
+/// `source` without comments and without the items under `#[cfg(test)]`.
+fn production_code(source: &str) -> String {
+    let mut code = String::new();
+    let mut lines = source.lines();
+    while let Some(line) = lines.next() {
+        let trimmed = line.trim_start();
+        if trimmed.starts_with("#[cfg(test)]") {
+            skip_item(&mut lines);
+            continue;
+        }
+        code.push_str(line.split("//").next().unwrap_or_default());
+        code.push('\n');
+    }
+    code
+}
+
+/// Every path a `use` tree names, braces expanded (`a::{b, c::{d}}` → `a::b`,
+/// `a::c::d`).
+fn expand_use(tree: &str) -> Vec<String> {
+    let tree: String = tree.chars().filter(|c| !c.is_whitespace()).collect();
+    let (Some(open), Some(close)) = (tree.find('{'), tree.rfind('}')) else { return vec![tree] };
+    if close < open {
+        return vec![tree[..open].to_owned()];
+    }
+    let prefix = &tree[..open];
+    let inner = &tree[open + 1..close];
+    let (mut parts, mut depth, mut start) = (Vec::new(), 0, 0);
+    for (i, c) in inner.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' => depth -= 1,
+            ',' if depth == 0 => {
+                parts.push(&inner[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    parts.push(&inner[start..]);
+    parts.into_iter().filter(|p| !p.is_empty()).flat_map(|p| expand_use(&format!("{prefix}{p}"))).collect()
+}
+
+/// The paths of `code` that may name a module of this crate: `use` trees (a
+/// statement from a line starting `use` or `pub … use` to its `;`), and `a::b`
+/// chains elsewhere, outside string literals.
+fn named_paths(code: &str) -> Vec<Vec<String>> {
+    let mut paths = Vec::new();
+    let mut other = String::new();
+    let mut statement: Option<String> = None;
+    for line in code.lines() {
+        let trimmed = line.trim_start();
+        let starts_use = trimmed.starts_with("use ")
+            || (trimmed.starts_with("pub")
+                && trimmed.split_once(' ').is_some_and(|(_, rest)| rest.starts_with("use ")));
+        if statement.is_none() && starts_use {
+            statement = Some(String::new());
+        }
+        match &mut statement {
+            Some(text) => {
+                text.push_str(line);
+                if let Some(end) = text.find(';') {
+                    let tree = text[..end].split_once("use ").map(|(_, t)| t).unwrap_or_default();
+                    paths.extend(expand_use(tree).iter().map(|p| p.split("::").map(str::to_owned).collect()));
+                    statement = None;
+                }
+            }
+            None => {
+                // String literals out: their text names nothing.
+                for (k, part) in line.split('"').enumerate() {
+                    if k % 2 == 0 {
+                        other.push_str(part);
+                        other.push(' ');
+                    }
+                }
+                other.push('\n');
+            }
+        }
+    }
+    let ident = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    let chars: Vec<char> = other.chars().collect();
+    let mut i = 0;
+    while i < chars.len() {
+        if ident(chars[i]) && (i == 0 || !ident(chars[i - 1])) {
+            let mut segments = Vec::new();
+            let mut j = i;
+            loop {
+                let start = j;
+                while j < chars.len() && ident(chars[j]) {
+                    j += 1;
+                }
+                segments.push(chars[start..j].iter().collect::<String>());
+                if j + 2 < chars.len() && chars[j] == ':' && chars[j + 1] == ':' && ident(chars[j + 2]) {
+                    j += 2;
+                } else {
+                    break;
+                }
+            }
+            if segments.len() > 1 {
+                paths.push(segments);
+            }
+            i = j.max(i + 1);
+        } else {
+            i += 1;
+        }
+    }
+    paths
+}
+
+/// The files of this crate `path` leads to from `module`: the deepest module
+/// along it with a file of its own (`crate::`, `super::`, `self::` or a child
+/// module of `module`).
+fn resolve(src: &Path, module: &[String], path: &[String]) -> Option<PathBuf> {
+    let mut at: Vec<String> = module.to_vec();
+    let mut rest = path;
+    match path.first().map(String::as_str) {
+        Some("crate") => {
+            at.clear();
+            rest = &path[1..];
+        }
+        Some("self") => rest = &path[1..],
+        Some("super") => {
+            while rest.first().is_some_and(|s| s == "super") {
+                at.pop();
+                rest = &rest[1..];
+            }
+        }
+        _ => {}
+    }
+    let mut found = None;
+    let mut full = at.clone();
+    for segment in rest {
+        full.push(segment.clone());
+        match file_of(src, &full) {
+            Some(file) => found = Some(file),
+            None => break,
+        }
+    }
+    found
+}
+
+/// File-to-file imports of `src` (test files and `lib.rs` left out; a file's
+/// uses of its own ancestors' `mod.rs`, where a module keeps what its files
+/// share, are not counted).
+fn file_imports(src: &Path) -> std::collections::BTreeMap<PathBuf, BTreeSet<PathBuf>> {
+    let mut files = Vec::new();
+    rust_files(src, &mut files);
+    let mut graph = std::collections::BTreeMap::new();
+    for file in files.iter().filter(|f| !is_test_file(f) && !f.ends_with("lib.rs")) {
+        let relative = file.strip_prefix(src).expect("under src");
+        let module = module_of(relative);
+        let code = production_code(&std::fs::read_to_string(file).expect("source"));
+        let ancestors: Vec<PathBuf> = (1..module.len()).filter_map(|n| file_of(src, &module[..n])).collect();
+        let targets: BTreeSet<PathBuf> = named_paths(&code)
+            .iter()
+            .filter_map(|p| resolve(src, &module, p))
+            .filter(|t| t != file && !ancestors.contains(t) && !t.ends_with("lib.rs"))
+            .collect();
+        graph.insert(file.clone(), targets);
+    }
+    graph
+}
+
+/// The import cycles of `graph`: each a list of files, one per strongly
+/// connected group of more than one file.
+fn cycles(graph: &std::collections::BTreeMap<PathBuf, BTreeSet<PathBuf>>) -> Vec<Vec<PathBuf>> {
+    let reaches = |from: &PathBuf| {
+        let mut seen = BTreeSet::new();
+        let mut stack = vec![from.clone()];
+        while let Some(f) = stack.pop() {
+            for t in graph.get(&f).into_iter().flatten() {
+                if seen.insert(t.clone()) {
+                    stack.push(t.clone());
+                }
+            }
+        }
+        seen
+    };
+    let reach: std::collections::BTreeMap<&PathBuf, BTreeSet<PathBuf>> =
+        graph.keys().map(|f| (f, reaches(f))).collect();
+    let mut groups: Vec<Vec<PathBuf>> = Vec::new();
+    for f in graph.keys() {
+        if groups.iter().any(|g| g.contains(f)) || !reach[f].contains(f) {
+            continue;
+        }
+        groups.push(graph.keys().filter(|g| reach[f].contains(*g) && reach[*g].contains(f)).cloned().collect());
+    }
+    groups
+}
+
+/// No circle of imports between the files of a module (or across modules):
+/// a file uses only files that do not use it back, directly or through others.
+#[test]
+fn no_import_cycle_between_source_files() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let graph = file_imports(&src);
+    let edges: usize = graph.values().map(BTreeSet::len).sum();
+    assert!(edges > 200, "the scan found only {edges} imports between files: it reads nothing");
+    let found: Vec<String> = cycles(&graph)
+        .iter()
+        .map(|g| {
+            g.iter().map(|f| f.strip_prefix(&src).unwrap_or(f).display().to_string()).collect::<Vec<_>>().join(", ")
+        })
+        .collect();
+    assert!(found.is_empty(), "files importing each other:\n{}", found.join("\n"));
+}
+
+#[test]
+fn the_file_cycle_check_sees_a_planted_cycle() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let src = dir.path();
+    std::fs::create_dir_all(src.join("sim")).expect("folder");
+    let files = [
+        ("lib.rs", "pub mod sim;\n"),
+        ("sim/mod.rs", "mod a;\nmod b;\nmod c;\npub use a::A;\n"),
+        ("sim/a.rs", "use super::b::B;\n// use super::c::C in a comment\npub struct A(B);\n"),
+        ("sim/b.rs", "use crate::sim::{c::{self, C}};\npub struct B(C);\n"),
+        (
+            "sim/c.rs",
+            "pub struct C;\nfn f() { let _ = super::a::A; }\n#[cfg(test)]\nmod t {\n    use super::super::b::B;\n}\n",
+        ),
+    ];
+    for (name, text) in files {
+        std::fs::write(src.join(name), text).expect("write");
+    }
+    let graph = file_imports(src);
+    let names: Vec<Vec<String>> = cycles(&graph)
+        .iter()
+        .map(|g| g.iter().map(|f| f.strip_prefix(src).unwrap_or(f).display().to_string()).collect())
+        .collect();
+    assert_eq!(names, [["sim/a.rs", "sim/b.rs", "sim/c.rs"]]);
+    // Without c's use of a, no cycle: b → c is one way, and the test module's use is not counted.
+    std::fs::write(src.join("sim/c.rs"), "pub struct C;\n#[cfg(test)]\nmod t {\n    use super::super::b::B;\n}\n")
+        .expect("write");
+    assert!(cycles(&file_imports(src)).is_empty());
+}
+
+/// Production code takes nothing from the CPU references (the tests'
+/// oracles): what both need (shared math, strand frames) lives beside the
+/// production code and the references import it. `sim/cpu.rs`, the public
+/// CPU simulation, is built from the references by design.
+#[test]
+fn production_code_does_not_import_the_references() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let is_reference =
+        |f: &Path| f.strip_prefix(&src).is_ok_and(|r| r.iter().any(|c| c.to_string_lossy().starts_with("reference")));
+    let graph = file_imports(&src);
+    let oracle_users: Vec<String> = graph
+        .iter()
+        .filter(|(from, _)| !is_reference(from) && !from.ends_with("sim/cpu.rs"))
+        .flat_map(|(from, to)| to.iter().filter(|t| is_reference(t)).map(move |t| (from, t)))
+        .map(|(from, to)| format!("{} imports {}", from.display(), to.display()))
+        .collect();
+    assert!(oracle_users.is_empty(), "production code importing a reference:\n{}", oracle_users.join("\n"));
+    assert!(graph.keys().filter(|f| is_reference(f)).count() >= 4, "the scan found no reference file");
+}

@@ -35,7 +35,7 @@
 
 use glam::{Mat3, Quat, Vec3, Vec4};
 
-use super::reference::{key_frame, smooth_strand};
+use super::strand_frames::{key_frame, rest_plane_normals, smooth_strand};
 use crate::error::{Error, Result};
 use crate::gpu_types::FollowerBinding;
 use crate::groom::binding::TriangleGrid;
@@ -280,7 +280,7 @@ impl Followers {
     /// The first `drawn` followers (in drawing order) evaluated on the CPU, as
     /// the interpolation stage evaluates them on the GPU: `guides` smoothed
     /// (position, tangent) per guide at any level, `references` the guides'
-    /// rest-plane normals ([`super::reference::rest_plane_normals`]) and the
+    /// rest-plane normals ([`rest_plane_normals`]) and the
     /// head's rotation `head`. Points follower after follower.
     /// Refused: fewer guides or references than the binding names, a guide of
     /// fewer than two points, more followers than bound.
@@ -361,7 +361,7 @@ impl GuideShapes {
                 smooth_strand(&keys, level)
             })
             .collect();
-        GuideShapes { smoothed, references: super::reference::rest_plane_normals(rest) }
+        GuideShapes { smoothed, references: rest_plane_normals(rest) }
     }
 
     /// The blend of guides `g` with weights `w` at parameter `s` along them,

@@ -40,7 +40,7 @@ use crate::vk::shaders::{
 
 /// Per key hair, its rest-plane normal ([`super::reference::rest_plane_normals`]).
 fn reference_vectors(rest: &SimState) -> Vec<Vec4> {
-    super::reference::rest_plane_normals(rest).into_iter().map(|n| n.extend(0.0)).collect()
+    super::strand_frames::rest_plane_normals(rest).into_iter().map(|n| n.extend(0.0)).collect()
 }
 
 /// Rejects `mode` when it cannot grow hairs from key hairs whose roots form

@@ -41,6 +41,7 @@ mod scalp_hair;
 mod shading;
 mod shadow;
 mod smooth;
+pub(crate) mod strand_frames;
 mod target;
 
 pub use draw::{OitPool, OitStats};

@@ -24,7 +24,7 @@
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 
-use super::reference::{cross, dot, rotate, transform_point};
+use super::math::{cross, dot, rotate, transform_point};
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuScalpRoot, ScalpRootView, SimStep};
 use crate::groom::binding::{bind_roots, RootBinding};

@@ -19,7 +19,6 @@ use std::sync::Arc;
 use glam::{Vec3, Vec4};
 
 use super::body::{RigidTransform, MAX_COLLIDERS};
-use super::lod::SimLod;
 use super::params::{SimParams, MAX_SIM_POINTS, MAX_SUBSTEPS};
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuCollider, SimStepParams};
@@ -215,8 +214,10 @@ pub(crate) mod binding {
 }
 
 impl GpuState {
-    /// Creates the buffers and uploads `state` into half 0 (this submits and waits).
-    pub(crate) fn new(device: &Arc<Device>, state: &SimState, lod: &SimLod) -> Result<Self> {
+    /// Creates the buffers and uploads `state` into half 0, with the key hairs'
+    /// level-of-detail `order` and each one's guide (`sim::lod`; this submits
+    /// and waits).
+    pub(crate) fn new(device: &Arc<Device>, state: &SimState, order: &[u32], guides: &[u32]) -> Result<Self> {
         let n = state.positions.len() as u64;
         let vec4_bytes = n * 16;
         if vec4_bytes > u64::from(device.info.max_storage_buffer_range) {
@@ -252,8 +253,8 @@ impl GpuState {
             scalp_vertices: storage("vkhair sim no scalp vertices", 16)?,
         };
         gpu.upload(device, state, 0)?;
-        device.upload_pod(&gpu.order, &lod.order.order)?;
-        device.upload_pod(&gpu.guides, &lod.guides)?;
+        device.upload_pod(&gpu.order, order)?;
+        device.upload_pod(&gpu.guides, guides)?;
         device.upload_pod(&gpu.rest, &state.rest)?;
         device.upload_pod(&gpu.rest_lengths, &state.rest_lengths)?;
         Ok(gpu)

@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use ash::vk;
 use gpu_allocator::vulkan::Allocator;
 
-use super::debug::ValidationLog;
+use super::validation::ValidationLog;
 use crate::error::{Error, Result};
 
 /// A queue the crate may submit to, with its family.

@@ -14,6 +14,7 @@ pub(crate) mod rendering;
 pub(crate) mod shaders;
 pub(crate) mod staging;
 pub(crate) mod submit;
+pub(crate) mod validation;
 
 #[cfg(test)]
 pub(crate) mod tests;

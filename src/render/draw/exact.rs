@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::transparent::ModeShaders;
+use super::ModeShaders;
 use crate::codes::sentinel::OIT_END;
 use crate::error::Result;
 use crate::render::OitParams;

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::transparent::ModeShaders;
+use super::ModeShaders;
 use crate::error::Result;
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::device::Device;

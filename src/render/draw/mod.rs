@@ -45,10 +45,18 @@ use crate::vk::barrier::{self, AccessKind, Barriers};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::rendering::{self, Load};
+use crate::vk::shaders::ShaderSource;
 use opaque::OpaquePipelines;
 use ribbons::RibbonIndices;
 use shading::ShadingResources;
 use transparent::TransparentPass;
+
+/// A transparency mode's fragment stages: the build's and the composite's
+/// (`exact` and `fast` give theirs, `transparent` builds the pass from them).
+pub(super) struct ModeShaders {
+    pub build: &'static ShaderSource,
+    pub composite: &'static ShaderSource,
+}
 
 /// Formats, sample count and primitive a draw pipeline is made for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -34,7 +34,7 @@ use super::fast::{self, WeightedSums, ABSORBANCE, WEIGHTED_SUM};
 use super::raster::{DepthSource, RasterBuffers};
 use super::ribbons::RibbonIndices;
 use super::shading::ShadingResources;
-use super::{DrawFrame, TargetKey};
+use super::{DrawFrame, ModeShaders, TargetKey};
 use crate::codes::sentinel::OIT_END;
 use crate::error::{Error, Result};
 use crate::gpu_types::OitCounters;
@@ -47,7 +47,7 @@ use crate::vk::image::Sampler;
 use crate::vk::pipeline::{Blend, ComputePipeline, GraphicsDesc, GraphicsPipeline};
 use crate::vk::rendering;
 use crate::vk::shaders::{
-    ShaderSource, RENDER_HAIR_RECT_COMP, RENDER_HAIR_RECT_VERT, RENDER_OIT_DEPTH_FRAG, RENDER_RIBBON_VERT_COVERAGE,
+    RENDER_HAIR_RECT_COMP, RENDER_HAIR_RECT_VERT, RENDER_OIT_DEPTH_FRAG, RENDER_RIBBON_VERT_COVERAGE,
     RENDER_SHADE_POINTS_COMP, RENDER_STRAND_RASTER_COMP,
 };
 
@@ -59,12 +59,6 @@ const WRITTEN_BY_ANY: &[AccessKind] = &[AccessKind::ComputeWrite, AccessKind::Fr
 
 /// Workgroups of a dispatch that every device runs (`maxComputeWorkGroupCount`'s minimum).
 const MAX_WORKGROUPS: u32 = 65_535;
-
-/// A transparency mode's fragment stages: the build's and the composite's.
-pub(super) struct ModeShaders {
-    pub build: &'static ShaderSource,
-    pub composite: &'static ShaderSource,
-}
 
 /// What the last exact-mode frame stored, read by
 /// [`crate::render::Renderer::transparency_stats`].

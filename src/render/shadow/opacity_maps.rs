@@ -219,7 +219,7 @@ impl ShadowFootprint {
     /// (1 − 1/n) × spacing (as the transparent bands), in texels rounded to the
     /// nearest, up to 3; at least `radius`.
     pub(crate) fn filter_radius(&self, radius: u32, texel: f32) -> u32 {
-        let spread = crate::render::reference::strand_spread(self.hairs, self.spacing);
+        let spread = crate::render::strand_frames::strand_spread(self.hairs, self.spacing);
         let wanted = if texel > 0.0 { (spread / texel).round() } else { 0.0 };
         radius.max(wanted.clamp(0.0, 3.0) as u32)
     }

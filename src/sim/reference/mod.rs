@@ -8,6 +8,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
+pub(crate) use super::math::{cross, dot, rotate, transform_point};
 use super::planner::SubstepInputs;
 use super::scalp::CpuScalp;
 use super::state::SimState;
@@ -18,15 +19,6 @@ mod bodies;
 
 pub(crate) use bodies::MeshField;
 use bodies::{collider_friction, Bodies};
-
-pub(crate) fn dot(a: Vec3, b: Vec3) -> f32 {
-    (a.x * b.x + a.y * b.y) + a.z * b.z
-}
-
-pub(crate) fn transform_point(m: &Mat4, p: Vec3) -> Vec3 {
-    let c = |i: usize| m.col(i).truncate();
-    ((c(0) * p.x + c(1) * p.y) + c(2) * p.z) + c(3)
-}
 
 /// A teleport or reset of the whole state (`glsl/sim/move.comp`); a reset with
 /// a bound scalp places each key hair by its root's frame at the start of
@@ -47,15 +39,6 @@ pub(crate) fn move_state(state: &mut SimState, mv: &super::teleport::Move, scalp
 }
 
 /// `sim_rotate`: R · v.
-pub(crate) fn rotate(m: &Mat4, v: Vec3) -> Vec3 {
-    let c = |i: usize| m.col(i).truncate();
-    (c(0) * v.x + c(1) * v.y) + c(2) * v.z
-}
-
-pub(crate) fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    Vec3::new(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x)
-}
-
 /// `sim_rotate_between`: v rotated by the smallest rotation taking a onto b.
 fn rotate_between(a: Vec3, b: Vec3, v: Vec3) -> Vec3 {
     let c = dot(a, b);
