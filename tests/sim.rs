@@ -186,8 +186,8 @@ fn a_pressure_iteration_is_four_passes_per_multigrid_level_and_six_more() {
     assert_eq!(work.barriers, 2 * per_iteration, "{work:?}");
 }
 
-/// The volume stage's dispatches per FLIP step with the default solve (in one
-/// workgroup), counted kernel by kernel: at most 40 at 32³ and 64³, and none of
+/// The volume stage's dispatches per FLIP step with the solve in one workgroup
+/// (the default on a CPU device), counted kernel by kernel: at most 40 at 32³ and 64³, and none of
 /// them per pressure iteration.
 #[test]
 fn a_flip_step_is_at_most_forty_dispatches_at_32_and_64_cells_per_axis() {
@@ -211,13 +211,18 @@ fn a_flip_step_is_at_most_forty_dispatches_at_32_and_64_cells_per_axis() {
         let transfer = 2; // gather, mark
         let pressure = (levels - 1) + 1 + shares + 1; // coarsening, stencil words, the solve, gradient
         let update = 1;
-        let flip = vkhair::sim::VolumeParams::flip([n; 3]);
+        let flip =
+            vkhair::sim::VolumeParams { solver: PressureSolver::Workgroup, ..vkhair::sim::VolumeParams::flip([n; 3]) };
         let volume = work(flip.clone()) - step;
         assert_eq!(volume, sort + transfer + pressure + update, "{n}³");
         assert!(volume <= 40, "{n}³: {volume} dispatches");
     }
     // At 32³ a cap of 44 iterations still fits one dispatch.
-    let capped = work(vkhair::sim::VolumeParams { max_iterations: 44, ..vkhair::sim::VolumeParams::flip([32; 3]) });
+    let capped = work(vkhair::sim::VolumeParams {
+        max_iterations: 44,
+        solver: PressureSolver::Workgroup,
+        ..vkhair::sim::VolumeParams::flip([32; 3])
+    });
     assert_eq!(capped - step, 21, "32³: a higher iteration cap records nothing more");
 }
 

@@ -52,6 +52,7 @@ mod body;
 mod cpu;
 mod driver;
 pub mod lod;
+pub(crate) mod math;
 mod mesh_collider;
 pub mod motion;
 mod packing;
@@ -230,7 +231,7 @@ impl HairSim {
         let subgroup = if device.full_subgroups { device.info.subgroup_size } else { 0 };
         let planner = SubstepPlanner::new(params, head, state.rest_roots(), state.points, subgroup)?;
         let lod = lod::SimLod::new(state);
-        let gpu = GpuState::new(&device, state, &lod)?;
+        let gpu = GpuState::new(&device, state, &lod.order.order, &lod.guides)?;
         let follow = ComputePipeline::new(&device, &SIM_FOLLOW_COMP, 2)?;
         let follow_sets = [
             follow.declared_buffer_set(0, &gpu.follow_bindings(0, None))?,
@@ -483,6 +484,13 @@ impl HairSim {
     /// it in the world with [`HairSim::volume_grid`].
     pub fn density_buffer(&self) -> Option<vk::Buffer> {
         self.volume.as_ref().map(|v| v.buffers.cells.raw())
+    }
+
+    /// How this simulation records the pressure solve: the parameters' solver,
+    /// [`PressureSolver::Auto`] resolved for this device. `None` when the volume
+    /// stage is off.
+    pub fn pressure_solver(&self) -> Option<PressureSolver> {
+        self.volume.as_ref().map(|v| v.params.solver)
     }
 
     /// What the pressure solve of the latest sub-step did (FLIP mode; this waits for

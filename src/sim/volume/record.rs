@@ -67,6 +67,7 @@ pub(crate) struct VolumeStage {
     pub grid: GridLayout,
     pub buffers: VolumeBuffers,
     kernels: Vec<KernelPipeline>,
+    /// The parameters, the solver resolved for this device (never `Auto`).
     pub params: VolumeParams,
 }
 
@@ -84,7 +85,9 @@ impl VolumeStage {
         params.validate()?;
         let buffers = VolumeBuffers::new(device, &grid)?;
         let kernels = buffers::kernels(device, &buffers, colliders, mesh_field, particles)?;
-        Ok(VolumeStage { device: device.clone(), grid, buffers, kernels, params: params.clone() })
+        // The solver as recorded here: `Auto` resolved by the device's type.
+        let params = VolumeParams { solver: params.solver.on_device(device.info.device_type), ..params.clone() };
+        Ok(VolumeStage { device: device.clone(), grid, buffers, kernels, params })
     }
 
     fn kernel(&self, kernel: Kernel) -> &KernelPipeline {

@@ -412,3 +412,44 @@ fn the_workgroup_solve_is_shared_to_stay_within_the_loop_budget() {
     assert_eq!(workgroup_share(&grid(128), Preconditioner::Multigrid), None, "2.10 million cells");
     assert_eq!(workgroup_share(&unit_grid([160, 160, 160], 1000), Preconditioner::Multigrid), None);
 }
+
+/// `Auto` records the solve in one workgroup on a CPU device and dispatched on
+/// a GPU; a chosen solver stays as chosen. On this device the stage records the
+/// resolved one.
+#[test]
+fn the_pressure_solver_is_chosen_by_the_device_type() {
+    use ash::vk::PhysicalDeviceType as T;
+    for (device, auto) in [
+        (T::CPU, PressureSolver::Workgroup),
+        (T::DISCRETE_GPU, PressureSolver::Dispatched),
+        (T::INTEGRATED_GPU, PressureSolver::Dispatched),
+        (T::VIRTUAL_GPU, PressureSolver::Dispatched),
+        (T::OTHER, PressureSolver::Dispatched),
+    ] {
+        assert_eq!(PressureSolver::Auto.on_device(device), auto, "{device:?}");
+        for chosen in [PressureSolver::Workgroup, PressureSolver::Dispatched] {
+            assert_eq!(chosen.on_device(device), chosen, "{device:?}");
+        }
+    }
+    assert_eq!(VolumeParams::default().solver, PressureSolver::Auto);
+    let gpu = TestGpu::new();
+    let d = gpu.device();
+    let pos = Buffer::storage(d, "test positions", 16).expect("buffer");
+    let vel = Buffer::storage(d, "test velocities", 16).expect("buffer");
+    let colliders = Buffer::new(
+        d,
+        &BufferDesc {
+            name: "test colliders",
+            size: (MAX_COLLIDERS * std::mem::size_of::<GpuCollider>()) as u64,
+            usage: ash::vk::BufferUsageFlags::UNIFORM_BUFFER,
+            location: gpu_allocator::MemoryLocation::GpuOnly,
+        },
+    )
+    .expect("buffer");
+    let no_mesh = Buffer::storage(d, "test no mesh collider", 16).expect("buffer");
+    let params = VolumeParams::flip([8; 3]);
+    let stage =
+        VolumeStage::new(d, unit_grid([8; 3], 1), &params, &colliders, &no_mesh, &[(&pos, &vel)]).expect("stage");
+    assert_eq!(stage.params.solver, PressureSolver::Auto.on_device(d.info.device_type));
+    assert_ne!(stage.params.solver, PressureSolver::Auto);
+}

@@ -3,6 +3,7 @@
 
 use clap::ValueEnum;
 use glam::Vec3;
+use vkhair::ash::vk;
 use vkhair::sim::{motion, Preconditioner, PressureSolver, RigidTransform, SimParams, SolverMode, VolumeMode};
 
 /// Flags over the simulation parameters: each given one wins over the command's
@@ -32,7 +33,8 @@ pub struct SimArgs {
     #[arg(long)]
     pub max_iterations: Option<u32>,
     /// How the GPU records the pressure solve: the whole solve in one workgroup
-    /// (one dispatch) or a dispatch per kernel and iteration [default: workgroup].
+    /// (one dispatch) or a dispatch per kernel and iteration over the device;
+    /// auto picks workgroup on a CPU device, dispatched on a GPU [default: auto].
     #[arg(long, value_enum)]
     pub pressure: Option<PressureSolver>,
     /// Head motion about the neck: still, the shake (0.6 rad at 1 Hz) or violent
@@ -48,10 +50,19 @@ pub struct SimArgs {
 
 impl SimArgs {
     /// The line every command that simulates prints: the knobs these flags set,
-    /// as they are after the defaults, the `--config` file and the flags.
-    pub fn describe(&self, p: &SimParams) -> String {
+    /// as they are after the defaults, the `--config` file and the flags, the
+    /// pressure solver as recorded on a device of `device_type`.
+    pub fn describe(&self, p: &SimParams, device_type: vk::PhysicalDeviceType) -> String {
+        let solver = p.volume.solver.on_device(device_type);
+        let solver = match p.volume.solver {
+            PressureSolver::Auto if device_type == vk::PhysicalDeviceType::CPU => {
+                format!("{solver:?}: auto, a CPU device")
+            }
+            PressureSolver::Auto => format!("{solver:?}: auto, a GPU"),
+            _ => format!("{solver:?}"),
+        };
         format!(
-            "parameters: {} iterations, {:?} solver, volume {:?} at {:?}, {} sub-step{}, {:?} pressure solve ({:?}) capped at {} iterations, motion {:?}",
+            "parameters: {} iterations, {:?} solver, volume {:?} at {:?}, {} sub-step{}, {:?} pressure solve ({}) capped at {} iterations, motion {:?}",
             p.iterations,
             p.solver,
             p.volume.mode,
@@ -59,7 +70,7 @@ impl SimArgs {
             p.substeps,
             if p.substeps == 1 { "" } else { "s" },
             p.volume.preconditioner,
-            p.volume.solver,
+            solver,
             p.volume.max_iterations,
             self.motion,
         )

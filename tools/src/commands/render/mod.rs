@@ -111,7 +111,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
         sim.set_simulated_hairs(count)?;
         say!("simulated: {count} of {} key hairs (the others follow them)", s.groom.strand_count());
     }
-    say!("{}", sa.sim.describe(&sim_params));
+    say!("{}", sa.sim.describe(&sim_params, ctx.info().device_type));
     if sa.input.colliding() || s.character.is_some() {
         sim.set_mesh_collider(Some(&s.head_mesh), &config.mesh_collider)?;
         say!(

@@ -95,7 +95,7 @@ fn announce(a: &SimulateArgs, label: &str, ctx: &GpuContext, sim: &HairSim, para
     );
     say!(
         "{}{}",
-        a.sim.describe(params),
+        a.sim.describe(params, ctx.info().device_type),
         a.config.as_ref().map(|c| format!(" (from {} and the flags)", c.display())).unwrap_or_default()
     );
 }
