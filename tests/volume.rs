@@ -251,8 +251,12 @@ fn every_volume_mode_is_bitwise_deterministic_run_to_run() {
     }
 }
 
+/// 2,000 steps of violent shaking stay finite with the pressure solve never
+/// meeting a non-finite number; a second simulation of the same input agrees
+/// with the first bit for bit after 500 of them (every mode's run-to-run
+/// determinism over 40 steps is the test above).
 #[test]
-fn volume_simulation_is_deterministic_and_finite_for_2000_shaking_steps() {
+fn volume_simulation_is_finite_for_2000_shaking_steps_and_deterministic_over_500() {
     let gpu = Gpu::new();
     let groom = common::grown_groom(200, 6, 11);
     let params =
@@ -264,20 +268,25 @@ fn volume_simulation_is_deterministic_and_finite_for_2000_shaking_steps() {
         sim.set_colliders(&motion::thesis_colliders()).expect("colliders");
     }
     let violent = |i: usize| motion::violent_motion((i + 1) as f32 * params.dt);
-    let mut done = 0;
-    for chunk in [1000, 1000] {
-        for sim in &mut sims {
-            sim.run(chunk, |i| violent(done + i), None).expect("run");
-        }
+    for sim in &mut sims {
+        sim.run(500, violent, None).expect("run");
+    }
+    let (a, b) = (sims[0].read_state().expect("readback"), sims[1].read_state().expect("readback"));
+    assert_finite(&a);
+    assert!(common::bits(&a) == common::bits(&b), "two identical runs differ after 500 steps");
+    let mut sim = sims.swap_remove(0);
+    drop(sims);
+    let mut done = 500;
+    for chunk in [500, 1000] {
+        sim.run(chunk, |i| violent(done + i), None).expect("run");
         done += chunk;
-        let a = sims[0].read_state().expect("readback");
-        let b = sims[1].read_state().expect("readback");
-        assert_finite(&a);
-        assert!(common::bits(&a) == common::bits(&b), "two identical runs differ after {done} steps");
-        let stats = sims[0].volume_stats().expect("stats").expect("volume on");
-        eprintln!("step {done}: {stats:?}, kinetic energy {:.3}", a.kinetic_energy());
+        let state = sim.read_state().expect("readback");
+        assert_finite(&state);
+        let stats = sim.volume_stats().expect("stats").expect("volume on");
+        eprintln!("step {done}: {stats:?}, kinetic energy {:.3}", state.kinetic_energy());
         assert!(!stats.non_finite);
     }
+    assert_eq!(done, 2000);
 }
 
 #[test]

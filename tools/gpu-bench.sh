@@ -92,7 +92,7 @@ run_goal "b. simulation of $guides guides × 32 points, FLIP on a ${grid}³ grid
   simulate --input "$goals/guides.hair" --guides all --points 32 --volume flip --grid "$grid" --steps "$steps" \
   --json "$goals/guides_step.json"
 run_goal "c. $((1750 * per_key)) drawn strands with transparency, ${width}×${height}" \
-  render --width "$width" --height "$height" --frames "$frames" --hairs-per-key "$per_key" --no-lod \
+  render --width "$width" --height "$height" --frames "$frames" --clumps --hairs-per-key "$per_key" --no-lod \
   --out "$goals/strands" --json "$goals/strands_frame.json"
 rm -f "$log.last"
 
@@ -146,16 +146,16 @@ for raster in hardware compute; do
   printf '  %-62s %9s ×    goal ≤ 1.2 ×: %s\n' "exact / opaque, the thesis frame above" "$ratio" \
     "$(verdict "$ratio" 1.2)" >>"$report"
   frame_goal "strands_$raster" "$((1750 * per_key)) strands, both shadowed lights" 20 ".*" "${size[@]}" \
-    --raster "$raster" --hairs-per-key "$per_key" --no-lod
+    --raster "$raster" --clumps --hairs-per-key "$per_key" --no-lod
   frame_goal "dense_$raster" "dense groom: $((smoke == 1 ? 2000 : 20000)) followers of 300 guides" 2 ".*" \
     "${size[@]}" --raster "$raster" --input "$frame/dense.hair" --guides 300
   if [ -f "$sintel/sintel_hair.tfx" ]; then
     peer=(--input "$sintel/sintel_hair.tfx" --obj "$sintel/sintel_bust.obj" --scale 0.01 --width "$peer_width"
       --height "$peer_height" --frames "$frames" --raster "$raster")
     frame_goal "sintel_$raster" "Sintel at the peer's geometry, ${peer_width}×${peer_height}" 1.25 ".*" "${peer[@]}" \
-      --points 32 --level 1 --hairs-per-key 15 --no-lod
+      --points 32 --level 1 --clumps --hairs-per-key 15 --no-lod
     frame_goal "closeup_$raster" "Sintel close-up, 171,000 segments: draw + composite" 0.7 "draw|composite" \
-      "${peer[@]}" --hairs-per-key 50 --level 1 --no-lod --distance 0.5
+      "${peer[@]}" --clumps --hairs-per-key 50 --level 1 --no-lod --distance 0.5
   else
     echo "  Sintel: skipped, no $sintel/sintel_hair.tfx (set VKHAIR_SINTEL)" >>"$report"
   fi

@@ -145,6 +145,15 @@ fn options_that_need_others_say_so() {
     }
 }
 
+/// Over the scalp the drawn count follows the density: a per-key count there
+/// is refused, naming the flag and what it needs, not ignored.
+#[test]
+fn hairs_per_key_over_the_scalp_is_refused_not_ignored() {
+    let out = run(&["render", "--frames", "1", "--width", "32", "--height", "32", "--hairs-per-key", "4"], LIMIT);
+    out.assert_error("--hairs-per-key: 4");
+    assert!(out.stderr.contains("--clumps") && out.stderr.contains("--density"), "{}", out.stderr);
+}
+
 /// `render --gltf` puts hair on the shared character and follows its run: the
 /// PNGs show the hair (brown) and the body; an unknown animation or joint is
 /// named with the ones the file has, before any GPU work.

@@ -197,7 +197,7 @@ fn render_memory_does_not_grow_with_the_frame_count() {
     common::write_groom(&groom, &common::cap_groom(40, 8, 0.1));
     let peak = |frames: u32| {
         let args = format!(
-            "render --input {} --motion still --no-shadows --hairs-per-key 1 --width 1024 --height 768 --frames {frames}",
+            "render --input {} --motion still --no-shadows --clumps --hairs-per-key 1 --width 1024 --height 768 --frames {frames}",
             groom.display()
         );
         profiled(&args).1["peak_resident_bytes"].as_f64().expect("peak")
@@ -220,7 +220,18 @@ fn memory_stays_flat_however_many_frames_are_rendered() {
         let summary = dir.path().join(format!("run{frames}.json"));
         let out = dir.path().join(format!("frames{frames}"));
         let frames = frames.to_string();
-        let args = ["render", "--width", "32", "--height", "32", "--shadow-resolution", "64", "--hairs-per-key", "2"];
+        let args = [
+            "render",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--shadow-resolution",
+            "64",
+            "--clumps",
+            "--hairs-per-key",
+            "2",
+        ];
         let mut command = common::vkhair();
         command
             .env("LP_NUM_THREADS", "0")

@@ -24,7 +24,10 @@ pub struct SceneArgs {
     /// material; the flags below win over it.
     #[arg(long)]
     pub config: Option<PathBuf>,
-    /// Hairs grown per key hair [default: 16].
+    /// Hairs grown per key hair with --clumps (per triangle of key-hair roots
+    /// with --barycentric), or the share of followers drawn with --guides; over
+    /// the scalp the count follows --density instead, and this is refused
+    /// [default: 16].
     #[arg(long)]
     pub hairs_per_key: Option<u32>,
     /// Smoothed segments per key segment [default: 4].

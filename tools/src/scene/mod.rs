@@ -16,7 +16,7 @@ use vkhair::render::Camera;
 use vkhair::sim::{motion, Collider};
 
 pub use character::{load as load_character, CharacterScene};
-pub use parameters::{bind_followers, make_renderer, parameters, FULL_HEAD_HAIRS};
+pub use parameters::{bind_followers, make_renderer, parameters};
 
 use crate::args::input::{Dense, InputArgs, Scaled};
 use crate::args::scene::SceneArgs;

@@ -128,6 +128,17 @@ pub fn make_renderer(
     };
     let mut renderer = match (&s.dense, scalp) {
         (None, Some(followers)) => {
+            if let Some(hairs) = a.hairs_per_key {
+                return Err(vkhair::Error::InvalidParameter {
+                    name: "--hairs-per-key",
+                    value: hairs.to_string(),
+                    allowed: format!(
+                        "only with --clumps, --barycentric or followers (--guides): over the scalp the count \
+                         follows --density, {} hairs here",
+                        followers.count()
+                    ),
+                });
+            }
             let mut render = config.render.clone();
             // Full detail while the roots lie at least SCALP_LOD_PIXELS apart on
             // screen; farther, fewer hairs, each standing for more (level of detail).

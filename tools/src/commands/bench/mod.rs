@@ -372,7 +372,7 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     say!("{}", clock.describe());
     let b = Bench { ctx: &ctx, args: a, clock };
     let base = b.params(VolumeMode::Off, 32);
-    say!("{} (each row sets its own volume stage)", a.sim.describe(&base));
+    say!("{} (each row sets its own volume stage)", a.sim.describe(&base, info.device_type));
     let (scenes, skipped) = bench_scenes(a)?;
     let mut rows = Vec::new();
     let mut modes = Vec::new();
@@ -411,7 +411,7 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
                         s.name
                     );
                 } else {
-                    let t = truth::against_full_head(&b, args, s.groom.strand_count())?;
+                    let t = truth::against_full_head(&b, args)?;
                     say!(
                         "{}: the default frame ({} strands) against a full head ({} strands, one hair each): mean {:.1}, \
                          p95 {:.1} 8-bit sRGB steps over {} hair pixels",

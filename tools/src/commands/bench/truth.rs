@@ -2,17 +2,15 @@
 //! full-density scalp distribution (the tool's default, `[scalp]` density
 //! over the scalp the key hairs' roots cover: about 107,000 hairs for Sintel),
 //! each one hair at its physical width, level of detail off, K = 32 and a pool
-//! of 24 fragments per pixel, the same simulated state and camera. (Where the
-//! key hairs make no scalp and hairs grow in clumps, the truth is those clumps
-//! at `hairs_per_key` such that key hairs × it ≈ 100,000.) The figure is the error of
-//! the default frame over hair pixels, as `render::reference::srgb_error_stats`.
+//! of 24 fragments per pixel, the same simulated state and camera. The figure
+//! is the error of the default frame over hair pixels, as
+//! `render::reference::srgb_error_stats`.
 
 use vkhair::render::reference::{srgb_error_stats, ImageError};
 
 use super::frames::{bench_frames, Keep, LIT_BACKGROUND};
 use super::Bench;
 use crate::output::Error;
-use crate::scene::FULL_HEAD_HAIRS;
 
 /// The default frame of `args` (a render scene's flags) against its ground
 /// truth, and the strands each draws at full detail.
@@ -22,18 +20,13 @@ pub struct TruthFigures {
     pub truth_strands: u64,
 }
 
-/// Renders the default frame of `args` and its ground truth (`key_hairs` key
-/// hairs grown to a full head) after the same steps, and compares them.
-pub fn against_full_head(b: &Bench<'_>, args: &[String], key_hairs: usize) -> Result<TruthFigures, Error> {
+/// Renders the default frame of `args` and its ground truth (every hair of
+/// the scalp distribution, one hair each) after the same steps, and compares them.
+pub fn against_full_head(b: &Bench<'_>, args: &[String]) -> Result<TruthFigures, Error> {
     let base: Vec<&str> = args.iter().map(String::as_str).collect();
     let default = bench_frames(b.ctx, &base, &b.args.sim, 1, Keep::Lit)?;
-    let per_key =
-        ((FULL_HEAD_HAIRS / key_hairs.max(1) as f32).round() as u32).clamp(1, vkhair::render::MAX_HAIRS_PER_KEY);
-    let per_key = per_key.to_string();
     let mut truth_args = base.clone();
     truth_args.extend([
-        "--hairs-per-key",
-        &per_key,
         "--no-lod",
         "--transparency",
         "exact",
