@@ -21,10 +21,11 @@ pub const MAX_SHADOW_MAPS: u32 = 4;
 /// reduction halves it).
 pub const VOL_GROUP: u32 = 256;
 const _: () = assert!(VOL_GROUP.is_power_of_two());
-/// Keys one radix-sort block ranks, one per invocation.
-pub const VOL_SORT_BLOCK: u32 = 256;
-/// Elements of one prefix-sum tile, four per invocation.
-pub const VOL_SCAN_TILE: u32 = 1024;
+/// uint words per cell of the volume transfer's fixed-point sums: weight and
+/// weighted velocity (x, y, z), two words each (`volume_fixed.glsl`).
+pub const VOL_CELL_WORDS: u32 = 8;
+/// uint words per face of the same sums: weight and weighted velocity.
+pub const VOL_FACE_WORDS: u32 = 4;
 /// Damped Jacobi sweeps of the multigrid preconditioner on its coarsest level
 /// (an even number).
 pub const VOL_COARSEST_SWEEPS: u32 = 16;
@@ -52,8 +53,8 @@ pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
     ("MAX_LIGHTS", MAX_LIGHTS),
     ("MAX_SHADOW_MAPS", MAX_SHADOW_MAPS),
     ("VOL_GROUP", VOL_GROUP),
-    ("VOL_SORT_BLOCK", VOL_SORT_BLOCK),
-    ("VOL_SCAN_TILE", VOL_SCAN_TILE),
+    ("VOL_CELL_WORDS", VOL_CELL_WORDS),
+    ("VOL_FACE_WORDS", VOL_FACE_WORDS),
     ("VOL_COARSEST_SWEEPS", VOL_COARSEST_SWEEPS),
     ("ITEM_GROUP", ITEM_GROUP),
     ("SDF_MAX_RESOLUTION", SDF_MAX_RESOLUTION),

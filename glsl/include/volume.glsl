@@ -18,10 +18,11 @@
 // The packed blocks below are read only through the accessors of their views
 // (views.glsl, generated from src/gpu_types/views.rs): `vol_*(p)` for
 // VolumeParams; for VolumePush, which means something else to each kernel
-// family, `radix_*`, `scan_*`, `reduce_*`, `level_*`, `mg_smooth_*` and
+// family, `reduce_*`, `level_*`, `mg_smooth_*` and
 // `mg_coarsest_*`. The VOL_* codes (cell labels, modes, preconditioners,
-// statuses, stencil bits: src/codes.rs) and the workgroup sizes VOL_GROUP,
-// VOL_SORT_BLOCK and VOL_SCAN_TILE (src/limits.rs) are injected by build.rs.
+// statuses, stencil bits: src/codes.rs), the workgroup size VOL_GROUP and the
+// transfer's words per cell and face, VOL_CELL_WORDS and VOL_FACE_WORDS
+// (src/limits.rs), are injected by build.rs.
 
 // Per-sub-step parameters (uniform block, binding 0). Twin:
 // gpu_types::GpuVolumeParams, view gpu_types::VolumeStep.
@@ -86,13 +87,6 @@ uint vol_cell_of(vec3 g, uvec3 dims, uint outside) {
         return vol_cell_index(min(uvec3(g), dims - 1u), dims);
     }
     return outside;
-}
-
-// Trilinear hat weight of a sample at offset d (cells) from a grid point.
-float vol_weight(vec3 d) {
-    precise vec3 a = max(vec3(0.0), vec3(1.0) - abs(d));
-    precise float w = (a.x * a.y) * a.z;
-    return w;
 }
 
 // Axis of face f, given the first v and w faces (the u faces come first).

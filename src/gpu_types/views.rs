@@ -239,30 +239,6 @@ shader_views! {
         mesh_solid: uint = mesh_dims.w,
     }
 
-    /// The radix sort's passes (`VolumePush` of `radix_count` and `radix_scatter`).
-    RadixPass for VolumePush in "volume.glsl" as "VolumePush" prefix "radix" {
-        /// 0: the keys are in the A buffers, 1: in the B buffers.
-        source: uint = op.x,
-        /// Bits the keys are shifted right by for this pass's digit.
-        shift: uint = op.y,
-        /// Keys.
-        keys: uint = op.z,
-        /// Blocks of `VOL_SORT_BLOCK` keys.
-        blocks: uint = op.w,
-        /// Bits of one digit.
-        digit_bits: uint = coarse.x,
-    }
-
-    /// The prefix sum's passes (`VolumePush` of `scan`).
-    ScanPass for VolumePush in "volume.glsl" as "VolumePush" prefix "scan" {
-        /// 0: each tile's total; 1: the scan of the totals; 2: each tile's scan.
-        mode: uint = op.x,
-        /// Elements.
-        len: uint = op.z,
-        /// Tiles of `VOL_SCAN_TILE` elements.
-        tiles: uint = op.w,
-    }
-
     /// The conjugate-gradient scalar updates (`VolumePush` of `pcg_reduce`).
     ReducePass for VolumePush in "volume.glsl" as "VolumePush" prefix "reduce" {
         /// 0: start; 1: the step length; 2: the convergence check and direction.

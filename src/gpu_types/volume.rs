@@ -29,8 +29,8 @@ gpu_struct!(GpuVolumeParams => "VolumeParams" {
 });
 
 /// Push constants of the volume kernels (`VolumePush`); one view per kernel
-/// family: [`super::RadixPass`], [`super::ScanPass`], [`super::ReducePass`],
-/// [`super::LevelPass`], [`super::SmoothingPass`], [`super::CoarsestPass`],
+/// family: [`super::ReducePass`], [`super::LevelPass`],
+/// [`super::SmoothingPass`], [`super::CoarsestPass`],
 /// [`super::WorkgroupSolvePass`].
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]

@@ -36,10 +36,10 @@
 //!    detail only: one dispatch after each step dispatch moves the key hairs
 //!    left out with their guides ([`SimStage::Follow`]).
 //! 2. **Volume** ([`volume`], `glsl/sim/volume/`), when
-//!    [`SimParams::volume`] switches it on: particles sorted into a MAC grid,
-//!    then either FLIP (pressure projection with a GPU conjugate-gradient solve)
+//!    [`SimParams::volume`] switches it on: particles scattered onto a MAC
+//!    grid (fixed-point sums: the same bits in any order), then either FLIP (pressure projection with a GPU conjugate-gradient solve)
 //!    or density friction/repulsion corrects the new velocities. Four
-//!    timestamp scopes: [`SimStage::VolumeSort`], [`SimStage::VolumeTransfer`],
+//!    timestamp scopes: [`SimStage::VolumeScatter`], [`SimStage::VolumeTransfer`],
 //!    [`SimStage::VolumePressure`], [`SimStage::VolumeUpdate`].
 //!
 //! Parameters ([`SimParams`]), colliders ([`Collider`], [`MeshCollider`]) and the head transform
@@ -105,9 +105,11 @@ pub enum SimStage {
     /// Stage 1b (with a level of detail, [`HairSim::set_simulated_hairs`]): the
     /// key hairs left out follow their guides, one dispatch after each step dispatch.
     Follow,
-    /// Stage 2a: binning and counting sort of particles by grid cell.
-    VolumeSort,
-    /// Stage 2b: cell densities and labels, particle velocities to the MAC faces.
+    /// Stage 2a: every particle's weight and weighted velocity added to the
+    /// cell centres and MAC faces around it.
+    VolumeScatter,
+    /// Stage 2b: cell densities, mean velocities and labels, face velocities
+    /// from those sums.
     VolumeTransfer,
     /// Stage 2c: pressure solve and projection (FLIP mode only).
     VolumePressure,
@@ -120,7 +122,7 @@ impl SimStage {
     pub const ALL: [SimStage; 6] = [
         SimStage::Step,
         SimStage::Follow,
-        SimStage::VolumeSort,
+        SimStage::VolumeScatter,
         SimStage::VolumeTransfer,
         SimStage::VolumePressure,
         SimStage::VolumeUpdate,
@@ -128,14 +130,14 @@ impl SimStage {
 
     /// The scopes of the volume stage.
     const VOLUME: [SimStage; 4] =
-        [SimStage::VolumeSort, SimStage::VolumeTransfer, SimStage::VolumePressure, SimStage::VolumeUpdate];
+        [SimStage::VolumeScatter, SimStage::VolumeTransfer, SimStage::VolumePressure, SimStage::VolumeUpdate];
 
     /// The debug label and timestamp scope name of the stage.
     pub fn label(self) -> &'static str {
         match self {
             SimStage::Step => "vkhair sim: step",
             SimStage::Follow => "vkhair sim: followers",
-            SimStage::VolumeSort => "vkhair sim: volume sort",
+            SimStage::VolumeScatter => "vkhair sim: volume scatter",
             SimStage::VolumeTransfer => "vkhair sim: volume transfer",
             SimStage::VolumePressure => "vkhair sim: volume pressure",
             SimStage::VolumeUpdate => "vkhair sim: volume update",

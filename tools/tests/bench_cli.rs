@@ -153,7 +153,13 @@ fn the_gpu_bench_script_runs_every_goal_and_writes_one_report() {
     let r = common::run_command(&mut command, LIMIT);
     assert!(r.status.success(), "{}\n{}", r.stdout, r.stderr);
     let report = std::fs::read_to_string(dir.path().join("report.txt")).expect("report.txt");
-    let goals = ["a. thesis full frame", "b. simulation of 300 guides × 32 points, FLIP", "c. 7000 drawn strands"];
+    let goals = [
+        "a. thesis full frame",
+        "b. simulation of 300 guides × 32 points, FLIP",
+        "b2. simulation of 300 guides × 32 points, density friction",
+        "b3. the thesis scene's simulation, FLIP",
+        "c. 7000 drawn strands",
+    ];
     for goal in goals {
         assert!(report.contains(goal), "{goal} missing from:\n{report}");
     }
@@ -162,10 +168,15 @@ fn the_gpu_bench_script_runs_every_goal_and_writes_one_report() {
         .filter_map(|l| l.split_once("GPU ms per frame or step (timestamps, mean): "))
         .map(|(_, x)| x.trim().parse().expect("a number"))
         .collect();
-    assert_eq!(figures.len(), 3, "{report}");
+    assert_eq!(figures.len(), 5, "{report}");
     assert!(figures.iter().all(|&x| x > 0.0), "{report}");
-    assert_eq!(report.matches(" key hairs × ").count(), 3, "each goal names its device and scene:\n{report}");
-    for json in ["thesis_frame.json", "guides_step.json", "strands_frame.json"] {
+    assert_eq!(report.matches(" key hairs × ").count(), 5, "each goal names its device and scene:\n{report}");
+    let step_goals: Vec<&str> = report.lines().filter(|l| l.contains("ms a step: ")).collect();
+    assert_eq!(step_goals.len(), 2, "the volume goals, each beside its bound:\n{report}");
+    assert!(step_goals.iter().all(|l| l.ends_with(": met") || l.ends_with(": missed")), "{report}");
+    for json in
+        ["thesis_frame.json", "guides_step.json", "friction_step.json", "thesis_step.json", "strands_frame.json"]
+    {
         let text = std::fs::read_to_string(dir.path().join("goals").join(json)).expect(json);
         let v: serde_json::Value = serde_json::from_str(&text).expect("parse");
         assert!(v["passes"].as_array().is_some_and(|p| !p.is_empty()), "{json}: {v}");

@@ -183,7 +183,7 @@ fn simulate_writes_a_trace_and_summary_that_agree_with_its_table() {
     let (out, summary) = profiled("simulate --steps 25 --volume flip --grid 16");
     assert_eq!(summary["per"], "step");
     let (rows, _) = table(&out.stdout);
-    for pass in ["vkhair sim: step", "vkhair sim: volume sort", "vkhair sim: volume pressure"] {
+    for pass in ["vkhair sim: step", "vkhair sim: volume scatter", "vkhair sim: volume pressure"] {
         assert!(rows.keys().any(|(_, name)| name == pass), "{pass} missing:\n{}", out.stdout);
     }
 }

@@ -8,6 +8,7 @@ use gpu_allocator::MemoryLocation;
 use super::grid::GridLayout;
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuVolumeParams, PcgScalars};
+use crate::limits::{VOL_CELL_WORDS, VOL_FACE_WORDS};
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::device::Device;
 use crate::vk::pipeline::ComputePipeline;
@@ -19,17 +20,9 @@ pub(crate) mod binding {
     pub const COLLIDERS: u32 = 1;
     pub const POSITIONS: u32 = 2;
     pub const VELOCITIES: u32 = 3;
-    pub const KEYS_A: u32 = 4;
-    pub const VALS_A: u32 = 5;
-    pub const KEYS_B: u32 = 6;
-    pub const VALS_B: u32 = 7;
-    pub const TABLE: u32 = 8;
-    pub const TILE_SUMS: u32 = 9;
     pub const GRID_POS: u32 = 10;
     pub const GRID_VEL: u32 = 11;
-    pub const SORTED_POS: u32 = 12;
-    pub const SORTED_VEL: u32 = 13;
-    pub const START: u32 = 14;
+    pub const COUNTS: u32 = 14;
     pub const CELLS: u32 = 15;
     pub const LABELS: u32 = 16;
     pub const FACE_VEL: u32 = 17;
@@ -46,12 +39,9 @@ pub(crate) mod binding {
     pub const INDIRECT: u32 = 28;
     pub const MESH_FIELD: u32 = 29;
     pub const STENCIL: u32 = 30;
+    pub const ACCUM: u32 = 31;
 }
 
-/// Keys per sort block (one workgroup of `radix_count`/`radix_scatter`).
-pub(crate) const SORT_BLOCK: u32 = crate::limits::VOL_SORT_BLOCK;
-/// Elements per tile of `scan.comp`.
-pub(crate) const SCAN_TILE: u32 = crate::limits::VOL_SCAN_TILE;
 /// Invocations of the per-cell kernels.
 pub(crate) const GROUP: u32 = crate::limits::VOL_GROUP;
 /// Bytes per indirect dispatch entry (a `VkDispatchIndirectCommand` padded to 16).
@@ -60,17 +50,13 @@ pub(crate) const INDIRECT_STRIDE: u64 = 16;
 /// The volume stage's own buffers (the particle buffers belong to the simulation).
 pub(crate) struct VolumeBuffers {
     pub params: Buffer,
-    pub keys_a: Buffer,
-    pub vals_a: Buffer,
-    pub keys_b: Buffer,
-    pub vals_b: Buffer,
-    pub table: Buffer,
-    pub tile_sums: Buffer,
     pub grid_pos: Buffer,
     pub grid_vel: Buffer,
-    pub sorted_pos: Buffer,
-    pub sorted_vel: Buffer,
-    pub start: Buffer,
+    /// Particles per cell (the scatter's count; a cell holding one is fluid).
+    pub counts: Buffer,
+    /// The transfer's fixed-point sums: [`VOL_CELL_WORDS`] words per cell, then
+    /// [`VOL_FACE_WORDS`] per face (`glsl/include/volume_fixed.glsl`).
+    pub accum: Buffer,
     pub cells: Buffer,
     pub labels: Buffer,
     pub stencil: Buffer,
@@ -94,11 +80,10 @@ impl VolumeBuffers {
         let cells = u64::from(grid.cells());
         let levels = u64::from(grid.level_cells());
         let faces = u64::from(grid.faces[2]);
-        let blocks = n.div_ceil(u64::from(SORT_BLOCK));
-        let table = 256 * blocks;
+        let accum = 4 * (u64::from(VOL_CELL_WORDS) * cells + u64::from(VOL_FACE_WORDS) * faces);
         let limit = u64::from(device.info.max_storage_buffer_range);
-        for (what, bytes) in [("particles", n * 16), ("cells", levels * 4), ("faces", faces * 4), ("cells", cells * 16)]
-        {
+        let sizes = [("particles", n * 16), ("cells", levels * 4), ("faces", faces * 4), ("cells", cells * 16)];
+        for (what, bytes) in sizes.into_iter().chain([("the transfer's sums", accum)]) {
             if bytes > limit {
                 return Err(Error::device(
                     "the volume grid",
@@ -113,17 +98,10 @@ impl VolumeBuffers {
         device.upload(&density, 0, &vec![0u8; density.size() as usize])?;
         Ok(VolumeBuffers {
             params: Buffer::uniform(device, "vkhair volume params", std::mem::size_of::<GpuVolumeParams>() as u64)?,
-            keys_a: storage("vkhair volume keys A", n * 4)?,
-            vals_a: storage("vkhair volume particles A", n * 4)?,
-            keys_b: storage("vkhair volume keys B", n * 4)?,
-            vals_b: storage("vkhair volume particles B", n * 4)?,
-            table: storage("vkhair volume digit table", table * 4)?,
-            tile_sums: storage("vkhair volume scan tiles", table.div_ceil(u64::from(SCAN_TILE)) * 4)?,
             grid_pos: storage("vkhair volume grid positions", n * 16)?,
             grid_vel: storage("vkhair volume grid velocities", n * 16)?,
-            sorted_pos: storage("vkhair volume sorted positions", n * 16)?,
-            sorted_vel: storage("vkhair volume sorted velocities", n * 16)?,
-            start: storage("vkhair volume cell start", (cells + 1) * 4)?,
+            counts: storage("vkhair volume particles per cell", cells * 4)?,
+            accum: storage("vkhair volume transfer sums", accum)?,
             cells: density,
             labels: storage("vkhair volume labels", levels * 4)?,
             stencil: storage("vkhair volume stencil words", levels * 4)?,
@@ -160,7 +138,7 @@ impl VolumeBuffers {
         mesh_field: &'a Buffer,
         positions: &'a Buffer,
         velocities: &'a Buffer,
-    ) -> [(u32, &'a Buffer); 31] {
+    ) -> [(u32, &'a Buffer); 24] {
         use binding::*;
         [
             (PARAMS, &self.params),
@@ -168,17 +146,10 @@ impl VolumeBuffers {
             (COLLIDERS, colliders),
             (POSITIONS, positions),
             (VELOCITIES, velocities),
-            (KEYS_A, &self.keys_a),
-            (VALS_A, &self.vals_a),
-            (KEYS_B, &self.keys_b),
-            (VALS_B, &self.vals_b),
-            (TABLE, &self.table),
-            (TILE_SUMS, &self.tile_sums),
             (GRID_POS, &self.grid_pos),
             (GRID_VEL, &self.grid_vel),
-            (SORTED_POS, &self.sorted_pos),
-            (SORTED_VEL, &self.sorted_vel),
-            (START, &self.start),
+            (COUNTS, &self.counts),
+            (ACCUM, &self.accum),
             (CELLS, &self.cells),
             (LABELS, &self.labels),
             (STENCIL, &self.stencil),
@@ -201,12 +172,8 @@ impl VolumeBuffers {
 /// The kernels of the volume stage.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Kernel {
-    Bin,
-    RadixCount,
-    RadixScatter,
-    Scan,
-    Reorder,
-    Gather,
+    Scatter,
+    Cells,
     Mark,
     PcgInit,
     PcgApply,
@@ -224,13 +191,9 @@ pub(crate) enum Kernel {
 }
 
 impl Kernel {
-    pub(crate) const ALL: [Kernel; 20] = [
-        Kernel::Bin,
-        Kernel::RadixCount,
-        Kernel::RadixScatter,
-        Kernel::Scan,
-        Kernel::Reorder,
-        Kernel::Gather,
+    pub(crate) const ALL: [Kernel; 16] = [
+        Kernel::Scatter,
+        Kernel::Cells,
         Kernel::Mark,
         Kernel::PcgInit,
         Kernel::PcgApply,
@@ -260,12 +223,8 @@ impl Kernel {
             _ => {}
         }
         match self {
-            Kernel::Bin => &SIM_VOLUME_BIN_COMP,
-            Kernel::RadixCount => &SIM_VOLUME_RADIX_COUNT_COMP,
-            Kernel::RadixScatter => &SIM_VOLUME_RADIX_SCATTER_COMP,
-            Kernel::Scan => &SIM_VOLUME_SCAN_COMP,
-            Kernel::Reorder => &SIM_VOLUME_REORDER_COMP,
-            Kernel::Gather => &SIM_VOLUME_GATHER_COMP,
+            Kernel::Scatter => &SIM_VOLUME_SCATTER_COMP,
+            Kernel::Cells => &SIM_VOLUME_CELLS_COMP,
             Kernel::Mark => &SIM_VOLUME_MARK_COMP,
             Kernel::PcgInit => &SIM_VOLUME_PCG_INIT_COMP,
             Kernel::PcgApply => &SIM_VOLUME_PCG_APPLY_COMP,

@@ -6,28 +6,26 @@
 //! velocities just written, and corrects the velocities in place (positions are
 //! left alone: the next sub-step's prediction carries the correction). Steps:
 //!
-//! 1. **Bin** (`bin.comp`): grid coordinates, velocity along the grid axes and
-//!    cell id per particle. Particles outside the grid get the cell count as
-//!    their id: the sort puts them last, nothing reads them and their velocity
-//!    stays as it is (they are *rejected*, not clamped).
-//! 2. **Sort** (`radix_count`, `scan`, `radix_scatter`): a stable counting sort
-//!    of (cell id, particle) pairs, one radix digit per pass (two 8-bit passes up
-//!    to 65,535 cells, else four 6-bit passes): per-block digit histograms, an
-//!    exclusive scan of the digit-major table, a scatter that ranks equal digits
-//!    by position. Integer-only and stable, so the order is the same every run.
-//! 3. **Reorder** (`reorder.comp`): particle data in cell order and the first
-//!    index of every occupied cell (empty cells keep the particle count).
-//! 4. **Cells** (`gather.comp`): density and mean velocity around every cell
-//!    centre; labels solid (centre inside a collider), fluid (holds a
-//!    particle) or air.
-//! 5. **Transfer** (`gather.comp`, the same pass): every u/v/w face gathers its
-//!    component from the particles of the neighbouring cells with trilinear
-//!    weights; faces next to solid cells take the colliders' velocity. One
-//!    invocation per cell visits its 27 neighbouring cells once for the centre
-//!    and its three lower faces. An air cell whose six
-//!    faces all carry particle weight becomes fluid (`mark.comp`): key-hair
-//!    particles are sparse, and the gaps between them must not be free surface.
-//! 6. **Pressure** (FLIP only, `pcg_*`, `mg_*`): the Poisson system over fluid
+//! 1. **Scatter** (`scatter.comp`), one invocation per particle: its grid
+//!    position and velocity along the grid axes (kept for the update), a count
+//!    for its cell, and its trilinear weight w and weighted velocity v·w added
+//!    to the 8 cell centres and the 8 faces of each axis within a cell of it.
+//!    The sums are fixed point (trunc(x · 2³²) in two 32-bit words, carried
+//!    with 32-bit atomics; `glsl/include/volume_fixed.glsl`): integer sums,
+//!    the same bits whatever order the particles add in, so the stage stays
+//!    bitwise deterministic without sorting. The cost follows the particle
+//!    count, not the densest cell (no invocation loops over a cell's
+//!    particles). Particles outside the grid add nothing and keep their
+//!    velocity (they are *rejected*, not clamped).
+//! 2. **Cells** (`cells.comp`), one invocation per cell of a grid one larger
+//!    along every axis: density (summed weight) and mean velocity per cell;
+//!    labels solid (centre inside a collider), fluid (holds a particle) or
+//!    air; per u/v/w face Σ w·v / Σ w, or the colliders' velocity next to a
+//!    solid cell.
+//! 3. **Mark** (`mark.comp`): an air cell whose six faces all carry particle
+//!    weight becomes fluid: key-hair particles are sparse, and the gaps
+//!    between them must not be free surface.
+//! 4. **Pressure** (FLIP only, `pcg_*`, `mg_*`): the Poisson system over fluid
 //!    cells (air p = 0, solid faces Neumann with their velocity), solved by
 //!    preconditioned conjugate gradients entirely on the GPU, with dot products
 //!    summed in a fixed order, until max |r| ≤ tolerance · max |b| or the
@@ -46,11 +44,11 @@
 //!    first post-sweep, the next dot product into the last) and an iteration 4
 //!    passes per level above the coarsest plus 6. Then the pressure difference is subtracted on faces between a
 //!    fluid cell and a non-solid one (`gradient.comp`).
-//! 7. **Update** (`g2p.comp`): FLIP/PIC blend ṽ = α(v + Lerp(x, v − v*)) +
+//! 5. **Update** (`g2p.comp`): FLIP/PIC blend ṽ = α(v + Lerp(x, v − v*)) +
 //!    (1 − α)Lerp(x, v), or friction and repulsion from the cells.
 //!
-//! [`SimStage::VolumeSort`](super::SimStage) and the three stages after it name
-//! the debug labels and timestamp scopes (steps 1–3, 4–5, 6, 7). The cells'
+//! [`SimStage::VolumeScatter`](super::SimStage) and the three stages after it name
+//! the debug labels and timestamp scopes (steps 1, 2–3, 4, 5). The cells'
 //! (mean velocity, density) stay in a GPU buffer for the renderer
 //! ([`HairSim::density_buffer`](super::HairSim::density_buffer)).
 //! `reference.rs` is the CPU oracle, with modified incomplete Cholesky (MIC(0))

@@ -4,15 +4,14 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::buffers::{self, Kernel, KernelPipeline, VolumeBuffers, GROUP, INDIRECT_STRIDE, SCAN_TILE, SORT_BLOCK};
+use super::buffers::{self, Kernel, KernelPipeline, VolumeBuffers, GROUP, INDIRECT_STRIDE};
 use super::grid::GridLayout;
 use super::params::{Preconditioner, PressureSolver, VolumeMode, VolumeParams};
 use super::VolumeStats;
 use crate::codes::vol_status;
 use crate::error::Result;
 use crate::gpu_types::{
-    CoarsestPass, GpuVolumeParams, LevelPass, PcgScalars, RadixPass, ReducePass, ScanPass, SmoothingPass, VolumePush,
-    WorkgroupSolvePass,
+    CoarsestPass, GpuVolumeParams, LevelPass, PcgScalars, ReducePass, SmoothingPass, VolumePush, WorkgroupSolvePass,
 };
 use crate::profiler::{PassScope, Timing};
 use crate::vk::barrier::{self, AccessKind};
@@ -95,7 +94,7 @@ impl VolumeStage {
     }
 
     /// Records the transfers that start a sub-step: the uniform block, the indirect
-    /// dispatch sizes and the empty-cell marks of the start array. The caller orders
+    /// dispatch sizes, and zero counts and sums for the scatter. The caller orders
     /// them after earlier use and before the kernels (TRANSFER_WRITE → COMPUTE_SHADER
     /// and DRAW_INDIRECT).
     ///
@@ -111,7 +110,8 @@ impl VolumeStage {
         unsafe {
             d.cmd_update_buffer(cmd, self.buffers.params.raw(), 0, bytemuck::bytes_of(gpu));
             d.cmd_update_buffer(cmd, self.buffers.indirect.raw(), 0, bytemuck::cast_slice(&indirect));
-            d.cmd_fill_buffer(cmd, self.buffers.start.raw(), 0, vk::WHOLE_SIZE, self.grid.particles);
+            d.cmd_fill_buffer(cmd, self.buffers.counts.raw(), 0, vk::WHOLE_SIZE, 0);
+            d.cmd_fill_buffer(cmd, self.buffers.accum.raw(), 0, vk::WHOLE_SIZE, 0);
         }
     }
 
@@ -144,9 +144,9 @@ impl VolumeStage {
         }
     }
 
-    /// Records steps 1–7 on particle variant `variant`, after a barrier that made the
+    /// Records steps 1–6 on particle variant `variant`, after a barrier that made the
     /// particle buffers and the uploads visible. `labels` name the four timestamp
-    /// scopes (sort, transfer, pressure, update).
+    /// scopes (scatter, transfer, pressure, update).
     ///
     /// # Safety
     /// `cmd` is recording on this device outside a render pass; the profiler, when
@@ -156,61 +156,27 @@ impl VolumeStage {
             // SAFETY: guaranteed by the caller.
             unsafe { PassScope::record(&self.device, cmd, timing, label, LabelColor::Compute, body) }
         };
+        let none = VolumePush::default();
         // SAFETY (all closures): guaranteed by the caller.
-        scoped(labels[0], &|| unsafe { self.record_sort(cmd, variant) });
+        scoped(labels[0], &|| unsafe {
+            self.run(cmd, Kernel::Scatter, variant, none, Launch::Threads(self.grid.particles));
+        });
+        let flip = self.params.mode == VolumeMode::Flip;
         scoped(labels[1], &|| unsafe {
             let [nx, ny, nz] = self.grid.dims;
             let extended = (nx + 1) * (ny + 1) * (nz + 1);
-            self.run(cmd, Kernel::Gather, variant, VolumePush::default(), Launch::Threads(extended));
-            self.run(cmd, Kernel::Mark, variant, VolumePush::default(), Launch::Threads(self.grid.cells()));
+            self.run(cmd, Kernel::Cells, variant, none, Launch::Threads(extended));
+            // Faces and the labels they complete serve the pressure solve only.
+            if flip {
+                self.run(cmd, Kernel::Mark, variant, none, Launch::Threads(self.grid.cells()));
+            }
         });
-        if self.params.mode == VolumeMode::Flip {
+        if flip {
             scoped(labels[2], &|| unsafe { self.record_pressure(cmd, variant) });
         }
         scoped(labels[3], &|| unsafe {
-            self.run(cmd, Kernel::G2p, variant, VolumePush::default(), Launch::Threads(self.grid.particles));
+            self.run(cmd, Kernel::G2p, variant, none, Launch::Threads(self.grid.particles));
         });
-    }
-
-    /// Steps 1–3: bin, sort, reorder.
-    unsafe fn record_sort(&self, cmd: vk::CommandBuffer, variant: usize) {
-        let n = self.grid.particles;
-        let none = VolumePush::default();
-        // SAFETY: guaranteed by the caller.
-        unsafe { self.run(cmd, Kernel::Bin, variant, none, Launch::Threads(n)) };
-        let blocks = n.div_ceil(SORT_BLOCK);
-        let key_bits = 32 - self.grid.cells().leading_zeros();
-        let (digit_bits, passes) = if key_bits <= 16 { (8, 2) } else { (6, 4) };
-        for pass in 0..passes {
-            let push = VolumePush::from(&RadixPass {
-                source: pass % 2,
-                shift: pass * digit_bits,
-                keys: n,
-                blocks,
-                digit_bits,
-            });
-            // SAFETY: guaranteed by the caller.
-            unsafe {
-                self.run(cmd, Kernel::RadixCount, variant, push, Launch::Threads(blocks * SORT_BLOCK));
-                self.record_scan(cmd, variant, (1 << digit_bits) * blocks);
-                self.run(cmd, Kernel::RadixScatter, variant, push, Launch::Threads(blocks * SORT_BLOCK));
-            }
-        }
-        // An even number of passes leaves the sorted pairs in A.
-        // SAFETY: guaranteed by the caller.
-        unsafe { self.run(cmd, Kernel::Reorder, variant, none, Launch::Threads(n)) };
-    }
-
-    /// Exclusive scan of the first `len` entries of the digit table.
-    unsafe fn record_scan(&self, cmd: vk::CommandBuffer, variant: usize, len: u32) {
-        let tiles = len.div_ceil(SCAN_TILE);
-        let push = |mode: u32| VolumePush::from(&ScanPass { mode, len, tiles });
-        // SAFETY: guaranteed by the caller.
-        unsafe {
-            self.run(cmd, Kernel::Scan, variant, push(0), Launch::Threads(tiles * GROUP));
-            self.run(cmd, Kernel::Scan, variant, push(1), Launch::Threads(GROUP));
-            self.run(cmd, Kernel::Scan, variant, push(2), Launch::Threads(tiles * GROUP));
-        }
     }
 
     /// Multigrid level `level` and the next coarser one (zero past the coarsest).
@@ -238,7 +204,7 @@ impl VolumeStage {
         })
     }
 
-    /// Step 6: the pressure solve (in one workgroup, or a dispatch per kernel and
+    /// Step 5: the pressure solve (in one workgroup, or a dispatch per kernel and
     /// iteration) and the gradient subtraction.
     unsafe fn record_pressure(&self, cmd: vk::CommandBuffer, variant: usize) {
         let levels = self.grid.levels.len();

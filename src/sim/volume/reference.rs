@@ -1,7 +1,8 @@
 //! CPU reference of the volume stage: the oracle of the GPU tests.
 //!
-//! Binning, sort, cells and transfer repeat the GPU's f32 operations in the same
-//! order. The pressure solve is different on purpose: conjugate gradients in f64
+//! The scatter, cells and transfer repeat the GPU's f32 operations, and its
+//! fixed-point sums ([`fixed_point`]) bit for bit: integer sums, so the order
+//! the particles add in does not matter on either side. The pressure solve is different on purpose: conjugate gradients in f64
 //! preconditioned with modified incomplete Cholesky (MIC(0), τ = 0.97,
 //! σ = 0.25, as in Bridson's fluid notes), the preconditioner the thesis' CPU
 //! version used; it converges in a handful of iterations and gives the GPU
@@ -18,12 +19,8 @@ use crate::sim::reference::MeshField;
 /// Every intermediate result of one volume step.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct VolumeSnapshot {
-    /// Sorted cell ids (the cell count for particles outside the grid).
-    pub keys: Vec<u32>,
-    /// Particle index of each sorted entry.
-    pub particles: Vec<u32>,
-    /// First sorted index per cell (particle count when empty), plus the outside entry.
-    pub start: Vec<u32>,
+    /// Particles per cell (those outside the grid in none).
+    pub counts: Vec<u32>,
     /// Per cell: mean velocity (grid axes), density.
     pub cells: Vec<Vec4>,
     pub labels: Vec<u32>,
@@ -50,9 +47,35 @@ fn linear(m: &Mat4, v: Vec3) -> Vec3 {
     (c(0) * v.x + c(1) * v.y) + c(2) * v.z
 }
 
-fn weight(d: Vec3) -> f32 {
-    let a = (Vec3::ONE - d.abs()).max(Vec3::ZERO);
-    (a.x * a.y) * a.z
+/// The largest f32 below 2³¹: the transfer's fixed point caps |x| there.
+const FIXED_MAX: f32 = 2_147_483_520.0;
+
+/// x in the transfer's fixed point (`vol_fixed`, `glsl/include/volume_fixed.glsl`):
+/// trunc(x · 2³²), |x| capped below 2³¹, NaN as 0. Sums of these wrap as the
+/// GPU's two 32-bit words do.
+pub(crate) fn fixed_point(x: f32) -> i64 {
+    let a = x.abs();
+    let a = if a.is_nan() { 0.0 } else { a.min(FIXED_MAX) };
+    let whole = a.floor();
+    let magnitude = (i64::from(whole as u32) << 32) | i64::from(((a - whole) * 4_294_967_296.0) as u32);
+    if x < 0.0 {
+        -magnitude
+    } else {
+        magnitude
+    }
+}
+
+/// A fixed-point sum as the GPU reads it (`vol_fixed_value`): its
+/// magnitude's high word plus its low word × 2⁻³², each rounded to f32, then
+/// the sign.
+pub(crate) fn fixed_value(sum: i64) -> f32 {
+    let m = sum.unsigned_abs();
+    let x = (m >> 32) as u32 as f32 + m as u32 as f32 * 2.328_306_4e-10;
+    if sum < 0 {
+        -x
+    } else {
+        x
+    }
 }
 
 /// Cell grid shape helper.
@@ -134,83 +157,77 @@ pub(crate) fn step(
     let dims = Dims(grid.dims);
     let cells = dims.count();
     let colliders = &colliders[..(p.colliders as usize).min(colliders.len())];
-    // 1. Bin.
+    // 1. Scatter: grid position and velocity, a count per cell, and the
+    // fixed-point sums of w and v·w at the cell centres and faces around each
+    // particle (any order: integer sums).
     let grid_pos: Vec<Vec4> = positions.iter().map(|x| affine(&p.grid_from_world, x.xyz()).extend(x.w)).collect();
     let grid_vel: Vec<Vec3> = velocities.iter().map(|v| linear(&p.axes, v.xyz())).collect();
-    let unsorted: Vec<u32> = grid_pos
-        .iter()
-        .map(|g| cell_of(g.xyz(), grid.dims).and_then(|c| dims.index(c)).map_or(cells as u32, |c| c as u32))
-        .collect();
-    // 2.–3. Stable sort, start index.
-    let mut particles: Vec<u32> = (0..n as u32).collect();
-    particles.sort_by_key(|&i| unsorted[i as usize]);
-    let keys: Vec<u32> = particles.iter().map(|&i| unsorted[i as usize]).collect();
-    let mut start = vec![n as u32; cells + 1];
-    for i in 0..n {
-        if i == 0 || keys[i - 1] != keys[i] {
-            start[keys[i] as usize] = i as u32;
+    let face_count = grid.faces[2] as usize;
+    let mut counts = vec![0u32; cells];
+    let mut cell_sums = vec![[0i64; 4]; cells];
+    let mut face_sums = vec![[0i64; 2]; face_count];
+    let add = |sum: &mut i64, x: f32| *sum = sum.wrapping_add(fixed_point(x));
+    let flip = p.mode == vol_mode::FLIP as f32;
+    let corner =
+        |base: Vec3, k: i64| [base.x as i64 + (k & 1), base.y as i64 + ((k >> 1) & 1), base.z as i64 + (k >> 2)];
+    let at = |q: [i64; 3]| Vec3::new(q[0] as f32, q[1] as f32, q[2] as f32) + 0.5;
+    for (g, v) in grid_pos.iter().map(|g| g.xyz()).zip(&grid_vel) {
+        let Some(cell) = cell_of(g, grid.dims).and_then(|c| dims.index(c)) else { continue };
+        counts[cell] += 1;
+        // Along each axis the grid point below with weight 1 − t, the one above
+        // with t; w = (x · y) · z, as `scatter.comp`.
+        let s = g - 0.5;
+        let below = s.floor();
+        let (t, lower) = (s - below, Vec3::ONE - (s - below));
+        for k in 0..8 {
+            let q = corner(below, k);
+            let Some(c) = dims.index(q) else { continue };
+            let a = Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), t, lower);
+            let w = (a.x * a.y) * a.z;
+            let sum = &mut cell_sums[c];
+            add(&mut sum[0], w);
+            add(&mut sum[1], v.x * w);
+            add(&mut sum[2], v.y * w);
+            add(&mut sum[3], v.z * w);
+        }
+        // Faces serve the pressure solve only: FLIP.
+        for axis in (0..3).filter(|_| flip) {
+            let mut fs = s;
+            fs[axis] = g[axis];
+            let fbelow = fs.floor();
+            let (ft, flower) = (fs - fbelow, Vec3::ONE - (fs - fbelow));
+            for k in 0..8 {
+                let q = corner(fbelow, k);
+                let Some(f) = face_index(grid, axis, q) else { continue };
+                let a = Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), ft, flower);
+                let w = (a.x * a.y) * a.z;
+                add(&mut face_sums[f][0], w);
+                add(&mut face_sums[f][1], v[axis] * w);
+            }
         }
     }
-    let sorted_pos: Vec<Vec3> = particles.iter().map(|&i| grid_pos[i as usize].xyz()).collect();
-    let sorted_vel: Vec<Vec3> = particles.iter().map(|&i| grid_vel[i as usize]).collect();
-    let sorted_keys = &keys;
-    let cell_start = &start;
-    let in_cell = move |cell: usize| {
-        let first = cell_start[cell] as usize;
-        (first..n).take_while(move |&s| sorted_keys[s] as usize == cell)
-    };
-    // 4. Cells and labels.
+    // 2. Cells and labels.
     let mut cell_data = vec![Vec4::ZERO; cells];
     let mut labels = vec![AIR; cells];
     for c in 0..cells {
-        let ijk = dims.coords(c);
-        let centre = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) + 0.5;
-        let mut density = 0.0f32;
-        let mut momentum = Vec3::ZERO;
-        for dz in -1..=1 {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let Some(cell) = dims.index([ijk[0] + dx, ijk[1] + dy, ijk[2] + dz]) else { continue };
-                    for s in in_cell(cell) {
-                        let w = weight(sorted_pos[s] - centre);
-                        density += w;
-                        momentum += sorted_vel[s] * w;
-                    }
-                }
-            }
-        }
-        labels[c] = if (start[c] as usize) < n { FLUID } else { AIR };
+        let centre = at(dims.coords(c));
+        let [w, mx, my, mz] = cell_sums[c].map(fixed_value);
+        labels[c] = if counts[c] > 0 { FLUID } else { AIR };
         let in_mesh = mesh.is_some_and(|m| m.sample(affine(&p.mesh_from_grid, centre)).1 < 0.0);
         if in_mesh || inside(colliders, affine(&p.world_from_grid, centre)) {
             labels[c] = SOLID;
         }
-        let mean = if density > 0.0 { momentum / density } else { Vec3::ZERO };
-        cell_data[c] = mean.extend(density);
+        let mean = if w > 0.0 { Vec3::new(mx, my, mz) / w } else { Vec3::ZERO };
+        cell_data[c] = mean.extend(w);
     }
-    // 5. Transfer.
-    let face_count = grid.faces[2] as usize;
+    // Faces: Σ w·v / Σ w, or the colliders' velocity next to a solid cell.
     let mut face_vel = vec![0.0f32; face_count];
     let mut face_weight = vec![0.0f32; face_count];
-    for (axis, ijk) in faces(grid) {
-        let mut x = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) + 0.5;
+    for (axis, ijk) in faces(grid).filter(|_| flip) {
+        let mut x = at(ijk);
         x[axis] -= 0.5;
-        let lo = ijk.map(|v| v - 1);
-        let mut hi = ijk.map(|v| v + 1);
-        hi[axis] -= 1;
-        let mut sum = 0.0f32;
-        let mut wsum = 0.0f32;
-        for k in lo[2]..=hi[2] {
-            for j in lo[1]..=hi[1] {
-                for i in lo[0]..=hi[0] {
-                    let Some(cell) = dims.index([i, j, k]) else { continue };
-                    for s in in_cell(cell) {
-                        let w = weight(sorted_pos[s] - x);
-                        wsum += w;
-                        sum += sorted_vel[s][axis] * w;
-                    }
-                }
-            }
-        }
+        let f = face_index(grid, axis, ijk).unwrap_or(0);
+        let [wsum, sum] = face_sums[f].map(fixed_value);
         let mut u = if wsum > 0.0 { sum / wsum } else { 0.0 };
         let mut below = ijk;
         below[axis] -= 1;
@@ -218,12 +235,11 @@ pub(crate) fn step(
         if solid {
             u = affine(&p.solid_velocity, x)[axis];
         }
-        let f = face_index(grid, axis, ijk).unwrap_or(0);
         face_vel[f] = u;
         face_weight[f] = wsum;
     }
-    // Air cells whose six faces all carry particle weight are fluid too.
-    for (c, label) in labels.iter_mut().enumerate() {
+    // 3. Air cells whose six faces all carry particle weight are fluid too (FLIP).
+    for (c, label) in labels.iter_mut().enumerate().filter(|_| flip) {
         let ijk = dims.coords(c);
         let covered = (0..3).all(|axis| {
             let mut up = ijk;
@@ -236,9 +252,7 @@ pub(crate) fn step(
     }
     let face_star = face_vel.clone();
     let mut snapshot = VolumeSnapshot {
-        keys,
-        particles,
-        start,
+        counts,
         cells: cell_data,
         labels,
         face_vel,
@@ -248,7 +262,7 @@ pub(crate) fn step(
         rhs: vec![0.0; cells],
         iterations: 0,
     };
-    // 6. Pressure.
+    // 4. Pressure.
     if p.mode == vol_mode::FLIP as f32 {
         snapshot.rhs = rhs(grid, &snapshot.labels, &snapshot.face_vel);
         let (pressure, iterations) = mic_pcg(grid, &snapshot.labels, &snapshot.rhs, p.tolerance.into(), 1000);
@@ -256,7 +270,7 @@ pub(crate) fn step(
         snapshot.iterations = iterations;
         subtract_gradient(grid, &snapshot.labels, &snapshot.pressure, &mut snapshot.face_vel);
     }
-    // 7. Grid to particles.
+    // 5. Grid to particles.
     for i in 0..n {
         let g = grid_pos[i];
         if g.w == 0.0 || cell_of(g.xyz(), grid.dims).is_none() {

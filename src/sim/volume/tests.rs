@@ -62,7 +62,7 @@ fn run_gpu(
         unsafe {
             stage.record_uploads(cmd, &GpuVolumeParams::from(block));
             d.cmd_barrier(cmd, &[uploaded], &[], &[]);
-            stage.record(cmd, 0, ["sort", "transfer", "pressure", "update"], crate::profiler::Timing::default());
+            stage.record(cmd, 0, ["scatter", "transfer", "pressure", "update"], crate::profiler::Timing::default());
         }
     })
     .expect("submit");
@@ -70,9 +70,7 @@ fn run_gpu(
     let cells = grid.cells() as usize;
     let faces = grid.faces[2] as usize;
     let snapshot = VolumeSnapshot {
-        keys: d.readback_pod(&b.keys_a, n as usize).expect("readback"),
-        particles: d.readback_pod(&b.vals_a, n as usize).expect("readback"),
-        start: d.readback_pod(&b.start, cells + 1).expect("readback"),
+        counts: d.readback_pod(&b.counts, cells).expect("readback"),
         cells: d.readback_pod(&b.cells, cells).expect("readback"),
         labels: d.readback_pod(&b.labels, cells).expect("readback"),
         face_vel: d.readback_pod(&b.face_vel, faces).expect("readback"),
@@ -128,14 +126,49 @@ fn friction_params() -> VolumeParams {
     VolumeParams { mode: VolumeMode::Friction, ..VolumeParams::default() }
 }
 
+fn bits(values: &[f32]) -> Vec<u32> {
+    values.iter().map(|v| v.to_bits()).collect()
+}
+
+fn bits4(values: &[Vec4]) -> Vec<[u32; 4]> {
+    values.iter().map(|v| v.to_array().map(f32::to_bits)).collect()
+}
+
+/// The transfer's fixed point: trunc(x · 2³²), |x| capped below 2³¹, NaN as 0;
+/// sums of a value and its negation cancel exactly; values with no bits below
+/// 2⁻³² come back exactly.
 #[test]
-fn sort_and_start_index_match_the_reference() {
+fn the_fixed_point_of_the_transfer_is_exact_where_it_can_be() {
+    use reference::{fixed_point, fixed_value};
+    assert_eq!(fixed_point(0.0), 0);
+    assert_eq!(fixed_point(-0.0), 0);
+    assert_eq!(fixed_point(1.0), 1 << 32);
+    assert_eq!(fixed_point(-0.5), -(1 << 31));
+    assert_eq!(fixed_point(1e-12), 0, "below 2⁻³²");
+    assert_eq!(fixed_point(f32::NAN), 0);
+    assert_eq!(fixed_point(f32::INFINITY), fixed_point(3e9), "capped");
+    assert_eq!(fixed_point(f32::NEG_INFINITY), -fixed_point(3e9));
+    assert_eq!(fixed_value(fixed_point(3e9)), 2_147_483_520.0);
+    for x in [1.5f32, -2.25, 0.125, -1e-3, 12345.678, -0.999_999_9] {
+        let q = fixed_point(x);
+        assert_eq!(q.wrapping_add(fixed_point(-x)), 0, "{x}");
+        assert!((fixed_value(q) - x).abs() <= 2.4e-10 + x.abs() * 6e-8, "{x}: {}", fixed_value(q));
+    }
+    assert_eq!(fixed_value(fixed_point(1.5)), 1.5);
+    assert_eq!(fixed_value(fixed_point(-2.25)), -2.25);
+}
+
+/// The scatter against the reference on particles inside, on cell boundaries,
+/// outside (below, on the far faces, NaN, infinite) and with a NaN and a
+/// huge velocity: counts, densities and face weights bit for bit (the same
+/// integer sums), means and face velocities to the division's rounding;
+/// particles outside keep their velocity.
+#[test]
+fn the_scatter_matches_the_reference_bit_for_bit() {
     let gpu = TestGpu::new();
     let mut rng = Pcg32::seed_from_u64(5);
     let grid_dims = [8, 6, 5];
-    // Random points inside, points exactly on cell boundaries, points outside the grid
-    // (below, above, NaN) and enough of them for several sort blocks.
-    let (mut positions, velocities) = random_particles(&mut rng, 1000, Vec3::ZERO, Vec3::new(8.0, 6.0, 5.0), 1.0);
+    let (mut positions, mut velocities) = random_particles(&mut rng, 1000, Vec3::ZERO, Vec3::new(8.0, 6.0, 5.0), 1.0);
     for (k, p) in positions.iter_mut().enumerate().take(100) {
         *p = Vec4::new((k % 9) as f32, (k % 7) as f32, (k % 6) as f32, 1.0);
     }
@@ -143,72 +176,92 @@ fn sort_and_start_index_match_the_reference() {
     positions[101] = Vec4::new(8.0, 1.0, 1.0, 1.0);
     positions[102] = Vec4::new(f32::NAN, 1.0, 1.0, 1.0);
     positions[103] = Vec4::new(1.0, f32::INFINITY, 1.0, 1.0);
+    velocities[200] = Vec4::new(f32::NAN, 0.0, 0.0, 0.0);
+    velocities[201] = Vec4::new(1e10, -1e10, 0.0, 0.0);
     let grid = unit_grid(grid_dims, positions.len());
-    let params = friction_params();
+    let params = VolumeParams::flip(grid_dims);
     let b = block(&grid, &params, Mat4::IDENTITY, 0);
     let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
     let mut cpu_vel = velocities.clone();
     let cpu = reference::step(&grid, &b, &[], None, &positions, &mut cpu_vel);
-    assert_eq!(run.snapshot.keys, cpu.keys, "sorted cell ids");
-    assert_eq!(run.snapshot.particles, cpu.particles, "sorted particle order (stable)");
-    assert_eq!(run.snapshot.start, cpu.start, "start index");
-    // The reference itself: sorted, stable, outside particles last, empty cells marked.
-    let cells = grid.cells();
-    assert!(cpu.keys.windows(2).all(|w| w[0] <= w[1]));
+    assert_eq!(run.snapshot.counts, cpu.counts, "particles per cell");
     let d = Vec3::new(8.0, 6.0, 5.0);
-    let outside = positions.iter().filter(|p| !(p.xyz().cmpge(Vec3::ZERO).all() && p.xyz().cmplt(d).all())).count();
-    assert!(outside > 4, "boundary points on the far faces are outside too");
-    assert_eq!(cpu.keys.iter().filter(|&&k| k == cells).count(), outside);
-    assert!((0..cpu.keys.len() - 1).all(|i| cpu.keys[i] != cpu.keys[i + 1] || cpu.particles[i] < cpu.particles[i + 1]));
-    assert!(cpu.start[..cells as usize].contains(&1000), "some cells are empty");
-    // Rejected particles keep their velocity.
-    assert_eq!(run.velocities[100..104], velocities[100..104], "particles outside the grid keep their velocity");
+    let inside = positions.iter().filter(|p| p.xyz().cmpge(Vec3::ZERO).all() && p.xyz().cmplt(d).all()).count();
+    assert!(inside < 996, "boundary points on the far faces are outside too");
+    assert_eq!(cpu.counts.iter().sum::<u32>() as usize, inside);
+    assert!(cpu.counts.contains(&0), "some cells are empty");
+    let density = |s: &VolumeSnapshot| s.cells.iter().map(|c| c.w).collect::<Vec<f32>>();
+    assert_eq!(bits(&density(&run.snapshot)), bits(&density(&cpu)), "densities");
+    assert_eq!(bits(&run.snapshot.face_weight), bits(&cpu.face_weight), "face weights");
+    assert_close("cells", &cell_floats(&run.snapshot.cells), &cell_floats(&cpu.cells), 1e-6);
+    assert_close("face velocities", &run.snapshot.face_star, &cpu.face_star, 1e-6);
+    assert_eq!(bits4(&run.velocities[100..104]), bits4(&velocities[100..104]), "particles outside keep their velocity");
 }
 
+/// The sums do not depend on the order the particles add in: the particles
+/// reversed give the same bits on the GPU. 700 particles in one cell far from
+/// the grid's edges (each a whole trilinear weight) sum to 700 at the centres
+/// and on each axis' faces, and count 700 in their cell.
 #[test]
-fn all_particles_in_one_cell_sort_like_the_reference() {
+fn the_scatter_is_the_same_in_any_order() {
     let gpu = TestGpu::new();
     let mut rng = Pcg32::seed_from_u64(6);
-    // 64³ cells: the four 6-bit passes.
     let (positions, velocities) = random_particles(&mut rng, 700, Vec3::splat(30.1), Vec3::splat(30.9), 0.5);
     let grid = unit_grid([64, 64, 64], positions.len());
-    let params = friction_params();
+    let params = VolumeParams { max_iterations: 1, ..VolumeParams::flip([64; 3]) };
     let b = block(&grid, &params, Mat4::IDENTITY, 0);
-    let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
-    let mut cpu_vel = velocities.clone();
-    let cpu = reference::step(&grid, &b, &[], None, &positions, &mut cpu_vel);
+    let forward = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
+    let reversed = |v: &[Vec4]| v.iter().rev().copied().collect::<Vec<_>>();
+    let backward = run_gpu(&gpu, &grid, &params, &b, &[], &reversed(&positions), &reversed(&velocities));
+    assert_eq!(bits(&cell_floats(&forward.snapshot.cells)), bits(&cell_floats(&backward.snapshot.cells)));
+    assert_eq!(bits(&forward.snapshot.face_star), bits(&backward.snapshot.face_star));
+    assert_eq!(bits(&forward.snapshot.face_weight), bits(&backward.snapshot.face_weight));
     let cell = 30 + 64 * (30 + 64 * 30);
-    assert!(cpu.keys.iter().all(|&k| k == cell));
-    assert_eq!(run.snapshot.keys, cpu.keys);
-    assert_eq!(run.snapshot.particles, (0..700).collect::<Vec<u32>>());
-    assert_eq!(run.snapshot.start, cpu.start);
-    assert_eq!(run.snapshot.start[cell as usize], 0);
+    assert_eq!(forward.snapshot.counts[cell], 700);
+    assert_eq!(forward.snapshot.counts.iter().sum::<u32>(), 700);
+    let total: f64 = forward.snapshot.cells.iter().map(|c| f64::from(c.w)).sum();
+    assert!((total - 700.0).abs() < 1e-3, "summed density {total}");
+    for axis in 0..3 {
+        let range = [0, grid.faces[0], grid.faces[1], grid.faces[2]];
+        let faces = &forward.snapshot.face_weight[range[axis] as usize..range[axis + 1] as usize];
+        let total: f64 = faces.iter().map(|&w| f64::from(w)).sum();
+        assert!((total - 700.0).abs() < 1e-3, "axis {axis}: summed face weight {total}");
+    }
 }
 
+/// Cells, labels and the friction update against the reference; then the
+/// same particles in FLIP, whose faces (the friction mode has none) take the
+/// moving sphere's velocity next to its solid cells.
 #[test]
 fn transfer_and_friction_match_the_reference() {
     let gpu = TestGpu::new();
     let mut rng = Pcg32::seed_from_u64(7);
     let (positions, velocities) = random_particles(&mut rng, 3000, Vec3::splat(2.0), Vec3::new(10.0, 9.0, 7.0), 1.0);
     let grid = unit_grid([12, 11, 9], positions.len());
-    let params = VolumeParams { repulsion_threshold: 2.0, repulsion: 5.0, friction: 0.3, ..friction_params() };
+    let friction = VolumeParams { repulsion_threshold: 2.0, repulsion: 5.0, friction: 0.3, ..friction_params() };
     // A moving sphere marks solid cells and gives their faces a velocity.
     let colliders = [sphere(Vec3::new(6.0, 5.0, 4.0), 2.2)];
     let previous = Mat4::from_translation(Vec3::new(-0.01, 0.02, 0.0));
-    let b = block(&grid, &params, previous, 1);
-    let run = run_gpu(&gpu, &grid, &params, &b, &colliders, &positions, &velocities);
+    let b = block(&grid, &friction, previous, 1);
+    let run = run_gpu(&gpu, &grid, &friction, &b, &colliders, &positions, &velocities);
     let mut cpu_vel = velocities.clone();
     let cpu = reference::step(&grid, &b, &colliders, None, &positions, &mut cpu_vel);
     assert_eq!(run.snapshot.labels, cpu.labels);
     assert!(cpu.labels.contains(&SOLID) && cpu.labels.contains(&FLUID));
+    assert!(cpu.face_weight.iter().all(|&w| w == 0.0), "the friction mode sums no faces");
     // Same operations in the same order: agreement to a few ulps (the division of a
     // vector may be a multiply by the reciprocal on the GPU).
     assert_close("cells", &cell_floats(&run.snapshot.cells), &cell_floats(&cpu.cells), 1e-6);
-    assert_close("face weights", &run.snapshot.face_weight, &cpu.face_weight, 1e-6);
-    assert_close("face velocities", &run.snapshot.face_star, &cpu.face_star, 1e-6);
     let gpu_v: Vec<f32> = run.velocities.iter().flat_map(|v| v.to_array()).collect();
     let cpu_v: Vec<f32> = cpu_vel.iter().flat_map(|v| v.to_array()).collect();
     assert_close("friction velocities", &gpu_v, &cpu_v, 1e-5);
+    let flip = VolumeParams { mode: VolumeMode::Flip, ..friction };
+    let b = block(&grid, &flip, previous, 1);
+    let run = run_gpu(&gpu, &grid, &flip, &b, &colliders, &positions, &velocities);
+    let cpu = reference::step(&grid, &b, &colliders, None, &positions, &mut velocities.clone());
+    assert_eq!(run.snapshot.labels, cpu.labels);
+    assert_eq!(bits(&run.snapshot.face_weight), bits(&cpu.face_weight), "face weights");
+    assert_close("face velocities", &run.snapshot.face_star, &cpu.face_star, 1e-6);
     // Solid faces carry the sphere's velocity: (0.01, −0.02, 0) / dt.
     let expected = Vec3::new(0.6, -1.2, 0.0);
     let dims = Dims(grid.dims);
