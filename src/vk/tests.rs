@@ -561,7 +561,7 @@ fn shaders_are_built_with_the_shared_constants() {
         assert_eq!(reflection.workgroup_size, Some([size, 1, 1]), "{}", shader.name);
         checked += 1;
     }
-    assert_eq!(checked, 33, "1 simulation, 7 per-item and 25 volume kernels (20 and 5 shared-memory variants)");
+    assert_eq!(checked, 29, "1 simulation, 7 per-item and 21 volume kernels (16 and 5 shared-memory variants)");
     let sources: String = glsl_sources().into_iter().map(|(_, text)| text).collect();
     for (name, _) in limits::SHADER_CONSTANTS {
         assert!(sources.contains(name), "{name} is injected but no shader uses it");
