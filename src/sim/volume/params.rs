@@ -40,12 +40,11 @@ pub enum Preconditioner {
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum PressureSolver {
-    /// [`Workgroup`](Self::Workgroup) on a CPU implementation of Vulkan (a
-    /// workgroup there is a CPU thread, and a dispatch costs more than a share of
-    /// the grid), [`Dispatched`](Self::Dispatched) on a GPU (one workgroup is one
-    /// of its compute units: measured on an H100, the 64³ pressure solve of
-    /// 100,000 × 32 particles took 68.6 ms in one workgroup and 4.8 ms
-    /// dispatched). See [`PressureSolver::on_device`].
+    /// The solve in one workgroup on a CPU implementation of Vulkan (a workgroup
+    /// there is a CPU thread, and a dispatch costs more than a share of the
+    /// grid), dispatched over the device on a GPU (one workgroup is one of its
+    /// compute units: measured on an H100, the 64³ pressure solve of 100,000 ×
+    /// 32 particles took 68.6 ms in one workgroup and 4.8 ms dispatched).
     #[default]
     Auto,
     /// The whole solve (every iteration, its preconditioner and its sums) in one
