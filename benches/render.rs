@@ -10,7 +10,7 @@
 //! lighting (draw) pass with 0, 1 and 2 shadow-casting lights, and with both
 //! lights shadowed through the simulation's density volume instead.
 //!
-//! `cargo bench --bench render` (add `-- quick` for one resolution, `-- shadows`
+//! `cargo bench --features bench --bench render` (add `-- quick` for one resolution, `-- shadows`
 //! for the shadow table alone).
 
 use std::fmt::Write as _;

@@ -13,7 +13,7 @@
 //!
 //! On lavapipe every "device" is the same CPU cores, so a second queue or device
 //! cannot be faster; the figures show the hand-off cost and that the overlap
-//! happens. `cargo bench --bench schedule` (`-- summary` skips criterion,
+//! happens. `cargo bench --features bench --bench schedule` (`-- summary` skips criterion,
 //! `-- quick` measures fewer frames).
 
 use std::fmt::Write as _;

@@ -189,7 +189,7 @@ fn summary() {
 criterion_group!(benches, bench_sim);
 
 fn main() {
-    // `cargo bench --bench sim -- summary` prints only the table.
+    // `cargo bench --features bench --bench sim -- summary` prints only the table.
     let summary_only = std::env::args().any(|a| a == "summary");
     if !summary_only {
         benches();

@@ -7,7 +7,7 @@ use glam::Vec3;
 use vkhair::sim::{Collider, CpuHairSim, HairSim, RigidTransform, SimParams, SimState, MAX_COLLIDERS};
 use vkhair::Groom;
 
-mod common;
+use crate::common;
 use common::Gpu;
 
 /// A curtain: 12 strands of 8 points hanging 20 cm straight down from roots

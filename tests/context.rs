@@ -12,7 +12,7 @@ use vkhair::ash::{self, vk};
 use vkhair::headless::Submit;
 use vkhair::{requirements, ContextOptions, GpuContext, GpuProfiler, HostDevice, HostQueue, ValidationLog};
 
-mod common;
+use crate::common;
 
 /// The helper every GPU test uses (`common::Gpu`) checks the validation log
 /// after the context is dropped: a buffer leaked on purpose fails the test.

@@ -12,7 +12,7 @@ use vkhair::render::{Camera, Followers, RenderParams, Renderer};
 use vkhair::sim::{HairSim, RigidTransform, SimParams, SimState};
 use vkhair::Groom;
 
-mod common;
+use crate::common;
 
 use common::Gpu;
 

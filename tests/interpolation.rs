@@ -9,7 +9,7 @@ use vkhair::render::{RenderParams, Renderer};
 use vkhair::sim::{FixedStepDriver, HairSim, RigidTransform, SimParams};
 use vkhair::Groom;
 
-mod common;
+use crate::common;
 
 use common::Gpu;
 

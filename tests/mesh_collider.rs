@@ -2,7 +2,7 @@
 //! ([`MeshSdf::build`]), the simulation colliding with it, and the local shape
 //! constraint.
 
-mod common;
+use crate::common;
 
 use common::{curls, mohawk, p, tip_drift_of, Gpu};
 use glam::Vec3;

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
+use crate::common;
 use vkhair::config::Config;
-mod common;
 
 #[test]
 fn every_preset_is_a_valid_parameter_file() {

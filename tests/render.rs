@@ -1,12 +1,12 @@
 //! The render passes against CPU references, under validation.
 
+use crate::common;
 use glam::Vec3;
 use vkhair::groom::grow::{grow, GrowParams};
 use vkhair::groom::scenes;
 use vkhair::headless::{MeshDrawer, Offscreen, Submit};
 use vkhair::render::{reference, RenderParams, Renderer, ShadowParams};
 use vkhair::sim::{motion, HairSim, RigidTransform, SimParams};
-mod common;
 
 use common::Gpu;
 use vkhair::Error;

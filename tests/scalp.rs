@@ -14,7 +14,7 @@ use vkhair::sim::scalp::{Scalp, VertexSkin};
 use vkhair::sim::{CpuHairSim, HairSim, RigidTransform, SimParams, SimState};
 use vkhair::Groom;
 
-mod common;
+use crate::common;
 use common::{bits, Gpu};
 
 /// The head's centre in the bind pose (the neck bone turns about the origin).

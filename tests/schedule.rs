@@ -16,7 +16,7 @@ use vkhair::schedule::{FrameScheduler, HandOff, Pipelining, ScheduleMode, Schedu
 use vkhair::sim::{motion, FixedStepDriver, RigidTransform, SimParams, VolumeParams};
 use vkhair::{ContextOptions, Error, GpuContext, Groom};
 
-mod common;
+use crate::common;
 
 use common::Gpu;
 

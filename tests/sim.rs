@@ -11,12 +11,12 @@
 //! state, within `common::OTHER_DEVICE_STEP_TOLERANCE_M` (50 µm of
 //! |Δx| + dt·|Δv|).
 
+use crate::common;
 use glam::{Vec3, Vec4};
 use vkhair::groom::{scenes, Groom};
 use vkhair::sim::{
     motion, Collider, CpuHairSim, HairSim, PressureSolver, RigidTransform, SimParams, SimState, SolverMode,
 };
-mod common;
 
 use common::{curls, mohawk, p, tip_drift_of, Gpu};
 use vkhair::{Error, GpuContext};

@@ -7,7 +7,7 @@ use glam::{Quat, Vec3};
 use vkhair::sim::{motion, CpuHairSim, HairSim, RigidTransform, SimParams, SimState, REFERENCE_STEP_TOLERANCE_M};
 use vkhair::{GpuContext, Groom};
 
-mod common;
+use crate::common;
 use common::{grown_groom, Gpu};
 
 /// Steps of head shaking before the cut: the hair is in motion when it comes.

@@ -5,6 +5,7 @@
 //! albedo at its t along the hair and the reference needs no shading model: what
 //! is compared is coverage and compositing.
 
+use crate::common;
 use glam::Vec3;
 use vkhair::groom::scenes;
 use vkhair::headless::{Offscreen, Submit};
@@ -12,7 +13,6 @@ use vkhair::render::reference::{composite_strands, linear_rgb, srgb_error, Compo
 use vkhair::render::{Camera, HairMaterial, LodParams, Raster, RenderParams, Renderer, Transparency};
 use vkhair::sim::{HairSim, RigidTransform, SimParams};
 use vkhair::Groom;
-mod common;
 
 use common::Gpu;
 

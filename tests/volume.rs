@@ -11,6 +11,7 @@
 //! tolerance of `vkhair simulate --check`). Density friction runs the same
 //! operations: its whole run is compared too, to 1e-4 m as in `tests/sim.rs`.
 
+use crate::common;
 use glam::{Vec3, Vec4};
 use vkhair::groom::Groom;
 use vkhair::sim::{
@@ -18,7 +19,6 @@ use vkhair::sim::{
     VolumeParams, REFERENCE_STEP_TOLERANCE_M,
 };
 use vkhair::Error;
-mod common;
 
 use common::Gpu;
 

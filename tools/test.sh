@@ -16,7 +16,7 @@ cargo test --workspace --locked "$@"
 # does not; the same code path runs on its graphics queue in the suite above).
 devices=$(cargo run --quiet --locked -p vkhair-tools -- devices 2>/dev/null || true)
 if grep -q "async compute queue: yes" <<<"$devices"; then
-  cargo test --locked --test schedule "$@" -- --ignored async_compute_on_a_second_queue
+  cargo test --locked --test suite "$@" -- --ignored schedule::async_compute_on_a_second_queue
 else
   echo "skipped: async compute on a real second queue (no device here has one)"
 fi

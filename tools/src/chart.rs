@@ -73,7 +73,7 @@ impl Table {
     fn column(&self, name: &str) -> Result<usize, Error> {
         self.header.iter().position(|h| h == name).ok_or_else(|| {
             format!(
-                "{} has no column \"{name}\" (its columns: {}); is it a CSV of `cargo bench --bench render` or `--bench volume`?",
+                "{} has no column \"{name}\" (its columns: {}); is it a CSV of `cargo bench --features bench --bench render` or `--bench volume`?",
                 self.path.display(),
                 self.header.join(", ")
             )

@@ -45,7 +45,7 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Print the default parameters as commented TOML, a starting point for --config.
     Config,
-    /// Chart the render benchmark's CSV (cargo bench --bench render) as a PNG.
+    /// Chart the render benchmark's CSV (cargo bench --features bench --bench render) as a PNG.
     Plot(plot::PlotArgs),
     /// Resample and/or pick key hairs from a .hair or .tfx file; write a .hair file.
     Convert(convert::ConvertArgs),

@@ -1,7 +1,7 @@
 //! USD and Alembic grooms through the tool: `inspect` (table and `--json`),
 //! `convert` to `.hair` and `.abc` and back, `render` and `simulate`.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;

@@ -2,7 +2,7 @@
 //! CPU reference with the keys the JSON promises, the one-dispatch step, and a
 //! scaling chart.
 
-mod common;
+use crate::common;
 
 use std::time::Duration;
 

@@ -8,7 +8,7 @@
 //! stand for a defect of the tool's first hostile round also check the
 //! message that names it.
 
-mod common;
+use crate::common;
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! What the user gives the tool: grooms of any size framed in the picture,
 //! options that need others, defective real assets, and the messages for each.
 
-mod common;
+use crate::common;
 
 use std::time::Duration;
 

@@ -1,7 +1,7 @@
 //! Where the tool's output goes when things go wrong: a closed pipe, a full
 //! device, a killed run, absurd figures in a CSV, tiny images.
 
-mod common;
+use crate::common;
 
 use std::os::fd::{FromRawFd, OwnedFd};
 use std::os::unix::process::ExitStatusExt;

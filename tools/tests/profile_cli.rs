@@ -2,7 +2,7 @@
 //! the per-pass table, the Chrome trace and the JSON summary, all from the same
 //! reports; and memory that does not grow with the frame count.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -1,7 +1,7 @@
 //! `vkhair simulate` as a user meets it: a --check that states its tolerance and
 //! holds the README's promises, progress on long runs, the violent motion.
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 use std::time::Duration;

@@ -3,7 +3,7 @@
 //! small (128 MiB on lavapipe), and where even those cannot hold the request the
 //! tool says what it did and renders with the pool the device holds.
 
-mod common;
+use crate::common;
 
 use std::time::Duration;
 

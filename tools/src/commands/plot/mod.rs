@@ -9,7 +9,7 @@ use crate::output::CliResult;
 
 #[derive(clap::Args)]
 pub struct PlotArgs {
-    /// CSV written by `cargo bench --bench render` or `--bench volume`, or the
+    /// CSV written by `cargo bench --features bench --bench render` or `--bench volume`, or the
     /// scaling.csv or transparency.csv of `vkhair bench`.
     #[arg(default_value = "target/vkhair-bench/render.csv")]
     csv: PathBuf,
