@@ -43,17 +43,7 @@ fn is_test_file(path: &Path) -> bool {
 /// the items marked `#[cfg(test)]` (a `mod x;` line, or a braced block).
 fn crate_references(source: &str) -> BTreeSet<String> {
     let mut found = BTreeSet::new();
-    let mut lines = source.lines();
-    while let Some(line) = lines.next() {
-        let code = line.trim_start();
-        if code.starts_with("#[cfg(test)]") {
-            skip_item(&mut lines);
-            continue;
-        }
-        if code.starts_with("//") {
-            continue;
-        }
-        let code = code.split("//").next().unwrap_or_default();
+    for code in production_code(source).lines() {
         for (i, _) in code.match_indices("crate::") {
             let name: String = code[i + 7..].chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
             let before = code[..i].chars().next_back();

@@ -20,6 +20,24 @@ layout(std430, set = 0, binding = 14) buffer Counts { uint counts[]; };
 layout(std430, set = 0, binding = 31) buffer Accum { uint accum[]; };
 #include "volume_fixed.glsl"
 
+// Corner k (bit 0: +x, bit 1: +y, bit 2: +z) of the 8 grid points around s,
+// a position in that grid's own coordinates: the point, inside `extent` or
+// not, and its trilinear weight, the product (x · y) · z of 1 − t below and
+// t above along each axis (t: s's offset from the point below). Twin:
+// `reference::trilinear`.
+ivec3 corner_of(vec3 s, uint k, uvec3 extent, out bool inside, out float weight) {
+    vec3 below = floor(s);
+    precise vec3 t = s - below;
+    precise vec3 lower = 1.0 - t;
+    bvec3 up = bvec3((k & 1u) != 0u, (k & 2u) != 0u, (k & 4u) != 0u);
+    ivec3 q = ivec3(below) + ivec3(up);
+    inside = all(greaterThanEqual(q, ivec3(0))) && all(lessThan(q, ivec3(extent)));
+    vec3 a = mix(lower, t, up);
+    precise float w = (a.x * a.y) * a.z;
+    weight = w;
+    return q;
+}
+
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= vol_particles(vp)) {
@@ -37,22 +55,15 @@ void main() {
     }
     atomicAdd(counts[cell], 1u);
     bool flip = vol_mode(vp) == float(VOL_MODE_FLIP);
-    // Cell centres (i + ½, j + ½, k + ½) within a cell of g along every axis:
-    // along each, the one below with weight 1 − t and the one above with t
-    // (t: g's offset from the one below), w their product (x · y) · z.
+    // Cell centres (i + ½, j + ½, k + ½) within a cell of g along every axis.
     vec3 s = g - 0.5;
-    vec3 below = floor(s);
-    precise vec3 t = s - below;
-    precise vec3 lower = 1.0 - t;
-    ivec3 base = ivec3(below);
     for (uint k = 0u; k < 8u; ++k) {
-        bvec3 up = bvec3((k & 1u) != 0u, (k & 2u) != 0u, (k & 4u) != 0u);
-        ivec3 q = base + ivec3(up);
-        if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, ivec3(dims)))) {
+        bool inside;
+        float w;
+        ivec3 q = corner_of(s, k, dims, inside, w);
+        if (!inside) {
             continue;
         }
-        vec3 a = mix(lower, t, up);
-        precise float w = (a.x * a.y) * a.z;
         uint at = VOL_CELL_WORDS * vol_cell_index(uvec3(q), dims);
         vol_fixed_add(at, w);
         vol_fixed_add(at + 2u, v.x * w);
@@ -67,19 +78,13 @@ void main() {
     for (uint axis = 0u; axis < 3u; ++axis) {
         vec3 fs = s;
         fs[axis] = g[axis];
-        vec3 fbelow = floor(fs);
-        precise vec3 ft = fs - fbelow;
-        precise vec3 flower = 1.0 - ft;
-        ivec3 first = ivec3(fbelow);
-        uvec3 fd = vol_face_dims(dims, axis);
         for (uint k = 0u; k < 8u; ++k) {
-            bvec3 up = bvec3((k & 1u) != 0u, (k & 2u) != 0u, (k & 4u) != 0u);
-            ivec3 q = first + ivec3(up);
-            if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, ivec3(fd)))) {
+            bool inside;
+            float w;
+            ivec3 q = corner_of(fs, k, vol_face_dims(dims, axis), inside, w);
+            if (!inside) {
                 continue;
             }
-            vec3 a = mix(flower, ft, up);
-            precise float w = (a.x * a.y) * a.z;
             uint at = faces + VOL_FACE_WORDS * vol_face_index(uvec3(q), axis, dims, vol_first_v_face(vp), vol_first_w_face(vp));
             vol_fixed_add(at, w);
             vol_fixed_add(at + 2u, v[axis] * w);

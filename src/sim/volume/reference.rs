@@ -168,22 +168,12 @@ pub(crate) fn step(
     let mut face_sums = vec![[0i64; 2]; face_count];
     let add = |sum: &mut i64, x: f32| *sum = sum.wrapping_add(fixed_point(x));
     let flip = p.mode == vol_mode::FLIP as f32;
-    let corner =
-        |base: Vec3, k: i64| [base.x as i64 + (k & 1), base.y as i64 + ((k >> 1) & 1), base.z as i64 + (k >> 2)];
-    let at = |q: [i64; 3]| Vec3::new(q[0] as f32, q[1] as f32, q[2] as f32) + 0.5;
     for (g, v) in grid_pos.iter().map(|g| g.xyz()).zip(&grid_vel) {
         let Some(cell) = cell_of(g, grid.dims).and_then(|c| dims.index(c)) else { continue };
         counts[cell] += 1;
-        // Along each axis the grid point below with weight 1 − t, the one above
-        // with t; w = (x · y) · z, as `scatter.comp`.
         let s = g - 0.5;
-        let below = s.floor();
-        let (t, lower) = (s - below, Vec3::ONE - (s - below));
-        for k in 0..8 {
-            let q = corner(below, k);
+        for (q, w) in trilinear(s) {
             let Some(c) = dims.index(q) else { continue };
-            let a = Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), t, lower);
-            let w = (a.x * a.y) * a.z;
             let sum = &mut cell_sums[c];
             add(&mut sum[0], w);
             add(&mut sum[1], v.x * w);
@@ -194,19 +184,15 @@ pub(crate) fn step(
         for axis in (0..3).filter(|_| flip) {
             let mut fs = s;
             fs[axis] = g[axis];
-            let fbelow = fs.floor();
-            let (ft, flower) = (fs - fbelow, Vec3::ONE - (fs - fbelow));
-            for k in 0..8 {
-                let q = corner(fbelow, k);
+            for (q, w) in trilinear(fs) {
                 let Some(f) = face_index(grid, axis, q) else { continue };
-                let a = Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), ft, flower);
-                let w = (a.x * a.y) * a.z;
                 add(&mut face_sums[f][0], w);
                 add(&mut face_sums[f][1], v[axis] * w);
             }
         }
     }
     // 2. Cells and labels.
+    let at = |q: [i64; 3]| Vec3::new(q[0] as f32, q[1] as f32, q[2] as f32) + 0.5;
     let mut cell_data = vec![Vec4::ZERO; cells];
     let mut labels = vec![AIR; cells];
     for c in 0..cells {
@@ -488,14 +474,16 @@ pub(crate) fn sample_faces(grid: &GridLayout, face_vel: &[f32], face_star: &[f32
     result
 }
 
-/// The 8 grid points around `q` (clamped into `dims`) with their trilinear weights,
-/// in the order and rounding of the GPU's sampling loops.
-fn trilinear_corners(q: Vec3, dims: [u32; 3]) -> impl Iterator<Item = ([i64; 3], f32)> {
+/// The 8 grid points around `q` (q in that grid's coordinates; bit 0 of the
+/// index +x, bit 1 +y, bit 2 +z) with their trilinear weights, in the order and
+/// rounding of the GPU's loops (`corner_of` in `scatter.comp`, the samplers of
+/// `g2p.comp`): 1 − t below and t above along each axis, (x · y) · z.
+fn trilinear(q: Vec3) -> impl Iterator<Item = ([i64; 3], f32)> {
     let base = q.floor();
     let t = q - base;
     (0..8usize).map(move |k| {
         let corner = [k & 1, (k >> 1) & 1, k >> 2];
-        let at = [0, 1, 2].map(|a| (base[a] as i64 + corner[a] as i64).clamp(0, i64::from(dims[a]) - 1));
+        let at = [0, 1, 2].map(|a| base[a] as i64 + corner[a] as i64);
         let w3 = Vec3::new(
             if corner[0] == 1 { t.x } else { 1.0 - t.x },
             if corner[1] == 1 { t.y } else { 1.0 - t.y },
@@ -503,6 +491,11 @@ fn trilinear_corners(q: Vec3, dims: [u32; 3]) -> impl Iterator<Item = ([i64; 3],
         );
         (at, (w3.x * w3.y) * w3.z)
     })
+}
+
+/// [`trilinear`] with the points clamped into `dims`, as the samplers read them.
+fn trilinear_corners(q: Vec3, dims: [u32; 3]) -> impl Iterator<Item = ([i64; 3], f32)> {
+    trilinear(q).map(move |(at, w)| ([0, 1, 2].map(|a| at[a].clamp(0, i64::from(dims[a]) - 1)), w))
 }
 
 fn sample_cells(grid: &GridLayout, cells: &[Vec4], g: Vec3) -> Vec4 {
