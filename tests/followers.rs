@@ -8,7 +8,7 @@
 use glam::{Quat, Vec3, Vec4};
 use vkhair::groom::guides;
 use vkhair::render::reference::{rest_plane_normals, smooth_strand};
-use vkhair::render::{Camera, Followers, RenderParams, Renderer};
+use vkhair::render::{Camera, Followers, Interpolator, RenderParams, Renderer};
 use vkhair::sim::{HairSim, RigidTransform, SimParams, SimState};
 use vkhair::Groom;
 
@@ -181,6 +181,16 @@ fn in_motion_followers_follow_their_guides_with_roots_on_the_scalp() {
     let worst = drawn.iter().flatten().zip(cpu.iter().flatten()).map(|(a, b)| a.distance(*b)).fold(0.0, f32::max);
     println!("motion: GPU against CPU {worst:e} m");
     assert!(worst < GPU_TOLERANCE_M, "{worst} m");
+    // The tessellation stages grow the same followers as the compute dispatch.
+    assert_eq!(renderer.interpolator(), Interpolator::Compute);
+    let tessellation = RenderParams { interpolator: Interpolator::Tessellation, ..params() };
+    let mut tess = Renderer::with_followers(gpu.ctx(), &sim, &tessellation, &s.followers).expect("renderer");
+    assert_eq!(tess.interpolator(), Interpolator::Tessellation);
+    let tess_drawn = gpu_followers(&mut tess, &sim, &s);
+    let apart =
+        drawn.iter().flatten().zip(tess_drawn.iter().flatten()).map(|(a, b)| a.distance(*b)).fold(0.0, f32::max);
+    println!("motion: tessellation against compute {apart:e} m");
+    assert!(apart <= 1e-6, "the two interpolators' followers are {apart} m apart");
     // Roots: the authored roots carried by the head.
     let m = last.matrix();
     let root_error = (0..s.dense.strand_count())

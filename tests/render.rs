@@ -148,12 +148,12 @@ fn interpolation_grows_stable_clumps() {
 }
 
 /// Hairs per key hair beyond one patch's isolines (instances of the patches,
-/// up to the most, 1024): every hair of both interpolation modes, a last
-/// partial instance included, stored where the CPU puts it (within 1e-5 m), each
-/// with a clump coordinate or blend of its own.
+/// up to the most, 1024) through the tessellation stages: every hair of both
+/// interpolation modes, a last partial instance included, stored where the CPU
+/// puts it (within 1e-5 m), each with a clump coordinate or blend of its own.
 #[test]
 fn hairs_beyond_one_patch_take_instances() {
-    use vkhair::render::{scalp, InterpolationMode, MAX_HAIRS_PER_KEY};
+    use vkhair::render::{scalp, InterpolationMode, Interpolator, MAX_HAIRS_PER_KEY};
     let gpu = Gpu::new();
     let sim = grown_sim(&gpu, 24);
     let state = sim.read_state().expect("state");
@@ -164,8 +164,15 @@ fn hairs_beyond_one_patch_take_instances() {
         (InterpolationMode::Barycentric, 129),
         (InterpolationMode::SingleStrand, MAX_HAIRS_PER_KEY),
     ] {
-        let render = RenderParams { hairs_per_key, interpolation: mode, smoothing_level: 2, ..RenderParams::default() };
+        let render = RenderParams {
+            hairs_per_key,
+            interpolation: mode,
+            smoothing_level: 2,
+            interpolator: Interpolator::Tessellation,
+            ..RenderParams::default()
+        };
         let mut renderer = Renderer::new(gpu.ctx(), &sim, &render).expect("renderer");
+        assert_eq!(renderer.interpolator(), Interpolator::Tessellation);
         renderer.prepare_now(&sim, None).expect("prepare");
         let (hairs, per_hair) = renderer.hair_counts();
         let units = if mode == InterpolationMode::Barycentric { triangles.len() } else { 24 };
@@ -234,6 +241,61 @@ fn hairs_beyond_one_patch_take_instances() {
     let fits = (24 * per_key as usize / triangles.len()) as u32;
     assert!(matches!(renderer.set_params(&big_bary(fits + 1)), Err(Error::InvalidParameter { .. })));
     renderer.set_params(&big_bary(fits)).expect("as many hairs as the renderer holds");
+}
+
+/// The compute interpolator grows the same hairs as the tessellation stages
+/// (`RenderParams::interpolator`): every vertex of both interpolation modes,
+/// more hairs per key hair than one patch holds and a smoothing level above
+/// one, positions within 1e-6 m and tangents within 1e-6, in motion (the
+/// followers' twin is in `followers.rs`); `Auto` resolves to compute on every
+/// device type.
+#[test]
+fn both_interpolators_grow_the_same_hairs() {
+    use vkhair::ash::vk::PhysicalDeviceType;
+    use vkhair::render::{InterpolationMode, Interpolator};
+    for device_type in [PhysicalDeviceType::CPU, PhysicalDeviceType::DISCRETE_GPU, PhysicalDeviceType::VIRTUAL_GPU] {
+        assert_eq!(Interpolator::Auto.resolve(device_type), Interpolator::Compute, "{device_type:?}");
+        assert_eq!(Interpolator::Tessellation.resolve(device_type), Interpolator::Tessellation);
+    }
+    let gpu = Gpu::new();
+    let params = SimParams::default();
+    let mut sim = grown_sim(&gpu, 24);
+    sim.run(10, |i| motion::reference_motion((i + 1) as f32 * params.dt), None).expect("run");
+    for mode in [InterpolationMode::SingleStrand, InterpolationMode::Barycentric] {
+        // Both renderers alive at once, so neither's hairs can sit in memory
+        // the other one left behind.
+        let renderers: Vec<Renderer> = [Interpolator::Tessellation, Interpolator::Compute]
+            .into_iter()
+            .map(|interpolator| {
+                let render = RenderParams {
+                    hairs_per_key: 37,
+                    interpolation: mode,
+                    smoothing_level: 3,
+                    interpolator,
+                    ..RenderParams::default()
+                };
+                let renderer = Renderer::new(gpu.ctx(), &sim, &render).expect("renderer");
+                assert_eq!(renderer.interpolator(), interpolator);
+                renderer
+            })
+            .collect();
+        let mut grown = Vec::new();
+        for mut renderer in renderers {
+            renderer.prepare_now(&sim, None).expect("prepare");
+            let (hairs, per_hair) = renderer.hair_counts();
+            let (positions, tangents) = renderer.read_hairs().expect("hairs");
+            assert_eq!(positions.len(), (hairs * per_hair) as usize);
+            grown.push((positions, tangents, renderer));
+        }
+        let [(tess_p, tess_t, _), (comp_p, comp_t, _)] = &grown[..] else { unreachable!("two renderers") };
+        let worst = |a: &[glam::Vec4], b: &[glam::Vec4]| {
+            a.iter().zip(b).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0, f32::max)
+        };
+        let (dp, dt) = (worst(tess_p, comp_p), worst(tess_t, comp_t));
+        eprintln!("{mode:?}: {} vertices, largest difference {dp:e} m, tangents {dt:e}", tess_p.len());
+        assert!(tess_p.iter().all(|p| p.is_finite() && p.truncate() != Vec3::ZERO), "{mode:?}: a vertex was not grown");
+        assert!(dp <= 1e-6 && dt <= 1e-6, "{mode:?}: {dp} {dt}");
+    }
 }
 
 // ---- Drawing -----------------------------------------------------------------

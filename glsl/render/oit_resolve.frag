@@ -1,125 +1,20 @@
 #version 460
-// Exact transparency, resolve (over the rectangle the ribbons reach,
-// hair_rect.vert): walks the pixel's list, keeps its K nearest fragments
-// sorted by depth (one compare-and-swap pass over the first K of the
-// SORT_CAPACITY slots per fragment), folds every farther one into an
-// order-independent tail (sum of premultiplied colour, sum of alpha, product
-// of transmittance) together with the fragments the full pool could not store
-// (the build's overflow sums), composites the K front to back and the tail
-// behind them, and blends the result over the target as premultiplied colour.
-// Pixels without hair are discarded.
-//
-// The kept fragments live in local arrays of SORT_CAPACITY entries (depth and
-// packed half-float colour), every pass over them unrolled: the smallest
-// variant that holds K is chosen (exact.rs), since each fragment costs
-// SORT_CAPACITY compare-and-swaps whatever K is.
+// Exact transparency, composite (over the rectangle the ribbons reach,
+// hair_rect.vert): each pixel's list resolved (oit_resolve.glsl) and blended
+// over the target as premultiplied colour; pixels without hair are discarded.
+// The compute rasteriser's frames resolve in compute instead
+// (oit_resolve.comp, then oit_resolved.frag).
 // vkhair variant: VKHAIR_SORT_4
 // vkhair variant: VKHAIR_SORT_8
 // vkhair variant: VKHAIR_SORT_16
-// vkhair variant: VKHAIR_OVERFLOW_BUFFER
-// vkhair variant: VKHAIR_SORT_4 VKHAIR_OVERFLOW_BUFFER
-// vkhair variant: VKHAIR_SORT_8 VKHAIR_OVERFLOW_BUFFER
-// vkhair variant: VKHAIR_SORT_16 VKHAIR_OVERFLOW_BUFFER
-//
-// The VKHAIR_OVERFLOW_BUFFER variants composite what the compute rasteriser
-// built: its overflow is the fixed-point sums of oit_overflow.glsl instead of
-// the hardware build's blended images.
-#extension GL_EXT_control_flow_attributes : require
-#include "oit.glsl"
-
-#if defined(VKHAIR_SORT_4)
-#define SORT_CAPACITY 4u
-#elif defined(VKHAIR_SORT_8)
-#define SORT_CAPACITY 8u
-#elif defined(VKHAIR_SORT_16)
-#define SORT_CAPACITY 16u
-#else
-#define SORT_CAPACITY OIT_MAX_SORTED
-#endif
-
-#ifdef VKHAIR_OVERFLOW_BUFFER
-#include "oit_overflow.glsl"
-#else
-// The build's sums of the fragments beyond the pool: Σ premultiplied colour and
-// Σ alpha; Σ absorbance −ln(1 − alpha).
-layout(set = 0, binding = 0) uniform sampler2D overflow_sum;
-layout(set = 0, binding = 1) uniform sampler2D overflow_absorbance;
-#endif
+#include "oit_resolve.glsl"
 
 layout(location = 0) out vec4 out_color;
 
-// The depth of an empty slot: beyond every fragment's (depths lie in 0..1).
-const float EMPTY = 2.0;
-
-// A node's colour and alpha from their half floats (oit_build.frag packs them).
-vec4 unpack_color(uvec2 packed) {
-    return vec4(unpackHalf2x16(packed.x), unpackHalf2x16(packed.y));
-}
-
 void main() {
-    uint node = oit_heads[oit_pixel(gl_FragCoord)];
-#ifdef VKHAIR_OVERFLOW_BUFFER
-    vec4 overflow = oit_overflow_sum(oit_pixel(gl_FragCoord));
-    float absorbance_sum = oit_overflow_absorbance(oit_pixel(gl_FragCoord));
-#else
-    vec4 overflow = texelFetch(overflow_sum, ivec2(gl_FragCoord.xy), 0);
-    float absorbance_sum = texelFetch(overflow_absorbance, ivec2(gl_FragCoord.xy), 0).r;
-#endif
-    if (node == OIT_END && overflow.a <= 0.0) {
+    vec4 result;
+    if (!oit_resolve_pixel(oit_pixel(gl_FragCoord), ivec2(gl_FragCoord.xy), result)) {
         discard;
     }
-    // Slot i holds the i-th nearest kept fragment; an empty slot holds depth
-    // EMPTY, beyond every fragment's. Every index below is a constant once the
-    // loops are unrolled: the arrays stay in registers (a dynamically indexed
-    // local array is scratch memory, gathered and scattered per lane on a CPU
-    // device, and cost the resolve about a third of its time on lavapipe).
-    float depth[SORT_CAPACITY];
-    uvec2 color[SORT_CAPACITY];
-    [[unroll]] for (uint i = 0u; i < SORT_CAPACITY; i++) {
-        depth[i] = EMPTY;
-        color[i] = uvec2(0u);
-    }
-    uint k = min(oit.sorted, SORT_CAPACITY);
-    vec3 tail_sum = overflow.rgb;
-    float tail_alpha = overflow.a;
-    float tail_transmittance = exp(-absorbance_sum);
-    // Each stored node is on exactly one list: at most min(used, capacity) steps.
-    uint steps = min(oit.used, oit.capacity);
-    for (uint step = 0u; node != OIT_END && step < steps; step++) {
-        uvec4 record = oit_load(node);
-        node = record.w;
-        // Insertion by one pass over the k slots: the fragment in hand swaps
-        // places with every kept one farther than it, so the slots stay sorted
-        // (fragments at one depth in no set order, as they reach the list in
-        // none) and what is left in hand is the farthest of the k + 1 — the
-        // new fragment or one pushed out — bound for the tail.
-        float z = uintBitsToFloat(record.z);
-        uvec2 c = record.xy;
-        [[unroll]] for (uint i = 0u; i < SORT_CAPACITY; i++) {
-            bool swap = i < k && z < depth[i];
-            float kept_z = depth[i];
-            uvec2 kept_c = color[i];
-            depth[i] = swap ? z : kept_z;
-            color[i] = swap ? c : kept_c;
-            z = swap ? kept_z : z;
-            c = swap ? kept_c : c;
-        }
-        // An empty slot's colour is zero: handed out, it adds nothing.
-        vec4 out_c = unpack_color(c);
-        tail_sum += out_c.rgb * out_c.a;
-        tail_alpha += out_c.a;
-        tail_transmittance *= 1.0 - out_c.a;
-    }
-    vec3 sum = vec3(0.0);
-    float transmittance = 1.0;
-    [[unroll]] for (uint i = 0u; i < SORT_CAPACITY; i++) {
-        vec4 c = unpack_color(color[i]);
-        sum += transmittance * c.a * c.rgb;
-        transmittance *= 1.0 - c.a;
-    }
-    if (tail_alpha > 0.0) {
-        sum += transmittance * (1.0 - tail_transmittance) * (tail_sum / tail_alpha);
-        transmittance *= tail_transmittance;
-    }
-    out_color = vec4(sum, 1.0 - transmittance);
+    out_color = result;
 }

@@ -15,6 +15,10 @@
 //! With [`Followers`] (a dense authored groom) a third evaluation stage draws
 //! them instead: one patch per follower segment, each point the blend of its
 //! guides plus its rest offset in their frames (see [`super::followers`]).
+//!
+//! Each mode's vertex is one function (`glsl/include/grow_*.glsl`) that either
+//! the evaluation stage above or a compute dispatch (`interpolate.comp`, one
+//! invocation per vertex) calls: [`Interpolator`] picks which.
 
 use std::sync::Arc;
 
@@ -24,18 +28,20 @@ use glam::{Vec3, Vec4};
 use super::followers::Followers;
 use super::pass::{self, RenderPass};
 use super::smooth::SmoothPass;
-use super::InterpolationMode;
+use super::{InterpolationMode, Interpolator};
 use crate::codes;
 use crate::error::{Error, Result};
 use crate::gpu_types::InterpolatePush;
 use crate::profiler::Timing;
 use crate::sim::SimState;
+use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
-use crate::vk::pipeline::GraphicsPipeline;
+use crate::vk::pipeline::{ComputePipeline, GraphicsPipeline};
 use crate::vk::shaders::{
-    ShaderSource, RENDER_INTERPOLATE_BARY_TESE, RENDER_INTERPOLATE_FOLLOW_TESE, RENDER_INTERPOLATE_TESC,
-    RENDER_INTERPOLATE_TESE, RENDER_INTERPOLATE_VERT,
+    ShaderSource, RENDER_INTERPOLATE_BARY_TESE, RENDER_INTERPOLATE_COMP, RENDER_INTERPOLATE_COMP_BARY,
+    RENDER_INTERPOLATE_COMP_FOLLOW, RENDER_INTERPOLATE_FOLLOW_TESE, RENDER_INTERPOLATE_TESC, RENDER_INTERPOLATE_TESE,
+    RENDER_INTERPOLATE_VERT,
 };
 
 /// Per key hair, its rest-plane normal ([`super::reference::rest_plane_normals`]).
@@ -104,9 +110,29 @@ struct Follow {
     _offsets: Buffer,
 }
 
+/// One mode's two ways to grow its hairs: the tessellation stages and the
+/// compute dispatch, each with its descriptor set.
 struct Pipeline {
     pipeline: GraphicsPipeline,
     set: vk::DescriptorSet,
+    compute: ComputePipeline,
+    compute_set: vk::DescriptorSet,
+}
+
+/// Shader stages that read the grown hairs.
+const HAIR_READERS: &[AccessKind] =
+    &[AccessKind::VertexRead, AccessKind::TessellationRead, AccessKind::FragmentRead, AccessKind::ComputeRead];
+
+/// Workgroups of one row of the compute dispatch: within
+/// `maxComputeWorkGroupCount`'s least x (65,535) on every device.
+const DISPATCH_ROW: u32 = 32_768;
+
+/// The workgroup counts (x, y) of a dispatch of `groups` workgroups in rows of
+/// at most [`DISPATCH_ROW`] (`interpolate.comp` numbers workgroup (x, y) as
+/// y · x-count + x; invocations past the vertices do nothing).
+fn dispatch_grid(groups: u32) -> (u32, u32) {
+    let x = groups.clamp(1, DISPATCH_ROW);
+    (x, groups.div_ceil(x).max(1))
 }
 
 impl InterpolatePass {
@@ -139,7 +165,7 @@ impl InterpolatePass {
             (4, &tangents),
             (5, &triangle_buffer),
         ];
-        let pipeline = |evaluation: &ShaderSource| -> Result<Pipeline> {
+        let pipeline = |evaluation: &ShaderSource, grow: &ShaderSource| -> Result<Pipeline> {
             let pipeline = pass::capture_pipeline(
                 device,
                 evaluation.name,
@@ -149,7 +175,9 @@ impl InterpolatePass {
             )?;
             // Each evaluation stage declares the bindings it uses.
             let set = pipeline.declared_buffer_set(0, &bindings)?;
-            Ok(Pipeline { pipeline, set })
+            let compute = ComputePipeline::new(device, grow, 1)?;
+            let compute_set = compute.declared_buffer_set(0, &bindings)?;
+            Ok(Pipeline { pipeline, set, compute, compute_set })
         };
         let colors = followers.and_then(Followers::colors);
         let widths = followers.and_then(Followers::width_factors);
@@ -192,7 +220,9 @@ impl InterpolatePass {
                     (8, &looks),
                 ];
                 let set = pipeline.declared_buffer_set(0, &all)?;
-                Some(Follow { pipeline: Pipeline { pipeline, set }, _bindings: b, _offsets: o })
+                let compute = ComputePipeline::new(device, &RENDER_INTERPOLATE_COMP_FOLLOW, 1)?;
+                let compute_set = compute.declared_buffer_set(0, &all)?;
+                Some(Follow { pipeline: Pipeline { pipeline, set, compute, compute_set }, _bindings: b, _offsets: o })
             }
         };
         Ok(InterpolatePass {
@@ -200,8 +230,8 @@ impl InterpolatePass {
             follow,
             own_colors: colors.is_some(),
             looks,
-            single_strand: pipeline(&RENDER_INTERPOLATE_TESE)?,
-            barycentric: pipeline(&RENDER_INTERPOLATE_BARY_TESE)?,
+            single_strand: pipeline(&RENDER_INTERPOLATE_TESE, &RENDER_INTERPOLATE_COMP)?,
+            barycentric: pipeline(&RENDER_INTERPOLATE_BARY_TESE, &RENDER_INTERPOLATE_COMP_BARY)?,
             reference,
             _triangle_buffer: triangle_buffer,
             triangles: triangles.len() as u32,
@@ -243,8 +273,10 @@ impl InterpolatePass {
         (&self.positions, &self.tangents)
     }
 
-    /// Records the pass in its own capture instance and scope; its stores are
-    /// visible to every later shader stage after it.
+    /// Records the pass in its own scope, through the tessellation stages (a
+    /// capture instance) or a compute dispatch as `interpolator` says
+    /// ([`Interpolator::Auto`] is taken as [`Interpolator::Compute`]); its
+    /// stores are visible to every later shader stage after it.
     ///
     /// # Safety
     /// `cmd` is a recording command buffer of this device outside a render pass,
@@ -256,6 +288,7 @@ impl InterpolatePass {
         &self,
         cmd: vk::CommandBuffer,
         mode: InterpolationMode,
+        interpolator: Interpolator,
         push: &InterpolatePush,
         timing: Timing<'_>,
     ) {
@@ -265,6 +298,25 @@ impl InterpolatePass {
             (None, InterpolationMode::SingleStrand) => &self.single_strand,
             (None, InterpolationMode::Barycentric) => &self.barycentric,
         };
+        if interpolator != Interpolator::Tessellation {
+            // Every grown vertex: the units' hairs' smoothed vertices (their
+            // points, with followers).
+            let per_hair = if self.follow.is_some() { push.points } else { push.stride };
+            let vertices = push.strands * push.hairs * per_hair;
+            let (x, y) = dispatch_grid(vertices.div_ceil(p.compute.workgroup_size()[0]));
+            let written = barrier::memory(&[AccessKind::ComputeWrite], HAIR_READERS);
+            // SAFETY: guaranteed by the caller; the dispatch covers every vertex
+            // (interpolate.comp returns past the last).
+            unsafe {
+                let scope = RenderPass::Interpolate.open(d, cmd, timing);
+                p.compute.bind(cmd, &[p.compute_set]);
+                p.compute.push(cmd, push);
+                p.compute.dispatch_groups(cmd, [x, y, 1]);
+                d.cmd_barrier(cmd, &[written], &[], &[]);
+                scope.close(d, cmd, timing);
+            }
+            return;
+        }
         // SAFETY: guaranteed by the caller: one patch per key segment of each
         // unit (per follower segment, one line each, with followers).
         unsafe {

@@ -48,8 +48,8 @@ pub use draw::{OitPool, OitStats};
 pub use followers::Followers;
 pub use marschner::MarschnerParams;
 pub use params::{
-    Detail, InterpolationMode, LodParams, OitParams, Primitive, Raster, RenderParams, Transparency, MAX_HAIRS_PER_KEY,
-    MAX_SMOOTHING_LEVEL,
+    Detail, InterpolationMode, Interpolator, LodParams, OitParams, Primitive, Raster, RenderParams, Transparency,
+    MAX_HAIRS_PER_KEY, MAX_SMOOTHING_LEVEL,
 };
 pub use pass::RenderPass;
 pub use scalp_coverage::{scalp_coverage, ScalpCoverage, MAX_COVERAGE_PROBES};
@@ -384,8 +384,11 @@ impl Renderer {
 impl Renderer {
     /// Records the geometry passes (smoothing, interpolation) for `sim`'s latest
     /// state into `cmd`, at the detail for `camera` ([`LodParams`]; full detail
-    /// without a camera). Leaves the interpolation pipeline bound and a 1 × 1
-    /// viewport and scissor set: a host binds its own pipeline and state again
+    /// without a camera). Leaves the interpolation pipeline bound (a graphics
+    /// one with a 1 × 1 viewport and scissor set through the tessellation
+    /// stages, a compute one through a dispatch, [`Renderer::interpolator`]; the
+    /// smoothing pass's graphics pipeline and 1 × 1 viewport and scissor
+    /// stay bound too then): a host binds its own pipeline and state again
     /// afterwards.
     ///
     /// # Safety
@@ -416,7 +419,13 @@ impl Renderer {
         }
         let entry = barrier::memory(
             &[AccessKind::AnyWrite],
-            &[AccessKind::VertexRead, AccessKind::TessellationRead, AccessKind::TessellationWrite],
+            &[
+                AccessKind::VertexRead,
+                AccessKind::TessellationRead,
+                AccessKind::TessellationWrite,
+                AccessKind::ComputeRead,
+                AccessKind::ComputeWrite,
+            ],
         );
         let (smooth_push, interpolate_push) = (self.smooth_push(sim.alpha), self.interpolate_push());
         let timing = Timing::of(profiler.as_deref());
@@ -424,9 +433,16 @@ impl Renderer {
         unsafe {
             self.device.cmd_barrier(cmd, &[entry], &[], &[]);
             self.smooth.record(cmd, sim.current, &smooth_push, timing);
-            self.interpolate.record(cmd, self.params.interpolation, &interpolate_push, timing);
+            let interpolator = self.interpolator();
+            self.interpolate.record(cmd, self.params.interpolation, interpolator, &interpolate_push, timing);
         }
         Ok(())
+    }
+
+    /// Who grows the drawn hairs on this device: [`RenderParams::interpolator`]
+    /// resolved for the device's type ([`Interpolator::resolve`]).
+    pub fn interpolator(&self) -> Interpolator {
+        self.params.interpolator.resolve(self.device.info.device_type)
     }
 
     /// Records [`Renderer::record_prepare`] in its own submission and waits (headless

@@ -43,6 +43,11 @@ pub struct RenderParams {
     /// rasteriser. Default: [`Raster::Auto`] (compute on GPUs, see
     /// [`Raster::Auto`] for CPU devices).
     pub raster: Raster,
+    /// Who grows the drawn hairs from the smoothed key hairs: the tessellation
+    /// isoline stages or a compute dispatch (the same vertices either way).
+    /// Default: [`Interpolator::Auto`] (compute on GPUs, see
+    /// [`Interpolator::Auto`] for CPU devices).
+    pub interpolator: Interpolator,
     /// Frames the host has in flight (1..=16): images a new target size makes
     /// obsolete are freed this many frames after their last use. Default: 2.
     pub frames_in_flight: u32,
@@ -87,6 +92,7 @@ impl Default for RenderParams {
             transparency: Transparency::Off,
             oit: OitParams::default(),
             raster: Raster::Auto,
+            interpolator: Interpolator::Auto,
             frames_in_flight: 2,
         }
     }
@@ -196,6 +202,53 @@ const CPU_DEVICE_STRANDS: Raster = Raster::Hardware;
 /// one faster there. Same runs, the two shadow passes: 51–53 ms through the
 /// hardware's lines against 23 ms through the compute rasteriser.
 const CPU_DEVICE_SHADOWS: Raster = Raster::Compute;
+
+/// Who grows the drawn hairs (pass 2, `render/interpolate.rs`; with the
+/// `clap` feature, a command-line value: `auto`, `tessellation`, `compute`).
+///
+/// Both run the same per-vertex code (`glsl/include/grow_*.glsl`) and store
+/// the same vertices at the same places; they differ in how the work reaches
+/// the GPU. The tessellation stages (the design's isolines: one patch per key
+/// segment, one isoline per grown hair) run where a GPU runs its geometry,
+/// which on an NVIDIA H100 is a small part of the chip: measured there
+/// (`tools/gpu-bench.sh`), 96,609 hairs over the thesis' scalp took 3.95 ms
+/// and 1,001,000 clump hairs 31.6 ms — about 1 ns a vertex, wherever the
+/// vertex's arithmetic was. A compute dispatch (one invocation per vertex)
+/// runs on every unit and writes neighbouring vertices from neighbouring
+/// invocations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "snake_case")]
+pub enum Interpolator {
+    /// A compute dispatch on GPUs (discrete, integrated, virtual); on a CPU
+    /// device (lavapipe) the one measured faster there ([`Interpolator::resolve`]).
+    #[default]
+    #[cfg_attr(feature = "clap", value(help = "Compute on GPUs; on a CPU device the faster one there"))]
+    Auto,
+    /// The tessellation isoline stages.
+    #[cfg_attr(feature = "clap", value(help = "The tessellation isoline stages"))]
+    Tessellation,
+    /// A compute dispatch, one invocation per grown vertex.
+    #[cfg_attr(feature = "clap", value(help = "A compute dispatch, one invocation per vertex"))]
+    Compute,
+}
+
+impl Interpolator {
+    /// What this choice names on a device of type `device_type`:
+    /// [`Interpolator::Tessellation`] or [`Interpolator::Compute`], never
+    /// [`Interpolator::Auto`].
+    pub fn resolve(self, device_type: ash::vk::PhysicalDeviceType) -> Interpolator {
+        match self {
+            Interpolator::Auto if device_type == ash::vk::PhysicalDeviceType::CPU => CPU_DEVICE_INTERPOLATOR,
+            Interpolator::Auto => Interpolator::Compute,
+            chosen => chosen,
+        }
+    }
+}
+
+/// What [`Interpolator::Auto`] picks on a CPU device (lavapipe): the one
+/// faster there (README, "Interpolation").
+const CPU_DEVICE_INTERPOLATOR: Interpolator = Interpolator::Compute;
 
 /// Smallest [`OitParams::max_buffer_bytes`] other than 0 (64 KiB).
 pub const MIN_POOL_BUFFER_BYTES: u32 = 65_536;

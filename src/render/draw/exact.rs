@@ -18,39 +18,49 @@ use crate::render::Raster;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::{Device, DeviceInfo};
 use crate::vk::shaders::{
-    RENDER_OIT_BUILD_FRAG, RENDER_OIT_RESOLVE_FRAG, RENDER_OIT_RESOLVE_FRAG_OVERFLOW_BUFFER,
-    RENDER_OIT_RESOLVE_FRAG_SORT_16, RENDER_OIT_RESOLVE_FRAG_SORT_16_OVERFLOW_BUFFER, RENDER_OIT_RESOLVE_FRAG_SORT_4,
-    RENDER_OIT_RESOLVE_FRAG_SORT_4_OVERFLOW_BUFFER, RENDER_OIT_RESOLVE_FRAG_SORT_8,
-    RENDER_OIT_RESOLVE_FRAG_SORT_8_OVERFLOW_BUFFER,
+    ShaderSource, RENDER_OIT_BUILD_FRAG, RENDER_OIT_RESOLVED_FRAG, RENDER_OIT_RESOLVE_COMP,
+    RENDER_OIT_RESOLVE_COMP_SORT_16, RENDER_OIT_RESOLVE_COMP_SORT_4, RENDER_OIT_RESOLVE_COMP_SORT_8,
+    RENDER_OIT_RESOLVE_FRAG, RENDER_OIT_RESOLVE_FRAG_SORT_16, RENDER_OIT_RESOLVE_FRAG_SORT_4,
+    RENDER_OIT_RESOLVE_FRAG_SORT_8,
 };
 
-/// The build's and the composite's fragment stages for `sorted` (K) fragments
-/// sorted per pixel: the composite variant with the smallest arrays that hold
-/// K, reading the overflow from the hardware build's images or, after the
-/// compute rasteriser (`raster.rs`, whose build is a compute pipeline of its
-/// own), from its sums.
+/// The build's and the composite's stages for `sorted` (K) fragments sorted
+/// per pixel: the resolve variant with the smallest arrays that hold K. After
+/// the hardware build, the composite's fragment stage resolves each pixel and
+/// reads the overflow from the build's images; after the compute rasteriser
+/// (`raster.rs`, whose build is a compute pipeline of its own), a compute
+/// dispatch resolves every pixel with its overflow sums
+/// (`oit_resolve.comp`) and the composite's fragment stage only blends the
+/// result (`oit_resolved.frag`).
 pub(super) fn shaders(sorted: u32, raster: Raster) -> ModeShaders {
-    let variants = match raster {
-        Raster::Compute => [
-            &RENDER_OIT_RESOLVE_FRAG_SORT_4_OVERFLOW_BUFFER,
-            &RENDER_OIT_RESOLVE_FRAG_SORT_8_OVERFLOW_BUFFER,
-            &RENDER_OIT_RESOLVE_FRAG_SORT_16_OVERFLOW_BUFFER,
-            &RENDER_OIT_RESOLVE_FRAG_OVERFLOW_BUFFER,
-        ],
-        _ => [
-            &RENDER_OIT_RESOLVE_FRAG_SORT_4,
-            &RENDER_OIT_RESOLVE_FRAG_SORT_8,
-            &RENDER_OIT_RESOLVE_FRAG_SORT_16,
-            &RENDER_OIT_RESOLVE_FRAG,
-        ],
-    };
-    let composite = match sorted {
+    let pick = |variants: [&'static ShaderSource; 4]| match sorted {
         0..=4 => variants[0],
         5..=8 => variants[1],
         9..=16 => variants[2],
         _ => variants[3],
     };
-    ModeShaders { build: &RENDER_OIT_BUILD_FRAG, composite }
+    match raster {
+        Raster::Compute => ModeShaders {
+            build: &RENDER_OIT_BUILD_FRAG,
+            composite: &RENDER_OIT_RESOLVED_FRAG,
+            resolve: Some(pick([
+                &RENDER_OIT_RESOLVE_COMP_SORT_4,
+                &RENDER_OIT_RESOLVE_COMP_SORT_8,
+                &RENDER_OIT_RESOLVE_COMP_SORT_16,
+                &RENDER_OIT_RESOLVE_COMP,
+            ])),
+        },
+        _ => ModeShaders {
+            build: &RENDER_OIT_BUILD_FRAG,
+            composite: pick([
+                &RENDER_OIT_RESOLVE_FRAG_SORT_4,
+                &RENDER_OIT_RESOLVE_FRAG_SORT_8,
+                &RENDER_OIT_RESOLVE_FRAG_SORT_16,
+                &RENDER_OIT_RESOLVE_FRAG,
+            ]),
+            resolve: None,
+        },
+    }
 }
 
 /// Bytes of one stored fragment (colour and alpha as half floats, depth, next).

@@ -18,7 +18,7 @@ use crate::vk::shaders::{RENDER_OIT_WEIGHTED_FRAG, RENDER_OIT_WEIGHTED_RESOLVE_F
 
 /// The build's and the composite's fragment stages.
 pub(super) const SHADERS: ModeShaders =
-    ModeShaders { build: &RENDER_OIT_WEIGHTED_FRAG, composite: &RENDER_OIT_WEIGHTED_RESOLVE_FRAG };
+    ModeShaders { build: &RENDER_OIT_WEIGHTED_FRAG, composite: &RENDER_OIT_WEIGHTED_RESOLVE_FRAG, resolve: None };
 
 /// Format of the weighted colour and weight sums.
 pub(super) const WEIGHTED_SUM: vk::Format = vk::Format::R32G32B32A32_SFLOAT;

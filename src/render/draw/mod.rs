@@ -56,6 +56,16 @@ use transparent::TransparentPass;
 pub(super) struct ModeShaders {
     pub build: &'static ShaderSource,
     pub composite: &'static ShaderSource,
+    /// A compute resolve recorded before the composite, when the mode has one.
+    pub resolve: Option<&'static ShaderSource>,
+}
+
+impl ModeShaders {
+    /// The name the mode's pipelines are kept under: the resolve's, else the
+    /// composite's (each names the mode and its K).
+    pub fn key(&self) -> &'static str {
+        self.resolve.map_or(self.composite.name, |r| r.name)
+    }
 }
 
 /// Formats, sample count and primitive a draw pipeline is made for.

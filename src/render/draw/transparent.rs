@@ -18,6 +18,12 @@
 //!    triangles, `hair_rect.vert`), blends each pixel's hair over the target as
 //!    premultiplied colour, then writes that nearest half-opaque depth into the
 //!    target's depth where it is nearer, so later host passes see the hair.
+//!    After the compute rasteriser the exact mode's lists are resolved by a
+//!    compute dispatch first (`oit_resolve.comp`, one invocation a pixel of the
+//!    rectangle, into four half floats a pixel), so the lists are walked by
+//!    every unit of the GPU and the fragment stage only blends
+//!    (`oit_resolved.frag`); after the hardware build the fragment stage
+//!    walks them (`oit_resolve.frag`).
 //!
 //! The pass owns the lists, the accumulation images and their pipelines for the
 //! current extent and mode; when either changes, the old ones are retired and
@@ -56,6 +62,11 @@ use crate::vk::shaders::{
 const READ_BY_ANY: &[AccessKind] = &[AccessKind::VertexRead, AccessKind::ComputeRead, AccessKind::FragmentRead];
 /// Writes to the pass's buffers by its stages.
 const WRITTEN_BY_ANY: &[AccessKind] = &[AccessKind::ComputeWrite, AccessKind::FragmentWrite];
+
+/// Bytes per pixel of the compute resolve's output (four half floats).
+const RESOLVED_BYTES_PER_PIXEL: u64 = 8;
+/// Its binding (`OitResolved` in `oit_resolve.comp` and `oit_resolved.frag`).
+const RESOLVED_BINDING: u32 = 28;
 
 /// Workgroups of a dispatch that every device runs (`maxComputeWorkGroupCount`'s minimum).
 const MAX_WORKGROUPS: u32 = 65_535;
@@ -98,6 +109,8 @@ struct Pipelines {
     points: (ComputePipeline, vk::DescriptorSet),
     rect: (ComputePipeline, vk::DescriptorSet),
     build: Build,
+    /// The compute resolve before the composite (the compute rasteriser's exact mode).
+    resolve: Option<(ComputePipeline, vk::DescriptorSet)>,
     composite: (GraphicsPipeline, vk::DescriptorSet),
     depth: Option<(GraphicsPipeline, vk::DescriptorSet)>,
 }
@@ -114,6 +127,9 @@ struct Resources {
     sums: Option<WeightedSums>,
     /// The compute rasteriser's copy of the target's depth and its overflow sums.
     raster_buffers: Option<RasterBuffers>,
+    /// The compute rasteriser's exact mode: per pixel its resolved hair
+    /// (`oit_resolve.comp`; four half floats), which the composite blends.
+    resolved: Option<Buffer>,
     /// By target and composite shader (the exact mode's depends on K).
     pipelines: HashMap<(TargetKey, &'static str), Pipelines>,
 }
@@ -186,9 +202,11 @@ impl TransparentPass {
             _ => fast::BYTES_PER_PIXEL * pixels,
         };
         let shared = std::mem::size_of::<OitCounters>() as u64 + self.colors.size() + 4 * pixels + overflow;
+        // The compute rasteriser's exact mode resolves into a buffer first.
+        let resolved = if raster == Raster::Compute { RESOLVED_BYTES_PER_PIXEL * pixels } else { 0 };
         match mode {
             Transparency::Off => 0,
-            Transparency::Exact => shared + Lists::memory_bytes(&OitPool::plan(info, params, extent)),
+            Transparency::Exact => shared + resolved + Lists::memory_bytes(&OitPool::plan(info, params, extent)),
             Transparency::Fast => shared,
         }
     }
@@ -263,7 +281,7 @@ impl TransparentPass {
             return Err(Error::incompatible(
                 "render target",
                 format!(
-                    "transparent hair drawn at {}×{} needs {pixel_words} bytes of per-pixel words, more than                      this device's storage buffer range ({} bytes): draw smaller or without supersampling",
+                    "transparent hair drawn at {}×{} needs {pixel_words} bytes of per-pixel words, more than this device's storage buffer range ({} bytes): draw smaller or without supersampling",
                     extent.width, extent.height, d.info.max_storage_buffer_range
                 ),
             ));
@@ -281,6 +299,12 @@ impl TransparentPass {
             lists,
             sums: if compute { None } else { Some(WeightedSums::new(d, extent)?) },
             raster_buffers: if compute { Some(RasterBuffers::new(d, extent)?) } else { None },
+            resolved: match (compute, pool) {
+                (true, Some(_)) => {
+                    Some(Buffer::storage(d, "vkhair transparency resolved pixels", RESOLVED_BYTES_PER_PIXEL * pixels)?)
+                }
+                _ => None,
+            },
             pipelines: HashMap::new(),
         });
         Ok(())
@@ -299,7 +323,7 @@ impl TransparentPass {
             return Err(Error::incompatible("transparency", "pipelines requested before the resources"));
         };
         let key = frame.target.key;
-        if let Some(made) = res.pipelines.get_mut(&(key, shaders.composite.name)) {
+        if let Some(made) = res.pipelines.get_mut(&(key, shaders.key())) {
             return made.points.0.prepare_variant(frame.features);
         }
         let d = &self.device;
@@ -325,6 +349,9 @@ impl TransparentPass {
         }
         if let Some(raster) = &res.raster_buffers {
             ours.extend(raster.bindings());
+        }
+        if let Some(resolved) = &res.resolved {
+            ours.push((RESOLVED_BINDING, resolved));
         }
         let (shading_buffers, shading_images) = shading.bindings(&frame.inputs);
         let mut buffers = shading_buffers.to_vec();
@@ -365,6 +392,19 @@ impl TransparentPass {
             }
         };
 
+        let resolve = match (shaders.resolve, &res.resolved) {
+            (Some(shader), Some(_)) => {
+                // Constant 0: the pool's buffers (oit.glsl).
+                let mut pipeline = ComputePipeline::new(d, shader, 1)?;
+                pipeline.prepare_variant(pool_buffers.unwrap_or(1))?;
+                let set = pipeline.declared_resource_set(0, &ours, &[])?;
+                Some((pipeline, set))
+            }
+            (None, _) => None,
+            (Some(_), None) => {
+                return Err(Error::incompatible("transparency", "a compute resolve without its output buffer"));
+            }
+        };
         let composite_stages = [&RENDER_HAIR_RECT_VERT, shaders.composite];
         let composite = GraphicsPipeline::specialised(
             d,
@@ -405,11 +445,12 @@ impl TransparentPass {
             None
         };
         res.pipelines.insert(
-            (key, shaders.composite.name),
+            (key, shaders.key()),
             Pipelines {
                 points: (points, points_set),
                 rect: (rect, rect_set),
                 build,
+                resolve,
                 composite: (composite, composite_set),
                 depth,
             },
@@ -453,7 +494,7 @@ impl TransparentPass {
         let Some(res) = self.current.as_ref() else {
             return Err(Error::incompatible("transparency", "no resources after preparing them"));
         };
-        let Some(pipelines) = res.pipelines.get(&(target.key, shaders.composite.name)) else {
+        let Some(pipelines) = res.pipelines.get(&(target.key, shaders.key())) else {
             return Err(Error::incompatible("transparency", "no pipelines after making them"));
         };
         let (d, cmd, timing) = (&*self.device, frame.cmd, frame.timing);
@@ -486,7 +527,13 @@ impl TransparentPass {
             barrier::memory(&[AccessKind::AnyTransferWrite], &[AccessKind::ComputeRead, AccessKind::ComputeWrite]);
         let cleared = barrier::memory(&[AccessKind::AnyTransferWrite], storage);
         // The lists, the counters and the overflow to the composite (its rectangle's vertex stage reads the counters).
-        let built = barrier::memory(&[build_write], &[AccessKind::VertexRead, AccessKind::FragmentRead]);
+        // (The compute rasteriser's are read by the compute resolve first.)
+        let built = barrier::memory(
+            &[build_write],
+            &[AccessKind::VertexRead, AccessKind::FragmentRead, AccessKind::ComputeRead],
+        );
+        // The compute resolve's pixels to the composite's fragment stage.
+        let resolved = barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::FragmentRead]);
         // The previous frame's ribbons (or rasteriser) read the colours this frame's dispatch writes.
         let to_shade = barrier::memory(&[AccessKind::VertexRead, AccessKind::ComputeRead], &[AccessKind::ComputeWrite]);
         // The colours and the rectangle (its atomics on the counters) to the
@@ -564,6 +611,11 @@ impl TransparentPass {
 
             let scope = RenderPass::Composite.open(d, cmd, timing);
             d.cmd_barrier(cmd, &[built, depth_order], &[], &from_sums);
+            if let Some((pipeline, set)) = &pipelines.resolve {
+                pipeline.bind_variant(cmd, pool.map_or(1, |p| p.buffers), &[*set]);
+                pipeline.dispatch_threads(cmd, [target.extent.width, target.extent.height, 1]);
+                d.cmd_barrier(cmd, &[resolved], &[], &[]);
+            }
             d.raw.cmd_begin_rendering(cmd, &composite_rendering);
             d.cmd_set_full_viewport(cmd, target.extent);
             for (pipeline, set) in [&pipelines.composite].into_iter().chain(&pipelines.depth) {

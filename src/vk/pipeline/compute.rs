@@ -224,6 +224,17 @@ impl ComputePipeline {
         unsafe { self.layout.device.raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
     }
 
+    /// Dispatches `groups` workgroups in each dimension.
+    ///
+    /// # Safety
+    /// `cmd` is recording with this pipeline bound; each count is within the
+    /// device's `maxComputeWorkGroupCount`.
+    pub(crate) unsafe fn dispatch_groups(&self, cmd: vk::CommandBuffer, groups: [u32; 3]) {
+        self.count_dispatch();
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.layout.device.raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
+    }
+
     /// Dispatches with the workgroup counts read from `buffer` at `offset` when the
     /// command executes (a `VkDispatchIndirectCommand`).
     ///

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use vkhair::render::{Raster, Transparency};
+use vkhair::render::{Interpolator, Raster, Transparency};
 
 use super::input::InputArgs;
 use super::sim::SimArgs;
@@ -72,6 +72,11 @@ pub struct SceneArgs {
     /// file's, else auto: compute on GPUs, on a CPU device the faster one there].
     #[arg(long, value_enum)]
     pub raster: Option<Raster>,
+    /// Who grows the drawn hairs from the smoothed key hairs: a compute
+    /// dispatch or the tessellation stages [default: the --config file's,
+    /// else auto: compute on GPUs, on a CPU device the faster one there].
+    #[arg(long, value_enum)]
+    pub interpolator: Option<Interpolator>,
     /// Fragments sorted exactly per pixel by --transparency exact (1..=32) [default: 8].
     #[arg(long)]
     pub sorted_fragments: Option<u32>,

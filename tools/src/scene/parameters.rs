@@ -66,6 +66,9 @@ pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
     if let Some(raster) = a.raster {
         r.raster = raster;
     }
+    if let Some(interpolator) = a.interpolator {
+        r.interpolator = interpolator;
+    }
     if a.marschner {
         config.material.shading = ShadingMode::Marschner;
     }

@@ -246,6 +246,11 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     bar.finish_and_clear();
     sink.finish()?;
     profile.print_table();
+    let grower = match renderer.interpolator() {
+        vkhair::render::Interpolator::Tessellation => "the tessellation stages",
+        _ => "a compute dispatch",
+    };
+    say!("interpolation: hairs grown by {grower}");
     if !sa.no_shadows && !sa.volume_shadows {
         say!("shadows: deep opacity maps drawn by {}", rasteriser(renderer.shadow_raster()));
     }
