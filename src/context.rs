@@ -91,6 +91,12 @@ pub struct HostDevice {
     /// Whether the host enabled the optional `subgroupSizeControl` and
     /// `computeFullSubgroups` features (see [`crate::Requirements::optional_features`]).
     pub compute_full_subgroups: bool,
+    /// Whether the host enabled the optional `shaderInt64` and
+    /// `shaderBufferInt64Atomics` features (see
+    /// [`crate::Requirements::optional_features`]): the volume stage's
+    /// transfer then adds with one 64-bit atomic a value instead of two 32-bit
+    /// ones, to the same sums.
+    pub buffer_int64_atomics: bool,
     /// Which of [`crate::Requirements::optional_device_extensions`] the host enabled
     /// (`VK_KHR_external_memory_fd` for the two-device hand-off without staging,
     /// `VK_EXT_calibrated_timestamps` for profiles on the host clock). Others are ignored.
@@ -146,6 +152,7 @@ impl GpuContext {
         let (physical, support) = chosen;
         let (raw, graphics, compute) = create_device(guard.instance_ref(), physical, &support)?;
         let full_subgroups = support.full_subgroups;
+        let int64_atomics = support.int64_atomics;
         let (instance, owned) = guard.release();
         let device = Device::new(DeviceParts {
             entry,
@@ -156,6 +163,7 @@ impl GpuContext {
             compute,
             debug_utils,
             full_subgroups,
+            int64_atomics,
             extensions: crate::vk::device::Extensions::from_names(&support.optional_extensions),
             allocator: None,
             owned: Some(owned),
@@ -195,6 +203,7 @@ impl GpuContext {
             compute: host.compute_queue.map(|q| Queue { family: q.family, raw: q.queue }),
             debug_utils: host.debug_utils,
             full_subgroups: host.compute_full_subgroups && support.full_subgroups,
+            int64_atomics: host.buffer_int64_atomics && support.int64_atomics,
             extensions: crate::vk::device::Extensions::from_names(
                 &host
                     .enabled_extensions

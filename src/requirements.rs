@@ -40,6 +40,16 @@ const CORE_OPTIONAL: &[Feature<vk::PhysicalDeviceFeatures>] = features!(vk::Phys
     pipeline_statistics_query => "pipelineStatisticsQuery",
 );
 
+/// 64-bit integer atomics on storage buffers, used when present (with
+/// `shaderInt64`): the volume stage's transfer adds each fixed-point value
+/// with one 64-bit atomic instead of two 32-bit ones, to the same sums.
+const CORE_OPTIONAL_INT64: &[Feature<vk::PhysicalDeviceFeatures>] = features!(vk::PhysicalDeviceFeatures:
+    shader_int64 => "shaderInt64",
+);
+const V12_OPTIONAL_INT64: &[Feature<vk::PhysicalDeviceVulkan12Features<'static>>] = features!(vk::PhysicalDeviceVulkan12Features<'static>:
+    shader_buffer_int64_atomics => "shaderBufferInt64Atomics",
+);
+
 /// Vulkan 1.3 features used when present: full subgroups in compute let the solver
 /// synchronise hairs with subgroup barriers.
 const V13_OPTIONAL: &[Feature<vk::PhysicalDeviceVulkan13Features<'static>>] = features!(vk::PhysicalDeviceVulkan13Features<'static>:
@@ -96,7 +106,9 @@ pub struct Requirements {
     pub optional_device_extensions: Vec<&'static CStr>,
     /// Device features vkhair uses when the host enables them: `subgroupSizeControl`
     /// and `computeFullSubgroups` (subgroup-synchronised constraint solving; say so in
-    /// [`crate::HostDevice::compute_full_subgroups`]) and `pipelineStatisticsQuery`.
+    /// [`crate::HostDevice::compute_full_subgroups`]), `pipelineStatisticsQuery`, and
+    /// `shaderInt64` with `shaderBufferInt64Atomics` (the volume transfer's
+    /// 64-bit atomics; say so in [`crate::HostDevice::buffer_int64_atomics`]).
     pub optional_features: Vec<&'static str>,
     /// Instance extensions vkhair uses when enabled: `VK_EXT_debug_utils` for
     /// object names and pass labels.
@@ -121,7 +133,13 @@ pub fn requirements() -> Requirements {
         features,
         device_extensions: Vec::new(),
         optional_device_extensions: OPTIONAL_EXTENSIONS.to_vec(),
-        optional_features: V13_OPTIONAL.iter().map(|f| f.name).chain(CORE_OPTIONAL.iter().map(|f| f.name)).collect(),
+        optional_features: V13_OPTIONAL
+            .iter()
+            .map(|f| f.name)
+            .chain(CORE_OPTIONAL.iter().map(|f| f.name))
+            .chain(CORE_OPTIONAL_INT64.iter().map(|f| f.name))
+            .chain(V12_OPTIONAL_INT64.iter().map(|f| f.name))
+            .collect(),
         optional_instance_extensions: vec![ash::ext::debug_utils::NAME],
     }
 }
@@ -132,6 +150,7 @@ pub(crate) struct Support {
     pub optional_extensions: Vec<&'static CStr>,
     pub pipeline_statistics: bool,
     pub full_subgroups: bool,
+    pub int64_atomics: bool,
 }
 
 impl Requirements {
@@ -180,6 +199,8 @@ impl Requirements {
             optional_extensions: self.optional_device_extensions.iter().copied().filter(|n| has(n)).collect(),
             pipeline_statistics: CORE_OPTIONAL.iter().all(|f| (f.get)(&core) == vk::TRUE),
             full_subgroups: V13_OPTIONAL.iter().all(|f| (f.get)(&v13) == vk::TRUE),
+            int64_atomics: CORE_OPTIONAL_INT64.iter().all(|f| (f.get)(&core) == vk::TRUE)
+                && V12_OPTIONAL_INT64.iter().all(|f| (f.get)(&v12) == vk::TRUE),
         })
     }
 }
@@ -213,5 +234,9 @@ pub(crate) fn enable_optional(features: &mut RequiredFeatures, support: &Support
     }
     if support.full_subgroups {
         V13_OPTIONAL.iter().for_each(|f| (f.set)(&mut features.vulkan13));
+    }
+    if support.int64_atomics {
+        CORE_OPTIONAL_INT64.iter().for_each(|f| (f.set)(&mut features.core));
+        V12_OPTIONAL_INT64.iter().for_each(|f| (f.set)(&mut features.vulkan12));
     }
 }

@@ -155,6 +155,7 @@ impl Host {
             allocator,
             debug_utils: true,
             compute_full_subgroups: false,
+            buffer_int64_atomics: false,
             enabled_extensions: Vec::new(),
         }
     }

@@ -142,6 +142,7 @@ fn frames_with(
             allocator: Some(allocator.clone()),
             debug_utils: true,
             compute_full_subgroups: false,
+            buffer_int64_atomics: false,
             enabled_extensions: Vec::new(),
         })
     }?;

@@ -110,6 +110,7 @@ impl Running {
                 allocator: Some(gpu.allocator().clone()),
                 debug_utils: true,
                 compute_full_subgroups: false,
+                buffer_int64_atomics: false,
                 enabled_extensions: Vec::new(),
             })
         }?;

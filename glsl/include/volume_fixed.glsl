@@ -24,7 +24,17 @@ uvec2 vol_fixed(float x) {
     return uvec2(low, high);
 }
 
-#ifndef VOL_FIXED_READ_ONLY
+#if defined(VKHAIR_INT64)
+// Words at, at + 1 (`at` even) += x, as one 64-bit integer (the including
+// shader declares `accum` as uint64_t; scatter.comp's INT64 variant).
+void vol_fixed_add(uint at, float x) {
+    uvec2 v = vol_fixed(x);
+    if (v.x == 0u && v.y == 0u) {
+        return;
+    }
+    atomicAdd(accum[at >> 1u], packUint2x32(v));
+}
+#elif !defined(VOL_FIXED_READ_ONLY)
 // accum[at], accum[at + 1] += x.
 void vol_fixed_add(uint at, float x) {
     uvec2 v = vol_fixed(x);
@@ -39,6 +49,7 @@ void vol_fixed_add(uint at, float x) {
 }
 #endif
 
+#ifndef VKHAIR_INT64
 // The sum at accum[at], accum[at + 1] as a float: its magnitude's high word
 // plus its low word × 2⁻³², each rounded to f32, then the sign.
 float vol_fixed_value(uint at) {
@@ -52,5 +63,7 @@ float vol_fixed_value(uint at) {
     precise float x = float(high) + float(low) * 2.3283064365386963e-10;
     return negative ? -x : x;
 }
+
+#endif
 
 #endif

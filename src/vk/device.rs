@@ -160,6 +160,10 @@ pub(crate) struct Device {
     /// Serialises the crate's own submissions to `graphics` (queue access must be
     /// externally synchronised).
     pub submit_lock: Mutex<()>,
+    /// Whether the volume transfer adds with 64-bit atomics: where
+    /// `shaderInt64` and `shaderBufferInt64Atomics` are enabled, unless
+    /// switched off (tests run both ways).
+    pub int64_atomics: std::sync::atomic::AtomicBool,
     /// Whether kernels with a reduction use their shared-memory variant: where
     /// [`DeviceInfo::subgroup_reductions`] is false, or forced (tests).
     pub shared_reductions: std::sync::atomic::AtomicBool,
@@ -177,6 +181,7 @@ pub(crate) struct DeviceParts {
     pub compute: Option<Queue>,
     pub debug_utils: bool,
     pub full_subgroups: bool,
+    pub int64_atomics: bool,
     pub extensions: Extensions,
     pub allocator: Option<Arc<Mutex<Allocator>>>,
     pub owned: Option<Owned>,
@@ -198,6 +203,7 @@ impl Device {
             info,
             debug_utils,
             full_subgroups: parts.full_subgroups,
+            int64_atomics: std::sync::atomic::AtomicBool::new(parts.int64_atomics),
             extensions: parts.extensions,
             allocator: parts.allocator,
             submit_lock: Mutex::new(()),

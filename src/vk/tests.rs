@@ -561,7 +561,10 @@ fn shaders_are_built_with_the_shared_constants() {
         assert_eq!(reflection.workgroup_size, Some([size, 1, 1]), "{}", shader.name);
         checked += 1;
     }
-    assert_eq!(checked, 29, "1 simulation, 7 per-item and 21 volume kernels (16 and 5 shared-memory variants)");
+    assert_eq!(
+        checked, 30,
+        "1 simulation, 7 per-item and 22 volume kernels (16, 5 shared-memory variants and the scatter's 64-bit one)"
+    );
     let sources: String = glsl_sources().into_iter().map(|(_, text)| text).collect();
     for (name, _) in limits::SHADER_CONSTANTS {
         assert!(sources.contains(name), "{name} is injected but no shader uses it");

@@ -7,6 +7,16 @@
 // order the particles add in. Particles outside the grid (or not finite) add
 // nothing: they are rejected, not clamped. Accumulators: per cell (w, w·vx,
 // w·vy, w·vz), then per face (w, w·v_axis), two words each.
+//
+// The INT64 variant (devices with shaderInt64 and shaderBufferInt64Atomics,
+// buffers.rs) adds each value's two words as one 64-bit integer: one atomic
+// whose result is not waited for, instead of two 32-bit ones the second of
+// which waits for the first's carry — the same sums, bit for bit.
+// vkhair variant: VKHAIR_INT64
+#ifdef VKHAIR_INT64
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+#endif
 #include "volume.glsl"
 
 layout(local_size_x = VOL_GROUP) in;
@@ -17,7 +27,12 @@ layout(std430, set = 0, binding = 3) readonly buffer Vel { vec4 vel[]; };
 layout(std430, set = 0, binding = 10) writeonly buffer GridPos { vec4 grid_pos[]; };
 layout(std430, set = 0, binding = 11) writeonly buffer GridVel { vec4 grid_vel[]; };
 layout(std430, set = 0, binding = 14) buffer Counts { uint counts[]; };
+#ifdef VKHAIR_INT64
+// The accumulators' word pairs (low, high) as one little-endian 64-bit word each.
+layout(std430, set = 0, binding = 31) buffer Accum { uint64_t accum[]; };
+#else
 layout(std430, set = 0, binding = 31) buffer Accum { uint accum[]; };
+#endif
 #include "volume_fixed.glsl"
 
 // Corner k (bit 0: +x, bit 1: +y, bit 2: +z) of the 8 grid points around s,

@@ -211,9 +211,13 @@ impl Kernel {
     ];
 
     /// The kernel's module; `shared` picks the shared-memory reductions of the
-    /// pressure solve's kernels (devices without subgroup arithmetic).
-    fn shader(self, shared: bool) -> &'static ShaderSource {
+    /// pressure solve's kernels (devices without subgroup arithmetic), `int64`
+    /// the scatter's 64-bit atomics.
+    fn shader(self, shared: bool, int64: bool) -> &'static ShaderSource {
         use shaders::*;
+        if self == Kernel::Scatter && int64 {
+            return &SIM_VOLUME_SCATTER_COMP_INT64;
+        }
         match (self, shared) {
             (Kernel::PcgInit, true) => return &SIM_VOLUME_PCG_INIT_COMP_SHARED_REDUCE,
             (Kernel::PcgApply, true) => return &SIM_VOLUME_PCG_APPLY_COMP_SHARED_REDUCE,
@@ -261,7 +265,8 @@ pub(crate) fn kernels(
         .iter()
         .map(|kernel| {
             let shared = device.shared_reductions.load(std::sync::atomic::Ordering::Relaxed);
-            let pipeline = ComputePipeline::new(device, kernel.shader(shared), particles.len() as u32)?;
+            let int64 = device.int64_atomics.load(std::sync::atomic::Ordering::Relaxed);
+            let pipeline = ComputePipeline::new(device, kernel.shader(shared, int64), particles.len() as u32)?;
             let sets = particles
                 .iter()
                 .map(|(pos, vel)| pipeline.declared_buffer_set(0, &buffers.table(colliders, mesh_field, pos, vel)))

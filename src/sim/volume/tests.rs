@@ -163,9 +163,29 @@ fn the_fixed_point_of_the_transfer_is_exact_where_it_can_be() {
 /// huge velocity: counts, densities and face weights bit for bit (the same
 /// integer sums), means and face velocities to the division's rounding;
 /// particles outside keep their velocity.
+/// The scatter's ways of adding: 64-bit atomics where the device has them
+/// (then the 32-bit pairs too, forced), else the 32-bit pairs alone.
+fn atomic_paths(gpu: &TestGpu) -> Vec<bool> {
+    use std::sync::atomic::Ordering;
+    if gpu.device().int64_atomics.load(Ordering::Relaxed) {
+        vec![true, false]
+    } else {
+        eprintln!("64-bit atomics: not on this device; the 32-bit pairs only");
+        vec![false]
+    }
+}
+
 #[test]
 fn the_scatter_matches_the_reference_bit_for_bit() {
     let gpu = TestGpu::new();
+    for int64 in atomic_paths(&gpu) {
+        gpu.device().int64_atomics.store(int64, std::sync::atomic::Ordering::Relaxed);
+        eprintln!("64-bit atomics: {int64}");
+        scatter_matches_the_reference(&gpu);
+    }
+}
+
+fn scatter_matches_the_reference(gpu: &TestGpu) {
     let mut rng = Pcg32::seed_from_u64(5);
     let grid_dims = [8, 6, 5];
     let (mut positions, mut velocities) = random_particles(&mut rng, 1000, Vec3::ZERO, Vec3::new(8.0, 6.0, 5.0), 1.0);
@@ -181,7 +201,7 @@ fn the_scatter_matches_the_reference_bit_for_bit() {
     let grid = unit_grid(grid_dims, positions.len());
     let params = VolumeParams::flip(grid_dims);
     let b = block(&grid, &params, Mat4::IDENTITY, 0);
-    let run = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
+    let run = run_gpu(gpu, &grid, &params, &b, &[], &positions, &velocities);
     let mut cpu_vel = velocities.clone();
     let cpu = reference::step(&grid, &b, &[], None, &positions, &mut cpu_vel);
     assert_eq!(run.snapshot.counts, cpu.counts, "particles per cell");
@@ -210,12 +230,20 @@ fn the_scatter_is_the_same_in_any_order() {
     let grid = unit_grid([64, 64, 64], positions.len());
     let params = VolumeParams { max_iterations: 1, ..VolumeParams::flip([64; 3]) };
     let b = block(&grid, &params, Mat4::IDENTITY, 0);
-    let forward = run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities);
     let reversed = |v: &[Vec4]| v.iter().rev().copied().collect::<Vec<_>>();
-    let backward = run_gpu(&gpu, &grid, &params, &b, &[], &reversed(&positions), &reversed(&velocities));
-    assert_eq!(bits(&cell_floats(&forward.snapshot.cells)), bits(&cell_floats(&backward.snapshot.cells)));
-    assert_eq!(bits(&forward.snapshot.face_star), bits(&backward.snapshot.face_star));
-    assert_eq!(bits(&forward.snapshot.face_weight), bits(&backward.snapshot.face_weight));
+    // Forward and backward, by each way of adding: all the same bits.
+    let mut runs = Vec::new();
+    for int64 in atomic_paths(&gpu) {
+        gpu.device().int64_atomics.store(int64, std::sync::atomic::Ordering::Relaxed);
+        runs.push(run_gpu(&gpu, &grid, &params, &b, &[], &positions, &velocities));
+        runs.push(run_gpu(&gpu, &grid, &params, &b, &[], &reversed(&positions), &reversed(&velocities)));
+    }
+    let forward = &runs[0];
+    for other in &runs[1..] {
+        assert_eq!(bits(&cell_floats(&forward.snapshot.cells)), bits(&cell_floats(&other.snapshot.cells)));
+        assert_eq!(bits(&forward.snapshot.face_star), bits(&other.snapshot.face_star));
+        assert_eq!(bits(&forward.snapshot.face_weight), bits(&other.snapshot.face_weight));
+    }
     let cell = 30 + 64 * (30 + 64 * 30);
     assert_eq!(forward.snapshot.counts[cell], 700);
     assert_eq!(forward.snapshot.counts.iter().sum::<u32>(), 700);
