@@ -168,6 +168,8 @@ fn render_lists_every_pass_and_writes_a_trace_and_summary_that_agree() {
         "vkhair render: shadow opacity, light 0",
         "vkhair render: shadow opacity, light 1",
         "vkhair render: draw",
+        "vkhair render: draw, vertex shading",
+        "vkhair render: draw, build",
         "vkhair render: resolve",
     ] {
         assert!(rows.contains_key(&(track.clone(), pass.to_owned())), "{pass} missing from the table:\n{}", out.stdout);

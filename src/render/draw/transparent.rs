@@ -44,10 +44,12 @@ use super::{DrawFrame, ModeShaders, TargetKey};
 use crate::codes::sentinel::OIT_END;
 use crate::error::{Error, Result};
 use crate::gpu_types::OitCounters;
+use crate::profiler::PassScope;
 use crate::render::pass::RenderPass;
 use crate::render::{OitParams, Raster, Transparency};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::{Buffer, BufferDesc};
+use crate::vk::debug::LabelColor;
 use crate::vk::device::{Device, DeviceInfo};
 use crate::vk::image::Sampler;
 use crate::vk::pipeline::{Blend, ComputePipeline, GraphicsDesc, GraphicsPipeline};
@@ -572,6 +574,8 @@ impl TransparentPass {
             d.cmd_barrier(cmd, &[to_clear, to_shade], &[], &to_sums);
             d.raw.cmd_update_buffer(cmd, self.counters.raw(), 0, bytemuck::bytes_of(&counters));
             d.cmd_barrier(cmd, &[counters_ready], &[], &[]);
+            let shading_label = format!("{}, vertex shading", RenderPass::Draw.label());
+            let inner = PassScope::open(d, cmd, timing, &shading_label, LabelColor::Compute);
             pipelines.points.0.bind_variant(cmd, frame.features, &[pipelines.points.1]);
             // At most 65,535 workgroups (every device's limit); the shader loops over the rest.
             let per_group = pipelines.points.0.workgroup_size()[0];
@@ -581,6 +585,7 @@ impl TransparentPass {
             // shading above, lavapipe's resident memory grew by ~0.4 MB a frame).
             pipelines.rect.0.bind(cmd, &[pipelines.rect.1]);
             pipelines.rect.0.dispatch_threads(cmd, [threads, 1, 1]);
+            inner.close(d, cmd, timing);
             if let Some(lists) = &res.lists {
                 lists.record_clear(d, cmd);
             }
@@ -589,6 +594,8 @@ impl TransparentPass {
                 buffers.record_inputs(d, cmd, depth_source, target.extent);
             }
             d.cmd_barrier(cmd, &[cleared, shaded], &[], &[]);
+            let build_label = format!("{}, build", RenderPass::Draw.label());
+            let inner = PassScope::open(d, cmd, timing, &build_label, LabelColor::Graphics);
             match &pipelines.build {
                 Build::Ribbons(pipeline, set) => {
                     let sums = res.sums.as_ref().map(WeightedSums::attachments);
@@ -607,14 +614,18 @@ impl TransparentPass {
                     pipeline.dispatch_threads(cmd, [segments, 1, 1]);
                 }
             }
+            inner.close(d, cmd, timing);
             scope.close(d, cmd, timing);
 
             let scope = RenderPass::Composite.open(d, cmd, timing);
             d.cmd_barrier(cmd, &[built, depth_order], &[], &from_sums);
             if let Some((pipeline, set)) = &pipelines.resolve {
+                let resolve_label = format!("{}, resolve in compute", RenderPass::Composite.label());
+                let inner = PassScope::open(d, cmd, timing, &resolve_label, LabelColor::Compute);
                 pipeline.bind_variant(cmd, pool.map_or(1, |p| p.buffers), &[*set]);
                 pipeline.dispatch_threads(cmd, [target.extent.width, target.extent.height, 1]);
                 d.cmd_barrier(cmd, &[resolved], &[], &[]);
+                inner.close(d, cmd, timing);
             }
             d.raw.cmd_begin_rendering(cmd, &composite_rendering);
             d.cmd_set_full_viewport(cmd, target.extent);
