@@ -154,6 +154,26 @@ fn hairs_per_key_over_the_scalp_is_refused_not_ignored() {
     assert!(out.stderr.contains("--clumps") && out.stderr.contains("--density"), "{}", out.stderr);
 }
 
+/// `--interpolator` picks who grows the hairs and the tool says which: on this
+/// device `auto` is the compute dispatch; the tessellation stages draw the
+/// same PNG, byte for byte, with the hairs over the scalp (followers).
+#[test]
+fn the_interpolator_is_chosen_and_said() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut frames = Vec::new();
+    for (flag, said) in [("auto", "a compute dispatch"), ("tessellation", "the tessellation stages")] {
+        let out_dir = dir.path().join(flag);
+        let out_arg = out_dir.to_str().expect("utf-8 path");
+        let args =
+            ["render", "--frames", "1", "--width", "64", "--height", "48", "--interpolator", flag, "--out", out_arg];
+        let out = run(&args, LIMIT);
+        out.assert_ok();
+        assert!(out.stdout.contains(&format!("interpolation: hairs grown by {said}")), "{flag}: {}", out.stdout);
+        frames.push(std::fs::read(out_dir.join("frame_0000.png")).expect("frame"));
+    }
+    assert!(frames[0] == frames[1], "the two interpolators drew different frames");
+}
+
 /// `render --gltf` puts hair on the shared character and follows its run: the
 /// PNGs show the hair (brown) and the body; an unknown animation or joint is
 /// named with the ones the file has, before any GPU work.
