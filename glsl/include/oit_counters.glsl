@@ -1,4 +1,4 @@
-// The transparency passes' per-frame words (render/draw/transparent.rs), in a
+// The transparency passes' per-frame words (render/draw/transparent/), in a
 // header of their own for the stages that use no list: hair_rect.comp finds
 // the hair's rectangle, the composite's vertex stage (hair_rect.vert) draws
 // it. Define OIT_COUNTERS_READONLY before including it in a stage that only

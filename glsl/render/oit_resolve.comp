@@ -1,6 +1,6 @@
 #version 460
 // Exact transparency after the compute rasteriser, the resolve in compute
-// (render/draw/transparent.rs): one invocation per pixel of the rectangle the
+// (render/draw/transparent/): one invocation per pixel of the rectangle the
 // hair reaches (OitCounters' hair_*; the dispatch covers the target, the rest
 // return at once) resolves its list (oit_resolve.glsl) into `oit_resolved`
 // as premultiplied colour and coverage in four half floats, coverage 0 for a

@@ -14,9 +14,9 @@
 //!
 //! - [`Transparency::Off`] — `opaque.rs`: a depth pre-pass and a shaded draw
 //!   of the nearest layer;
-//! - [`Transparency::Exact`] — `transparent.rs` with `exact.rs`: per-pixel
+//! - [`Transparency::Exact`] — `transparent/` with `exact.rs`: per-pixel
 //!   fragment lists, the nearest sorted;
-//! - [`Transparency::Fast`] — `transparent.rs` with `fast.rs`: weighted blended
+//! - [`Transparency::Fast`] — `transparent/` with `fast.rs`: weighted blended
 //!   sums.
 
 mod exact;
