@@ -54,15 +54,17 @@ float depth_limit(uint pixel) {
     return 3.0e38;
 }
 
-// One fragment of coverage-weighted `alpha`, colour `color` at depth `z`.
-void store(uint pixel, float z, vec3 color, float alpha) {
-    if (alpha < OIT_LEAST_ALPHA || z > depth_limit(pixel)) {
-        return;
-    }
+// Whether a fragment of coverage-weighted `alpha` at depth `z` is stored.
+bool kept(uint pixel, float z, float alpha) {
+    return alpha >= OIT_LEAST_ALPHA && z <= depth_limit(pixel);
+}
+
+// One kept fragment of coverage-weighted `alpha`, colour `color` at depth
+// `z`, into pool node `node` (the segment's nodes were taken at once).
+void store(uint pixel, float z, vec3 color, float alpha, uint node) {
     if (alpha >= OIT_OPAQUE_ALPHA) {
         atomicMin(oit_opaque[pixel], floatBitsToUint(z));
     }
-    uint node = atomicAdd(oit.used, 1u);
     if (node >= oit.capacity) {
         oit_overflow_add(pixel, color, alpha);
         return;
@@ -156,6 +158,25 @@ void raster_segment(End e0, End e1, bool last) {
     float k_hi = min(ceil(max(a_km.x, b_km.x) + reach), size_km.x);
     float inv_wa = 1.0 / ca.w;
     float inv_wb = 1.0 / cb.w;
+    // Two walks over the same pixels: the first counts the fragments kept,
+    // then one atomic takes that many nodes of the pool, and the second
+    // stores them — one atomic on the pool's counter a segment, not a
+    // fragment.
+    // The second walk never stores more than the first counted (should a
+    // driver evaluate the two walks' arithmetic differently, a node is left
+    // unused rather than one of another segment's taken).
+    uint count = 0u;
+    uint base = 0u;
+    uint taken = 0u;
+    for (uint walk = 0u; walk < 2u; ++walk) {
+    if (walk == 1u) {
+        if (count == 0u) {
+            return;
+        }
+        taken = count;
+        base = atomicAdd(oit.used, taken);
+        count = 0u;
+    }
     for (float k = k_lo; k < k_hi; k += 1.0) {
         float centre_m = a_km.y + (k + 0.5 - a_km.x) * slope;
         float m_lo = max(floor(centre_m - spread - 0.5), 0.0);
@@ -177,8 +198,18 @@ void raster_segment(End e0, End e1, bool last) {
             float alpha = strand_alpha(vec3(d, half_width, mix(e0.density, e1.density, u)));
             float z = mix(za, zb, s);
             uint pixel = uint(q.y) * oit.width + uint(q.x);
-            store(pixel, z, mix(e0.color, e1.color, u), alpha);
+            if (!kept(pixel, z, alpha)) {
+                continue;
+            }
+            if (walk == 1u) {
+                if (count == taken) {
+                    return;
+                }
+                store(pixel, z, mix(e0.color, e1.color, u), alpha, base + count);
+            }
+            count++;
         }
+    }
     }
 }
 
