@@ -22,7 +22,10 @@
 // the host's depth copied into SceneDepth, then stored as oit_build.frag
 // stores: pushed onto its pixel's list, or, beyond the pool, added to the
 // fixed-point overflow sums (oit_overflow.glsl); a fragment at least half
-// opaque lowers the pixel's nearest opaque depth.
+// opaque lowers the pixel's nearest opaque depth. A segment walks its pixels
+// twice — counting the fragments it keeps, then storing them into the nodes
+// one atomic took for all of them — so the pool's counter takes an atomic a
+// segment, not a fragment (README, "Raster").
 // Constant 0 is the pool's buffer count (oit.glsl); constant 1 the shading
 // features (this stage shades nothing: strand_alpha only).
 #define SHADING_FEATURES_ID 1
