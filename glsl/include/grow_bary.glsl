@@ -4,13 +4,8 @@
 // interpolate_bary.tese and interpolate.comp's BARY variant.
 #ifndef VKHAIR_GROW_BARY_GLSL
 #define VKHAIR_GROW_BARY_GLSL
-#include "render.glsl"
+#include "grow_io.glsl"
 
-layout(push_constant) uniform Push { InterpolatePush pc; };
-layout(std430, set = 0, binding = 0) readonly buffer SmoothPos { vec4 smooth_pos[]; };
-layout(std430, set = 0, binding = 1) readonly buffer SmoothTan { vec4 smooth_tan[]; };
-layout(std430, set = 0, binding = 3) writeonly buffer HairPos { vec4 hair_pos[]; };
-layout(std430, set = 0, binding = 4) writeonly buffer HairTan { vec4 hair_tan[]; };
 layout(std430, set = 0, binding = 5) readonly buffer Triangles { uvec4 triangles[]; };
 
 // Smoothed vertices per grown hair.

@@ -7,14 +7,9 @@
 // FOLLOW variant.
 #ifndef VKHAIR_GROW_FOLLOW_GLSL
 #define VKHAIR_GROW_FOLLOW_GLSL
-#include "render.glsl"
+#include "grow_io.glsl"
 
-layout(push_constant) uniform Push { InterpolatePush pc; };
-layout(std430, set = 0, binding = 0) readonly buffer SmoothPos { vec4 smooth_pos[]; };
-layout(std430, set = 0, binding = 1) readonly buffer SmoothTan { vec4 smooth_tan[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Reference { vec4 reference[]; };
-layout(std430, set = 0, binding = 3) writeonly buffer HairPos { vec4 hair_pos[]; };
-layout(std430, set = 0, binding = 4) writeonly buffer HairTan { vec4 hair_tan[]; };
 layout(std430, set = 0, binding = 6) readonly buffer Bindings { FollowerBinding bindings[]; };
 layout(std430, set = 0, binding = 7) readonly buffer Offsets { float offsets[]; };
 // Per follower its albedo and width factor (a) at the root (2f) and tip (2f + 1).
