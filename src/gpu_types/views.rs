@@ -288,6 +288,13 @@ shader_views! {
         partials: uint = op.y,
     }
 
+    /// The coarse levels' V-cycle in one workgroup (`VolumePush` of `mg_cycle`).
+    CyclePass for VolumePush in "volume.glsl" as "VolumePush" prefix "mg_cycle" {
+        /// The finest level the cycle starts at (its restricted residual
+        /// given, its correction x left): every level from it down.
+        first_level: uint = op.x,
+    }
+
     /// A share of the solve in one workgroup (`VolumePush` of `pcg_workgroup`).
     WorkgroupSolvePass for VolumePush in "volume.glsl" as "VolumePush" prefix "pcg_wg" {
         /// 1: the first share, which starts the solve; 0: one that goes on from

@@ -562,8 +562,8 @@ fn shaders_are_built_with_the_shared_constants() {
         checked += 1;
     }
     assert_eq!(
-        checked, 30,
-        "1 simulation, 7 per-item and 22 volume kernels (16, 5 shared-memory variants and the scatter's 64-bit one)"
+        checked, 31,
+        "1 simulation, 7 per-item and 23 volume kernels (17, 5 shared-memory variants and the scatter's 64-bit one)"
     );
     let sources: String = glsl_sources().into_iter().map(|(_, text)| text).collect();
     for (name, _) in limits::SHADER_CONSTANTS {

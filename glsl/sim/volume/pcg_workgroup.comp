@@ -37,12 +37,7 @@ layout(std430, set = 0, binding = 26) buffer Scalars { PcgScalars scalars; };
 
 shared vec2 sums[VOL_GROUP];
 
-// Every write of every invocation before it is visible to all after it.
-void sync() {
-    memoryBarrierBuffer();
-    memoryBarrierShared();
-    barrier();
-}
+#include "mg_workgroup.glsl"
 
 // (Σ, max) over the workgroup, the same in every invocation.
 vec2 group_sum_max(vec2 value) {
@@ -64,110 +59,6 @@ bool finite(vec2 v) {
     return !any(isnan(v)) && !any(isinf(v));
 }
 
-uvec3 lvl_dims(uint level) {
-    uvec3 dims = vol_dims(vp);
-    for (uint l = 0u; l < level; ++l) {
-        dims = (dims + 1u) / 2u;
-    }
-    return dims;
-}
-
-uint lvl_first(uint level) {
-    uvec3 dims = vol_dims(vp);
-    uint first = 0u;
-    for (uint l = 0u; l < level; ++l) {
-        first += dims.x * dims.y * dims.z;
-        dims = (dims + 1u) / 2u;
-    }
-    return first;
-}
-
-// One sweep from tmp into x on a level.
-void sweep_tmp_into_x(uint first, uint cells, uvec3 dims) {
-    for (uint c = gl_LocalInvocationIndex; c < cells; c += VOL_GROUP) {
-        uint i = first + c;
-        uint w = stencil[i];
-        precise float value = 0.0;
-        if (vol_is_fluid(w)) {
-            float own = tmp[i];
-            precise float ax = vol_diagonal(w) * own;
-            for (uint n = 0u; n < 6u; ++n) {
-                if (vol_has_fluid_neighbor(w, n)) {
-                    ax -= tmp[vol_neighbor_index(i, dims, n)];
-                }
-            }
-            value = mg_sweep(i, w, own, ax);
-        }
-        x[i] = value;
-    }
-    sync();
-}
-
-// Two sweeps from x = 0 on a level (tmp holds the first).
-void pre_smooth(uint first, uint cells, uvec3 dims) {
-    for (uint c = gl_LocalInvocationIndex; c < cells; c += VOL_GROUP) {
-        uint i = first + c;
-        uint w = stencil[i];
-        tmp[i] = vol_is_fluid(w) ? mg_sweep(i, w, 0.0, 0.0) : 0.0;
-    }
-    sync();
-    sweep_tmp_into_x(first, cells, dims);
-}
-
-// Half the summed residuals of a coarse cell's fluid children (mg_restrict).
-void restrict_residual(uint first, uvec3 dims, uint coarse_first, uvec3 coarse_dims) {
-    uint coarse_cells = coarse_dims.x * coarse_dims.y * coarse_dims.z;
-    for (uint c = gl_LocalInvocationIndex; c < coarse_cells; c += VOL_GROUP) {
-        bool fluid = vol_is_fluid(stencil[coarse_first + c]);
-        rhs[coarse_first + c] = fluid ? mg_restricted(vol_cell_coords(c, coarse_dims), first, dims) : 0.0;
-    }
-    sync();
-}
-
-// The coarsest level's solve (mg_coarsest) into x.
-void solve_coarsest(uint first, uvec3 dims) {
-    uint c = gl_LocalInvocationIndex;
-    bool live = c < dims.x * dims.y * dims.z;
-    uint i = first + c;
-    uint w = live ? stencil[i] : 0u;
-    float result = mg_coarsest_solve(c, dims, w, vol_is_fluid(w) ? rhs[i] : 0.0);
-    if (live) {
-        x[i] = result;
-    }
-    sync();
-}
-
-// x at cell j of a level plus its coarse parent's correction.
-float prolonged(uint j, uvec3 ijk, uint coarse_first, uvec3 coarse_dims) {
-    precise float value = x[j] + x[coarse_first + vol_cell_index(ijk / 2u, coarse_dims)];
-    return value;
-}
-
-// The prolongation with the first post-sweep (into tmp), then the second (into x).
-void post_smooth(uint first, uint cells, uvec3 dims, uint coarse_first, uvec3 coarse_dims) {
-    for (uint c = gl_LocalInvocationIndex; c < cells; c += VOL_GROUP) {
-        uint i = first + c;
-        uint w = stencil[i];
-        precise float value = 0.0;
-        if (vol_is_fluid(w)) {
-            uvec3 ijk = vol_cell_coords(c, dims);
-            float own = prolonged(i, ijk, coarse_first, coarse_dims);
-            precise float ax = vol_diagonal(w) * own;
-            for (uint n = 0u; n < 6u; ++n) {
-                if (vol_has_fluid_neighbor(w, n)) {
-                    uvec3 nb = ijk;
-                    nb[n >> 1u] = (n & 1u) == 0u ? nb[n >> 1u] - 1u : nb[n >> 1u] + 1u;
-                    ax -= prolonged(vol_neighbor_index(i, dims, n), nb, coarse_first, coarse_dims);
-                }
-            }
-            value = mg_sweep(i, w, own, ax);
-        }
-        tmp[i] = value;
-    }
-    sync();
-    sweep_tmp_into_x(first, cells, dims);
-}
-
 // z = M r into x (level 0), then (r·z, max |r|).
 vec2 precondition() {
     uint cells = vol_cells(vp);
@@ -177,18 +68,7 @@ vec2 precondition() {
         }
         sync();
     } else {
-        uint last = vol_levels(vp) - 1u;
-        for (uint l = 0u; l < last; ++l) {
-            uvec3 dims = lvl_dims(l);
-            uint first = lvl_first(l);
-            pre_smooth(first, dims.x * dims.y * dims.z, dims);
-            restrict_residual(first, dims, lvl_first(l + 1u), lvl_dims(l + 1u));
-        }
-        solve_coarsest(lvl_first(last), lvl_dims(last));
-        for (uint l = last; l > 0u; --l) {
-            uvec3 dims = lvl_dims(l - 1u);
-            post_smooth(lvl_first(l - 1u), dims.x * dims.y * dims.z, dims, lvl_first(l), lvl_dims(l));
-        }
+        mg_vcycle_from(0u);
     }
     vec2 local = vec2(0.0);
     for (uint c = gl_LocalInvocationIndex; c < cells; c += VOL_GROUP) {

@@ -186,12 +186,13 @@ pub(crate) enum Kernel {
     MgSmooth,
     MgRestrict,
     MgCoarsest,
+    MgCycle,
     PcgWorkgroup,
     G2p,
 }
 
 impl Kernel {
-    pub(crate) const ALL: [Kernel; 16] = [
+    pub(crate) const ALL: [Kernel; 17] = [
         Kernel::Scatter,
         Kernel::Cells,
         Kernel::Mark,
@@ -206,6 +207,7 @@ impl Kernel {
         Kernel::MgSmooth,
         Kernel::MgRestrict,
         Kernel::MgCoarsest,
+        Kernel::MgCycle,
         Kernel::PcgWorkgroup,
         Kernel::G2p,
     ];
@@ -241,6 +243,7 @@ impl Kernel {
             Kernel::MgSmooth => &SIM_VOLUME_MG_SMOOTH_COMP,
             Kernel::MgRestrict => &SIM_VOLUME_MG_RESTRICT_COMP,
             Kernel::MgCoarsest => &SIM_VOLUME_MG_COARSEST_COMP,
+            Kernel::MgCycle => &SIM_VOLUME_MG_CYCLE_COMP,
             Kernel::PcgWorkgroup => &SIM_VOLUME_PCG_WORKGROUP_COMP,
             Kernel::G2p => &SIM_VOLUME_G2P_COMP,
         }

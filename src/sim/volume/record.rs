@@ -11,7 +11,8 @@ use super::VolumeStats;
 use crate::codes::vol_status;
 use crate::error::Result;
 use crate::gpu_types::{
-    CoarsestPass, GpuVolumeParams, LevelPass, PcgScalars, ReducePass, SmoothingPass, VolumePush, WorkgroupSolvePass,
+    CoarsestPass, CyclePass, GpuVolumeParams, LevelPass, PcgScalars, ReducePass, SmoothingPass, VolumePush,
+    WorkgroupSolvePass,
 };
 use crate::profiler::{PassScope, Timing};
 use crate::vk::barrier::{self, AccessKind};
@@ -49,6 +50,21 @@ pub(crate) fn workgroup_share(grid: &GridLayout, preconditioner: Preconditioner)
     }
     let share = WORKGROUP_LOOP_BUDGET / trips;
     (share > 0).then_some(share)
+}
+
+/// Most cells of a level the dispatched solve's V-cycle leaves to its
+/// one-workgroup coarse cycle (16³: 16 cells an invocation of a workgroup of
+/// 256 a sweep).
+pub(crate) const CYCLE_CELLS: u32 = 4096;
+
+/// The level the dispatched solve's one-workgroup coarse cycle starts at: the
+/// first below the finest with at most [`CYCLE_CELLS`] cells, when it and the
+/// coarsest are two levels or more (else none: the per-level passes and the
+/// coarsest's own).
+pub(crate) fn cycle_start(grid: &GridLayout) -> Option<usize> {
+    let levels = &grid.levels;
+    let first = (1..levels.len()).find(|&l| levels[l].cells() <= CYCLE_CELLS)?;
+    (first + 1 < levels.len()).then_some(first)
 }
 
 /// How a kernel is dispatched.
@@ -267,25 +283,41 @@ impl VolumeStage {
     /// piecewise-constant prolongation, Jacobi sweeps on the coarsest level.
     /// Symmetric, so conjugate gradients may use it. Four passes per level: the
     /// two pre-sweeps are one pass, the prolongation is folded into the first
-    /// post-sweep and the partials into the last (see `mg_smooth.comp`).
+    /// post-sweep and the partials into the last (see `mg_smooth.comp`). The
+    /// levels of at most [`CYCLE_CELLS`] below the finest, when there are two
+    /// or more, are one dispatch of a single workgroup (`mg_cycle.comp`, the
+    /// same arithmetic a cell), since each dispatch and its barrier cost
+    /// microseconds on a GPU that a small level never fills.
     unsafe fn record_vcycle(&self, cmd: vk::CommandBuffer, variant: usize) {
         let levels = self.grid.levels.len();
+        let cycle = cycle_start(&self.grid);
+        // The levels dispatched a pass each: above the cycle's, or all but
+        // the coarsest without it.
+        let dispatched = cycle.unwrap_or(levels - 1);
         // SAFETY: guaranteed by the caller.
         unsafe {
-            for level in 0..levels - 1 {
+            for level in 0..dispatched {
                 let at = Launch::Indirect(level);
                 self.run(cmd, Kernel::MgSmooth, variant, self.smoothing_push(level, 0, false), at);
                 let restrict = VolumePush::from(&self.level_pass(level));
                 self.run(cmd, Kernel::MgRestrict, variant, restrict, Launch::Indirect(level + 1));
             }
-            let last = self.level_pass(levels - 1);
-            let coarsest = VolumePush::from(&CoarsestPass {
-                dims: last.dims,
-                first: last.first,
-                partials: u32::from(levels == 1),
-            });
-            self.run(cmd, Kernel::MgCoarsest, variant, coarsest, Launch::Indirect(levels));
-            for level in (0..levels - 1).rev() {
+            match cycle {
+                Some(first_level) => {
+                    let push = VolumePush::from(&CyclePass { first_level: first_level as u32 });
+                    self.run(cmd, Kernel::MgCycle, variant, push, Launch::Indirect(levels));
+                }
+                None => {
+                    let last = self.level_pass(levels - 1);
+                    let coarsest = VolumePush::from(&CoarsestPass {
+                        dims: last.dims,
+                        first: last.first,
+                        partials: u32::from(levels == 1),
+                    });
+                    self.run(cmd, Kernel::MgCoarsest, variant, coarsest, Launch::Indirect(levels));
+                }
+            }
+            for level in (0..dispatched).rev() {
                 let at = Launch::Indirect(level);
                 self.run(cmd, Kernel::MgSmooth, variant, self.smoothing_push(level, 1, false), at);
                 self.run(cmd, Kernel::MgSmooth, variant, self.smoothing_push(level, 2, level == 0), at);

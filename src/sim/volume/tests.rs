@@ -534,3 +534,18 @@ fn the_pressure_solver_is_chosen_by_the_device_type() {
     assert_eq!(stage.params.solver, PressureSolver::Auto.on_device(d.info.device_type));
     assert_ne!(stage.params.solver, PressureSolver::Auto);
 }
+
+/// The dispatched solve leaves its levels of at most 16³ below the finest to
+/// one workgroup when they are two or more (the coarsest included), else
+/// dispatches every level's passes.
+#[test]
+fn the_coarse_cycle_starts_at_the_first_level_of_at_most_16_cubed() {
+    use super::record::cycle_start;
+    let start = |dims: [u32; 3]| cycle_start(&unit_grid(dims, 1));
+    assert_eq!(start([32; 3]), Some(1), "32³: 16³, 8³, 4³ in one workgroup");
+    assert_eq!(start([64; 3]), Some(2), "64³: 16³ and below");
+    assert_eq!(start([16; 3]), Some(1), "16³: the finest stays dispatched");
+    assert_eq!(start([64, 64, 16]), Some(2), "64 × 64 × 16: 16 × 16 × 4 and below");
+    assert_eq!(start([8; 3]), None, "8³: the coarsest alone below the finest");
+    assert_eq!(start([4; 3]), None, "one level");
+}
