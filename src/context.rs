@@ -224,6 +224,20 @@ impl GpuContext {
         self.device.counters.read()
     }
 
+    /// Starts logging every compute dispatch vkhair records on this device
+    /// (emptying a log already kept): its kernel, workgroups and loop trips,
+    /// the counts that predict a kernel's cost on a GPU. For benchmarks and
+    /// tools; a host leaves it off (nothing is kept then).
+    pub fn start_dispatch_log(&self) {
+        self.device.counters.start_log();
+    }
+
+    /// The dispatches recorded since [`GpuContext::start_dispatch_log`], in
+    /// recording order, and stops the log (empty when none was started).
+    pub fn take_dispatch_log(&self) -> Vec<crate::vk::counters::DispatchRecord> {
+        self.device.counters.take_log()
+    }
+
     /// The device's name, type, driver and limits.
     pub fn info(&self) -> &DeviceInfo {
         &self.device.info

@@ -103,7 +103,7 @@ pub use error::{Error, FileFormat, Result};
 pub use groom::Groom;
 pub use profiler::{Clock, GpuProfiler, PassTiming, ProfileReport, ScopeId};
 pub use requirements::{requirements, RequiredFeatures, Requirements, API_VERSION};
-pub use vk::counters::RecordedWork;
+pub use vk::counters::{DispatchRecord, RecordedWork};
 pub use vk::device::DeviceInfo;
 pub use vk::validation::{Severity, ValidationLog, ValidationMessage};
 

@@ -2,6 +2,7 @@
 //! bytes of the buffers each dispatch binds.
 
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 
 /// Work recorded by vkhair on one device since it was created, counted as it is
 /// recorded (a command buffer recorded and never submitted still counts). Take
@@ -39,6 +40,24 @@ impl std::ops::Sub for RecordedWork {
     }
 }
 
+/// One compute dispatch as recorded ([`crate::GpuContext::take_dispatch_log`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DispatchRecord {
+    /// The kernel: its shader's name (`sim/volume/scatter.comp`).
+    pub kernel: String,
+    /// Workgroups it launches; for an indirect dispatch, the most it can (the
+    /// count the recorder uploaded, which the GPU may lower to zero).
+    pub workgroups: u64,
+    /// Invocations per workgroup.
+    pub workgroup_size: u32,
+    /// Whether the GPU reads its workgroup count from a buffer.
+    pub indirect: bool,
+    /// The most times one invocation goes round a loop over data (cells or
+    /// items it shares with others, iterations of a solve), as its recorder
+    /// states it; 1 for a kernel whose invocations each take one item.
+    pub loop_trips: u32,
+}
+
 /// The device's running counts.
 #[derive(Debug, Default)]
 pub(crate) struct Counters {
@@ -46,6 +65,8 @@ pub(crate) struct Counters {
     barriers: AtomicU64,
     bytes_read: AtomicU64,
     bytes_written: AtomicU64,
+    /// Every dispatch while a log is kept.
+    log: Mutex<Option<Vec<DispatchRecord>>>,
 }
 
 impl Counters {
@@ -58,6 +79,27 @@ impl Counters {
         self.dispatches.fetch_add(1, Ordering::Relaxed);
         self.bytes_read.fetch_add(traffic.0, Ordering::Relaxed);
         self.bytes_written.fetch_add(traffic.1, Ordering::Relaxed);
+    }
+
+    /// Keeps `record` when a log is kept.
+    pub(crate) fn log_dispatch(&self, record: impl FnOnce() -> DispatchRecord) {
+        if let Ok(mut log) = self.log.lock() {
+            if let Some(log) = log.as_mut() {
+                log.push(record());
+            }
+        }
+    }
+
+    /// Starts (or restarts, emptied) the dispatch log.
+    pub(crate) fn start_log(&self) {
+        if let Ok(mut log) = self.log.lock() {
+            *log = Some(Vec::new());
+        }
+    }
+
+    /// The dispatches logged since [`Counters::start_log`]; the log stops.
+    pub(crate) fn take_log(&self) -> Vec<DispatchRecord> {
+        self.log.lock().ok().and_then(|mut log| log.take()).unwrap_or_default()
     }
 
     pub(crate) fn read(&self) -> RecordedWork {

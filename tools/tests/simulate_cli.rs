@@ -106,3 +106,46 @@ fn render_takes_a_share_on_one_queue_and_on_a_second_device() {
         assert!(!r.stdout.contains("llvmpipe"), "{command}: GPU work before the refusal: {}", r.stdout);
     }
 }
+
+/// `simulate --dispatches` lists the last steps' kernels with the work each
+/// launches: the particle kernels' workgroups grow with the groom (8× the
+/// strands, 8× the workgroups), the dispatched solve's invocations loop a few
+/// hundred times at most (its coarse cycle's sweeps), and the solve in one
+/// workgroup is one invocation looping tens of thousands of times.
+#[test]
+fn dispatches_lists_the_work_each_kernel_launches_and_it_follows_the_groom() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // Per kernel: (dispatches a step, workgroups a step, loop trips).
+    let rows = |strands: u32, pressure: &str| -> std::collections::HashMap<String, (u64, u64, u64)> {
+        let groom = dir.path().join(format!("g{strands}.hair"));
+        let g = groom.to_str().expect("utf-8");
+        run(&["grow", "--scalp", "sphere", "--strands", &strands.to_string(), "--points", "32", "--out", g], LIMIT)
+            .assert_ok();
+        let args =
+            ["simulate", "--input", g, "--guides", "all", "--points", "32", "--steps", "2", "--pressure", pressure];
+        let out = run(&[&args[..], &["--dispatches"]].concat(), LIMIT);
+        out.assert_ok();
+        let table: Vec<&str> =
+            out.stdout.lines().skip_while(|l| !l.starts_with("compute dispatches a step")).skip(2).collect();
+        table
+            .iter()
+            .take_while(|l| l.starts_with("sim/"))
+            .map(|l| {
+                let f: Vec<&str> = l.split_whitespace().collect();
+                let n = |i: usize| f[i].trim_end_matches('*').parse::<u64>().expect("a count");
+                (f[0].to_owned(), (n(1), n(2), n(5)))
+            })
+            .collect()
+    };
+    let (small, large) = (rows(1000, "dispatched"), rows(8000, "dispatched"));
+    let scatter = |r: &std::collections::HashMap<String, (u64, u64, u64)>| {
+        r.iter().find(|(k, _)| k.starts_with("sim/volume/scatter.comp")).map(|(_, v)| *v).expect("a scatter row")
+    };
+    assert_eq!(scatter(&small).1 * 8, scatter(&large).1, "scatter workgroups: {small:?} / {large:?}");
+    assert_eq!(small["sim/step.comp"].1 * 8, large["sim/step.comp"].1);
+    let most = large.values().map(|v| v.2).max().expect("rows");
+    assert!(most <= 500, "an invocation of the dispatched solve loops {most} times: {large:?}");
+    assert!(large.contains_key("sim/volume/mg_cycle.comp"), "{large:?}");
+    let one = rows(1000, "workgroup");
+    assert!(one["sim/volume/pcg_workgroup.comp"].2 > 10_000, "{one:?}");
+}

@@ -34,22 +34,33 @@ const WORKGROUP_LOOP_BUDGET: u32 = 60_000;
 /// iteration would not (grids above about 1.9 million cells): the solve is then
 /// dispatched per kernel and iteration.
 pub(crate) fn workgroup_share(grid: &GridLayout, preconditioner: Preconditioner) -> Option<u32> {
+    let share = WORKGROUP_LOOP_BUDGET / workgroup_trips(grid, preconditioner);
+    (share > 0).then_some(share)
+}
+
+/// Loop trips of one invocation through one iteration of the solve in one
+/// workgroup (`pcg_workgroup.comp`).
+fn workgroup_trips(grid: &GridLayout, preconditioner: Preconditioner) -> u32 {
+    let per = |cells: u32| cells.div_ceil(GROUP);
+    let levels = &grid.levels;
+    // Matrix product, update, r·z and the new direction; three reductions.
+    let trips = 4 * per(levels[0].cells()) + 3 * GROUP.ilog2();
+    match preconditioner {
+        Preconditioner::Multigrid => trips + cycle_trips(grid, 0),
+        _ => trips + per(levels[0].cells()),
+    }
+}
+
+/// Loop trips of one invocation through a workgroup's V-cycle from level
+/// `from` down (`mg_workgroup.glsl`): per level two sweeps down, two up and
+/// the restriction over its cells, each invocation taking every `GROUP`th,
+/// and the level lookups; the coarsest level's sweeps.
+fn cycle_trips(grid: &GridLayout, from: usize) -> u32 {
     let per = |cells: u32| cells.div_ceil(GROUP);
     let levels = &grid.levels;
     let n = levels.len() as u32;
-    // Matrix product, update, r·z and the new direction; three reductions.
-    let mut trips = 4 * per(levels[0].cells()) + 3 * GROUP.ilog2();
-    if preconditioner == Preconditioner::Multigrid {
-        for pair in levels.windows(2) {
-            // Two sweeps down, two up, the restriction; the level lookups.
-            trips += 4 * per(pair[0].cells()) + per(pair[1].cells()) + 8 * n;
-        }
-        trips += VOL_COARSEST_SWEEPS;
-    } else {
-        trips += per(levels[0].cells());
-    }
-    let share = WORKGROUP_LOOP_BUDGET / trips;
-    (share > 0).then_some(share)
+    let down: u32 = levels[from..].windows(2).map(|pair| 4 * per(pair[0].cells()) + per(pair[1].cells()) + 8 * n).sum();
+    down + VOL_COARSEST_SWEEPS
 }
 
 /// Most cells of a level the dispatched solve's V-cycle leaves to its
@@ -74,6 +85,10 @@ enum Launch {
     Threads(u32),
     /// From indirect entry k (per multigrid level; the last is a single workgroup).
     Indirect(usize),
+    /// One workgroup whose invocations go round their loops this many times.
+    Workgroup(u32),
+    /// From the single-workgroup indirect entry, looping this many times.
+    IndirectWorkgroup(u32),
 }
 
 /// The volume stage's GPU side: grid, buffers and kernels, recorded per sub-step.
@@ -161,8 +176,16 @@ impl VolumeStage {
             k.pipeline.push(cmd, &push);
             match launch {
                 Launch::Threads(n) => k.pipeline.dispatch_threads(cmd, [n, 1, 1]),
+                Launch::Workgroup(trips) => k.pipeline.dispatch_looping(cmd, [1, 1, 1], trips),
                 Launch::Indirect(entry) => {
-                    k.pipeline.dispatch_indirect(cmd, self.buffers.indirect.raw(), entry as u64 * INDIRECT_STRIDE)
+                    // The most it launches: the count record_uploads set.
+                    let most = self.grid.levels.get(entry).map_or(1, |l| l.cells().div_ceil(GROUP));
+                    let offset = entry as u64 * INDIRECT_STRIDE;
+                    k.pipeline.dispatch_indirect_at_most(cmd, self.buffers.indirect.raw(), offset, [most, 1, 1], 1)
+                }
+                Launch::IndirectWorkgroup(trips) => {
+                    let offset = self.grid.levels.len() as u64 * INDIRECT_STRIDE;
+                    k.pipeline.dispatch_indirect_at_most(cmd, self.buffers.indirect.raw(), offset, [1, 1, 1], trips)
                 }
             }
             self.barrier(cmd, kernel == Kernel::PcgReduce);
@@ -253,7 +276,8 @@ impl VolumeStage {
             if let (PressureSolver::Workgroup, Some(share)) = (self.params.solver, share) {
                 for k in 0..self.params.max_iterations.div_ceil(share) {
                     let push = VolumePush::from(&WorkgroupSolvePass { start: u32::from(k == 0), iterations: share });
-                    self.run(cmd, Kernel::PcgWorkgroup, variant, push, Launch::Threads(GROUP));
+                    let trips = share.saturating_mul(workgroup_trips(&self.grid, self.params.preconditioner));
+                    self.run(cmd, Kernel::PcgWorkgroup, variant, push, Launch::Workgroup(trips));
                 }
                 self.run(cmd, Kernel::Gradient, variant, none, Launch::Threads(self.grid.faces[2]));
                 return;
@@ -305,7 +329,8 @@ impl VolumeStage {
             match cycle {
                 Some(first_level) => {
                     let push = VolumePush::from(&CyclePass { first_level: first_level as u32 });
-                    self.run(cmd, Kernel::MgCycle, variant, push, Launch::Indirect(levels));
+                    let trips = cycle_trips(&self.grid, first_level);
+                    self.run(cmd, Kernel::MgCycle, variant, push, Launch::IndirectWorkgroup(trips));
                 }
                 None => {
                     let last = self.level_pass(levels - 1);

@@ -8,6 +8,7 @@ use ash::vk;
 use super::{shader_module, ConstantZero, Layout};
 use crate::error::{Error, Result};
 use crate::vk::buffer::Buffer;
+use crate::vk::counters::DispatchRecord;
 use crate::vk::device::Device;
 use crate::vk::reflect::reflect;
 use crate::vk::shaders::ShaderSource;
@@ -219,7 +220,7 @@ impl ComputePipeline {
     /// `cmd` is recording with this pipeline bound.
     pub(crate) unsafe fn dispatch_threads(&self, cmd: vk::CommandBuffer, threads: [u32; 3]) {
         let groups = [0, 1, 2].map(|i| threads[i].div_ceil(self.workgroup_size[i]));
-        self.count_dispatch();
+        self.count_dispatch(groups, false, 1);
         // SAFETY: guaranteed by the caller.
         unsafe { self.layout.device.raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
     }
@@ -230,29 +231,57 @@ impl ComputePipeline {
     /// `cmd` is recording with this pipeline bound; each count is within the
     /// device's `maxComputeWorkGroupCount`.
     pub(crate) unsafe fn dispatch_groups(&self, cmd: vk::CommandBuffer, groups: [u32; 3]) {
-        self.count_dispatch();
+        self.count_dispatch(groups, false, 1);
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.layout.device.raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
+    }
+
+    /// Dispatches `groups` workgroups whose invocations go round their loops
+    /// at most `loop_trips` times (for the dispatch log).
+    ///
+    /// # Safety
+    /// As [`ComputePipeline::dispatch_groups`].
+    pub(crate) unsafe fn dispatch_looping(&self, cmd: vk::CommandBuffer, groups: [u32; 3], loop_trips: u32) {
+        self.count_dispatch(groups, false, loop_trips);
         // SAFETY: guaranteed by the caller.
         unsafe { self.layout.device.raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
     }
 
     /// Dispatches with the workgroup counts read from `buffer` at `offset` when the
-    /// command executes (a `VkDispatchIndirectCommand`).
+    /// command executes (a `VkDispatchIndirectCommand`), logged as launching at
+    /// most `groups` workgroups whose invocations go round their loops at most
+    /// `loop_trips` times ([`crate::GpuContext::start_dispatch_log`]).
     ///
     /// # Safety
     /// `cmd` is recording with this pipeline bound; `buffer` has INDIRECT_BUFFER usage,
     /// holds a command at `offset` (a multiple of 4) whose counts stay within the
     /// device limits, and writes to it are made visible to DRAW_INDIRECT reads.
-    pub(crate) unsafe fn dispatch_indirect(&self, cmd: vk::CommandBuffer, buffer: vk::Buffer, offset: u64) {
-        self.count_dispatch();
+    pub(crate) unsafe fn dispatch_indirect_at_most(
+        &self,
+        cmd: vk::CommandBuffer,
+        buffer: vk::Buffer,
+        offset: u64,
+        groups: [u32; 3],
+        loop_trips: u32,
+    ) {
+        self.count_dispatch(groups, true, loop_trips);
         // SAFETY: guaranteed by the caller.
         unsafe { self.layout.device.raw.cmd_dispatch_indirect(cmd, buffer, offset) };
     }
 }
 
 impl ComputePipeline {
-    fn count_dispatch(&self) {
+    fn count_dispatch(&self, groups: [u32; 3], indirect: bool, loop_trips: u32) {
         let traffic = self.bound.lock().map_or((0, 0), |b| *b);
-        self.layout.device.counters.dispatch(traffic);
+        let counters = &self.layout.device.counters;
+        counters.dispatch(traffic);
+        counters.log_dispatch(|| DispatchRecord {
+            kernel: self.name.clone(),
+            workgroups: groups.iter().map(|&g| u64::from(g)).product(),
+            workgroup_size: self.workgroup_size.iter().product(),
+            indirect,
+            loop_trips,
+        });
     }
 }
 

@@ -20,6 +20,7 @@ use crate::say;
 
 mod character;
 mod check;
+mod dispatches;
 mod drawn;
 
 use check::{share_inside, tip_drift, write_final, Reference, StepCheck};
@@ -53,6 +54,13 @@ pub struct SimulateArgs {
     /// grown from the key hairs.
     #[arg(long)]
     drawn_out: Option<PathBuf>,
+    /// Print the compute dispatches of the last steps (up to 10), per kernel
+    /// and step: how many, the workgroups they launch (the most, for those
+    /// whose count the GPU reads from a buffer), invocations per workgroup
+    /// and the most loop trips of one invocation — the counts that predict
+    /// their cost on a GPU.
+    #[arg(long)]
+    dispatches: bool,
     #[command(flatten)]
     profile_out: ProfileArgs,
 }
@@ -242,9 +250,14 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     // --check one step of the CPU reference from the GPU's state.
     let chunk = 10;
     let (mut done, mut worst_inside) = (0, 0.0f64);
+    let mut logged_steps = 0;
     while done < a.steps {
         let n = chunk.min(a.steps - done);
         let start = done;
+        if a.dispatches && done + n >= a.steps {
+            ctx.start_dispatch_log();
+            logged_steps = n;
+        }
         if a.check {
             // One step of the GPU against the same step of the reference.
             let state = sim.read_state()?;
@@ -277,6 +290,9 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
     }
     bar.finish_and_clear();
     profile.print_table();
+    if a.dispatches {
+        dispatches::print(&ctx.take_dispatch_log(), logged_steps);
+    }
     let state = sim.read_state()?;
     say!("kinetic energy {:.4} J/kg per particle", state.kinetic_energy() / state.positions.len() as f64);
     let last_head = head(a.steps - 1);
