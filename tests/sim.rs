@@ -159,33 +159,35 @@ fn a_step_is_one_dispatch_without_the_volume_stage() {
     assert_eq!(steps, 2, "one step dispatch per sub-step with the volume stage: {report}");
 }
 
-/// The dispatched solve's passes per iteration at 32³: the conjugate
-/// gradients' five, four for the finest multigrid level, and one for all the
-/// coarser ones (16³, 8³ and the coarsest, 4³, in one workgroup).
+/// The dispatched solve's passes per iteration: the conjugate gradients'
+/// five, four for each multigrid level above 16³, and one for all the coarser
+/// ones in one workgroup — at 32³ (16³, 8³ and the coarsest, 4³) 10, at 64³
+/// (32³ dispatched too) 14.
 #[test]
-fn a_pressure_iteration_is_four_passes_for_the_finest_level_one_for_the_rest_and_five_more() {
+fn a_pressure_iteration_is_four_passes_a_level_above_16_cubed_one_for_the_rest_and_five_more() {
     let gpu = Gpu::new();
     let groom = common::grown_groom(100, 16, 3);
     // Matrix product, reduction, update, reduction, new direction; on the
     // finest level pre-smoothing, restriction and two post-smoothing passes;
     // the coarse cycle. (Four passes a level and the coarsest's: 18; before
     // the passes were fused: 25.)
-    let per_iteration = 5 + 4 + 1;
-    let run = |max_iterations| {
-        let volume = vkhair::sim::VolumeParams {
-            max_iterations,
-            solver: PressureSolver::Dispatched,
-            ..vkhair::sim::VolumeParams::flip([32, 32, 32])
+    for (n, per_iteration) in [(32, 5 + 4 + 1), (64, 5 + 4 * 2 + 1)] {
+        let run = |max_iterations| {
+            let volume = vkhair::sim::VolumeParams {
+                max_iterations,
+                solver: PressureSolver::Dispatched,
+                ..vkhair::sim::VolumeParams::flip([n; 3])
+            };
+            let params = SimParams { volume, ..SimParams::default() };
+            let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
+            let before = gpu.ctx().recorded_work();
+            sim.run(1, |i| head_at(i, &params), None).expect("run");
+            gpu.ctx().recorded_work() - before
         };
-        let params = SimParams { volume, ..SimParams::default() };
-        let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
-        let before = gpu.ctx().recorded_work();
-        sim.run(1, |i| head_at(i, &params), None).expect("run");
-        gpu.ctx().recorded_work() - before
-    };
-    let work = run(3) - run(1);
-    assert_eq!(work.dispatches, 2 * per_iteration, "{work:?}");
-    assert_eq!(work.barriers, 2 * per_iteration, "{work:?}");
+        let work = run(3) - run(1);
+        assert_eq!(work.dispatches, 2 * per_iteration, "{n}³: {work:?}");
+        assert_eq!(work.barriers, 2 * per_iteration, "{n}³: {work:?}");
+    }
 }
 
 /// The volume stage's dispatches per FLIP step with the solve in one workgroup

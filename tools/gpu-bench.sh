@@ -59,6 +59,10 @@ if [ "$smoke" = 1 ]; then
   width=160 height=120 frames=2 steps=3 guides=300 grid=16 per_key=4 peer_width=160 peer_height=120
 else
   frames=${VKHAIR_FRAMES:-120}
+  if ! [[ $frames =~ ^[1-9][0-9]*$ ]]; then
+    echo "gpu-bench: VKHAIR_FRAMES must be a whole number of frames, at least 1 (got '$frames')" >&2
+    exit 2
+  fi
   steps=$frames
   width=1920 height=1080 guides=100000 grid=64 per_key=572 peer_width=1280 peer_height=720
 fi
@@ -192,7 +196,11 @@ for raster in hardware compute; do
 done
 # Interpolation per segment (issue: no costlier at 1,001,000 hairs than at the
 # thesis' count), for the default compute dispatch and the tessellation stages.
-"$vkhair" render "${size[@]}" --interpolator tessellation --out "$frame/thesis_tess" >"$frame/thesis_tess.txt" 2>&1
+"$vkhair" render "${size[@]}" --interpolator tessellation --out "$frame/thesis_tess" >"$frame/thesis_tess.txt" 2>&1 || {
+  cat "$frame/thesis_tess.txt" >&2
+  echo "gpu-bench: the thesis through the tessellation stages failed: vkhair render ${size[*]} --interpolator tessellation" >&2
+  exit 1
+}
 echo " interpolation, ns a drawn segment (the interpolate pass's mean GPU ms over the segments)" >>"$report"
 for key in thesis_compute strands_compute thesis_tess; do
   segments=$(sed -n 's/.* (\([0-9]*\) segments), .*/\1/p' "$frame/$key.txt" | head -n 1)

@@ -1,6 +1,7 @@
 // Per-cell arithmetic of the pressure solve, one definition for its dispatched
-// kernels (pcg_init, mg_smooth, mg_restrict) and the solve in one workgroup
-// (pcg_workgroup). Include after volume_ops.glsl and after declaring what the
+// kernels (pcg_init, mg_smooth, mg_restrict, mg_coarsest) and the phases of a
+// workgroup (mg_workgroup.glsl: pcg_workgroup, the solve in one workgroup, and
+// mg_cycle, the dispatched solve's coarse levels). Include after volume_ops.glsl and after declaring what the
 // parts used read:
 //   VKHAIR_PRESSURE_RHS:       `vp` (VolumeParams) and `face_vel[]` (binding 17);
 //   VKHAIR_PRESSURE_LEVELS:    `x[]` (binding 23) and `rhs[]` (binding 25);

@@ -1,7 +1,9 @@
 // Fixed-point sums of the volume stage's transfer, in any order to the same
 // bits: a value x is added as the 64-bit integer trunc(x · 2³²) (|x| capped
 // below 2³¹, NaN as 0), kept in two uint words (low, high) and added with
-// 32-bit atomics, the low word's carry going to the high one. Twin:
+// 32-bit atomics, the low word's carry going to the high one — or, in
+// scatter.comp's VKHAIR_INT64 variant, as one 64-bit atomic on the pair
+// (the same sums). Twin:
 // `fixed_point` in src/sim/volume/reference.rs. Include after declaring the
 // `accum` buffer (define VOL_FIXED_READ_ONLY first where it is read only).
 #ifndef VKHAIR_VOLUME_FIXED_GLSL

@@ -302,7 +302,10 @@ impl InterpolatePass {
             // Every grown vertex: the units' hairs' smoothed vertices (their
             // points, with followers).
             let per_hair = if self.follow.is_some() { push.points } else { push.stride };
-            let vertices = push.strands * push.hairs * per_hair;
+            // Within the hairs' buffer (at most maxStorageBufferRange / 16
+            // vertices, checked when the renderer was made): far below 2^32.
+            let vertices = u64::from(push.strands) * u64::from(push.hairs) * u64::from(per_hair);
+            let vertices = u32::try_from(vertices).unwrap_or(u32::MAX);
             let (x, y) = dispatch_grid(vertices.div_ceil(p.compute.workgroup_size()[0]));
             let written = barrier::memory(&[AccessKind::ComputeWrite], HAIR_READERS);
             // SAFETY: guaranteed by the caller; the dispatch covers every vertex

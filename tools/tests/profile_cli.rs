@@ -178,6 +178,12 @@ fn render_lists_every_pass_and_writes_a_trace_and_summary_that_agree() {
     assert!(rows[&(track.clone(), "vkhair render: draw".to_owned())] > 0.0);
     assert_eq!(summary["run"]["frames"], 3);
     assert_eq!(summary["per"], "frame");
+    // The compute rasteriser's frame names its resolve in compute.
+    let (out, _) = profiled("render --frames 2 --width 64 --height 48 --raster compute --schedule single");
+    let (rows, _) = table(&out.stdout);
+    for pass in ["vkhair render: draw, build", "vkhair render: composite, resolve in compute"] {
+        assert!(rows.contains_key(&(track.clone(), pass.to_owned())), "{pass} missing from the table:\n{}", out.stdout);
+    }
 }
 
 #[test]

@@ -228,7 +228,7 @@ impl Renderer {
     /// hair relying on this).
     ///
     /// With [`super::RenderParams::transparency`] on, the hair is composited over
-    /// the target's colour instead (see `render/draw/transparent.rs`): each
+    /// the target's colour instead (see `render/draw/transparent/`): each
     /// fragment depth-tested against the target's depth, and the depth of the
     /// nearest fragment at least half opaque written where it is nearer (not
     /// with supersampling, whose resolve leaves the host's depth as it was); the

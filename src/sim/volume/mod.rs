@@ -41,8 +41,10 @@
 //!    up to the cap recorded, a reduction kernel setting the indirect dispatches
 //!    of the remaining ones to zero once converged), where a V-cycle is four passes
 //!    per level (the two pre-sweeps in one, the prolongation folded into the
-//!    first post-sweep, the next dot product into the last) and an iteration 4
-//!    passes per level above the coarsest plus 6. Then the pressure difference is subtracted on faces between a
+//!    first post-sweep, the next dot product into the last) down to the levels
+//!    of at most 16³, which are one pass of a single workgroup (`mg_cycle.comp`;
+//!    else the coarsest level's own), and an iteration that plus 5 (10 passes at
+//!    32³, 14 at 64³). Then the pressure difference is subtracted on faces between a
 //!    fluid cell and a non-solid one (`gradient.comp`).
 //! 5. **Update** (`g2p.comp`): FLIP/PIC blend ṽ = α(v + Lerp(x, v − v*)) +
 //!    (1 − α)Lerp(x, v), or friction and repulsion from the cells.

@@ -56,7 +56,8 @@ pub enum PressureSolver {
     Workgroup,
     /// A dispatch per kernel and iteration over the whole device, every iteration up
     /// to the cap recorded (those after convergence dispatch zero workgroups):
-    /// 4 passes per multigrid level above the coarsest and 6 more per iteration.
+    /// per iteration 4 passes per multigrid level above those of at most 16³
+    /// (one pass of a single workgroup for all of those) and 5 more.
     Dispatched,
 }
 

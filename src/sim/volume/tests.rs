@@ -158,11 +158,6 @@ fn the_fixed_point_of_the_transfer_is_exact_where_it_can_be() {
     assert_eq!(fixed_value(fixed_point(-2.25)), -2.25);
 }
 
-/// The scatter against the reference on particles inside, on cell boundaries,
-/// outside (below, on the far faces, NaN, infinite) and with a NaN and a
-/// huge velocity: counts, densities and face weights bit for bit (the same
-/// integer sums), means and face velocities to the division's rounding;
-/// particles outside keep their velocity.
 /// The scatter's ways of adding: 64-bit atomics where the device has them
 /// (then the 32-bit pairs too, forced), else the 32-bit pairs alone.
 fn atomic_paths(gpu: &TestGpu) -> Vec<bool> {
@@ -175,6 +170,12 @@ fn atomic_paths(gpu: &TestGpu) -> Vec<bool> {
     }
 }
 
+/// The scatter against the reference on particles inside, on cell boundaries,
+/// outside (below, on the far faces, NaN, infinite) and with a NaN and a
+/// huge velocity: counts, densities and face weights bit for bit (the same
+/// integer sums), means and face velocities to the division's rounding;
+/// particles outside keep their velocity; both ways of adding where the device has
+/// 64-bit atomics.
 #[test]
 fn the_scatter_matches_the_reference_bit_for_bit() {
     let gpu = TestGpu::new();

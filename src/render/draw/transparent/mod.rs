@@ -384,7 +384,10 @@ impl TransparentPass {
             &[build_write],
             &[AccessKind::VertexRead, AccessKind::FragmentRead, AccessKind::ComputeRead],
         );
-        // The compute resolve's pixels to the composite's fragment stage.
+        // The compute resolve's pixels to the composite's fragment stage. (The
+        // previous frame's composite read them in its fragment stage before
+        // this frame's resolve writes them: `to_clear` waits for that stage,
+        // `cleared` and `built` carry the wait on to the resolve.)
         let resolved = barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::FragmentRead]);
         // The previous frame's ribbons (or rasteriser) read the colours this frame's dispatch writes.
         let to_shade = barrier::memory(&[AccessKind::VertexRead, AccessKind::ComputeRead], &[AccessKind::ComputeWrite]);
