@@ -1,7 +1,7 @@
 //! What a host changes on a running scheduler: parameters, colliders, the mesh
 //! collider, a scalp skinned from bone matrices, and stopping the simulation side.
 
-use super::worker::SimUpdate;
+use super::update::SimUpdate;
 use super::{Backend, FrameScheduler};
 use crate::error::{Error, Result};
 use crate::groom::mesh::TriMesh;
@@ -24,12 +24,7 @@ impl FrameScheduler {
                 "the volume stage's mode and resolution are fixed for a scheduler",
             ));
         }
-        match &mut self.backend {
-            Backend::Local { sim, .. } => sim.set_params(params),
-            Backend::Async { sim, .. } => sim.sim.set_params(params),
-            Backend::Remote { worker, .. } => worker.update(SimUpdate::Params(Box::new(params.clone()))),
-            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
-        }
+        self.forward(SimUpdate::Params(Box::new(params.clone())))
     }
 
     /// Replaces the colliders (validated now) from the next step on.
@@ -38,12 +33,7 @@ impl FrameScheduler {
         // Checked here, so that a second device's worker never fails on it.
         crate::sim::validate_collider_total(colliders.len(), self.colliders.1)?;
         self.colliders.0 = colliders.len();
-        match &mut self.backend {
-            Backend::Local { sim, .. } => sim.set_colliders(colliders),
-            Backend::Async { sim, .. } => sim.sim.set_colliders(colliders),
-            Backend::Remote { worker, .. } => worker.update(SimUpdate::Colliders(colliders.to_vec())),
-            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
-        }
+        self.forward(SimUpdate::Colliders(colliders.to_vec()))
     }
 
     /// The body's colliders in the world at the end of the next step (validated
@@ -52,40 +42,19 @@ impl FrameScheduler {
         crate::sim::validate_colliders(colliders)?;
         crate::sim::validate_collider_total(self.colliders.0, colliders.len())?;
         self.colliders.1 = colliders.len();
-        match &mut self.backend {
-            Backend::Local { sim, .. } => sim.set_body_colliders(colliders),
-            Backend::Async { sim, .. } => sim.sim.set_body_colliders(colliders),
-            Backend::Remote { worker, .. } => worker.update(SimUpdate::Body(colliders.to_vec())),
-            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
-        }
+        self.forward(SimUpdate::Body(colliders.to_vec()))
     }
 
     /// A cut or a respawn: the next step starts with the state moved rigidly to
     /// the head `to` (checked now; see [`crate::sim::HairSim::teleport`]).
     pub fn teleport(&mut self, to: &RigidTransform) -> Result<()> {
         to.validate()?;
-        match &mut self.backend {
-            Backend::Local { sim, .. } => sim.teleport(to),
-            Backend::Async { sim, .. } => sim.sim.teleport(to),
-            Backend::Remote { worker, .. } => worker.update(SimUpdate::Teleport(*to)),
-            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
-        }
+        self.forward(SimUpdate::Teleport(*to))
     }
 
     /// The next step starts from the rest pose (see [`crate::sim::HairSim::reset`]).
     pub fn reset(&mut self) -> Result<()> {
-        match &mut self.backend {
-            Backend::Local { sim, .. } => {
-                sim.reset();
-                Ok(())
-            }
-            Backend::Async { sim, .. } => {
-                sim.sim.reset();
-                Ok(())
-            }
-            Backend::Remote { worker, .. } => worker.update(SimUpdate::Reset),
-            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
-        }
+        self.forward(SimUpdate::Reset)
     }
 
     /// Simulates only `count` key hairs from the next step on, the others
@@ -96,12 +65,7 @@ impl FrameScheduler {
         if !(1..=strands).contains(&count) {
             return Err(Error::param("simulated key hairs", count, format!("1..={strands} (the key hairs)")));
         }
-        match &mut self.backend {
-            Backend::Local { sim, .. } => sim.set_simulated_hairs(count),
-            Backend::Async { sim, .. } => sim.sim.set_simulated_hairs(count),
-            Backend::Remote { worker, .. } => worker.update(SimUpdate::Simulated(count)),
-            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
-        }
+        self.forward(SimUpdate::Simulated(count))
     }
 
     /// Sets the mesh collider of `mesh` (head frame, the groom's units; `None`
@@ -112,14 +76,7 @@ impl FrameScheduler {
         if let Some(m) = mesh {
             MeshCollider::validate(m, params)?;
         }
-        match &mut self.backend {
-            Backend::Local { sim, .. } => sim.set_mesh(mesh, params),
-            Backend::Async { sim, .. } => sim.sim.set_mesh(mesh, params),
-            Backend::Remote { worker, .. } => {
-                worker.update(SimUpdate::Mesh(mesh.map(|m| Box::new((m.clone(), params.clone())))))
-            }
-            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
-        }
+        self.forward(SimUpdate::Mesh(mesh.map(|m| Box::new((m.clone(), params.clone())))))
     }
 
     /// Binds the key hairs' roots to `scalp`, skinned by vkhair from `bones`
@@ -132,14 +89,7 @@ impl FrameScheduler {
             return Err(Error::incompatible("scalp bones", "the scalp has no vertex bones (Scalp::skin)"));
         }
         scalp.skin(bones)?;
-        match &mut self.backend {
-            Backend::Local { sim, .. } => sim.bind_scalp_bones(scalp, bones),
-            Backend::Async { sim, .. } => sim.sim.bind_scalp_bones(scalp, bones),
-            Backend::Remote { worker, .. } => {
-                worker.update(SimUpdate::ScalpBind(Box::new((scalp.clone(), bones.to_vec()))))
-            }
-            Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
-        }?;
+        self.forward(SimUpdate::ScalpBind(Box::new((scalp.clone(), bones.to_vec()))))?;
         self.scalp = Some(scalp.clone());
         Ok(())
     }
@@ -153,10 +103,16 @@ impl FrameScheduler {
             return Err(Error::incompatible("scalp bones", "no scalp skinned from bone matrices is bound"));
         };
         scalp.skin(bones)?;
+        self.forward(SimUpdate::ScalpBones(bones.to_vec()))
+    }
+
+    /// Applies `update` to the simulation in place, or sends it to the
+    /// second device's worker, which applies it before its next step.
+    fn forward(&mut self, update: SimUpdate) -> Result<()> {
         match &mut self.backend {
-            Backend::Local { sim, .. } => sim.set_scalp_bones(bones),
-            Backend::Async { sim, .. } => sim.sim.set_scalp_bones(bones),
-            Backend::Remote { worker, .. } => worker.update(SimUpdate::ScalpBones(bones.to_vec())),
+            Backend::Local { sim, .. } => update.apply(sim),
+            Backend::Async { sim, .. } => update.apply(&mut sim.sim),
+            Backend::Remote { worker, .. } => worker.update(update),
             Backend::Stopped(why) => Err(Error::SimulationStopped(why.clone())),
         }
     }

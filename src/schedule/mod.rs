@@ -43,6 +43,7 @@ mod control;
 mod mirror;
 mod mode;
 mod options;
+mod update;
 mod worker;
 
 use std::sync::Arc;

@@ -24,10 +24,10 @@ use std::time::{Duration, Instant};
 use ash::vk;
 
 use super::mirror::{record_copy, Layout, Meta, Parts};
+use super::update::SimUpdate;
 use crate::error::{Error, Result};
-use crate::groom::mesh::TriMesh;
 use crate::profiler::{GpuProfiler, ProfileReport};
-use crate::sim::{Collider, HairSim, MeshColliderParams, RigidTransform, SimParams, SimState};
+use crate::sim::{HairSim, RigidTransform, SimState};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
@@ -36,20 +36,6 @@ use crate::vk::submit::CommandRing;
 
 /// How often a blocked worker looks at the stop flag.
 const SLICE: Duration = Duration::from_millis(20);
-
-/// A change to the simulation, applied before the next job.
-pub(crate) enum SimUpdate {
-    Params(Box<SimParams>),
-    ScalpBind(Box<(crate::sim::scalp::Scalp, Vec<glam::Mat4>)>),
-    ScalpBones(Vec<glam::Mat4>),
-    Colliders(Vec<Collider>),
-    Body(Vec<Collider>),
-    Teleport(RigidTransform),
-    Reset,
-    Mesh(Option<Box<(TriMesh, MeshColliderParams)>>),
-    /// Key hairs simulated (checked by the sender).
-    Simulated(usize),
-}
 
 enum Request {
     Step {
@@ -276,21 +262,7 @@ fn run(mut side: SimSide, slots: usize, timeout: Duration, shared: &Shared) {
         };
         let result = match request {
             Request::Step { job, heads } => step(&mut side, shared, job, &heads, slots, timeout),
-            Request::Update(SimUpdate::Params(p)) => side.sim.set_params(&p),
-            Request::Update(SimUpdate::Colliders(c)) => side.sim.set_colliders(&c),
-            Request::Update(SimUpdate::Body(c)) => side.sim.set_body_colliders(&c),
-            Request::Update(SimUpdate::Teleport(to)) => side.sim.teleport(&to),
-            Request::Update(SimUpdate::Reset) => {
-                side.sim.reset();
-                Ok(())
-            }
-            Request::Update(SimUpdate::Simulated(count)) => side.sim.set_simulated_hairs(count),
-            Request::Update(SimUpdate::ScalpBind(bound)) => side.sim.bind_scalp_bones(&bound.0, &bound.1),
-            Request::Update(SimUpdate::ScalpBones(bones)) => side.sim.set_scalp_bones(&bones),
-            Request::Update(SimUpdate::Mesh(m)) => match m.as_deref() {
-                Some((mesh, params)) => side.sim.set_mesh(Some(mesh), params),
-                None => side.sim.set_mesh(None, &MeshColliderParams::default()),
-            },
+            Request::Update(update) => update.apply(&mut side.sim),
             Request::Read(reply) => {
                 let _ = reply.send(side.sim.read_state());
                 Ok(())
