@@ -197,6 +197,46 @@ fn a_cycle_of_objects_is_refused() {
     assert!(text.contains("belongs to another object too"), "{text}");
 }
 
+/// A thousand child objects naming one group of 150,000 children (1.2 MB)
+/// would have the reader copy that list a thousand times (2.4 GB, past the
+/// decoding budget) before the cycle check saw them: refused at the second,
+/// naming it, before the list is read again.
+#[test]
+fn a_fan_out_of_objects_to_one_group_is_refused_before_it_is_read_again() {
+    const CHILDREN: usize = 1000;
+    let mut f = b"Ogawa\xff\x00\x01".to_vec();
+    f.extend_from_slice(&[0u8; 8]);
+    let shared = f.len() as u64;
+    f.extend_from_slice(&150_000u64.to_le_bytes());
+    f.extend(std::iter::repeat_n(0u8, 8 * 150_000));
+    let headers_at = f.len() as u64;
+    let mut headers = Vec::new();
+    for i in 0..CHILDREN {
+        let name = format!("c{i}");
+        headers.extend_from_slice(&(name.len() as u32).to_le_bytes());
+        headers.extend_from_slice(name.as_bytes());
+        headers.push(0xff);
+        headers.extend_from_slice(&0u32.to_le_bytes());
+    }
+    headers.extend_from_slice(&[0u8; 32]);
+    f.extend_from_slice(&(headers.len() as u64).to_le_bytes());
+    f.extend_from_slice(&headers);
+    let top = f.len() as u64;
+    f.extend_from_slice(&(CHILDREN as u64 + 2).to_le_bytes());
+    f.extend_from_slice(&0u64.to_le_bytes());
+    for _ in 0..CHILDREN {
+        f.extend_from_slice(&shared.to_le_bytes());
+    }
+    f.extend_from_slice(&(headers_at | 1 << 63).to_le_bytes());
+    let root = f.len() as u64;
+    for v in [6u64, 1 << 63, 1 << 63, top, 1 << 63, 1 << 63, 1 << 63] {
+        f.extend_from_slice(&v.to_le_bytes());
+    }
+    f[8..16].copy_from_slice(&root.to_le_bytes());
+    let text = alembic::parse(&f).expect_err("a fan-out").to_string();
+    assert!(text.contains("object c1's group belongs to another object too"), "{text}");
+}
+
 #[test]
 fn not_alembic_files_are_named() {
     let e = alembic::parse(b"\x89HDF\r\n\x1a\n and more bytes").expect_err("HDF5");

@@ -203,9 +203,12 @@ impl<'a> Archive<'a> {
     }
 
     fn indexed(&self, index: u32, what: &str) -> Result<String> {
-        self.indexed.get(index as usize).cloned().ok_or_else(|| {
+        let text = self.indexed.get(index as usize).ok_or_else(|| {
             malformed(format!("{what} refers to metadata {index}, past the archive's {}", self.indexed.len()))
-        })
+        })?;
+        // Each object or property naming it takes a copy.
+        self.file.charge(text.len() as u64, what)?;
+        Ok(text.clone())
     }
 
     /// The child objects of an object group: header, group position and
@@ -213,13 +216,16 @@ impl<'a> Archive<'a> {
     pub fn children(&self, object: &[Child]) -> Result<Vec<(ObjectHeader, u64, Vec<Child>)>> {
         let Some((&Child::Data(at), groups)) = object.split_last() else { return Ok(Vec::new()) };
         let block = self.file.data(at)?;
+        // Their names and metadata are copied out: a block many objects
+        // share is charged each time.
+        self.file.charge(block.len() as u64, "object headers")?;
         if !block.is_empty() && block.len() < 32 {
             return Err(malformed(format!("object headers of {} bytes, shorter than their hashes", block.len())));
         }
         // The last 32 bytes are the object's hashes.
         let headers = &block[..block.len().saturating_sub(32)];
         let mut c = Cursor { b: headers, at: 0, what: "object headers" };
-        let mut out = Vec::new();
+        let mut out: Vec<(ObjectHeader, u64, Vec<Child>)> = Vec::new();
         while c.at < headers.len() {
             let n = c.u32()? as usize;
             if n == 0 {
@@ -236,8 +242,13 @@ impl<'a> Archive<'a> {
             // Child i is group i + 1 (group 0 holds the properties).
             let child =
                 groups.get(out.len() + 1).copied().ok_or_else(|| malformed(format!("object {name} has no group")))?;
-            let group = self.file.group_of(child, &format!("object {name}"))?;
             let (Child::Group(at) | Child::Data(at)) = child;
+            // Two children in one group are a cycle (or a fan-out) refused
+            // before their group is read again.
+            if at != 0 && out.iter().any(|(_, seen, _)| *seen == at) {
+                return Err(malformed(format!("object {name}'s group belongs to another object too")));
+            }
+            let group = self.file.group_of(child, &format!("object {name}"))?;
             out.push((ObjectHeader { name, metadata }, at, group));
         }
         Ok(out)
@@ -255,6 +266,7 @@ impl<'a> Archive<'a> {
     pub fn properties(&self, compound: &[Child]) -> Result<Vec<(PropertyHeader, Child)>> {
         let Some((&Child::Data(at), groups)) = compound.split_last() else { return Ok(Vec::new()) };
         let block = self.file.data(at)?;
+        self.file.charge(block.len() as u64, "property headers")?;
         let mut c = Cursor { b: block, at: 0, what: "property headers" };
         let mut out = Vec::new();
         while c.at < block.len() {

@@ -56,6 +56,10 @@ pub const MAX_ABC_BYTES: u64 = 1 << 30;
 pub const MAX_DEPTH: usize = 256;
 /// The most objects read.
 pub const MAX_OBJECTS: usize = 1 << 20;
+/// The most bytes decoding one file may allocate (2 GiB): group lists, object
+/// and property headers with their metadata, values widened to numbers —
+/// whatever the file's size, however often it points at the same bytes.
+pub const MAX_ABC_DECODED: u64 = 2 << 30;
 
 /// Reads the Alembic file at `path`, refusing any defect (see the module docs).
 pub fn open(path: impl AsRef<Path>) -> Result<AuthoredGroom> {
@@ -200,13 +204,14 @@ fn compound(a: &Archive<'_>, props: &[(PropertyHeader, Child)], name: &str) -> R
 fn numbers(a: &Archive<'_>, props: &[(PropertyHeader, Child)], name: &str, extent: usize) -> Result<Option<Vec<f64>>> {
     let Some((h, c)) = find(props, name) else { return Ok(None) };
     let Some(sample) = a.first_sample(h, *c)? else { return Ok(None) };
-    checked(name, sample, extent).map(Some)
+    checked(a, name, sample, extent).map(Some)
 }
 
-fn checked(name: &str, sample: Sample<'_>, extent: usize) -> Result<Vec<f64>> {
+fn checked(a: &Archive<'_>, name: &str, sample: Sample<'_>, extent: usize) -> Result<Vec<f64>> {
     if sample.extent != extent {
         return Err(malformed(format!("{name} has {} values per element; {extent} belong there", sample.extent)));
     }
+    a.file.charge((sample.len() as u64).saturating_mul(8), name)?;
     sample.numbers().ok_or_else(|| malformed(format!("{name} holds {:?} values, not numbers", sample.pod)))
 }
 
@@ -217,14 +222,14 @@ fn xform(a: &Archive<'_>, object: &[Child], parent: DMat4) -> Result<DMat4> {
     let x = compound(a, &props, ".xform")?;
     let ops: Vec<u8> = match find(&x, ".ops") {
         Some((h, c)) => match a.first_sample(h, *c)? {
-            Some(s) => checked(".xform/.ops", s, s.extent)?.into_iter().map(|v| v as u8).collect(),
+            Some(s) => checked(a, ".xform/.ops", s, s.extent)?.into_iter().map(|v| v as u8).collect(),
             None => Vec::new(),
         },
         None => Vec::new(),
     };
     let vals: Vec<f64> = match find(&x, ".vals") {
         Some((h, c)) => match a.first_sample(h, *c)? {
-            Some(s) => checked(".xform/.vals", s, s.extent)?,
+            Some(s) => checked(a, ".xform/.vals", s, s.extent)?,
             None => Vec::new(),
         },
         None => Vec::new(),
@@ -284,7 +289,7 @@ fn geom_param(
     let Some((h, c)) = find(props, name) else { return Ok(None) };
     let mut scope = scope_of(&h.metadata);
     if h.kind != Kind::Compound {
-        let values = a.first_sample(h, *c)?.map(|s| checked(name, s, extent)).transpose()?;
+        let values = a.first_sample(h, *c)?.map(|s| checked(a, name, s, extent)).transpose()?;
         return Ok(values.map(|values| Param { values, scope, name }));
     }
     let inner = a.properties(&a.file.group_of(*c, name)?)?;

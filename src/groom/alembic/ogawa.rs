@@ -7,7 +7,11 @@
 //! block at the position in its low 63 bits, any other a group (position 0:
 //! an empty group or, with the high bit, an empty block). A data block is a
 //! u64 byte count and the bytes. Every position and length is checked against
-//! the file before it is used.
+//! the file before it is used, and what decoding the file allocates is
+//! charged to one budget ([`Ogawa::charge`], [`super::MAX_ABC_DECODED`]): a
+//! group read many times, metadata repeated, narrow numbers widened all count.
+
+use std::cell::Cell;
 
 use crate::error::{Error, FileFormat, Result};
 
@@ -27,6 +31,8 @@ pub(crate) enum Child {
 /// An Ogawa file held in memory.
 pub(crate) struct Ogawa<'a> {
     bytes: &'a [u8],
+    /// Bytes decoding has allocated so far.
+    decoded: Cell<u64>,
 }
 
 pub(crate) fn malformed(reason: impl Into<String>) -> Error {
@@ -59,7 +65,7 @@ impl<'a> Ogawa<'a> {
         if version != 1 {
             return Err(Error::Unsupported { format: FileFormat::Alembic, reason: format!("Ogawa version {version}") });
         }
-        let file = Ogawa { bytes };
+        let file = Ogawa { bytes, decoded: Cell::new(0) };
         let root = file.u64_at(8, "root group position")?;
         Ok((file, root))
     }
@@ -67,6 +73,21 @@ impl<'a> Ogawa<'a> {
     /// The file's length, bytes.
     pub fn len(&self) -> u64 {
         self.bytes.len() as u64
+    }
+
+    /// Charges `bytes` that decoding `what` allocates to the file's budget,
+    /// refusing the file past [`super::MAX_ABC_DECODED`] in all.
+    pub fn charge(&self, bytes: u64, what: &str) -> Result<()> {
+        let total = self.decoded.get().saturating_add(bytes);
+        if total > super::MAX_ABC_DECODED {
+            return Err(malformed(format!(
+                "decoding it takes more than {} MiB (at {what}): its groups, metadata or values are read over \
+                 and over or widened past what a groom of its size needs",
+                super::MAX_ABC_DECODED >> 20
+            )));
+        }
+        self.decoded.set(total);
+        Ok(())
     }
 
     fn u64_at(&self, at: u64, what: &'static str) -> Result<u64> {
@@ -95,6 +116,7 @@ impl<'a> Ogawa<'a> {
             malformed(format!("a group at byte {at} claims {n} children, more than the file can hold"))
         })?;
         let raw = self.slice(at + 8, bytes, "group children")?;
+        self.charge(n.saturating_mul(std::mem::size_of::<Child>() as u64), "a group's children")?;
         Ok(raw
             .chunks_exact(8)
             .map(|c| {
@@ -133,5 +155,36 @@ impl<'a> Ogawa<'a> {
             Child::Data(at) => self.data(at),
             Child::Group(_) => Err(malformed(format!("{what} is a group where a data block belongs"))),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A file whose root group has `n` empty children.
+    fn file(n: u64) -> Vec<u8> {
+        let mut f = b"Ogawa\xff\x00\x01".to_vec();
+        f.extend_from_slice(&16u64.to_le_bytes());
+        f.extend_from_slice(&n.to_le_bytes());
+        f.extend(std::iter::repeat_n(0u8, 8 * n as usize));
+        f
+    }
+
+    /// Every read of a group charges its child list to the budget, and the
+    /// budget refuses the file past MAX_ABC_DECODED, naming what it was
+    /// decoding.
+    #[test]
+    fn decoding_is_charged_and_refused_past_the_budget() {
+        let bytes = file(1000);
+        let (ogawa, root) = Ogawa::new(&bytes).expect("file");
+        for _ in 0..3 {
+            assert_eq!(ogawa.group(root).expect("group").len(), 1000);
+        }
+        assert_eq!(ogawa.decoded.get(), 3 * 1000 * std::mem::size_of::<Child>() as u64);
+        let left = super::super::MAX_ABC_DECODED - ogawa.decoded.get();
+        ogawa.charge(left, "the rest").expect("up to the budget");
+        let e = ogawa.group(root).expect_err("past the budget").to_string();
+        assert!(e.contains("decoding it takes more than 2048 MiB (at a group's children)"), "{e}");
     }
 }
