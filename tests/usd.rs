@@ -309,3 +309,38 @@ fn a_stage_of_too_many_layers_is_refused() {
     let err = chain(usd::MAX_USD_LAYERS + 1).expect_err("one more").to_string();
     assert!(err.contains("more than 256 layers"), "{err}");
 }
+
+/// A binary layer's bootstrap and table of contents are checked before the
+/// USD library trusts them: a version it cannot read, a table of contents
+/// outside the file, too many sections, a section past the end, a cut
+/// bootstrap — each refused naming the file and the value; the file itself
+/// reads.
+#[test]
+fn binary_layers_are_checked_before_the_reader_trusts_them() {
+    let bytes = std::fs::read(data("usd/small_cm_zup.usdc")).expect("fixture");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("b.usdc");
+    std::fs::write(&path, &bytes).expect("write");
+    assert_eq!(usd::open(&path).expect("the fixture reads").groom.strand_count(), 4);
+    let toc = u64::from_le_bytes(bytes[16..24].try_into().expect("8 bytes")) as usize;
+    let set = |at: usize, value: &[u8]| {
+        let mut b = bytes.clone();
+        b[at..at + value.len()].copy_from_slice(value);
+        b
+    };
+    let cases: Vec<(Vec<u8>, &str)> = vec![
+        (set(8, &[0, 3, 0]), "crate version 0.3.0"),
+        (set(8, &[1, 0, 0]), "crate version 1.0.0"),
+        (set(16, &(bytes.len() as u64 + 100).to_le_bytes()), "its table of contents is at byte"),
+        (set(toc, &100u64.to_le_bytes()), "lists 100 sections"),
+        (set(toc, &0u64.to_le_bytes()), "lists 0 sections"),
+        (set(toc + 8 + 24, &u64::MAX.to_le_bytes()), "section \"TOKENS\""),
+        (set(toc + 8 + 32 + 16, &(bytes.len() as u64).to_le_bytes()), "section \"STRINGS\""),
+        (bytes[..20].to_vec(), "without a whole PXR-USDC bootstrap"),
+    ];
+    for (i, (b, expected)) in cases.iter().enumerate() {
+        std::fs::write(&path, b).expect("write");
+        let e = usd::open(&path).expect_err("refused").to_string();
+        assert!(e.contains(expected) && e.contains("b.usdc"), "case {i}: {e}");
+    }
+}

@@ -39,6 +39,7 @@ pub mod sdf;
 pub mod tfx;
 pub mod usd;
 pub mod usda_check;
+pub mod usdc_check;
 
 mod repair;
 mod resample;

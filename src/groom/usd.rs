@@ -83,8 +83,9 @@ pub const MAX_USD_LAYERS: usize = 256;
 /// of them together within `cap` bytes, text layers checked by
 /// [`super::usda_check`]. A layer that cannot be read is an error naming it
 /// and the layer and line that named it, never a layer the stage goes
-/// without. (Binary layers are bounded in size; the layers they name are
-/// not followed here.)
+/// without. (Binary layers are bounded in size and their bootstrap and table
+/// of contents checked by [`super::usdc_check`]; the layers they name are not
+/// followed here.)
 fn check_layers(path: &Path, cap: u64) -> Result<()> {
     let mut queue = vec![(path.to_path_buf(), None::<(std::path::PathBuf, String)>)];
     let mut seen = std::collections::HashSet::new();
@@ -111,9 +112,15 @@ fn check_layers(path: &Path, cap: u64) -> Result<()> {
             ))
             .in_asset(path));
         }
-        let mut magic = Vec::with_capacity(5);
-        std::fs::File::open(&layer).and_then(|f| f.take(5).read_to_end(&mut magic)).map_err(io)?;
-        if magic != b"#usda" {
+        let mut magic = Vec::with_capacity(8);
+        std::fs::File::open(&layer).and_then(|f| f.take(8).read_to_end(&mut magic)).map_err(io)?;
+        if magic == b"PXR-USDC" {
+            // Its bootstrap and table of contents, before the library trusts them.
+            let bytes = crate::files::read_capped(&layer, cap, "a USD layer").map_err(named)?;
+            super::usdc_check::check(&bytes).map_err(|e| named(e.in_asset(&layer)))?;
+            continue;
+        }
+        if !magic.starts_with(b"#usda") {
             continue;
         }
         let bytes = crate::files::read_capped(&layer, cap, "a USD layer").map_err(named)?;
