@@ -237,6 +237,27 @@ fn a_fan_out_of_objects_to_one_group_is_refused_before_it_is_read_again() {
     assert!(text.contains("object c1's group belongs to another object too"), "{text}");
 }
 
+/// A transform that moves a groom farther than 10 km from the origin (or
+/// scales it there) is refused naming the object, the strand, the point and
+/// where it lies, not read into a groom no scene can frame.
+#[test]
+fn a_transform_that_throws_the_groom_far_away_is_refused() {
+    let (groom, _, _) = small_groom();
+    for (m, what) in [
+        (DMat4::from_translation(DVec3::new(1e30, 0.0, 0.0)), "a 1e30 translation"),
+        (DMat4::from_scale(DVec3::splat(1e6)), "a scale of a million"),
+    ] {
+        let o = write::CurvesObject { name: "far", groom: &groom, guides: None, root_uvs: None, transform: Some(m) };
+        let text = alembic::parse(&write::to_bytes(&[o]).expect("written")).expect_err(what).to_string();
+        assert!(text.contains("/far_xform/far") && text.contains("strand 0 point"), "{what}: {text}");
+        assert!(text.contains("within 1e4 m of the origin"), "{what}: {text}");
+    }
+    // 1 km away reads.
+    let near = DMat4::from_translation(DVec3::new(1e3, 0.0, 0.0));
+    let o = write::CurvesObject { name: "near", groom: &groom, guides: None, root_uvs: None, transform: Some(near) };
+    assert!(alembic::parse(&write::to_bytes(&[o]).expect("written")).is_ok());
+}
+
 #[test]
 fn not_alembic_files_are_named() {
     let e = alembic::parse(b"\x89HDF\r\n\x1a\n and more bytes").expect_err("HDF5");

@@ -344,3 +344,17 @@ fn binary_layers_are_checked_before_the_reader_trusts_them() {
         assert!(e.contains(expected) && e.contains("b.usdc"), "case {i}: {e}");
     }
 }
+
+/// A point thrown beyond 10 km from the origin by the stage's values and
+/// units is refused naming the prim, the strand and the point.
+#[test]
+fn a_point_far_beyond_any_scene_is_refused_naming_it() {
+    let text = std::fs::read_to_string(data("usd/small_cm_zup.usda")).expect("fixture");
+    let far = text.replace("(0, 0, 100)", "(0, 0, 1e12)");
+    assert_ne!(far, text);
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("far.usda");
+    std::fs::write(&path, far).expect("write");
+    let e = usd::open(&path).expect_err("refused").to_string();
+    assert!(e.contains("far.usda") && e.contains("point") && e.contains("within 1e4 m of the origin"), "{e}");
+}

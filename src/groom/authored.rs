@@ -421,6 +421,29 @@ pub(crate) fn assemble(
         positions.extend(o.points.iter().map(|&p| (to_y_up(p) * k).as_vec3()));
         counts.extend_from_slice(&o.counts);
     }
+    // Whatever the transforms and units did: a finite point farther than
+    // MAX_COORDINATE_M from the origin is refused, named (non-finite ones are
+    // the groom check's).
+    if let Some(i) = positions.iter().position(|p| p.is_finite() && p.abs().max_element() > MAX_COORDINATE_M) {
+        let mut end = 0usize;
+        let strand = counts.iter().position(|&c| {
+            end += c as usize;
+            i < end
+        });
+        let strand = strand.unwrap_or(0);
+        let point = i - (end - counts.get(strand).map_or(0, |&c| c as usize));
+        let object = object_starts.partition_point(|&s| s <= strand).saturating_sub(1);
+        let p = positions[i];
+        let reason = format!(
+            "strand {} point {point} lies at ({:e}, {:e}, {:e}) m after its transforms and the stage's units: \
+             a groom lies within {MAX_COORDINATE_M:e} m of the origin",
+            strand - object_starts[object],
+            p.x,
+            p.y,
+            p.z
+        );
+        return Err(in_object(&objects[object].path, Error::Malformed { format: frame.format, reason }));
+    }
     let all = |what: &str, has: &dyn Fn(&RawCurves) -> bool, skipped: &mut Vec<String>| {
         let n = objects.iter().filter(|o| has(o)).count();
         if n > 0 && n < objects.len() {
@@ -495,6 +518,12 @@ fn kept<T: Copy>(v: Vec<T>, repairs: Option<&Repairs>) -> Vec<T> {
         None => v,
     }
 }
+
+/// Farthest a point of an authored groom may lie from the origin, along any
+/// axis, meters (after the object's transforms and the file's units): 10 km,
+/// far beyond any character, near enough that single-precision positions and
+/// the renderer's framing stay meaningful.
+pub const MAX_COORDINATE_M: f32 = 1e4;
 
 /// `source` as an error of the object at `path`.
 pub(crate) fn in_object(path: &str, source: Error) -> Error {
