@@ -135,10 +135,10 @@ fn require_gpu_refuses_a_cpu_device() {
 }
 
 /// `tools/gpu-bench.sh --smoke` runs every goal of the GPU report (the thesis
-/// frame, the guides' FLIP step, the drawn strands with transparency, and the
-/// frame's goals for both rasterisers) at toy sizes and writes one report
-/// naming each with the device and a GPU figure, each frame goal's figure
-/// beside its bound.
+/// frame, the four simulation steps, the drawn strands with transparency, the
+/// frame's goals for both rasterisers, the interpolation's cost a segment both
+/// ways) at toy sizes and writes one report naming each with the device and a
+/// GPU figure, each step and frame goal's figure beside its bound.
 #[test]
 fn the_gpu_bench_script_runs_every_goal_and_writes_one_report() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -158,6 +158,7 @@ fn the_gpu_bench_script_runs_every_goal_and_writes_one_report() {
         "b. simulation of 300 guides × 32 points, FLIP",
         "b2. simulation of 300 guides × 32 points, density friction",
         "b3. the thesis scene's simulation, FLIP",
+        "b4. simulation of 300 guides × 32 points, FLIP on a 32³ grid",
         "c. 7000 drawn strands",
     ];
     for goal in goals {
@@ -168,14 +169,16 @@ fn the_gpu_bench_script_runs_every_goal_and_writes_one_report() {
         .filter_map(|l| l.split_once("GPU ms per frame or step (timestamps, mean): "))
         .map(|(_, x)| x.trim().parse().expect("a number"))
         .collect();
-    assert_eq!(figures.len(), 5, "{report}");
+    assert_eq!(figures.len(), 6, "{report}");
     assert!(figures.iter().all(|&x| x > 0.0), "{report}");
-    assert_eq!(report.matches(" key hairs × ").count(), 5, "each goal names its device and scene:\n{report}");
+    assert_eq!(report.matches(" key hairs × ").count(), 6, "each goal names its device and scene:\n{report}");
     let step_goals: Vec<&str> = report.lines().filter(|l| l.contains("ms a step: ")).collect();
-    assert_eq!(step_goals.len(), 2, "the volume goals, each beside its bound:\n{report}");
+    assert_eq!(step_goals.len(), 4, "the simulation goals, each beside its bound:\n{report}");
     assert!(step_goals.iter().all(|l| l.ends_with(": met") || l.ends_with(": missed")), "{report}");
     for json in
-        ["thesis_frame.json", "guides_step.json", "friction_step.json", "thesis_step.json", "strands_frame.json"]
+        ["thesis_frame.json", "guides_step.json", "friction_step.json", "thesis_step.json", "friction_flip_step.json"]
+            .into_iter()
+            .chain(["strands_frame.json"])
     {
         let text = std::fs::read_to_string(dir.path().join("goals").join(json)).expect(json);
         let v: serde_json::Value = serde_json::from_str(&text).expect("parse");
@@ -206,6 +209,16 @@ fn the_gpu_bench_script_runs_every_goal_and_writes_one_report() {
             assert!(line.ends_with(": met") || line.ends_with(": missed"), "{line}");
         }
     }
+    // The interpolation's ns a drawn segment: the compute dispatch (thesis,
+    // strands) and the tessellation stages (thesis), each a number.
+    let section = report.split(" interpolation, ns a drawn segment").nth(1).expect("the interpolation's lines");
+    let ns: Vec<f64> = section
+        .lines()
+        .filter_map(|l| l.trim_end().strip_suffix(" ns"))
+        .map(|l| l.split_whitespace().last().and_then(|x| x.parse().ok()).expect("a figure"))
+        .collect();
+    assert_eq!(ns.len(), 3, "{report}");
+    assert!(ns.iter().all(|&x| x > 0.0), "{report}");
     for entry in std::fs::read_dir(dir.path().join("frame")).expect("frame/") {
         let path = entry.expect("entry").path();
         if path.extension().is_some_and(|e| e == "txt") {
