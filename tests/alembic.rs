@@ -166,6 +166,21 @@ fn the_writer_refuses_what_it_cannot_write() {
     assert!(write::to_bytes(&[object("a", Some(&guides), Some(&uvs))]).is_ok());
 }
 
+/// Appends to `f` a data block of object headers, one per name (inline
+/// empty metadata), then the 32 bytes of the objects' hashes.
+fn append_object_headers(f: &mut Vec<u8>, names: &[&str]) {
+    let mut headers = Vec::new();
+    for name in names {
+        headers.extend_from_slice(&(name.len() as u32).to_le_bytes());
+        headers.extend_from_slice(name.as_bytes());
+        headers.push(0xff);
+        headers.extend_from_slice(&0u32.to_le_bytes());
+    }
+    headers.extend_from_slice(&[0u8; 32]);
+    f.extend_from_slice(&(headers.len() as u64).to_le_bytes());
+    f.extend_from_slice(&headers);
+}
+
 #[test]
 fn a_cycle_of_objects_is_refused() {
     // Header, then the top object's child headers (two children named "a"),
@@ -173,16 +188,7 @@ fn a_cycle_of_objects_is_refused() {
     let mut f = b"Ogawa\xff\x00\x01".to_vec();
     f.extend_from_slice(&[0u8; 8]);
     let headers_at = f.len() as u64;
-    let mut headers = Vec::new();
-    for _ in 0..2 {
-        headers.extend_from_slice(&1u32.to_le_bytes());
-        headers.push(b'a');
-        headers.push(0xff);
-        headers.extend_from_slice(&0u32.to_le_bytes());
-    }
-    headers.extend_from_slice(&[0u8; 32]);
-    f.extend_from_slice(&(headers.len() as u64).to_le_bytes());
-    f.extend_from_slice(&headers);
+    append_object_headers(&mut f, &["a", "a"]);
     let top = f.len() as u64;
     for v in [4u64, 0, top, top, headers_at | 1 << 63] {
         f.extend_from_slice(&v.to_le_bytes());
@@ -210,17 +216,8 @@ fn a_fan_out_of_objects_to_one_group_is_refused_before_it_is_read_again() {
     f.extend_from_slice(&150_000u64.to_le_bytes());
     f.extend(std::iter::repeat_n(0u8, 8 * 150_000));
     let headers_at = f.len() as u64;
-    let mut headers = Vec::new();
-    for i in 0..CHILDREN {
-        let name = format!("c{i}");
-        headers.extend_from_slice(&(name.len() as u32).to_le_bytes());
-        headers.extend_from_slice(name.as_bytes());
-        headers.push(0xff);
-        headers.extend_from_slice(&0u32.to_le_bytes());
-    }
-    headers.extend_from_slice(&[0u8; 32]);
-    f.extend_from_slice(&(headers.len() as u64).to_le_bytes());
-    f.extend_from_slice(&headers);
+    let names: Vec<String> = (0..CHILDREN).map(|i| format!("c{i}")).collect();
+    append_object_headers(&mut f, &names.iter().map(String::as_str).collect::<Vec<_>>());
     let top = f.len() as u64;
     f.extend_from_slice(&(CHILDREN as u64 + 2).to_le_bytes());
     f.extend_from_slice(&0u64.to_le_bytes());
