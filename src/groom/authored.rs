@@ -425,19 +425,21 @@ pub(crate) fn assemble(
     // MAX_COORDINATE_M from the origin is refused, named (non-finite ones are
     // the groom check's).
     if let Some(i) = positions.iter().position(|p| p.is_finite() && p.abs().max_element() > MAX_COORDINATE_M) {
-        let mut end = 0usize;
-        let strand = counts.iter().position(|&c| {
-            end += c as usize;
-            i < end
-        });
-        let strand = strand.unwrap_or(0);
-        let point = i - (end - counts.get(strand).map_or(0, |&c| c as usize));
-        let object = object_starts.partition_point(|&s| s <= strand).saturating_sub(1);
+        // The strand holding point i, and its first point.
+        let (mut strand, mut first) = (0, 0);
+        for (s, &c) in counts.iter().enumerate() {
+            if i < first + c as usize {
+                strand = s;
+                break;
+            }
+            first += c as usize;
+        }
+        let (object, local) = object_of(&object_starts, strand);
         let p = positions[i];
         let reason = format!(
-            "strand {} point {point} lies at ({:e}, {:e}, {:e}) m after its transforms and the stage's units: \
+            "strand {local} point {} lies at ({:e}, {:e}, {:e}) m after its transforms and the stage's units: \
              a groom lies within {MAX_COORDINATE_M:e} m of the origin",
-            strand - object_starts[object],
+            i - first,
             p.x,
             p.y,
             p.z
@@ -487,9 +489,8 @@ pub(crate) fn assemble(
     });
     if let Some(uvs) = &root_uvs {
         if let Some(s) = uvs.iter().position(|uv| !uv.is_finite()) {
-            let object = object_starts.partition_point(|&start| start <= s).saturating_sub(1);
-            let e = Error::NonFinite { strand: s - object_starts[object], point: 0, what: "root UV" };
-            return Err(in_object(&objects[object].path, e));
+            let e = Error::NonFinite { strand: s, point: 0, what: "root UV" };
+            return Err(locate(e, &objects, &object_starts));
         }
     }
     let attributes = Attributes { thickness, transparency: None, colors };
@@ -530,6 +531,13 @@ pub(crate) fn in_object(path: &str, source: Error) -> Error {
     Error::CurveObject { object: path.to_owned(), source: Box::new(source) }
 }
 
+/// The object holding strand `strand` of the whole groom (objects starting at
+/// `starts`), and the strand's index within it.
+fn object_of(starts: &[usize], strand: usize) -> (usize, usize) {
+    let object = starts.partition_point(|&s| s <= strand).saturating_sub(1);
+    (object, strand - starts[object])
+}
+
 /// A groom check's error with its strand counted within its object.
 fn locate(e: Error, objects: &[RawCurves], starts: &[usize]) -> Error {
     let strand = match &e {
@@ -539,8 +547,7 @@ fn locate(e: Error, objects: &[RawCurves], starts: &[usize]) -> Error {
         | Error::StrandPointCount { strand, .. } => *strand,
         _ => return e,
     };
-    let object = starts.partition_point(|&s| s <= strand).saturating_sub(1);
-    let local = strand - starts[object];
+    let (object, local) = object_of(starts, strand);
     let e = match e {
         Error::NonFinite { point, what, .. } => Error::NonFinite { strand: local, point, what },
         Error::ZeroLengthSegment { segment, .. } => Error::ZeroLengthSegment { strand: local, segment },
