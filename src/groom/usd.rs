@@ -105,7 +105,8 @@ fn check_layers(path: &Path, cap: u64) -> Result<()> {
         // A regular file (checked above): its length bounds the stage, and only
         // a text layer is read here (the library reads the binary ones).
         let io = |source| named(Error::Io { path: layer.clone(), source });
-        total += std::fs::metadata(&layer).map_err(io)?.len();
+        let len = std::fs::metadata(&layer).map_err(io)?.len();
+        total += len;
         if total > cap {
             return Err(malformed(format!(
                 "the stage's layers add up to more than {cap} bytes (set VKHAIR_MAX_INPUT_BYTES to read more)"
@@ -116,8 +117,7 @@ fn check_layers(path: &Path, cap: u64) -> Result<()> {
         std::fs::File::open(&layer).and_then(|f| f.take(8).read_to_end(&mut magic)).map_err(io)?;
         if magic == b"PXR-USDC" {
             // Its bootstrap and table of contents, before the library trusts them.
-            let bytes = crate::files::read_capped(&layer, cap, "a USD layer").map_err(named)?;
-            super::usdc_check::check(&bytes).map_err(|e| named(e.in_asset(&layer)))?;
+            super::usdc_check::check(&layer, len).map_err(|e| named(e.in_asset(&layer)))?;
             continue;
         }
         if !magic.starts_with(b"#usda") {

@@ -1,6 +1,7 @@
 //! What a USD binary (crate) layer must satisfy before the `openusd` crate
 //! reads it, which trusts its bootstrap and table of contents: [`check`]
-//! reads them, without the crate, and refuses
+//! reads those alone (at most a few KiB, whatever the layer's size), without
+//! the crate, and refuses
 //!
 //! - a bootstrap that is not `PXR-USDC` or is cut short;
 //! - a crate version the reader cannot read: before 0.4.0 (the crate stops
@@ -9,6 +10,9 @@
 //!   [`MAX_SECTIONS`], or whose sections reach past the file's end.
 //!
 //! Each error names the value found and the file's length.
+
+use std::io::{Read, Seek, SeekFrom};
+use std::path::Path;
 
 use crate::error::{Error, FileFormat, Result};
 
@@ -28,16 +32,27 @@ fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }
 }
 
-fn u64_at(bytes: &[u8], at: u64) -> Option<u64> {
-    let at = usize::try_from(at).ok()?;
-    let b = bytes.get(at..at.checked_add(8)?)?;
-    Some(u64::from_le_bytes(b.try_into().ok()?))
+fn u64_at(bytes: &[u8], at: usize) -> u64 {
+    let mut b = [0u8; 8];
+    b.copy_from_slice(&bytes[at..at + 8]);
+    u64::from_le_bytes(b)
 }
 
-/// Checks the crate file `bytes` (a whole layer).
-pub fn check(bytes: &[u8]) -> Result<()> {
-    let len = bytes.len() as u64;
-    if bytes.len() < BOOTSTRAP || &bytes[..8] != b"PXR-USDC" {
+/// Checks the crate file at `path`, `len` bytes long.
+pub fn check(path: &Path, len: u64) -> Result<()> {
+    let io = |source| Error::Io { path: path.into(), source };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    // Reads `n` bytes at `at`, which the caller has checked lie in the file.
+    let mut read_at = |at: u64, n: usize| -> Result<Vec<u8>> {
+        let mut b = vec![0u8; n];
+        file.seek(SeekFrom::Start(at)).and_then(|_| file.read_exact(&mut b)).map_err(io)?;
+        Ok(b)
+    };
+    if len < BOOTSTRAP as u64 {
+        return Err(malformed(format!("a binary layer of {len} bytes without a whole PXR-USDC bootstrap")));
+    }
+    let bytes = read_at(0, BOOTSTRAP)?;
+    if &bytes[..8] != b"PXR-USDC" {
         return Err(malformed(format!("a binary layer of {len} bytes without a whole PXR-USDC bootstrap")));
     }
     let version = (bytes[8], bytes[9], bytes[10]);
@@ -51,10 +66,11 @@ pub fn check(bytes: &[u8]) -> Result<()> {
             ),
         });
     }
-    let toc = u64_at(bytes, 16).unwrap_or(0);
-    let count = u64_at(bytes, toc)
-        .filter(|_| toc >= BOOTSTRAP as u64)
-        .ok_or_else(|| malformed(format!("its table of contents is at byte {toc}, outside the file ({len} bytes)")))?;
+    let toc = u64_at(&bytes, 16);
+    if toc < BOOTSTRAP as u64 || toc.saturating_add(8) > len {
+        return Err(malformed(format!("its table of contents is at byte {toc}, outside the file ({len} bytes)")));
+    }
+    let count = u64_at(&read_at(toc, 8)?, 0);
     if !(1..=MAX_SECTIONS).contains(&count) {
         return Err(malformed(format!("its table of contents lists {count} sections (1 to {MAX_SECTIONS} are read)")));
     }
@@ -64,17 +80,15 @@ pub fn check(bytes: &[u8]) -> Result<()> {
             "its table of contents of {count} sections ends at byte {end}, past the file's end ({len} bytes)"
         )));
     }
-    for i in 0..count {
-        let entry = toc + 8 + i * SECTION;
-        let name_bytes = &bytes[entry as usize..entry as usize + 16];
-        let name: String = name_bytes.iter().take_while(|&&b| b != 0).map(|&b| char::from(b)).collect();
-        let (start, size) = (u64_at(bytes, entry + 16).unwrap_or(0), u64_at(bytes, entry + 24).unwrap_or(0));
+    let table = read_at(toc + 8, (count * SECTION) as usize)?;
+    for entry in table.chunks_exact(SECTION as usize) {
+        let name: String = entry[..16].iter().take_while(|&&b| b != 0).map(|&b| char::from(b)).collect();
+        let (start, size) = (u64_at(entry, 16), u64_at(entry, 24));
         match start.checked_add(size) {
             Some(stop) if stop <= len && start >= BOOTSTRAP as u64 => {}
             _ => {
                 return Err(malformed(format!(
-                    "its section {:?} of {size} bytes at byte {start} lies outside the file ({len} bytes)",
-                    name.escape_debug().to_string()
+                    "its section {name:?} of {size} bytes at byte {start} lies outside the file ({len} bytes)"
                 )));
             }
         }
