@@ -314,7 +314,7 @@ impl InterpolatePass {
                 let scope = RenderPass::Interpolate.open(d, cmd, timing);
                 p.compute.bind(cmd, &[p.compute_set]);
                 p.compute.push(cmd, push);
-                p.compute.dispatch_groups(cmd, [x, y, 1]);
+                p.compute.dispatch_groups(cmd, [x, y, 1], 1);
                 d.cmd_barrier(cmd, &[written], &[], &[]);
                 scope.close(d, cmd, timing);
             }

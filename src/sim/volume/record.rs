@@ -176,7 +176,7 @@ impl VolumeStage {
             k.pipeline.push(cmd, &push);
             match launch {
                 Launch::Threads(n) => k.pipeline.dispatch_threads(cmd, [n, 1, 1]),
-                Launch::Workgroup(trips) => k.pipeline.dispatch_looping(cmd, [1, 1, 1], trips),
+                Launch::Workgroup(trips) => k.pipeline.dispatch_groups(cmd, [1, 1, 1], trips),
                 Launch::Indirect(entry) => {
                     // The most it launches: the count record_uploads set.
                     let most = self.grid.levels.get(entry).map_or(1, |l| l.cells().div_ceil(GROUP));

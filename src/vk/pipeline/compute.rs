@@ -220,28 +220,18 @@ impl ComputePipeline {
     /// `cmd` is recording with this pipeline bound.
     pub(crate) unsafe fn dispatch_threads(&self, cmd: vk::CommandBuffer, threads: [u32; 3]) {
         let groups = [0, 1, 2].map(|i| threads[i].div_ceil(self.workgroup_size[i]));
-        self.count_dispatch(groups, false, 1);
-        // SAFETY: guaranteed by the caller.
-        unsafe { self.layout.device.raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
+        // SAFETY: guaranteed by the caller; the counts cover `threads`.
+        unsafe { self.dispatch_groups(cmd, groups, 1) };
     }
 
-    /// Dispatches `groups` workgroups in each dimension.
+    /// Dispatches `groups` workgroups in each dimension, whose invocations go
+    /// round their loops at most `loop_trips` times (for the dispatch log; 1
+    /// for a kernel whose invocations each take one item).
     ///
     /// # Safety
     /// `cmd` is recording with this pipeline bound; each count is within the
     /// device's `maxComputeWorkGroupCount`.
-    pub(crate) unsafe fn dispatch_groups(&self, cmd: vk::CommandBuffer, groups: [u32; 3]) {
-        self.count_dispatch(groups, false, 1);
-        // SAFETY: guaranteed by the caller.
-        unsafe { self.layout.device.raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
-    }
-
-    /// Dispatches `groups` workgroups whose invocations go round their loops
-    /// at most `loop_trips` times (for the dispatch log).
-    ///
-    /// # Safety
-    /// As [`ComputePipeline::dispatch_groups`].
-    pub(crate) unsafe fn dispatch_looping(&self, cmd: vk::CommandBuffer, groups: [u32; 3], loop_trips: u32) {
+    pub(crate) unsafe fn dispatch_groups(&self, cmd: vk::CommandBuffer, groups: [u32; 3], loop_trips: u32) {
         self.count_dispatch(groups, false, loop_trips);
         // SAFETY: guaranteed by the caller.
         unsafe { self.layout.device.raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
