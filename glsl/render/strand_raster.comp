@@ -172,47 +172,47 @@ void raster_segment(End e0, End e1, bool last) {
     uint base = 0u;
     uint taken = 0u;
     for (uint walk = 0u; walk < 2u; ++walk) {
-    if (walk == 1u) {
-        if (count == 0u) {
-            return;
+        if (walk == 1u) {
+            if (count == 0u) {
+                return;
+            }
+            taken = count;
+            base = atomicAdd(oit.used, taken);
+            count = 0u;
         }
-        taken = count;
-        base = atomicAdd(oit.used, taken);
-        count = 0u;
-    }
-    for (float k = k_lo; k < k_hi; k += 1.0) {
-        float centre_m = a_km.y + (k + 0.5 - a_km.x) * slope;
-        float m_lo = max(floor(centre_m - spread - 0.5), 0.0);
-        float m_hi = min(ceil(centre_m + spread + 0.5), size_km.y);
-        for (float m = m_lo; m < m_hi; m += 1.0) {
-            vec2 q = x_major ? vec2(k + 0.5, m + 0.5) : vec2(m + 0.5, k + 0.5);
-            float s = dot(q - a, dir) / len;
-            if (s < 0.0 || s > 1.0 || (s == 1.0 && !last)) {
-                continue;
-            }
-            float d = dot(q - a, normal);
-            // Perspective-correct position along the unclipped segment.
-            float inv_w = mix(inv_wa, inv_wb, s);
-            float u = mix(u0 * inv_wa, u1 * inv_wb, s) / inv_w;
-            float half_width = half_width_at(e0, e1, u);
-            if (abs(d) >= half_width + 0.5) {
-                continue;
-            }
-            float alpha = strand_alpha(vec3(d, half_width, mix(e0.density, e1.density, u)));
-            float z = mix(za, zb, s);
-            uint pixel = uint(q.y) * oit.width + uint(q.x);
-            if (!kept(pixel, z, alpha)) {
-                continue;
-            }
-            if (walk == 1u) {
-                if (count == taken) {
-                    return;
+        for (float k = k_lo; k < k_hi; k += 1.0) {
+            float centre_m = a_km.y + (k + 0.5 - a_km.x) * slope;
+            float m_lo = max(floor(centre_m - spread - 0.5), 0.0);
+            float m_hi = min(ceil(centre_m + spread + 0.5), size_km.y);
+            for (float m = m_lo; m < m_hi; m += 1.0) {
+                vec2 q = x_major ? vec2(k + 0.5, m + 0.5) : vec2(m + 0.5, k + 0.5);
+                float s = dot(q - a, dir) / len;
+                if (s < 0.0 || s > 1.0 || (s == 1.0 && !last)) {
+                    continue;
                 }
-                store(pixel, z, mix(e0.color, e1.color, u), alpha, base + count);
+                float d = dot(q - a, normal);
+                // Perspective-correct position along the unclipped segment.
+                float inv_w = mix(inv_wa, inv_wb, s);
+                float u = mix(u0 * inv_wa, u1 * inv_wb, s) / inv_w;
+                float half_width = half_width_at(e0, e1, u);
+                if (abs(d) >= half_width + 0.5) {
+                    continue;
+                }
+                float alpha = strand_alpha(vec3(d, half_width, mix(e0.density, e1.density, u)));
+                float z = mix(za, zb, s);
+                uint pixel = uint(q.y) * oit.width + uint(q.x);
+                if (!kept(pixel, z, alpha)) {
+                    continue;
+                }
+                if (walk == 1u) {
+                    if (count == taken) {
+                        return;
+                    }
+                    store(pixel, z, mix(e0.color, e1.color, u), alpha, base + count);
+                }
+                count++;
             }
-            count++;
         }
-    }
     }
 }
 
