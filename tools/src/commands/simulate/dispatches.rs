@@ -21,13 +21,17 @@ struct Kernel {
 /// invocations per workgroup and the most loop trips of an invocation.
 pub fn print(log: &[DispatchRecord], steps: usize) {
     let steps = steps.max(1) as u64;
-    let mut order: Vec<&str> = Vec::new();
-    let mut kernels: std::collections::HashMap<&str, Kernel> = std::collections::HashMap::new();
+    // In the order each first ran (a step has a few dozen kernels at most).
+    let mut kernels: Vec<(&str, Kernel)> = Vec::new();
     for d in log {
-        let k = kernels.entry(d.kernel.as_str()).or_insert_with(|| {
-            order.push(d.kernel.as_str());
-            Kernel::default()
-        });
+        let at = match kernels.iter().position(|(name, _)| *name == d.kernel) {
+            Some(at) => at,
+            None => {
+                kernels.push((d.kernel.as_str(), Kernel::default()));
+                kernels.len() - 1
+            }
+        };
+        let k = &mut kernels[at].1;
         k.dispatches += 1;
         k.workgroups += d.workgroups;
         k.largest = k.largest.max(d.workgroups);
@@ -44,8 +48,7 @@ pub fn print(log: &[DispatchRecord], steps: usize) {
         "size",
         "loop trips"
     );
-    for name in order {
-        let k = &kernels[name];
+    for (name, k) in &kernels {
         say!(
             "{:<40} {:>10} {:>12} {:>10} {:>6} {:>10}",
             name,
