@@ -1,7 +1,7 @@
 //! Counts of the work vkhair records: dispatches, pipeline barriers and the
 //! bytes of the buffers each dispatch binds.
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Mutex;
 
 /// Work recorded by vkhair on one device since it was created, counted as it is
@@ -65,6 +65,9 @@ pub(crate) struct Counters {
     barriers: AtomicU64,
     bytes_read: AtomicU64,
     bytes_written: AtomicU64,
+    /// Whether a log is kept: read by every dispatch, so that recording
+    /// without a log takes no lock.
+    logging: AtomicBool,
     /// Every dispatch while a log is kept.
     log: Mutex<Option<Vec<DispatchRecord>>>,
 }
@@ -83,6 +86,9 @@ impl Counters {
 
     /// Keeps `record` when a log is kept.
     pub(crate) fn log_dispatch(&self, record: impl FnOnce() -> DispatchRecord) {
+        if !self.logging.load(Ordering::Relaxed) {
+            return;
+        }
         if let Ok(mut log) = self.log.lock() {
             if let Some(log) = log.as_mut() {
                 log.push(record());
@@ -94,11 +100,13 @@ impl Counters {
     pub(crate) fn start_log(&self) {
         if let Ok(mut log) = self.log.lock() {
             *log = Some(Vec::new());
+            self.logging.store(true, Ordering::Relaxed);
         }
     }
 
     /// The dispatches logged since [`Counters::start_log`]; the log stops.
     pub(crate) fn take_log(&self) -> Vec<DispatchRecord> {
+        self.logging.store(false, Ordering::Relaxed);
         self.log.lock().ok().and_then(|mut log| log.take()).unwrap_or_default()
     }
 
