@@ -425,15 +425,7 @@ pub(crate) fn assemble(
     // MAX_COORDINATE_M from the origin is refused, named (non-finite ones are
     // the groom check's).
     if let Some(i) = positions.iter().position(|p| p.is_finite() && p.abs().max_element() > MAX_COORDINATE_M) {
-        // The strand holding point i, and its first point.
-        let (mut strand, mut first) = (0, 0);
-        for (s, &c) in counts.iter().enumerate() {
-            if i < first + c as usize {
-                strand = s;
-                break;
-            }
-            first += c as usize;
-        }
+        let (strand, first) = strand_of_point(&counts, i).unwrap_or((0, 0));
         let (object, local) = object_of(&object_starts, strand);
         let p = positions[i];
         let reason = format!(
@@ -460,14 +452,7 @@ pub(crate) fn assemble(
     let negative = objects.iter().find_map(|o| {
         let widths = o.widths.as_ref()?;
         let at = widths.iter().position(|&w| w < 0.0)?;
-        let strand = o
-            .counts
-            .iter()
-            .scan(0usize, |end, &c| {
-                *end += c as usize;
-                Some(*end)
-            })
-            .position(|end| at < end)?;
+        let (strand, _) = strand_of_point(&o.counts, at)?;
         Some((o.path.as_str(), strand, widths[at]))
     });
     if let Some((path, strand, width)) = negative {
@@ -531,6 +516,19 @@ pub(crate) fn in_object(path: &str, source: Error) -> Error {
     Error::CurveObject { object: path.to_owned(), source: Box::new(source) }
 }
 
+/// The strand of `counts` (points per strand) holding point `point`, and the
+/// strand's first point; `None` past the last.
+fn strand_of_point(counts: &[u32], point: usize) -> Option<(usize, usize)> {
+    let mut first = 0usize;
+    for (strand, &c) in counts.iter().enumerate() {
+        if point < first + c as usize {
+            return Some((strand, first));
+        }
+        first += c as usize;
+    }
+    None
+}
+
 /// The object holding strand `strand` of the whole groom (objects starting at
 /// `starts`), and the strand's index within it.
 fn object_of(starts: &[usize], strand: usize) -> (usize, usize) {
@@ -559,46 +557,4 @@ fn locate(e: Error, objects: &[RawCurves], starts: &[usize]) -> Error {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn bezier_strands_pass_through_their_ends_and_thirds() {
-        let p = [DVec3::ZERO, DVec3::X, DVec3::new(2.0, 1.0, 0.0), DVec3::new(3.0, 1.0, 0.0)];
-        let s = bezier_samples(&p).expect("4 points");
-        assert_eq!(s.len(), 4);
-        assert_eq!((s[0], s[3]), (p[0], p[3]));
-        // B(1/3) = (8 p0 + 12 p1 + 6 p2 + p3) / 27.
-        let third = (p[0] * 8.0 + p[1] * 12.0 + p[2] * 6.0 + p[3]) / 27.0;
-        assert!((s[1] - third).length() < 1e-12);
-        assert!(bezier_samples(&p[..3]).is_none());
-    }
-
-    #[test]
-    fn pinned_b_spline_ends_are_kept_once() {
-        let (a, b, c, d) = (DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z);
-        let mut o = RawCurves {
-            path: "/c".into(),
-            basis: Basis::Bspline,
-            counts: vec![7, 3, 1, 4],
-            points: vec![a, a, a, b, c, c, c, a, b, c, d, a, a, b, c],
-            widths: Some((0..15).map(|i| i as f32).collect()),
-            colors: None,
-            guides: None,
-            root_uvs: None,
-        };
-        collapse_pinned_ends(&mut o);
-        // Two equal points are a zero-length segment, left for the checks.
-        assert_eq!(o.counts, vec![3, 3, 1, 4]);
-        assert_eq!(o.points, vec![a, b, c, a, b, c, d, a, a, b, c]);
-        assert_eq!(o.widths, Some(vec![2.0, 3.0, 4.0, 7.0, 8.0, 9.0, 10.0, 11.0, 12.0, 13.0, 14.0]));
-    }
-
-    #[test]
-    fn spaced_values_interpolate_along_each_curve() {
-        // Two curves of 3 and 5 points, values at 2 places along each.
-        let v = per_point_from_spaced(&[0.0f32, 1.0, 10.0, 20.0], &[3, 5], |_| 2).expect("lengths add up");
-        assert_eq!(v, vec![0.0, 0.5, 1.0, 10.0, 12.5, 15.0, 17.5, 20.0]);
-        assert!(per_point_from_spaced(&[0.0f32; 3], &[3, 5], |_| 2).is_none());
-    }
-}
+mod tests;
