@@ -31,6 +31,8 @@ include!("src/limits.rs");
 include!("src/codes.rs");
 include!("src/gpu_types/views_table.rs");
 include!("src/gpu_types/views.rs");
+include!("src/gpu_types/constraints_table.rs");
+include!("src/gpu_types/constraints.rs");
 
 const STAGES: &[(&str, shaderc::ShaderKind, &str)] = &[
     ("comp", shaderc::ShaderKind::Compute, "Compute"),
@@ -47,7 +49,14 @@ fn main() {
     let out_dir = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
     println!("cargo:rerun-if-changed=glsl");
 
-    for file in ["src/limits.rs", "src/codes.rs", "src/gpu_types/views_table.rs", "src/gpu_types/views.rs"] {
+    for file in [
+        "src/limits.rs",
+        "src/codes.rs",
+        "src/gpu_types/views_table.rs",
+        "src/gpu_types/views.rs",
+        "src/gpu_types/constraints_table.rs",
+        "src/gpu_types/constraints.rs",
+    ] {
         println!("cargo:rerun-if-changed={file}");
     }
     check_views();
@@ -57,6 +66,11 @@ fn main() {
         panic!("glsl/include/views.glsl would hide the header build.rs generates");
     }
     std::fs::write(generated.join("views.glsl"), views_header()).expect("write views.glsl");
+    check_constraints(&include_dir);
+    if include_dir.join("constraint_solve.glsl").exists() {
+        panic!("glsl/include/constraint_solve.glsl would hide the header build.rs generates");
+    }
+    std::fs::write(generated.join("constraint_solve.glsl"), constraint_solve()).expect("write constraint_solve.glsl");
 
     let mut sources = Vec::new();
     collect(&glsl, &include_dir, &mut sources);
@@ -156,10 +170,18 @@ fn collect(dir: &Path, include_dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// The headers under `glsl/include/`.
+/// The headers under `glsl/include/` and its folders.
 fn headers(include_dir: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
     let entries = std::fs::read_dir(include_dir).unwrap_or_else(|e| panic!("read {}: {e}", include_dir.display()));
-    entries.map(|e| e.expect("directory entry").path()).filter(|p| p.is_file()).collect()
+    for path in entries.map(|e| e.expect("directory entry").path()) {
+        if path.is_dir() {
+            found.extend(headers(&path));
+        } else {
+            found.push(path);
+        }
+    }
+    found
 }
 
 /// Lines of `path` that declare a name of [`SHADER_CONSTANTS`] or
@@ -191,6 +213,7 @@ fn compile(
     for (name, value) in SHADER_CONSTANTS.iter().chain(SHADER_CODES) {
         options.add_macro_definition(name, Some(&format!("{value}u")));
     }
+    options.add_macro_definition("SIM_KNOB_VEC4S", Some(&knob_count().div_ceil(4).to_string()));
     for name in variant.into_iter().flat_map(str::split_whitespace) {
         options.add_macro_definition(name, None);
     }
@@ -254,6 +277,7 @@ fn check_views() {
             ("float" | "uint", "x" | "y" | "z" | "w") => f.lanes,
             ("vec3" | "uvec3", "xyz") => f.lanes,
             ("mat4", "") => "xyzw",
+            ("knobs", "") => "k",
             _ => panic!("src/gpu_types/views.rs: {}: kind {} with lanes {:?}", f.accessor, f.kind, f.lanes),
         };
         if !accessors.insert(f.accessor) {
@@ -282,6 +306,17 @@ fn views_header() -> String {
         if f.view != view {
             view = f.view;
             let _ = write!(text, "\n// {} (struct {} of {})\n", f.view, f.glsl_block, f.header);
+        }
+        if f.kind == "knobs" {
+            let prefix = f.accessor.strip_suffix(f.member).unwrap_or(f.accessor);
+            for (n, (knob, doc)) in knobs().enumerate() {
+                for line in doc.lines() {
+                    let _ = writeln!(text, "//{line}");
+                }
+                let lane = ["x", "y", "z", "w"][n % 4];
+                let _ = writeln!(text, "#define {prefix}{knob}(b) ((b).{}[{}].{lane})", f.member, n / 4);
+            }
+            continue;
         }
         for line in f.doc.lines() {
             let _ = writeln!(text, "//{line}");
@@ -337,6 +372,13 @@ fn views_probe() -> String {
     );
     for f in SHADER_VIEWS {
         let binding = views.iter().position(|(v, _)| *v == f.view).expect("listed");
+        if f.kind == "knobs" {
+            let prefix = f.accessor.strip_suffix(f.member).unwrap_or(f.accessor);
+            for (knob, _) in knobs() {
+                let _ = writeln!(text, "    put({prefix}{knob}(view_{binding}));");
+            }
+            continue;
+        }
         let _ = writeln!(text, "    put({}(view_{binding}));", f.accessor);
     }
     for (name, _) in SHADER_CODES {
@@ -344,4 +386,133 @@ fn views_probe() -> String {
     }
     text.push_str("}\n");
     text
+}
+
+/// Every knob of the constraint list, in its order: name and doc.
+fn knobs() -> impl Iterator<Item = (&'static str, &'static str)> {
+    SIM_CONSTRAINTS.iter().flat_map(|c| c.knobs.iter().copied())
+}
+
+fn knob_count() -> usize {
+    knobs().count()
+}
+
+/// Refuses a constraint list the solve's generator would turn into wrong
+/// GLSL: an unknown kind, a constraint without sets or without its include,
+/// a name or knob named twice or clashing with a view's accessor.
+fn check_constraints(include_dir: &Path) {
+    let mut names = std::collections::HashSet::new();
+    let accessors: std::collections::HashSet<&str> = SHADER_VIEWS.iter().map(|f| f.accessor).collect();
+    for c in SIM_CONSTRAINTS {
+        if !matches!(c.kind, "pairs" | "sweep" | "point" | "after") {
+            panic!("src/gpu_types/constraints.rs: {}: unknown kind {}", c.name, c.kind);
+        }
+        if c.sets.is_empty() || (c.kind != "pairs" && c.sets.len() != 1) {
+            panic!("src/gpu_types/constraints.rs: {}: a {} constraint has {} sets", c.name, c.kind, c.sets.len());
+        }
+        if !names.insert(c.name) {
+            panic!("src/gpu_types/constraints.rs: {} is listed twice", c.name);
+        }
+        let include = include_dir.join("constraints").join(format!("{}.glsl", c.name));
+        if !include.is_file() {
+            panic!("src/gpu_types/constraints.rs: {} has no include {}", c.name, include.display());
+        }
+        println!("cargo:rerun-if-changed={}", include.display());
+    }
+    let mut seen = std::collections::HashSet::new();
+    for (knob, _) in knobs() {
+        if !seen.insert(knob) || accessors.contains(format!("sim_{knob}").as_str()) {
+            panic!("src/gpu_types/constraints.rs: the knob {knob} is named twice");
+        }
+    }
+}
+
+/// `constraint_solve.glsl`: the step kernel's solve, calling each constraint's
+/// include (`glsl/include/constraints/NAME.glsl`) in the list's order. Each
+/// set of a `pairs` or `sweep` constraint starts by publishing every lane's
+/// point to the other half of `s_pos` when something moved it since the last
+/// barrier; `point` constraints share the next barrier.
+fn constraint_solve() -> String {
+    let mut text = String::from(
+        "// Generated by build.rs from src/gpu_types/constraints.rs: do not edit.\n\
+         // The constraint solve of glsl/sim/step.comp, which defines before including\n\
+         // this: params, step_flags(), sync(), collide_all(), s_pos, own_radius,\n\
+         // own_start and the rest buffers (see the list's header for each kind's functions).\n\
+         #ifndef VKHAIR_CONSTRAINT_SOLVE_GLSL\n#define VKHAIR_CONSTRAINT_SOLVE_GLSL\n\n\
+         #include \"constraints/common.glsl\"\n",
+    );
+    for c in SIM_CONSTRAINTS {
+        let _ = writeln!(text, "#include \"constraints/{}.glsl\"", c.name);
+    }
+    text.push_str(
+        "\n// Once per dispatch, for a live invocation: point i of its hair's `points`,\n\
+         // at `index` in the buffers.\n\
+         void constraints_load(uint i, uint points, uint index) {\n",
+    );
+    for c in of_kind(&["pairs"]) {
+        let _ = writeln!(text, "    {}_load(i, points, index);", c.name);
+    }
+    text.push_str(
+        "}\n\n// Once per sub-step, for a live invocation, its rest pose placed by `frame`.\n\
+         void constraints_prepare(mat4 frame, uint lid, uint index, uint i, uint points) {\n",
+    );
+    for c in of_kind(&["sweep", "point", "after"]) {
+        let _ = writeln!(text, "    {}_prepare(frame, lid, index, i, points);", c.name);
+    }
+    text.push_str(
+        "}\n\n// Publishes every live lane's point to the other half of s_pos.\n\
+         void constraints_publish(vec4 own, inout uint src, uint lid, bool live, uint group) {\n\
+         \x20   if (live) { s_pos[1u - src][lid] = own; }\n\
+         \x20   sync(group);\n\
+         \x20   src = 1u - src;\n\
+         }\n\n\
+         // Iteration `it` of the solve: own's position after it, published to half\n\
+         // `src` of s_pos. `group` and everything the branches test are uniform.\n\
+         vec4 constraints_iterate(vec4 own, uint it, inout uint src, uint lid, bool live, uint group, bool sweeps,\n\
+         \x20                        uint sweep_root, uint points) {\n\
+         \x20   bool pending = false;\n",
+    );
+    for c in of_kind(&["pairs", "sweep", "point"]) {
+        let _ = writeln!(text, "    // {}: {}", c.name, c.kind);
+        let _ = writeln!(text, "    if ({}_on(it)) {{", c.name);
+        match c.kind {
+            "pairs" => {
+                for (set, what) in c.sets.iter().enumerate() {
+                    let _ = writeln!(text, "        // set {set}: {what}");
+                    text.push_str("        if (pending) { constraints_publish(own, src, lid, live, group); }\n");
+                    let _ = writeln!(text, "        own = {}_apply({set}u, own, lid, src);", c.name);
+                    text.push_str("        pending = true;\n");
+                }
+            }
+            "sweep" => {
+                text.push_str("        if (pending) { constraints_publish(own, src, lid, live, group); }\n");
+                let _ = writeln!(text, "        if (sweeps) {{ {}_sweep(sweep_root, points, src); }}", c.name);
+                text.push_str(
+                    "        sync(group);\n        if (live) { own = s_pos[src][lid]; }\n        pending = false;\n",
+                );
+            }
+            _ => {
+                let _ = writeln!(text, "        if (live && own.w > 0.0) {{ own = {}_apply(own); }}", c.name);
+                text.push_str("        pending = true;\n");
+            }
+        }
+        text.push_str("    }\n");
+    }
+    text.push_str(
+        "    if (pending) { constraints_publish(own, src, lid, live, group); }\n    return own;\n}\n\n\
+         // After the last of `iterations` iterations, once per sub-step.\n\
+         vec4 constraints_after(vec4 own, uint iterations, bool live) {\n",
+    );
+    for c in of_kind(&["after"]) {
+        let _ = writeln!(text, "    if ({}_on(iterations) && live && own.w > 0.0) {{", c.name);
+        let _ = writeln!(text, "        own = {}_apply(own);", c.name);
+        text.push_str("    }\n");
+    }
+    text.push_str("    return own;\n}\n\n#endif\n");
+    text
+}
+
+/// The constraints of the list whose kind is one of `kinds`, in its order.
+fn of_kind(kinds: &'static [&'static str]) -> impl Iterator<Item = &'static ConstraintRow> {
+    SIM_CONSTRAINTS.iter().filter(move |c| kinds.contains(&c.kind))
 }

@@ -145,7 +145,7 @@ include!("../src/gpu_types/views.rs");
 fn simulation_shaders() -> Vec<PathBuf> {
     let glsl = Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
     let mut files = Vec::new();
-    let mut dirs = vec![glsl.join("sim")];
+    let mut dirs = vec![glsl.join("sim"), glsl.join("include").join("constraints")];
     while let Some(dir) = dirs.pop() {
         for entry in std::fs::read_dir(&dir).expect("shader folder") {
             let path = entry.expect("entry").path();
@@ -204,6 +204,100 @@ fn the_packed_member_check_sees_a_raw_read() {
                   float ok = sim_dt(params);\nvec4 counts = vec4(1.0);\n";
     assert_eq!(packed_member_reads(source), vec!["1: .counts", "2: .gravity_dt"]);
     assert!(SHADER_VIEWS.len() > 80, "the view table has only {} fields", SHADER_VIEWS.len());
+}
+
+// The constraint list (src/gpu_types/constraints.rs) as a table.
+include!("../src/gpu_types/constraints_table.rs");
+include!("../src/gpu_types/constraints.rs");
+
+/// The file stems in `dir`, less `skip`.
+fn stems(dir: &Path, skip: &str) -> BTreeSet<String> {
+    std::fs::read_dir(dir)
+        .expect("folder")
+        .map(|e| e.expect("entry").path())
+        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .filter(|s| s != skip)
+        .collect()
+}
+
+/// A constraint is its include and its twin, listed once: an include or twin
+/// not listed (never run), a listed one without either, a twin or include that
+/// lacks a function its kind needs or never reads one of its knobs, and a step
+/// kernel that calls a constraint but through the generated solve all fail.
+fn constraint_problems(root: &Path) -> Vec<String> {
+    let listed: BTreeSet<String> = SIM_CONSTRAINTS.iter().map(|c| c.name.to_owned()).collect();
+    let includes_dir = root.join("glsl/include/constraints");
+    let twins_dir = root.join("src/sim/reference/constraints");
+    let mut problems = Vec::new();
+    for (what, found) in [("include", stems(&includes_dir, "common")), ("twin", stems(&twins_dir, "mod"))] {
+        for name in found.symmetric_difference(&listed) {
+            problems.push(format!("{name}: {what} and list disagree"));
+        }
+    }
+    let step = std::fs::read_to_string(root.join("glsl/sim/step.comp")).unwrap_or_default();
+    for c in SIM_CONSTRAINTS {
+        let include = std::fs::read_to_string(includes_dir.join(format!("{}.glsl", c.name))).unwrap_or_default();
+        let twin = std::fs::read_to_string(twins_dir.join(format!("{}.rs", c.name))).unwrap_or_default();
+        let glsl_needs: &[&str] = match c.kind {
+            "pairs" => &["load", "on", "apply"],
+            "sweep" => &["prepare", "on", "sweep"],
+            _ => &["prepare", "on", "apply"],
+        };
+        for f in glsl_needs {
+            if !include.contains(&format!(" {}_{f}(", c.name)) {
+                problems.push(format!("{}: the include defines no {}_{f}", c.name, c.name));
+            }
+        }
+        for f in ["on", "load", "apply"] {
+            if !twin.contains(&format!("pub(super) fn {f}(")) {
+                problems.push(format!("{}: the twin defines no {f}", c.name));
+            }
+        }
+        for (knob, _) in c.knobs {
+            if !include.contains(&format!("sim_{knob}(")) || !twin.contains(&format!("knobs.{knob}")) {
+                problems.push(format!("{}: the knob {knob} is not read by both include and twin", c.name));
+            }
+        }
+        if step.contains(&format!("{}_", c.name)) {
+            problems.push(format!("{}: glsl/sim/step.comp calls it directly", c.name));
+        }
+    }
+    problems
+}
+
+#[test]
+fn every_constraint_is_one_include_and_one_twin_in_the_list() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    assert!(SIM_CONSTRAINTS.len() >= 6, "the list has {} constraints", SIM_CONSTRAINTS.len());
+    let problems = constraint_problems(root);
+    assert!(problems.is_empty(), "constraints:\n{}", problems.join("\n"));
+}
+
+/// The check above sees a twin that is not listed and an include without its
+/// `on`: planted in a copy of the two folders.
+#[test]
+fn the_constraint_check_sees_an_unlisted_twin_and_a_missing_function() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let copy = tempfile::tempdir().expect("temp dir");
+    for folder in ["glsl/include/constraints", "src/sim/reference/constraints", "glsl/sim"] {
+        let to = copy.path().join(folder);
+        std::fs::create_dir_all(&to).expect("folder");
+        for entry in std::fs::read_dir(root.join(folder)).expect("folder") {
+            let path = entry.expect("entry").path();
+            if path.is_file() {
+                std::fs::copy(&path, to.join(path.file_name().expect("name"))).expect("copy");
+            }
+        }
+    }
+    assert!(constraint_problems(copy.path()).is_empty(), "the copy already has problems");
+    let twins = copy.path().join("src/sim/reference/constraints");
+    std::fs::write(twins.join("twist.rs"), "pub(super) fn on() {}").expect("plant");
+    let include = copy.path().join("glsl/include/constraints/bending.glsl");
+    let text = std::fs::read_to_string(&include).expect("include").replace("bool bending_on(", "bool bending_is_on(");
+    std::fs::write(&include, text).expect("plant");
+    let problems = constraint_problems(copy.path());
+    assert!(problems.iter().any(|p| p.starts_with("twist: twin")), "{problems:?}");
+    assert!(problems.iter().any(|p| p == "bending: the include defines no bending_on"), "{problems:?}");
 }
 
 /// The commands a source names through `commands::` (one name, or a braced

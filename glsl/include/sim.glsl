@@ -12,7 +12,8 @@
 // (views.glsl, generated from src/gpu_types/views.rs, which names every lane):
 // `sim_*(p)` for SimStepParams, `step_range_*(p)` for SimPush, `state_move_*(p)`
 // for MovePush, `collider_*(c)` for Collider. The SIM_* switches (src/codes.rs) and SIM_MAX_COLLIDERS and
-// SIM_WORKGROUP (src/limits.rs) are injected by build.rs.
+// SIM_WORKGROUP (src/limits.rs) and SIM_KNOB_VEC4S (src/gpu_types/constraints.rs)
+// are injected by build.rs.
 
 // Per-sub-step parameters (one array entry per sub-step, binding 0). Twin:
 // gpu_types::SimStepParams, view gpu_types::SimStep.
@@ -21,10 +22,11 @@ struct SimStepParams {
     vec4 gravity_dt;
     vec4 wind;
     vec4 wind_noise;
-    vec4 bending;
+    vec4 solver;
     uvec4 counts;
     uvec4 layout_info;
-    vec4 shape;
+    // The constraints' knobs, one lane each (src/gpu_types/constraints.rs).
+    vec4 knobs[SIM_KNOB_VEC4S];
     mat4 previous_head;
     vec4 mesh_grid;
     uvec4 mesh_dims;

@@ -11,29 +11,16 @@
 //      pinned particles (inverse mass 0) follow the head: x* = head · rest
 //      (with SIM_SCALP every "head" here is the key hair's root frame, see
 //      glsl/include/scalp.glsl);
-//   2. the constraint solve: N iterations with a barrier between the sets.
-//      The barrier's scope is the "sync group": the subgroup when every hair
-//      fits into one (hairs are packed so none straddles two), else the whole
-//      workgroup (barrier()). The sets are:
-//        a. distance constraints of even segments, b. of odd segments,
-//        c. bending (distance between points i−1 and i+1, rest from the rest
-//           shape, stiffness from root to tip) centred on i mod 4 ∈ {0,1},
-//           d. on {2,3},
-//        e. (with SIM_LOCAL_SHAPE, in the last iteration only, so that its
-//           stiffness is the fraction removed per sub-step whatever the
-//           iteration count) the local shape constraints, swept root to tip by
-//           one invocation per hair (Gauss-Seidel: a correction reaches
-//           the tip within the sweep): segment (j−1, j) is pulled toward its
-//           rest offset carried along by the smallest rotation taking the
-//           parent segment's rest direction onto its current one (parallel
-//           transport of the rest frame; the first segment's frame is the
-//           head's); both ends move, by their inverse masses, so the
-//           constraint conserves momentum like the distance constraints,
-//        f. the global shape constraint (each point pulled toward its rest
-//           position in the head's frame; it touches only the own point) and
-//           body collisions (spheres, capsules and, with SIM_MESH, the mesh
-//           collider's field; each particle has its own radius),
-//      then, with the mesh collider, friction against it (once per sub-step);
+//   2. the constraint solve: N iterations of the constraints listed in
+//      src/gpu_types/constraints.rs, in that order, each in its own include
+//      (glsl/include/constraints/) called through the generated
+//      constraint_solve.glsl, with a barrier between the sets. The barrier's
+//      scope is the "sync group": the subgroup when every hair fits into one
+//      (hairs are packed so none straddles two), else the whole workgroup
+//      (barrier()). Today: distance (even, odd segments), bending (two sets of
+//      centres), local shape (one sweep per hair, last iteration), global
+//      shape and collisions (own point only, sharing the iteration's last
+//      barrier); then, once per sub-step, friction against the mesh collider;
 //   3. velocity from the position change, friction, damping:
 //        v = (x_solved − x_old) / dt  [− s·d_{i+1} / dt in DFTL mode],
 //        against each sphere and capsule touched: the velocity along its
@@ -46,9 +33,9 @@
 // positions, and each keeps its own result: every invocation holds its point
 // in a register and, per set, reads its partner from one half of a
 // double-buffered shared array and writes its own point to the other half, so
-// one barrier per set suffices (collisions, which touch only the own point,
-// share the last set's barrier). The arithmetic is exactly that of projecting
-// the pair in one place, which the CPU reference does.
+// one barrier per set suffices (constraints that touch only the own point share
+// the last set's barrier). The arithmetic is exactly that of projecting the
+// pair in one place, which the CPU reference does.
 //
 // The pipeline is specialised (constant 0, STEP_FEATURES) to the switches a
 // dispatch can meet: a switch outside it is off whatever the parameters say,
@@ -92,17 +79,16 @@ layout(std430, set = 0, binding = 16) readonly buffer ScalpSource { float scalp_
 #include "scalp.glsl"
 
 shared vec4 s_pos[2][SIM_WORKGROUP];
+// DFTL mode: each point's rest length to its child, and its correction vector.
 shared float s_length[SIM_WORKGROUP];
-// Local shape, per point i ≥ 1 (its segment from i−1): the parent segment's rest
-// direction (world, unit; zero for the first segment and degenerate ones) and
-// the rest offset of i from i−1 (world).
-shared vec3 s_local_dir[SIM_WORKGROUP];
-// In DFTL mode s_local_offset holds each point's correction vector instead.
-shared vec3 s_local_offset[SIM_WORKGROUP];
+shared vec3 s_correction[SIM_WORKGROUP];
 
 // The parameters of the sub-step being run, and where its colliders start.
 SimStepParams params;
 uint collider_base;
+// The own point's radius, and its position at the start of the sub-step.
+float own_radius = 0.0;
+vec4 own_start = vec4(0.0);
 
 // The switches of the sub-step being run, within the pipeline's features.
 uint step_flags() {
@@ -124,66 +110,6 @@ vec3 collide_all(vec3 p, float radius) {
     return sim_collide_bodies(params, step_flags(), collider_base, p, radius);
 }
 
-// One end of a constraint between this invocation's point `own` and the point
-// `offset` invocations away, read from half `src`. `first`: own is the lower
-// index (a) of the pair. Returns own's projected position.
-vec4 project_end(vec4 own, uint lid, int offset, bool first, float rest_d, float k, uint src) {
-    if (offset == 0) {
-        return own;
-    }
-    vec4 other = s_pos[src][uint(int(lid) + offset)];
-    vec4 a = first ? own : other;
-    vec4 b = first ? other : own;
-    precise float w = a.w + b.w;
-    precise vec3 d = b.xyz - a.xyz;
-    precise float len = sqrt(dot(d, d));
-    if (w > 0.0 && len > 0.0) {
-        precise float c = ((len - rest_d) / (len * w)) * k;
-        if (first) {
-            precise vec3 pa = a.xyz + d * (a.w * c);
-            own.xyz = pa;
-        } else {
-            precise vec3 pb = b.xyz - d * (b.w * c);
-            own.xyz = pb;
-        }
-    }
-    return own;
-}
-
-// Sweeps the local shape constraints of the hair whose root sits at invocation
-// `root`, root to tip, in place in half `src` (see the header). The segments'
-// rest data are in s_local (direction of the parent segment, offset). The two
-// points before the segment are carried in registers: they are what the
-// previous segment left in shared memory.
-void local_shape_sweep(uint root, uint points, uint src) {
-    vec4 grandparent = vec4(0.0);
-    vec4 parent = s_pos[src][root];
-    for (uint j = 1u; j < points; j++) {
-        vec4 child = s_pos[src][root + j];
-        precise vec3 carried = s_local_offset[root + j];
-        vec3 dir = s_local_dir[root + j];
-        if (j >= 2u && sim_dot(dir, dir) > 0.0) {
-            precise vec3 d = parent.xyz - grandparent.xyz;
-            precise float len = sqrt(sim_dot(d, d));
-            if (len > 0.0) {
-                carried = sim_rotate_between(dir, d / len, carried);
-            }
-        }
-        precise float w = parent.w + child.w;
-        if (w > 0.0) {
-            precise vec3 delta = (carried - (child.xyz - parent.xyz)) * sim_local_shape(params);
-            precise vec3 moved_parent = parent.xyz - delta * (parent.w / w);
-            precise vec3 moved_child = child.xyz + delta * (child.w / w);
-            parent.xyz = moved_parent;
-            child.xyz = moved_child;
-            s_pos[src][root + j - 1u] = parent;
-            s_pos[src][root + j] = child;
-        }
-        grandparent = parent;
-        parent = child;
-    }
-}
-
 // Where the rest pose of key hair `strand` is placed at the end of the
 // sub-step being run: the head, or with SIM_SCALP its root's frame.
 mat4 hair_frame(uint strand) {
@@ -193,26 +119,7 @@ mat4 hair_frame(uint strand) {
     return sim_head(params);
 }
 
-// The rest offset of particle k from its parent, rotated into the world by `frame`.
-vec3 local_rest_offset(mat4 frame, uint k) {
-    return sim_rotate(frame, rest[k].xyz - rest[k - 1u].xyz);
-}
-
-// The unit rest direction of the segment ending at particle k, in the world
-// (zero for a degenerate segment).
-vec3 local_rest_dir(mat4 frame, uint k) {
-    vec3 d = local_rest_offset(frame, k);
-    precise float len = sqrt(sim_dot(d, d));
-    return len > 0.0 ? d / len : vec3(0.0);
-}
-
-// Rest distance and stiffness of the bending constraint centred on point c.
-vec2 bend_at(uint strand_base, uint c, uint points) {
-    precise vec3 r = rest[strand_base + c + 1u].xyz - rest[strand_base + c - 1u].xyz;
-    precise float t = float(c) / float(points - 1u);
-    precise float k = sim_bending_root(params) + (sim_bending_tip(params) - sim_bending_root(params)) * t;
-    return vec2(sqrt(dot(r, r)), k);
-}
+#include "constraint_solve.glsl"
 
 // Stage 1 for the own point: its predicted position (w: inverse mass) from the
 // position `x` and velocity `v` at the start of the sub-step, its rest
@@ -258,7 +165,6 @@ void main() {
     bool live = in_sync < per_sync && hair < per_group && slot < simulated;
     uint strand = live ? sim_order[slot] : 0u;
     uint index = strand * points + i;
-    uint base = strand * points;
     // The sequential sweeps (local shape, DFTL) of the sync group's hairs run on
     // its first lanes side by side, lane h for its h-th hair, rather than on each
     // hair's root: neighbouring lanes share a SIMD batch or subgroup.
@@ -269,19 +175,11 @@ void main() {
     uint sweep_base = sweeps ? sim_order[swept_slot] * points : 0u;
 
     // What stays the same over the step: the state (in registers from here to the
-    // store), the rest data and each constraint set's partner, rest distance and
-    // stiffness.
-    bool bending = (step_flags() & SIM_BENDING) != 0u;
+    // store), the rest data and what the constraints load (partners, rest
+    // distances, stiffnesses).
     vec4 x = vec4(0.0);
     vec3 v = vec3(0.0);
     vec3 rest_head = vec3(0.0);
-    float radius = 0.0;
-    // Per set: partner offset (0 = none), whether own is the pair's first point,
-    // rest distance and stiffness.
-    int off_even = 0, off_odd = 0, off_bend_a = 0, off_bend_b = 0;
-    bool first_even = false, first_odd = false, first_bend_a = false, first_bend_b = false;
-    float rest_even = 0.0, rest_odd = 0.0;
-    vec2 bend_a = vec2(0.0), bend_b = vec2(0.0);
     if (live) {
         x = pos_in[index];
         if (step_range_first(push) == 0u) {
@@ -290,38 +188,9 @@ void main() {
         v = vel_in[index].xyz;
         vec4 r = rest[index];
         rest_head = r.xyz;
-        radius = r.w;
+        own_radius = r.w;
         s_length[lid] = rest_length[index];
-        bool has_next = i + 1u < points;
-        float len_next = rest_length[index];
-        float len_prev = i > 0u ? rest_length[index - 1u] : 0.0;
-        // Distance sets: segment (j, j+1) is even when j is even.
-        if ((i & 1u) == 0u) {
-            if (has_next) { off_even = 1; first_even = true; rest_even = len_next; }
-            if (i > 0u) { off_odd = -1; rest_odd = len_prev; }
-        } else {
-            off_even = -1; rest_even = len_prev;
-            if (has_next) { off_odd = 1; first_odd = true; rest_odd = len_next; }
-        }
-        // Bending sets: centre c joins c−1 and c+1; set A has c mod 4 ∈ {0,1}.
-        if (bending) {
-            if (i + 2u < points) {
-                uint c = i + 1u;
-                vec2 bk = bend_at(base, c, points);
-                if (bk.y > 0.0) {
-                    if ((c & 3u) < 2u) { off_bend_a = 2; first_bend_a = true; bend_a = bk; }
-                    else { off_bend_b = 2; first_bend_b = true; bend_b = bk; }
-                }
-            }
-            if (i >= 2u) {
-                uint c = i - 1u;
-                vec2 bk = bend_at(base, c, points);
-                if (bk.y > 0.0) {
-                    if ((c & 3u) < 2u) { off_bend_a = -2; bend_a = bk; }
-                    else { off_bend_b = -2; bend_b = bk; }
-                }
-            }
-        }
+        constraints_load(i, points, index);
     }
 
     for (uint sub = 0u; sub < step_range_count(push); sub++) {
@@ -332,28 +201,15 @@ void main() {
         collider_base = (step_range_first(push) + sub) * SIM_MAX_COLLIDERS;
         uint flags = step_flags();
         bool collisions = (flags & SIM_COLLISIONS) != 0u;
-        bool global_shape = (flags & SIM_GLOBAL_SHAPE) != 0u;
-        bool local_shape = (flags & SIM_LOCAL_SHAPE) != 0u;
-        vec3 shape_target = vec3(0.0);
-        float shape_k = 0.0;
+        own_start = x;
 
-        // 1. Prediction, and what the shape constraints need of this sub-step's head.
+        // 1. Prediction, and what the constraints need of this sub-step's frame.
         vec4 own = vec4(0.0);
         if (live) {
             mat4 frame = hair_frame(strand);
             own = predict(x, v, rest_head, strand, frame);
             s_pos[0][lid] = own;
-            if (global_shape) {
-                precise float t = float(i) / float(points - 1u);
-                precise float k = sim_global_shape(params) * sim_shape_weight(t, sim_global_shape_range(params));
-                shape_k = k;
-                vec3 at_rest = sim_transform_point(frame, rest_head);
-                shape_target = sim_shape_target(at_rest, k, sim_iterations(params), flags, sim_gravity(params), sim_dt(params));
-            }
-            if (local_shape && i >= 1u) {
-                s_local_offset[lid] = local_rest_offset(frame, index);
-                s_local_dir[lid] = i >= 2u ? local_rest_dir(frame, index - 1u) : vec3(0.0);
-            }
+            constraints_prepare(frame, lid, index, i, points);
         }
         sync(group);
         vec4 predicted = own;
@@ -380,55 +236,16 @@ void main() {
             if (live) {
                 own = s_pos[0][lid];
                 precise vec3 d = own.xyz - predicted.xyz;
-                s_local_offset[lid] = d;
+                s_correction[lid] = d;
             }
             sync(group);
         } else {
             // Halves alternate: each set reads `src` and writes the other one.
             uint src = 0u;
             for (uint it = 0u; it < sim_iterations(params); it++) {
-                own = project_end(own, lid, off_even, first_even, rest_even, 1.0, src);
-                if (live) { s_pos[1u - src][lid] = own; }
-                sync(group);
-                src = 1u - src;
-                own = project_end(own, lid, off_odd, first_odd, rest_odd, 1.0, src);
-                if (live) { s_pos[1u - src][lid] = own; }
-                sync(group);
-                src = 1u - src;
-                // Without bending the two sets move nothing: they are skipped
-                // (`bending` is uniform, so are the barriers inside).
-                if (bending) {
-                    own = project_end(own, lid, off_bend_a, first_bend_a, bend_a.x, bend_a.y, src);
-                    if (live) { s_pos[1u - src][lid] = own; }
-                    sync(group);
-                    src = 1u - src;
-                    own = project_end(own, lid, off_bend_b, first_bend_b, bend_b.x, bend_b.y, src);
-                }
-                if (local_shape && it + 1u == sim_iterations(params)) {
-                    if (live) { s_pos[1u - src][lid] = own; }
-                    sync(group);
-                    src = 1u - src;
-                    if (sweeps) {
-                        local_shape_sweep(sweep_root, points, src);
-                    }
-                    sync(group);
-                    if (live) { own = s_pos[src][lid]; }
-                }
-                if (global_shape && live && own.w > 0.0 && shape_k > 0.0) {
-                    precise vec3 pulled = own.xyz + (shape_target - own.xyz) * shape_k;
-                    own.xyz = pulled;
-                }
-                if (collisions && live && own.w > 0.0) {
-                    own.xyz = collide_all(own.xyz, radius);
-                }
-                if (live) { s_pos[1u - src][lid] = own; }
-                sync(group);
-                src = 1u - src;
+                own = constraints_iterate(own, it, src, lid, live, group, sweeps, sweep_root, points);
             }
-            if ((flags & SIM_MESH) != 0u && collisions && live && own.w > 0.0) {
-                own.xyz = mesh_friction(sim_head(params), sim_previous_head(params), sim_mesh_grid(params), own.xyz,
-                                        x.xyz, radius, sim_mesh_friction(params));
-            }
+            own = constraints_after(own, sim_iterations(params), live);
         }
 
         // 3. Velocity from the position change, damping.
@@ -436,10 +253,10 @@ void main() {
             float dt = sim_dt(params);
             precise vec3 vel = (own.xyz - x.xyz) / dt;
             if ((flags & SIM_DFTL) != 0u && i + 1u < points) {
-                vel = vel - s_local_offset[lid + 1u] * (sim_dftl_damping(params) / dt);
+                vel = vel - s_correction[lid + 1u] * (sim_dftl_damping(params) / dt);
             }
             if ((flags & SIM_COLLISIONS) != 0u && own.w > 0.0) {
-                vel = sim_collider_friction_all(params, collider_base, own.xyz, vel, radius);
+                vel = sim_collider_friction_all(params, collider_base, own.xyz, vel, own_radius);
             }
             vel = vel * (1.0 - sim_damping(params));
             x = own;

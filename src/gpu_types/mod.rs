@@ -51,6 +51,9 @@ macro_rules! view_type {
     (mat4) => {
         Mat4
     };
+    (knobs) => {
+        SimKnobs
+    };
 }
 
 /// The index of one lane.
@@ -86,6 +89,9 @@ macro_rules! view_get {
     (mat4, $m:expr,) => {
         Mat4::from_cols_array_2d(&$m)
     };
+    (knobs, $m:expr,) => {
+        SimKnobs::from_lanes(&$m)
+    };
 }
 
 /// Writes a view field's value into its block member's lanes.
@@ -104,6 +110,9 @@ macro_rules! view_set {
     };
     (mat4, $m:expr,, $v:expr) => {
         $m = $v.to_cols_array_2d()
+    };
+    (knobs, $m:expr,, $v:expr) => {
+        $m = $v.to_lanes()
     };
 }
 
@@ -165,6 +174,58 @@ macro_rules! shader_views {
     };
 }
 
+/// The crate's form of the constraint list (`constraints.rs`): the knobs'
+/// struct, whose fields take the lanes of `SimStepParams::knobs` in the
+/// list's order (build.rs gives the shaders' accessors the same lanes).
+macro_rules! sim_constraints {
+    ($(
+        $(#[doc = $doc:literal])*
+        $name:ident : $kind:ident [ $($set:literal),* ] {
+            $( $(#[doc = $kdoc:literal])* $knob:ident = $from:expr ),* $(,)?
+        }
+    )*) => {
+        /// The solver constraints' knobs (`gpu_types/constraints.rs`), each in
+        /// its own lane of `SimStepParams::knobs`; shaders read them as
+        /// `sim_KNOB(params)`.
+        #[derive(Debug, Clone, Copy, Default, PartialEq)]
+        pub(crate) struct SimKnobs {
+            $( $( $(#[doc = $kdoc])* pub $knob: f32, )* )*
+        }
+
+        /// How many knobs the list names.
+        const SIM_KNOB_COUNT: usize = [$($(stringify!($knob),)*)*].len();
+
+        /// The `vec4`s of `SimStepParams::knobs` (build.rs defines the same
+        /// count for the shaders as `SIM_KNOB_VEC4S`).
+        pub(crate) const SIM_KNOB_VEC4S: usize = SIM_KNOB_COUNT.div_ceil(4);
+
+        impl SimKnobs {
+            /// The knobs in their lanes, the list's order.
+            fn to_lanes(self) -> [[f32; 4]; SIM_KNOB_VEC4S] {
+                let flat = [$($(self.$knob,)*)*];
+                let mut lanes = [[0.0; 4]; SIM_KNOB_VEC4S];
+                for (i, v) in flat.into_iter().enumerate() {
+                    lanes[i / 4][i % 4] = v;
+                }
+                lanes
+            }
+
+            /// The knobs read back from their lanes.
+            fn from_lanes(lanes: &[[f32; 4]; SIM_KNOB_VEC4S]) -> Self {
+                let mut flat = lanes.iter().flatten().copied();
+                SimKnobs { $($( $knob: flat.next().unwrap_or_default(), )*)* }
+            }
+
+            /// Every knob's value, the list's order.
+            #[cfg(test)]
+            pub(crate) fn values(&self) -> Vec<f32> {
+                vec![$($(self.$knob,)*)*]
+            }
+        }
+    };
+}
+
+include!("constraints.rs");
 include!("views.rs");
 
 impl ColliderShape {

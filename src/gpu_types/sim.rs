@@ -16,10 +16,10 @@ pub(crate) struct SimStepParams {
     pub(super) gravity_dt: [f32; 4],
     pub(super) wind: [f32; 4],
     pub(super) wind_noise: [f32; 4],
-    pub(super) bending: [f32; 4],
+    pub(super) solver: [f32; 4],
     pub(super) counts: [u32; 4],
     pub(super) layout_info: [u32; 4],
-    pub(super) shape: [f32; 4],
+    pub(super) knobs: [[f32; 4]; super::SIM_KNOB_VEC4S],
     pub(super) previous_head: [[f32; 4]; 4],
     pub(super) mesh_grid: [f32; 4],
     pub(super) mesh_dims: [u32; 4],
@@ -27,7 +27,7 @@ pub(crate) struct SimStepParams {
     pub(super) scalp_source: [u32; 4],
 }
 gpu_struct!(SimStepParams => "SimStepParams" {
-    head, gravity_dt, wind, wind_noise, bending, counts, layout_info, shape, previous_head, mesh_grid, mesh_dims,
+    head, gravity_dt, wind, wind_noise, solver, counts, layout_info, knobs, previous_head, mesh_grid, mesh_dims,
     scalp_lerp, scalp_source
 });
 

@@ -61,6 +61,12 @@ impl ProbeWords for [u32; 3] {
     }
 }
 
+impl ProbeWords for super::SimKnobs {
+    fn probe_words(&self) -> Vec<u32> {
+        self.values().into_iter().map(f32::to_bits).collect()
+    }
+}
+
 impl ProbeWords for Mat4 {
     fn probe_words(&self) -> Vec<u32> {
         self.to_cols_array().map(f32::to_bits).to_vec()

@@ -22,7 +22,8 @@
 //   simulation shader reads one but through an accessor.
 //
 // Kinds: float, uint (one lane), vec3, uvec3 (lanes xyz), mat4 (a whole
-// member). A view names each lane at most once; a block may have several
+// member), knobs (the array of the constraints' knobs, `constraints.rs`: one
+// accessor per knob, its lanes in that list's order). A view names each lane at most once; a block may have several
 // views (the volume kernels' push constants mean different things to
 // different kernels).
 
@@ -48,15 +49,11 @@ shader_views! {
         spring_stiffness: float = wind_noise.z,
         /// Fraction of velocity removed per sub-step.
         damping: float = wind_noise.w,
-        /// Bending stiffness per iteration at the root.
-        bending_root: float = bending.x,
-        /// Bending stiffness per iteration at the tip.
-        bending_tip: float = bending.y,
         /// DFTL velocity correction factor.
-        dftl_damping: float = bending.z,
+        dftl_damping: float = solver.x,
         /// Share of a follower's deviation from its guide kept per step
         /// (`sim::lod::FOLLOW_FADE`).
-        follow_fade: float = bending.w,
+        follow_fade: float = solver.y,
         /// Key hairs.
         strands: uint = counts.x,
         /// Points per key hair.
@@ -74,15 +71,9 @@ shader_views! {
         /// Invocations a constraint set's barrier spans: a subgroup, or the
         /// whole workgroup (`SIM_WORKGROUP`).
         sync_group: uint = layout_info.w,
-        /// Global shape stiffness per iteration at full strength.
-        global_shape: float = shape.x,
-        /// Fraction of each strand, from the root, the global shape constraint
-        /// holds at full strength.
-        global_shape_range: float = shape.y,
-        /// Local shape stiffness per sub-step.
-        local_shape: float = shape.z,
-        /// Friction against the mesh collider (0..=1).
-        mesh_friction: float = shape.w,
+        /// The solver constraints' knobs (`gpu_types/constraints.rs`), each
+        /// in its own lane, read as `sim_KNOB(params)`.
+        knobs: knobs = knobs,
         /// World-from-head transform at the start of the sub-step.
         previous_head: mat4 = previous_head,
         /// Mesh collider: grid point (0, 0, 0) in the head frame.

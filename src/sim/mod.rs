@@ -12,16 +12,20 @@
 //!       spring toward the rest shape in the head frame, each switchable —
 //!       then v* = v + dt·a, x* = x + dt·v*; pinned particles (roots) follow
 //!       the head transform;
-//!    2. the constraint solve: for N iterations the even then odd distance
-//!       constraints, two sets of bending constraints, in the last iteration
-//!       the local shape constraints (one sweep root to tip,
+//!    2. the constraint solve: for N iterations the constraints of the list
+//!       in `gpu_types/constraints.rs`, in its order, separated by barriers
+//!       between their sets — the even then odd distance constraints, two
+//!       sets of bending constraints, in the last iteration the local shape
+//!       constraints (one sweep root to tip,
 //!       [`SimParams::local_shape_stiffness`]), the global shape constraint
 //!       (each particle pulled toward its rest position in the head frame,
 //!       [`SimParams::global_shape_stiffness`]) and the body collisions
-//!       (spheres, capsules and the [`MeshCollider`]'s field), separated by
-//!       barriers; then friction against the mesh collider. DFTL mode replaces
-//!       the iterations with one follow-the-leader sweep and keeps the
-//!       correction vectors in shared memory;
+//!       (spheres, capsules and the [`MeshCollider`]'s field); then friction
+//!       against the mesh collider. Each constraint is one GLSL include
+//!       (`glsl/include/constraints/`) and one CPU twin
+//!       (`reference/constraints/`); build.rs generates the calls. DFTL mode
+//!       replaces the iterations with one follow-the-leader sweep and keeps
+//!       the correction vectors in shared memory;
 //!    3. velocity from the position change (plus the DFTL correction) and
 //!       damping;
 //!

@@ -10,7 +10,7 @@ use super::mesh_collider::MeshGrid;
 use super::params::{SimParams, SolverMode};
 use super::step::Packing;
 use crate::codes::sim_flags;
-use crate::gpu_types::SimStep;
+use crate::gpu_types::{SimKnobs, SimStep};
 
 /// The `SIM_*` switches for `p`, with a mesh collider set when `mesh`.
 pub(crate) fn flags(p: &SimParams, mesh: bool) -> u32 {
@@ -39,6 +39,29 @@ pub(crate) fn per_iteration(p: &SimParams, k: f32) -> f32 {
     };
     1.0 - (1.0 - k).powf(1.0 / n as f32)
 }
+
+/// Each knob's value from `SimParams`, as the constraint list
+/// (`gpu_types/constraints.rs`) says.
+macro_rules! sim_constraints {
+    ($(
+        $(#[doc = $doc:literal])*
+        $name:ident : $kind:ident [ $($set:literal),* ] {
+            $( $(#[doc = $kdoc:literal])* $knob:ident = $from:expr ),* $(,)?
+        }
+    )*) => {
+        /// The constraints' knobs for `p`.
+        pub(crate) fn knobs(p: &SimParams) -> SimKnobs {
+            SimKnobs {
+                $($( $knob: {
+                    let from: fn(&SimParams) -> f32 = $from;
+                    from(p)
+                }, )*)*
+            }
+        }
+    };
+}
+
+include!("../gpu_types/constraints.rs");
 
 /// Where and when one sub-step happens.
 pub(crate) struct SubstepPose {
@@ -81,8 +104,6 @@ pub(crate) fn sim_step(
         time: pose.time,
         spring_stiffness: p.spring_stiffness,
         damping: p.damping,
-        bending_root: per_iteration(p, p.bending_root),
-        bending_tip: per_iteration(p, p.bending_tip),
         dftl_damping: p.dftl_damping,
         follow_fade: super::lod::FOLLOW_FADE,
         strands: shape.strands,
@@ -93,10 +114,7 @@ pub(crate) fn sim_step(
         hairs_per_group: shape.packing.hairs_per_group,
         step_index: pose.index,
         sync_group: shape.packing.sync_group,
-        global_shape: per_iteration(p, p.global_shape_stiffness),
-        global_shape_range: p.global_shape_range,
-        local_shape: p.local_shape_stiffness,
-        mesh_friction: p.mesh_friction,
+        knobs: knobs(p),
         previous_head: pose.previous_head,
         mesh_origin: grid.origin,
         mesh_cell: grid.cell,
@@ -185,8 +203,6 @@ mod tests {
             time: 4.75,
             spring_stiffness: 3.5,
             damping: 0.0625,
-            bending_root: 1.0 - 0.25f32.powf(1.0 / 7.0),
-            bending_tip: 1.0 - 0.875f32.powf(1.0 / 7.0),
             dftl_damping: 0.8125,
             follow_fade: crate::sim::lod::FOLLOW_FADE,
             strands: 13,
@@ -204,10 +220,14 @@ mod tests {
             hairs_per_group: 3,
             step_index: 11,
             sync_group: 8,
-            global_shape: 1.0 - 0.5f32.powf(1.0 / 7.0),
-            global_shape_range: 0.625,
-            local_shape: 0.4375,
-            mesh_friction: 0.15625,
+            knobs: SimKnobs {
+                bending_root: 1.0 - 0.25f32.powf(1.0 / 7.0),
+                bending_tip: 1.0 - 0.875f32.powf(1.0 / 7.0),
+                global_shape: 1.0 - 0.5f32.powf(1.0 / 7.0),
+                global_shape_range: 0.625,
+                local_shape: 0.4375,
+                mesh_friction: 0.15625,
+            },
             previous_head: pose.previous_head,
             mesh_origin: grid.origin,
             mesh_cell: 0.03125,

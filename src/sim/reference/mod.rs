@@ -16,6 +16,7 @@ use crate::codes::sim_flags as flags;
 use crate::gpu_types::{ColliderShape, SimStep};
 
 mod bodies;
+mod constraints;
 
 pub(crate) use bodies::MeshField;
 use bodies::{collider_friction, Bodies};
@@ -38,7 +39,6 @@ pub(crate) fn move_state(state: &mut SimState, mv: &super::teleport::Move, scalp
     }
 }
 
-/// `sim_rotate`: R · v.
 /// `sim_rotate_between`: v rotated by the smallest rotation taking a onto b.
 fn rotate_between(a: Vec3, b: Vec3, v: Vec3) -> Vec3 {
     let c = dot(a, b);
@@ -62,51 +62,6 @@ pub(crate) fn noise(t: f32, strand: u32) -> f32 {
     let a = hash(i);
     let b = hash(i.wrapping_add(1));
     a + (b - a) * s
-}
-
-/// Weight of the global shape constraint at strand parameter `t`, as
-/// `sim_shape_weight` in `glsl/include/sim.glsl`.
-pub(crate) fn shape_weight(t: f32, range: f32) -> f32 {
-    if t <= range {
-        1.0
-    } else {
-        ((range + 0.25 - t) * 4.0).max(0.0)
-    }
-}
-
-/// The global shape constraint's target, as `sim_shape_target` in
-/// `glsl/include/sim.glsl` (raised against gravity by the static sag with
-/// `flags::SAG_FREE`).
-fn shape_target(target: Vec3, k: f32, iterations: u32, flags: u32, gravity: Vec3, dt: f32) -> Vec3 {
-    if flags & flags::SAG_FREE == 0 || flags & flags::GRAVITY == 0 || k <= 0.0 {
-        return target;
-    }
-    let mut keep = 1.0f32;
-    for _ in 0..iterations {
-        keep *= 1.0 - k;
-    }
-    let s = 1.0 - keep;
-    if s < 0.01 {
-        return target;
-    }
-    let f = 1.0 / s - 1.0;
-    let step_sag = gravity * (dt * dt);
-    let sag = step_sag * f;
-    target - sag
-}
-
-fn project(s: &mut [Vec4], i: usize, j: usize, rest_d: f32, k: f32) {
-    let (a, b) = (s[i], s[j]);
-    let w = a.w + b.w;
-    let d = b.truncate() - a.truncate();
-    let len = dot(d, d).sqrt();
-    if w > 0.0 && len > 0.0 {
-        let c = ((len - rest_d) / (len * w)) * k;
-        let pa = a.truncate() + d * (a.w * c);
-        let pb = b.truncate() - d * (b.w * c);
-        s[i] = pa.extend(a.w);
-        s[j] = pb.extend(b.w);
-    }
 }
 
 /// Whether strand `s` is simulated (every strand without a level of detail).
@@ -151,7 +106,8 @@ fn predict(p: &SimStep, frames: Option<&[Mat4]>, state: &SimState, active: Optio
     }
 }
 
-/// Stage 2: constraint solve, hair by hair.
+/// Stage 2: constraint solve, hair by hair (`constraints::solve_strand`, or
+/// the DFTL sweep).
 fn solve(
     (p, frames): (&SimStep, Option<&[Mat4]>),
     colliders: &[ColliderShape],
@@ -166,16 +122,7 @@ fn solve(
     let collisions = flags & flags::COLLISIONS != 0;
     let mesh = mesh.filter(|_| flags & flags::MESH != 0);
     let bodies = Bodies { colliders, mesh, head: &p.head };
-    // Per point of the strand: the local shape constraint's parent rest direction
-    // and rest offset (world), and the positions the set reads.
-    let local_shape = flags & flags::LOCAL_SHAPE != 0;
-    let mut local = vec![(Vec3::ZERO, Vec3::ZERO); points];
     let mut s = vec![Vec4::ZERO; points];
-    let mut bend = vec![(0.0f32, 0.0f32); points];
-    // Per point of the strand: the global shape constraint's target and stiffness.
-    let global_shape = flags & flags::GLOBAL_SHAPE != 0;
-    let (shape_stiffness, shape_range) = (p.global_shape, p.global_shape_range);
-    let mut shape = vec![(Vec3::ZERO, 0.0f32); points];
     for strand in (0..p.strands as usize).filter(|&strand| simulated(active, strand)) {
         let base = strand * points;
         s.copy_from_slice(&predicted[base..base + points]);
@@ -202,97 +149,15 @@ fn solve(
             }
             continue;
         }
-        for (i, b) in bend.iter_mut().enumerate() {
-            *b = (0.0, 0.0);
-            if i > 0 && i + 1 < points {
-                let r = state.rest[base + i + 1].truncate() - state.rest[base + i - 1].truncate();
-                let t = i as f32 / (points - 1) as f32;
-                *b = (dot(r, r).sqrt(), p.bending_root + (p.bending_tip - p.bending_root) * t);
-            }
-        }
-        let bending = flags & flags::BENDING != 0;
-        if global_shape {
-            for (i, slot) in shape.iter_mut().enumerate() {
-                let t = i as f32 / (points - 1) as f32;
-                let k = shape_stiffness * shape_weight(t, shape_range);
-                let at_rest = transform_point(hair_frame(p, frames, strand), state.rest[base + i].truncate());
-                *slot = (shape_target(at_rest, k, p.iterations, flags, p.gravity, p.dt), k);
-            }
-        }
-        if local_shape {
-            let frame = hair_frame(p, frames, strand);
-            let offset =
-                |j: usize| rotate(frame, state.rest[base + j].truncate() - state.rest[base + j - 1].truncate());
-            for (i, slot) in local.iter_mut().enumerate().skip(1) {
-                let mut dir = Vec3::ZERO;
-                if i >= 2 {
-                    let d = offset(i - 1);
-                    let len = dot(d, d).sqrt();
-                    dir = if len > 0.0 { d / len } else { Vec3::ZERO };
-                }
-                *slot = (dir, offset(i));
-            }
-        }
-        for iteration in 0..p.iterations {
-            for i in (0..points - 1).step_by(2) {
-                project(&mut s, i, i + 1, lengths[i], 1.0);
-            }
-            for i in (1..points - 1).step_by(2) {
-                project(&mut s, i, i + 1, lengths[i], 1.0);
-            }
-            if bending {
-                for phase in [0usize, 2] {
-                    for (i, &(rest_d, k)) in bend.iter().enumerate() {
-                        if k > 0.0 && (i & 3) >= phase && (i & 3) < phase + 2 {
-                            project(&mut s, i - 1, i + 1, rest_d, k);
-                        }
-                    }
-                }
-            }
-            if local_shape && iteration + 1 == p.iterations {
-                // `local_shape_sweep` in glsl/sim/step.comp.
-                for (j, &(dir, offset)) in local.iter().enumerate().skip(1) {
-                    let (parent, child) = (s[j - 1], s[j]);
-                    let mut carried = offset;
-                    if j >= 2 && dot(dir, dir) > 0.0 {
-                        let d = parent.truncate() - s[j - 2].truncate();
-                        let len = dot(d, d).sqrt();
-                        if len > 0.0 {
-                            carried = rotate_between(dir, d / len, carried);
-                        }
-                    }
-                    let w = parent.w + child.w;
-                    if w > 0.0 {
-                        let delta = (carried - (child.truncate() - parent.truncate())) * p.local_shape;
-                        s[j - 1] = (parent.truncate() - delta * (parent.w / w)).extend(parent.w);
-                        s[j] = (child.truncate() + delta * (child.w / w)).extend(child.w);
-                    }
-                }
-            }
-            if global_shape {
-                for (q, &(target, k)) in s.iter_mut().zip(&shape) {
-                    if q.w > 0.0 && k > 0.0 {
-                        *q = (q.truncate() + (target - q.truncate()) * k).extend(q.w);
-                    }
-                }
-            }
-            if collisions {
-                for (i, q) in s.iter_mut().enumerate() {
-                    if q.w > 0.0 {
-                        *q = bodies.collide(q.truncate(), radius(i)).extend(q.w);
-                    }
-                }
-            }
-        }
-        if let (Some(mesh), true) = (&mesh, collisions) {
-            for (i, q) in s.iter_mut().enumerate() {
-                if q.w > 0.0 {
-                    let from = state.positions[base + i].truncate();
-                    let held = mesh.friction(&p.head, &p.previous_head, q.truncate(), from, radius(i), p.mesh_friction);
-                    *q = held.extend(q.w);
-                }
-            }
-        }
+        let strand_view = constraints::Strand {
+            p,
+            frame: hair_frame(p, frames, strand),
+            rest: &state.rest[base..base + points],
+            lengths,
+            start: &state.positions[base..base + points],
+            bodies: &bodies,
+        };
+        constraints::solve_strand(&strand_view, &mut s);
         predicted[base..base + points].copy_from_slice(&s);
     }
 }
