@@ -28,6 +28,7 @@ const ACCEPTED: &[(&str, &str)] = &[
     ("sim.global_shape_stiffness", "0"),
     ("sim.global_shape_range", "0"),
     ("sim.local_shape_stiffness", "0"),
+    ("sim.stretch_limit", "0"),
     ("sim.mesh_friction", "0"),
     ("sim.collider_friction", "0"),
     ("sim.damping", "0"),

@@ -80,6 +80,14 @@ sim_constraints! {
     /// capsules and mesh collider (with `SIM_COLLISIONS`).
     collisions: point ["every movable point"] {}
 
+    /// Stretch limit: no segment leaves the solve longer than (1 + limit) ×
+    /// its rest length; one sweep per hair in the last iteration.
+    stretch_limit: sweep ["root to tip, one lane per hair"] {
+        /// The most a segment may stretch, a fraction of its rest length
+        /// (0 switches the limit off).
+        stretch_limit = |p| p.stretch_limit,
+    }
+
     /// Mesh friction: the motion along the mesh collider's surface braked,
     /// once per sub-step (with `SIM_MESH` and `SIM_COLLISIONS`).
     mesh_friction: after ["every movable point"] {

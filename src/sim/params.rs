@@ -94,6 +94,13 @@ pub struct SimParams {
     /// constraint (pair them, as `presets/curly.toml` does). 1 makes strands
     /// rigid. Default: 0.
     pub local_shape_stiffness: f32,
+    /// Stretch limit (PBD solver): after the last iteration's other
+    /// constraints and the collisions, one sweep root to tip shortens every
+    /// segment longer than (1 + this) × its rest length to that length, moving
+    /// the point toward the tip only, so hair never stretches visibly under
+    /// violent motion even at few iterations (a fraction, 0..=1; 0 switches
+    /// it off). Default: 0.
+    pub stretch_limit: f32,
     /// Friction against the mesh collider: the fraction of a touching particle's
     /// motion along the surface, relative to the mesh, removed per sub-step
     /// (0..=1). Default: 0.3.
@@ -158,6 +165,7 @@ impl Default for SimParams {
             global_shape_range: 0.5,
             sag_free: true,
             local_shape_stiffness: 0.0,
+            stretch_limit: 0.0,
             mesh_friction: 0.3,
             collider_friction: 0.3,
             collisions_enabled: true,
@@ -230,6 +238,7 @@ impl SimParams {
         in_range("global_shape_stiffness", self.global_shape_stiffness, 0.0, 1.0)?;
         in_range("global_shape_range", self.global_shape_range, 0.0, 1.0)?;
         in_range("local_shape_stiffness", self.local_shape_stiffness, 0.0, 1.0)?;
+        in_range("stretch_limit", self.stretch_limit, 0.0, 1.0)?;
         in_range("mesh_friction", self.mesh_friction, 0.0, 1.0)?;
         in_range("collider_friction", self.collider_friction, 0.0, 1.0)?;
         in_range("damping", self.damping, 0.0, 0.999)?;
