@@ -20,6 +20,8 @@ mod followers;
 mod groom_files;
 #[path = "grow.rs"]
 mod grow;
+#[path = "host_frame.rs"]
+mod host_frame;
 #[path = "interpolation.rs"]
 mod interpolation;
 #[path = "layers.rs"]

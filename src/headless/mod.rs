@@ -39,12 +39,13 @@ pub mod coverage;
 mod host_buffer;
 mod mesh;
 mod offscreen;
+mod texels;
 
 use ash::vk;
 
 pub use host_buffer::HostBuffer;
 pub use mesh::MeshDrawer;
-pub use offscreen::{Offscreen, OFFSCREEN_COLOR, OFFSCREEN_DEPTH};
+pub use offscreen::{Offscreen, OFFSCREEN_COLOR, OFFSCREEN_COLOR_FORMATS, OFFSCREEN_DEPTH};
 
 use crate::context::GpuContext;
 use crate::error::Result;

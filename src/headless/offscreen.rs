@@ -3,7 +3,7 @@
 use std::sync::Arc;
 
 use ash::vk;
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
@@ -18,11 +18,27 @@ use crate::vk::rendering::{self, Load};
 pub const OFFSCREEN_COLOR: vk::Format = vk::Format::R8G8B8A8_SRGB;
 /// Depth format of [`Offscreen`].
 pub const OFFSCREEN_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
+/// The colour formats [`Offscreen::with_format`] makes and reads back: 8-bit
+/// sRGB (the default), half-float HDR and packed unsigned floats. The hair's
+/// shading is linear in all three; the target stores it as its format does.
+pub const OFFSCREEN_COLOR_FORMATS: [vk::Format; 3] =
+    [vk::Format::R8G8B8A8_SRGB, vk::Format::R16G16B16A16_SFLOAT, vk::Format::B10G11R11_UFLOAT_PACK32];
+
+/// Bytes per texel of an [`OFFSCREEN_COLOR_FORMATS`] format.
+fn texel_bytes(format: vk::Format) -> u64 {
+    if format == vk::Format::R16G16B16A16_SFLOAT {
+        8
+    } else {
+        4
+    }
+}
 
 /// An offscreen single-sample color + depth target.
 pub struct Offscreen {
     device: Arc<Device>,
     color: Image,
+    /// `color`'s format, one of [`OFFSCREEN_COLOR_FORMATS`].
+    format: vk::Format,
     depth: Image,
     /// Host-visible copy target of `color`, kept between reads.
     readback: Buffer,
@@ -32,19 +48,40 @@ pub struct Offscreen {
 }
 
 impl Offscreen {
-    /// A `width` × `height` target (1..=8192 each).
+    /// A `width` × `height` target (1..=8192 each) of [`OFFSCREEN_COLOR`].
     pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Result<Self> {
+        Self::with_format(ctx, width, height, OFFSCREEN_COLOR)
+    }
+
+    /// A `width` × `height` target (1..=8192 each) whose colour image has
+    /// `format`, one of [`OFFSCREEN_COLOR_FORMATS`]; refused for another
+    /// format, or one the device cannot render and blend into.
+    pub fn with_format(ctx: &GpuContext, width: u32, height: u32, format: vk::Format) -> Result<Self> {
         if !(1..=8192).contains(&width) || !(1..=8192).contains(&height) {
             return Err(Error::param("extent", format!("{width}×{height}"), "1..=8192 × 1..=8192"));
         }
+        if !OFFSCREEN_COLOR_FORMATS.contains(&format) {
+            return Err(Error::param(
+                "offscreen format",
+                format!("{format:?}"),
+                "R8G8B8A8_SRGB, R16G16B16A16_SFLOAT or B10G11R11_UFLOAT_PACK32",
+            ));
+        }
         let device = ctx.device.clone();
+        let needed = vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND | vk::FormatFeatureFlags::TRANSFER_SRC;
+        if !device.optimal_tiling_features(format).contains(needed) {
+            return Err(Error::incompatible(
+                "offscreen format",
+                format!("{format:?} is not a blendable colour attachment on this device"),
+            ));
+        }
         let extent = vk::Extent2D { width, height };
         let color = Image::new(
             &device,
             &ImageDesc {
                 name: "offscreen color",
                 extent,
-                format: OFFSCREEN_COLOR,
+                format,
                 usage: vk::ImageUsageFlags::COLOR_ATTACHMENT
                     | vk::ImageUsageFlags::TRANSFER_SRC
                     | vk::ImageUsageFlags::SAMPLED,
@@ -64,8 +101,9 @@ impl Offscreen {
                 aspect: vk::ImageAspectFlags::DEPTH,
             },
         )?;
-        let readback = device.readback_staging("offscreen readback", u64::from(width) * u64::from(height) * 4)?;
-        Ok(Offscreen { device, color, depth, readback, snapshot: None })
+        let bytes = u64::from(width) * u64::from(height) * texel_bytes(format);
+        let readback = device.readback_staging("offscreen readback", bytes)?;
+        Ok(Offscreen { device, color, format, depth, readback, snapshot: None })
     }
 
     /// Makes the buffer [`Offscreen::record_snapshot`] copies into (as large
@@ -73,7 +111,7 @@ impl Offscreen {
     pub fn keep_snapshots(&mut self) -> Result<()> {
         if self.snapshot.is_none() {
             let (w, h) = self.size();
-            let bytes = u64::from(w) * u64::from(h) * 4;
+            let bytes = u64::from(w) * u64::from(h) * texel_bytes(self.format);
             self.snapshot = Some(self.device.readback_staging("offscreen snapshot", bytes)?);
         }
         Ok(())
@@ -124,9 +162,10 @@ impl Offscreen {
         Ok(())
     }
 
-    /// The colour image as [`Offscreen::record_snapshot`] copied it, sRGB
-    /// RGBA8 rows top to bottom, into `out` (its memory reused). Call after
-    /// the frame that recorded the snapshot has completed.
+    /// The colour image as [`Offscreen::record_snapshot`] copied it, rows top
+    /// to bottom in the target's format (sRGB RGBA8 for [`Offscreen::new`]),
+    /// into `out` (its memory reused). Call after the frame that recorded the
+    /// snapshot has completed.
     pub fn read_snapshot_into(&self, out: &mut Vec<u8>) -> Result<()> {
         let snapshot = self
             .snapshot
@@ -145,7 +184,7 @@ impl Offscreen {
     pub fn target(&self) -> RenderTarget {
         RenderTarget {
             color: self.color.view(),
-            color_format: OFFSCREEN_COLOR,
+            color_format: self.format,
             depth: self.depth.view(),
             depth_format: OFFSCREEN_DEPTH,
             depth_image: self.depth.raw(),
@@ -197,8 +236,35 @@ impl Offscreen {
 
     /// [`Offscreen::read_rgba8`] into `out`, reusing its memory (and the
     /// target's own staging buffer): reading every frame allocates nothing.
+    /// Refused for a target of another format than [`OFFSCREEN_COLOR`]
+    /// ([`Offscreen::read_linear`] reads every format).
     pub fn read_rgba8_into(&self, out: &mut Vec<u8>) -> Result<()> {
+        if self.format != OFFSCREEN_COLOR {
+            return Err(Error::incompatible(
+                "offscreen readback",
+                format!("read_rgba8 of a {:?} target (read_linear reads it)", self.format),
+            ));
+        }
         self.device.readback_image_via(&self.color, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, &self.readback, out)
+    }
+
+    /// Reads the colour image back as linear RGBA, rows top to bottom, whatever
+    /// its format: sRGB decoded, half and packed floats widened (the packed
+    /// format has no alpha: 1). This submits and waits.
+    pub fn read_linear(&self) -> Result<Vec<Vec4>> {
+        let mut bytes = Vec::new();
+        self.device.readback_image_via(
+            &self.color,
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            &self.readback,
+            &mut bytes,
+        )?;
+        Ok(super::texels::decode(self.format, &bytes))
+    }
+
+    /// The colour image's format.
+    pub fn format(&self) -> vk::Format {
+        self.format
     }
 
     /// Width and height.

@@ -1,7 +1,7 @@
 //! The look of the hair: camera, lights and material, and the noise texture
 //! the shading samples.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -21,6 +21,12 @@ pub struct Camera {
     pub projection: Mat4,
     /// Vertical field of view, radians (for pixel-size estimates).
     pub fov_y: f32,
+    /// This frame's sub-pixel jitter, in pixels of the render target: +x to
+    /// the right, +y down the rows (each within ±1). The hair is drawn with
+    /// `projection` moved by it in clip space ([`Camera::jittered_projection`]),
+    /// as a TAA or upscaling host jitters its own geometry; `projection`
+    /// itself stays unjittered. Default (from [`Camera::look_at`]): zero.
+    pub jitter: Vec2,
 }
 
 impl Camera {
@@ -43,7 +49,28 @@ impl Camera {
             view: glam::camera::rh::view::look_at_mat4(eye, target, Vec3::Y),
             projection: glam::camera::rh::proj::vulkan::perspective(fov_y, aspect, near, far),
             fov_y,
+            jitter: Vec2::ZERO,
         })
+    }
+
+    /// The same camera with `jitter` (pixels, see [`Camera::jitter`]);
+    /// refused unless finite and within ±1 pixel on each axis.
+    pub fn with_jitter(self, jitter: Vec2) -> Result<Camera> {
+        if !jitter.is_finite() || jitter.abs().max_element() > 1.0 {
+            return Err(Error::param("camera jitter", jitter, "finite, within ±1 pixel on each axis"));
+        }
+        Ok(Camera { jitter, ..self })
+    }
+
+    /// `projection` moved by [`Camera::jitter`] for a target of `width` ×
+    /// `height` pixels: clip x and y gain 2·jitter/size · w, so every point
+    /// lands `jitter` pixels away from where `projection` puts it.
+    pub fn jittered_projection(&self, (width, height): (u32, u32)) -> Mat4 {
+        let shift = 2.0 * self.jitter / Vec2::new(width.max(1) as f32, height.max(1) as f32);
+        let mut clip = Mat4::IDENTITY;
+        clip.w_axis.x = shift.x;
+        clip.w_axis.y = shift.y;
+        clip * self.projection
     }
 
     /// The camera's world position.

@@ -188,6 +188,12 @@ pub(crate) struct DeviceParts {
 }
 
 impl Device {
+    /// What `format` supports in optimal tiling on this device.
+    pub(crate) fn optimal_tiling_features(&self, format: vk::Format) -> vk::FormatFeatureFlags {
+        // SAFETY: `physical` belongs to `instance`, which outlives this record.
+        unsafe { self.instance.get_physical_device_format_properties(self.physical, format) }.optimal_tiling_features
+    }
+
     /// Assembles the record; creates an allocator when none is given.
     pub(crate) fn new(parts: DeviceParts) -> Result<Arc<Self>> {
         let info = DeviceInfo::query(&parts.instance, parts.physical, parts.graphics.family);

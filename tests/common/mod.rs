@@ -228,17 +228,17 @@ pub struct HostFrame<'a> {
 
 /// Records, submits and waits for one frame — the hairs prepared for `camera`,
 /// their shadows, the host's clear and `host`'s meshes around the hair's draw
-/// into `offscreen` — and returns its RGBA8 rows.
+/// into `offscreen` (the meshes with the camera's jittered projection).
 #[allow(dead_code, reason = "not every test file draws")]
-pub fn draw_frame(
+pub fn record_frame(
     gpu: &Gpu,
     (sim, renderer): (&vkhair::sim::HairSim, &mut vkhair::render::Renderer),
     offscreen: &vkhair::headless::Offscreen,
     camera: &vkhair::render::Camera,
     host: &HostFrame<'_>,
-) -> Vec<u8> {
+) {
     use vkhair::headless::Submit;
-    let view_proj = camera.projection * camera.view;
+    let view_proj = camera.jittered_projection(offscreen.size()) * camera.view;
     let mesh = |cmd, m: Option<&vkhair::headless::MeshDrawer>| {
         if let Some(m) = m {
             // SAFETY: a recording command buffer of the context's device.
@@ -265,5 +265,17 @@ pub fn draw_frame(
         })
         .expect("submit");
     result.expect("record");
+}
+
+/// [`record_frame`], then the target's RGBA8 rows.
+#[allow(dead_code, reason = "not every test file draws")]
+pub fn draw_frame(
+    gpu: &Gpu,
+    (sim, renderer): (&vkhair::sim::HairSim, &mut vkhair::render::Renderer),
+    offscreen: &vkhair::headless::Offscreen,
+    camera: &vkhair::render::Camera,
+    host: &HostFrame<'_>,
+) -> Vec<u8> {
+    record_frame(gpu, (sim, renderer), offscreen, camera, host);
     offscreen.read_rgba8().expect("readback")
 }

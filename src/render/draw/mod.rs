@@ -274,6 +274,9 @@ impl Renderer {
                 "finite view, projection and field of view",
             ));
         }
+        if !camera.jitter.is_finite() || camera.jitter.abs().max_element() > 1.0 {
+            return Err(Error::param("camera jitter", camera.jitter, "finite, within ±1 pixel on each axis"));
+        }
         // The host's earlier attachment writes (its head, its clear) before ours.
         let host_writes = Barriers {
             memory: vec![barrier::memory(HOST_ATTACHMENT_WRITES, barrier::ATTACHMENTS)],
@@ -318,7 +321,7 @@ impl Renderer {
                         spacing: self.strand_spacing(),
                     },
                     self.hair_counts(),
-                    camera,
+                    (camera, target.extent),
                     drawn.extent,
                 ),
                 self.interpolate.looks().1,
@@ -438,7 +441,8 @@ fn own_looks(mut params: DrawParams, own: bool) -> DrawParams {
 
 /// The draw's uniform block for `hairs` hairs of `per_hair` vertices with
 /// `material`, `lights` and the frame's strand `footprint`, seen by `camera`
-/// into a target of `extent`; `transparent` strands are drawn with their
+/// (jittered by pixels of the host's target, of `target_extent`) into an
+/// image of `extent`; `transparent` strands are drawn with their
 /// coverage (no least width, bands standing for the footprint's hairs),
 /// opaque ones at the footprint's width factor.
 pub(super) fn draw_params(
@@ -447,7 +451,7 @@ pub(super) fn draw_params(
     lights: &[GpuLight],
     footprint: StrandFootprint,
     (hairs, per_hair): (u32, u32),
-    camera: &Camera,
+    (camera, target_extent): (&Camera, vk::Extent2D),
     extent: vk::Extent2D,
 ) -> DrawParams {
     let m = material;
@@ -459,7 +463,8 @@ pub(super) fn draw_params(
     // World size of one pixel at distance 1.
     let pixel = 2.0 * (0.5 * camera.fov_y).tan() / extent.height.max(1) as f32;
     DrawParams {
-        view_proj: (camera.projection * camera.view).to_cols_array_2d(),
+        view_proj: (camera.jittered_projection((target_extent.width, target_extent.height)) * camera.view)
+            .to_cols_array_2d(),
         camera: camera.position().extend(pixel).to_array(),
         root_color: m.root_color.extend(m.ambient).to_array(),
         tip_color: m.tip_color.extend(m.diffuse_wrap).to_array(),
