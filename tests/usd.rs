@@ -266,6 +266,61 @@ fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
     }
 }
 
+/// The ways round the layer checks a probe found, each closed: a deep layer
+/// led by blank space, a variant's reference to a FIFO, many chains each
+/// within the depth limit, a sublayer the library cannot parse (refused with
+/// its line and column, not dropped), and sublayers that are not USD text at
+/// all (no header, a byte-order mark) — each refused in well under a second,
+/// naming the layer.
+#[test]
+fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
+    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    write("curves.usda", &format!("#usda 1.0\n{curves}"));
+    let deep = |levels: usize| {
+        let open: String = (0..levels).map(|i| format!("def Xform \"p{i}\" {{\n")).collect();
+        format!("{open}{}", "}\n".repeat(levels))
+    };
+    write("blank_led.usda", &format!("\n  #usda 1.0\n{}", deep(1500)));
+    let c = std::ffi::CString::new(dir.path().join("pipe.usda").to_str().expect("utf-8")).expect("path");
+    // SAFETY: mkfifo with a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    write(
+        "variant.usda",
+        &format!(
+            "#usda 1.0\ndef Xform \"x\" (\n    variants = {{ string v = \"a\" }}\n    prepend variantSets = \"v\"\n) {{\n    \
+             variantSet \"v\" = {{\n        \"a\" (\n            references = @pipe.usda@</x>\n        ) {{ }}\n    }}\n}}\n{curves}"
+        ),
+    );
+    let chains: String = (0..300).map(|i| deep(125).replacen("\"p0\"", &format!("\"chain{i}\""), 1)).collect();
+    write("wide.usda", &format!("#usda 1.0\n{chains}"));
+    write("bad_value.usda", &format!("#usda 1.0\ndef Xform \"x\" {{\n    int a = two\n}}\n{curves}"));
+    write("garbage.usda", "hello, not a stage\n");
+    write("bom.usda", &format!("\u{feff}#usda 1.0\n{curves}"));
+    for sub in ["bad_value.usda", "garbage.usda", "bom.usda"] {
+        write(&format!("names_{sub}"), &format!("#usda 1.0\n(\n    subLayers = [@curves.usda@, @{sub}@]\n)\n"));
+    }
+    for (root, parts) in [
+        ("blank_led.usda", &["blank_led.usda", "nesting deeper than 128"][..]),
+        ("variant.usda", &["variant.usda", "line 8", "pipe.usda", "not a regular file"][..]),
+        ("wide.usda", &["wide.usda", "nest too deeply all together"][..]),
+        (
+            "names_bad_value.usda",
+            &["names_bad_value.usda", "line 3", "bad_value.usda", "cannot parse", "line 3, column"][..],
+        ),
+        ("names_garbage.usda", &["garbage.usda", "not a USD layer"][..]),
+        ("names_bom.usda", &["bom.usda", "byte-order mark"][..]),
+    ] {
+        let started = std::time::Instant::now();
+        let err = usd::open(dir.path().join(root)).expect_err(root).to_string();
+        println!("{root}: {err} ({:?})", started.elapsed());
+        for part in parts {
+            assert!(err.contains(part), "{root}: {part:?} missing from {err}");
+        }
+    }
+}
+
 /// A negative width (a diameter) is a defect: refused strictly, naming the
 /// prim and strand; when repairing, the widths are passed over and said, the
 /// strands kept.

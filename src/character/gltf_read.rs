@@ -233,6 +233,9 @@ pub(super) fn parse(bytes: &[u8], dir: Option<&Path>) -> Result<Character> {
             if !pos.is_finite() {
                 return Err(malformed(what("a position is not finite")));
             }
+            if pos.abs().max_element() > MAX_TRANSFORM_COMPONENT {
+                return Err(malformed(what(&format!("a position {pos} is beyond ±{MAX_TRANSFORM_COMPONENT} m"))));
+            }
             if let Some(bad) = joint.iter().find(|&&i| usize::from(i) >= joints.len()) {
                 return Err(malformed(what(&format!("joint {bad} past the skin's {} joints", joints.len()))));
             }

@@ -46,6 +46,10 @@ pub struct HairRig {
     pub capsules: Vec<BoneCapsule>,
 }
 
+/// Times over the animation at which [`HairRig::new`] checks the head has a
+/// frame (its start and end included).
+const HEAD_FRAME_SAMPLES: usize = 64;
+
 impl HairRig {
     /// The rig of `character` playing `animation` (by name or index; the first
     /// when `None`) with the head at `head_joint` (by name; found by the
@@ -65,6 +69,25 @@ impl HairRig {
             None => character.head_joint(),
         };
         let rest = character.bind_pose();
+        // The head's frame must be a frame wherever the animation takes it: a
+        // scale of zero (or next to it) on the way to the head collapses it.
+        let duration = sk.animations[animation].duration();
+        for k in 0..=HEAD_FRAME_SAMPLES {
+            let time = duration * k as f32 / HEAD_FRAME_SAMPLES as f32;
+            let m = character.joint_transform(&character.pose(Some(animation), time), head);
+            let scales = [m.x_axis, m.y_axis, m.z_axis].map(|a| a.truncate().length());
+            if !m.is_finite() || scales.iter().any(|&s| s.is_nan() || s <= 1e-4) {
+                let name = &sk.nodes[sk.joints[head]].name;
+                return Err(Error::incompatible(
+                    "character",
+                    format!(
+                        "the head joint {head} ({name:?}) has no frame at {time} s of animation {:?}: its \
+                         transform scales by {scales:?} (a scale of zero on the way to it)",
+                        sk.animations[animation].name
+                    ),
+                ));
+            }
+        }
         let origin = character.joint_transform(&rest, head).transform_point3(Vec3::ZERO);
         let mut capsules = character.fit_capsules(&[head]);
         let distance = |c: &BoneCapsule| {

@@ -274,6 +274,40 @@ fn absurd_transforms_are_refused_naming_the_node_or_channel() {
     assert!(err.contains("channel") && err.contains("a key's translation") && err.contains("beyond"), "{err}");
 }
 
+/// A vertex far beyond any character is refused naming the mesh's
+/// position, and a head joint that an animation scales to nothing has no frame:
+/// refused naming the joint, the time and the animation, not a NaN head.
+#[test]
+fn a_far_vertex_and_a_head_scaled_to_nothing_are_refused_naming_them() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
+    let bytes = std::fs::read(path).expect("read");
+    // The first vertex's x, in the binary chunk: after the JSON chunk and the
+    // eight bytes of the binary chunk's header.
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().expect("length")) as usize;
+    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).expect("json");
+    let accessor = &json["accessors"]
+        [json["meshes"][0]["primitives"][0]["attributes"]["POSITION"].as_u64().expect("POSITION") as usize];
+    let view = &json["bufferViews"][accessor["bufferView"].as_u64().expect("view") as usize];
+    let offset = 20
+        + json_len
+        + 8
+        + view["byteOffset"].as_u64().unwrap_or(0) as usize
+        + accessor["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let mut far = bytes.clone();
+    far[offset..offset + 4].copy_from_slice(&3e38f32.to_le_bytes());
+    let err = Character::parse(&far).expect_err("a far vertex").to_string();
+    assert!(err.contains("position") && err.contains("beyond ±10000 m"), "{err}");
+
+    let flat = mutated(&bytes, |j| {
+        for node in j["nodes"].as_array_mut().expect("nodes") {
+            node["scale"] = serde_json::json!([0.0, 0.0, 0.0]);
+        }
+    });
+    let character = Character::parse(&flat).expect("a zero scale is a pose, not a broken file");
+    let err = HairRig::new(character, None, None).map(|_| ()).expect_err("a head without a frame").to_string();
+    assert!(err.contains("head joint") && err.contains("no frame at 0 s") && err.contains("scale"), "{err}");
+}
+
 /// The mannequin's GLB (`bytes`) with an animation sampler of its own added
 /// to its first animation: `times` and translation `values` (three a key)
 /// written to `dir`/`name`, a buffer naming that file, and `channels`

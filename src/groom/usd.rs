@@ -81,9 +81,10 @@ pub const MAX_USD_LAYERS: usize = 256;
 /// Checks the root layer at `path` and, transitively, every layer its text
 /// layers name, before the USD library opens any: each a regular file, all
 /// of them together within `cap` bytes, text layers checked by
-/// [`super::usda_check`]. A layer that cannot be read is an error naming it
-/// and the layer and line that named it, never a layer the stage goes
-/// without. (Binary layers are bounded in size and their bootstrap and table
+/// [`super::usda_check`], then parsed by the library's text parser (its
+/// errors with line and column); a text layer must start with `#usda`. A
+/// layer that cannot be read or parsed is an error naming it and the layer
+/// and line that named it, never a layer the stage goes without. (Binary layers are bounded in size and their bootstrap and table
 /// of contents checked by [`super::usdc_check`]; the layers they name are not
 /// followed here.)
 fn check_layers(path: &Path, cap: u64) -> Result<()> {
@@ -120,13 +121,32 @@ fn check_layers(path: &Path, cap: u64) -> Result<()> {
             super::usdc_check::check(&layer, len).map_err(|e| named(e.in_asset(&layer)))?;
             continue;
         }
-        if !magic.starts_with(b"#usda") {
-            continue;
-        }
+        // Every other layer is read as text, whatever it starts with (the
+        // library takes a layer led by blank space as text too): one that is
+        // not text is refused here rather than dropped by the library.
         let bytes = crate::files::read_capped(&layer, cap, "a USD layer").map_err(named)?;
         let text = std::str::from_utf8(&bytes)
             .map_err(|e| named(malformed(format!("the text is not UTF-8 ({e})")).in_asset(&layer)))?;
+        if !text.trim_start_matches([' ', '\t', '\r', '\n']).starts_with("#usda") {
+            let what = if text.starts_with('\u{feff}') { "a byte-order mark" } else { "something else" };
+            return Err(named(
+                malformed(format!("not a USD layer: it starts with {what}, not the `#usda` header")).in_asset(&layer),
+            ));
+        }
         let assets = super::usda_check::check(text).map_err(|e| named(e.in_asset(&layer)))?;
+        // The library's own parse, here where a failure names the layer: the
+        // stage would drop a layer it cannot parse without a word.
+        let parsed = crate::files::read_guarded(|| {
+            let mut parser = openusd::usda::parser::Parser::new(text);
+            parser.parse().map(|_| ()).map_err(|e| {
+                let at = parser.last_error_highlight().map(|h| format!("line {}, column {}: ", h.line, h.column));
+                format!("{}{e:#}", at.unwrap_or_default())
+            })
+        })
+        .unwrap_or_else(|what| Err(format!("the USD reader stopped: {what}")));
+        if let Err(why) = parsed {
+            return Err(named(malformed(format!("the USD reader cannot parse it: {why}")).in_asset(&layer)));
+        }
         let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
         for (asset, at) in assets {
             let line = super::usda_check::position(text, at);
