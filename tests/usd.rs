@@ -400,6 +400,58 @@ fn binary_layers_are_checked_before_the_reader_trusts_them() {
     }
 }
 
+/// The counts and block sizes at the head of the sections the USD library
+/// reads first, each byte set to 0xFF, 0x7F and 0x20 in turn (the bytes a
+/// probe's sweep found aborting the process with a request for up to 9 × 10¹⁸
+/// bytes): every mutant is read or refused as a file error — the test process
+/// would not survive an abort — and a count past its blocks is refused naming
+/// its section.
+#[test]
+fn counts_inside_binary_sections_are_bounded_before_the_reader_allocates() {
+    let bytes = std::fs::read(data("usd/small_cm_zup.usdc")).expect("fixture");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("b.usdc");
+    let toc = u64::from_le_bytes(bytes[16..24].try_into().expect("8 bytes")) as usize;
+    let sections = u64::from_le_bytes(bytes[toc..toc + 8].try_into().expect("8 bytes")) as usize;
+    let mut heads = Vec::new();
+    for k in 0..sections {
+        let entry = &bytes[toc + 8 + 32 * k..toc + 8 + 32 * (k + 1)];
+        let name: String = entry[..16].iter().take_while(|&&b| b != 0).map(|&b| char::from(b)).collect();
+        let start = u64::from_le_bytes(entry[16..24].try_into().expect("8 bytes")) as usize;
+        let size = u64::from_le_bytes(entry[24..32].try_into().expect("8 bytes")) as usize;
+        if ["TOKENS", "STRINGS", "FIELDS", "FIELDSETS", "PATHS", "SPECS"].contains(&name.as_str()) {
+            heads.push((name, start, size));
+        }
+    }
+    assert_eq!(heads.len(), 6, "{heads:?}");
+    let (mut read, mut refused) = (0, 0);
+    for (_, start, size) in &heads {
+        for at in *start..start + size.min(&40) {
+            for value in [0xFFu8, 0x7F, 0x20] {
+                let mut b = bytes.clone();
+                b[at] = value;
+                std::fs::write(&path, &b).expect("write");
+                match usd::open(&path) {
+                    Ok(_) => read += 1,
+                    Err(e) => {
+                        assert!(e.to_string().contains("b.usdc"), "byte {at} = {value:#x}: {e}");
+                        refused += 1;
+                    }
+                }
+            }
+        }
+    }
+    println!("{read} mutants read, {refused} refused");
+    assert!(refused > 100, "only {refused} of the mutants were refused");
+    // The field count of FIELDS at 2⁶² is refused by the check, naming it.
+    let (_, fields, _) = heads.iter().find(|(n, _, _)| n == "FIELDS").expect("FIELDS");
+    let mut b = bytes.clone();
+    b[*fields..fields + 8].copy_from_slice(&(1u64 << 62).to_le_bytes());
+    std::fs::write(&path, &b).expect("write");
+    let e = usd::open(&path).expect_err("a huge count").to_string();
+    assert!(e.contains("section \"FIELDS\"") && e.contains("4611686018427387904 fields"), "{e}");
+}
+
 /// A point thrown beyond 10 km from the origin by the stage's values and
 /// units is refused naming the prim, the strand and the point.
 #[test]

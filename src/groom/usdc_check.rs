@@ -7,9 +7,17 @@
 //! - a crate version the reader cannot read: before 0.4.0 (the crate stops
 //!   on those with a panic) or after [`NEWEST`];
 //! - a table of contents outside the file, of no section or more than
-//!   [`MAX_SECTIONS`], or whose sections reach past the file's end.
+//!   [`MAX_SECTIONS`], or whose sections reach past the file's end;
+//! - in the sections the crate reads first (`TOKENS`, `STRINGS`, `FIELDS`,
+//!   `FIELDSETS`, `PATHS`, `SPECS`), a count or a compressed block that its
+//!   section cannot hold: the crate allocates what a count asks for before
+//!   it decompresses (a changed byte asked for 5 × 10¹⁸ bytes and aborted the
+//!   process), so each count is bounded by what its compressed blocks can
+//!   decode to ([`MAX_ITEMS_PER_BYTE`] a byte, at most [`MAX_ITEMS`]) and
+//!   every block must lie inside its section.
 //!
-//! Each error names the value found and the file's length.
+//! Each error names the value found and the file's length. The values the
+//! sections point at (attributes' arrays) are not checked here.
 
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
@@ -27,6 +35,14 @@ pub const MAX_SECTIONS: u64 = 63;
 pub const OLDEST: (u8, u8, u8) = (0, 4, 0);
 /// The newest crate version read.
 pub const NEWEST: (u8, u8, u8) = (0, 12, 0);
+
+/// Most items (tokens, fields, paths, specs) a compressed byte can decode to:
+/// the integer coding's two bits an item at best, times LZ4's best ratio
+/// (255), rounded up.
+pub const MAX_ITEMS_PER_BYTE: u64 = 1024;
+/// Most items a section may count (what the crate's own bound on strings is):
+/// a gibibyte of 8-byte values.
+pub const MAX_ITEMS: u64 = 1 << 27;
 
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }
@@ -81,6 +97,7 @@ pub fn check(path: &Path, len: u64) -> Result<()> {
         )));
     }
     let table = read_at(toc + 8, (count * SECTION) as usize)?;
+    let mut sections = Vec::new();
     for entry in table.chunks_exact(SECTION as usize) {
         let name: String = entry[..16].iter().take_while(|&&b| b != 0).map(|&b| char::from(b)).collect();
         let (start, size) = (u64_at(entry, 16), u64_at(entry, 24));
@@ -92,6 +109,108 @@ pub fn check(path: &Path, len: u64) -> Result<()> {
                 )));
             }
         }
+        sections.push((name, start, size));
+    }
+    for (name, start, size) in sections {
+        let mut section = Section { name: &name, at: start, end: start + size, read_at: &mut read_at };
+        section.check()?;
     }
     Ok(())
+}
+
+/// One section's bytes as the crate reads them, front to back.
+struct Section<'a, F: FnMut(u64, usize) -> Result<Vec<u8>>> {
+    name: &'a str,
+    /// The next byte to read.
+    at: u64,
+    /// Its end.
+    end: u64,
+    read_at: &'a mut F,
+}
+
+impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
+    fn refuse(&self, what: String) -> Error {
+        malformed(format!("its section {:?}: {what}", self.name))
+    }
+
+    /// The next eight bytes, `what` they hold.
+    fn u64(&mut self, what: &str) -> Result<u64> {
+        if self.at + 8 > self.end {
+            return Err(self.refuse(format!("{what} would lie past the section's end (byte {})", self.end)));
+        }
+        let value = u64_at(&(self.read_at)(self.at, 8)?, 0);
+        self.at += 8;
+        Ok(value)
+    }
+
+    /// A compressed block (its size, then its bytes): its size.
+    fn block(&mut self) -> Result<u64> {
+        let size = self.u64("a compressed block's size")?;
+        if size > self.end - self.at {
+            return Err(self.refuse(format!(
+                "a compressed block of {size} bytes at byte {} reaches past the section's end (byte {})",
+                self.at, self.end
+            )));
+        }
+        self.at += size;
+        Ok(size)
+    }
+
+    /// `count` items `what`, decoded from compressed blocks of `bytes` bytes.
+    fn bound(&self, count: u64, what: &str, bytes: u64) -> Result<()> {
+        let most = bytes.saturating_add(16).saturating_mul(MAX_ITEMS_PER_BYTE).min(MAX_ITEMS);
+        if count > most {
+            return Err(self
+                .refuse(format!("{count} {what}, more than its {bytes} compressed bytes can hold (at most {most})")));
+        }
+        Ok(())
+    }
+
+    /// The section's counts and blocks, by its name (other sections pass).
+    fn check(&mut self) -> Result<()> {
+        match self.name {
+            "TOKENS" => {
+                let count = self.u64("the token count")?;
+                let decoded = self.u64("the tokens' decoded size")?;
+                let bytes = self.block()?;
+                self.bound(decoded, "bytes of tokens", bytes)?;
+                if count > decoded {
+                    return Err(self.refuse(format!("{count} tokens in {decoded} bytes")));
+                }
+            }
+            "STRINGS" => {
+                let count = self.u64("the string count")?;
+                if count.saturating_mul(4) > self.end - self.at || count > MAX_ITEMS {
+                    return Err(
+                        self.refuse(format!("{count} strings, more than its {} bytes hold", self.end - self.at))
+                    );
+                }
+            }
+            "FIELDS" => {
+                let count = self.u64("the field count")?;
+                let (indices, reps) = (self.block()?, self.block()?);
+                self.bound(count, "fields", indices.min(reps))?;
+            }
+            "FIELDSETS" => {
+                let count = self.u64("the field set count")?;
+                let bytes = self.block()?;
+                self.bound(count, "field set entries", bytes)?;
+            }
+            "PATHS" => {
+                let paths = self.u64("the path count")?;
+                let encoded = self.u64("the encoded path count")?;
+                let bytes = [self.block()?, self.block()?, self.block()?];
+                let least = bytes.into_iter().min().unwrap_or(0);
+                self.bound(paths, "paths", least)?;
+                self.bound(encoded, "encoded paths", least)?;
+            }
+            "SPECS" => {
+                let count = self.u64("the spec count")?;
+                let bytes = [self.block()?, self.block()?, self.block()?];
+                self.bound(count, "specs", bytes.into_iter().min().unwrap_or(0))?;
+            }
+            _ => {}
+        }
+        Ok(())
+    }
 }
