@@ -30,6 +30,15 @@ layout(std430, set = 0, binding = 9) OIT_COUNTERS_ACCESS buffer OitCounters {
     // How the compute rasteriser's copy of the target's depth is encoded
     // (SCENE_DEPTH_*; NONE: no depth test).
     uint scene_depth;
+    // 1 when the target's depth is reversed (near = 1, `Camera::depth_reversed`).
+    uint reverse_z;
 } oit;
+
+// A depth of the target's convention as the lists keep it, forward (near 0,
+// far 1), and back: the same map both ways. The lists, their sorting and the
+// nearest opaque depth always run forward.
+float oit_forward(float z) {
+    return oit.reverse_z != 0u ? 1.0 - z : z;
+}
 
 #endif

@@ -27,8 +27,9 @@ void main() {
     }
     vec3 color = g_color;
     uint pixel = oit_pixel(gl_FragCoord);
+    float z = oit_forward(gl_FragCoord.z);
     if (alpha >= OIT_OPAQUE_ALPHA) {
-        atomicMin(oit_opaque[pixel], floatBitsToUint(gl_FragCoord.z));
+        atomicMin(oit_opaque[pixel], floatBitsToUint(z));
     }
     uint node = atomicAdd(oit.used, 1u);
     if (node >= oit.capacity) {
@@ -40,5 +41,5 @@ void main() {
     out_absorbance = vec4(0.0);
     uint next = atomicExchange(oit_heads[pixel], node);
     oit_store(node, uvec4(packHalf2x16(color.rg), packHalf2x16(vec2(color.b, alpha)),
-                          floatBitsToUint(gl_FragCoord.z), next));
+                          floatBitsToUint(z), next));
 }

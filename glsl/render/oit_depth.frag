@@ -11,5 +11,5 @@ void main() {
     if (bits == OIT_END) {
         discard;
     }
-    gl_FragDepth = uintBitsToFloat(bits);
+    gl_FragDepth = oit_forward(uintBitsToFloat(bits));
 }

@@ -23,10 +23,11 @@ void main() {
         discard;
     }
     vec3 color = g_color;
+    float z = oit_forward(gl_FragCoord.z);
     if (alpha >= OIT_OPAQUE_ALPHA) {
-        atomicMin(oit_opaque[oit_pixel(gl_FragCoord)], floatBitsToUint(gl_FragCoord.z));
+        atomicMin(oit_opaque[oit_pixel(gl_FragCoord)], floatBitsToUint(z));
     }
-    float weight = max(1e-2, 3e3 * pow(1.0 - gl_FragCoord.z, 3.0));
+    float weight = max(1e-2, 3e3 * pow(1.0 - z, 3.0));
     out_sum = vec4(color * alpha, alpha) * weight;
     out_absorbance = vec4(-log(max(1.0 - alpha, 1e-4)), 0.0, 0.0, 0.0);
 }

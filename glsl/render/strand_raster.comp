@@ -43,16 +43,16 @@ layout(std430, set = 0, binding = 20) readonly buffer PointColor { vec4 point_co
 // (oit.scene_depth says how it is encoded; unread for SCENE_DEPTH_NONE).
 layout(std430, set = 0, binding = 25) readonly buffer SceneDepth { uint scene_depth[]; };
 
-// The depth a fragment at `pixel` must not exceed to be drawn.
+// The forward depth (oit_forward) a fragment at `pixel` must not exceed to be drawn.
 float depth_limit(uint pixel) {
     if (oit.scene_depth == SCENE_DEPTH_FLOAT32) {
-        return uintBitsToFloat(scene_depth[pixel]);
+        return oit_forward(uintBitsToFloat(scene_depth[pixel]));
     }
     if (oit.scene_depth == SCENE_DEPTH_UNORM24) {
-        return float(scene_depth[pixel] & 0xFFFFFFu) / 16777215.0;
+        return oit_forward(float(scene_depth[pixel] & 0xFFFFFFu) / 16777215.0);
     }
     if (oit.scene_depth == SCENE_DEPTH_UNORM16) {
-        return float((scene_depth[pixel >> 1u] >> (16u * (pixel & 1u))) & 0xFFFFu) / 65535.0;
+        return oit_forward(float((scene_depth[pixel >> 1u] >> (16u * (pixel & 1u))) & 0xFFFFu) / 65535.0);
     }
     return 3.0e38;
 }
@@ -136,8 +136,9 @@ void raster_segment(End e0, End e1, bool last) {
     // Screen positions (pixels, rows from NDC y = −1) and depths of the clipped ends.
     vec2 a = (ca.xy / ca.w * 0.5 + 0.5) * size;
     vec2 b = (cb.xy / cb.w * 0.5 + 0.5) * size;
-    float za = ca.z / ca.w;
-    float zb = cb.z / cb.w;
+    // Forward depths (oit_forward): the lists keep them so in either convention.
+    float za = oit_forward(ca.z / ca.w);
+    float zb = oit_forward(cb.z / cb.w);
     vec2 along = b - a;
     float len = length(along);
     if (!(len > 1e-4) || !(len < 1e9)) {

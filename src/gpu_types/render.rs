@@ -166,9 +166,12 @@ pub(crate) struct OitCounters {
     /// How the compute rasteriser's copy of the target's depth is encoded
     /// (`codes::scene_depth`; `NONE` for no depth test).
     pub scene_depth: u32,
+    /// 1 when the target's depth is reversed (near = 1): the lists keep
+    /// depths forward (`oit_forward` in `glsl/include/oit_counters.glsl`).
+    pub reverse_z: u32,
 }
 gpu_struct!(OitCounters => "OitCounters" {
-    used, capacity, width, sorted, pool_nodes, height, hair_x0, hair_y0, hair_x1, hair_y1, scene_depth
+    used, capacity, width, sorted, pool_nodes, height, hair_x0, hair_y0, hair_x1, hair_y1, scene_depth, reverse_z
 });
 
 /// Push constants of the Marschner table builder (`MarschnerPush` in `glsl/include/marschner.glsl`).

@@ -58,7 +58,13 @@ impl MeshDrawer {
     /// Uploads `mesh` (flat-shaded: one normal per triangle) for the [`super::Offscreen`]
     /// formats (this submits and waits).
     pub fn new(ctx: &GpuContext, mesh: &TriMesh) -> Result<Self> {
-        Self::build(ctx, mesh, None)
+        Self::build(ctx, mesh, None, false)
+    }
+
+    /// As [`MeshDrawer::new`], for a reversed depth buffer (near = 1, cleared
+    /// to 0, a reverse-Z projection): its depth test passes the greater depth.
+    pub fn reverse_z(ctx: &GpuContext, mesh: &TriMesh) -> Result<Self> {
+        Self::build(ctx, mesh, None, true)
     }
 
     /// As [`MeshDrawer::new`], and the hair of `renderer` shadows the mesh from light
@@ -68,7 +74,7 @@ impl MeshDrawer {
     /// [`Renderer::set_shadows`]: a later change of the atlas size replaces the
     /// images this drawer reads.
     pub fn with_hair_shadows(ctx: &GpuContext, mesh: &TriMesh, renderer: &Renderer, light: usize) -> Result<Self> {
-        Self::build(ctx, mesh, Some((renderer, light)))
+        Self::build(ctx, mesh, Some((renderer, light)), false)
     }
 
     /// Replaces the mesh's positions by `mesh`'s, which has the same triangles
@@ -87,7 +93,7 @@ impl MeshDrawer {
         self.device.upload_pod(&self.buffers[1], &normals)
     }
 
-    fn build(ctx: &GpuContext, mesh: &TriMesh, shadows: Option<(&Renderer, usize)>) -> Result<Self> {
+    fn build(ctx: &GpuContext, mesh: &TriMesh, shadows: Option<(&Renderer, usize)>, reverse_z: bool) -> Result<Self> {
         let device = ctx.device.clone();
         let (positions, normals) = corners(mesh);
         let storage = |name: &str, data: &[Vec4]| -> Result<Buffer> {
@@ -112,6 +118,7 @@ impl MeshDrawer {
                 samples: vk::SampleCountFlags::TYPE_1,
                 depth_test: true,
                 depth_write: true,
+                reverse_z,
                 blend: Blend::None,
                 rasterizer_discard: false,
             },

@@ -200,6 +200,16 @@ impl Offscreen {
     /// `cmd` is a recording command buffer of the context's device, outside a render
     /// pass; earlier work on this target was submitted before it on the same queue.
     pub unsafe fn record_clear(&self, cmd: vk::CommandBuffer, rgb: Vec3) {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.record_clear_to(cmd, rgb, 1.0) }
+    }
+
+    /// As [`Offscreen::record_clear`], the depth cleared to `depth` (0 for a
+    /// reversed depth buffer, whose far is 0).
+    ///
+    /// # Safety
+    /// As [`Offscreen::record_clear`].
+    pub unsafe fn record_clear_to(&self, cmd: vk::CommandBuffer, rgb: Vec3, depth: f32) {
         let d = &self.device;
         let to_color = barrier::image(
             &self.color,
@@ -216,7 +226,7 @@ impl Offscreen {
             vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
         );
         let color = [rendering::color(self.color.view(), Load::color([rgb.x, rgb.y, rgb.z, 1.0]))];
-        let depth = rendering::depth(self.depth.view(), Load::depth(1.0));
+        let depth = rendering::depth(self.depth.view(), Load::depth(depth));
         let rendering = rendering::info(self.color.extent, &color, Some(&depth));
         // SAFETY: guaranteed by the caller.
         unsafe {

@@ -121,6 +121,7 @@ pub(super) fn capture_pipeline(
             samples: vk::SampleCountFlags::TYPE_1,
             depth_test: false,
             depth_write: false,
+            reverse_z: false,
             blend: Blend::None,
             rasterizer_discard: true,
         },

@@ -23,7 +23,7 @@ use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc, Sampler};
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
 use crate::vk::rendering::{self, Load};
-use crate::vk::shaders::{RENDER_RESOLVE_FRAG, RENDER_RESOLVE_VERT};
+use crate::vk::shaders::{RENDER_RESOLVE_FRAG, RENDER_RESOLVE_FRAG_REVERSE_Z, RENDER_RESOLVE_VERT};
 
 /// Color format of the supersampled hair image (linear, with coverage in alpha).
 const SUPERSAMPLED_COLOR: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
@@ -86,7 +86,10 @@ impl Supersampling {
                 &self.device,
                 &GraphicsDesc {
                     name: "vkhair supersampling resolve",
-                    stages: &[&RENDER_RESOLVE_VERT, &RENDER_RESOLVE_FRAG],
+                    stages: &[
+                        &RENDER_RESOLVE_VERT,
+                        if key.reverse_z { &RENDER_RESOLVE_FRAG_REVERSE_Z } else { &RENDER_RESOLVE_FRAG },
+                    ],
                     topology: vk::PrimitiveTopology::TRIANGLE_LIST,
                     patch_control_points: 0,
                     color_formats: &color_formats,
@@ -94,6 +97,7 @@ impl Supersampling {
                     samples: key.samples,
                     depth_test: key.depth != vk::Format::UNDEFINED,
                     depth_write: false,
+                    reverse_z: key.reverse_z,
                     blend: Blend::Premultiplied,
                     rasterizer_discard: false,
                 },
@@ -118,17 +122,19 @@ impl Supersampling {
 
     /// Where the frame's hair is drawn: these images, colour cleared to
     /// transparent and depth to 1, after the barriers that make them attachments.
-    pub(super) fn draw_target(&self, primitive: Primitive) -> DrawTarget {
+    pub(super) fn draw_target(&self, primitive: Primitive, reverse_z: bool) -> DrawTarget {
         DrawTarget {
             key: TargetKey {
                 color: SUPERSAMPLED_COLOR,
                 depth: SUPERSAMPLED_DEPTH,
                 samples: vk::SampleCountFlags::TYPE_1,
                 primitive,
+                reverse_z,
             },
             extent: self.extent(),
             color: (self.color.view(), Load::color([0.0; 4])),
-            depth: Some((self.depth.view(), Load::depth(1.0))),
+            // Cleared to the far depth of the convention.
+            depth: Some((self.depth.view(), Load::depth(if reverse_z { 0.0 } else { 1.0 }))),
             depth_image: None,
             before: Barriers { images: self.to_attachments().to_vec(), ..Barriers::default() },
         }

@@ -27,6 +27,25 @@ pub struct Camera {
     /// as a TAA or upscaling host jitters its own geometry; `projection`
     /// itself stays unjittered. Default (from [`Camera::look_at`]): zero.
     pub jitter: Vec2,
+    /// How the host's depth buffer orders depth: the hair's depth test and
+    /// the depth it writes follow it ([`Camera::depth_reversed`]). Default:
+    /// [`DepthConvention::Auto`], read from `projection`.
+    pub depth: DepthConvention,
+}
+
+/// Which way a host's depth buffer runs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum DepthConvention {
+    /// Read from the projection: reversed when a point farther along the view
+    /// axis gets a smaller depth ([`Camera::depth_reversed`]).
+    #[default]
+    Auto,
+    /// Near 0, far 1: the nearer fragment has the smaller depth, the buffer is
+    /// cleared to 1 (`LESS_OR_EQUAL`).
+    Forward,
+    /// Reverse-Z: near 1, far 0 (or an infinite far plane at 0), the buffer
+    /// cleared to 0 (`GREATER_OR_EQUAL`).
+    Reverse,
 }
 
 impl Camera {
@@ -50,7 +69,39 @@ impl Camera {
             projection: glam::camera::rh::proj::vulkan::perspective(fov_y, aspect, near, far),
             fov_y,
             jitter: Vec2::ZERO,
+            depth: DepthConvention::Auto,
         })
+    }
+
+    /// A reverse-Z camera with an infinite far plane (near maps to depth 1,
+    /// infinity to 0), as many modern hosts draw: otherwise as
+    /// [`Camera::look_at`], whose checks it shares.
+    pub fn look_at_reverse_z(eye: Vec3, target: Vec3, fov_y: f32, aspect: f32, near: f32) -> Result<Camera> {
+        let camera = Camera::look_at(eye, target, fov_y, aspect, near, near * 2.0)?;
+        Ok(Camera {
+            projection: glam::camera::rh::proj::vulkan::perspective_infinite_reverse(fov_y, aspect, near),
+            ..camera
+        })
+    }
+
+    /// Whether the host's depth is reversed: [`Camera::depth`], with
+    /// [`DepthConvention::Auto`] read from `projection` — reversed when a
+    /// point two units along the view axis gets a smaller depth than one at
+    /// one unit (a projective depth runs one way over the whole view axis).
+    /// A projection that gives both the same depth (or a non-finite one) is
+    /// taken as forward.
+    pub fn depth_reversed(&self) -> bool {
+        match self.depth {
+            DepthConvention::Forward => false,
+            DepthConvention::Reverse => true,
+            DepthConvention::Auto => {
+                let depth = |v: f32| {
+                    let c = self.projection * glam::Vec4::new(0.0, 0.0, -v, 1.0);
+                    c.z / c.w
+                };
+                depth(2.0) < depth(1.0)
+            }
+        }
     }
 
     /// The same camera with `jitter` (pixels, see [`Camera::jitter`]);

@@ -322,6 +322,7 @@ fn graphics_pipeline_draws_with_dynamic_rendering() {
             samples: vk::SampleCountFlags::TYPE_1,
             depth_test: false,
             depth_write: false,
+            reverse_z: false,
             blend: Blend::None,
             rasterizer_discard: false,
         },

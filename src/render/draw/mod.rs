@@ -75,6 +75,8 @@ pub(super) struct TargetKey {
     pub depth: vk::Format,
     pub samples: vk::SampleCountFlags,
     pub primitive: Primitive,
+    /// The depth is reversed (near = 1; [`super::Camera::depth_reversed`]).
+    pub reverse_z: bool,
 }
 
 /// Where a frame's hair goes: images with `key`'s formats, how each
@@ -283,12 +285,14 @@ impl Renderer {
             ..Barriers::default()
         };
         let has_depth = target.depth_format != vk::Format::UNDEFINED;
+        let reverse_z = camera.depth_reversed();
         let host = DrawTarget {
             key: TargetKey {
                 color: target.color_format,
                 depth: target.depth_format,
                 samples: target.samples,
                 primitive: self.params.primitive,
+                reverse_z,
             },
             extent: target.extent,
             color: (target.color, Load::Keep),
@@ -302,7 +306,7 @@ impl Renderer {
             false => None,
         };
         let drawn = match &images {
-            Some(images) => images.draw_target(self.params.primitive),
+            Some(images) => images.draw_target(self.params.primitive, reverse_z),
             None => host.clone(),
         };
         let mode = self.params.transparency;

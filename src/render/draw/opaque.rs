@@ -79,6 +79,7 @@ impl OpaquePipelines {
             samples: key.samples,
             depth_test: has_depth,
             depth_write,
+            reverse_z: key.reverse_z,
             blend,
             rasterizer_discard: false,
         };

@@ -69,6 +69,7 @@ impl OpacityMaps {
                     samples: vk::SampleCountFlags::TYPE_1,
                     depth_test: depth_format != vk::Format::UNDEFINED,
                     depth_write: depth_format != vk::Format::UNDEFINED,
+                    reverse_z: false,
                     blend,
                     rasterizer_discard: false,
                 },

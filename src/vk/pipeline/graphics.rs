@@ -25,6 +25,9 @@ pub(crate) struct GraphicsDesc<'a> {
     pub samples: vk::SampleCountFlags,
     pub depth_test: bool,
     pub depth_write: bool,
+    /// The depth buffer is reversed (near = 1): the test passes a fragment at
+    /// least as great (`GREATER_OR_EQUAL`), else at most as great.
+    pub reverse_z: bool,
     /// Color blending.
     pub blend: Blend,
     /// Discard primitives before rasterization (capture passes that only store).
@@ -105,7 +108,10 @@ impl GraphicsPipeline {
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth_test)
             .depth_write_enable(desc.depth_write)
-            .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL);
+            .depth_compare_op(match desc.reverse_z {
+                true => vk::CompareOp::GREATER_OR_EQUAL,
+                false => vk::CompareOp::LESS_OR_EQUAL,
+            });
         let attachment = match desc.blend {
             Blend::None => {
                 vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)

@@ -365,6 +365,7 @@ impl TransparentPass {
             hair_x1: 0,
             hair_y1: 0,
             scene_depth: depth_source.code(),
+            reverse_z: u32::from(target.key.reverse_z),
         };
         // Where the build's fragments are made and stored.
         let storage: &[AccessKind] = match compute {

@@ -46,6 +46,7 @@ impl TransparentPass {
             samples: vk::SampleCountFlags::TYPE_1,
             depth_test,
             depth_write,
+            reverse_z: key.reverse_z,
             blend,
             rasterizer_discard: false,
         };
