@@ -269,9 +269,11 @@ fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
 /// The ways round the layer checks a probe found, each closed: a deep layer
 /// led by blank space, a variant's reference to a FIFO, many chains each
 /// within the depth limit, a sublayer the library cannot parse (refused with
-/// its line and column, not dropped), and sublayers that are not USD text at
-/// all (no header, a byte-order mark) — each refused in well under a second,
-/// naming the layer.
+/// its line and column, not dropped), sublayers that are not USD text at
+/// all (no header, a byte-order mark), and references or payloads to a prim
+/// their layer does not have (or to a default prim it does not name) — each
+/// refused in well under a second, naming the layer; references that do find
+/// their prim read.
 #[test]
 fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -298,6 +300,23 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
     write("bad_value.usda", &format!("#usda 1.0\ndef Xform \"x\" {{\n    int a = two\n}}\n{curves}"));
     write("garbage.usda", "hello, not a stage\n");
     write("bom.usda", &format!("\u{feff}#usda 1.0\n{curves}"));
+    // A reference to a prim its layer does not have, a payload likewise, and
+    // a reference without a prim path to a layer without a default prim: the
+    // stage read 2 of 3 strands without a word.
+    write("strand.usda", &format!("#usda 1.0\n(\n    defaultPrim = \"c\"\n)\n{curves}"));
+    write("no_default.usda", &format!("#usda 1.0\n{curves}"));
+    let arc = |name: &str, arc: &str| {
+        write(name, &format!("#usda 1.0\ndef Xform \"x\" (\n    {arc}\n) {{ }}\n{curves}"));
+    };
+    arc("ref_missing.usda", "references = @strand.usda@</gone>");
+    arc("payload_missing.usda", "payload = @strand.usda@</gone>");
+    arc("ref_no_default.usda", "references = @no_default.usda@");
+    arc("ref_default.usda", "references = @strand.usda@");
+    arc("ref_prim.usda", "references = @no_default.usda@</c>");
+    arc("ref_twice.usda", "references = [@strand.usda@</c>, @strand.usda@</gone>]");
+    for good in ["ref_default.usda", "ref_prim.usda"] {
+        usd::open(dir.path().join(good)).unwrap_or_else(|e| panic!("{good}: {e}"));
+    }
     for sub in ["bad_value.usda", "garbage.usda", "bom.usda"] {
         write(&format!("names_{sub}"), &format!("#usda 1.0\n(\n    subLayers = [@curves.usda@, @{sub}@]\n)\n"));
     }
@@ -311,6 +330,10 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
         ),
         ("names_garbage.usda", &["garbage.usda", "not a USD layer"][..]),
         ("names_bom.usda", &["bom.usda", "byte-order mark"][..]),
+        ("ref_missing.usda", &["ref_missing.usda", "line 3", "strand.usda", "no prim /gone"][..]),
+        ("payload_missing.usda", &["payload_missing.usda", "strand.usda", "no prim /gone"][..]),
+        ("ref_twice.usda", &["ref_twice.usda", "strand.usda", "no prim /gone"][..]),
+        ("ref_no_default.usda", &["ref_no_default.usda", "no_default.usda", "names no default prim"][..]),
     ] {
         let started = std::time::Instant::now();
         let err = usd::open(dir.path().join(root)).expect_err(root).to_string();

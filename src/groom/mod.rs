@@ -38,6 +38,7 @@ pub mod scenes;
 pub mod sdf;
 pub mod tfx;
 pub mod usd;
+mod usd_layers;
 pub mod usda_check;
 pub mod usdc_check;
 

@@ -28,7 +28,6 @@
 //! without any `BasisCurves` prim is refused. The root file must be a regular
 //! file within [`MAX_USD_BYTES`] (or `VKHAIR_MAX_INPUT_BYTES`).
 
-use std::io::Read as _;
 use std::path::Path;
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
@@ -61,7 +60,7 @@ pub fn open_repairing(path: impl AsRef<Path>) -> Result<(AuthoredGroom, Repairs)
 
 fn open_as(path: &Path, load: Load) -> Result<(AuthoredGroom, Option<Repairs>)> {
     let cap = crate::files::input_cap(MAX_USD_BYTES)?;
-    check_layers(path, cap)?;
+    super::usd_layers::check_layers(path, cap)?;
     let text = path.to_str().ok_or_else(|| Error::Asset {
         path: path.into(),
         source: Box::new(unsupported("the path is not UTF-8 text".into())),
@@ -77,84 +76,6 @@ fn open_as(path: &Path, load: Load) -> Result<(AuthoredGroom, Option<Repairs>)> 
 /// Most layers a stage may pull in through its text layers' `subLayers`,
 /// `references` and `payload`, the root included.
 pub const MAX_USD_LAYERS: usize = 256;
-
-/// Checks the root layer at `path` and, transitively, every layer its text
-/// layers name, before the USD library opens any: each a regular file, all
-/// of them together within `cap` bytes, text layers checked by
-/// [`super::usda_check`], then parsed by the library's text parser (its
-/// errors with line and column); a text layer must start with `#usda`. A
-/// layer that cannot be read or parsed is an error naming it and the layer
-/// and line that named it, never a layer the stage goes without. (Binary layers are bounded in size and their bootstrap and table
-/// of contents checked by [`super::usdc_check`]; the layers they name are not
-/// followed here.)
-fn check_layers(path: &Path, cap: u64) -> Result<()> {
-    let mut queue = vec![(path.to_path_buf(), None::<(std::path::PathBuf, String)>)];
-    let mut seen = std::collections::HashSet::new();
-    let mut total = 0u64;
-    while let Some((layer, named_by)) = queue.pop() {
-        let named = |e: Error| match &named_by {
-            None => e,
-            Some((by, line)) => malformed(format!("{line} a layer it names cannot be used: {e}")).in_asset(by),
-        };
-        crate::files::check_regular(&layer, cap, "a USD layer").map_err(named)?;
-        if !seen.insert(std::fs::canonicalize(&layer).unwrap_or_else(|_| layer.clone())) {
-            continue;
-        }
-        if seen.len() > MAX_USD_LAYERS {
-            return Err(malformed(format!("the stage pulls in more than {MAX_USD_LAYERS} layers")).in_asset(path));
-        }
-        // A regular file (checked above): its length bounds the stage, and only
-        // a text layer is read here (the library reads the binary ones).
-        let io = |source| named(Error::Io { path: layer.clone(), source });
-        let len = std::fs::metadata(&layer).map_err(io)?.len();
-        total += len;
-        if total > cap {
-            return Err(malformed(format!(
-                "the stage's layers add up to more than {cap} bytes (set VKHAIR_MAX_INPUT_BYTES to read more)"
-            ))
-            .in_asset(path));
-        }
-        let mut magic = Vec::with_capacity(8);
-        std::fs::File::open(&layer).and_then(|f| f.take(8).read_to_end(&mut magic)).map_err(io)?;
-        if magic == b"PXR-USDC" {
-            // Its bootstrap and table of contents, before the library trusts them.
-            super::usdc_check::check(&layer, len).map_err(|e| named(e.in_asset(&layer)))?;
-            continue;
-        }
-        // Every other layer is read as text, whatever it starts with (the
-        // library takes a layer led by blank space as text too): one that is
-        // not text is refused here rather than dropped by the library.
-        let bytes = crate::files::read_capped(&layer, cap, "a USD layer").map_err(named)?;
-        let text = std::str::from_utf8(&bytes)
-            .map_err(|e| named(malformed(format!("the text is not UTF-8 ({e})")).in_asset(&layer)))?;
-        if !text.trim_start_matches([' ', '\t', '\r', '\n']).starts_with("#usda") {
-            let what = if text.starts_with('\u{feff}') { "a byte-order mark" } else { "something else" };
-            return Err(named(
-                malformed(format!("not a USD layer: it starts with {what}, not the `#usda` header")).in_asset(&layer),
-            ));
-        }
-        let assets = super::usda_check::check(text).map_err(|e| named(e.in_asset(&layer)))?;
-        // The library's own parse, here where a failure names the layer: the
-        // stage would drop a layer it cannot parse without a word.
-        let parsed = crate::files::read_guarded(|| {
-            let mut parser = openusd::usda::parser::Parser::new(text);
-            parser.parse().map(|_| ()).map_err(|e| {
-                let at = parser.last_error_highlight().map(|h| format!("line {}, column {}: ", h.line, h.column));
-                format!("{}{e:#}", at.unwrap_or_default())
-            })
-        })
-        .unwrap_or_else(|what| Err(format!("the USD reader stopped: {what}")));
-        if let Err(why) = parsed {
-            return Err(named(malformed(format!("the USD reader cannot parse it: {why}")).in_asset(&layer)));
-        }
-        let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
-        for (asset, at) in assets {
-            let line = super::usda_check::position(text, at);
-            queue.push((dir.join(&asset), Some((layer.clone(), line))));
-        }
-    }
-    Ok(())
-}
 
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }

@@ -169,7 +169,29 @@ pub const MAX_USDA_ARCS: usize = 10_000;
 
 /// The other layers a text layer composes: each asset path of its
 /// `subLayers`, `references` and `payload`, with its byte offset.
-pub type LayerAssets = Vec<(String, usize)>;
+pub type LayerAssets = Vec<LayerAsset>;
+
+/// One layer a text layer names.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LayerAsset {
+    /// Its asset path, as written.
+    pub path: String,
+    /// Where it is written (a byte offset of the naming layer's text).
+    pub at: usize,
+    /// What of it the naming layer takes.
+    pub takes: Takes,
+}
+
+/// What a layer takes of a layer it names.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Takes {
+    /// The whole layer (a sublayer).
+    Layer,
+    /// Its default prim (a reference or payload without a prim path).
+    DefaultPrim,
+    /// The prim at this path (`@layer@</Prim>`).
+    Prim(String),
+}
 
 /// Checks the USD text `text` (see the module docs) and returns the other
 /// layers it names ([`LayerAssets`]).
@@ -235,13 +257,13 @@ pub fn check(text: &str) -> Result<LayerAssets> {
                     declaring = true;
                     pending = None;
                 } else if *w == "subLayers" && open.len() == 1 && prims.is_empty() && pending.is_none() {
-                    assets.extend(asset_paths(&tokens[k + 1..]));
+                    assets.extend(asset_paths(&tokens[k + 1..], false));
                 } else if ARCS.contains(w) && matches!(tokens.get(k + 1), Some((_, Token::Equals))) && !in_metadata {
                     // An arc outside a prim's own metadata (a variant's): its
                     // layers are checked like any other.
-                    assets.extend(asset_paths(&tokens[k + 2..]));
+                    assets.extend(asset_paths(&tokens[k + 2..], true));
                 } else if ARCS.contains(w) && in_metadata && matches!(tokens.get(k + 1), Some((_, Token::Equals))) {
-                    assets.extend(asset_paths(&tokens[k + 2..]));
+                    assets.extend(asset_paths(&tokens[k + 2..], true));
                     let from =
                         format!("{}/{}", prims.last().map_or("", String::as_str), pending.as_deref().unwrap_or(""));
                     for target in arc_targets(&tokens[k + 2..]) {
@@ -273,17 +295,25 @@ pub fn check(text: &str) -> Result<LayerAssets> {
 
 /// The asset paths of a value (`tokens` start after its key, at `=` or at
 /// the value): one, or those of a list, to the list's end.
-fn asset_paths<'a>(tokens: &[(usize, Token<'a>)]) -> Vec<(String, usize)> {
+fn asset_paths<'a>(tokens: &[(usize, Token<'a>)], arc: bool) -> LayerAssets {
     let tokens = match tokens.first() {
         Some((_, Token::Equals)) => &tokens[1..],
         _ => tokens,
     };
+    // What an arc's asset at `i` takes: the prim path right after it, else
+    // the default prim; a sublayer takes the layer.
+    let takes = |i: usize| match (arc, tokens.get(i + 1)) {
+        (false, _) => Takes::Layer,
+        (true, Some((_, Token::Path(p)))) => Takes::Prim((*p).to_owned()),
+        (true, _) => Takes::DefaultPrim,
+    };
+    let asset = |i: usize, a: &str, at: usize| LayerAsset { path: a.to_owned(), at, takes: takes(i) };
     match tokens.first() {
-        Some((at, Token::Asset(a))) => vec![((*a).to_owned(), *at)],
+        Some((at, Token::Asset(a))) => vec![asset(0, a, *at)],
         Some((_, Token::Open(b'['))) => {
             let mut depth = 0usize;
             let mut out = Vec::new();
-            for (at, t) in tokens {
+            for (i, (at, t)) in tokens.iter().enumerate() {
                 match t {
                     Token::Open(_) => depth += 1,
                     Token::Close(_) => {
@@ -294,7 +324,7 @@ fn asset_paths<'a>(tokens: &[(usize, Token<'a>)]) -> Vec<(String, usize)> {
                     }
                     // Only the list's own entries: not an asset inside a
                     // reference's metadata.
-                    Token::Asset(a) if depth == 1 => out.push(((*a).to_owned(), *at)),
+                    Token::Asset(a) if depth == 1 => out.push(asset(i, a, *at)),
                     _ => {}
                 }
             }

@@ -1,0 +1,152 @@
+//! Every layer of a USD stage checked before the USD library opens any of
+//! them ([`check_layers`]): the library reads what a stage names without
+//! bounds and goes without a layer, a reference or a payload it cannot use
+//! in silence.
+
+use std::collections::{HashMap, HashSet};
+use std::io::Read as _;
+use std::path::{Path, PathBuf};
+
+use openusd::sdf::{Path as SdfPath, SpecType};
+
+use super::usd::MAX_USD_LAYERS;
+use super::usda_check::Takes;
+use crate::error::{Error, FileFormat, Result};
+
+fn malformed(reason: String) -> Error {
+    Error::Malformed { format: FileFormat::Usd, reason }
+}
+
+/// What a text layer offers a reference or payload.
+struct Targets {
+    /// It has sublayers, which may hold the prim an arc takes (left to the
+    /// stage to judge).
+    sublayers: bool,
+    /// Its prims' paths.
+    prims: HashSet<String>,
+    /// The default prim it names.
+    default: Option<String>,
+}
+
+impl Targets {
+    /// Why the layer lacks what an arc `takes` of it, if it does.
+    fn missing(&self, takes: &Takes) -> Option<String> {
+        match takes {
+            Takes::Layer => None,
+            _ if self.sublayers => None,
+            // A relative or malformed path is the library's to judge.
+            Takes::Prim(p) if !p.starts_with('/') || SdfPath::new(p).is_err() => None,
+            Takes::Prim(p) => {
+                (!self.prims.contains(p)).then(|| format!("it has no prim {p}, which a reference or payload takes"))
+            }
+            Takes::DefaultPrim => match &self.default {
+                Some(name) if self.prims.contains(&format!("/{name}")) => None,
+                Some(name) => {
+                    Some(format!("its default prim {name:?} is not there, and a reference or payload takes it"))
+                }
+                None => {
+                    Some("it names no default prim, and a reference or payload without a prim path takes it".into())
+                }
+            },
+        }
+    }
+}
+
+/// The library's parse of text layer `text` (its errors with line and
+/// column), on a guarded thread: what the layer offers an arc.
+fn parse(text: &str, sublayers: bool) -> std::result::Result<Targets, String> {
+    crate::files::read_guarded(|| {
+        let mut parser = openusd::usda::parser::Parser::new(text);
+        let specs = parser.parse().map_err(|e| {
+            let at = parser.last_error_highlight().map(|h| format!("line {}, column {}: ", h.line, h.column));
+            format!("the USD reader cannot parse it: {}{e:#}", at.unwrap_or_default())
+        })?;
+        let default = specs
+            .get(&SdfPath::abs_root())
+            .and_then(|root| root.fields.iter().find(|(key, _)| key == "defaultPrim"))
+            .and_then(|(_, value)| value.try_as_token_ref().map(|t| t.as_str().to_owned()));
+        let prims = specs.iter().filter(|(_, s)| s.ty == SpecType::Prim).map(|(p, _)| p.as_str().to_owned()).collect();
+        Ok(Targets { sublayers, prims, default })
+    })
+    .unwrap_or_else(|what| Err(format!("the USD reader stopped: {what}")))
+}
+
+/// Checks the root layer at `path` and, transitively, every layer its text
+/// layers name, before the USD library opens any: each a regular file, all
+/// of them together within `cap` bytes, at most [`MAX_USD_LAYERS`]; text
+/// layers start with `#usda`, pass [`super::usda_check`] and parse with the
+/// library's text parser (its errors with line and column); the prim a
+/// reference or payload takes (or the default prim one without a prim path
+/// takes) is in the layer it names, unless that layer has sublayers. A layer
+/// that cannot be read, parsed or used is an error naming it and the layer
+/// and line that named it, never a layer the stage goes without. (Binary
+/// layers are bounded in size and checked by [`super::usdc_check`]; the
+/// layers they name are not followed here.)
+pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
+    let mut queue = vec![(path.to_path_buf(), None::<(PathBuf, String)>, Takes::Layer)];
+    // Per text layer read, what it offers the arcs that name it again.
+    let mut seen: HashMap<PathBuf, Option<Targets>> = HashMap::new();
+    let mut total = 0u64;
+    while let Some((layer, named_by, takes)) = queue.pop() {
+        let named = |e: Error| match &named_by {
+            None => e,
+            Some((by, line)) => malformed(format!("{line} a layer it names cannot be used: {e}")).in_asset(by),
+        };
+        crate::files::check_regular(&layer, cap, "a USD layer").map_err(named)?;
+        let key = std::fs::canonicalize(&layer).unwrap_or_else(|_| layer.clone());
+        if let Some(targets) = seen.get(&key) {
+            if let Some(why) = targets.as_ref().and_then(|t| t.missing(&takes)) {
+                return Err(named(malformed(why).in_asset(&layer)));
+            }
+            continue;
+        }
+        if seen.len() >= MAX_USD_LAYERS {
+            return Err(malformed(format!("the stage pulls in more than {MAX_USD_LAYERS} layers")).in_asset(path));
+        }
+        // A regular file (checked above): its length bounds the stage, and only
+        // a text layer is read here (the library reads the binary ones).
+        let io = |source| named(Error::Io { path: layer.clone(), source });
+        let len = std::fs::metadata(&layer).map_err(io)?.len();
+        total += len;
+        if total > cap {
+            return Err(malformed(format!(
+                "the stage's layers add up to more than {cap} bytes (set VKHAIR_MAX_INPUT_BYTES to read more)"
+            ))
+            .in_asset(path));
+        }
+        let mut magic = Vec::with_capacity(8);
+        std::fs::File::open(&layer).and_then(|f| f.take(8).read_to_end(&mut magic)).map_err(io)?;
+        if magic == b"PXR-USDC" {
+            // Its bootstrap, table of contents and section heads, before the
+            // library trusts them.
+            super::usdc_check::check(&layer, len).map_err(|e| named(e.in_asset(&layer)))?;
+            seen.insert(key, None);
+            continue;
+        }
+        // Every other layer is read as text, whatever it starts with (the
+        // library takes a layer led by blank space as text too): one that is
+        // not text is refused here rather than dropped by the library.
+        let bytes = crate::files::read_capped(&layer, cap, "a USD layer").map_err(named)?;
+        let text = std::str::from_utf8(&bytes)
+            .map_err(|e| named(malformed(format!("the text is not UTF-8 ({e})")).in_asset(&layer)))?;
+        if !text.trim_start_matches([' ', '\t', '\r', '\n']).starts_with("#usda") {
+            let what = if text.starts_with('\u{feff}') { "a byte-order mark" } else { "something else" };
+            return Err(named(
+                malformed(format!("not a USD layer: it starts with {what}, not the `#usda` header")).in_asset(&layer),
+            ));
+        }
+        let assets = super::usda_check::check(text).map_err(|e| named(e.in_asset(&layer)))?;
+        let targets = parse(text, assets.iter().any(|a| a.takes == Takes::Layer))
+            .map_err(|why| named(malformed(why).in_asset(&layer)))?;
+        if let Some(why) = targets.missing(&takes) {
+            return Err(named(malformed(why).in_asset(&layer)));
+        }
+        seen.insert(key, Some(targets));
+        let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
+        for asset in assets {
+            let line = super::usda_check::position(text, asset.at);
+            queue.push((dir.join(&asset.path), Some((layer.clone(), line)), asset.takes));
+        }
+    }
+    Ok(())
+}
