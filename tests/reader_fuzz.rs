@@ -6,11 +6,11 @@
 //! fixed, so CI runs the same cases every time; raise `PROPTEST_CASES` to
 //! search further).
 //!
-//! USD binary (`.usdc`) has no target here yet: the USD library sizes value
-//! arrays by counts it reads from the file, and a byte change can ask it for
-//! 5 × 10¹⁸ bytes, which aborts the process (no panic to catch) — bounding
-//! that needs the file's value representations checked before the library
-//! reads them.
+//! USD binary (`.usdc`) is mutated byte by byte (any byte of the file to one
+//! of a few telling values): the USD library sizes its tables and value
+//! arrays by counts it reads from the file, and an unchecked count asked it
+//! for up to 9 × 10¹⁸ bytes, which aborts the process (no panic to catch);
+//! `groom::usdc_check` and its value checks bound them first.
 
 use std::path::{Path, PathBuf};
 
@@ -119,6 +119,25 @@ proptest! {
             Ok(c) => prop_assert!(c.positions.iter().all(|p| p.is_finite())),
             Err(e) => prop_assert!(!e.to_string().is_empty()),
         }
+    }
+}
+
+proptest! {
+    #![proptest_config(config(400))]
+
+    #[test]
+    fn mutated_usdc_files_give_grooms_or_file_errors(
+        changes in prop::collection::vec(
+            (any::<prop::sample::Index>(), prop::sample::select(vec![0x00u8, 0x01, 0x20, 0x40, 0x7F, 0x80, 0xFF])),
+            1..4,
+        ),
+    ) {
+        let mut bytes = std::fs::read(data("usd/small_cm_zup.usdc")).expect("fixture");
+        for (at, value) in &changes {
+            let i = at.index(bytes.len());
+            bytes[i] = *value;
+        }
+        read_usd("mutated.usdc", &bytes)?;
     }
 }
 

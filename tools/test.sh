@@ -29,10 +29,10 @@ seconds=${VKHAIR_FUZZ_SECONDS:-20}
 if [ "$seconds" = 0 ]; then
   echo "fuzz: skipped (VKHAIR_FUZZ_SECONDS=0)"
 elif cargo +nightly fuzz --version >/dev/null 2>&1; then
-  for target in hair tfx obj abc; do
+  for target in hair tfx obj abc usda usdc gltf; do
     (cd fuzz && cargo +nightly fuzz run "$target" -- -max_total_time="$seconds" -rss_limit_mb=2048)
   done
-  echo "fuzz: hair, tfx, obj and abc ran ${seconds} s each without a crash"
+  echo "fuzz: hair, tfx, obj, abc, usda, usdc and gltf ran ${seconds} s each without a crash"
 else
   echo "fuzz: skipped (needs a nightly toolchain and cargo-fuzz: rustup toolchain install nightly; cargo install cargo-fuzz)"
 fi

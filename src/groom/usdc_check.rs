@@ -16,8 +16,8 @@
 //!   decode to ([`MAX_ITEMS_PER_BYTE`] a byte, at most [`MAX_ITEMS`]) and
 //!   every block must lie inside its section.
 //!
-//! Each error names the value found and the file's length. The values the
-//! sections point at (attributes' arrays) are not checked here.
+//! Each error names the value found and the file's length. Then the values
+//! the fields point at are checked by [`super::usdc_values`].
 
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
@@ -115,7 +115,7 @@ pub fn check(path: &Path, len: u64) -> Result<()> {
         let mut section = Section { name: &name, at: start, end: start + size, read_at: &mut read_at };
         section.check()?;
     }
-    Ok(())
+    super::usdc_values::check(path, len, version)
 }
 
 /// One section's bytes as the crate reads them, front to back.

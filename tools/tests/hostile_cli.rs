@@ -689,3 +689,27 @@ fn a_signal_ends_a_run_without_leaving_a_partial_file() {
         assert!(partial_files(dir.path()).is_empty(), "signal {signal}: {:?}", partial_files(dir.path()));
     }
 }
+
+/// A `.hair` file of four 1 cm-segment strands, one with a point thrown
+/// 100 km away: without `--strict` that strand alone is dropped and named as
+/// an outlier (strand, point, value) and the other three keep every segment
+/// (judged against the whole groom's 100 km extent, their segments had been
+/// "zero-length" and dropped, the broken strand kept); with `--strict` the
+/// file is refused naming the outlier.
+#[test]
+fn a_file_with_one_far_point_loses_that_strand_alone() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("outlier.hair");
+    let strand = |x: f32| (0..6).map(|i| glam::Vec3::new(x, -0.01 * i as f32, 0.0)).collect::<Vec<_>>();
+    let mut broken = strand(0.2);
+    broken[3] = glam::Vec3::new(1e5, 0.0, 0.0);
+    write_groom_unchecked(&path, &[strand(0.0), strand(0.1), broken, strand(0.3)]);
+    let run = run_command(vkhair().arg("inspect").arg(&path), LIMIT);
+    run.assert_ok();
+    let said = format!("{}{}", run.stdout, run.stderr);
+    assert!(said.contains("dropped 1 strand with an outlier point") && said.contains("strand 2 point 3"), "{said}");
+    assert!(said.contains("strands            3"), "{said}");
+    assert!(!said.contains("zero-length"), "{said}");
+    let strict = run_command(vkhair().args(["inspect", "--strict"]).arg(&path), LIMIT);
+    assert!(strict.stderr.contains("strand 2") && strict.stderr.contains("100000"), "{}", strict.stderr);
+}
