@@ -344,6 +344,43 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
     }
 }
 
+/// A binary layer's sublayers, references and payloads are checked like a
+/// text layer's: a FIFO it sublayers is refused (not waited on), a reference
+/// to a prim its layer lacks is refused naming both, and a good reference
+/// reads (the binary layers written from text by the USD library's writer).
+#[test]
+fn the_layers_a_binary_layer_names_are_checked_too() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
+    let binary = |name: &str, text: &str| {
+        let data = openusd::usda::parse(text).expect("text");
+        openusd::usdc::CrateWriter::write_to_file(&data, dir.path().join(name)).expect("binary");
+    };
+    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    write("strand.usda", &format!("#usda 1.0\n(\n    defaultPrim = \"c\"\n)\n{curves}"));
+    let c = std::ffi::CString::new(dir.path().join("pipe.usda").to_str().expect("utf-8")).expect("path");
+    // SAFETY: mkfifo with a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    binary("fifo.usdc", &format!("#usda 1.0\n(\n    subLayers = [@pipe.usda@]\n)\n{curves}"));
+    let arc = |arc: &str| format!("#usda 1.0\ndef Xform \"x\" (\n    {arc}\n) {{ }}\n");
+    binary("missing.usdc", &arc("references = @strand.usda@</gone>"));
+    // A typeless prim takes its type, BasisCurves, from what it references.
+    binary("good.usdc", "#usda 1.0\ndef \"x\" (\n    references = @strand.usda@</c>\n) { }\n");
+    let g = usd::open(dir.path().join("good.usdc")).expect("a binary layer referencing a strand");
+    assert_eq!(g.groom.strand_count(), 1);
+    for (root, parts) in [
+        ("fifo.usdc", &["fifo.usdc", "pipe.usda", "not a regular file"][..]),
+        ("missing.usdc", &["missing.usdc", "strand.usda", "no prim /gone"][..]),
+    ] {
+        let started = std::time::Instant::now();
+        let err = usd::open(dir.path().join(root)).expect_err(root).to_string();
+        println!("{root}: {err} ({:?})", started.elapsed());
+        for part in parts {
+            assert!(err.contains(part), "{root}: {part:?} missing from {err}");
+        }
+    }
+}
+
 /// A negative width (a diameter) is a defect: refused strictly, naming the
 /// prim and strand; when repairing, the widths are passed over and said, the
 /// strands kept.

@@ -71,6 +71,62 @@ fn parse(text: &str, sublayers: bool) -> std::result::Result<Targets, String> {
     .unwrap_or_else(|what| Err(format!("the USD reader stopped: {what}")))
 }
 
+/// What a binary layer names (asset path, what it takes) and offers, read by
+/// the library after [`super::usdc_check`] has bounded it: its sublayers and
+/// every spec's references and payloads.
+fn binary(path: &Path) -> std::result::Result<(Vec<(String, Takes)>, Targets), String> {
+    use openusd::sdf::{AbstractData, Value};
+    crate::files::read_guarded(|| {
+        let data = openusd::usdc::read_file(path).map_err(|e| format!("the USD reader cannot read it: {e:#}"))?;
+        let mut named = Vec::new();
+        if let Ok(Some(v)) = data.try_field(&SdfPath::abs_root(), "subLayers") {
+            if let Value::StringVec(layers) = v.as_ref() {
+                named.extend(layers.iter().map(|l| (l.clone(), Takes::Layer)));
+            }
+        }
+        let sublayers = !named.is_empty();
+        let takes = |asset: &str, prim: &SdfPath| {
+            let takes = match prim.as_str() {
+                "" => Takes::DefaultPrim,
+                p => Takes::Prim(p.to_owned()),
+            };
+            (!asset.is_empty()).then(|| (asset.to_owned(), takes))
+        };
+        let mut prims = HashSet::new();
+        for spec in data.spec_paths() {
+            if data.spec_type(&spec) == Some(SpecType::Prim) {
+                prims.insert(spec.as_str().to_owned());
+            }
+            for field in ["references", "payload"] {
+                let Ok(Some(v)) = data.try_field(&spec, field) else { continue };
+                match v.as_ref() {
+                    Value::ReferenceListOp(op) => named.extend(
+                        [&op.explicit_items, &op.added_items, &op.prepended_items, &op.appended_items]
+                            .into_iter()
+                            .flatten()
+                            .filter_map(|r| takes(&r.asset_path, &r.prim_path)),
+                    ),
+                    Value::PayloadListOp(op) => named.extend(
+                        [&op.explicit_items, &op.added_items, &op.prepended_items, &op.appended_items]
+                            .into_iter()
+                            .flatten()
+                            .filter_map(|p| takes(&p.asset_path, &p.prim_path)),
+                    ),
+                    Value::Payload(p) => named.extend(takes(&p.asset_path, &p.prim_path)),
+                    _ => {}
+                }
+            }
+        }
+        let default = data
+            .try_field(&SdfPath::abs_root(), "defaultPrim")
+            .ok()
+            .flatten()
+            .and_then(|v| v.try_as_token_ref().map(|t| t.as_str().to_owned()));
+        Ok((named, Targets { sublayers, prims, default }))
+    })
+    .unwrap_or_else(|what| Err(format!("the USD reader stopped: {what}")))
+}
+
 /// Checks the root layer at `path` and, transitively, every layer its text
 /// layers name, before the USD library opens any: each a regular file, all
 /// of them together within `cap` bytes, at most [`MAX_USD_LAYERS`]; text
@@ -79,9 +135,9 @@ fn parse(text: &str, sublayers: bool) -> std::result::Result<Targets, String> {
 /// reference or payload takes (or the default prim one without a prim path
 /// takes) is in the layer it names, unless that layer has sublayers. A layer
 /// that cannot be read, parsed or used is an error naming it and the layer
-/// and line that named it, never a layer the stage goes without. (Binary
-/// layers are bounded in size and checked by [`super::usdc_check`]; the
-/// layers they name are not followed here.)
+/// and line that named it, never a layer the stage goes without. Binary layers
+/// are checked by [`super::usdc_check`] before the library reads what they
+/// name (sublayers, references, payloads), which is checked the same way.
 pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
     let mut queue = vec![(path.to_path_buf(), None::<(PathBuf, String)>, Takes::Layer)];
     // Per text layer read, what it offers the arcs that name it again.
@@ -117,10 +173,18 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
         let mut magic = Vec::with_capacity(8);
         std::fs::File::open(&layer).and_then(|f| f.take(8).read_to_end(&mut magic)).map_err(io)?;
         if magic == b"PXR-USDC" {
-            // Its bootstrap, table of contents and section heads, before the
-            // library trusts them.
+            // Its bootstrap, table of contents, section heads and values,
+            // before the library trusts them; then what it names.
             super::usdc_check::check(&layer, len).map_err(|e| named(e.in_asset(&layer)))?;
-            seen.insert(key, None);
+            let (assets, targets) = binary(&layer).map_err(|why| named(malformed(why).in_asset(&layer)))?;
+            if let Some(why) = targets.missing(&takes) {
+                return Err(named(malformed(why).in_asset(&layer)));
+            }
+            seen.insert(key, Some(targets));
+            let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
+            for (asset, takes) in assets {
+                queue.push((dir.join(&asset), Some((layer.clone(), format!("its arc to {asset:?}:"))), takes));
+            }
             continue;
         }
         // Every other layer is read as text, whatever it starts with (the
