@@ -234,6 +234,27 @@ fn a_fan_out_of_objects_to_one_group_is_refused_before_it_is_read_again() {
     assert!(text.contains("object c1's group belongs to another object too"), "{text}");
 }
 
+/// A negative width (a diameter) in an Alembic file is a defect: refused
+/// strictly naming the object and strand, passed over when repairing (the
+/// widths dropped and said, the strands kept). The file is written, then one
+/// width's bytes turned negative.
+#[test]
+fn a_negative_width_is_refused_strictly_and_passed_over_when_repairing() {
+    let (groom, _, _) = small_groom();
+    let o = write::CurvesObject { name: "w", groom: &groom, guides: None, root_uvs: None, transform: None };
+    let mut bytes = write::to_bytes(&[o]).expect("written");
+    // The fourth point's width, 7e-5, is the only one of its value.
+    let width = 7e-5f32.to_le_bytes();
+    let at = bytes.windows(4).position(|w| w == width).expect("the width in the file");
+    bytes[at..at + 4].copy_from_slice(&(-7e-5f32).to_le_bytes());
+    let text = alembic::parse(&bytes).expect_err("strict").to_string();
+    assert!(text.contains("/w") && text.contains("strand 1 has a negative width"), "{text}");
+    let (g, _) = alembic::parse_repairing(&bytes).expect("repairing");
+    assert_eq!(g.groom.strand_count(), 3);
+    assert!(g.groom.thickness().is_none(), "the widths were read");
+    assert!(g.skipped.iter().any(|s| s.contains("negative width")), "{:?}", g.skipped);
+}
+
 /// A transform that moves a groom farther than 10 km from the origin (or
 /// scales it there) is refused naming the object, the strand, the point and
 /// where it lies, not read into a groom no scene can frame.

@@ -203,7 +203,8 @@ fn a_fifo_read_once_gets_the_whole_output() {
 
 /// Names from files and paths reach the terminal escaped: a control character
 /// (here the escape that starts a terminal sequence) is printed as `\u{1b}`,
-/// on standard output and in errors alike.
+/// on standard output and in errors alike, and so is an object's name read
+/// from inside a file, in the listing and in JSON.
 #[test]
 fn control_characters_in_names_are_printed_escaped() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -226,6 +227,38 @@ fn control_characters_in_names_are_printed_escaped() {
         out.stderr
     );
     assert!(out.stderr.contains("gone\\u{1b}]0;title\\u{7}.hair"), "{}", out.stderr);
+    // A name from inside a file: an Alembic object named with escapes, in
+    // the text listing and in JSON.
+    let strands = common::cap_groom(20, 6, 0.1);
+    let counts: Vec<u32> = strands.iter().map(|s| s.len() as u32).collect();
+    let groom = vkhair::Groom::new(strands.concat(), &counts).expect("groom");
+    let object = vkhair::groom::alembic::write::CurvesObject {
+        name: "hair\u{1b}[31m\u{7}",
+        groom: &groom,
+        guides: None,
+        root_uvs: None,
+        transform: None,
+    };
+    let abc = dir.path().join("named.abc");
+    std::fs::write(&abc, vkhair::groom::alembic::write::to_bytes(&[object]).expect("written")).expect("write");
+    for json in [false, true] {
+        let mut args = vec!["inspect", abc.to_str().expect("utf-8")];
+        if json {
+            args.push("--json");
+        }
+        let out = run(&args, LIMIT);
+        out.assert_ok();
+        assert!(
+            !out.stdout.contains('\u{1b}') && !out.stdout.contains('\u{7}'),
+            "raw control characters:\n{:?}",
+            out.stdout
+        );
+        assert!(
+            out.stdout.contains("hair\\u{1b}[31m\\u{7}") || out.stdout.contains("hair\\u001b[31m\\u0007"),
+            "{}",
+            out.stdout
+        );
+    }
 }
 
 /// A folder in the place of a frame the run writes is found before rendering:
