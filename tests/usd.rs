@@ -314,6 +314,10 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
     arc("ref_default.usda", "references = @strand.usda@");
     arc("ref_prim.usda", "references = @no_default.usda@</c>");
     arc("ref_twice.usda", "references = [@strand.usda@</c>, @strand.usda@</gone>]");
+    arc("ref_relative.usda", "references = @strand.usda@<c>");
+    // A text layer named .usdc (the library would read it as binary and drop it).
+    write("text.usdc", &format!("#usda 1.0\n{curves}"));
+    write("names_text_usdc.usda", "#usda 1.0\n(\n    subLayers = [@text.usdc@]\n)\n");
     for good in ["ref_default.usda", "ref_prim.usda"] {
         usd::open(dir.path().join(good)).unwrap_or_else(|e| panic!("{good}: {e}"));
     }
@@ -333,6 +337,8 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
         ("ref_missing.usda", &["ref_missing.usda", "line 3", "strand.usda", "no prim /gone"][..]),
         ("payload_missing.usda", &["payload_missing.usda", "strand.usda", "no prim /gone"][..]),
         ("ref_twice.usda", &["ref_twice.usda", "strand.usda", "no prim /gone"][..]),
+        ("ref_relative.usda", &["ref_relative.usda", "<c>, a relative path"][..]),
+        ("names_text_usdc.usda", &["names_text_usdc.usda", "text.usdc", "a text USD layer named .usdc"][..]),
         ("ref_no_default.usda", &["ref_no_default.usda", "no_default.usda", "names no default prim"][..]),
     ] {
         let started = std::time::Instant::now();

@@ -33,9 +33,12 @@ impl Targets {
     fn missing(&self, takes: &Takes) -> Option<String> {
         match takes {
             Takes::Layer => None,
+            Takes::Prim(p) if !p.starts_with('/') => {
+                Some(format!("a reference or payload takes its prim <{p}>, a relative path (it must be absolute)"))
+            }
             _ if self.sublayers => None,
-            // A relative or malformed path is the library's to judge.
-            Takes::Prim(p) if !p.starts_with('/') || SdfPath::new(p).is_err() => None,
+            // A malformed path is the library's to judge.
+            Takes::Prim(p) if SdfPath::new(p).is_err() => None,
             Takes::Prim(p) => {
                 (!self.prims.contains(p)).then(|| format!("it has no prim {p}, which a reference or payload takes"))
             }
@@ -172,6 +175,15 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
         }
         let mut magic = Vec::with_capacity(8);
         std::fs::File::open(&layer).and_then(|f| f.take(8).read_to_end(&mut magic)).map_err(io)?;
+        // The library picks a layer's reader by its name: a binary layer named
+        // `.usda` or a text one named `.usdc` would be dropped in silence.
+        let extension = layer.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+        let binary_bytes = magic == b"PXR-USDC";
+        if (binary_bytes && extension == "usda") || (!binary_bytes && extension == "usdc") {
+            let (is, called) = if binary_bytes { ("binary", ".usda") } else { ("text", ".usdc") };
+            let why = format!("a {is} USD layer named {called}: the USD library reads a layer as its name says");
+            return Err(named(malformed(why).in_asset(&layer)));
+        }
         if magic == b"PXR-USDC" {
             // Its bootstrap, table of contents, section heads and values,
             // before the library trusts them; then what it names.
