@@ -230,6 +230,19 @@ fn text_layers_that_recurse_without_bound_are_refused_before_reading() {
     }
 }
 
+/// Opens each `(root, parts)` stage under `dir`: refused, with every part in
+/// the error (printed with the time it took).
+fn refused_naming(dir: &Path, cases: &[(&str, &[&str])]) {
+    for (root, parts) in cases {
+        let started = std::time::Instant::now();
+        let err = usd::open(dir.join(root)).expect_err(root).to_string();
+        println!("{root}: {err} ({:?})", started.elapsed());
+        for part in *parts {
+            assert!(err.contains(part), "{root}: {part:?} missing from {err}");
+        }
+    }
+}
+
 /// Every layer a stage's text layers name is checked before the USD library
 /// opens any: a sublayer that is there loads; a missing one, a FIFO in a
 /// referenced layer's place (which the library would block on forever) and a
@@ -252,18 +265,14 @@ fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
     write("fifo.usda", &format!("#usda 1.0\ndef Xform \"x\" (\n    references = @pipe.usda@</x>\n) {{ }}\n{curves}"));
     write("cyclic.usda", &format!("#usda 1.0\nclass \"A\" (\n    inherits = </A>\n) {{ }}\n{curves}"));
     write("names_cyclic.usda", "#usda 1.0\n(\n    subLayers = [@cyclic.usda@]\n)\n");
-    for (root, parts) in [
-        ("missing.usda", &["missing.usda", "line 3", "gone.usda"][..]),
-        ("fifo.usda", &["fifo.usda", "line 3", "pipe.usda", "not a regular file"][..]),
-        ("names_cyclic.usda", &["names_cyclic.usda", "line 3", "cyclic.usda", "line 3, column 5", "itself"][..]),
-    ] {
-        let started = std::time::Instant::now();
-        let err = usd::open(dir.path().join(root)).expect_err(root).to_string();
-        println!("{root}: {err} ({:?})", started.elapsed());
-        for part in parts {
-            assert!(err.contains(part), "{root}: {part:?} missing from {err}");
-        }
-    }
+    refused_naming(
+        dir.path(),
+        &[
+            ("missing.usda", &["missing.usda", "line 3", "gone.usda"][..]),
+            ("fifo.usda", &["fifo.usda", "line 3", "pipe.usda", "not a regular file"][..]),
+            ("names_cyclic.usda", &["names_cyclic.usda", "line 3", "cyclic.usda", "line 3, column 5", "itself"][..]),
+        ],
+    );
 }
 
 /// The ways round the layer checks a probe found, each closed: a deep layer
@@ -324,30 +333,26 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
     for sub in ["bad_value.usda", "garbage.usda", "bom.usda"] {
         write(&format!("names_{sub}"), &format!("#usda 1.0\n(\n    subLayers = [@curves.usda@, @{sub}@]\n)\n"));
     }
-    for (root, parts) in [
-        ("blank_led.usda", &["blank_led.usda", "nesting deeper than 128"][..]),
-        ("variant.usda", &["variant.usda", "line 8", "pipe.usda", "not a regular file"][..]),
-        ("wide.usda", &["wide.usda", "nest too deeply all together"][..]),
-        (
-            "names_bad_value.usda",
-            &["names_bad_value.usda", "line 3", "bad_value.usda", "cannot parse", "line 3, column"][..],
-        ),
-        ("names_garbage.usda", &["garbage.usda", "not a USD layer"][..]),
-        ("names_bom.usda", &["bom.usda", "byte-order mark"][..]),
-        ("ref_missing.usda", &["ref_missing.usda", "line 3", "strand.usda", "no prim /gone"][..]),
-        ("payload_missing.usda", &["payload_missing.usda", "strand.usda", "no prim /gone"][..]),
-        ("ref_twice.usda", &["ref_twice.usda", "strand.usda", "no prim /gone"][..]),
-        ("ref_relative.usda", &["ref_relative.usda", "<c>, a relative path"][..]),
-        ("names_text_usdc.usda", &["names_text_usdc.usda", "text.usdc", "a text USD layer named .usdc"][..]),
-        ("ref_no_default.usda", &["ref_no_default.usda", "no_default.usda", "names no default prim"][..]),
-    ] {
-        let started = std::time::Instant::now();
-        let err = usd::open(dir.path().join(root)).expect_err(root).to_string();
-        println!("{root}: {err} ({:?})", started.elapsed());
-        for part in parts {
-            assert!(err.contains(part), "{root}: {part:?} missing from {err}");
-        }
-    }
+    refused_naming(
+        dir.path(),
+        &[
+            ("blank_led.usda", &["blank_led.usda", "nesting deeper than 128"][..]),
+            ("variant.usda", &["variant.usda", "line 8", "pipe.usda", "not a regular file"][..]),
+            ("wide.usda", &["wide.usda", "nest too deeply all together"][..]),
+            (
+                "names_bad_value.usda",
+                &["names_bad_value.usda", "line 3", "bad_value.usda", "cannot parse", "line 3, column"][..],
+            ),
+            ("names_garbage.usda", &["garbage.usda", "not a USD layer"][..]),
+            ("names_bom.usda", &["bom.usda", "byte-order mark"][..]),
+            ("ref_missing.usda", &["ref_missing.usda", "line 3", "strand.usda", "no prim /gone"][..]),
+            ("payload_missing.usda", &["payload_missing.usda", "strand.usda", "no prim /gone"][..]),
+            ("ref_twice.usda", &["ref_twice.usda", "strand.usda", "no prim /gone"][..]),
+            ("ref_relative.usda", &["ref_relative.usda", "<c>, a relative path"][..]),
+            ("names_text_usdc.usda", &["names_text_usdc.usda", "text.usdc", "a text USD layer named .usdc"][..]),
+            ("ref_no_default.usda", &["ref_no_default.usda", "no_default.usda", "names no default prim"][..]),
+        ],
+    );
 }
 
 /// A binary layer's sublayers, references and payloads are checked like a
@@ -374,17 +379,13 @@ fn the_layers_a_binary_layer_names_are_checked_too() {
     binary("good.usdc", "#usda 1.0\ndef \"x\" (\n    references = @strand.usda@</c>\n) { }\n");
     let g = usd::open(dir.path().join("good.usdc")).expect("a binary layer referencing a strand");
     assert_eq!(g.groom.strand_count(), 1);
-    for (root, parts) in [
-        ("fifo.usdc", &["fifo.usdc", "pipe.usda", "not a regular file"][..]),
-        ("missing.usdc", &["missing.usdc", "strand.usda", "no prim /gone"][..]),
-    ] {
-        let started = std::time::Instant::now();
-        let err = usd::open(dir.path().join(root)).expect_err(root).to_string();
-        println!("{root}: {err} ({:?})", started.elapsed());
-        for part in parts {
-            assert!(err.contains(part), "{root}: {part:?} missing from {err}");
-        }
-    }
+    refused_naming(
+        dir.path(),
+        &[
+            ("fifo.usdc", &["fifo.usdc", "pipe.usda", "not a regular file"][..]),
+            ("missing.usdc", &["missing.usdc", "strand.usda", "no prim /gone"][..]),
+        ],
+    );
 }
 
 /// A negative width (a diameter) is a defect: refused strictly, naming the

@@ -73,9 +73,7 @@ fn open_as(path: &Path, load: Load) -> Result<(AuthoredGroom, Option<Repairs>)> 
     assemble(raw, frame, skipped, load).map_err(|e| e.in_asset(path))
 }
 
-/// Most layers a stage may pull in through its text layers' `subLayers`,
-/// `references` and `payload`, the root included.
-pub const MAX_USD_LAYERS: usize = 256;
+pub use super::usd_layers::MAX_USD_LAYERS;
 
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }

@@ -9,9 +9,12 @@ use std::path::{Path, PathBuf};
 
 use openusd::sdf::{Path as SdfPath, SpecType};
 
-use super::usd::MAX_USD_LAYERS;
 use super::usda_check::Takes;
 use crate::error::{Error, FileFormat, Result};
+
+/// Most layers a stage may pull in through its layers' `subLayers`,
+/// `references` and `payload`, the root included.
+pub const MAX_USD_LAYERS: usize = 256;
 
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }

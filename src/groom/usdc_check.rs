@@ -36,13 +36,7 @@ pub const OLDEST: (u8, u8, u8) = (0, 4, 0);
 /// The newest crate version read.
 pub const NEWEST: (u8, u8, u8) = (0, 12, 0);
 
-/// Most items (tokens, fields, paths, specs) a compressed byte can decode to:
-/// the integer coding's two bits an item at best, times LZ4's best ratio
-/// (255), rounded up.
-pub const MAX_ITEMS_PER_BYTE: u64 = 1024;
-/// Most items a section may count (what the crate's own bound on strings is):
-/// a gibibyte of 8-byte values.
-pub const MAX_ITEMS: u64 = 1 << 27;
+pub use super::usdc_values::{MAX_ITEMS, MAX_ITEMS_PER_BYTE};
 
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }

@@ -19,8 +19,15 @@
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
-use super::usdc_check::{MAX_ITEMS, MAX_ITEMS_PER_BYTE};
 use crate::error::{Error, FileFormat, Result};
+
+/// Most items (tokens, fields, paths, specs) a compressed byte can decode to:
+/// the integer coding's two bits an item at best, times LZ4's best ratio
+/// (255), rounded up.
+pub const MAX_ITEMS_PER_BYTE: u64 = 1024;
+/// Most items a section may count (what the crate's own bound on strings is):
+/// a gibibyte of 8-byte values.
+pub const MAX_ITEMS: u64 = 1 << 27;
 
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }
