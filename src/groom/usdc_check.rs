@@ -17,7 +17,7 @@
 //!   every block must lie inside its section.
 //!
 //! Each error names the value found and the file's length. Then the values
-//! the fields point at are checked by [`super::usdc_values`].
+//! the fields point at are checked (`groom/usdc_values.rs`).
 
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
