@@ -279,7 +279,8 @@ fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
 /// led by blank space, a variant's reference to a FIFO, many chains each
 /// within the depth limit, a sublayer the library cannot parse (refused with
 /// its line and column, not dropped), sublayers that are not USD text at
-/// all (no header, a byte-order mark), and references or payloads to a prim
+/// all (no header, a byte-order mark), arcs that chain through 200 prims or
+/// name a path of 200 elements, and references or payloads to a prim
 /// their layer does not have (or to a default prim it does not name) — each
 /// refused in well under a second, naming the layer; references that do find
 /// their prim read.
@@ -307,6 +308,13 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
     let chains: String = (0..300).map(|i| deep(125).replacen("\"p0\"", &format!("\"chain{i}\""), 1)).collect();
     write("wide.usda", &format!("#usda 1.0\n{chains}"));
     write("bad_value.usda", &format!("#usda 1.0\ndef Xform \"x\" {{\n    int a = two\n}}\n{curves}"));
+    // A chain of 200 classes, each inheriting the next (the reader took 13 s
+    // at 1,000), and an arc to a path of 200 elements (10,000: past 15 s).
+    let chain: String =
+        (0..200).map(|i| format!("class \"c{i}\" (\n    inherits = </c{}>\n) {{ }}\n", i + 1)).collect();
+    write("chain.usda", &format!("#usda 1.0\n{chain}{curves}"));
+    let long: String = "/a".repeat(200);
+    write("long_path.usda", &format!("#usda 1.0\ndef \"x\" (\n    inherits = <{long}>\n) {{ }}\n{curves}"));
     write("garbage.usda", "hello, not a stage\n");
     write("bom.usda", &format!("\u{feff}#usda 1.0\n{curves}"));
     // A reference to a prim its layer does not have, a payload likewise, and
@@ -345,6 +353,8 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
             ),
             ("names_garbage.usda", &["garbage.usda", "not a USD layer"][..]),
             ("names_bom.usda", &["bom.usda", "byte-order mark"][..]),
+            ("chain.usda", &["chain.usda", "chain through more than 128 prims"][..]),
+            ("long_path.usda", &["long_path.usda", "line 3", "a path of 200 elements"][..]),
             ("ref_missing.usda", &["ref_missing.usda", "line 3", "strand.usda", "no prim /gone"][..]),
             ("payload_missing.usda", &["payload_missing.usda", "strand.usda", "no prim /gone"][..]),
             ("ref_twice.usda", &["ref_twice.usda", "strand.usda", "no prim /gone"][..]),

@@ -34,6 +34,11 @@ pub const MAX_USDA_DEPTH: usize = 128;
 /// 700,000; 300 chains of 125 levels for 198,000,000.
 pub const MAX_USDA_DEPTH_WORK: u64 = 4_000_000;
 
+/// Most prims a chain of composition arcs (inherits, specializes, internal
+/// references) may pass through within a layer: the reader's time grows with
+/// the cube of the chain (1,000 links took it 13 s).
+pub const MAX_USDA_ARC_CHAIN: usize = 128;
+
 /// Metadata keys whose path values are composition arcs.
 const ARCS: [&str; 4] = ["inherits", "specializes", "references", "payload"];
 
@@ -283,7 +288,17 @@ pub fn check(text: &str) -> Result<LayerAssets> {
                     pending = Some((*name).to_owned());
                 }
             }
-            Token::Path(_) | Token::Asset(_) | Token::Equals => {}
+            Token::Path(p) => {
+                let elements = p.split('/').filter(|e| !e.is_empty()).count();
+                if elements > MAX_USDA_DEPTH {
+                    return Err(malformed(format!(
+                        "{} a path of {elements} elements (no prim of a checked layer lies deeper than \
+                         {MAX_USDA_DEPTH})",
+                        position(text, *at)
+                    )));
+                }
+            }
+            Token::Asset(_) | Token::Equals => {}
         }
     }
     if let Some((c, _)) = open.last() {
@@ -380,6 +395,8 @@ fn check_arcs(text: &str, arcs: &HashMap<String, Vec<(String, usize)>>) -> Resul
     // ancestors bring, so an arc into a prim that (or whose descendant) leads
     // back counts.
     let mut state: HashMap<&str, u8> = HashMap::new();
+    // Per finished prim, the most prims a chain of arcs from it passes.
+    let mut longest: HashMap<&str, usize> = HashMap::new();
     // The arcs leaving `node`: its own and its descendants' (found once per
     // node visited).
     let out_of = |node: &str| -> Vec<&(String, usize)> {
@@ -395,6 +412,17 @@ fn check_arcs(text: &str, arcs: &HashMap<String, Vec<(String, usize)>>) -> Resul
         let mut stack = vec![(start.as_str(), out_of(start), 0usize)];
         while let Some((node, out, next)) = stack.last_mut() {
             let Some((to, at)) = out.get(*next).copied() else {
+                // Every arc out of `node` is finished (no cycle): the longest
+                // chain of arcs from it is one more than its targets' longest.
+                let chain =
+                    1 + out.iter().map(|(to, _)| longest.get(to.as_str()).copied().unwrap_or(0)).max().unwrap_or(0);
+                if chain > MAX_USDA_ARC_CHAIN {
+                    return Err(malformed(format!(
+                        "the composition arcs from {node} chain through more than {MAX_USDA_ARC_CHAIN} prims \
+                         (the reader's time grows with the cube of the chain)"
+                    )));
+                }
+                longest.insert(node, chain);
                 state.insert(node, 2);
                 stack.pop();
                 continue;
