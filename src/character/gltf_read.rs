@@ -302,9 +302,21 @@ fn buffers(gltf: &gltf::Gltf, dir: Option<&Path>) -> Result<Vec<Vec<u8>>> {
                         buffer.index()
                     )));
                 }
-                files::read_capped(&dir.join(uri), budget, "a glTF buffer").map_err(|e| match e {
+                // A buffer that is not a regular file (missing, a folder, a
+                // FIFO no one writes) is the document's defect, named with
+                // the buffer and reported under the document's name.
+                let file = dir.join(uri);
+                let unreadable =
+                    |e: Error| malformed(format!("buffer {} at {uri:?} cannot be read: {e}", buffer.index()));
+                files::check_regular(&file, budget, "a glTF buffer").map_err(|e| match e {
                     Error::InputTooLarge { .. } if budget < MAX_GLTF_BYTES => too_much(),
-                    e => e,
+                    Error::InputTooLarge { .. } => e,
+                    e => unreadable(e),
+                })?;
+                files::read_capped(&file, budget, "a glTF buffer").map_err(|e| match e {
+                    Error::InputTooLarge { .. } if budget < MAX_GLTF_BYTES => too_much(),
+                    Error::InputTooLarge { .. } => e,
+                    e => unreadable(e),
                 })?
             }
         };

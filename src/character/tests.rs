@@ -308,6 +308,29 @@ fn a_far_vertex_and_a_head_scaled_to_nothing_are_refused_naming_them() {
     assert!(err.contains("head joint") && err.contains("no frame at 0 s") && err.contains("scale"), "{err}");
 }
 
+/// A `.gltf` document whose buffer file is missing, a folder or a FIFO no one
+/// writes is refused naming the document, the buffer and its file — not a
+/// bare "no such file" about the buffer, nor a truncated file.
+#[test]
+fn an_unreadable_buffer_file_is_named_with_its_document() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
+    let bytes = std::fs::read(path).expect("read");
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().expect("length")) as usize;
+    let mut json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).expect("json");
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::create_dir(dir.path().join("folder.bin")).expect("mkdir");
+    let fifo = std::ffi::CString::new(dir.path().join("pipe.bin").to_str().expect("utf-8")).expect("path");
+    // SAFETY: mkfifo with a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(fifo.as_ptr(), 0o600) }, 0, "mkfifo");
+    for (file, what) in [("gone.bin", "gone.bin"), ("folder.bin", "folder.bin"), ("pipe.bin", "not a regular file")] {
+        json["buffers"][0]["uri"] = serde_json::json!(file);
+        let doc = dir.path().join(format!("{file}.gltf"));
+        std::fs::write(&doc, serde_json::to_vec(&json).expect("json")).expect("write");
+        let err = Character::load(&doc).map(|_| ()).expect_err(file).to_string();
+        assert!(err.contains(&format!("{file}.gltf")) && err.contains("buffer 0") && err.contains(what), "{err}");
+    }
+}
+
 /// The mannequin's GLB (`bytes`) with an animation sampler of its own added
 /// to its first animation: `times` and translation `values` (three a key)
 /// written to `dir`/`name`, a buffer naming that file, and `channels`
