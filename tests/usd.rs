@@ -280,7 +280,8 @@ fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
 /// within the depth limit, a sublayer the library cannot parse (refused with
 /// its line and column, not dropped), sublayers that are not USD text at
 /// all (no header, a byte-order mark), arcs that chain through 200 prims or
-/// name a path of 200 elements, and references or payloads to a prim
+/// name a path of 200 elements, references within a layer to a root prim it
+/// does not declare, and references or payloads to a prim
 /// their layer does not have (or to a default prim it does not name) — each
 /// refused in well under a second, naming the layer; references that do find
 /// their prim read.
@@ -332,10 +333,12 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
     arc("ref_prim.usda", "references = @no_default.usda@</c>");
     arc("ref_twice.usda", "references = [@strand.usda@</c>, @strand.usda@</gone>]");
     arc("ref_relative.usda", "references = @strand.usda@<c>");
+    arc("internal_missing.usda", "references = </Nope>");
+    arc("internal_good.usda", "references = </c>");
     // A text layer named .usdc (the library would read it as binary and drop it).
     write("text.usdc", &format!("#usda 1.0\n{curves}"));
     write("names_text_usdc.usda", "#usda 1.0\n(\n    subLayers = [@text.usdc@]\n)\n");
-    for good in ["ref_default.usda", "ref_prim.usda"] {
+    for good in ["ref_default.usda", "ref_prim.usda", "internal_good.usda"] {
         usd::open(dir.path().join(good)).unwrap_or_else(|e| panic!("{good}: {e}"));
     }
     for sub in ["bad_value.usda", "garbage.usda", "bom.usda"] {
@@ -359,6 +362,10 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
             ("payload_missing.usda", &["payload_missing.usda", "strand.usda", "no prim /gone"][..]),
             ("ref_twice.usda", &["ref_twice.usda", "strand.usda", "no prim /gone"][..]),
             ("ref_relative.usda", &["ref_relative.usda", "<c>, a relative path"][..]),
+            (
+                "internal_missing.usda",
+                &["internal_missing.usda", "line 3", "to /Nope, a prim the layer does not have"][..],
+            ),
             ("names_text_usdc.usda", &["names_text_usdc.usda", "text.usdc", "a text USD layer named .usdc"][..]),
             ("ref_no_default.usda", &["ref_no_default.usda", "no_default.usda", "names no default prim"][..]),
         ],
@@ -418,6 +425,16 @@ fn a_negative_width_is_refused_strictly_and_passed_over_when_repairing() {
     assert_eq!(g.groom.strand_count(), 2);
     assert!(g.groom.end_thickness().is_none(), "the widths were read");
     assert!(g.skipped.iter().any(|s| s.contains("negative width")), "{:?}", g.skipped);
+    // A width of 1e30 m is no hair's either.
+    let text = std::fs::read_to_string(&path).expect("read").replace("-0.0005", "1e30");
+    std::fs::write(&path, text).expect("write");
+    let err = usd::open(&path).expect_err("strict").to_string();
+    assert!(
+        err.contains("/hair") && err.contains("strand 1 has a width of 1e30") && err.contains("at most 1 m"),
+        "{err}"
+    );
+    let (g, _) = usd::open_repairing(&path).expect("repairing");
+    assert!(g.groom.end_thickness().is_none() && g.groom.strand_count() == 2, "the absurd widths were read");
 }
 
 /// A stage pulls in at most `usd::MAX_USD_LAYERS` layers: a chain of

@@ -19,7 +19,7 @@
 //! Strings, comments and path literals are skipped as USD text writes them;
 //! errors carry the line and column.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use crate::error::{Error, FileFormat, Result};
 
@@ -213,6 +213,10 @@ pub fn check(text: &str) -> Result<LayerAssets> {
     let mut count = 0usize;
     let mut work = 0u64;
     let mut assets = LayerAssets::new();
+    // The names of the prims declared at the root, and the targets (with
+    // where they are written) of the references and payloads within the layer.
+    let mut roots: HashSet<String> = HashSet::new();
+    let mut internal: Vec<(String, usize)> = Vec::new();
     for (k, (at, token)) in tokens.iter().enumerate() {
         match token {
             Token::Open(c) => {
@@ -226,6 +230,9 @@ pub fn check(text: &str) -> Result<LayerAssets> {
                 if body {
                     let name = pending.take().unwrap_or_default();
                     let parent = prims.last().map_or("", String::as_str);
+                    if parent.is_empty() {
+                        roots.insert(name.clone());
+                    }
                     prims.push(format!("{parent}/{name}"));
                     declaring = false;
                     work += (prims.len() as u64).pow(2);
@@ -279,7 +286,11 @@ pub fn check(text: &str) -> Result<LayerAssets> {
                                 position(text, *at)
                             )));
                         }
-                        arcs.entry(from.clone()).or_default().push((absolute(target, &from), *at));
+                        let target = absolute(target, &from);
+                        if matches!(*w, "references" | "payload") {
+                            internal.push((target.clone(), *at));
+                        }
+                        arcs.entry(from.clone()).or_default().push((target, *at));
                     }
                 }
             }
@@ -305,6 +316,20 @@ pub fn check(text: &str) -> Result<LayerAssets> {
         return Err(malformed(format!("a '{}' is never closed", *c as char)));
     }
     check_arcs(text, &arcs)?;
+    // A reference or payload within the layer whose target's root prim the
+    // layer does not declare brings nothing, and the stage says nothing (a
+    // sublayer may declare it: then it is left to the stage).
+    if !assets.iter().any(|a| a.takes == Takes::Layer) {
+        for (target, at) in &internal {
+            let root = target.trim_start_matches('/').split('/').next().unwrap_or_default();
+            if !roots.contains(root) {
+                return Err(malformed(format!(
+                    "{} a reference or payload to {target}, a prim the layer does not have",
+                    position(text, *at)
+                )));
+            }
+        }
+    }
     Ok(assets)
 }
 

@@ -447,16 +447,24 @@ pub(crate) fn assemble(
     };
     let mut thickness: Option<Vec<f32>> = all("widths", &|o| o.widths.is_some(), &mut skipped)
         .then(|| objects.iter().flat_map(|o| o.widths.iter().flatten().map(|&w| (f64::from(w) * k) as f32)).collect());
-    // A width is a diameter: a negative one is a defect, refused (strict) or
-    // the widths passed over, with the first named (repairing).
+    // A width is a diameter: a negative one, or one thicker than any hair
+    // (MAX_WIDTH_M in metres), is a defect, refused (strict) or the widths
+    // passed over, with the first named (repairing).
+    let absurd = |w: f32| w < 0.0 || f64::from(w) * k > MAX_WIDTH_M;
     let negative = objects.iter().find_map(|o| {
         let widths = o.widths.as_ref()?;
-        let at = widths.iter().position(|&w| w < 0.0)?;
+        let at = widths.iter().position(|&w| absurd(w))?;
         let (strand, _) = strand_of_point(&o.counts, at)?;
         Some((o.path.as_str(), strand, widths[at]))
     });
     if let Some((path, strand, width)) = negative {
-        let what = format!("strand {strand} has a negative width ({width})");
+        let what = match width < 0.0 {
+            true => format!("strand {strand} has a negative width ({width})"),
+            false => format!(
+                "strand {strand} has a width of {width:e} ({:.3e} m), thicker than any hair (at most {MAX_WIDTH_M} m)",
+                f64::from(width) * k
+            ),
+        };
         match load {
             Load::Strict => return Err(in_object(path, Error::Malformed { format: frame.format, reason: what })),
             Load::Repair => {
@@ -504,6 +512,10 @@ fn kept<T: Copy>(v: Vec<T>, repairs: Option<&Repairs>) -> Vec<T> {
         None => v,
     }
 }
+
+/// Thickest width (a diameter, in metres after the file's units) a strand of
+/// an authored groom may have: a hair a metre thick is a broken file.
+pub const MAX_WIDTH_M: f64 = 1.0;
 
 /// Farthest a point of an authored groom may lie from the origin, along any
 /// axis, meters (after the object's transforms and the file's units): 10 km,
