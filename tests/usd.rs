@@ -558,4 +558,9 @@ fn a_point_far_beyond_any_scene_is_refused_naming_it() {
     std::fs::write(&path, far).expect("write");
     let e = usd::open(&path).expect_err("refused").to_string();
     assert!(e.contains("far.usda") && e.contains("point") && e.contains("within 1e4 m of the origin"), "{e}");
+    // Past f32's range (a translation of 1e300 cm, 1e298 m): named as far, not as
+    // a NaN or infinite value.
+    std::fs::write(&path, text.replace("(0, 0, 100)", "(0, 0, 1e300)")).expect("write");
+    let e = usd::open(&path).expect_err("refused").to_string();
+    assert!(e.contains("e298") && e.contains("within 1e4 m of the origin") && !e.contains("NaN"), "{e}");
 }

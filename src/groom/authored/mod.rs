@@ -423,11 +423,17 @@ pub(crate) fn assemble(
     }
     // Whatever the transforms and units did: a finite point farther than
     // MAX_COORDINATE_M from the origin is refused, named (non-finite ones are
-    // the groom check's).
-    if let Some(i) = positions.iter().position(|p| p.is_finite() && p.abs().max_element() > MAX_COORDINATE_M) {
+    // the groom check's) — judged in double precision, before a point past
+    // f32's range would become an infinity.
+    let far = objects
+        .iter()
+        .flat_map(|o| o.points.iter())
+        .map(|&p| to_y_up(p) * k)
+        .position(|q| q.is_finite() && q.abs().max_element() > f64::from(MAX_COORDINATE_M));
+    if let Some(i) = far {
         let (strand, first) = strand_of_point(&counts, i).unwrap_or((0, 0));
         let (object, local) = object_of(&object_starts, strand);
-        let p = positions[i];
+        let p = objects.iter().flat_map(|o| o.points.iter()).nth(i).map_or(DVec3::ZERO, |&p| to_y_up(p) * k);
         let reason = format!(
             "strand {local} point {} lies at ({:e}, {:e}, {:e}) m after its transforms and the stage's units: \
              a groom lies within {MAX_COORDINATE_M:e} m of the origin",
