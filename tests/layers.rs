@@ -234,7 +234,7 @@ fn constraint_problems(root: &Path) -> Vec<String> {
             problems.push(format!("{name}: {what} and list disagree"));
         }
     }
-    let step = std::fs::read_to_string(root.join("glsl/sim/step.comp")).unwrap_or_default();
+    let step = std::fs::read_to_string(root.join("glsl/sim/step.comp")).expect("glsl/sim/step.comp");
     for c in SIM_CONSTRAINTS {
         let include = std::fs::read_to_string(includes_dir.join(format!("{}.glsl", c.name))).unwrap_or_default();
         let twin = std::fs::read_to_string(twins_dir.join(format!("{}.rs", c.name))).unwrap_or_default();

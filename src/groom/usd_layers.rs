@@ -42,8 +42,12 @@ impl Targets {
             _ if self.sublayers => None,
             // A malformed path is the library's to judge.
             Takes::Prim(p) if SdfPath::new(p).is_err() => None,
+            // Only the root prim is judged: a prim under it may come from the
+            // root's own arcs or variants.
             Takes::Prim(p) => {
-                (!self.prims.contains(p)).then(|| format!("it has no prim {p}, which a reference or payload takes"))
+                let root = format!("/{}", p.trim_start_matches('/').split('/').next().unwrap_or_default());
+                (!self.prims.contains(&root))
+                    .then(|| format!("it has no prim {root}, which a reference or payload takes"))
             }
             Takes::DefaultPrim => match &self.default {
                 Some(name) if self.prims.contains(&format!("/{name}")) => None,
@@ -214,7 +218,8 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
                 malformed(format!("not a USD layer: it starts with {what}, not the `#usda` header")).in_asset(&layer),
             ));
         }
-        let assets = super::usda_check::check(text).map_err(|e| named(e.in_asset(&layer)))?;
+        let assets = super::usda_check::check(text, takes == Takes::Layer && named_by.is_some())
+            .map_err(|e| named(e.in_asset(&layer)))?;
         let targets = parse(text, assets.iter().any(|a| a.takes == Takes::Layer))
             .map_err(|why| named(malformed(why).in_asset(&layer)))?;
         if let Some(why) = targets.missing(&takes) {

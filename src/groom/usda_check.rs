@@ -200,7 +200,7 @@ pub enum Takes {
 
 /// Checks the USD text `text` (see the module docs) and returns the other
 /// layers it names ([`LayerAssets`]).
-pub fn check(text: &str) -> Result<LayerAssets> {
+pub fn check(text: &str, sublayer: bool) -> Result<LayerAssets> {
     let tokens = tokens(text)?;
     // Brackets open; for each whether it opened a prim's body.
     let mut open: Vec<(u8, bool)> = Vec::new();
@@ -319,7 +319,9 @@ pub fn check(text: &str) -> Result<LayerAssets> {
     // A reference or payload within the layer whose target's root prim the
     // layer does not declare brings nothing, and the stage says nothing (a
     // sublayer may declare it: then it is left to the stage).
-    if !assets.iter().any(|a| a.takes == Takes::Layer) {
+    // (A layer used as a sublayer composes with its parent's and siblings'
+    // prims: not judged either.)
+    if !sublayer && !assets.iter().any(|a| a.takes == Takes::Layer) {
         for (target, at) in &internal {
             let root = target.trim_start_matches('/').split('/').next().unwrap_or_default();
             if !roots.contains(root) {
@@ -485,7 +487,7 @@ mod tests {
              class \"Base\" {{ }}\ndef Xform \"groom\" (\n  inherits = </Base>\n  references = @other.usda@</Thing>\n) {{\n  \
              {CURVES} }}\n# a comment with {{ ( [\n"
         );
-        check(&text).expect("passes");
+        check(&text, false).expect("passes");
     }
 
     #[test]
@@ -500,8 +502,8 @@ mod tests {
             t
         };
         // The curves prim adds three levels (its body, a list and a tuple).
-        check(&deep(MAX_USDA_DEPTH - 3)).expect("within the limit");
-        let err = check(&deep(MAX_USDA_DEPTH + 5)).expect_err("too deep").to_string();
+        check(&deep(MAX_USDA_DEPTH - 3), false).expect("within the limit");
+        let err = check(&deep(MAX_USDA_DEPTH + 5), false).expect_err("too deep").to_string();
         assert!(
             err.contains("nesting deeper than 128") && err.contains(&format!("line {}", MAX_USDA_DEPTH + 2)),
             "{err}"
@@ -511,7 +513,7 @@ mod tests {
             "{ dictionary a = ".repeat(500),
             " }".repeat(500)
         );
-        assert!(check(&dictionaries).expect_err("too deep").to_string().contains("nesting deeper"));
+        assert!(check(&dictionaries, false).expect_err("too deep").to_string().contains("nesting deeper"));
     }
 
     #[test]
@@ -524,12 +526,12 @@ mod tests {
         ];
         for (body, what) in cases {
             let text = format!("#usda 1.0\n{body}{CURVES}");
-            let err = check(&text).expect_err(what).to_string();
+            let err = check(&text, false).expect_err(what).to_string();
             assert!(err.contains(what) && err.contains("line "), "{what}: {err}");
         }
         // A chain without a cycle, and an arc into another layer, pass.
         let chain = "class \"A\" (\n inherits = </B>\n) { }\nclass \"B\" { }\ndef Xform \"C\" (\n references = @a.usda@</C>\n) { }\n";
-        check(&format!("#usda 1.0\n{chain}{CURVES}")).expect("no cycle");
+        check(&format!("#usda 1.0\n{chain}{CURVES}"), false).expect("no cycle");
     }
 
     #[test]
@@ -541,8 +543,8 @@ mod tests {
             }
             t + CURVES
         };
-        check(&arcs(MAX_USDA_ARCS)).expect("at the limit");
-        let err = check(&arcs(MAX_USDA_ARCS + 1)).expect_err("past it").to_string();
+        check(&arcs(MAX_USDA_ARCS), false).expect("at the limit");
+        let err = check(&arcs(MAX_USDA_ARCS + 1), false).expect_err("past it").to_string();
         assert!(err.contains("more than 10000 composition arcs"), "{err}");
     }
 
@@ -554,7 +556,7 @@ mod tests {
             ("#usda 1.0\ndef Xform \"a { }\n", "a string that never ends"),
             ("#usda 1.0\ndef Xform \"a\" (inherits = </A) { }\n", "a path that never ends"),
         ] {
-            let err = check(text).expect_err(what).to_string();
+            let err = check(text, false).expect_err(what).to_string();
             assert!(err.contains(what), "{what}: {err}");
         }
     }
