@@ -20,7 +20,8 @@
 //      (barrier()). Today: distance (even, odd segments), bending (two sets of
 //      centres), local shape (one sweep per hair, last iteration), global
 //      shape and collisions (own point only, sharing the iteration's last
-//      barrier); then, once per sub-step, friction against the mesh collider;
+//      barrier), the stretch limit (one sweep per hair, last iteration, when
+//      set); then, once per sub-step, friction against the mesh collider;
 //   3. velocity from the position change, friction, damping:
 //        v = (x_solved − x_old) / dt  [− s·d_{i+1} / dt in DFTL mode],
 //        against each sphere and capsule touched: the velocity along its

@@ -40,11 +40,12 @@
 // and its test: build.rs calls the include from the step kernel in this
 // order, and the reference calls the twin in the same place.
 //
-// This file is included four times, each after a different definition of
-// `sim_constraints!`: by `gpu_types` (the knobs' struct and lanes), by build.rs
-// (the knobs' accessors and the solve's GLSL), by `sim::packing` (each knob's
-// value from `SimParams`) and by `sim::reference::constraints` (the CPU
-// solve). Plain tokens only: no inner doc comments.
+// This file is included by each of these, after its own definition of
+// `sim_constraints!`: `gpu_types` (the knobs' struct and lanes), build.rs (the
+// knobs' accessors and the solve's GLSL), `sim::packing` (each knob's value
+// from `SimParams`), `sim::reference::constraints` (the CPU solve) and
+// tests/layers.rs (each row's include and twin). Plain tokens only: no inner
+// doc comments.
 
 sim_constraints! {
     /// Distance: each segment held at its rest length (stiffness 1).

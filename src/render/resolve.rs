@@ -121,7 +121,7 @@ impl Supersampling {
     }
 
     /// Where the frame's hair is drawn: these images, colour cleared to
-    /// transparent and depth to 1, after the barriers that make them attachments.
+    /// transparent and depth to the convention's far (1, or 0 reversed), after the barriers that make them attachments.
     pub(super) fn draw_target(&self, primitive: Primitive, reverse_z: bool) -> DrawTarget {
         DrawTarget {
             key: TargetKey {

@@ -20,7 +20,9 @@
 //!       [`SimParams::local_shape_stiffness`]), the global shape constraint
 //!       (each particle pulled toward its rest position in the head frame,
 //!       [`SimParams::global_shape_stiffness`]) and the body collisions
-//!       (spheres, capsules and the [`MeshCollider`]'s field); then friction
+//!       (spheres, capsules and the [`MeshCollider`]'s field), and in the
+//!       last iteration the stretch limit ([`SimParams::stretch_limit`],
+//!       when set); then friction
 //!       against the mesh collider. Each constraint is one GLSL include
 //!       (`glsl/include/constraints/`) and one CPU twin
 //!       (`reference/constraints/`); build.rs generates the calls. DFTL mode
