@@ -193,6 +193,18 @@ shader_codes! {
         MAX_SPREAD = 2,
     }
 
+    /// The tiled rasteriser (`render/draw/tiles.rs`, `glsl/render/tile_*.comp`).
+    tile = "TILE_" {
+        /// Pixels along each side of a screen tile: the fine pass's workgroup
+        /// is SIZE × SIZE invocations, one a pixel.
+        SIZE = 16,
+        /// Fragments a tile's workgroup holds in shared memory (16 bytes
+        /// each) before it sorts them into its pixels' K-buffers.
+        FRAGMENTS = 1024,
+        /// Invocations of the one workgroup that scans the tiles' counts.
+        SCAN_GROUP = 256,
+    }
+
     /// "None" words that buffers are cleared to.
     sentinel = "" {
         /// No node in a per-pixel list, no depth stored (transparency).

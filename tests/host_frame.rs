@@ -255,6 +255,7 @@ fn a_reverse_z_host_gets_the_frame_a_forward_host_gets() {
         ("opaque, supersampled", Transparency::Off, Raster::Auto, true),
         ("exact, hardware", Transparency::Exact, Raster::Hardware, false),
         ("exact, compute", Transparency::Exact, Raster::Compute, false),
+        ("exact, tiles", Transparency::Exact, Raster::Tiles, false),
         ("fast", Transparency::Fast, Raster::Auto, false),
     ];
     for (name, transparency, raster, supersampling) in configs {

@@ -142,8 +142,13 @@ fn each_mode_against_the_exact_reference() {
     let groom = common::grown_groom(300, 8, 5);
     let m = material(WIDTH, OPACITY);
     let mut errors = Vec::new();
-    let modes =
-        [params(Transparency::Off), params(Transparency::Fast), exact(Raster::Hardware), exact(Raster::Compute)];
+    let modes = [
+        params(Transparency::Off),
+        params(Transparency::Fast),
+        exact(Raster::Hardware),
+        exact(Raster::Compute),
+        exact(Raster::Tiles),
+    ];
     for p in modes {
         let mode = (p.transparency, p.raster);
         let mut s = scene(&gpu, &groom, &p, &m);
@@ -155,8 +160,8 @@ fn each_mode_against_the_exact_reference() {
         println!("{mode:?}: mean absolute error against the reference {e:.2} (8-bit sRGB steps)");
         errors.push(e);
     }
-    let [off, fast, hardware, compute] = [errors[0], errors[1], errors[2], errors[3]];
-    for (raster, exact) in [("hardware", hardware), ("compute", compute)] {
+    let [off, fast, hardware, compute, tiles] = [errors[0], errors[1], errors[2], errors[3], errors[4]];
+    for (raster, exact) in [("hardware", hardware), ("compute", compute), ("tiles", tiles)] {
         assert!(exact <= 0.5 * off, "exact's error ({raster}) {exact:.2} is not at most half of off's {off:.2}");
     }
     assert!(fast < off, "fast's error {fast:.2} is not below off's {off:.2}");
@@ -465,7 +470,7 @@ fn hair_behind_host_geometry_drawn_first_is_hidden_by_both_rasterisers() {
     let sphere = vkhair::groom::mesh::TriMesh::uv_sphere(front, 0.1, 16, 24).expect("sphere");
     let mesh = vkhair::headless::MeshDrawer::new(gpu.ctx(), &sphere).expect("mesh");
     let green = |c: &Vec3| c.y > 0.05 && c.y > 4.0 * c.x && c.y > 4.0 * c.z;
-    for raster in RASTERS {
+    for raster in [Raster::Hardware, Raster::Compute, Raster::Tiles] {
         let mut s = scene(&gpu, &groom, &exact(raster), &m);
         let alone = draw(&gpu, &mut s);
         let host = common::HostFrame { clear: BACKGROUND, before: Some(&mesh), after: None };
@@ -581,6 +586,8 @@ fn the_compute_rasteriser_draws_what_the_hardware_one_draws() {
         (RenderParams { raster: Raster::Compute, ..params(Transparency::Off) }, Raster::Hardware),
         (exact(Raster::Hardware), Raster::Hardware),
         (exact(Raster::Compute), Raster::Compute),
+        (exact(Raster::Tiles), Raster::Tiles),
+        (RenderParams { raster: Raster::Tiles, ..params(Transparency::Fast) }, Raster::Hardware),
     ] {
         let renderer = Renderer::new(gpu_ctx, &sim, &p).expect("renderer");
         assert_eq!(renderer.raster(), drawn, "{:?} with {:?}", p.transparency, p.raster);
@@ -710,7 +717,7 @@ fn every_size_renders_in_the_exact_mode() {
         let offscreen = Offscreen::new(gpu.ctx(), w, h).expect("offscreen");
         let camera = common::front_camera(0.9, (w, h));
         let mut hair_pixels = Vec::new();
-        for p in [params(Transparency::Fast), exact(Raster::Hardware), exact(Raster::Compute)] {
+        for p in [params(Transparency::Fast), exact(Raster::Hardware), exact(Raster::Compute), exact(Raster::Tiles)] {
             let mode = p.transparency;
             let mut renderer = Renderer::new(gpu.ctx(), &sim, &p).expect("renderer");
             renderer.set_material(&m).expect("material");
@@ -718,7 +725,14 @@ fn every_size_renders_in_the_exact_mode() {
             let rgba = common::draw_frame(&gpu, (&sim, &mut renderer), &offscreen, &camera, &host);
             let image = linear_rgb(&rgba);
             hair_pixels.push(image.iter().filter(|c| (**c - BACKGROUND).abs().max_element() > 0.01).count());
-            if mode == Transparency::Exact {
+            if p.raster == Raster::Tiles {
+                // No pool: every fragment is sorted or in the tail, and the bins held every entry.
+                let stats = renderer.transparency_stats().expect("stats");
+                println!("{w}×{h}, tiles: {stats:?}");
+                assert_eq!(renderer.transparency_pool(extent), None);
+                assert!(stats.tile_entries <= stats.tile_capacity && stats.tile_entries > 0, "{stats:?}");
+                assert!(stats.stored > 1000, "too few fragments: {stats:?}");
+            } else if mode == Transparency::Exact {
                 let pool = renderer.transparency_pool(extent).expect("an exact pool");
                 let stats = renderer.transparency_stats().expect("stats");
                 println!("{w}×{h}: {pool:?}, {stats:?}");
@@ -739,9 +753,10 @@ fn every_size_renders_in_the_exact_mode() {
             }
         }
         println!(
-            "{w}×{h}: hair pixels fast {}, exact {} (hardware), {} (compute)",
-            hair_pixels[0], hair_pixels[1], hair_pixels[2]
+            "{w}×{h}: hair pixels fast {}, exact {} (hardware), {} (compute), {} (tiles)",
+            hair_pixels[0], hair_pixels[1], hair_pixels[2], hair_pixels[3]
         );
+        assert_eq!(hair_pixels[3], hair_pixels[2], "the tiled rasteriser covers other pixels than the compute one");
         assert!(hair_pixels[1] > 1000, "no hair at {w}×{h}");
         let (a, b, c) = (hair_pixels[0] as f64, hair_pixels[1] as f64, hair_pixels[2] as f64);
         assert!((a - b).abs() <= 0.01 * a, "the exact mode covers other pixels than the fast one at {w}×{h}");
@@ -998,4 +1013,95 @@ fn level_of_detail_keeps_the_optical_density_of_hair_over_the_scalp() {
             assert!((ratio - 1.0).abs() <= 0.1, "{raster:?}: {kept:.3} of the hairs darken {ratio:.3} as much");
         }
     }
+}
+
+/// The tiled rasteriser (`Raster::Tiles`) keeps the fragments the per-segment
+/// compute rasteriser keeps — the same count, every pixel within one 8-bit
+/// step, on average within a hundredth of one (they differ only where
+/// fragments at one depth, or the tail's float sums, meet in another order) —
+/// for each K-buffer variant (K = 4, 8, 16 and 32), on a target whose sides
+/// are not multiples of the tile (partial tiles at the right and bottom), with
+/// more fragments than a tile's shared buffer holds at once (so tiles take
+/// several rounds), and against the host's depth (a sphere drawn first).
+#[test]
+fn the_tiled_rasteriser_keeps_the_fragments_of_the_per_segment_one() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(2000, 8, 5);
+    // Wide faint strands: deep pixels, several rounds a tile.
+    let m = material(0.004, 0.3);
+    let (w, h) = (157u32, 93u32);
+    let offscreen = Offscreen::new(gpu.ctx(), w, h).expect("offscreen");
+    let camera = common::front_camera(0.9, (w, h));
+    let front = scenes::THESIS_HEAD_CENTER + Vec3::new(0.0, -0.12, 0.45);
+    let sphere = vkhair::groom::mesh::TriMesh::uv_sphere(front, 0.1, 16, 24).expect("sphere");
+    let mesh = vkhair::headless::MeshDrawer::new(gpu.ctx(), &sphere).expect("mesh");
+    let sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
+    let to8 = |c: Vec3| c.to_array().map(|v| v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0);
+    let tiles = u64::from(w.div_ceil(16)) * u64::from(h.div_ceil(16));
+    for (k, before) in [(4u32, None), (8, Some(&mesh)), (16, None), (32, Some(&mesh))] {
+        let mut images = Vec::new();
+        let mut fragments = Vec::new();
+        for raster in [Raster::Compute, Raster::Tiles] {
+            let mut p = exact(raster);
+            p.oit.sorted_fragments = k;
+            // A pool that holds them all.
+            p.oit.fragments_per_pixel = 64.0;
+            let mut renderer = Renderer::new(gpu.ctx(), &sim, &p).expect("renderer");
+            renderer.set_material(&m).expect("material");
+            let host = common::HostFrame { clear: BACKGROUND, before, after: None };
+            let rgba = common::draw_frame(&gpu, (&sim, &mut renderer), &offscreen, &camera, &host);
+            let stats = renderer.transparency_stats().expect("stats");
+            assert_eq!(stats.overflowed, 0, "{stats:?}");
+            fragments.push(stats.fragments);
+            images.push(linear_rgb(&rgba));
+            if raster == Raster::Tiles {
+                assert!(stats.tile_entries > 0 && stats.tile_entries <= stats.tile_capacity, "{stats:?}");
+                // More fragments than every tile's buffer holds at once: some tile took rounds.
+                assert!(stats.fragments > tiles * 1024, "too few fragments for rounds: {stats:?}");
+            }
+        }
+        let steps: Vec<f32> = images[0]
+            .iter()
+            .zip(&images[1])
+            .map(|(a, b)| (0..3).map(|i| (to8(*a)[i] - to8(*b)[i]).abs()).fold(0.0f32, f32::max))
+            .collect();
+        let worst = steps.iter().copied().fold(0.0f32, f32::max);
+        let mean = steps.iter().sum::<f32>() / steps.len() as f32;
+        println!("K {k}, sphere {}: fragments {fragments:?}; worst {worst:.3}, mean {mean:.5} steps", before.is_some());
+        assert_eq!(fragments[0], fragments[1], "K {k}: the rasterisers kept other fragments");
+        assert!(fragments[0] > 10_000, "too few fragments to compare: {fragments:?}");
+        assert!(worst <= 1.0 && mean < 0.01, "K {k}: the tiled image differs: worst {worst}, mean {mean}");
+    }
+}
+
+/// Bins too small for a frame's segments (`OitParams::tile_entries_per_segment`
+/// at its least, wide strands reaching more than the bins' least 256 entries a
+/// tile) draw the entries that fit and say so (`OitStats::tile_entries` beyond
+/// `tile_capacity`); the next frame's bins hold them all and it draws what the
+/// per-segment rasteriser draws.
+#[test]
+fn bins_too_small_draw_what_fits_say_so_and_grow() {
+    let gpu = Gpu::new();
+    let groom = common::grown_groom(2000, 8, 5);
+    let m = material(0.004, OPACITY);
+    let mut p = exact(Raster::Compute);
+    p.oit.fragments_per_pixel = 32.0;
+    let mut s = scene(&gpu, &groom, &p, &m);
+    let whole = draw(&gpu, &mut s);
+    let all = s.renderer.transparency_stats().expect("stats").fragments;
+    let mut p = exact(Raster::Tiles);
+    p.oit.tile_entries_per_segment = 0.1;
+    s.renderer.set_params(&p).expect("params");
+    let first = draw(&gpu, &mut s);
+    let short = s.renderer.transparency_stats().expect("stats");
+    println!("too small: {short:?}; all {all}");
+    assert!(short.tile_entries > short.tile_capacity, "the bins held every entry: {short:?}");
+    assert!(short.fragments < all, "fragments of entries past the bins were kept: {short:?}");
+    assert!(mae(&first, &whole) > 0.5, "a frame missing entries looks whole");
+    let second = draw(&gpu, &mut s);
+    let grown = s.renderer.transparency_stats().expect("stats");
+    println!("grown: {grown:?}");
+    assert!(grown.tile_entries <= grown.tile_capacity, "the bins did not grow: {grown:?}");
+    assert_eq!(grown.fragments, all, "{grown:?}");
+    assert!(mae(&second, &whole) < 0.05, "the grown bins draw other hair: {:.3}", mae(&second, &whole));
 }

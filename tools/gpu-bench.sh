@@ -16,8 +16,8 @@
 #           detail off) with transparency (the default exact mode) at
 #           1920×1080 (strands_frame.json);
 #   2. the frame's goals (frame/), each figure beside its bound and whether it
-#      is met, for both rasterisers of the exact mode (--raster hardware and
-#      compute): the hair passes' GPU ms (the per-pass table's top-level
+#      is met, for each rasteriser of the exact mode (--raster hardware,
+#      compute and tiles): the hair passes' GPU ms (the per-pass table's top-level
 #      `vkhair render:` rows, the host's head mesh and the simulation left out)
 #      of the thesis at 1920×1080 (≤ 1.5 ms, and exact ≤ 1.2 × opaque on the
 #      same frame), 1,001,000 strands with both shadowed lights (≤ 20 ms),
@@ -168,7 +168,7 @@ echo "d. the frame's goals, hair passes (GPU timestamps, mean ms a frame)" >>"$r
 "$vkhair" grow --scalp sphere --strands "$((smoke == 1 ? 2000 : 20000))" --points 24 --out "$frame/dense.hair" \
   >>"$log" 2>&1
 size=(--width "$width" --height "$height" --frames "$frames")
-for raster in hardware compute; do
+for raster in hardware compute tiles; do
   echo " --raster $raster" >>"$report"
   # The opaque frame's strands always go through the hardware; its maps by --raster.
   frame_goal "thesis_off_$raster" "thesis ${width}×${height}, opaque" 1.5 ".*" "${size[@]}" --raster "$raster" \

@@ -3,15 +3,7 @@
 #ifndef VKHAIR_OIT_GLSL
 #define VKHAIR_OIT_GLSL
 
-// OIT_END, the end of a pixel's list and the "no opaque layer" depth word, is
-// injected by build.rs from src/codes.rs.
-// A fragment at least this opaque counts as the pixel's opaque layer: the
-// nearest such depth is written to the target's depth image.
-const float OIT_OPAQUE_ALPHA = 0.5;
-// Fragments fainter than this are not stored (1/1024: below an 8-bit step).
-const float OIT_LEAST_ALPHA = 1.0 / 1024.0;
-
-#include "oit_counters.glsl"
+#include "oit_opaque.glsl"
 // Per pixel: the newest node of its list (exact mode), OIT_END for none.
 layout(std430, set = 0, binding = 10) buffer OitHeads { uint oit_heads[]; };
 // The node pool, split over up to eight buffers (one binding's range is
@@ -26,8 +18,6 @@ layout(std430, set = 0, binding = 16) buffer OitNodes4 { uvec4 oit_nodes4[]; };
 layout(std430, set = 0, binding = 17) buffer OitNodes5 { uvec4 oit_nodes5[]; };
 layout(std430, set = 0, binding = 18) buffer OitNodes6 { uvec4 oit_nodes6[]; };
 layout(std430, set = 0, binding = 19) buffer OitNodes7 { uvec4 oit_nodes7[]; };
-// Per pixel: the nearest depth (float bits) of a fragment of alpha ≥ OIT_OPAQUE_ALPHA.
-layout(std430, set = 0, binding = 12) buffer OitOpaque { uint oit_opaque[]; };
 
 // Buffers the pool is split over (the pipeline's specialisation constant 0,
 // set from the pool by exact.rs; 8, the most, by default). With one buffer the

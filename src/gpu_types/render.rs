@@ -174,6 +174,21 @@ gpu_struct!(OitCounters => "OitCounters" {
     used, capacity, width, sorted, pool_nodes, height, hair_x0, hair_y0, hair_x1, hair_y1, scene_depth, reverse_z
 });
 
+/// The tiled rasteriser's per-frame words (`TileCounters` in `glsl/include/tile_lists.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct TileCounters {
+    /// Tile entries the frame's segments asked for (written by the scan).
+    pub entries: u32,
+    /// Entries the list holds; those past it are not drawn.
+    pub capacity: u32,
+    /// Tiles per row.
+    pub tiles_x: u32,
+    /// Rows of tiles.
+    pub tiles_y: u32,
+}
+gpu_struct!(TileCounters => "TileCounters" { entries, capacity, tiles_x, tiles_y });
+
 /// Push constants of the Marschner table builder (`MarschnerPush` in `glsl/include/marschner.glsl`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]

@@ -125,11 +125,12 @@ pub enum Transparency {
 
 /// Who rasterises the strands of [`Transparency::Exact`] and of the deep
 /// opacity maps (with the `clap` feature, a command-line value: `auto`,
-/// `hardware`, `compute`). The other transparency modes always draw through
-/// the hardware raster pipeline.
+/// `hardware`, `compute`, `tiles`). The other transparency modes always draw
+/// through the hardware raster pipeline.
 ///
-/// For the exact mode both rasterisers feed the same per-pixel lists and the
-/// same composite; they differ in how a segment becomes fragments:
+/// For the exact mode the hardware and compute rasterisers feed the same
+/// per-pixel lists and the same composite; they differ in how a segment
+/// becomes fragments:
 ///
 /// - the hardware raster pipeline draws each segment as a camera-facing ribbon
 ///   (two triangles) whose fragments compute their coverage;
@@ -150,7 +151,9 @@ pub enum Transparency {
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum Raster {
-    /// The compute rasteriser on GPUs (discrete, integrated, virtual); on a CPU
+    /// On GPUs (discrete, integrated, virtual) the compute rasteriser for the
+    /// strands ([`Raster::Compute`], measured faster there than
+    /// [`Raster::Tiles`]) and for the maps; on a CPU
     /// device (lavapipe) the one measured faster there, for the strands
     /// ([`Raster::resolve`]: the hardware) and for the maps
     /// ([`Raster::resolve_shadows`]: the compute rasteriser).
@@ -160,19 +163,28 @@ pub enum Raster {
     /// Ribbons through the hardware raster pipeline.
     #[cfg_attr(feature = "clap", value(help = "Ribbons through the hardware raster pipeline"))]
     Hardware,
-    /// vkhair's compute rasteriser.
-    #[cfg_attr(feature = "clap", value(help = "vkhair's compute rasteriser"))]
+    /// vkhair's compute rasteriser, one invocation a segment into per-pixel lists.
+    #[cfg_attr(feature = "clap", value(help = "vkhair's compute rasteriser, per-pixel lists"))]
     Compute,
+    /// vkhair's tiled compute rasteriser: the segments binned into screen
+    /// tiles, each tile's fragments sorted in one workgroup's shared memory
+    /// (`render/draw/tiles.rs`), no per-pixel lists. The same fragments as
+    /// [`Raster::Compute`] (one definition, `glsl/include/strand_segment.glsl`)
+    /// and the same K nearest and tail per pixel, every fragment sorted or in
+    /// the tail (no pool to overflow). The deep opacity maps draw with
+    /// [`Raster::Compute`].
+    #[cfg_attr(feature = "clap", value(help = "vkhair's tiled compute rasteriser, no per-pixel lists"))]
+    Tiles,
 }
 
 impl Raster {
     /// The rasteriser this choice names for the exact mode's strands on a
-    /// device of type `device_type`: [`Raster::Hardware`] or
-    /// [`Raster::Compute`], never [`Raster::Auto`].
+    /// device of type `device_type`: [`Raster::Hardware`],
+    /// [`Raster::Compute`] or [`Raster::Tiles`], never [`Raster::Auto`].
     pub fn resolve(self, device_type: ash::vk::PhysicalDeviceType) -> Raster {
         match self {
             Raster::Auto if device_type == ash::vk::PhysicalDeviceType::CPU => CPU_DEVICE_STRANDS,
-            Raster::Auto => Raster::Compute,
+            Raster::Auto => GPU_STRANDS,
             chosen => chosen,
         }
     }
@@ -183,11 +195,22 @@ impl Raster {
     pub fn resolve_shadows(self, device_type: ash::vk::PhysicalDeviceType) -> Raster {
         match self {
             Raster::Auto if device_type == ash::vk::PhysicalDeviceType::CPU => CPU_DEVICE_SHADOWS,
-            Raster::Auto => Raster::Compute,
+            Raster::Auto | Raster::Tiles => Raster::Compute,
             chosen => chosen,
         }
     }
 }
+
+/// What [`Raster::Auto`] picks on a GPU for the exact mode's strands: the
+/// one faster there. Measured on an NVIDIA H100 (`tools/gpu-bench.sh`'s
+/// frames, the hair passes' GPU ms, the same binary): the thesis at 1920×1080
+/// 2.11 against 2.59 through the tiled rasteriser, Sintel at the peer's
+/// geometry 0.76 against 1.13, its close-up 1.23 against 1.66, 1,001,000
+/// strands 49.9 against 56.4 — the per-segment rasteriser's atomics on the
+/// per-pixel lists cost that GPU less than a tile's workgroup sorting its
+/// fragments in shared memory. The tiled one needs no per-pixel lists: at
+/// 3840×2160 the thesis took 189 MiB against 1,360 MiB.
+const GPU_STRANDS: Raster = Raster::Compute;
 
 /// What [`Raster::Auto`] picks on a CPU device (lavapipe) for the exact
 /// mode's strands: the one faster there. Measured on lavapipe (Mesa 22.3.6, 2
@@ -272,11 +295,19 @@ pub struct OitParams {
     /// else 65,536..=4,294,967,295 (the device's limits still apply), e.g. to
     /// keep each buffer within a host allocator's block. Default: 0.
     pub max_buffer_bytes: u32,
+    /// Entries of the tiled rasteriser's bins ([`Raster::Tiles`]) per hair
+    /// vertex the renderer can draw (0.1..=256; 4 bytes each; at least 256 a
+    /// tile of the target): a segment takes one entry for each screen tile of
+    /// 16 × 16 pixels its band reaches. A
+    /// frame whose segments ask for more draws the entries that fit and says
+    /// so ([`super::OitStats::tile_entries`]); the bins of the frames after it
+    /// grow to what it asked for. Default: 4.
+    pub tile_entries_per_segment: f32,
 }
 
 impl Default for OitParams {
     fn default() -> Self {
-        OitParams { sorted_fragments: 8, fragments_per_pixel: 8.0, max_buffer_bytes: 0 }
+        OitParams { sorted_fragments: 8, fragments_per_pixel: 8.0, max_buffer_bytes: 0, tile_entries_per_segment: 4.0 }
     }
 }
 
@@ -363,6 +394,10 @@ impl RenderParams {
         let b = self.oit.max_buffer_bytes;
         if b != 0 && b < MIN_POOL_BUFFER_BYTES {
             return Err(Error::param("oit.max_buffer_bytes", b, format!("0 or {MIN_POOL_BUFFER_BYTES}..=4294967295")));
+        }
+        let e = self.oit.tile_entries_per_segment;
+        if !(e.is_finite() && (0.1..=256.0).contains(&e)) {
+            return Err(Error::param("oit.tile_entries_per_segment", e, "0.1..=256"));
         }
         let lod = &self.lod;
         let d = lod.full_detail_distance;

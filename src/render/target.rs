@@ -20,11 +20,11 @@ pub struct RenderTarget {
     /// The image behind `depth` (its mip level 0 and array layer 0 are the ones
     /// the view shows; a depth-only format: `D32_SFLOAT`, `X8_D24_UNORM_PACK32`
     /// or `D16_UNORM`), created with `TRANSFER_SRC` usage, or null. The compute
-    /// rasteriser ([`super::Raster::Compute`]) copies the host's depth out of
+    /// rasterisers ([`super::Raster::Compute`], [`super::Raster::Tiles`]) copy the host's depth out of
     /// it to test each hair fragment against (its depth aspect passes through
     /// `TRANSFER_SRC_OPTIMAL` and is back in `DEPTH_ATTACHMENT_OPTIMAL` before
-    /// the draw returns); with a depth view and a null image, that rasteriser
-    /// refuses the target. The hardware raster pipeline never reads it.
+    /// the draw returns); with a depth view and a null image, they refuse the
+    /// target. The hardware raster pipeline never reads it.
     pub depth_image: vk::Image,
     /// Extent of both.
     pub extent: vk::Extent2D,

@@ -208,6 +208,7 @@ fn every_shader_struct_matches_its_rust_twin() {
         gpu_types::GpuLight::GLSL_NAME,
         gpu_types::DrawParams::GLSL_NAME,
         gpu_types::OitCounters::GLSL_NAME,
+        gpu_types::TileCounters::GLSL_NAME,
         gpu_types::MarschnerPush::GLSL_NAME,
         gpu_types::GpuVolumeParams::GLSL_NAME,
         gpu_types::VolumePush::GLSL_NAME,

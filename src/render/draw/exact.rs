@@ -40,6 +40,13 @@ pub(super) fn shaders(sorted: u32, raster: Raster) -> ModeShaders {
         _ => variants[3],
     };
     match raster {
+        // The fine pass rasterises and resolves each tile (tiles.rs); the
+        // build's dispatches are the bins' own.
+        Raster::Tiles => ModeShaders {
+            build: &RENDER_OIT_BUILD_FRAG,
+            composite: &RENDER_OIT_RESOLVED_FRAG,
+            resolve: Some(super::tiles::fine_shader(sorted)),
+        },
         Raster::Compute => ModeShaders {
             build: &RENDER_OIT_BUILD_FRAG,
             composite: &RENDER_OIT_RESOLVED_FRAG,

@@ -25,6 +25,7 @@ mod opaque;
 mod raster;
 mod ribbons;
 mod shading;
+mod tiles;
 mod transparent;
 
 use std::sync::Arc;
@@ -404,9 +405,10 @@ impl Renderer {
     /// supersampled extent where supersampling is on) on this device: what
     /// [`OitParams::fragments_per_pixel`] asks for and what the device's buffers
     /// hold ([`OitPool::is_capped`] when fewer). `None` unless the current mode
-    /// is [`Transparency::Exact`].
+    /// is [`Transparency::Exact`] with per-pixel lists (the tiled rasteriser,
+    /// [`Raster::Tiles`], keeps none).
     pub fn transparency_pool(&self, extent: vk::Extent2D) -> Option<OitPool> {
-        if self.params.transparency != Transparency::Exact {
+        if self.params.transparency != Transparency::Exact || self.raster() == Raster::Tiles {
             return None;
         }
         Some(OitPool::plan(&self.device.info, &self.params.oit, self.drawn_extent(extent)))

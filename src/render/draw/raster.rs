@@ -40,15 +40,20 @@ const OVERFLOW_PLANE_BYTES: [u64; 2] = [12, 8];
 pub(super) struct RasterBuffers {
     /// The target's depth, a 32-bit word a pixel (16-bit depths two a word).
     scene_depth: Buffer,
-    /// Fixed-point overflow sums, in two planes.
-    overflow: [Buffer; 2],
+    /// Fixed-point overflow sums, in two planes (none for the tiled
+    /// rasteriser, which keeps every fragment: `tiles.rs`).
+    overflow: Option<[Buffer; 2]>,
 }
 
 impl RasterBuffers {
-    /// The buffers for a target of `extent` on `device`: an error where a
-    /// plane would exceed one binding's range.
-    pub(super) fn new(device: &Arc<Device>, extent: vk::Extent2D) -> Result<Self> {
+    /// The buffers for a target of `extent` on `device`, the overflow sums
+    /// `with_overflow`: an error where a plane would exceed one binding's range.
+    pub(super) fn new(device: &Arc<Device>, extent: vk::Extent2D, with_overflow: bool) -> Result<Self> {
         let pixels = pixels(extent);
+        let plane = |name, bytes: u64| Buffer::storage(device, name, bytes * pixels);
+        if !with_overflow {
+            return Ok(RasterBuffers { scene_depth: plane("vkhair compute raster scene depth", 4)?, overflow: None });
+        }
         let largest = OVERFLOW_PLANE_BYTES[0] * pixels;
         if largest > u64::from(device.info.max_storage_buffer_range) {
             return Err(Error::incompatible(
@@ -61,28 +66,28 @@ impl RasterBuffers {
                 ),
             ));
         }
-        let plane = |name, bytes: u64| Buffer::storage(device, name, bytes * pixels);
         Ok(RasterBuffers {
-            scene_depth: Buffer::storage(device, "vkhair compute raster scene depth", 4 * pixels)?,
-            overflow: [
+            scene_depth: plane("vkhair compute raster scene depth", 4)?,
+            overflow: Some([
                 plane("vkhair compute raster overflow colour", OVERFLOW_PLANE_BYTES[0])?,
                 plane("vkhair compute raster overflow alpha", OVERFLOW_PLANE_BYTES[1])?,
-            ],
+            ]),
         })
     }
 
-    /// Bytes of the buffers at `extent`.
-    pub(super) fn memory_bytes(extent: vk::Extent2D) -> u64 {
-        (4 + OVERFLOW_PLANE_BYTES[0] + OVERFLOW_PLANE_BYTES[1]) * pixels(extent)
+    /// Bytes of the buffers at `extent`, the overflow sums `with_overflow`.
+    pub(super) fn memory_bytes(extent: vk::Extent2D, with_overflow: bool) -> u64 {
+        let overflow = if with_overflow { OVERFLOW_PLANE_BYTES[0] + OVERFLOW_PLANE_BYTES[1] } else { 0 };
+        (4 + overflow) * pixels(extent)
     }
 
     /// The buffers by binding.
-    pub(super) fn bindings(&self) -> [(u32, &Buffer); 3] {
-        [
-            (SCENE_DEPTH_BINDING, &self.scene_depth),
-            (OVERFLOW_BINDINGS[0], &self.overflow[0]),
-            (OVERFLOW_BINDINGS[1], &self.overflow[1]),
-        ]
+    pub(super) fn bindings(&self) -> Vec<(u32, &Buffer)> {
+        let mut out = vec![(SCENE_DEPTH_BINDING, &self.scene_depth)];
+        if let Some([colour, alpha]) = &self.overflow {
+            out.extend([(OVERFLOW_BINDINGS[0], colour), (OVERFLOW_BINDINGS[1], alpha)]);
+        }
+        out
     }
 }
 
@@ -163,7 +168,7 @@ impl RasterBuffers {
     ) {
         // SAFETY: guaranteed by the caller.
         unsafe {
-            for plane in &self.overflow {
+            for plane in self.overflow.iter().flatten() {
                 device.raw.cmd_fill_buffer(cmd, plane.raw(), 0, vk::WHOLE_SIZE, 0);
             }
         }

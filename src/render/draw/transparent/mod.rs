@@ -42,6 +42,7 @@ use super::fast::{self, WeightedSums};
 use super::raster::{DepthSource, RasterBuffers};
 use super::ribbons::RibbonIndices;
 use super::shading::ShadingResources;
+use super::tiles::{self, BinPipelines, TileBins};
 use super::{DrawFrame, TargetKey};
 use crate::codes::sentinel::OIT_END;
 use crate::error::{Error, Result};
@@ -88,6 +89,13 @@ pub struct OitStats {
     /// more than `capacity` where the device's buffers could not hold them
     /// (see [`OitPool`]).
     pub requested: u64,
+    /// Tile entries the tiled rasteriser's segments asked for
+    /// ([`Raster::Tiles`]; 0 with the other rasterisers): the frame drew those
+    /// within `tile_capacity`, and later frames' bins hold them all.
+    pub tile_entries: u64,
+    /// Entries the tiled rasteriser's bins held for the frame (0 with the
+    /// other rasterisers; see [`OitParams::tile_entries_per_segment`]).
+    pub tile_capacity: u64,
     /// The pixels the composite ran over, `[x0, y0, x1, y1]` (the last column
     /// and row excluded; rows from the top; pixels of the drawn target, twice
     /// each side with supersampling): a rectangle holding every pixel the
@@ -102,6 +110,8 @@ enum Build {
     Ribbons(GraphicsPipeline, vk::DescriptorSet),
     /// The compute rasteriser (`strand_raster.comp`, `raster.rs`).
     Compute(ComputePipeline, vk::DescriptorSet),
+    /// The tiled rasteriser's bins (`tiles.rs`; its fine pass is the resolve).
+    Tiles(Box<BinPipelines>),
 }
 
 /// The pipelines of one target and their descriptor sets.
@@ -125,8 +135,11 @@ struct Resources {
     lists: Option<Lists>,
     /// Weighted sums and absorbance (fast mode; the hardware build's overflow).
     sums: Option<WeightedSums>,
-    /// The compute rasteriser's copy of the target's depth and its overflow sums.
+    /// The compute rasterisers' copy of the target's depth (and the
+    /// per-segment one's overflow sums).
     raster_buffers: Option<RasterBuffers>,
+    /// The tiled rasteriser's bins.
+    tiles: Option<TileBins>,
     /// The compute rasteriser's exact mode: per pixel its resolved hair
     /// (`oit_resolve.comp`; four half floats), which the composite blends.
     resolved: Option<Buffer>,
@@ -140,12 +153,19 @@ impl Resources {
         self.lists.as_ref().map(|l| l.pool)
     }
 
-    /// Who makes the fragments: the compute rasteriser where its buffers are.
+    /// Who makes the fragments: the tiled rasteriser where its bins are, the
+    /// compute rasteriser where its buffers are.
     fn raster(&self) -> Raster {
-        match self.raster_buffers {
-            Some(_) => Raster::Compute,
-            None => Raster::Hardware,
+        match (&self.tiles, &self.raster_buffers) {
+            (Some(_), _) => Raster::Tiles,
+            (None, Some(_)) => Raster::Compute,
+            (None, None) => Raster::Hardware,
         }
+    }
+
+    /// The tiled rasteriser's entries: those it holds.
+    fn tile_capacity(&self) -> Option<u64> {
+        self.tiles.as_ref().map(TileBins::capacity)
     }
 }
 
@@ -161,6 +181,9 @@ pub(super) struct TransparentPass {
     nearest: Sampler,
     current: Option<Resources>,
     retired: Vec<(u64, Resources)>,
+    /// Tile entries an earlier frame asked for beyond its bins' capacity: the
+    /// next bins hold at least this many.
+    tile_demand: u64,
 }
 
 impl TransparentPass {
@@ -182,6 +205,7 @@ impl TransparentPass {
             nearest: Sampler::nearest(device, "vkhair transparency sums")?,
             current: None,
             retired: Vec::new(),
+            tile_demand: 0,
         })
     }
 
@@ -195,20 +219,34 @@ impl TransparentPass {
         extent: vk::Extent2D,
     ) -> u64 {
         let pixels = u64::from(extent.width) * u64::from(extent.height);
-        // Both: the counters, the vertex colours, a depth word per pixel and
-        // the overflow: the weighted sums, or the compute rasteriser's buffers.
-        let overflow = match raster {
-            Raster::Compute => RasterBuffers::memory_bytes(extent),
+        // All: the counters, the vertex colours, a depth word per pixel and
+        // the overflow: the weighted sums, or the compute rasterisers' buffers.
+        let overflow = match (mode, raster) {
+            (Transparency::Exact, Raster::Compute) => RasterBuffers::memory_bytes(extent, true),
+            (Transparency::Exact, Raster::Tiles) => RasterBuffers::memory_bytes(extent, false),
             _ => fast::BYTES_PER_PIXEL * pixels,
         };
         let shared = std::mem::size_of::<OitCounters>() as u64 + self.colors.size() + 4 * pixels + overflow;
-        // The compute rasteriser's exact mode resolves into a buffer first.
-        let resolved = if raster == Raster::Compute { RESOLVED_BYTES_PER_PIXEL * pixels } else { 0 };
-        match mode {
-            Transparency::Off => 0,
-            Transparency::Exact => shared + resolved + Lists::memory_bytes(&OitPool::plan(info, params, extent)),
-            Transparency::Fast => shared,
+        // The compute rasterisers' exact mode resolves into a buffer first.
+        let resolved = RESOLVED_BYTES_PER_PIXEL * pixels;
+        match (mode, raster) {
+            (Transparency::Off, _) => 0,
+            (Transparency::Exact, Raster::Tiles) => {
+                shared + resolved + TileBins::memory_bytes(extent, self.tile_capacity(info, params, extent))
+            }
+            (Transparency::Exact, Raster::Compute) => {
+                shared + resolved + Lists::memory_bytes(&OitPool::plan(info, params, extent))
+            }
+            (Transparency::Exact, _) => shared + Lists::memory_bytes(&OitPool::plan(info, params, extent)),
+            (Transparency::Fast, _) => shared,
         }
+    }
+
+    /// Entries of the tiled rasteriser's bins with `params` on a device with
+    /// `info`'s limits: per hair vertex the renderer can draw, or what an
+    /// earlier frame asked for.
+    fn tile_capacity(&self, info: &DeviceInfo, params: &OitParams, extent: vk::Extent2D) -> u64 {
+        tiles::capacity(info, params, (self.colors.size() / 16, extent), self.tile_demand)
     }
 
     /// Drops every pipeline and set (the draw's inputs changed); the caller made
@@ -234,18 +272,35 @@ impl TransparentPass {
     /// valid once that frame completed and before the next one is submitted.
     pub(super) fn stats(&self) -> Option<OitStats> {
         // The current resources are those of the latest transparent frame.
-        let pool = self.current.as_ref().filter(|r| r.mode == Transparency::Exact)?.pool()?;
+        let res = self.current.as_ref().filter(|r| r.mode == Transparency::Exact)?;
         let bytes = self.counters.mapped()?;
         let counters: OitCounters = bytemuck::pod_read_unaligned(bytes.get(..std::mem::size_of::<OitCounters>())?);
-        let stored = counters.used.min(counters.capacity);
         let rect = [counters.hair_x0, counters.hair_y0, counters.hair_x1, counters.hair_y1];
+        let composited = (rect[0] < rect[2] && rect[1] < rect[3]).then_some(rect);
+        if let Some(bins) = &res.tiles {
+            // Every kept fragment is sorted or in the tail: no pool.
+            return Some(OitStats {
+                fragments: u64::from(counters.used),
+                stored: u64::from(counters.used),
+                overflowed: 0,
+                capacity: 0,
+                requested: 0,
+                tile_entries: bins.entries_asked()?,
+                tile_capacity: bins.capacity(),
+                composited,
+            });
+        }
+        let pool = res.pool()?;
+        let stored = counters.used.min(counters.capacity);
         Some(OitStats {
             fragments: u64::from(counters.used),
             stored: u64::from(stored),
             overflowed: u64::from(counters.used - stored),
             capacity: u64::from(counters.capacity),
             requested: pool.requested,
-            composited: (rect[0] < rect[2] && rect[1] < rect[3]).then_some(rect),
+            tile_entries: 0,
+            tile_capacity: 0,
+            composited,
         })
     }
 }
@@ -262,11 +317,26 @@ impl TransparentPass {
         raster: Raster,
         extent: vk::Extent2D,
     ) -> Result<()> {
+        let tiled = mode == Transparency::Exact && raster == Raster::Tiles;
         let pool = match mode {
-            Transparency::Exact => Some(OitPool::plan(&self.device.info, params, extent)),
+            Transparency::Exact if !tiled => Some(OitPool::plan(&self.device.info, params, extent)),
             _ => None,
         };
-        let fits = |r: &Resources| r.extent == extent && r.mode == mode && r.pool() == pool && r.raster() == raster;
+        // The bins grow to what the latest frame asked for (read once it
+        // completed; an earlier frame's or zero while it runs).
+        if let Some(asked) = self.current.as_ref().and_then(|r| r.tiles.as_ref()).and_then(TileBins::entries_asked) {
+            if asked > self.current.as_ref().and_then(Resources::tile_capacity).unwrap_or(u64::MAX) {
+                self.tile_demand = self.tile_demand.max(asked + asked / 4);
+            }
+        }
+        let bins = tiled.then(|| self.tile_capacity(&self.device.info, params, extent));
+        let fits = |r: &Resources| {
+            r.extent == extent
+                && r.mode == mode
+                && r.pool() == pool
+                && r.raster() == raster
+                && r.tile_capacity() == bins
+        };
         if let Some(old) = self.current.take_if(|r| !fits(r)) {
             // Frames up to the previous one may still be using them.
             self.retired.push((frame.saturating_sub(1), old));
@@ -291,16 +361,20 @@ impl TransparentPass {
             None => None,
         };
         let pixels = u64::from(extent.width) * u64::from(extent.height);
-        let compute = raster == Raster::Compute;
+        let compute = raster == Raster::Compute || tiled;
         self.current = Some(Resources {
             extent,
             mode,
             opaque: Buffer::storage(d, "vkhair transparency opaque depth", 4 * pixels)?,
             lists,
             sums: if compute { None } else { Some(WeightedSums::new(d, extent)?) },
-            raster_buffers: if compute { Some(RasterBuffers::new(d, extent)?) } else { None },
-            resolved: match (compute, pool) {
-                (true, Some(_)) => {
+            raster_buffers: if compute { Some(RasterBuffers::new(d, extent, !tiled)?) } else { None },
+            tiles: match bins {
+                Some(capacity) => Some(TileBins::new(d, extent, capacity)?),
+                None => None,
+            },
+            resolved: match (compute, mode) {
+                (true, Transparency::Exact) => {
                     Some(Buffer::storage(d, "vkhair transparency resolved pixels", RESOLVED_BYTES_PER_PIXEL * pixels)?)
                 }
                 _ => None,
@@ -334,7 +408,7 @@ impl TransparentPass {
                 "transparent hair needs a single-sample target (use supersampling for more samples)",
             ));
         }
-        let compute = raster == Raster::Compute;
+        let compute = raster != Raster::Hardware;
         // Checked, made (or found) before anything is recorded: a failure leaves `cmd` as it was.
         let depth_source = if compute { DepthSource::of(target)? } else { DepthSource::None };
         self.prepare(frame.frame, mode, params, raster, target.extent)?;
@@ -447,6 +521,9 @@ impl TransparentPass {
             if let Some(buffers) = &res.raster_buffers {
                 buffers.record_inputs(d, cmd, depth_source, target.extent);
             }
+            if let Some(bins) = &res.tiles {
+                bins.record_clear(d, cmd);
+            }
             d.cmd_barrier(cmd, &[cleared, shaded], &[], &[]);
             let build_label = format!("{}, build", RenderPass::Draw.label());
             let inner = PassScope::open(d, cmd, timing, &build_label, LabelColor::Graphics);
@@ -467,6 +544,7 @@ impl TransparentPass {
                     let segments = frame.segments.min(MAX_WORKGROUPS.saturating_mul(per_group));
                     pipeline.dispatch_threads(cmd, [segments, 1, 1]);
                 }
+                Build::Tiles(bins) => bins.record(d, cmd, frame.segments),
             }
             inner.close(d, cmd, timing);
             scope.close(d, cmd, timing);
@@ -474,10 +552,21 @@ impl TransparentPass {
             let scope = RenderPass::Composite.open(d, cmd, timing);
             d.cmd_barrier(cmd, &[built, depth_order], &[], &from_sums);
             if let Some((pipeline, set)) = &pipelines.resolve {
-                let resolve_label = format!("{}, resolve in compute", RenderPass::Composite.label());
+                let what = if res.tiles.is_some() { "tiles drawn and resolved" } else { "resolve in compute" };
+                let resolve_label = format!("{}, {what}", RenderPass::Composite.label());
                 let inner = PassScope::open(d, cmd, timing, &resolve_label, LabelColor::Compute);
-                pipeline.bind_variant(cmd, pool.map_or(1, |p| p.buffers), &[*set]);
-                pipeline.dispatch_threads(cmd, [target.extent.width, target.extent.height, 1]);
+                match &res.tiles {
+                    // One workgroup a tile: its size is the tile's.
+                    Some(bins) => {
+                        pipeline.bind(cmd, &[*set]);
+                        let [x, y] = bins.grid();
+                        pipeline.dispatch_groups(cmd, [x, y, 1], 1);
+                    }
+                    None => {
+                        pipeline.bind_variant(cmd, pool.map_or(1, |p| p.buffers), &[*set]);
+                        pipeline.dispatch_threads(cmd, [target.extent.width, target.extent.height, 1]);
+                    }
+                }
                 d.cmd_barrier(cmd, &[resolved], &[], &[]);
                 inner.close(d, cmd, timing);
             }

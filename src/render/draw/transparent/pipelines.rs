@@ -5,6 +5,7 @@ use ash::vk;
 use super::{Build, Pipelines, TransparentPass, RESOLVED_BINDING};
 use crate::error::{Error, Result};
 use crate::render::draw::shading::ShadingResources;
+use crate::render::draw::tiles::BinPipelines;
 use crate::render::draw::{DrawFrame, ModeShaders};
 use crate::render::Raster;
 use crate::vk::pipeline::{Blend, ComputePipeline, GraphicsDesc, GraphicsPipeline};
@@ -60,6 +61,9 @@ impl TransparentPass {
         if let Some(resolved) = &res.resolved {
             ours.push((RESOLVED_BINDING, resolved));
         }
+        if let Some(bins) = &res.tiles {
+            ours.extend(bins.bindings());
+        }
         let (shading_buffers, shading_images) = shading.bindings(&frame.inputs);
         let mut buffers = shading_buffers.to_vec();
         buffers.extend_from_slice(&ours);
@@ -73,6 +77,7 @@ impl TransparentPass {
         let rect_set = rect.declared_resource_set(0, &buffers, &[])?;
         let build_stages = [&RENDER_RIBBON_VERT_COVERAGE, shaders.build];
         let build = match res.raster() {
+            Raster::Tiles => Build::Tiles(Box::new(BinPipelines::new(d, &buffers, &shading_images)?)),
             Raster::Compute => {
                 // Constant 0: the pool's buffers (oit.glsl), as the hardware build's.
                 let mut pipeline = ComputePipeline::new(d, &RENDER_STRAND_RASTER_COMP, 1)?;
@@ -100,6 +105,12 @@ impl TransparentPass {
         };
 
         let resolve = match (shaders.resolve, &res.resolved) {
+            // The tiled rasteriser's fine pass walks the segments: the whole table.
+            (Some(shader), Some(_)) if res.tiles.is_some() => {
+                let pipeline = ComputePipeline::new(d, shader, 1)?;
+                let set = pipeline.declared_resource_set(0, &buffers, &shading_images)?;
+                Some((pipeline, set))
+            }
             (Some(shader), Some(_)) => {
                 // Constant 0: the pool's buffers (oit.glsl).
                 let mut pipeline = ComputePipeline::new(d, shader, 1)?;

@@ -361,6 +361,7 @@ impl FaceCover {
 fn rasteriser(raster: vkhair::render::Raster) -> &'static str {
     match raster {
         vkhair::render::Raster::Compute => "the compute rasteriser",
+        vkhair::render::Raster::Tiles => "the tiled compute rasteriser",
         _ => "the hardware raster pipeline",
     }
 }

@@ -1,0 +1,239 @@
+//! Pass 4 with [`Transparency::Exact`](crate::render::Transparency::Exact) and
+//! [`Raster::Tiles`](crate::render::Raster::Tiles): vkhair's tiled compute
+//! rasteriser. The segments are binned into screen tiles of
+//! [`TILE_SIZE`]² pixels and each tile is drawn by one workgroup whose
+//! fragments stay in its shared memory: no per-pixel lists, no node pool, no
+//! atomics on device memory per fragment.
+//!
+//! 1. **Count** (`tile_bin.comp`, the build's first dispatch): one invocation
+//!    a segment finds the tiles its band reaches and counts itself in each.
+//! 2. **Scan** (`tile_scan.comp`, one workgroup): the counts into each tile's
+//!    run of one list, and the total.
+//! 3. **Fill** (`tile_bin.comp`'s `VKHAIR_TILE_FILL` variant): each segment
+//!    writes its index into the runs of the tiles it reaches.
+//! 4. **Fine** (`tile_fine.comp`, in the composite's scope, where the list
+//!    path resolves): one workgroup a tile, one invocation a pixel; the
+//!    tile's segments walk their pixels within it (the same pixels and
+//!    fragments as the per-segment rasteriser, `strand_segment.glsl`) into
+//!    shared memory, and each invocation sorts its pixel's fragments into its
+//!    K-buffer (the same K nearest and tail as the list path's resolve,
+//!    `oit_kbuffer.glsl`), composites it and writes the nearest half-opaque
+//!    depth.
+//!
+//! Memory at an extent: per pixel the target's depth copy, the resolved
+//! colour and the opaque depth (16 bytes); per tile three words; the list, 4
+//! bytes an entry, sized by [`OitParams::tile_entries_per_segment`] (and at
+//! least [`LEAST_ENTRIES_PER_TILE`] a tile). A frame
+//! whose segments ask for more entries than the list holds draws the tiles'
+//! entries that fit ([`OitStats::tile_entries`](super::OitStats) says how many
+//! were asked for), and the next frame's list grows to hold them.
+
+use std::sync::Arc;
+
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+use crate::codes::tile::{SCAN_GROUP, SIZE as TILE_SIZE};
+use crate::error::Result;
+use crate::gpu_types::TileCounters;
+use crate::render::OitParams;
+use crate::vk::barrier::{self, AccessKind};
+use crate::vk::buffer::{Buffer, BufferDesc};
+use crate::vk::device::{Device, DeviceInfo};
+use crate::vk::pipeline::ComputePipeline;
+use crate::vk::shaders::{ShaderSource, RENDER_TILE_BIN_COMP, RENDER_TILE_BIN_COMP_TILE_FILL, RENDER_TILE_SCAN_COMP};
+
+/// Bindings (`tile_lists.glsl`): the counters, the three per-tile words, the list.
+const COUNTERS_BINDING: u32 = 29;
+const PER_TILE_BINDINGS: [u32; 3] = [30, 31, 32];
+const LIST_BINDING: u32 = 33;
+/// Bytes of one list entry (a segment's index).
+const ENTRY_BYTES: u64 = 4;
+/// Workgroups of a dispatch that every device runs (`maxComputeWorkGroupCount`'s minimum).
+const MAX_WORKGROUPS: u32 = 65_535;
+
+/// Tiles across and down a target of `extent`.
+pub(super) fn grid(extent: vk::Extent2D) -> [u32; 2] {
+    [extent.width.div_ceil(TILE_SIZE), extent.height.div_ceil(TILE_SIZE)]
+}
+
+/// Least entries of the list a tile of the target: few hairs drawn large (a
+/// close-up of a small groom at 4K) reach many tiles a segment, and the
+/// per-segment share alone would not hold their first frame.
+pub(super) const LEAST_ENTRIES_PER_TILE: u64 = 256;
+
+/// Entries of the list for `segments` drawn segments with `params` at
+/// `extent`, at least `demand` (what an earlier frame asked for), within one
+/// buffer on a device with `info`'s limits.
+pub(super) fn capacity(
+    info: &DeviceInfo,
+    params: &OitParams,
+    (segments, extent): (u64, vk::Extent2D),
+    demand: u64,
+) -> u64 {
+    let wanted = (segments as f64 * f64::from(params.tile_entries_per_segment)).ceil() as u64;
+    let [x, y] = grid(extent);
+    let least = LEAST_ENTRIES_PER_TILE * u64::from(x) * u64::from(y);
+    let most = (u64::from(info.max_storage_buffer_range).min(info.max_memory_allocation_size) / ENTRY_BYTES)
+        .min(u64::from(u32::MAX));
+    wanted.max(least).max(demand).clamp(1, most)
+}
+
+/// The bins of one extent: the counters (host-visible, so a later frame sees
+/// what this one asked for), the per-tile words and the list.
+pub(super) struct TileBins {
+    counters: Buffer,
+    per_tile: [Buffer; 3],
+    list: Buffer,
+    grid: [u32; 2],
+    capacity: u64,
+}
+
+impl TileBins {
+    /// The bins for a target of `extent` holding `capacity` entries.
+    pub(super) fn new(device: &Arc<Device>, extent: vk::Extent2D, capacity: u64) -> Result<Self> {
+        let grid = grid(extent);
+        let tiles = u64::from(grid[0]) * u64::from(grid[1]);
+        let counters = Buffer::new(
+            device,
+            &BufferDesc {
+                name: "vkhair tile counters",
+                size: std::mem::size_of::<TileCounters>() as u64,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuToCpu,
+            },
+        )?;
+        let word = |name| Buffer::storage(device, name, 4 * tiles);
+        Ok(TileBins {
+            counters,
+            per_tile: [word("vkhair tile counts")?, word("vkhair tile starts")?, word("vkhair tile cursors")?],
+            list: Buffer::storage(device, "vkhair tile list", ENTRY_BYTES * capacity)?,
+            grid,
+            capacity,
+        })
+    }
+
+    /// Bytes of the bins at `extent` holding `capacity` entries.
+    pub(super) fn memory_bytes(extent: vk::Extent2D, capacity: u64) -> u64 {
+        let [x, y] = grid(extent);
+        std::mem::size_of::<TileCounters>() as u64 + 12 * u64::from(x) * u64::from(y) + ENTRY_BYTES * capacity
+    }
+
+    /// Entries the list holds.
+    pub(super) fn capacity(&self) -> u64 {
+        self.capacity
+    }
+
+    /// Tiles across and down.
+    pub(super) fn grid(&self) -> [u32; 2] {
+        self.grid
+    }
+
+    /// Entries the latest frame's segments asked for, read from host-visible
+    /// memory: that frame's once it completed (an earlier one's, or zero,
+    /// while it runs).
+    pub(super) fn entries_asked(&self) -> Option<u64> {
+        let bytes = self.counters.mapped()?;
+        let counters: TileCounters = bytemuck::pod_read_unaligned(bytes.get(..std::mem::size_of::<TileCounters>())?);
+        Some(u64::from(counters.entries))
+    }
+
+    /// The bins' buffers by binding.
+    pub(super) fn bindings(&self) -> [(u32, &Buffer); 5] {
+        [
+            (COUNTERS_BINDING, &self.counters),
+            (PER_TILE_BINDINGS[0], &self.per_tile[0]),
+            (PER_TILE_BINDINGS[1], &self.per_tile[1]),
+            (PER_TILE_BINDINGS[2], &self.per_tile[2]),
+            (LIST_BINDING, &self.list),
+        ]
+    }
+
+    /// Records the counts zeroed and the counters set for the frame (transfer writes).
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of `device` outside a render pass;
+    /// earlier uses of the bins are ordered before by the caller's barrier.
+    pub(super) unsafe fn record_clear(&self, device: &Device, cmd: vk::CommandBuffer) {
+        let counters = TileCounters {
+            entries: 0,
+            // The plan keeps it within a word.
+            capacity: self.capacity.min(u64::from(u32::MAX)) as u32,
+            tiles_x: self.grid[0],
+            tiles_y: self.grid[1],
+        };
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            device.raw.cmd_fill_buffer(cmd, self.per_tile[0].raw(), 0, vk::WHOLE_SIZE, 0);
+            device.raw.cmd_update_buffer(cmd, self.counters.raw(), 0, bytemuck::bytes_of(&counters));
+        }
+    }
+}
+
+/// The fine pass's shader for K sorted fragments: the variant with the
+/// smallest K-buffer that holds K.
+pub(super) fn fine_shader(sorted: u32) -> &'static ShaderSource {
+    use crate::vk::shaders::{
+        RENDER_TILE_FINE_COMP, RENDER_TILE_FINE_COMP_SORT_16, RENDER_TILE_FINE_COMP_SORT_4,
+        RENDER_TILE_FINE_COMP_SORT_8,
+    };
+    match sorted {
+        0..=4 => &RENDER_TILE_FINE_COMP_SORT_4,
+        5..=8 => &RENDER_TILE_FINE_COMP_SORT_8,
+        9..=16 => &RENDER_TILE_FINE_COMP_SORT_16,
+        _ => &RENDER_TILE_FINE_COMP,
+    }
+}
+
+/// The build's three dispatches (count, scan, fill) and their descriptor sets.
+pub(super) struct BinPipelines {
+    count: (ComputePipeline, vk::DescriptorSet),
+    scan: (ComputePipeline, vk::DescriptorSet),
+    fill: (ComputePipeline, vk::DescriptorSet),
+}
+
+impl BinPipelines {
+    /// The pipelines, their sets bound to `buffers` and `images` (the
+    /// transparency pass's table, the bins' included).
+    pub(super) fn new(
+        device: &Arc<Device>,
+        buffers: &[(u32, &Buffer)],
+        images: &[(u32, vk::ImageView, vk::Sampler)],
+    ) -> Result<Self> {
+        let make = |shader| -> Result<(ComputePipeline, vk::DescriptorSet)> {
+            let pipeline = ComputePipeline::new(device, shader, 1)?;
+            let set = pipeline.declared_resource_set(0, buffers, images)?;
+            Ok((pipeline, set))
+        };
+        Ok(BinPipelines {
+            count: make(&RENDER_TILE_BIN_COMP)?,
+            scan: make(&RENDER_TILE_SCAN_COMP)?,
+            fill: make(&RENDER_TILE_BIN_COMP_TILE_FILL)?,
+        })
+    }
+
+    /// Records the count, the scan and the fill of `segments` segments, each
+    /// after the last (compute writes; the caller's barrier makes the fill's
+    /// visible to the fine pass).
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of `device` outside a render pass;
+    /// the bins were cleared ([`TileBins::record_clear`]) and the hair's
+    /// vertices and colours written, each made visible to compute reads.
+    pub(super) unsafe fn record(&self, device: &Device, cmd: vk::CommandBuffer, segments: u32) {
+        let after = barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::ComputeRead, AccessKind::ComputeWrite]);
+        let per_group = self.count.0.workgroup_size()[0];
+        let threads = segments.min(MAX_WORKGROUPS.saturating_mul(per_group));
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            self.count.0.bind(cmd, &[self.count.1]);
+            self.count.0.dispatch_threads(cmd, [threads, 1, 1]);
+            device.cmd_barrier(cmd, &[after], &[], &[]);
+            self.scan.0.bind(cmd, &[self.scan.1]);
+            self.scan.0.dispatch_threads(cmd, [SCAN_GROUP, 1, 1]);
+            device.cmd_barrier(cmd, &[after], &[], &[]);
+            self.fill.0.bind(cmd, &[self.fill.1]);
+            self.fill.0.dispatch_threads(cmd, [threads, 1, 1]);
+        }
+    }
+}
