@@ -564,3 +564,36 @@ fn a_point_far_beyond_any_scene_is_refused_naming_it() {
     let e = usd::open(&path).expect_err("refused").to_string();
     assert!(e.contains("e298") && e.contains("within 1e4 m of the origin") && !e.contains("NaN"), "{e}");
 }
+
+/// A binary layer's children lists are checked against its paths before the
+/// USD library composes them. The fixture's root lists its one child as token
+/// 5 (the four bytes at 104); set to the empty token (1) the library's
+/// composition went round a loop that never ended. That, a name the layer has
+/// no path for, a token past the table (a panic inside the library) and a
+/// name that is no identifier are each refused, naming the prim and what it
+/// lists, within seconds (a hang fails the test instead of stalling it).
+#[test]
+fn a_binary_prims_children_must_be_among_its_paths() {
+    let bytes = std::fs::read(data("usd/small_cm_zup.usdc")).expect("fixture");
+    assert_eq!(bytes[104..108], [5, 0, 0, 0], "the fixture's root's primChildren moved");
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (token, expected) in [
+        (1u8, "lists an empty name"),
+        (2, "lists \"metersPerUnit\", which the layer has no path for"),
+        (44, "lists token 44 of 44"),
+        (0, "a name that is not an identifier"),
+    ] {
+        let path = dir.path().join(format!("b{token}.usdc"));
+        let mut b = bytes.clone();
+        b[104] = token;
+        std::fs::write(&path, &b).expect("write");
+        let (send, receive) = std::sync::mpsc::channel();
+        let opened = path.clone();
+        std::thread::spawn(move || send.send(usd::open(&opened).map(|_| ()).map_err(|e| e.to_string())));
+        let result = receive
+            .recv_timeout(std::time::Duration::from_secs(60))
+            .unwrap_or_else(|_| panic!("token {token}: the reader did not return within a minute"));
+        let e = result.expect_err("refused");
+        assert!(e.contains(expected) && e.contains(&format!("b{token}.usdc")) && e.contains("primChildren"), "{e}");
+    }
+}

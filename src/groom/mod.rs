@@ -41,6 +41,7 @@ pub mod usd;
 mod usd_layers;
 pub mod usda_check;
 pub mod usdc_check;
+mod usdc_children;
 mod usdc_values;
 
 mod repair;

@@ -14,7 +14,9 @@
 //!   a list operation of tokens, strings, paths or integers: its count times
 //!   its item's size.
 //!
-//! Values inside dictionaries and time samples are not reached.
+//! Values inside dictionaries and time samples are not reached. Then the
+//! prims' children lists are checked against the layer's paths
+//! (`groom/usdc_children.rs`).
 
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
@@ -175,5 +177,5 @@ pub fn check(path: &Path, len: u64, version: (u8, u8, u8)) -> Result<()> {
             return Err(what(format!("starts at byte {at}, past the file's end ({len} bytes)")));
         }
     }
-    Ok(())
+    super::usdc_children::check(path)
 }
