@@ -42,21 +42,37 @@ fn bad_name(field: &str, name: &str) -> Option<&'static str> {
     }
 }
 
-/// The first item of the token list that value representation `rep` points
-/// at (a count, then 32-bit token indices; its count already bounded by the
-/// file's size) that lies past a table of `tokens` tokens.
-fn token_past_the_table(file: &mut std::fs::File, rep: u64, tokens: usize) -> std::result::Result<Option<u64>, String> {
+/// The crate type of a token vector.
+const TOKEN_VECTOR: u64 = 41;
+
+/// Why value representation `rep` cannot be read as a list of tokens from a
+/// table of `tokens`, if it cannot: not a token vector stored out of line, a
+/// count the file cannot hold, or the first item past the table (the crate
+/// indexes its table with each item unchecked).
+fn bad_token_list(file: &mut std::fs::File, rep: u64, tokens: usize) -> std::result::Result<Option<String>, String> {
     use std::io::{Read, Seek, SeekFrom};
+    let (ty, inlined) = ((rep >> 48) & 0xFF, rep & (1 << 62) != 0);
+    if ty != TOKEN_VECTOR || inlined {
+        return Ok(Some(format!("is not a token list (value type {ty})")));
+    }
     let at = rep & ((1 << 48) - 1);
+    let len = file.metadata().map_err(|e| format!("{e}"))?.len();
     let mut word = [0u8; 8];
+    if at.saturating_add(8) > len {
+        return Ok(Some(format!("starts at byte {at}, past the file's end ({len} bytes)")));
+    }
     file.seek(SeekFrom::Start(at)).and_then(|_| file.read_exact(&mut word)).map_err(|e| format!("{e}"))?;
     let count = u64::from_le_bytes(word);
-    let mut items = vec![0u8; usize::try_from(count.saturating_mul(4)).map_err(|e| format!("{e}"))?];
+    if count > (len - at - 8) / 4 {
+        return Ok(Some(format!("counts {count} tokens, more than the file holds")));
+    }
+    let mut items = vec![0u8; (count * 4) as usize];
     file.read_exact(&mut items).map_err(|e| format!("{e}"))?;
-    Ok(items
+    let past = items
         .chunks_exact(4)
         .map(|b| u64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])))
-        .find(|&index| index >= tokens as u64))
+        .find(|&index| index >= tokens as u64);
+    Ok(past.map(|index| format!("lists token {index} of {tokens}")))
 }
 
 /// Checks the children lists of the crate file at `path`.
@@ -75,9 +91,8 @@ pub fn check(path: &Path) -> Result<()> {
                 if name != "primChildren" && name != "propertyChildren" {
                     continue;
                 }
-                // The crate indexes its token table with each item unchecked.
-                if let Some(index) = token_past_the_table(&mut raw, field.value_rep.0, layer.tokens.len())? {
-                    return Ok(Some(format!("{parent}'s {name} lists token {index} of {}", layer.tokens.len())));
+                if let Some(why) = bad_token_list(&mut raw, field.value_rep.0, layer.tokens.len())? {
+                    return Ok(Some(format!("{parent}'s {name} {why}")));
                 }
                 let children = match layer.value(field.value_rep).map_err(|e| format!("{e:#}"))? {
                     openusd::sdf::Value::TokenVec(children) => children,
