@@ -80,9 +80,10 @@ layout(std430, set = 0, binding = 16) readonly buffer ScalpSource { float scalp_
 #include "scalp.glsl"
 
 shared vec4 s_pos[2][SIM_WORKGROUP];
-// DFTL mode: each point's rest length to its child, and its correction vector.
+// Each point's rest length to its child (DFTL mode keeps its correction
+// vectors in the local shape's s_local_offset: the modes do not meet, and the
+// step's shared memory bounds how many of its workgroups a multiprocessor holds).
 shared float s_length[SIM_WORKGROUP];
-shared vec3 s_correction[SIM_WORKGROUP];
 
 // The parameters of the sub-step being run, and where its colliders start.
 SimStepParams params;
@@ -237,7 +238,7 @@ void main() {
             if (live) {
                 own = s_pos[0][lid];
                 precise vec3 d = own.xyz - predicted.xyz;
-                s_correction[lid] = d;
+                s_local_offset[lid] = d;
             }
             sync(group);
         } else {
@@ -254,7 +255,7 @@ void main() {
             float dt = sim_dt(params);
             precise vec3 vel = (own.xyz - x.xyz) / dt;
             if ((flags & SIM_DFTL) != 0u && i + 1u < points) {
-                vel = vel - s_correction[lid + 1u] * (sim_dftl_damping(params) / dt);
+                vel = vel - s_local_offset[lid + 1u] * (sim_dftl_damping(params) / dt);
             }
             if ((flags & SIM_COLLISIONS) != 0u && own.w > 0.0) {
                 vel = sim_collider_friction_all(params, collider_base, own.xyz, vel, own_radius);

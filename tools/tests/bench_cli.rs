@@ -136,7 +136,7 @@ fn require_gpu_refuses_a_cpu_device() {
 
 /// `tools/gpu-bench.sh --smoke` runs every goal of the GPU report (the thesis
 /// frame, the four simulation steps, the drawn strands with transparency, the
-/// frame's goals for both rasterisers, the interpolation's cost a segment both
+/// frame's goals for each rasteriser, the interpolation's cost a segment both
 /// ways) at toy sizes and writes one report naming each with the device and a
 /// GPU figure, each step and frame goal's figure beside its bound.
 #[test]
@@ -192,7 +192,7 @@ fn the_gpu_bench_script_runs_every_goal_and_writes_one_report() {
     assert!(report.contains("d. the frame's goals"), "{report}");
     let sintel = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/sintel/sintel_hair.tfx");
     let per_raster = if sintel.exists() { 8 } else { 6 };
-    for raster in ["hardware", "compute"] {
+    for raster in ["hardware", "compute", "tiles"] {
         let section = report.split(&format!(" --raster {raster}\n")).nth(1).expect("the rasteriser's section");
         let lines: Vec<&str> = section.lines().take_while(|l| !l.starts_with(" --raster")).collect();
         let goals: Vec<&str> = lines.iter().copied().filter(|l| l.contains("goal ≤")).collect();

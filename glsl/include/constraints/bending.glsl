@@ -26,17 +26,21 @@ void bending_load(uint i, uint points, uint index) {
     if (i + 2u < points) {
         uint c = i + 1u;
         vec2 bk = bending_at(base, c, points);
-        if (bk.y > 0.0) {
-            uint set = (c & 3u) < 2u ? 0u : 1u;
-            bending_offset[set] = 2; bending_first[set] = true; bending_rest_k[set] = bk;
+        // Constant indices only: an array written at a computed index may
+        // live in memory rather than registers.
+        if (bk.y > 0.0 && (c & 3u) < 2u) {
+            bending_offset[0] = 2; bending_first[0] = true; bending_rest_k[0] = bk;
+        } else if (bk.y > 0.0) {
+            bending_offset[1] = 2; bending_first[1] = true; bending_rest_k[1] = bk;
         }
     }
     if (i >= 2u) {
         uint c = i - 1u;
         vec2 bk = bending_at(base, c, points);
-        if (bk.y > 0.0) {
-            uint set = (c & 3u) < 2u ? 0u : 1u;
-            bending_offset[set] = -2; bending_rest_k[set] = bk;
+        if (bk.y > 0.0 && (c & 3u) < 2u) {
+            bending_offset[0] = -2; bending_rest_k[0] = bk;
+        } else if (bk.y > 0.0) {
+            bending_offset[1] = -2; bending_rest_k[1] = bk;
         }
     }
 }
@@ -46,6 +50,8 @@ bool bending_on(uint it) {
 }
 
 vec4 bending_apply(uint set, vec4 own, uint lid, uint src) {
-    return constraint_project_end(own, lid, bending_offset[set], bending_first[set], bending_rest_k[set].x,
-                                  bending_rest_k[set].y, src);
+    return set == 0u ? constraint_project_end(own, lid, bending_offset[0], bending_first[0], bending_rest_k[0].x,
+                                              bending_rest_k[0].y, src)
+                     : constraint_project_end(own, lid, bending_offset[1], bending_first[1], bending_rest_k[1].x,
+                                              bending_rest_k[1].y, src);
 }

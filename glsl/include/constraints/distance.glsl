@@ -27,5 +27,7 @@ bool distance_on(uint it) {
 }
 
 vec4 distance_apply(uint set, vec4 own, uint lid, uint src) {
-    return constraint_project_end(own, lid, distance_offset[set], distance_first[set], distance_rest[set], 1.0, src);
+    // Set by a choice between constant indices (see bending_load).
+    return set == 0u ? constraint_project_end(own, lid, distance_offset[0], distance_first[0], distance_rest[0], 1.0, src)
+                     : constraint_project_end(own, lid, distance_offset[1], distance_first[1], distance_rest[1], 1.0, src);
 }

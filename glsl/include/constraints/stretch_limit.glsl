@@ -5,15 +5,10 @@
 // solve longer, whatever the iteration count. Twin:
 // src/sim/reference/constraints/stretch_limit.rs.
 
-// Per point i (its segment to i + 1), placed each sub-step: the longest the
-// segment may be.
-shared float s_stretch_most[SIM_WORKGROUP];
-
+// The longest each segment may be comes from its rest length in s_length
+// (no shared array of its own: the step's shared memory bounds how many of
+// its workgroups a multiprocessor holds).
 void stretch_limit_prepare(mat4 frame, uint lid, uint index, uint i, uint points) {
-    if (i + 1u < points) {
-        precise float most = rest_length[index] * (1.0 + sim_stretch_limit(params));
-        s_stretch_most[lid] = most;
-    }
 }
 
 bool stretch_limit_on(uint it) {
@@ -27,7 +22,7 @@ void stretch_limit_sweep(uint root, uint points, uint src) {
         vec4 child = s_pos[src][root + j];
         precise vec3 d = child.xyz - parent.xyz;
         precise float len = sqrt(sim_dot(d, d));
-        float most = s_stretch_most[root + j - 1u];
+        precise float most = s_length[root + j - 1u] * (1.0 + sim_stretch_limit(params));
         if (child.w > 0.0 && len > most) {
             precise vec3 placed = parent.xyz + d * (most / len);
             child.xyz = placed;
