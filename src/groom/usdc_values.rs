@@ -177,5 +177,5 @@ pub fn check(path: &Path, len: u64, version: (u8, u8, u8)) -> Result<()> {
             return Err(what(format!("starts at byte {at}, past the file's end ({len} bytes)")));
         }
     }
-    super::usdc_children::check(path)
+    super::usdc_children::check(path, version)
 }
