@@ -323,3 +323,20 @@ fn twenty_thousand_strands_read_back() {
     assert_eq!((g.groom.strand_count(), g.groom.point_count()), (20_000, 480_000));
     assert_eq!(g.groom.positions(), groom.positions());
 }
+
+/// An empty Alembic file is named as empty, and a FIFO nothing writes to as
+/// what it is, not as an archive cut short.
+#[test]
+fn an_empty_file_and_a_silent_fifo_are_named_as_such() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let empty = dir.path().join("empty.abc");
+    std::fs::write(&empty, b"").expect("write");
+    let e = alembic::open(&empty).expect_err("empty").to_string();
+    assert!(e.contains("empty.abc") && e.contains("the file is empty"), "{e}");
+    let fifo = dir.path().join("pipe.abc");
+    let c = std::ffi::CString::new(fifo.to_str().expect("utf-8")).expect("path");
+    // SAFETY: mkfifo with a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    let e = alembic::open(&fifo).expect_err("a silent FIFO").to_string();
+    assert!(e.contains("pipe.abc") && e.contains("a FIFO nothing wrote to"), "{e}");
+}

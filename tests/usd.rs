@@ -338,6 +338,12 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
     // A text layer named .usdc (the library would read it as binary and drop it).
     write("text.usdc", &format!("#usda 1.0\n{curves}"));
     write("names_text_usdc.usda", "#usda 1.0\n(\n    subLayers = [@text.usdc@]\n)\n");
+    // A binary layer named .usda, and a .usdc whose bootstrap is damaged.
+    let data = openusd::usda::parse(&format!("#usda 1.0\n{curves}")).expect("text");
+    openusd::usdc::CrateWriter::write_to_file(&data, dir.path().join("binary.usda")).expect("binary");
+    write("names_binary_usda.usda", "#usda 1.0\n(\n    subLayers = [@binary.usda@]\n)\n");
+    write("damaged.usdc", &format!("PXR-USDX{}", "\0".repeat(80)));
+    write("names_damaged.usda", "#usda 1.0\n(\n    subLayers = [@damaged.usdc@]\n)\n");
     for good in ["ref_default.usda", "ref_prim.usda", "internal_good.usda"] {
         usd::open(dir.path().join(good)).unwrap_or_else(|e| panic!("{good}: {e}"));
     }
@@ -367,6 +373,8 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
                 &["internal_missing.usda", "line 3", "to /Nope, a prim the layer does not have"][..],
             ),
             ("names_text_usdc.usda", &["names_text_usdc.usda", "text.usdc", "a text USD layer named .usdc"][..]),
+            ("names_binary_usda.usda", &["binary.usda", "a binary USD layer named .usda"][..]),
+            ("names_damaged.usda", &["damaged.usdc", "not a USD binary layer", "PXR-USDX"][..]),
             ("ref_no_default.usda", &["ref_no_default.usda", "no_default.usda", "names no default prim"][..]),
         ],
     );

@@ -180,12 +180,21 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
             ))
             .in_asset(path));
         }
-        let mut magic = Vec::with_capacity(8);
-        std::fs::File::open(&layer).and_then(|f| f.take(8).read_to_end(&mut magic)).map_err(io)?;
+        let mut head = Vec::with_capacity(64);
+        std::fs::File::open(&layer).and_then(|f| f.take(64).read_to_end(&mut head)).map_err(io)?;
+        let magic = &head[..head.len().min(8)];
         // The library picks a layer's reader by its name: a binary layer named
         // `.usda` or a text one named `.usdc` would be dropped in silence.
         let extension = layer.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
         let binary_bytes = magic == b"PXR-USDC";
+        let text_head =
+            head.iter().position(|b| !b" \t\r\n".contains(b)).is_some_and(|at| head[at..].starts_with(b"#usda"));
+        if extension == "usdc" && !binary_bytes && !text_head {
+            // Neither a binary layer nor a text one: a damaged bootstrap.
+            let shown: String = magic.iter().map(|&b| std::ascii::escape_default(b).to_string()).collect();
+            let why = format!("not a USD binary layer: it starts with \"{shown}\", not the PXR-USDC bootstrap");
+            return Err(named(malformed(why).in_asset(&layer)));
+        }
         if (binary_bytes && extension == "usda") || (!binary_bytes && extension == "usdc") {
             let (is, called) = if binary_bytes { ("binary", ".usda") } else { ("text", ".usdc") };
             let why = format!("a {is} USD layer named {called}: the USD library reads a layer as its name says");

@@ -85,7 +85,15 @@ pub fn parse_repairing(bytes: &[u8]) -> Result<(AuthoredGroom, Repairs)> {
 }
 
 fn read(path: &Path) -> Result<Vec<u8>> {
-    crate::files::read_capped(path, crate::files::input_cap(MAX_ABC_BYTES)?, "an Alembic file")
+    let bytes = crate::files::read_capped(path, crate::files::input_cap(MAX_ABC_BYTES)?, "an Alembic file")?;
+    if bytes.is_empty() {
+        // Named as empty, not as an archive cut short: a FIFO nothing wrote to reads so.
+        use std::os::unix::fs::FileTypeExt;
+        let fifo = std::fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo());
+        let what = if fifo { "a FIFO nothing wrote to: it read as empty" } else { "the file is empty (0 bytes)" };
+        return Err(Error::Malformed { format: FileFormat::Alembic, reason: what.into() }.in_asset(path));
+    }
+    Ok(bytes)
 }
 
 fn parse_as(bytes: &[u8], load: Load) -> Result<(AuthoredGroom, Option<Repairs>)> {
