@@ -88,6 +88,25 @@ impl HairRig {
                 ));
             }
         }
+        // Between the samples: a scale channel on the way to the head that
+        // comes near zero at a key or crosses it between two.
+        let mut on_the_way = vec![false; sk.nodes.len()];
+        let mut node = Some(sk.joints[head]);
+        while let Some(n) = node.filter(|&n| !on_the_way[n]) {
+            on_the_way[n] = true;
+            node = sk.nodes[n].parent;
+        }
+        let channels = sk.animations[animation].channels.iter().filter(|c| on_the_way.get(c.node) == Some(&true));
+        if let Some((c, time)) = channels.filter_map(|c| c.scale_near_zero().map(|t| (c, t))).next() {
+            return Err(Error::incompatible(
+                "character",
+                format!(
+                    "the head joint {head} ({:?}) has no frame at {time} s of animation {:?}: node {} ({:?}) on \
+                     the way to it is scaled to zero there",
+                    sk.nodes[sk.joints[head]].name, sk.animations[animation].name, c.node, sk.nodes[c.node].name
+                ),
+            ));
+        }
         let origin = character.joint_transform(&rest, head).transform_point3(Vec3::ZERO);
         let mut capsules = character.fit_capsules(&[head]);
         let distance = |c: &BoneCapsule| {

@@ -117,6 +117,43 @@ impl Channel {
         (a, b, u, span)
     }
 
+    /// The first time a scale channel takes a component to within 1e-4 of
+    /// zero, at a key or between two (a linear segment whose ends differ in
+    /// sign crosses zero where it does; a cubic one is sampled 32 times a
+    /// segment); `None` for a channel of another property or one that never
+    /// comes near zero.
+    pub fn scale_near_zero(&self) -> Option<f32> {
+        let Keys::Scale(v) = &self.keys else { return None };
+        let near = |s: Vec3| s.abs().min_element() <= 1e-4;
+        let key = |k: usize| if self.sampling == Sampling::CubicSpline { v[3 * k + 1] } else { v[k] };
+        let mut previous: Option<(f32, Vec3)> = None;
+        for (k, &t) in self.times.iter().enumerate() {
+            if let (Some((t0, a)), Sampling::Linear) = (previous, self.sampling) {
+                let b = key(k);
+                let crossing = (0..3).filter(|&i| a[i] * b[i] < 0.0).map(|i| t0 + (t - t0) * a[i] / (a[i] - b[i]));
+                if let Some(at) = crossing.reduce(f32::min) {
+                    return Some(at);
+                }
+            }
+            if let (Some((t0, _)), Sampling::CubicSpline) = (previous, self.sampling) {
+                let mut last = self.sample_vec(v, t0);
+                for j in 1..=32 {
+                    let at = t0 + (t - t0) * j as f32 / 32.0;
+                    let s = self.sample_vec(v, at);
+                    if near(s) || (0..3).any(|i| s[i] * last[i] < 0.0) {
+                        return Some(at);
+                    }
+                    last = s;
+                }
+            }
+            if near(key(k)) {
+                return Some(t);
+            }
+            previous = Some((t, key(k)));
+        }
+        None
+    }
+
     /// Samples a vector channel.
     fn sample_vec(&self, v: &[Vec3], t: f32) -> Vec3 {
         let (a, b, u, span) = self.segment(t);

@@ -306,6 +306,15 @@ fn a_far_vertex_and_a_head_scaled_to_nothing_are_refused_naming_them() {
     let character = Character::parse(&flat).expect("a zero scale is a pose, not a broken file");
     let err = HairRig::new(character, None, None).map(|_| ()).expect_err("a head without a frame").to_string();
     assert!(err.contains("head joint") && err.contains("no frame at 0 s") && err.contains("scale"), "{err}");
+
+    // A scale through zero between two keys, at 1/3 s, between the samples.
+    let mut character = Character::parse(&bytes).expect("the character");
+    let node = character.skeleton.joints[character.head_joint()];
+    let keys = Keys::Scale(vec![Vec3::ONE, Vec3::new(-2.0, 1.0, 1.0)]);
+    let through = Channel { node, times: vec![0.0, 1.0], keys, sampling: Sampling::Linear };
+    character.skeleton.animations[0].channels.push(through);
+    let err = HairRig::new(character, None, None).map(|_| ()).expect_err("a head scaled through zero").to_string();
+    assert!(err.contains("head joint") && err.contains("no frame at 0.333") && err.contains("scaled to zero"), "{err}");
 }
 
 /// A `.gltf` document whose buffer file is missing, a folder or a FIFO no one
