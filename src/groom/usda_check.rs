@@ -441,12 +441,15 @@ fn check_arcs(text: &str, arcs: &HashMap<String, Vec<(String, usize)>>) -> Resul
             let Some((to, at)) = out.get(*next).copied() else {
                 // Every arc out of `node` is finished (no cycle): the longest
                 // chain of arcs from it is one more than its targets' longest.
-                let chain =
-                    1 + out.iter().map(|(to, _)| longest.get(to.as_str()).copied().unwrap_or(0)).max().unwrap_or(0);
+                let step = |arc: &&&(String, usize)| longest.get(arc.0.as_str()).copied().unwrap_or(0);
+                let chain = 1 + out.iter().map(|arc| step(&arc)).max().unwrap_or(0);
                 if chain > MAX_USDA_ARC_CHAIN {
+                    // Named at the arc the longest chain leaves by.
+                    let at = out.iter().max_by_key(step).map_or(0, |(_, at)| *at);
                     return Err(malformed(format!(
-                        "the composition arcs from {node} chain through more than {MAX_USDA_ARC_CHAIN} prims \
-                         (the reader's time grows with the cube of the chain)"
+                        "{} the composition arcs from {node} chain through more than {MAX_USDA_ARC_CHAIN} prims \
+                         (the reader's time grows with the cube of the chain)",
+                        position(text, at)
                     )));
                 }
                 longest.insert(node, chain);
