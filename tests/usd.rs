@@ -404,6 +404,15 @@ fn the_layers_a_binary_layer_names_are_checked_too() {
     binary("good.usdc", "#usda 1.0\ndef \"x\" (\n    references = @strand.usda@</c>\n) { }\n");
     let g = usd::open(dir.path().join("good.usdc")).expect("a binary layer referencing a strand");
     assert_eq!(g.groom.strand_count(), 1);
+    // Children inside a variant (`/x{look=a}c`), listed as that writer lists
+    // them (a token array): read, not refused by the children check.
+    let variant = format!(
+        "#usda 1.0\n(\n    defaultPrim = \"x\"\n)\ndef Xform \"x\" (\n    variants = {{\n        string look = \"a\"\n    }}\n    \
+         prepend variantSets = \"look\"\n)\n{{\n    variantSet \"look\" = {{\n        \"a\" {{\n{curves}        }}\n    }}\n}}\n"
+    );
+    binary("variant.usdc", &variant);
+    let v = usd::open(dir.path().join("variant.usdc")).expect("a binary layer with a variant");
+    assert_eq!(v.groom.strand_count(), 1);
     refused_naming(
         dir.path(),
         &[

@@ -6,8 +6,8 @@
 // first and last pixel column; the centre line is straight) can visit, so
 // every pixel the segment can draw lies in a tile it is binned to — and
 // counts itself in each (this variant) or writes itself into each tile's run
-// (VKHAIR_TILE_FILL, after tile_scan.comp), an entry past the list's
-// capacity not written (the fine pass reads only what fits).
+// (VKHAIR_TILE_FILL, after tile_scan.comp), never past its tile's run nor
+// the list's capacity (the fine pass reads only what fits).
 // vkhair variant: VKHAIR_TILE_FILL
 // Constant 1: the shading features (this stage shades nothing).
 #define SHADING_FEATURES_ID 1
@@ -40,8 +40,10 @@ void bin_segment(uint seg, uint first, bool last) {
             uvec2 tile = sg.x_major ? uvec2(tk, tm) : uvec2(tm, tk);
             uint t = tile.y * tiles.tiles_x + tile.x;
 #ifdef VKHAIR_TILE_FILL
+            // Within the tile's own run (the count's) and the list, whatever
+            // the two variants' arithmetic.
             uint slot = atomicAdd(tile_cursor[t], 1u);
-            if (slot < tiles.capacity) {
+            if (slot < tile_start[t] + tile_count[t] && slot < tiles.capacity) {
                 tile_list[slot] = seg;
             }
 #else

@@ -12,9 +12,9 @@
 // order-independent tail); a segment interrupted by a full buffer resumes at
 // the pixel it stopped at. Last, each invocation composites its pixel into
 // `oit_resolved` (oit_resolved.frag blends it over the host's target) and
-// writes its nearest half-opaque depth. No per-pixel lists in device memory,
-// no atomics on device memory: a tile's fragments never leave the
-// multiprocessor that draws them.
+// writes its nearest half-opaque depth. No per-pixel lists in device memory
+// and no device atomics per fragment (one a tile adds its count to
+// oit.used): a tile's fragments never leave the multiprocessor that draws them.
 // vkhair variant: VKHAIR_SORT_4
 // vkhair variant: VKHAIR_SORT_8
 // vkhair variant: VKHAIR_SORT_16
@@ -69,6 +69,7 @@ void main() {
     if (lid == 0u) {
         tile_kept = 0u;
     }
+    barrier();
     const float side = float(TILE_SIZE);
     vec2 origin = vec2(tile) * side;
     for (uint chunk = begin; chunk < end; chunk += PIXELS) {
@@ -82,9 +83,12 @@ void main() {
         float m = 0.0;
         float m_end = 0.0;
         vec2 rows = vec2(0.0);
-        if (chunk + lid < end) {
+        // An entry the fill never wrote (only past a mismatch of its run) is
+        // skipped where it names no segment of the frame.
+        uint seg = chunk + lid < end ? tile_list[chunk + lid] : NONE;
+        if (seg < dp.counts.x * (dp.counts.y - 1u)) {
             bool last;
-            uint first = segment_first(tile_list[chunk + lid], last);
+            uint first = segment_first(seg, last);
             if (segment_on_screen(first, last, sg)) {
                 vec2 origin_km = sg.x_major ? origin : origin.yx;
                 rows = vec2(origin_km.y, origin_km.y + side);
@@ -124,12 +128,14 @@ void main() {
                     uint slot = atomicAdd(taken, 1u);
                     if (slot >= TILE_FRAGMENTS) {
                         // Full: this pixel again in the next round.
-                        pending = 1u;
+                        atomicOr(pending, 1u);
                         break;
                     }
                     uvec2 p = segment_pixel(sg, k, m) - tile * TILE_SIZE;
                     uint next = atomicExchange(heads[p.y * TILE_SIZE + p.x], slot);
-                    uint depth = floatBitsToUint(z) | (alpha >= OIT_OPAQUE_ALPHA ? OPAQUE_BIT : 0u);
+                    // Depths lie in 0..1 (clipped); a −0 or a rounding below 0 is 0,
+                    // so that the sign bit is free for the flag.
+                    uint depth = floatBitsToUint(max(z, 0.0)) | (alpha >= OIT_OPAQUE_ALPHA ? OPAQUE_BIT : 0u);
                     fragments[slot] = uvec4(pack_color(color, alpha), depth, next);
                 }
                 m += 1.0;

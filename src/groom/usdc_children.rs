@@ -24,6 +24,8 @@ fn malformed(reason: String) -> Error {
 fn child_path(parent: &str, field: &str, name: &str) -> String {
     match (field, parent) {
         ("primChildren", "/") => format!("/{name}"),
+        // A prim inside a variant: `/A{v=s}B`.
+        ("primChildren", _) if parent.ends_with('}') => format!("{parent}{name}"),
         ("primChildren", _) => format!("{parent}/{name}"),
         _ => format!("{parent}.{name}"),
     }

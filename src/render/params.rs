@@ -202,14 +202,14 @@ impl Raster {
 }
 
 /// What [`Raster::Auto`] picks on a GPU for the exact mode's strands: the
-/// one faster there. Measured on an NVIDIA H100 (`tools/gpu-bench.sh`'s
-/// frames, the hair passes' GPU ms, the same binary): the thesis at 1920×1080
-/// 2.11 against 2.59 through the tiled rasteriser, Sintel at the peer's
-/// geometry 0.76 against 1.13, its close-up 1.23 against 1.66, 1,001,000
-/// strands 49.9 against 56.4 — the per-segment rasteriser's atomics on the
+/// one faster there. Measured on an NVIDIA H100 (`tools/gpu-bench.sh`, the
+/// hair passes' GPU ms, one run; README, "Raster"): the thesis at 1920×1080
+/// 2.05 against 2.56 through the tiled rasteriser, Sintel at the peer's
+/// geometry 0.50 against 0.88, its close-up 0.74 against 1.21, 1,001,000
+/// strands 65.1 against 72.0 — the per-segment rasteriser's atomics on the
 /// per-pixel lists cost that GPU less than a tile's workgroup sorting its
 /// fragments in shared memory. The tiled one needs no per-pixel lists: at
-/// 3840×2160 the thesis took 189 MiB against 1,360 MiB.
+/// 3840×2160 the thesis took 190 MiB against 1,360 MiB.
 const GPU_STRANDS: Raster = Raster::Compute;
 
 /// What [`Raster::Auto`] picks on a CPU device (lavapipe) for the exact
@@ -298,16 +298,16 @@ pub struct OitParams {
     /// Entries of the tiled rasteriser's bins ([`Raster::Tiles`]) per hair
     /// vertex the renderer can draw (0.1..=256; 4 bytes each; at least 256 a
     /// tile of the target): a segment takes one entry for each screen tile of
-    /// 16 × 16 pixels its band reaches. A
-    /// frame whose segments ask for more draws the entries that fit and says
-    /// so ([`super::OitStats::tile_entries`]); the bins of the frames after it
-    /// grow to what it asked for. Default: 4.
-    pub tile_entries_per_segment: f32,
+    /// 16 × 16 pixels its band reaches. A frame whose segments ask for more
+    /// draws the entries that fit and says so
+    /// ([`super::OitStats::tile_entries`]); the bins of the frame
+    /// `frames_in_flight` after it grow to what it asked for. Default: 4.
+    pub tile_entries_per_vertex: f32,
 }
 
 impl Default for OitParams {
     fn default() -> Self {
-        OitParams { sorted_fragments: 8, fragments_per_pixel: 8.0, max_buffer_bytes: 0, tile_entries_per_segment: 4.0 }
+        OitParams { sorted_fragments: 8, fragments_per_pixel: 8.0, max_buffer_bytes: 0, tile_entries_per_vertex: 4.0 }
     }
 }
 
@@ -395,9 +395,9 @@ impl RenderParams {
         if b != 0 && b < MIN_POOL_BUFFER_BYTES {
             return Err(Error::param("oit.max_buffer_bytes", b, format!("0 or {MIN_POOL_BUFFER_BYTES}..=4294967295")));
         }
-        let e = self.oit.tile_entries_per_segment;
+        let e = self.oit.tile_entries_per_vertex;
         if !(e.is_finite() && (0.1..=256.0).contains(&e)) {
-            return Err(Error::param("oit.tile_entries_per_segment", e, "0.1..=256"));
+            return Err(Error::param("oit.tile_entries_per_vertex", e, "0.1..=256"));
         }
         let lod = &self.lod;
         let d = lod.full_detail_distance;

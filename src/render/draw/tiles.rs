@@ -22,19 +22,20 @@
 //!
 //! Memory at an extent: per pixel the target's depth copy, the resolved
 //! colour and the opaque depth (16 bytes); per tile three words; the list, 4
-//! bytes an entry, sized by [`OitParams::tile_entries_per_segment`] (and at
+//! bytes an entry, sized by [`OitParams::tile_entries_per_vertex`] (and at
 //! least [`LEAST_ENTRIES_PER_TILE`] a tile). A frame
 //! whose segments ask for more entries than the list holds draws the tiles'
 //! entries that fit ([`OitStats::tile_entries`](super::OitStats) says how many
-//! were asked for), and the next frame's list grows to hold them.
+//! were asked for), and the list of the frame `frames_in_flight` after it
+//! grows to hold them (up to one buffer's range).
 
 use std::sync::Arc;
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use crate::codes::tile::{SCAN_GROUP, SIZE as TILE_SIZE};
-use crate::error::Result;
+use crate::codes::tile::{FRAGMENTS, SCAN_GROUP, SIZE as TILE_SIZE};
+use crate::error::{Error, Result};
 use crate::gpu_types::TileCounters;
 use crate::render::OitParams;
 use crate::vk::barrier::{self, AccessKind};
@@ -51,6 +52,33 @@ const LIST_BINDING: u32 = 33;
 const ENTRY_BYTES: u64 = 4;
 /// Workgroups of a dispatch that every device runs (`maxComputeWorkGroupCount`'s minimum).
 const MAX_WORKGROUPS: u32 = 65_535;
+/// Frames whose asked-for entries are kept for the host, one slot each (the
+/// most frames in flight, `RenderParams::frames_in_flight`).
+const READBACK_SLOTS: u64 = 16;
+
+/// Shared memory of the fine pass's workgroup: the fragments (16 bytes
+/// each), a head a pixel and three words (`tile_fine.comp`).
+pub(super) const FINE_SHARED_BYTES: u32 = 16 * FRAGMENTS + 4 * TILE_SIZE * TILE_SIZE + 12;
+
+/// Whether a device with `info`'s limits runs the fine pass: an error naming
+/// the limit and the way out where its workgroups cannot hold the fragments.
+pub(super) fn check_device(info: &DeviceInfo) -> Result<()> {
+    check_shared_memory(info.max_compute_shared_memory)
+}
+
+/// As [`check_device`], for a device whose workgroups hold `limit` bytes.
+fn check_shared_memory(limit: u32) -> Result<()> {
+    if limit < FINE_SHARED_BYTES {
+        return Err(Error::incompatible(
+            "device",
+            format!(
+                "the tiled rasteriser's workgroups need {FINE_SHARED_BYTES} bytes of shared memory, more than this \
+                 device's {limit} (maxComputeSharedMemorySize): draw with Raster::Compute"
+            ),
+        ));
+    }
+    Ok(())
+}
 
 /// Tiles across and down a target of `extent`.
 pub(super) fn grid(extent: vk::Extent2D) -> [u32; 2] {
@@ -62,16 +90,16 @@ pub(super) fn grid(extent: vk::Extent2D) -> [u32; 2] {
 /// per-segment share alone would not hold their first frame.
 pub(super) const LEAST_ENTRIES_PER_TILE: u64 = 256;
 
-/// Entries of the list for `segments` drawn segments with `params` at
-/// `extent`, at least `demand` (what an earlier frame asked for), within one
-/// buffer on a device with `info`'s limits.
+/// Entries of the list for a renderer drawing at most `vertices` hair
+/// vertices with `params` at `extent`, at least `demand` (what an earlier
+/// frame asked for), within one buffer on a device with `info`'s limits.
 pub(super) fn capacity(
     info: &DeviceInfo,
     params: &OitParams,
-    (segments, extent): (u64, vk::Extent2D),
+    (vertices, extent): (u64, vk::Extent2D),
     demand: u64,
 ) -> u64 {
-    let wanted = (segments as f64 * f64::from(params.tile_entries_per_segment)).ceil() as u64;
+    let wanted = (vertices as f64 * f64::from(params.tile_entries_per_vertex)).ceil() as u64;
     let [x, y] = grid(extent);
     let least = LEAST_ENTRIES_PER_TILE * u64::from(x) * u64::from(y);
     let most = (u64::from(info.max_storage_buffer_range).min(info.max_memory_allocation_size) / ENTRY_BYTES)
@@ -79,10 +107,15 @@ pub(super) fn capacity(
     wanted.max(least).max(demand).clamp(1, most)
 }
 
-/// The bins of one extent: the counters (host-visible, so a later frame sees
-/// what this one asked for), the per-tile words and the list.
+/// The bins of one extent: the counters (host-visible), the per-tile words,
+/// the list, and per frame slot a copy of what the frame asked for (so that a
+/// later frame reads a completed frame's, never one the GPU may be writing).
 pub(super) struct TileBins {
     counters: Buffer,
+    readback: Buffer,
+    /// The frames recorded with these bins, newest last, with the slot each
+    /// copied its count into (at most READBACK_SLOTS), and the slots taken.
+    recorded: std::sync::Mutex<(std::collections::VecDeque<(u64, u64)>, u64)>,
     per_tile: [Buffer; 3],
     list: Buffer,
     grid: [u32; 2],
@@ -94,18 +127,28 @@ impl TileBins {
     pub(super) fn new(device: &Arc<Device>, extent: vk::Extent2D, capacity: u64) -> Result<Self> {
         let grid = grid(extent);
         let tiles = u64::from(grid[0]) * u64::from(grid[1]);
-        let counters = Buffer::new(
-            device,
-            &BufferDesc {
-                name: "vkhair tile counters",
-                size: std::mem::size_of::<TileCounters>() as u64,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                location: MemoryLocation::GpuToCpu,
-            },
+        let host = |name, size, usage| {
+            let mut buffer =
+                Buffer::new(device, &BufferDesc { name, size, usage, location: MemoryLocation::GpuToCpu })?;
+            // Zeroed: read before any frame wrote it, it asks for nothing.
+            if let Some(bytes) = buffer.mapped_mut() {
+                bytes.fill(0);
+            }
+            Ok::<_, Error>(buffer)
+        };
+        let counters = host(
+            "vkhair tile counters",
+            std::mem::size_of::<TileCounters>() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER
+                | vk::BufferUsageFlags::TRANSFER_DST
+                | vk::BufferUsageFlags::TRANSFER_SRC,
         )?;
+        let readback = host("vkhair tile entries asked", 4 * READBACK_SLOTS, vk::BufferUsageFlags::TRANSFER_DST)?;
         let word = |name| Buffer::storage(device, name, 4 * tiles);
         Ok(TileBins {
             counters,
+            readback,
+            recorded: std::sync::Mutex::default(),
             per_tile: [word("vkhair tile counts")?, word("vkhair tile starts")?, word("vkhair tile cursors")?],
             list: Buffer::storage(device, "vkhair tile list", ENTRY_BYTES * capacity)?,
             grid,
@@ -116,7 +159,10 @@ impl TileBins {
     /// Bytes of the bins at `extent` holding `capacity` entries.
     pub(super) fn memory_bytes(extent: vk::Extent2D, capacity: u64) -> u64 {
         let [x, y] = grid(extent);
-        std::mem::size_of::<TileCounters>() as u64 + 12 * u64::from(x) * u64::from(y) + ENTRY_BYTES * capacity
+        std::mem::size_of::<TileCounters>() as u64
+            + 4 * READBACK_SLOTS
+            + 12 * u64::from(x) * u64::from(y)
+            + ENTRY_BYTES * capacity
     }
 
     /// Entries the list holds.
@@ -129,9 +175,22 @@ impl TileBins {
         self.grid
     }
 
+    /// Entries asked for by the newest frame recorded with these bins that
+    /// is `done` or older (so completed when `done` is), from its own copy;
+    /// `None` where no such frame is among the last few recorded.
+    pub(super) fn entries_asked_by(&self, done: u64) -> Option<u64> {
+        let slot = {
+            let recorded = self.recorded.lock().ok()?;
+            recorded.0.iter().rev().find(|(frame, _)| *frame <= done)?.1
+        };
+        let at = (4 * slot) as usize;
+        let bytes = self.readback.mapped()?.get(at..at + 4)?;
+        Some(u64::from(u32::from_le_bytes(bytes.try_into().ok()?)))
+    }
+
     /// Entries the latest frame's segments asked for, read from host-visible
-    /// memory: that frame's once it completed (an earlier one's, or zero,
-    /// while it runs).
+    /// memory: valid once that frame completed and before the next one is
+    /// submitted (as [`super::OitStats`]).
     pub(super) fn entries_asked(&self) -> Option<u64> {
         let bytes = self.counters.mapped()?;
         let counters: TileCounters = bytemuck::pod_read_unaligned(bytes.get(..std::mem::size_of::<TileCounters>())?);
@@ -166,6 +225,40 @@ impl TileBins {
         unsafe {
             device.raw.cmd_fill_buffer(cmd, self.per_tile[0].raw(), 0, vk::WHOLE_SIZE, 0);
             device.raw.cmd_update_buffer(cmd, self.counters.raw(), 0, bytemuck::bytes_of(&counters));
+        }
+    }
+}
+
+impl TileBins {
+    /// Records the copy of what frame `frame` asked for into its slot, after
+    /// the scan wrote it (compute writes made visible to the copy here; the
+    /// copy made visible to the host).
+    ///
+    /// # Safety
+    /// `cmd` is a recording command buffer of `device` outside a render pass,
+    /// after this frame's scan.
+    pub(super) unsafe fn record_readback(&self, device: &Device, cmd: vk::CommandBuffer, frame: u64) {
+        // A slot the frames in flight do not use: the oldest of READBACK_SLOTS.
+        let slot = match self.recorded.lock() {
+            Ok(mut recorded) => {
+                let slot = recorded.1 % READBACK_SLOTS;
+                recorded.1 += 1;
+                recorded.0.push_back((frame, slot));
+                if recorded.0.len() > READBACK_SLOTS as usize {
+                    recorded.0.pop_front();
+                }
+                slot
+            }
+            Err(_) => return,
+        };
+        let to_copy = barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::TransferRead]);
+        let to_host = barrier::memory(&[AccessKind::AnyTransferWrite], &[AccessKind::HostRead]);
+        let region = vk::BufferCopy { src_offset: 0, dst_offset: 4 * slot, size: 4 };
+        // SAFETY: guaranteed by the caller; both ranges lie in their buffers.
+        unsafe {
+            device.cmd_barrier(cmd, &[to_copy], &[], &[]);
+            device.raw.cmd_copy_buffer(cmd, self.counters.raw(), self.readback.raw(), &[region]);
+            device.cmd_barrier(cmd, &[to_host], &[], &[]);
         }
     }
 }
@@ -235,5 +328,20 @@ impl BinPipelines {
             self.fill.0.bind(cmd, &[self.fill.1]);
             self.fill.0.dispatch_threads(cmd, [threads, 1, 1]);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A device at Vulkan's least shared memory (16 KiB) is refused naming the
+    /// way out; the 48 KiB most desktop devices offer holds the fine pass.
+    #[test]
+    fn the_fine_pass_needs_its_shared_memory() {
+        let err = check_shared_memory(16_384).expect_err("16 KiB").to_string();
+        assert!(err.contains("17420 bytes") && err.contains("Raster::Compute"), "{err}");
+        check_shared_memory(49_152).expect("48 KiB");
+        check_shared_memory(FINE_SHARED_BYTES).expect("exactly enough");
     }
 }

@@ -30,6 +30,9 @@
 //! freed once the frames that used them are `frames_in_flight` behind.
 
 mod pipelines;
+mod stats;
+
+pub use stats::OitStats;
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -71,37 +74,6 @@ const RESOLVED_BINDING: u32 = 28;
 
 /// Workgroups of a dispatch that every device runs (`maxComputeWorkGroupCount`'s minimum).
 const MAX_WORKGROUPS: u32 = 65_535;
-
-/// What the last exact-mode frame stored, read by
-/// [`crate::render::Renderer::transparency_stats`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct OitStats {
-    /// Hair fragments that passed the depth test.
-    pub fragments: u64,
-    /// Of those, the ones stored in the pool.
-    pub stored: u64,
-    /// The ones the full pool could not store: composited unsorted, in the
-    /// order-independent tail behind the sorted ones (not dropped).
-    pub overflowed: u64,
-    /// Fragments the pool holds.
-    pub capacity: u64,
-    /// Fragments [`OitParams::fragments_per_pixel`] asked the pool to hold:
-    /// more than `capacity` where the device's buffers could not hold them
-    /// (see [`OitPool`]).
-    pub requested: u64,
-    /// Tile entries the tiled rasteriser's segments asked for
-    /// ([`Raster::Tiles`]; 0 with the other rasterisers): the frame drew those
-    /// within `tile_capacity`, and later frames' bins hold them all.
-    pub tile_entries: u64,
-    /// Entries the tiled rasteriser's bins held for the frame (0 with the
-    /// other rasterisers; see [`OitParams::tile_entries_per_segment`]).
-    pub tile_capacity: u64,
-    /// The pixels the composite ran over, `[x0, y0, x1, y1]` (the last column
-    /// and row excluded; rows from the top; pixels of the drawn target, twice
-    /// each side with supersampling): a rectangle holding every pixel the
-    /// hair's ribbons can reach. `None` when no hair was drawn.
-    pub composited: Option<[u32; 4]>,
-}
 
 /// How the build makes fragments.
 enum Build {
@@ -184,6 +156,9 @@ pub(super) struct TransparentPass {
     /// Tile entries an earlier frame asked for beyond its bins' capacity: the
     /// next bins hold at least this many.
     tile_demand: u64,
+    /// Frames in flight (`collect_retired`'s): frame N − this one has completed
+    /// when frame N is recorded. None before the first.
+    frames_in_flight: Option<u32>,
 }
 
 impl TransparentPass {
@@ -206,6 +181,7 @@ impl TransparentPass {
             current: None,
             retired: Vec::new(),
             tile_demand: 0,
+            frames_in_flight: None,
         })
     }
 
@@ -259,6 +235,7 @@ impl TransparentPass {
 
     /// Frees retired resources whose last frame is `frames_in_flight` frames before `frame`.
     pub(super) fn collect_retired(&mut self, frame: u64, frames_in_flight: u32) {
+        self.frames_in_flight = Some(frames_in_flight);
         let keep = u64::from(frames_in_flight);
         self.retired.retain(|(last, _)| last.saturating_add(keep) > frame);
     }
@@ -266,42 +243,6 @@ impl TransparentPass {
     /// Sets of resources waiting for their frames to complete.
     pub(super) fn retired_count(&self) -> usize {
         self.retired.len()
-    }
-
-    /// What the latest exact-mode frame stored, read from host-visible memory:
-    /// valid once that frame completed and before the next one is submitted.
-    pub(super) fn stats(&self) -> Option<OitStats> {
-        // The current resources are those of the latest transparent frame.
-        let res = self.current.as_ref().filter(|r| r.mode == Transparency::Exact)?;
-        let bytes = self.counters.mapped()?;
-        let counters: OitCounters = bytemuck::pod_read_unaligned(bytes.get(..std::mem::size_of::<OitCounters>())?);
-        let rect = [counters.hair_x0, counters.hair_y0, counters.hair_x1, counters.hair_y1];
-        let composited = (rect[0] < rect[2] && rect[1] < rect[3]).then_some(rect);
-        if let Some(bins) = &res.tiles {
-            // Every kept fragment is sorted or in the tail: no pool.
-            return Some(OitStats {
-                fragments: u64::from(counters.used),
-                stored: u64::from(counters.used),
-                overflowed: 0,
-                capacity: 0,
-                requested: 0,
-                tile_entries: bins.entries_asked()?,
-                tile_capacity: bins.capacity(),
-                composited,
-            });
-        }
-        let pool = res.pool()?;
-        let stored = counters.used.min(counters.capacity);
-        Some(OitStats {
-            fragments: u64::from(counters.used),
-            stored: u64::from(stored),
-            overflowed: u64::from(counters.used - stored),
-            capacity: u64::from(counters.capacity),
-            requested: pool.requested,
-            tile_entries: 0,
-            tile_capacity: 0,
-            composited,
-        })
     }
 }
 
@@ -322,12 +263,17 @@ impl TransparentPass {
             Transparency::Exact if !tiled => Some(OitPool::plan(&self.device.info, params, extent)),
             _ => None,
         };
-        // The bins grow to what the latest frame asked for (read once it
-        // completed; an earlier frame's or zero while it runs).
-        if let Some(asked) = self.current.as_ref().and_then(|r| r.tiles.as_ref()).and_then(TileBins::entries_asked) {
-            if asked > self.current.as_ref().and_then(Resources::tile_capacity).unwrap_or(u64::MAX) {
+        // The bins grow to what a completed frame asked for: the one
+        // `frames_in_flight` before this one (its own copy in the bins).
+        let done = self.frames_in_flight.and_then(|f| frame.checked_sub(u64::from(f)));
+        let bins_now = self.current.as_ref().and_then(|r| r.tiles.as_ref());
+        if let Some(asked) = done.and_then(|done| bins_now.and_then(|b| b.entries_asked_by(done))) {
+            if asked > bins_now.map_or(u64::MAX, TileBins::capacity) {
                 self.tile_demand = self.tile_demand.max(asked + asked / 4);
             }
+        }
+        if tiled {
+            tiles::check_device(&self.device.info)?;
         }
         let bins = tiled.then(|| self.tile_capacity(&self.device.info, params, extent));
         let fits = |r: &Resources| {
@@ -544,7 +490,12 @@ impl TransparentPass {
                     let segments = frame.segments.min(MAX_WORKGROUPS.saturating_mul(per_group));
                     pipeline.dispatch_threads(cmd, [segments, 1, 1]);
                 }
-                Build::Tiles(bins) => bins.record(d, cmd, frame.segments),
+                Build::Tiles(passes) => {
+                    passes.record(d, cmd, frame.segments);
+                    if let Some(bins) = &res.tiles {
+                        bins.record_readback(d, cmd, frame.frame);
+                    }
+                }
             }
             inner.close(d, cmd, timing);
             scope.close(d, cmd, timing);
