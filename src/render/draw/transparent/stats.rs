@@ -17,18 +17,18 @@ pub struct OitStats {
     pub overflowed: u64,
     /// Fragments the pool holds.
     pub capacity: u64,
-    /// Fragments [`OitParams::fragments_per_pixel`] asked the pool to hold:
+    /// Fragments [`OitParams::fragments_per_pixel`](crate::render::OitParams::fragments_per_pixel) asked the pool to hold:
     /// more than `capacity` where the device's buffers could not hold them
-    /// (see [`OitPool`]).
+    /// (see [`OitPool`](crate::render::OitPool)).
     pub requested: u64,
     /// Tile entries the tiled rasteriser's segments asked for
-    /// ([`Raster::Tiles`]; 0 with the other rasterisers): the frame drew those
+    /// ([`Raster::Tiles`](crate::render::Raster::Tiles); 0 with the other rasterisers): the frame drew those
     /// within `tile_capacity`, and the bins of the frame
     /// [`RenderParams::frames_in_flight`](crate::render::RenderParams::frames_in_flight)
     /// after it grow to hold them, up to one buffer's range.
     pub tile_entries: u64,
     /// Entries the tiled rasteriser's bins held for the frame (0 with the
-    /// other rasterisers; see [`OitParams::tile_entries_per_vertex`]).
+    /// other rasterisers; see [`OitParams::tile_entries_per_vertex`](crate::render::OitParams::tile_entries_per_vertex)).
     pub tile_capacity: u64,
     /// The pixels the composite ran over, `[x0, y0, x1, y1]` (the last column
     /// and row excluded; rows from the top; pixels of the drawn target, twice
