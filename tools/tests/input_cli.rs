@@ -174,6 +174,32 @@ fn the_interpolator_is_chosen_and_said() {
     assert!(frames[0] == frames[1], "the two interpolators drew different frames");
 }
 
+/// `render --raster tiles` says what the tiled rasteriser did: every
+/// fragment sorted or in the tail, and, with bins too small for the frame
+/// (`oit.tile_entries_per_vertex` at its least), that entries past the list
+/// were not drawn and what to raise.
+#[test]
+fn the_tiled_rasteriser_says_when_its_list_was_too_small() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let config = dir.path().join("small_bins.toml");
+    std::fs::write(&config, "[render.oit]\ntile_entries_per_vertex = 0.1\n").expect("config");
+    let out_dir = dir.path().join("frames");
+    let args = format!(
+        "render --frames 1 --width 64 --height 48 --no-lod --raster tiles --config {} --out {}",
+        config.display(),
+        out_dir.display()
+    );
+    let out = run_line(&args, LIMIT);
+    out.assert_ok();
+    assert!(out.stdout.contains("strands drawn by the tiled compute rasteriser"), "{}", out.stdout);
+    assert!(out.stdout.contains("every one sorted or in the tail"), "{}", out.stdout);
+    assert!(
+        out.stdout.contains("more than the list held") && out.stdout.contains("oit.tile_entries_per_vertex"),
+        "{}",
+        out.stdout
+    );
+}
+
 /// `render --gltf` puts hair on the shared character and follows its run: the
 /// PNGs show the hair (brown) and the body; an unknown animation or joint is
 /// named with the ones the file has, before any GPU work.

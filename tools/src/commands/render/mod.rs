@@ -264,14 +264,29 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
         );
     }
     if let Some(stats) = renderer.transparency_stats() {
-        say!(
-            "last frame: {} hair fragments, {} stored, {} beyond the pool blended unsorted (pool of {}{}; raise oit.fragments_per_pixel if many are)",
-            stats.fragments,
-            stats.stored,
-            stats.overflowed,
-            stats.capacity,
-            if stats.capacity < stats.requested { format!(" of the {} asked for", stats.requested) } else { String::new() }
-        );
+        if stats.tile_capacity > 0 {
+            let short = if stats.tile_entries > stats.tile_capacity {
+                " — more than the list held: those past it were not drawn (later frames' list has grown; \
+                 raise oit.tile_entries_per_vertex to hold them from the first)"
+            } else {
+                ""
+            };
+            say!(
+                "last frame: {} hair fragments, every one sorted or in the tail; {} tile entries of a list of {}{short}",
+                stats.fragments,
+                stats.tile_entries,
+                stats.tile_capacity
+            );
+        } else {
+            say!(
+                "last frame: {} hair fragments, {} stored, {} beyond the pool blended unsorted (pool of {}{}; raise oit.fragments_per_pixel if many are)",
+                stats.fragments,
+                stats.stored,
+                stats.overflowed,
+                stats.capacity,
+                if stats.capacity < stats.requested { format!(" of the {} asked for", stats.requested) } else { String::new() }
+            );
+        }
         if let Some([x0, y0, x1, y1]) = stats.composited {
             say!("composited over {}×{} pixels from ({x0}, {y0}), where the ribbons reach", x1 - x0, y1 - y0);
         }
