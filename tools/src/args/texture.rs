@@ -83,3 +83,32 @@ impl Texture {
         top.lerp(bottom, fy)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A file past 64 MiB is refused by its size, unread; an image declaring
+    /// more than 8192 × 8192 texels by its header, before decoding.
+    #[test]
+    fn a_texture_is_bounded_by_its_file_and_its_texels() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let big = dir.path().join("big.png");
+        let file = std::fs::File::create(&big).expect("create");
+        // Sparse: no 65 MiB written.
+        file.set_len((64 << 20) + 1).expect("length");
+        let err = Texture::open(&big).err().expect("refused").to_string();
+        assert!(err.contains("big.png") && err.contains("67108864"), "{err}");
+        let wide = dir.path().join("wide.png");
+        let mut bytes = Vec::new();
+        {
+            let encoder = png::Encoder::new(&mut bytes, 9000, 9000);
+            let mut writer = encoder.write_header().expect("header");
+            // The header of an image of 81 M texels, then the start of its data.
+            writer.write_chunk(png::chunk::IDAT, &[0u8; 16]).expect("a data chunk");
+        }
+        std::fs::write(&wide, &bytes).expect("write");
+        let err = Texture::open(&wide).err().expect("refused").to_string();
+        assert!(err.contains("wide.png") && err.contains("9000×9000") && err.contains("67108864 texels"), "{err}");
+    }
+}
