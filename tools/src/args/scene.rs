@@ -68,7 +68,8 @@ pub struct SceneArgs {
     #[arg(long, value_enum)]
     pub transparency: Option<Transparency>,
     /// Who rasterises the strands of --transparency exact: the compute
-    /// rasteriser or the hardware raster pipeline [default: the --config
+    /// rasteriser (per-pixel lists), the tiled one (no per-pixel lists, the
+    /// least memory) or the hardware raster pipeline [default: the --config
     /// file's, else auto: compute on GPUs, on a CPU device the faster one there].
     #[arg(long, value_enum)]
     pub raster: Option<Raster>,
