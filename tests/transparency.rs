@@ -1040,18 +1040,26 @@ fn the_tiled_rasteriser_keeps_the_fragments_of_the_per_segment_one() {
     let sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &RigidTransform::default()).expect("sim");
     let to8 = |c: Vec3| c.to_array().map(|v| v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0);
     let tiles = u64::from(w.div_ceil(16)) * u64::from(h.div_ceil(16));
+    // One renderer a rasteriser, its K changed between frames.
+    let mut renderers: Vec<Renderer> = [Raster::Compute, Raster::Tiles]
+        .into_iter()
+        .map(|raster| {
+            let mut renderer = Renderer::new(gpu.ctx(), &sim, &exact(raster)).expect("renderer");
+            renderer.set_material(&m).expect("material");
+            renderer
+        })
+        .collect();
     for (k, before) in [(4u32, None), (8, Some(&mesh)), (16, None), (32, Some(&mesh))] {
         let mut images = Vec::new();
         let mut fragments = Vec::new();
-        for raster in [Raster::Compute, Raster::Tiles] {
+        for (raster, renderer) in [Raster::Compute, Raster::Tiles].into_iter().zip(renderers.iter_mut()) {
             let mut p = exact(raster);
             p.oit.sorted_fragments = k;
             // A pool that holds them all.
             p.oit.fragments_per_pixel = 64.0;
-            let mut renderer = Renderer::new(gpu.ctx(), &sim, &p).expect("renderer");
-            renderer.set_material(&m).expect("material");
+            renderer.set_params(&p).expect("params");
             let host = common::HostFrame { clear: BACKGROUND, before, after: None };
-            let rgba = common::draw_frame(&gpu, (&sim, &mut renderer), &offscreen, &camera, &host);
+            let rgba = common::draw_frame(&gpu, (&sim, renderer), &offscreen, &camera, &host);
             let stats = renderer.transparency_stats().expect("stats");
             assert_eq!(stats.overflowed, 0, "{stats:?}");
             fragments.push(stats.fragments);

@@ -62,6 +62,14 @@ void main() {
     uint t = tile.y * tiles.tiles_x + tile.x;
     uint begin = tile_start[t];
     uint end = begin + min(tile_count[t], tiles.capacity - min(begin, tiles.capacity));
+    if (begin == end) {
+        // No segment reaches the tile (most of a frame): no hair here.
+        if (inside) {
+            oit_resolved[pixel] = uvec2(0u);
+            oit_opaque[pixel] = OIT_END;
+        }
+        return;
+    }
     float limit = inside ? scene_depth_limit(pixel) : -1.0;
     kb_begin(oit.sorted, vec4(0.0), 0.0);
     uint opaque = OIT_END;
