@@ -281,7 +281,6 @@ impl Running {
         }
         let messages = self.messages.clone();
         drop(self);
-        let log = messages.lock().unwrap_or_else(|e| e.into_inner()).clone();
-        log
+        messages.lock().unwrap_or_else(|e| e.into_inner()).clone()
     }
 }

@@ -244,7 +244,7 @@ impl HairRig {
         let (forward, up) = self.head_axes();
         let face = face_triangles(&local, (forward, up), NO_ROOT_FACING);
         let scalp_triangles: Vec<[u32; 3]> =
-            local.triangles.iter().zip(&face).filter(|(_, &f)| !f).map(|(t, _)| *t).collect();
+            local.triangles.iter().zip(&face).filter(|&(_, &f)| !f).map(|(t, _)| *t).collect();
         let scalp_mesh = TriMesh::new(local.positions.clone(), scalp_triangles)?;
         let scalp = GrowScalp::Mesh { mesh: scalp_mesh, up, min_height: 0.45, min_up_dot: -0.2 };
         let params = GrowParams {

@@ -51,7 +51,7 @@ pub fn spread(groom: &Groom, count: usize) -> Result<Vec<usize>> {
 
 /// The strands `marks` marks (a file's `groom_guide`), refused when none is.
 pub fn marked(marks: &[bool]) -> Result<Vec<usize>> {
-    let guides: Vec<usize> = marks.iter().enumerate().filter(|(_, &m)| m).map(|(s, _)| s).collect();
+    let guides: Vec<usize> = marks.iter().enumerate().filter(|&(_, &m)| m).map(|(s, _)| s).collect();
     if guides.is_empty() {
         return Err(Error::param("guides", "none marked", "at least one strand marked as a guide"));
     }

@@ -72,7 +72,7 @@ pub fn covered_pixels(before: &[u8], after: &[u8], mask: &[bool]) -> Option<(usi
         .chunks_exact(4)
         .zip(after.chunks_exact(4))
         .zip(mask)
-        .filter(|((b, a), &m)| m && b[..3].iter().zip(&a[..3]).any(|(x, y)| x.abs_diff(*y) > COVERED_STEPS))
+        .filter(|&((b, a), &m)| m && b[..3].iter().zip(&a[..3]).any(|(x, y)| x.abs_diff(*y) > COVERED_STEPS))
         .count();
     Some((covered, mask.iter().filter(|&&m| m).count()))
 }

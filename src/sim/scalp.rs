@@ -87,7 +87,7 @@ impl Scalp {
             .zip(&self.skin)
             .map(|(&p, s)| {
                 let mut out = Vec3::ZERO;
-                for (&j, &w) in s.joints.iter().zip(&s.weights).filter(|(_, &w)| w != 0.0) {
+                for (&j, &w) in s.joints.iter().zip(&s.weights).filter(|&(_, &w)| w != 0.0) {
                     let bone = bones.get(j as usize).ok_or_else(|| {
                         Error::param("scalp joint", j, format!("below the {} bone matrices given", bones.len()))
                     })?;
