@@ -14,7 +14,9 @@ export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-$(mktemp -d)}
 cargo test --workspace --locked "$@"
 # ASYNC COMPUTE on a real second queue: only where a device has one (lavapipe
 # does not; the same code path runs on its graphics queue in the suite above).
-devices=$(cargo run --quiet --locked -p vkhair-tools -- devices 2>/dev/null || true)
+# The program the tests just built (`cargo run -p vkhair-tools` would build the
+# crate again with the tool's features alone: 41 s here).
+devices=$("${CARGO_TARGET_DIR:-target}/debug/vkhair" devices 2>/dev/null || true)
 if grep -q "async compute queue: yes" <<<"$devices"; then
   cargo test --locked --test suite "$@" -- --ignored schedule::async_compute_on_a_second_queue
 else
