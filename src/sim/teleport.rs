@@ -29,10 +29,6 @@ use crate::vk::shaders::SIM_MOVE_COMP;
 /// Debug label of the move's dispatch.
 pub const MOVE_LABEL: &str = "vkhair sim: teleport or reset";
 
-/// Workgroups of one move dispatch at most (every device offers 65,535); the
-/// kernel loops over the rest.
-const MAX_WORKGROUPS: u32 = 65_535;
-
 /// A move asked for and not yet applied.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct PendingMove {
@@ -92,8 +88,7 @@ impl MoveKernel {
         let push = MovePush::from(&StateMove { transform: mv.transform, reset: u32::from(mv.reset), points });
         let before = barrier::memory(&[AccessKind::AnyWrite], barrier::COMPUTE_READ_WRITE);
         let after = barrier::memory(&[AccessKind::ComputeWrite], barrier::COMPUTE_READ_WRITE);
-        let per_group = self.pipeline.workgroup_size()[0];
-        let threads = points.min(MAX_WORKGROUPS.saturating_mul(per_group));
+        let threads = self.pipeline.grid_stride_threads(points);
         let d = &self.device;
         // SAFETY: guaranteed by the caller; the sets hold this simulation's buffers.
         unsafe {

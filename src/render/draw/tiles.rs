@@ -50,8 +50,6 @@ const PER_TILE_BINDINGS: [u32; 3] = [30, 31, 32];
 const LIST_BINDING: u32 = 33;
 /// Bytes of one list entry (a segment's index).
 const ENTRY_BYTES: u64 = 4;
-/// Workgroups of a dispatch that every device runs (`maxComputeWorkGroupCount`'s minimum).
-const MAX_WORKGROUPS: u32 = 65_535;
 /// Frames whose asked-for entries are kept for the host, one slot each (the
 /// most frames in flight, `RenderParams::frames_in_flight`).
 const READBACK_SLOTS: u64 = 16;
@@ -315,8 +313,7 @@ impl BinPipelines {
     /// vertices and colours written, each made visible to compute reads.
     pub(super) unsafe fn record(&self, device: &Device, cmd: vk::CommandBuffer, segments: u32) {
         let after = barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::ComputeRead, AccessKind::ComputeWrite]);
-        let per_group = self.count.0.workgroup_size()[0];
-        let threads = segments.min(MAX_WORKGROUPS.saturating_mul(per_group));
+        let threads = self.count.0.grid_stride_threads(segments);
         // SAFETY: guaranteed by the caller.
         unsafe {
             self.count.0.bind(cmd, &[self.count.1]);

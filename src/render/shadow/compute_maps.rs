@@ -29,8 +29,6 @@ use crate::vk::device::Device;
 use crate::vk::pipeline::ComputePipeline;
 use crate::vk::shaders::{RENDER_SHADOW_RASTER_COMP, RENDER_SHADOW_RASTER_COMP_SHADOW_Z0, RENDER_SHADOW_RESOLVE_COMP};
 
-/// Workgroups of a dispatch every device runs (`maxComputeWorkGroupCount`'s minimum).
-const MAX_WORKGROUPS: u32 = 65_535;
 /// `SHADOW_NO_HAIR` of `glsl/include/shadow_sums.glsl`: z0's key where no strand is.
 const NO_HAIR: u32 = u32::MAX;
 
@@ -164,8 +162,7 @@ impl ComputeMaps {
         let d = &self.device;
         let segments = uniforms.counts[0].saturating_mul(uniforms.counts[1].saturating_sub(1));
         let light_of = |map: usize| (0..8).find(|&i| uniforms.light_map[i / 4][i % 4] == map as u32).unwrap_or(map);
-        let per_group = pass.0.workgroup_size()[0];
-        let threads = segments.min(MAX_WORKGROUPS.saturating_mul(per_group));
+        let threads = pass.0.grid_stride_threads(segments);
         // SAFETY: guaranteed by the caller.
         unsafe {
             pass.0.bind(cmd, &[pass.1]);

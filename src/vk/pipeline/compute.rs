@@ -13,6 +13,11 @@ use crate::vk::device::Device;
 use crate::vk::reflect::reflect;
 use crate::vk::shaders::ShaderSource;
 
+/// Workgroups of a dispatch that every device runs (`maxComputeWorkGroupCount`'s
+/// minimum): a grid-stride kernel dispatches at most this many and loops over
+/// the rest ([`ComputePipeline::grid_stride_threads`]).
+pub(crate) const MAX_WORKGROUPS: u32 = 65_535;
+
 /// A compute pipeline, and variants of it with its specialisation constant 0
 /// set (see [`ComputePipeline::prepare_variant`]).
 pub(crate) struct ComputePipeline {
@@ -76,6 +81,13 @@ impl ComputePipeline {
             self.variants.insert(constant, raw);
         }
         Ok(())
+    }
+
+    /// Invocations to dispatch for `threads` items of a grid-stride kernel:
+    /// all of them, or as many as [`MAX_WORKGROUPS`] workgroups hold (the
+    /// kernel loops over the rest).
+    pub(crate) fn grid_stride_threads(&self, threads: u32) -> u32 {
+        threads.min(MAX_WORKGROUPS.saturating_mul(self.workgroup_size[0]))
     }
 
     /// Invocations per workgroup in each dimension.

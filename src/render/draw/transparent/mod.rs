@@ -72,9 +72,6 @@ const RESOLVED_BYTES_PER_PIXEL: u64 = 8;
 /// Its binding (`OitResolved` in `oit_resolve.comp` and `oit_resolved.frag`).
 const RESOLVED_BINDING: u32 = 28;
 
-/// Workgroups of a dispatch that every device runs (`maxComputeWorkGroupCount`'s minimum).
-const MAX_WORKGROUPS: u32 = 65_535;
-
 /// How the build makes fragments.
 enum Build {
     /// The ribbons through the hardware raster pipeline (`ribbon.vert`'s
@@ -452,8 +449,7 @@ impl TransparentPass {
             let inner = PassScope::open(d, cmd, timing, &shading_label, LabelColor::Compute);
             pipelines.points.0.bind_variant(cmd, frame.features, &[pipelines.points.1]);
             // At most 65,535 workgroups (every device's limit); the shader loops over the rest.
-            let per_group = pipelines.points.0.workgroup_size()[0];
-            let threads = hairs.saturating_mul(per_hair).min(MAX_WORKGROUPS.saturating_mul(per_group));
+            let threads = pipelines.points.0.grid_stride_threads(hairs.saturating_mul(per_hair));
             pipelines.points.0.dispatch_threads(cmd, [threads, 1, 1]);
             // The rectangle the ribbons reach: a dispatch of its own (folded into the
             // shading above, lavapipe's resident memory grew by ~0.4 MB a frame).
@@ -486,9 +482,7 @@ impl TransparentPass {
                 }
                 Build::Compute(pipeline, set) => {
                     pipeline.bind_variant(cmd, pool.map_or(1, |p| p.buffers), &[*set]);
-                    let per_group = pipeline.workgroup_size()[0];
-                    let segments = frame.segments.min(MAX_WORKGROUPS.saturating_mul(per_group));
-                    pipeline.dispatch_threads(cmd, [segments, 1, 1]);
+                    pipeline.dispatch_threads(cmd, [pipeline.grid_stride_threads(frame.segments), 1, 1]);
                 }
                 Build::Tiles(passes) => {
                     passes.record(d, cmd, frame.segments);
