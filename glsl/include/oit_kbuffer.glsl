@@ -8,7 +8,7 @@
 //
 // The slots live in per-invocation arrays of SORT_CAPACITY entries (depth and
 // packed half-float colour), every pass over them unrolled: the smallest
-// variant that holds K is chosen (exact.rs, tiles.rs), since each fragment costs
+// variant that holds K is chosen (exact.rs), since each fragment costs
 // SORT_CAPACITY compare-and-swaps whatever K is. The includer defines
 // VKHAIR_SORT_4/8/16 (else OIT_MAX_SORTED slots).
 #ifndef VKHAIR_OIT_KBUFFER_GLSL

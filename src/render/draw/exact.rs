@@ -21,7 +21,8 @@ use crate::vk::shaders::{
     ShaderSource, RENDER_OIT_BUILD_FRAG, RENDER_OIT_RESOLVED_FRAG, RENDER_OIT_RESOLVE_COMP,
     RENDER_OIT_RESOLVE_COMP_SORT_16, RENDER_OIT_RESOLVE_COMP_SORT_4, RENDER_OIT_RESOLVE_COMP_SORT_8,
     RENDER_OIT_RESOLVE_FRAG, RENDER_OIT_RESOLVE_FRAG_SORT_16, RENDER_OIT_RESOLVE_FRAG_SORT_4,
-    RENDER_OIT_RESOLVE_FRAG_SORT_8,
+    RENDER_OIT_RESOLVE_FRAG_SORT_8, RENDER_TILE_FINE_COMP, RENDER_TILE_FINE_COMP_SORT_16, RENDER_TILE_FINE_COMP_SORT_4,
+    RENDER_TILE_FINE_COMP_SORT_8,
 };
 
 /// The build's and the composite's stages for `sorted` (K) fragments sorted
@@ -45,7 +46,12 @@ pub(super) fn shaders(sorted: u32, raster: Raster) -> ModeShaders {
         Raster::Tiles => ModeShaders {
             build: &RENDER_OIT_BUILD_FRAG,
             composite: &RENDER_OIT_RESOLVED_FRAG,
-            resolve: Some(super::tiles::fine_shader(sorted)),
+            resolve: Some(pick([
+                &RENDER_TILE_FINE_COMP_SORT_4,
+                &RENDER_TILE_FINE_COMP_SORT_8,
+                &RENDER_TILE_FINE_COMP_SORT_16,
+                &RENDER_TILE_FINE_COMP,
+            ])),
         },
         Raster::Compute => ModeShaders {
             build: &RENDER_OIT_BUILD_FRAG,

@@ -42,7 +42,7 @@ use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::device::{Device, DeviceInfo};
 use crate::vk::pipeline::ComputePipeline;
-use crate::vk::shaders::{ShaderSource, RENDER_TILE_BIN_COMP, RENDER_TILE_BIN_COMP_TILE_FILL, RENDER_TILE_SCAN_COMP};
+use crate::vk::shaders::{RENDER_TILE_BIN_COMP, RENDER_TILE_BIN_COMP_TILE_FILL, RENDER_TILE_SCAN_COMP};
 
 /// Bindings (`tile_lists.glsl`): the counters, the three per-tile words, the list.
 const COUNTERS_BINDING: u32 = 29;
@@ -112,8 +112,8 @@ pub(super) struct TileBins {
     counters: Buffer,
     readback: Buffer,
     /// The frames recorded with these bins, newest last, with the slot each
-    /// copied its count into (at most READBACK_SLOTS), and the slots taken.
-    recorded: std::sync::Mutex<(std::collections::VecDeque<(u64, u64)>, u64)>,
+    /// copied its count into (at most READBACK_SLOTS of them).
+    recorded: std::sync::Mutex<std::collections::VecDeque<(u64, u64)>>,
     per_tile: [Buffer; 3],
     list: Buffer,
     grid: [u32; 2],
@@ -179,7 +179,7 @@ impl TileBins {
     pub(super) fn entries_asked_by(&self, done: u64) -> Option<u64> {
         let slot = {
             let recorded = self.recorded.lock().ok()?;
-            recorded.0.iter().rev().find(|(frame, _)| *frame <= done)?.1
+            recorded.iter().rev().find(|(frame, _)| *frame <= done)?.1
         };
         let at = (4 * slot) as usize;
         let bytes = self.readback.mapped()?.get(at..at + 4)?;
@@ -236,14 +236,14 @@ impl TileBins {
     /// `cmd` is a recording command buffer of `device` outside a render pass,
     /// after this frame's scan.
     pub(super) unsafe fn record_readback(&self, device: &Device, cmd: vk::CommandBuffer, frame: u64) {
-        // A slot the frames in flight do not use: the oldest of READBACK_SLOTS.
+        // A slot the frames in flight do not use: the one after the newest's,
+        // the oldest of READBACK_SLOTS.
         let slot = match self.recorded.lock() {
             Ok(mut recorded) => {
-                let slot = recorded.1 % READBACK_SLOTS;
-                recorded.1 += 1;
-                recorded.0.push_back((frame, slot));
-                if recorded.0.len() > READBACK_SLOTS as usize {
-                    recorded.0.pop_front();
+                let slot = recorded.back().map_or(0, |(_, newest)| (newest + 1) % READBACK_SLOTS);
+                recorded.push_back((frame, slot));
+                if recorded.len() > READBACK_SLOTS as usize {
+                    recorded.pop_front();
                 }
                 slot
             }
@@ -258,21 +258,6 @@ impl TileBins {
             device.raw.cmd_copy_buffer(cmd, self.counters.raw(), self.readback.raw(), &[region]);
             device.cmd_barrier(cmd, &[to_host], &[], &[]);
         }
-    }
-}
-
-/// The fine pass's shader for K sorted fragments: the variant with the
-/// smallest K-buffer that holds K.
-pub(super) fn fine_shader(sorted: u32) -> &'static ShaderSource {
-    use crate::vk::shaders::{
-        RENDER_TILE_FINE_COMP, RENDER_TILE_FINE_COMP_SORT_16, RENDER_TILE_FINE_COMP_SORT_4,
-        RENDER_TILE_FINE_COMP_SORT_8,
-    };
-    match sorted {
-        0..=4 => &RENDER_TILE_FINE_COMP_SORT_4,
-        5..=8 => &RENDER_TILE_FINE_COMP_SORT_8,
-        9..=16 => &RENDER_TILE_FINE_COMP_SORT_16,
-        _ => &RENDER_TILE_FINE_COMP,
     }
 }
 

@@ -264,8 +264,8 @@ impl TransparentPass {
         // `frames_in_flight` before this one (its own copy in the bins).
         let done = self.frames_in_flight.and_then(|f| frame.checked_sub(u64::from(f)));
         let bins_now = self.current.as_ref().and_then(|r| r.tiles.as_ref());
-        if let Some(asked) = done.and_then(|done| bins_now.and_then(|b| b.entries_asked_by(done))) {
-            if asked > bins_now.map_or(u64::MAX, TileBins::capacity) {
+        if let (Some(done), Some(bins)) = (done, bins_now) {
+            if let Some(asked) = bins.entries_asked_by(done).filter(|&asked| asked > bins.capacity()) {
                 self.tile_demand = self.tile_demand.max(asked + asked / 4);
             }
         }
