@@ -28,6 +28,8 @@ mod interpolation;
 mod layers;
 #[path = "mesh_collider.rs"]
 mod mesh_collider;
+#[path = "motion.rs"]
+mod motion;
 #[path = "params_walk.rs"]
 mod params_walk;
 #[path = "presets.rs"]

@@ -426,6 +426,8 @@ fn frames_with(
                 depth: depth_view,
                 depth_format: DEPTH,
                 depth_image: depth,
+                velocity: vk::ImageView::null(),
+                velocity_format: vk::Format::UNDEFINED,
                 extent: scissor.extent,
                 samples: vk::SampleCountFlags::TYPE_1,
             };

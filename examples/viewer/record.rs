@@ -87,6 +87,8 @@ impl Running {
                 depth: self.swapchain.depth_view,
                 depth_format: DEPTH,
                 depth_image: self.swapchain.depth,
+                velocity: vk::ImageView::null(),
+                velocity_format: vk::Format::UNDEFINED,
                 extent,
                 samples: vk::SampleCountFlags::TYPE_1,
             };

@@ -32,6 +32,9 @@ layout(std430, set = 0, binding = 9) OIT_COUNTERS_ACCESS buffer OitCounters {
     uint scene_depth;
     // 1 when the target's depth is reversed (near = 1, `Camera::depth_reversed`).
     uint reverse_z;
+    // The accumulated opacity at which a pixel's motion vector takes its hair
+    // (render/draw/motion.rs); 0 when the frame writes none.
+    float motion_threshold;
 } oit;
 
 // A depth of the target's convention as the lists keep it, forward (near 0,

@@ -103,4 +103,33 @@ vec4 kb_composite() {
     return vec4(sum, 1.0 - transmittance);
 }
 
+// The depth of the kept fragment at which the K, composited front to back,
+// first reach an opacity of `threshold`: the hair a pixel's motion vector
+// follows (render/draw/motion.rs). EMPTY when the K never reach it (the tail,
+// unordered, is not searched).
+float kb_crossing(float threshold) {
+    float transmittance = 1.0;
+    float depth = EMPTY;
+    [[unroll]] for (uint i = 0u; i < SORT_CAPACITY; i++) {
+        transmittance *= 1.0 - unpack_color(kb_color[i]).a;
+        if (depth == EMPTY && 1.0 - transmittance >= threshold) {
+            depth = kb_depth[i];
+        }
+    }
+    return depth;
+}
+
+// Per pixel the depth its motion vector follows (kb_crossing), written when
+// the frame writes motion vectors (render/draw/motion.rs).
+layout(std430, set = 0, binding = 35) writeonly buffer MotionDepth { uint motion_depth[]; };
+
+// Writes kb_crossing's depth for the frame's motion threshold (OitCounters'
+// motion_threshold; nothing when it is 0: no motion vectors) for `pixel`.
+void kb_write_motion_depth(uint pixel) {
+    if (oit.motion_threshold > 0.0) {
+        float crossing = kb_crossing(oit.motion_threshold);
+        motion_depth[pixel] = crossing < EMPTY ? floatBitsToUint(crossing) : OIT_END;
+    }
+}
+
 #endif

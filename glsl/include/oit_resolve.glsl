@@ -16,6 +16,7 @@
 #include "oit.glsl"
 #include "oit_kbuffer.glsl"
 
+
 #ifdef VKHAIR_OVERFLOW_BUFFER
 #include "oit_overflow.glsl"
 #else
@@ -49,6 +50,7 @@ bool oit_resolve_pixel(uint pixel, ivec2 coord, out vec4 result) {
         kb_insert(uintBitsToFloat(record.z), record.xy);
     }
     result = kb_composite();
+    kb_write_motion_depth(pixel);
     return true;
 }
 

@@ -14,9 +14,10 @@
 // interpolates them. Every rasteriser takes its pixels and fragments from
 // here, so they make the same fragments.
 //
-// The includer declares hair_pos, hair_tan (bindings 1, 2) and point_color
-// (binding 20), and includes hair_shading.glsl (dp, strand_alpha) and
-// oit_counters.glsl (oit).
+// The includer declares hair_pos, hair_tan (bindings 1, 2), point_color
+// (binding 20) and scene_depth (binding 25; not where it defines
+// STRAND_SEGMENT_NO_DEPTH_TEST and tests no depth), and includes
+// hair_shading.glsl (dp, strand_alpha) and oit_counters.glsl (oit).
 #ifndef VKHAIR_STRAND_SEGMENT_GLSL
 #define VKHAIR_STRAND_SEGMENT_GLSL
 
@@ -190,6 +191,7 @@ uint segment_first(uint seg, out bool last) {
     return hair * dp.counts.y + within;
 }
 
+#ifndef STRAND_SEGMENT_NO_DEPTH_TEST
 // The depth of a pixel of the target as the compute rasterisers test hair
 // against it (forward, oit_forward): the host's depth copied into SceneDepth
 // (binding 25, declared by the includer), encoded as oit.scene_depth says;
@@ -206,5 +208,6 @@ float scene_depth_limit(uint pixel) {
     }
     return 3.0e38;
 }
+#endif
 
 #endif

@@ -177,5 +177,6 @@ void main() {
         vec4 result = kb_composite();
         oit_resolved[pixel] = uvec2(packHalf2x16(result.rg), packHalf2x16(result.ba));
         oit_opaque[pixel] = opaque;
+        kb_write_motion_depth(pixel);
     }
 }

@@ -28,8 +28,8 @@ mod volume;
 #[cfg(test)]
 pub(crate) use probe::{LayoutProbe, ScaleAddPush};
 pub(crate) use render::{
-    DrawParams, FollowerBinding, GpuLight, GpuShadowMap, GpuShadowParams, InterpolatePush, MarschnerPush, OitCounters,
-    SmoothPush, TileCounters,
+    DrawParams, FollowerBinding, GpuLight, GpuMotion, GpuShadowMap, GpuShadowParams, InterpolatePush, MarschnerPush,
+    OitCounters, SmoothPush, TileCounters,
 };
 pub(crate) use sim::{GpuCollider, GpuScalpRoot, MovePush, SdfPush, SimPush, SimStepParams};
 pub(crate) use volume::{GpuVolumeParams, PcgScalars, VolumePush};
@@ -261,6 +261,7 @@ pub(crate) fn check_all(reflection: &crate::vk::reflect::Reflection) -> Vec<Stri
     check::<GpuLight>(reflection, &mut problems);
     check::<DrawParams>(reflection, &mut problems);
     check::<OitCounters>(reflection, &mut problems);
+    check::<GpuMotion>(reflection, &mut problems);
     check::<TileCounters>(reflection, &mut problems);
     check::<MarschnerPush>(reflection, &mut problems);
     check::<GpuVolumeParams>(reflection, &mut problems);

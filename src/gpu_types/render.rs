@@ -169,10 +169,33 @@ pub(crate) struct OitCounters {
     /// 1 when the target's depth is reversed (near = 1): the lists keep
     /// depths forward (`oit_forward` in `glsl/include/oit_counters.glsl`).
     pub reverse_z: u32,
+    /// The accumulated opacity at which a pixel's motion vector takes its
+    /// hair (the exact mode's composite writes that depth); 0 when the frame
+    /// writes no motion vectors.
+    pub motion_threshold: f32,
 }
 gpu_struct!(OitCounters => "OitCounters" {
-    used, capacity, width, sorted, pool_nodes, height, hair_x0, hair_y0, hair_x1, hair_y1, scene_depth, reverse_z
+    used, capacity, width, sorted, pool_nodes, height, hair_x0, hair_y0, hair_x1, hair_y1, scene_depth, reverse_z,
+    motion_threshold
 });
+
+/// The motion vectors' block (`MotionBlock` in `glsl/include/motion.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct GpuMotion {
+    /// World → clip of this frame, without its jitter.
+    pub now: [[f32; 4]; 4],
+    /// World → clip of the previous frame, without its jitter.
+    pub before: [[f32; 4]; 4],
+    /// xy: an NDC difference (now − before) to the host's units and sign.
+    pub scale: [f32; 4],
+    /// This frame's projection: clip z = x·z_view + y, clip w = z·z_view + w.
+    pub depth: [f32; 4],
+    /// x: hairs (a prefix) whose previous positions are kept; y: drawn
+    /// pixels per target pixel along each axis.
+    pub counts: [u32; 4],
+}
+gpu_struct!(GpuMotion => "MotionBlock" { now, before, scale, depth, counts });
 
 /// The tiled rasteriser's per-frame words (`TileCounters` in `glsl/include/tile_lists.glsl`).
 #[repr(C)]

@@ -45,6 +45,16 @@ pub struct Offscreen {
     /// Host-visible copy of `color` taken mid-frame ([`Offscreen::record_snapshot`]),
     /// made by [`Offscreen::keep_snapshots`].
     snapshot: Option<Buffer>,
+    /// A velocity image, made by [`Offscreen::add_velocity`].
+    velocity: Option<Velocity>,
+}
+
+/// An [`Offscreen`]'s velocity image, its readback buffer and what a clear writes.
+struct Velocity {
+    image: Image,
+    format: vk::Format,
+    readback: Buffer,
+    clear: glam::Vec2,
 }
 
 impl Offscreen {
@@ -103,7 +113,66 @@ impl Offscreen {
         )?;
         let bytes = u64::from(width) * u64::from(height) * texel_bytes(format);
         let readback = device.readback_staging("offscreen readback", bytes)?;
-        Ok(Offscreen { device, color, format, depth, readback, snapshot: None })
+        Ok(Offscreen { device, color, format, depth, readback, snapshot: None, velocity: None })
+    }
+
+    /// Gives the target a velocity image of `format` (one of
+    /// [`crate::render::VELOCITY_FORMATS`]) for the hair's motion vectors
+    /// ([`RenderTarget::velocity`]), which [`Offscreen::record_clear`] clears
+    /// to `clear` (pixels, or whatever units the renderer writes).
+    pub fn add_velocity(&mut self, format: vk::Format, clear: glam::Vec2) -> Result<()> {
+        if !crate::render::VELOCITY_FORMATS.contains(&format) {
+            return Err(Error::param("velocity format", format!("{format:?}"), "R16G16_SFLOAT or R32G32_SFLOAT"));
+        }
+        let needed = vk::FormatFeatureFlags::COLOR_ATTACHMENT | vk::FormatFeatureFlags::TRANSFER_SRC;
+        if !self.device.optimal_tiling_features(format).contains(needed) {
+            return Err(Error::incompatible("velocity format", format!("{format:?} is not a colour attachment here")));
+        }
+        let image = Image::new(
+            &self.device,
+            &ImageDesc {
+                name: "offscreen velocity",
+                extent: self.color.extent,
+                format,
+                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+                samples: vk::SampleCountFlags::TYPE_1,
+                aspect: vk::ImageAspectFlags::COLOR,
+            },
+        )?;
+        let texel = if format == vk::Format::R16G16_SFLOAT { 4 } else { 8 };
+        let (w, h) = self.size();
+        let bytes = u64::from(w) * u64::from(h) * texel;
+        let readback = self.device.readback_staging("offscreen velocity readback", bytes)?;
+        self.velocity = Some(Velocity { image, format, readback, clear });
+        Ok(())
+    }
+
+    /// Reads the velocity image back, rows top to bottom (this submits and
+    /// waits); refused without [`Offscreen::add_velocity`].
+    pub fn read_velocity(&self) -> Result<Vec<glam::Vec2>> {
+        let v = self
+            .velocity
+            .as_ref()
+            .ok_or_else(|| Error::incompatible("offscreen velocity", "read_velocity before add_velocity"))?;
+        let mut bytes = Vec::new();
+        let layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+        self.device.readback_image_via(&v.image, layout, &v.readback, &mut bytes)?;
+        Ok(match v.format {
+            vk::Format::R16G16_SFLOAT => bytes
+                .chunks_exact(4)
+                .map(|t| {
+                    let c = |i: usize| half::f16::from_le_bytes([t[2 * i], t[2 * i + 1]]).to_f32();
+                    glam::Vec2::new(c(0), c(1))
+                })
+                .collect(),
+            _ => bytes
+                .chunks_exact(8)
+                .map(|t| {
+                    let c = |i: usize| f32::from_le_bytes([t[4 * i], t[4 * i + 1], t[4 * i + 2], t[4 * i + 3]]);
+                    glam::Vec2::new(c(0), c(1))
+                })
+                .collect(),
+        })
     }
 
     /// Makes the buffer [`Offscreen::record_snapshot`] copies into (as large
@@ -188,6 +257,8 @@ impl Offscreen {
             depth: self.depth.view(),
             depth_format: OFFSCREEN_DEPTH,
             depth_image: self.depth.raw(),
+            velocity: self.velocity.as_ref().map_or(vk::ImageView::null(), |v| v.image.view()),
+            velocity_format: self.velocity.as_ref().map_or(vk::Format::UNDEFINED, |v| v.format),
             extent: self.color.extent,
             samples: vk::SampleCountFlags::TYPE_1,
         }
@@ -225,12 +296,23 @@ impl Offscreen {
             vk::ImageLayout::UNDEFINED,
             vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
         );
-        let color = [rendering::color(self.color.view(), Load::color([rgb.x, rgb.y, rgb.z, 1.0]))];
+        let mut color = vec![rendering::color(self.color.view(), Load::color([rgb.x, rgb.y, rgb.z, 1.0]))];
+        let mut images = vec![to_color, to_depth];
+        if let Some(v) = &self.velocity {
+            color.push(rendering::color(v.image.view(), Load::color([v.clear.x, v.clear.y, 0.0, 0.0])));
+            images.push(barrier::image(
+                &v.image,
+                barrier::ANY,
+                barrier::COLOR_ATTACHMENT,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            ));
+        }
         let depth = rendering::depth(self.depth.view(), Load::depth(depth));
         let rendering = rendering::info(self.color.extent, &color, Some(&depth));
         // SAFETY: guaranteed by the caller.
         unsafe {
-            d.cmd_barrier(cmd, &[], &[], &[to_color, to_depth]);
+            d.cmd_barrier(cmd, &[], &[], &images);
             d.raw.cmd_begin_rendering(cmd, &rendering);
             d.raw.cmd_end_rendering(cmd);
         }

@@ -30,6 +30,7 @@ pub mod followers;
 mod frame;
 mod interpolate;
 pub mod marschner;
+mod motion_reference;
 mod params;
 pub(crate) mod pass;
 mod readback;
@@ -44,12 +45,12 @@ mod smooth;
 pub(crate) mod strand_frames;
 mod target;
 
-pub use draw::{OitPool, OitStats};
+pub use draw::{OitPool, OitStats, VELOCITY_FORMATS};
 pub use followers::Followers;
 pub use marschner::MarschnerParams;
 pub use params::{
-    Detail, InterpolationMode, Interpolator, LodParams, OitParams, Primitive, Raster, RenderParams, Transparency,
-    MAX_HAIRS_PER_KEY, MAX_SMOOTHING_LEVEL,
+    Detail, InterpolationMode, Interpolator, LodParams, MotionDirection, MotionParams, MotionUnits, OitParams,
+    Primitive, Raster, RenderParams, Transparency, MAX_HAIRS_PER_KEY, MAX_SMOOTHING_LEVEL,
 };
 pub use pass::RenderPass;
 pub use scalp_coverage::{scalp_coverage, ScalpCoverage, MAX_COVERAGE_PROBES};
@@ -150,6 +151,9 @@ pub struct Renderer {
     last_frame: Option<u64>,
     /// Followers drawn instead of grown hairs, when created with them.
     followers: Option<FollowerCounts>,
+    /// The previous frame's drawn positions and camera, made by the first
+    /// frame that writes motion vectors.
+    motion: Option<draw::MotionHistory>,
 }
 
 /// What the renderer keeps of its [`Followers`].
@@ -265,6 +269,7 @@ impl Renderer {
             detail,
             source: sim.bound_buffers(),
             last_frame: None,
+            motion: None,
             followers: followers.map(|f| FollowerCounts {
                 count: f.count() as u32,
                 points: f.points() as u32,

@@ -51,6 +51,60 @@ pub struct RenderParams {
     /// Frames the host has in flight (1..=16): images a new target size makes
     /// obsolete are freed this many frames after their last use. Default: 2.
     pub frames_in_flight: u32,
+    /// How motion vectors are written into a target's velocity image
+    /// ([`super::RenderTarget::velocity`]): which hair a pixel follows, the
+    /// units and the sign.
+    pub motion: MotionParams,
+}
+
+/// How the hair's motion vectors are written ([`super::RenderTarget::velocity`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MotionParams {
+    /// The opacity, accumulated front to back, at which a pixel's motion takes
+    /// its hair (0 < threshold ≤ 1): in [`Transparency::Exact`] the motion is
+    /// that of the hair whose fragment brings the pixel's sorted fragments to
+    /// this opacity (a pixel whose nearest [`OitParams::sorted_fragments`]
+    /// never reach it gets none). [`Transparency::Fast`], which keeps no
+    /// order, follows the nearest fragment at least half opaque, whatever
+    /// this is. Default: 0.5.
+    pub threshold: f32,
+    /// The units of a motion vector. Default: [`MotionUnits::Pixels`].
+    pub units: MotionUnits,
+    /// Which way a motion vector points. Default:
+    /// [`MotionDirection::CurrentMinusPrevious`].
+    pub direction: MotionDirection,
+}
+
+impl Default for MotionParams {
+    fn default() -> Self {
+        MotionParams { threshold: 0.5, units: MotionUnits::Pixels, direction: MotionDirection::CurrentMinusPrevious }
+    }
+}
+
+/// The units of a motion vector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MotionUnits {
+    /// Pixels of the host's target (not of the supersampled images), +x to
+    /// the right, +y down the rows.
+    #[default]
+    Pixels,
+    /// Vulkan normalised device coordinates: the same axes, 2 across the
+    /// target's width and height.
+    Ndc,
+}
+
+/// Which way a motion vector points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MotionDirection {
+    /// Where the pixel's hair is in this frame minus where it was in the
+    /// previous one (a TAA resolve subtracts it to find the history).
+    #[default]
+    CurrentMinusPrevious,
+    /// Where it was minus where it is (the history's offset from the pixel).
+    PreviousMinusCurrent,
 }
 
 /// What the draw pass turns each hair segment into.
@@ -94,6 +148,7 @@ impl Default for RenderParams {
             raster: Raster::Auto,
             interpolator: Interpolator::Auto,
             frames_in_flight: 2,
+            motion: MotionParams::default(),
         }
     }
 }
@@ -394,6 +449,10 @@ impl RenderParams {
         let b = self.oit.max_buffer_bytes;
         if b != 0 && b < MIN_POOL_BUFFER_BYTES {
             return Err(Error::param("oit.max_buffer_bytes", b, format!("0 or {MIN_POOL_BUFFER_BYTES}..=4294967295")));
+        }
+        let t = self.motion.threshold;
+        if !(t.is_finite() && t > 0.0 && t <= 1.0) {
+            return Err(Error::param("motion.threshold", t, "greater than 0, at most 1"));
         }
         let e = self.oit.tile_entries_per_vertex;
         if !(e.is_finite() && (0.1..=256.0).contains(&e)) {

@@ -51,13 +51,15 @@ pub enum RenderPass {
     /// Pass 4b (with transparency): sorting and blending each pixel's fragments
     /// into the target.
     Composite,
+    /// Pass 4c (a target with a velocity image): the hair's motion vectors.
+    Motion,
     /// Pass 5: supersampling resolve.
     Resolve,
 }
 
 impl RenderPass {
     /// Every pass, in recording order.
-    pub const ALL: [RenderPass; 8] = [
+    pub const ALL: [RenderPass; 9] = [
         RenderPass::Smooth,
         RenderPass::Interpolate,
         RenderPass::ShadowDepth,
@@ -65,6 +67,7 @@ impl RenderPass {
         RenderPass::ShadowVolume,
         RenderPass::Draw,
         RenderPass::Composite,
+        RenderPass::Motion,
         RenderPass::Resolve,
     ];
 
@@ -78,6 +81,7 @@ impl RenderPass {
             RenderPass::ShadowVolume => "vkhair render: shadow volume",
             RenderPass::Draw => "vkhair render: draw",
             RenderPass::Composite => "vkhair render: composite",
+            RenderPass::Motion => "vkhair render: motion vectors",
             RenderPass::Resolve => "vkhair render: resolve",
         }
     }
@@ -85,7 +89,7 @@ impl RenderPass {
     /// What the pass's commands are (its label colour).
     pub(crate) fn kind(self) -> LabelColor {
         match self {
-            RenderPass::ShadowVolume => LabelColor::Compute,
+            RenderPass::ShadowVolume | RenderPass::Motion => LabelColor::Compute,
             _ => LabelColor::Graphics,
         }
     }

@@ -2,6 +2,7 @@
 
 use glam::Vec3;
 
+pub use super::motion_reference::{hair_motion, hair_motions_at, MotionPick, MotionScene};
 pub use super::strand_frames::{key_frame, rest_plane_normals, smooth_strand, strand_spread};
 
 /// The key points drawn at `alpha` between the state before the latest step and

@@ -26,7 +26,18 @@ pub struct RenderTarget {
     /// the draw returns); with a depth view and a null image, they refuse the
     /// target. The hardware raster pipeline never reads it.
     pub depth_image: vk::Image,
-    /// Extent of both.
+    /// Velocity image view (in `COLOR_ATTACHMENT_OPTIMAL`; created with
+    /// `COLOR_ATTACHMENT` usage, as large as the colour image), or null for
+    /// none. Where given, each pixel the hair covers gets its motion since the
+    /// previous frame ([`super::MotionParams`]: which hair, the units, the
+    /// sign), the jitter excluded; every other pixel keeps what the host wrote.
+    /// Written by the transparent modes ([`super::Transparency::Exact`] with
+    /// every rasteriser, [`super::Transparency::Fast`]); refused with
+    /// [`super::Transparency::Off`].
+    pub velocity: vk::ImageView,
+    /// Its format: `R16G16_SFLOAT` or `R32G32_SFLOAT` (`UNDEFINED` for none).
+    pub velocity_format: vk::Format,
+    /// Extent of all three.
     pub extent: vk::Extent2D,
     /// Sample count of both.
     pub samples: vk::SampleCountFlags,

@@ -208,6 +208,7 @@ fn every_shader_struct_matches_its_rust_twin() {
         gpu_types::GpuLight::GLSL_NAME,
         gpu_types::DrawParams::GLSL_NAME,
         gpu_types::OitCounters::GLSL_NAME,
+        gpu_types::GpuMotion::GLSL_NAME,
         gpu_types::TileCounters::GLSL_NAME,
         gpu_types::MarschnerPush::GLSL_NAME,
         gpu_types::GpuVolumeParams::GLSL_NAME,
@@ -229,6 +230,26 @@ fn every_shader_struct_matches_its_rust_twin() {
     for (count, name) in found.iter().zip(names) {
         assert!(*count > 0, "no shader uses {name}");
     }
+}
+
+/// No shader declares two resources at one binding: GLSL accepts it and the
+/// two would alias one descriptor (a header's buffer landing on another
+/// header's binding, as the motion depths once did on the tiled rasteriser's
+/// per-tile counts).
+#[test]
+fn no_shader_declares_two_resources_at_one_binding() {
+    let mut checked = 0;
+    for shader in shaders::ALL {
+        let r = reflect(shader).expect("reflect");
+        let mut seen = std::collections::HashMap::new();
+        for b in &r.bindings {
+            if let Some(other) = seen.insert((b.set, b.binding), &b.name) {
+                panic!("{}: {} and {other} both at set {} binding {}", shader.name, b.name, b.set, b.binding);
+            }
+        }
+        checked += r.bindings.len();
+    }
+    assert!(checked > 100, "only {checked} bindings reflected");
 }
 
 /// Deliberately wrong twins: the comparison must reject them.

@@ -21,6 +21,7 @@
 
 mod exact;
 mod fast;
+mod motion;
 mod opaque;
 mod raster;
 mod ribbons;
@@ -47,6 +48,9 @@ use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::rendering::{self, Load};
 use crate::vk::shaders::ShaderSource;
+pub(super) use motion::MotionHistory;
+pub use motion::VELOCITY_FORMATS;
+use motion::{HairLayout, MotionFrame};
 use opaque::OpaquePipelines;
 use ribbons::RibbonIndices;
 use shading::ShadingResources;
@@ -149,6 +153,15 @@ pub(super) struct DrawFrame<'a> {
     /// ([`crate::codes::shading_features`]): the shading pipelines are
     /// specialised to them.
     pub features: u32,
+    /// The motion vectors, where the host's target has a velocity image.
+    pub motion: Option<MotionFrame<'a>>,
+}
+
+impl DrawFrame<'_> {
+    /// The format of the frame's velocity image (`UNDEFINED` for none).
+    fn velocity_format(&self) -> vk::Format {
+        self.motion.as_ref().map_or(vk::Format::UNDEFINED, |m| m.format)
+    }
 }
 
 /// Pass 4: the shading every mode shares, the opaque pipelines and the
@@ -311,6 +324,24 @@ impl Renderer {
             None => host.clone(),
         };
         let mode = self.params.transparency;
+        let hairs = self.hair_layout();
+        let motion = match target.velocity == vk::ImageView::null() {
+            true => None,
+            false if mode == Transparency::Off => {
+                return Err(Error::unsupported(
+                    "motion vectors of opaque hair (Transparency::Off)",
+                    "draw with Transparency::Exact or Fast, or give the target no velocity image",
+                ))
+            }
+            false => {
+                if self.motion.is_none() {
+                    self.motion = Some(MotionHistory::new(&self.device, self.interpolate.hairs().0.size() / 16)?);
+                }
+                let history = self.motion.as_ref().ok_or_else(|| Error::incompatible("motion", "no history"))?;
+                let images = (target.velocity, target.velocity_format);
+                Some(history.frame(&self.params.motion, images, (camera, target.extent, drawn.extent), hairs)?)
+            }
+        };
         let frame = DrawFrame {
             cmd,
             frame,
@@ -342,6 +373,7 @@ impl Renderer {
                 looks: self.interpolate.looks().0,
             },
             marschner: self.material.marschner,
+            motion,
         };
         // SAFETY: guaranteed by the caller; the supersampling images are this
         // renderer's and earlier resolves that sampled them are ordered by the barriers.
@@ -355,7 +387,37 @@ impl Renderer {
         if let Some(images) = images {
             self.resolve.restore(images);
         }
+        let wrote_motion = frame.motion.is_some();
+        drop(frame);
+        if let (Ok(()), true, Some(history)) = (&result, wrote_motion, self.motion.as_mut()) {
+            // SAFETY: guaranteed by the caller; recorded after the frame's walk.
+            unsafe { history.record_keep(cmd, self.interpolate.hairs().0, camera, hairs) };
+        }
         result
+    }
+
+    /// Forgets the previous frame for motion vectors: the next frame's are
+    /// zero for every hair, whatever moved (for a camera cut or a teleport,
+    /// where the motion since the last frame means nothing to a TAA history).
+    pub fn reset_motion(&mut self) {
+        if let Some(history) = &mut self.motion {
+            history.reset();
+        }
+    }
+
+    /// The drawn hairs of the frame as the motion vectors see them.
+    fn hair_layout(&self) -> HairLayout {
+        let (hairs, per_hair) = self.hair_counts();
+        // Followers keep one stable order; grown hairs are numbered by the
+        // hairs grown per key (and the mode that grows them).
+        let order = match self.followers {
+            Some(_) => 0,
+            None => {
+                (u64::from(self.params.interpolation == super::InterpolationMode::Barycentric) << 32)
+                    | (u64::from(self.detail.hairs_per_key) + 1)
+            }
+        };
+        HairLayout { hairs, per_hair, order }
     }
 
     /// The rasteriser the current parameters draw with on this device:

@@ -42,6 +42,7 @@ use gpu_allocator::MemoryLocation;
 
 use super::exact::{self, Lists, OitPool};
 use super::fast::{self, WeightedSums};
+use super::motion::{MotionBuffers, MotionPipelines};
 use super::raster::{DepthSource, RasterBuffers};
 use super::ribbons::RibbonIndices;
 use super::shading::ShadingResources;
@@ -92,7 +93,14 @@ struct Pipelines {
     resolve: Option<(ComputePipeline, vk::DescriptorSet)>,
     composite: (GraphicsPipeline, vk::DescriptorSet),
     depth: Option<(GraphicsPipeline, vk::DescriptorSet)>,
+    /// The motion vectors' walk and write (targets with a velocity image).
+    motion: Option<MotionPipelines>,
 }
+
+/// What the pipelines of a target are kept under: the target, the mode's
+/// shaders ([`super::ModeShaders::key`]) and the velocity image's format
+/// (`UNDEFINED` for none).
+type PipelineKey = (TargetKey, &'static str, vk::Format);
 
 /// The buffers and images of one extent and mode, and the pipelines bound to them.
 struct Resources {
@@ -112,8 +120,11 @@ struct Resources {
     /// The compute rasteriser's exact mode: per pixel its resolved hair
     /// (`oit_resolve.comp`; four half floats), which the composite blends.
     resolved: Option<Buffer>,
-    /// By target and composite shader (the exact mode's depends on K).
-    pipelines: HashMap<(TargetKey, &'static str), Pipelines>,
+    /// The motion vectors' per-pixel words, made by the first frame that
+    /// writes motion vectors.
+    motion: Option<MotionBuffers>,
+    /// By target, composite shader (the exact mode's depends on K) and velocity format.
+    pipelines: HashMap<PipelineKey, Pipelines>,
 }
 
 impl Resources {
@@ -148,6 +159,9 @@ pub(super) struct TransparentPass {
     /// each vertex the renderer can draw.
     colors: Buffer,
     nearest: Sampler,
+    /// Bound where the exact mode's composites would write the depths motion
+    /// vectors follow, in frames that write none (never written then).
+    motion_placeholder: Buffer,
     current: Option<Resources>,
     retired: Vec<(u64, Resources)>,
     /// Tile entries an earlier frame asked for beyond its bins' capacity: the
@@ -175,6 +189,7 @@ impl TransparentPass {
             counters,
             colors: Buffer::storage(device, "vkhair hair vertex colors", hair_vertices.max(1) * 16)?,
             nearest: Sampler::nearest(device, "vkhair transparency sums")?,
+            motion_placeholder: Buffer::storage(device, "vkhair motion depth placeholder", 16)?,
             current: None,
             retired: Vec::new(),
             tile_demand: 0,
@@ -322,8 +337,19 @@ impl TransparentPass {
                 }
                 _ => None,
             },
+            motion: None,
             pipelines: HashMap::new(),
         });
+        Ok(())
+    }
+
+    /// Makes the current resources' motion words, where `frame` writes motion
+    /// vectors and they have none yet.
+    fn prepare_motion(&mut self, frame: &DrawFrame<'_>) -> Result<()> {
+        let Some(res) = self.current.as_mut().filter(|r| r.motion.is_none() && frame.motion.is_some()) else {
+            return Ok(());
+        };
+        res.motion = Some(MotionBuffers::new(&self.device, res.extent, res.mode == Transparency::Exact)?);
         Ok(())
     }
 }
@@ -355,6 +381,7 @@ impl TransparentPass {
         // Checked, made (or found) before anything is recorded: a failure leaves `cmd` as it was.
         let depth_source = if compute { DepthSource::of(target)? } else { DepthSource::None };
         self.prepare(frame.frame, mode, params, raster, target.extent)?;
+        self.prepare_motion(frame)?;
         let shaders = match mode {
             Transparency::Exact => exact::shaders(params.sorted_fragments, raster),
             _ => fast::SHADERS,
@@ -363,7 +390,7 @@ impl TransparentPass {
         let Some(res) = self.current.as_ref() else {
             return Err(Error::incompatible("transparency", "no resources after preparing them"));
         };
-        let Some(pipelines) = res.pipelines.get(&(target.key, shaders.key())) else {
+        let Some(pipelines) = res.pipelines.get(&(target.key, shaders.key(), frame.velocity_format())) else {
             return Err(Error::incompatible("transparency", "no pipelines after making them"));
         };
         let (d, cmd, timing) = (&*self.device, frame.cmd, frame.timing);
@@ -383,6 +410,10 @@ impl TransparentPass {
             hair_y1: 0,
             scene_depth: depth_source.code(),
             reverse_z: u32::from(target.key.reverse_z),
+            motion_threshold: match (&frame.motion, mode) {
+                (Some(motion), Transparency::Exact) => motion.threshold,
+                _ => 0.0,
+            },
         };
         // Where the build's fragments are made and stored.
         let storage: &[AccessKind] = match compute {
@@ -466,6 +497,9 @@ impl TransparentPass {
             if let Some(bins) = &res.tiles {
                 bins.record_clear(d, cmd);
             }
+            if let (Some(words), Some(_)) = (&res.motion, &frame.motion) {
+                words.record_clear(d, cmd);
+            }
             d.cmd_barrier(cmd, &[cleared, shaded], &[], &[]);
             let build_label = format!("{}, build", RenderPass::Draw.label());
             let inner = PassScope::open(d, cmd, timing, &build_label, LabelColor::Graphics);
@@ -522,8 +556,13 @@ impl TransparentPass {
                 d.raw.cmd_draw(cmd, 6, 1, 0, 0);
             }
             d.raw.cmd_end_rendering(cmd);
-            d.cmd_barrier(cmd, &[to_host], &[], &[]);
             scope.close(d, cmd, timing);
+            if let (Some(motion), Some(walk)) = (&frame.motion, &pipelines.motion) {
+                let scope = RenderPass::Motion.open(d, cmd, timing);
+                walk.record(d, cmd, motion, frame.segments);
+                scope.close(d, cmd, timing);
+            }
+            d.cmd_barrier(cmd, &[to_host], &[], &[]);
         }
         Ok(())
     }

@@ -4,6 +4,7 @@ use ash::vk;
 
 use super::{Build, Pipelines, TransparentPass, RESOLVED_BINDING};
 use crate::error::{Error, Result};
+use crate::render::draw::motion::{self, MotionPipelines};
 use crate::render::draw::shading::ShadingResources;
 use crate::render::draw::tiles::BinPipelines;
 use crate::render::draw::{DrawFrame, ModeShaders};
@@ -30,7 +31,8 @@ impl TransparentPass {
             return Err(Error::incompatible("transparency", "pipelines requested before the resources"));
         };
         let key = frame.target.key;
-        if let Some(made) = res.pipelines.get_mut(&(key, shaders.key())) {
+        let velocity = frame.velocity_format();
+        if let Some(made) = res.pipelines.get_mut(&(key, shaders.key(), velocity)) {
             return made.points.0.prepare_variant(frame.features);
         }
         let d = &self.device;
@@ -63,6 +65,16 @@ impl TransparentPass {
         }
         if let Some(bins) = &res.tiles {
             ours.extend(bins.bindings());
+        }
+        // The depths motion vectors follow: written by the exact mode's
+        // composites where the frame has motion vectors (a placeholder, never
+        // written, where it has none); the fast mode's nearest half-opaque ones.
+        match (&res.motion, &frame.motion) {
+            (Some(words), Some(motion)) => {
+                ours.extend(words.bindings(&res.opaque));
+                ours.extend([(motion::PREVIOUS_BINDING, motion.previous), (motion::BLOCK_BINDING, motion.uniforms)]);
+            }
+            _ => ours.push((motion::DEPTH_BINDING, &self.motion_placeholder)),
         }
         let (shading_buffers, shading_images) = shading.bindings(&frame.inputs);
         let mut buffers = shading_buffers.to_vec();
@@ -162,8 +174,12 @@ impl TransparentPass {
         } else {
             None
         };
+        let motion = match &frame.motion {
+            Some(_) => Some(MotionPipelines::new(d, &buffers, &shading_images, velocity)?),
+            None => None,
+        };
         res.pipelines.insert(
-            (key, shaders.key()),
+            (key, shaders.key(), velocity),
             Pipelines {
                 points: (points, points_set),
                 rect: (rect, rect_set),
@@ -171,6 +187,7 @@ impl TransparentPass {
                 resolve,
                 composite: (composite, composite_set),
                 depth,
+                motion,
             },
         );
         Ok(())

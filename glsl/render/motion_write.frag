@@ -1,0 +1,42 @@
+#version 460
+// Motion vectors, the write (render/draw/motion.rs): over the host's velocity
+// image (one triangle, resolve.vert), each pixel takes the motion the walk
+// picked (motion_raster.comp) — with supersampling, of its drawn pixels the
+// one whose matched depth is nearest — and a pixel no hair reached is
+// discarded, keeping what the host wrote there.
+#define OIT_COUNTERS_READONLY
+#include "oit_counters.glsl"
+#include "motion.glsl"
+
+layout(std430, set = 0, binding = 35) readonly buffer MotionDepth { uint motion_depth[]; };
+layout(std430, set = 0, binding = 36) readonly buffer MotionKeys { uvec2 motion_keys[]; };
+
+layout(location = 0) out vec2 out_velocity;
+
+void main() {
+    uint n = mb.counts.y;
+    uvec2 base = uvec2(gl_FragCoord.xy) * n;
+    float nearest = 3.0e38;
+    uint velocity = 0u;
+    bool found = false;
+    for (uint sy = 0u; sy < n; sy++) {
+        for (uint sx = 0u; sx < n; sx++) {
+            uvec2 at = base + uvec2(sx, sy);
+            if (at.x >= oit.width || at.y >= oit.height) {
+                continue;
+            }
+            uint pixel = at.y * oit.width + at.x;
+            uvec2 key = motion_keys[pixel];
+            float depth = uintBitsToFloat(motion_depth[pixel]);
+            if (key.y != MOTION_NONE && depth < nearest) {
+                nearest = depth;
+                velocity = key.x;
+                found = true;
+            }
+        }
+    }
+    if (!found) {
+        discard;
+    }
+    out_velocity = unpackHalf2x16(velocity);
+}
