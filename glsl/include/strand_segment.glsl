@@ -15,7 +15,8 @@
 // here, so they make the same fragments.
 //
 // The includer declares hair_pos, hair_tan (bindings 1, 2), point_color
-// (binding 20) and scene_depth (binding 25; not where it defines
+// (binding 20; not where it defines STRAND_SEGMENT_NO_COLOR and reads no
+// colour) and scene_depth (binding 25; not where it defines
 // STRAND_SEGMENT_NO_DEPTH_TEST and tests no depth), and includes
 // hair_shading.glsl (dp, strand_alpha) and oit_counters.glsl (oit).
 #ifndef VKHAIR_STRAND_SEGMENT_GLSL
@@ -35,10 +36,17 @@ End end_of(uint vertex) {
     float t = hair_tan[vertex].w;
     float pixel = max(dp.camera.w * length(dp.camera.xyz - pos.xyz), 1e-12);
     float width = mix(dp.widths.x, dp.widths.y, t) * pos.w;
-    vec3 band = coverage_band(width, dp.coverage.z, mix(dp.band.x, dp.band.y, t), pixel);
+    // A transparent strand is its band of the hairs it stands for; an opaque
+    // one (dp.coverage.x 0: the motion vectors of Transparency::Off) its ribbon.
+    float hairs = dp.coverage.x > 0.5 ? dp.coverage.z : 1.0;
+    vec3 band = coverage_band(width, hairs, mix(dp.band.x, dp.band.y, t), pixel);
     End e;
     e.clip = dp.view_proj * vec4(pos.xyz, 1.0);
+#ifdef STRAND_SEGMENT_NO_COLOR
+    e.color = vec3(0.0);
+#else
     e.color = point_color[vertex].rgb;
+#endif
     e.half_width = band.y * pixel;
     e.density = band.z;
     return e;

@@ -27,7 +27,6 @@ layout(local_size_x = 64) in;
 
 layout(std430, set = 0, binding = 1) readonly buffer HairPos { vec4 hair_pos[]; };
 layout(std430, set = 0, binding = 2) readonly buffer HairTan { vec4 hair_tan[]; };
-layout(std430, set = 0, binding = 20) readonly buffer PointColor { vec4 point_color[]; };
 // The drawn positions of the previous frame (the same vertex layout for the
 // first mb.counts.x hairs).
 layout(std430, set = 0, binding = 34) readonly buffer Previous { vec4 previous_pos[]; };
@@ -45,8 +44,10 @@ layout(push_constant) uniform Walk { uint walk; } pc;
 // Fragments fainter than this are not stored by any mode (oit_opaque.glsl).
 const float LEAST_ALPHA = 1.0 / 1024.0;
 
-// The fragments were depth-tested by the frame's draw: the depths matched are of kept ones.
+// The fragments were depth-tested by the frame's draw: the depths matched are
+// of kept ones. Their colours do not matter here.
 #define STRAND_SEGMENT_NO_DEPTH_TEST
+#define STRAND_SEGMENT_NO_COLOR
 #include "strand_segment.glsl"
 
 // The motion of the point at u along segment `first` (the vertex it starts
@@ -88,27 +89,38 @@ void walk_segment(uint first, bool last) {
             }
             uvec2 at = segment_pixel(sg, k, m);
             uint pixel = at.y * oit.width + at.x;
-            uint match = motion_depth[pixel];
-            if (match == OIT_END) {
-                continue;
-            }
             // Perspective-correct position along the unclipped segment (as segment_fragment).
             vec2 q = sg.x_major ? vec2(k + 0.5, m + 0.5) : vec2(m + 0.5, k + 0.5);
             float s = clamp(dot(q - sg.a, sg.dir) / sg.len, 0.0, 1.0);
             float inv_w = mix(sg.inv_wa, sg.inv_wb, s);
             float u = mix(sg.u0 * sg.inv_wa, sg.u1 * sg.inv_wb, s) / inv_w;
-            // The gap between the fragment and the depth to match, in view
-            // space: a fragment of the hair the composite picked lies within
-            // the hair's width and a pixel's of it (the hardware's ribbons and
-            // this walk cover a pixel a little differently); beyond, the
-            // pixel's hair made no fragment here and another hair must not
-            // stand in for it.
-            float gap = abs(motion_view_z(oit_forward(z)) - motion_view_z(oit_forward(uintBitsToFloat(match))));
-            float reach = (2.0 * half_width_at(sg.e0, sg.e1, u) + 2.0) * dp.camera.w / inv_w;
-            if (!(gap <= reach)) {
-                continue;
+            uint distance;
+            if (mb.counts.z != 0u) {
+                // Opaque ribbons: the nearest whose ribbon (at least the least
+                // pixel width) covers the pixel's centre, as the draw shaded it.
+                float d = abs(dot(q - sg.a, vec2(-sg.dir.y, sg.dir.x)));
+                if (d > max(half_width_at(sg.e0, sg.e1, u), 0.5 * dp.widths.z)) {
+                    continue;
+                }
+                distance = floatBitsToUint(max(z, 0.0));
+            } else {
+                uint match = motion_depth[pixel];
+                if (match == OIT_END) {
+                    continue;
+                }
+                // The gap between the fragment and the depth to match, in view
+                // space: a fragment of the hair the composite picked lies within
+                // the hair's width and a pixel's of it (the hardware's ribbons and
+                // this walk cover a pixel a little differently); beyond, the
+                // pixel's hair made no fragment here and another hair must not
+                // stand in for it.
+                float gap = abs(motion_view_z(oit_forward(z)) - motion_view_z(oit_forward(uintBitsToFloat(match))));
+                float reach = (2.0 * half_width_at(sg.e0, sg.e1, u) + 2.0) * dp.camera.w / inv_w;
+                if (!(gap <= reach)) {
+                    continue;
+                }
+                distance = floatBitsToUint(gap);
             }
-            uint distance = floatBitsToUint(gap);
 #ifdef VKHAIR_INT64
             atomicMin(motion_keys[pixel], (uint64_t(distance) << 32) | uint64_t(motion_of(first, u)));
 #else

@@ -27,7 +27,8 @@ void main() {
             }
             uint pixel = at.y * oit.width + at.x;
             uvec2 key = motion_keys[pixel];
-            float depth = uintBitsToFloat(motion_depth[pixel]);
+            // Opaque frames pick the nearest fragment: its distance is its depth.
+            float depth = uintBitsToFloat(mb.counts.z != 0u ? key.y : motion_depth[pixel]);
             if (key.y != MOTION_NONE && depth < nearest) {
                 nearest = depth;
                 velocity = key.x;

@@ -46,10 +46,16 @@ pub enum MotionPick {
     Accumulated(f32),
     /// The nearest of at least this alpha ([`super::Transparency::Fast`]: 0.5).
     NearestAtLeast(f32),
+    /// The nearest whose ribbon covers the pixel's centre, a ribbon being at
+    /// least this many pixels wide ([`super::Transparency::Off`]:
+    /// [`super::HairMaterial::least_pixel_width`]).
+    NearestRibbon(f32),
 }
 
-/// One fragment: forward depth, alpha, motion.
-type Fragment = (f32, f32, Vec2);
+/// One fragment: forward depth, alpha, motion, and where the pixel's centre
+/// lies: 0 within the segment's true half width, else its distance from the
+/// centre line, pixels.
+type Fragment = (f32, f32, Vec2, f32);
 
 /// The motion of each pixel's hair, rows from the top, in pixels, this frame
 /// minus the previous one, by the definition the renderer follows
@@ -69,11 +75,12 @@ pub fn hair_motion(scene: &MotionScene<'_>) -> Vec<Option<Vec2>> {
         .map(|mut f| {
             f.sort_by(|a, b| a.0.total_cmp(&b.0));
             let mut transmittance = 1.0;
-            f.into_iter().find_map(|(z, alpha, motion)| {
+            f.into_iter().find_map(|(z, alpha, motion, outside)| {
                 transmittance *= 1.0 - alpha;
                 let opaque = match scene.pick {
                     MotionPick::Accumulated(threshold) => 1.0 - transmittance >= threshold,
                     MotionPick::NearestAtLeast(least) => alpha >= least,
+                    MotionPick::NearestRibbon(least) => outside <= least * 0.5,
                 };
                 opaque.then_some((z, motion))
             })
@@ -167,7 +174,10 @@ fn segment(scene: &MotionScene<'_>, (w, h): (u32, u32), (hair, i): (usize, usize
                 continue;
             }
             let z = depth[0] + (depth[1] - depth[0]) * s;
-            out[(y * w + x) as usize].push((z, alpha, motion(scene, hair, i, u)));
+            // Outside the ribbon by d − its half width; inside a least width w
+            // where d ≤ w / 2 (NearestRibbon compares with that).
+            let outside = if d <= half_width { 0.0 } else { d };
+            out[(y * w + x) as usize].push((z, alpha, motion(scene, hair, i, u), outside));
         }
     }
 }

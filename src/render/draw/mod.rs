@@ -23,6 +23,7 @@ mod exact;
 mod fast;
 mod motion;
 mod opaque;
+mod opaque_motion;
 mod raster;
 mod ribbons;
 mod shading;
@@ -52,6 +53,7 @@ pub(super) use motion::MotionHistory;
 pub use motion::VELOCITY_FORMATS;
 use motion::{HairLayout, MotionFrame};
 use opaque::OpaquePipelines;
+use opaque_motion::OpaqueMotion;
 use ribbons::RibbonIndices;
 use shading::ShadingResources;
 use transparent::TransparentPass;
@@ -170,6 +172,8 @@ pub(super) struct DrawPass {
     shading: ShadingResources,
     ribbons: RibbonIndices,
     opaque: OpaquePipelines,
+    /// Motion vectors of opaque frames (the transparent pass has its own).
+    opaque_motion: OpaqueMotion,
     transparent: TransparentPass,
 }
 
@@ -180,6 +184,7 @@ impl DrawPass {
             shading: ShadingResources::new(device)?,
             ribbons: RibbonIndices::new(device)?,
             opaque: OpaquePipelines::new(device),
+            opaque_motion: OpaqueMotion::new(device),
             transparent: TransparentPass::new(device, hair_vertices)?,
         })
     }
@@ -188,6 +193,7 @@ impl DrawPass {
     /// sure no pending work uses them.
     pub(super) fn forget(&mut self) {
         self.opaque.forget();
+        self.opaque_motion.forget();
         self.transparent.forget();
     }
 
@@ -210,7 +216,10 @@ impl DrawPass {
         // SAFETY: guaranteed by the caller.
         unsafe {
             match mode {
-                Transparency::Off => self.opaque.record(frame, &mut self.shading, &self.ribbons),
+                Transparency::Off => self
+                    .opaque
+                    .record(frame, &mut self.shading, &self.ribbons)
+                    .and_then(|_| self.opaque_motion.record(frame, &self.shading)),
                 _ => self.transparent.record(frame, mode, oit, raster, &mut self.shading, &self.ribbons),
             }
         }
@@ -282,6 +291,7 @@ impl Renderer {
         self.last_frame = Some(frame);
         self.resolve.collect_retired(frame, self.params.frames_in_flight);
         self.draw.transparent.collect_retired(frame, self.params.frames_in_flight);
+        self.draw.opaque_motion.collect_retired(frame, self.params.frames_in_flight);
         let finite = camera.view.is_finite() && camera.projection.is_finite() && camera.fov_y.is_finite();
         if !finite {
             return Err(Error::param(
@@ -327,19 +337,19 @@ impl Renderer {
         let hairs = self.hair_layout();
         let motion = match target.velocity == vk::ImageView::null() {
             true => None,
-            false if mode == Transparency::Off => {
-                return Err(Error::unsupported(
-                    "motion vectors of opaque hair (Transparency::Off)",
-                    "draw with Transparency::Exact or Fast, or give the target no velocity image",
-                ))
-            }
             false => {
                 if self.motion.is_none() {
                     self.motion = Some(MotionHistory::new(&self.device, self.interpolate.hairs().0.size() / 16)?);
                 }
                 let history = self.motion.as_ref().ok_or_else(|| Error::incompatible("motion", "no history"))?;
                 let images = (target.velocity, target.velocity_format);
-                Some(history.frame(&self.params.motion, images, (camera, target.extent, drawn.extent), hairs)?)
+                let opaque = mode == Transparency::Off;
+                Some(history.frame(
+                    &self.params.motion,
+                    images,
+                    (camera, target.extent, drawn.extent),
+                    (hairs, opaque),
+                )?)
             }
         };
         let frame = DrawFrame {
@@ -435,7 +445,7 @@ impl Renderer {
     /// Sets of size-dependent images waiting for their frames to complete
     /// (supersampling images and transparency lists).
     pub fn retired_image_sets(&self) -> usize {
-        self.resolve.retired_count() + self.draw.transparent.retired_count()
+        self.resolve.retired_count() + self.draw.transparent.retired_count() + self.draw.opaque_motion.retired_count()
     }
 
     /// The extent the hair is drawn at for a target of `extent`: twice each

@@ -138,13 +138,14 @@ impl MotionHistory {
     }
 
     /// The frame's motion for a target of `target` pixels drawn at `drawn`
-    /// pixels, seen by `camera`, with `hairs`.
+    /// pixels, seen by `camera`, with `hairs` drawn (as `opaque` ribbons or
+    /// transparent strands).
     pub(super) fn frame(
         &self,
         params: &MotionParams,
         (velocity, format): (vk::ImageView, vk::Format),
         (camera, target, drawn): (&Camera, vk::Extent2D, vk::Extent2D),
-        hairs: HairLayout,
+        (hairs, opaque): (HairLayout, bool),
     ) -> Result<MotionFrame<'_>> {
         if !VELOCITY_FORMATS.contains(&format) {
             return Err(Error::incompatible(
@@ -184,7 +185,7 @@ impl MotionHistory {
                     let p = camera.projection;
                     [p.z_axis.z, p.w_axis.z, p.z_axis.w, p.w_axis.w]
                 },
-                counts: [kept, samples, 0, 0],
+                counts: [kept, samples, u32::from(opaque), 0],
             },
         })
     }
@@ -345,6 +346,18 @@ impl MotionBuffers {
     /// The words for `extent` drawn pixels, the depths `exact`.
     pub(super) fn new(device: &Arc<Device>, extent: vk::Extent2D, exact: bool) -> Result<Self> {
         let pixels = u64::from(extent.width) * u64::from(extent.height);
+        Ok(MotionBuffers {
+            keys: Self::keys_buffer(device, extent)?,
+            depth: match exact {
+                true => Some(Buffer::storage(device, "vkhair motion depths", 4 * pixels)?),
+                false => None,
+            },
+        })
+    }
+
+    /// The picks of `extent` drawn pixels: an error where one binding's range cannot hold them.
+    pub(super) fn keys_buffer(device: &Arc<Device>, extent: vk::Extent2D) -> Result<Buffer> {
+        let pixels = u64::from(extent.width) * u64::from(extent.height);
         let keys = KEY_BYTES * pixels;
         if keys > u64::from(device.info.max_storage_buffer_range) {
             return Err(Error::incompatible(
@@ -356,13 +369,7 @@ impl MotionBuffers {
                 ),
             ));
         }
-        Ok(MotionBuffers {
-            keys: Buffer::storage(device, "vkhair motion picks", keys)?,
-            depth: match exact {
-                true => Some(Buffer::storage(device, "vkhair motion depths", 4 * pixels)?),
-                false => None,
-            },
-        })
+        Buffer::storage(device, "vkhair motion picks", keys)
     }
 
     /// The buffers by binding: the depths to match are `fallback` (the fast
