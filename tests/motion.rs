@@ -287,8 +287,9 @@ fn motion_vectors_leave_out_the_jitter() {
 }
 
 /// The host's conventions: NDC units, the other sign, a 32-bit float image —
-/// the same motion; a reset frame's motion is zero; an image of another
-/// format is refused.
+/// the same motion; a reset frame's motion is zero; a frame drawn without a
+/// velocity image leaves the history where it was; hairs numbered otherwise
+/// move with the camera only; an image of another format is refused.
 #[test]
 fn motion_vectors_follow_the_hosts_conventions() {
     let gpu = Gpu::new();
@@ -332,6 +333,26 @@ fn motion_vectors_follow_the_hosts_conventions() {
     println!("after a reset: {covered} pixels, the largest motion {largest} px");
     assert!(covered > 300 && largest == 0.0, "a frame after reset_motion moved {largest} px");
 
+    // A frame without a velocity image between two with: the third moves from the first.
+    let mut s = scene(&gpu, &pixels, false);
+    let plain = Offscreen::new(gpu.ctx(), W, H).expect("offscreen");
+    frame(&gpu, &mut s, &camera);
+    let host = HostFrame { clear: Vec3::ZERO, before: None, after: None };
+    let halfway = Camera { view: camera.view * Mat4::from_translation(Vec3::new(0.006, 0.002, 0.0)), ..camera };
+    common::record_frame(&gpu, (&s.sim, &mut s.renderer), &plain, &halfway, &host);
+    let skipped = frame(&gpu, &mut s, &moved).0;
+    let worst =
+        reference.iter().zip(&skipped).filter(|(a, _)| **a != CLEAR).map(|(a, b)| a.distance(*b)).fold(0.0, f32::max);
+    println!("a frame without a velocity image between: at most {worst} px from the direct pair");
+    assert!(worst <= 0.01, "the frame without a velocity image moved the history: {worst} px");
+    // Grown hairs numbered otherwise (another hairs_per_key): the camera's motion only.
+    let renumbered = RenderParams { hairs_per_key: 3, ..pixels.clone() };
+    frame(&gpu, &mut s, &camera);
+    s.renderer.set_params(&renumbered).expect("params");
+    let still = frame(&gpu, &mut s, &camera).0;
+    let largest = still.iter().filter(|v| **v != CLEAR).map(|v| v.length()).fold(0.0, f32::max);
+    println!("renumbered hairs under a still camera: the largest motion {largest} px");
+    assert!(largest == 0.0, "renumbered hairs moved {largest} px");
     let mut offscreen = Offscreen::new(gpu.ctx(), 8, 8).expect("offscreen");
     assert!(offscreen.add_velocity(vk::Format::R8G8_UNORM, Vec2::ZERO).is_err(), "an 8-bit velocity image");
 }
