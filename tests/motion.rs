@@ -170,8 +170,17 @@ fn check(what: &str, params: &RenderParams, a: &Agreement) {
         Transparency::Off => true,
         Transparency::Fast => false,
     };
-    // Measured: walked 0–1 pixel in 5,000 off; the hardware's 2–6 % off, a mean of 0.01–0.11 px.
-    let (off, mean, one_only) = if walked { (0.01, 0.01, 0.02) } else { (0.08, 0.15, 0.04) };
+    // Measured: walked 0–1 pixel in 5,000 off; the hardware's 2–6 % off, a
+    // mean of 0.01–0.11 px. The opaque mode's write is tested against the
+    // target's depth, where its draw wrote the nearest ribbon: a pixel whose
+    // drawn ribbon the walk does not count as covering it (their edges
+    // differ a little) keeps no motion rather than a hair's behind (1–2 %).
+    let one_only = match params.transparency {
+        Transparency::Off if !params.supersampling => 0.03,
+        _ if walked => 0.02,
+        _ => 0.04,
+    };
+    let (off, mean) = if walked { (0.01, 0.01) } else { (0.08, 0.15) };
     assert!(share(a.off) <= off && a.mean <= mean, "{what}: {} of {} pixels past {TOLERANCE} px", a.off, a.both);
     assert!(share(a.one_only) <= one_only, "{what}: {} pixels have a motion vector on one side only", a.one_only);
     assert!(share(a.no_hair) <= 0.005, "{what}: {} motion vectors are no hair's at their pixel", a.no_hair);
@@ -355,4 +364,53 @@ fn motion_vectors_follow_the_hosts_conventions() {
     assert!(largest == 0.0, "renumbered hairs moved {largest} px");
     let mut offscreen = Offscreen::new(gpu.ctx(), 8, 8).expect("offscreen");
     assert!(offscreen.add_velocity(vk::Format::R8G8_UNORM, Vec2::ZERO).is_err(), "an 8-bit velocity image");
+}
+
+/// A host's mesh in front of the hair keeps its own motion: no pixel it covers
+/// gets the hair's (the opaque mode's walk picks the nearest ribbon whatever
+/// the host drew, and its write is tested against the host's depth; the
+/// transparent modes pick only fragments their composite kept).
+#[test]
+fn a_mesh_in_front_of_the_hair_keeps_the_hosts_motion() {
+    use vkhair::groom::mesh::TriMesh;
+    use vkhair::headless::MeshDrawer;
+    let gpu = Gpu::new();
+    let before_camera = common::front_camera(0.6, (W, H));
+    let camera =
+        Camera { view: before_camera.view * Mat4::from_translation(Vec3::new(0.01, 0.0, 0.0)), ..before_camera };
+    let centre = vkhair::groom::scenes::THESIS_HEAD_CENTER;
+    let sphere = TriMesh::uv_sphere(centre + Vec3::new(0.0, -0.12, 0.3), 0.05, 12, 16).expect("sphere");
+    let mesh = MeshDrawer::new(gpu.ctx(), &sphere).expect("mesh");
+    for params in [
+        params(Transparency::Off, Raster::Hardware, false),
+        params(Transparency::Off, Raster::Hardware, true),
+        params(Transparency::Exact, Raster::Compute, false),
+        params(Transparency::Exact, Raster::Hardware, false),
+    ] {
+        let mut s = scene(&gpu, &params, false);
+        let host = HostFrame { clear: Vec3::ZERO, before: Some(&mesh), after: None };
+        common::record_frame(&gpu, (&s.sim, &mut s.renderer), &s.offscreen, &before_camera, &host);
+        common::record_frame(&gpu, (&s.sim, &mut s.renderer), &s.offscreen, &camera, &host);
+        let velocity = s.offscreen.read_velocity().expect("velocity");
+        let colour = s.offscreen.read_linear().expect("colour");
+        let (now, along) = drawn(&s.renderer);
+        let (hair, _) = reference(&params, (&now, &along), &now, &camera, &before_camera);
+        // The sphere's pixels: green (the host's meshes are lit green) where the hair would be.
+        let covered: Vec<usize> = (0..velocity.len())
+            .filter(|&i| colour[i].y > 2.0 * colour[i].x.max(colour[i].z) && hair[i].is_some())
+            .collect();
+        let hair_motion = covered.iter().filter(|&&i| velocity[i] != CLEAR).count();
+        let elsewhere = velocity.iter().filter(|v| **v != CLEAR).count();
+        let what = format!("{:?} {:?} ss {}", params.transparency, params.raster, params.supersampling);
+        println!(
+            "{what}: {} sphere pixels over hair, {hair_motion} with the hair's motion; {elsewhere} hair pixels",
+            covered.len()
+        );
+        assert!(covered.len() > 50 && elsewhere > 300, "{what}: the sphere covers {} hair pixels", covered.len());
+        assert!(
+            hair_motion * 100 <= covered.len(),
+            "{what}: {hair_motion} of {} pixels of the sphere took the hair's motion",
+            covered.len()
+        );
+    }
 }

@@ -181,6 +181,63 @@ fn the_viewer_runs_clean_in_a_window_and_shows_hair_overlay_and_floor() {
     }
 }
 
+/// `--taa`: the viewer as a TAA host (a jittered camera, vkhair's motion
+/// vectors into its velocity image, a resolve blending each pixel with its
+/// reprojected history into the swapchain image), with the head moving,
+/// through a resize (new images, a new history) and in the opaque and exact
+/// modes: validation clean, hair shown, the still floor resolved to its
+/// colour, and the motion vectors' pass timed exactly when they are asked for.
+#[test]
+fn the_viewer_resolves_taa_with_the_hairs_motion_vectors() {
+    let (display, _server) = match display() {
+        Ok(d) => d,
+        Err(why) => {
+            println!("SKIPPED the viewer TAA test: {why}");
+            eprintln!("SKIPPED the viewer TAA test: {why}");
+            return;
+        }
+    };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let exact = dir.path().join("exact.toml");
+    std::fs::write(&exact, "[render]\ntransparency = \"exact\"\n").expect("write config");
+    let exact = exact.to_string_lossy().into_owned();
+    let common = ["--taa", "--moving", "--no-overlay", "--frame-time", "0.0167", "--width", "320", "--height", "240"];
+    let resize = ["--frames", "16", "--resize", "400x300", "--resize-frame", "6"];
+    let (_, _, bare, _) =
+        run_printing(&display, &dir.path().join("bare.png"), &[&common[..], &resize, &["--no-hair"]].concat());
+    // The least share of the window the hair changes: transparent strands
+    // change fewer pixels by that much (measured 11 % opaque, 3.8 % exact).
+    let cases: [(&str, Vec<&str>, bool, f64); 3] = [
+        ("opaque", vec![], true, 0.05),
+        ("opaque, no motion vectors", vec!["--no-motion-vectors"], false, 0.05),
+        ("exact", vec!["--config", &exact], true, 0.02),
+    ];
+    for (name, extra, motion, least) in cases {
+        let shot = dir.path().join(format!("{}.png", name.replace([' ', ','], "_")));
+        let (w, h, image, printed) = run_printing(&display, &shot, &[&common[..], &resize, &extra].concat());
+        assert_eq!((w, h), (400, 300), "{name}: the resize did not reach the swapchain");
+        let hair = image
+            .chunks_exact(4)
+            .zip(bare.chunks_exact(4))
+            .filter(|(a, b)| a.iter().zip(b.iter()).take(3).any(|(x, y)| x.abs_diff(*y) > 24))
+            .count() as f64
+            / f64::from(400 * 300);
+        let floor = mean(&image, 400, (60, 285, 120, 299));
+        println!("TAA, {name}: hair on {:.1} % of the window, floor {floor:?}", 100.0 * hair);
+        assert!(hair > least, "{name}: hair on {:.2} % of the window", 100.0 * hair);
+        assert!(
+            floor.iter().zip(floor_srgb()).all(|(g, e)| (g - e).abs() <= 6.0),
+            "{name}: the floor is {floor:?} under TAA, expected {:?}",
+            floor_srgb()
+        );
+        assert_eq!(
+            printed.contains("vkhair render: motion vectors"),
+            motion,
+            "{name}: the motion vectors' pass is timed only when they are asked for:\n{printed}"
+        );
+    }
+}
+
 /// `--gltf`: the viewer, as a host with a skinned character, skins the mesh on
 /// the GPU every frame, draws it, and hands the skinned vertices to vkhair:
 /// after 40 frames of the run (fixed frame times, so that runs with and

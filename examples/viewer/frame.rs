@@ -23,6 +23,7 @@ use crate::overlay::{Changes, Overlay, Painted};
 use crate::scene::HostScene;
 use crate::skin::GpuSkin;
 use crate::swapchain::Swapchain;
+use crate::taa::Taa;
 use crate::Args;
 
 /// Vertical field of view, radians.
@@ -65,6 +66,8 @@ pub struct Running {
     pub(crate) skin: Option<GpuSkin>,
     pub(crate) overlay: Option<Overlay>,
     pub(crate) scene: HostScene,
+    /// The TAA resolve (keys J and V).
+    pub(crate) taa: Taa,
     pub(crate) swapchain: Swapchain,
     pub(crate) pool: vk::CommandPool,
     pub(crate) cmds: Vec<vk::CommandBuffer>,
@@ -120,7 +123,8 @@ impl Running {
             Some(rig) => Some(GpuSkin::new(&gpu.device, gpu.allocator(), &rig.character)?),
             None => None,
         };
-        let hair = Hair::new(&ctx, &scene_data, config, skin.as_ref())?;
+        let mut hair = Hair::new(&ctx, &scene_data, config, skin.as_ref())?;
+        hair.moving |= args.moving;
         let size = window.inner_size();
         let swapchain = Swapchain::new(&gpu, (size.width.max(1), size.height.max(1)))?;
         let floor_y = scene_data.floor_y;
@@ -131,6 +135,7 @@ impl Running {
             &scene_data.head,
             (scene_data.center, floor_y, 3.0 * scene_data.radius),
         )?;
+        let taa = Taa::new(&gpu.device, swapchain.format, args.taa, !args.no_motion_vectors)?;
         let d = &gpu.device;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(gpu.family)
@@ -165,6 +170,7 @@ impl Running {
             skin,
             overlay,
             scene,
+            taa,
             swapchain,
             pool,
             cmds,
@@ -217,10 +223,26 @@ impl Running {
             "r" => {
                 idle(self)?;
                 self.hair().reset()?;
+                self.taa.restart();
+            }
+            "j" => {
+                self.taa.on = !self.taa.on;
+                self.taa.restart();
+                // The hair's motion starts again from the next frame that writes it.
+                self.hair().renderer.reset_motion();
+            }
+            "v" => {
+                self.taa.motion_vectors = !self.taa.motion_vectors;
+                self.hair().renderer.reset_motion();
             }
             _ => return Ok(()),
         }
-        println!("viewer: {}", self.hair().status());
+        let taa = match (self.taa.on, self.taa.motion_vectors) {
+            (false, _) => "off",
+            (true, true) => "on, the hair's motion vectors",
+            (true, false) => "on, without the hair's motion vectors",
+        };
+        println!("viewer: {} · TAA {taa}", self.hair().status());
         Ok(())
     }
 

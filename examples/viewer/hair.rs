@@ -323,6 +323,8 @@ impl Hair {
         }
         self.driver = FixedStepDriver::new(f64::from(self.config.sim.dt), 2)?;
         self.steps_done = 0;
+        // The hair jumps back: no motion across the jump.
+        self.renderer.reset_motion();
         Ok(())
     }
 

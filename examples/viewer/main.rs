@@ -22,8 +22,10 @@
 //! colliders and M pauses the animation.
 //!
 //! Mouse: drag to orbit, scroll to zoom. Keys: L level of detail, S shadows,
-//! A supersampling, K shading model, T transparency, M head motion, Space
-//! pause, N one step while paused, R reset, Esc quit. `--frames N
+//! A supersampling, K shading model, T transparency, M head motion, J TAA
+//! (`taa.rs`: a jittered camera, vkhair's motion vectors and a resolve), V the
+//! hair's motion vectors in the TAA, Space pause, N one step while paused, R
+//! reset, Esc quit. `--frames N
 //! --screenshot FILE.png` renders N frames through the swapchain, saves the last
 //! presented image and exits; `--validation` turns on the Khronos layer with
 //! synchronization validation and makes any message an error.
@@ -50,6 +52,7 @@ mod record;
 mod scene;
 mod skin;
 mod swapchain;
+mod taa;
 
 use frame::Running;
 use host::BoxError;
@@ -110,6 +113,17 @@ pub struct Args {
     /// Simulate but draw no hair: the host's scene alone, for comparison.
     #[arg(long)]
     pub no_hair: bool,
+    /// Start with TAA on (key J): a jittered camera, the hair's motion
+    /// vectors, and a resolve that blends each pixel with its history.
+    #[arg(long)]
+    pub taa: bool,
+    /// Start with the hair's motion vectors left out of the TAA (key V): its
+    /// pixels reprojected as if the hair stood still with the head.
+    #[arg(long)]
+    pub no_motion_vectors: bool,
+    /// Start with the head moving (key M).
+    #[arg(long)]
+    pub moving: bool,
     /// The Khronos validation layer with synchronization validation; any message
     /// fails the run (exit status 2).
     #[arg(long)]

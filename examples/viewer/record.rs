@@ -25,10 +25,25 @@ impl Running {
         let d = self.gpu.device.clone();
         let cmd = self.cmds[slot];
         let extent = self.swapchain.extent;
-        let camera = self.orbit.camera(extent)?;
-        let color = (self.swapchain.images[image], range(vk::ImageAspectFlags::COLOR));
+        let taa = self.taa.on;
+        let jitter = self.taa.jitter();
+        let camera = match taa {
+            // The frame's sub-pixel offset: vkhair and the host's meshes draw with it.
+            true => self.orbit.camera(extent)?.with_jitter(jitter)?,
+            false => self.orbit.camera(extent)?,
+        };
+        let output = (self.swapchain.images[image], self.swapchain.views[image]);
+        // With TAA the scene goes into images of the TAA's, resolved into the swapchain image.
+        let (scene_color, velocity) = match taa {
+            true => {
+                let (scene, velocity) = self.taa.images(self.gpu.allocator(), extent, self.swapchain.depth_view)?;
+                (scene, Some(velocity))
+            }
+            false => (output, None),
+        };
+        let color = (scene_color.0, range(vk::ImageAspectFlags::COLOR));
         let depth = (self.swapchain.depth, range(vk::ImageAspectFlags::DEPTH));
-        let color_view = self.swapchain.views[image];
+        let color_view = scene_color.1;
         if capture {
             self.ensure_readback(extent)?;
         }
@@ -76,10 +91,29 @@ impl Running {
                 .layer_count(1)
                 .color_attachments(&colors)
                 .depth_attachment(&depth_attachment);
-            let view_projection = camera.projection * camera.view;
+            let view_projection = camera.jittered_projection((extent.width, extent.height)) * camera.view;
             d.cmd_begin_rendering(cmd, &rendering);
             self.scene.record_head(cmd, extent, view_projection, self.skin.as_ref().map(GpuSkin::drawn));
             d.cmd_end_rendering(cmd);
+            // The velocity image: no motion where the hair writes none (the
+            // resolve then reprojects the pixel by its depth).
+            if let Some((velocity_image, velocity_view)) = velocity {
+                let to_attachment = [transition(
+                    (velocity_image, range(vk::ImageAspectFlags::COLOR)),
+                    (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::NONE),
+                    attachment,
+                    (vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
+                )];
+                d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&to_attachment));
+                let none = vk::ClearValue {
+                    color: vk::ClearColorValue { float32: [crate::taa::NO_MOTION, crate::taa::NO_MOTION, 0.0, 0.0] },
+                };
+                let colors = [cleared(velocity_view, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, none)];
+                let rendering =
+                    vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&colors);
+                d.cmd_begin_rendering(cmd, &rendering);
+                d.cmd_end_rendering(cmd);
+            }
             // 3. vkhair: the hair over them, depth-tested against the head and floor.
             let target = RenderTarget {
                 color: color_view,
@@ -87,8 +121,14 @@ impl Running {
                 depth: self.swapchain.depth_view,
                 depth_format: DEPTH,
                 depth_image: self.swapchain.depth,
-                velocity: vk::ImageView::null(),
-                velocity_format: vk::Format::UNDEFINED,
+                velocity: match (velocity, self.taa.motion_vectors) {
+                    (Some((_, view)), true) => view,
+                    _ => vk::ImageView::null(),
+                },
+                velocity_format: match (velocity, self.taa.motion_vectors) {
+                    (Some(_), true) => crate::taa::VELOCITY,
+                    _ => vk::Format::UNDEFINED,
+                },
                 extent,
                 samples: vk::SampleCountFlags::TYPE_1,
             };
@@ -134,7 +174,13 @@ impl Running {
             d.cmd_begin_rendering(cmd, &rendering);
             self.scene.record_floor(cmd, view_projection);
             d.cmd_end_rendering(cmd);
-            // 5. The overlay over everything (its own pipeline, viewport and scissor).
+            // 5. With TAA: the resolve into the swapchain image.
+            let color = (output.0, range(vk::ImageAspectFlags::COLOR));
+            let color_view = output.1;
+            if taa {
+                self.taa.record(cmd, output, self.swapchain.depth, &camera, jitter)?;
+            }
+            // 6. The overlay over everything (its own pipeline, viewport and scissor).
             if let (Some(overlay), Some(painted)) = (self.overlay.as_mut(), painted) {
                 let after_hair = [transition(
                     color,
@@ -157,7 +203,7 @@ impl Running {
                 overlay.record(cmd, extent, painted)?;
                 d.cmd_end_rendering(cmd);
             }
-            // 6. Present (and the screenshot's copy first).
+            // 7. Present (and the screenshot's copy first).
             let mut layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
             if let (true, Some((buffer, _, _))) = (capture, &self.readback) {
                 let to_copy = [transition(
@@ -271,6 +317,7 @@ impl Running {
             skin.destroy(self.gpu.allocator());
         }
         self.free_readback();
+        self.taa.destroy(self.gpu.allocator());
         self.scene.destroy(self.gpu.allocator());
         self.swapchain.destroy(d.clone(), self.gpu.allocator());
         // SAFETY: the device is idle; nothing uses these any more.

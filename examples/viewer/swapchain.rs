@@ -107,8 +107,13 @@ impl Swapchain {
             .mip_levels(1)
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
-            // Transfer source: vkhair's compute rasteriser copies the depth out.
-            .usage(vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC);
+            // Transfer source: vkhair's compute rasteriser copies the depth out;
+            // sampled: the TAA resolve reprojects the host's pixels by it.
+            .usage(
+                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                    | vk::ImageUsageFlags::TRANSFER_SRC
+                    | vk::ImageUsageFlags::SAMPLED,
+            );
         // SAFETY: valid create info; destroyed in `destroy`.
         let depth = unsafe { device.create_image(&depth_info, None) }?;
         // SAFETY: the image is alive.

@@ -8,7 +8,7 @@
 struct MotionBlock {
     mat4 now;     // world → clip of this frame, without its jitter
     mat4 before;  // world → clip of the previous frame, without its jitter
-    vec4 scale;   // xy: an NDC difference (now − before) to the host's units and sign; zw unused
+    vec4 scale;   // xy: an NDC difference (now − before) to the host's units and sign; z: world size of a target pixel at distance 1; w unused
     vec4 depth;   // the projection's clip z = x·z_view + y and clip w = z·z_view + w (this frame's)
     uvec4 counts; // x: hairs (a prefix) whose previous positions are kept (0: none); y: drawn pixels per target pixel along each axis (1, or 2 supersampled); z: 1 for opaque ribbons (the nearest covering the pixel's centre, no depth to match); w unused
 };

@@ -3,7 +3,9 @@
 // image (one triangle, resolve.vert), each pixel takes the motion the walk
 // picked (motion_raster.comp) — with supersampling, of its drawn pixels the
 // one whose matched depth is nearest — and a pixel no hair reached is
-// discarded, keeping what the host wrote there.
+// discarded, keeping what the host wrote there. Opaque frames are written
+// through the host's depth test (transparent ones pick only hair their
+// composite kept, which passed it).
 #define OIT_COUNTERS_READONLY
 #include "oit_counters.glsl"
 #include "motion.glsl"
@@ -40,4 +42,12 @@ void main() {
         discard;
     }
     out_velocity = unpackHalf2x16(velocity);
+    // Opaque frames test the pick against the host's depth attachment (a
+    // ribbon behind the host's meshes is not the pixel's): its depth in the
+    // host's convention, brought toward the camera by four pixels' size at its
+    // distance, so that the ribbon the draw wrote there passes (the draw's
+    // ribbon and the walk's centre line differ a little in depth).
+    float z_view = motion_view_z(oit_forward(nearest)) * (1.0 - 4.0 * mb.scale.z);
+    float ndc = (mb.depth.x * z_view + mb.depth.y) / (mb.depth.z * z_view + mb.depth.w);
+    gl_FragDepth = clamp(ndc, 0.0, 1.0);
 }

@@ -187,7 +187,8 @@ pub(crate) struct GpuMotion {
     pub now: [[f32; 4]; 4],
     /// World → clip of the previous frame, without its jitter.
     pub before: [[f32; 4]; 4],
-    /// xy: an NDC difference (now − before) to the host's units and sign.
+    /// xy: an NDC difference (now − before) to the host's units and sign;
+    /// z: the world size of a target pixel at distance 1.
     pub scale: [f32; 4],
     /// This frame's projection: clip z = x·z_view + y, clip w = z·z_view + w.
     pub depth: [f32; 4],

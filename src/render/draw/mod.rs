@@ -343,7 +343,12 @@ impl Renderer {
                 }
                 let history = self.motion.as_ref().ok_or_else(|| Error::incompatible("motion", "no history"))?;
                 let images = (target.velocity, target.velocity_format);
-                let opaque = mode == Transparency::Off;
+                // Opaque hair is tested against the host's depth when written
+                // (the walk's nearest ribbon may lie behind the host's meshes).
+                let opaque = match mode {
+                    Transparency::Off => Some(has_depth.then_some((target.depth, target.depth_format))),
+                    _ => None,
+                };
                 Some(history.frame(
                     &self.params.motion,
                     images,

@@ -68,6 +68,11 @@ pub(in crate::render) struct MotionFrame<'a> {
     /// The frame's block, written from `block` by the pass.
     pub uniforms: &'a Buffer,
     pub block: GpuMotion,
+    /// Opaque frames: the host's depth attachment (view and format) the
+    /// write is tested against, `None` where the target has none.
+    pub host_depth: Option<(vk::ImageView, vk::Format)>,
+    /// The depth runs reversed (near = 1).
+    pub reverse_z: bool,
 }
 
 /// The camera and the hairs of the latest frame that wrote motion vectors.
@@ -138,14 +143,15 @@ impl MotionHistory {
     }
 
     /// The frame's motion for a target of `target` pixels drawn at `drawn`
-    /// pixels, seen by `camera`, with `hairs` drawn (as `opaque` ribbons or
-    /// transparent strands).
+    /// pixels, seen by `camera`, with `hairs` drawn as transparent strands
+    /// (`opaque` `None`) or as opaque ribbons over the host's depth
+    /// attachment (`Some` of it, or of `None` without one).
     pub(super) fn frame(
         &self,
         params: &MotionParams,
         (velocity, format): (vk::ImageView, vk::Format),
         (camera, target, drawn): (&Camera, vk::Extent2D, vk::Extent2D),
-        (hairs, opaque): (HairLayout, bool),
+        (hairs, opaque): (HairLayout, Option<Option<(vk::ImageView, vk::Format)>>),
     ) -> Result<MotionFrame<'_>> {
         if !VELOCITY_FORMATS.contains(&format) {
             return Err(Error::incompatible(
@@ -173,6 +179,8 @@ impl MotionHistory {
         Ok(MotionFrame {
             velocity,
             format,
+            host_depth: opaque.flatten(),
+            reverse_z: camera.depth_reversed(),
             extent: target,
             threshold: params.threshold,
             previous: &self.previous,
@@ -180,12 +188,18 @@ impl MotionHistory {
             block: GpuMotion {
                 now: now.to_cols_array_2d(),
                 before: before.to_cols_array_2d(),
-                scale: [half[0] * sign, half[1] * sign, 0.0, 0.0],
+                scale: [
+                    half[0] * sign,
+                    half[1] * sign,
+                    // World size of a target pixel at distance 1.
+                    2.0 * (0.5 * camera.fov_y).tan() / target.height.max(1) as f32,
+                    0.0,
+                ],
                 depth: {
                     let p = camera.projection;
                     [p.z_axis.z, p.w_axis.z, p.z_axis.w, p.w_axis.w]
                 },
-                counts: [kept, samples, u32::from(opaque), 0],
+                counts: [kept, samples, u32::from(opaque.is_some()), 0],
             },
         })
     }
@@ -237,12 +251,15 @@ pub(super) struct MotionPipelines {
 
 impl MotionPipelines {
     /// The pipelines for a velocity image of `format`, bound to `buffers`
-    /// (the draw's and the pass's, by binding) and the shading's `images`.
+    /// (the draw's and the pass's, by binding) and the shading's `images`;
+    /// the write tested against a depth attachment of `depth`'s format (and
+    /// convention: reversed) where given.
     pub(super) fn new(
         device: &Arc<Device>,
         buffers: &[(u32, &Buffer)],
         images: &[(u32, vk::ImageView, vk::Sampler)],
         format: vk::Format,
+        depth: Option<(vk::Format, bool)>,
     ) -> Result<Self> {
         let int64 = device.int64_atomics.load(std::sync::atomic::Ordering::Relaxed);
         let shader = if int64 { &RENDER_MOTION_RASTER_COMP_INT64 } else { &RENDER_MOTION_RASTER_COMP };
@@ -256,11 +273,11 @@ impl MotionPipelines {
                 topology: vk::PrimitiveTopology::TRIANGLE_LIST,
                 patch_control_points: 0,
                 color_formats: &[format],
-                depth_format: vk::Format::UNDEFINED,
+                depth_format: depth.map_or(vk::Format::UNDEFINED, |d| d.0),
                 samples: vk::SampleCountFlags::TYPE_1,
-                depth_test: false,
+                depth_test: depth.is_some(),
                 depth_write: false,
-                reverse_z: false,
+                reverse_z: depth.is_some_and(|d| d.1),
                 blend: Blend::None,
                 rasterizer_discard: false,
             },
@@ -302,7 +319,8 @@ impl MotionPipelines {
         let walked =
             barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::FragmentRead, AccessKind::FragmentUniformRead]);
         let color = [rendering::color(motion.velocity, Load::Keep)];
-        let info = rendering::info(motion.extent, &color, None);
+        let depth = motion.host_depth.map(|(view, _)| rendering::depth(view, Load::Keep));
+        let info = rendering::info(motion.extent, &color, depth.as_ref());
         let threads = self.walk.grid_stride_threads(segments);
         // SAFETY: guaranteed by the caller.
         unsafe {

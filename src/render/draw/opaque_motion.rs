@@ -26,8 +26,8 @@ struct Words {
     counters: Buffer,
     /// Per drawn pixel the pick (velocity, depth).
     keys: Buffer,
-    /// By target and velocity format.
-    pipelines: HashMap<(TargetKey, vk::Format), MotionPipelines>,
+    /// By target, velocity format and the host's depth format.
+    pipelines: HashMap<(TargetKey, vk::Format, vk::Format), MotionPipelines>,
 }
 
 /// The opaque frames' motion words: the current extent's, and earlier ones
@@ -93,7 +93,8 @@ impl OpaqueMotion {
                 self.current.insert(Words { extent, counters, keys, pipelines: HashMap::new() })
             }
         };
-        let key = (frame.target.key, motion.format);
+        let host_depth = motion.host_depth.map(|(_, format)| (format, motion.reverse_z));
+        let key = (frame.target.key, motion.format, host_depth.map_or(vk::Format::UNDEFINED, |d| d.0));
         if !words.pipelines.contains_key(&key) {
             let (shading_buffers, images) = shading.bindings(&frame.inputs);
             let mut buffers = shading_buffers.to_vec();
@@ -106,7 +107,7 @@ impl OpaqueMotion {
                 (motion::KEYS_BINDING, &words.keys),
                 (motion::BLOCK_BINDING, motion.uniforms),
             ]);
-            words.pipelines.insert(key, MotionPipelines::new(&d, &buffers, &images, motion.format)?);
+            words.pipelines.insert(key, MotionPipelines::new(&d, &buffers, &images, motion.format, host_depth)?);
         }
         let walk = &words.pipelines[&key];
         let counters = OitCounters {

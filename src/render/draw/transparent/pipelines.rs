@@ -175,7 +175,7 @@ impl TransparentPass {
             None
         };
         let motion = match &frame.motion {
-            Some(_) => Some(MotionPipelines::new(d, &buffers, &shading_images, velocity)?),
+            Some(_) => Some(MotionPipelines::new(d, &buffers, &shading_images, velocity, None)?),
             None => None,
         };
         res.pipelines.insert(
