@@ -202,7 +202,7 @@ fn the_viewer_resolves_taa_with_the_hairs_motion_vectors() {
     std::fs::write(&exact, "[render]\ntransparency = \"exact\"\n").expect("write config");
     let exact = exact.to_string_lossy().into_owned();
     let common = ["--taa", "--moving", "--no-overlay", "--frame-time", "0.0167", "--width", "320", "--height", "240"];
-    let resize = ["--frames", "16", "--resize", "400x300", "--resize-frame", "6"];
+    let resize = ["--frames", "10", "--resize", "400x300", "--resize-frame", "4"];
     let (_, _, bare, _) =
         run_printing(&display, &dir.path().join("bare.png"), &[&common[..], &resize, &["--no-hair"]].concat());
     // The least share of the window the hair changes: transparent strands

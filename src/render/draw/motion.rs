@@ -414,5 +414,4 @@ impl MotionBuffers {
 }
 
 #[cfg(test)]
-#[path = "motion_tests.rs"]
 mod tests;
