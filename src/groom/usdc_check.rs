@@ -1,7 +1,6 @@
 //! What a USD binary (crate) layer must satisfy before the `openusd` crate
-//! reads it, which trusts its bootstrap and table of contents: [`check`]
-//! reads those alone (at most a few KiB, whatever the layer's size), without
-//! the crate, and refuses
+//! reads it, which trusts its bootstrap, table of contents and structure:
+//! [`check`] reads those without the crate, and refuses
 //!
 //! - a bootstrap that is not `PXR-USDC` or is cut short;
 //! - a crate version the reader cannot read: before 0.4.0 (the crate stops
@@ -14,7 +13,12 @@
 //!   it decompresses (a changed byte asked for 5 × 10¹⁸ bytes and aborted the
 //!   process), so each count is bounded by what its compressed blocks can
 //!   decode to ([`MAX_ITEMS_PER_BYTE`] a byte, at most [`MAX_ITEMS`]) and
-//!   every block must lie inside its section.
+//!   every block must lie inside its section;
+//! - in those sections' compressed blocks, decoded as the crate decodes them
+//!   (`groom/usdc_blocks.rs`): chunked or undecodable LZ4 data, integer
+//!   blocks shorter than their counts, value representations fewer than the
+//!   fields, and a path tree whose tokens, path indices or jumps leave their
+//!   tables or reach an entry twice.
 //!
 //! Each error names the value found and the file's length. Then the values
 //! the fields point at are checked (`groom/usdc_values.rs`).
@@ -105,8 +109,14 @@ pub fn check(path: &Path, len: u64) -> Result<()> {
         }
         sections.push((name, start, size));
     }
+    // The token count the paths are checked against (the crate reads the
+    // tokens first, whatever the table's order).
+    let tokens = match sections.iter().find(|s| s.0 == "TOKENS") {
+        Some(&(_, start, size)) if size >= 8 => u64_at(&read_at(start, 8)?, 0),
+        _ => 0,
+    };
     for (name, start, size) in sections {
-        let mut section = Section { name: &name, at: start, end: start + size, read_at: &mut read_at };
+        let mut section = Section { name: &name, at: start, end: start + size, tokens, read_at: &mut read_at };
         section.check()?;
     }
     super::usdc_values::check(path, len, version)
@@ -119,6 +129,8 @@ struct Section<'a, F: FnMut(u64, usize) -> Result<Vec<u8>>> {
     at: u64,
     /// Its end.
     end: u64,
+    /// Tokens in the layer's table.
+    tokens: u64,
     read_at: &'a mut F,
 }
 
@@ -150,6 +162,20 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
         Ok(size)
     }
 
+    /// A compressed block's bytes, decompressed into at most `room` bytes.
+    fn decompressed(&mut self, room: u64) -> Result<Vec<u8>> {
+        let start = self.at + 8;
+        let size = self.block()?;
+        let bytes = (self.read_at)(start, size as usize)?;
+        super::usdc_blocks::decompress(&bytes, room, &format!("its section {:?}", self.name))
+    }
+
+    /// A block of `count` integers of `width` bytes in the crate's coding, decoded.
+    fn ints(&mut self, count: u64, width: u64) -> Result<Vec<i64>> {
+        let data = self.decompressed(super::usdc_blocks::encoded_room(count, width))?;
+        super::usdc_blocks::decode_ints(&data, count, width, &format!("its section {:?}", self.name))
+    }
+
     /// `count` items `what`, decoded from compressed blocks of `bytes` bytes.
     fn bound(&self, count: u64, what: &str, bytes: u64) -> Result<()> {
         let most = bytes.saturating_add(16).saturating_mul(MAX_ITEMS_PER_BYTE).min(MAX_ITEMS);
@@ -166,8 +192,11 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
             "TOKENS" => {
                 let count = self.u64("the token count")?;
                 let decoded = self.u64("the tokens' decoded size")?;
+                let at = self.at;
                 let bytes = self.block()?;
                 self.bound(decoded, "bytes of tokens", bytes)?;
+                self.at = at;
+                self.decompressed(decoded)?;
                 if count > decoded {
                     return Err(self.refuse(format!("{count} tokens in {decoded} bytes")));
                 }
@@ -182,26 +211,51 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
             }
             "FIELDS" => {
                 let count = self.u64("the field count")?;
+                let at = self.at;
                 let (indices, reps) = (self.block()?, self.block()?);
                 self.bound(count, "fields", indices.min(reps))?;
+                self.at = at;
+                self.ints(count, 4)?;
+                let reps = self.decompressed(count.saturating_mul(8))?;
+                if (reps.len() as u64) < count * 8 {
+                    return Err(
+                        self.refuse(format!("{} bytes of value representations for {count} fields", reps.len()))
+                    );
+                }
             }
             "FIELDSETS" => {
                 let count = self.u64("the field set count")?;
+                let at = self.at;
                 let bytes = self.block()?;
                 self.bound(count, "field set entries", bytes)?;
+                self.at = at;
+                self.ints(count, 4)?;
             }
             "PATHS" => {
                 let paths = self.u64("the path count")?;
                 let encoded = self.u64("the encoded path count")?;
+                let at = self.at;
                 let bytes = [self.block()?, self.block()?, self.block()?];
                 let least = bytes.into_iter().min().unwrap_or(0);
                 self.bound(paths, "paths", least)?;
                 self.bound(encoded, "encoded paths", least)?;
+                self.at = at;
+                let arrays = [self.ints(encoded, 4)?, self.ints(encoded, 4)?, self.ints(encoded, 4)?];
+                // As the crate keeps them: path indices unsigned, tokens and jumps signed, of 32 bits.
+                let indexes: Vec<i64> = arrays[0].iter().map(|&v| i64::from(v as u32)).collect();
+                let [tokens, jumps] =
+                    [&arrays[1], &arrays[2]].map(|a| a.iter().map(|&v| i64::from(v as i32)).collect::<Vec<_>>());
+                super::usdc_blocks::check_paths((&indexes, &tokens, &jumps), paths, self.tokens)?;
             }
             "SPECS" => {
                 let count = self.u64("the spec count")?;
+                let at = self.at;
                 let bytes = [self.block()?, self.block()?, self.block()?];
                 self.bound(count, "specs", bytes.into_iter().min().unwrap_or(0))?;
+                self.at = at;
+                for _ in 0..3 {
+                    self.ints(count, 4)?;
+                }
             }
             _ => {}
         }

@@ -14,7 +14,13 @@
 //!   a list operation of tokens, strings, paths or integers: its count times
 //!   its item's size.
 //!
-//! Values inside dictionaries and time samples are not reached. Then the
+//! Then every index a value holds into the layer's tables — single tokens,
+//! strings and asset paths, token and string arrays, token, string and path
+//! vectors and list operations — must lie inside its table, and an array may
+//! not be marked inlined, nor compressed unless its type's arrays are (the
+//! crate indexes and asserts without checking); the crate's own
+//! cross-checks of its tables run first (`CrateFile::validate`). Values
+//! inside dictionaries, time samples and references are not reached. Then the
 //! prims' children lists are checked against the layer's paths
 //! (`groom/usdc_children.rs`).
 
@@ -106,20 +112,45 @@ fn counted_items(ty: u64) -> Option<(u64, bool)> {
 /// its crate version, whose structure [`super::usdc_check::check`] passed.
 pub fn check(path: &Path, len: u64, version: (u8, u8, u8)) -> Result<()> {
     let io = |source| Error::Io { path: path.into(), source };
-    let reps = crate::files::read_guarded(|| {
+    let (reps, tables) = crate::files::read_guarded(|| {
         let file = std::fs::File::open(path).map_err(|e| format!("{e}"))?;
         let crate_file = openusd::usdc::CrateFile::open(std::io::BufReader::new(file)).map_err(|e| format!("{e:#}"))?;
-        Ok::<_, String>(crate_file.fields.iter().map(|f| f.value_rep.0).collect::<Vec<u64>>())
+        // The crate's own cross-checks of its tables (fields' tokens,
+        // field sets, specs' paths), which reading a stage does not run.
+        crate_file.validate().map_err(|e| format!("{e:#}"))?;
+        let tables = Tables {
+            tokens: crate_file.tokens.len() as u64,
+            strings: crate_file.strings.len() as u64,
+            paths: crate_file.paths.len() as u64,
+            string_tokens: crate_file.strings.iter().map(|&t| t as u64).collect(),
+            // `validate` checked the fields' tokens.
+            field_names: crate_file.fields.iter().map(|f| crate_file.tokens[f.token_index].clone()).collect(),
+        };
+        Ok::<_, String>((crate_file.fields.iter().map(|f| f.value_rep.0).collect::<Vec<u64>>(), tables))
     })
     .unwrap_or_else(|what| Err(format!("the USD reader stopped: {what}")))
     .map_err(|why| malformed(format!("its structure cannot be read: {why}")))?;
+    if let Some((i, &token)) = tables.string_tokens.iter().enumerate().find(|(_, t)| **t >= tables.tokens) {
+        return Err(malformed(format!("its string {i} names token {token} of {}", tables.tokens)));
+    }
     let mut file = std::fs::File::open(path).map_err(io)?;
     let mut read_at = |at: u64, n: usize| -> Result<u64> {
         let mut b = [0u8; 8];
         file.seek(SeekFrom::Start(at)).and_then(|_| file.read_exact(&mut b[..n])).map_err(io)?;
         Ok(u64::from_le_bytes(b))
     };
-    for (field, rep) in reps.into_iter().map(ValueRep).enumerate() {
+    for (field, rep) in reps.iter().copied().map(ValueRep).enumerate() {
+        // The crate asserts what an array's bits may be: never inlined, and
+        // compressed only where its type's arrays are (integers from 0.5.0,
+        // floating point from 0.6.0).
+        if rep.is_array() && (rep.is_inlined() || (rep.is_compressed() && !compressible(rep.ty(), version))) {
+            let bits = if rep.is_inlined() { "inlined" } else { "compressed" };
+            return Err(malformed(format!(
+                "{}'s value (type {}) is an array marked {bits}",
+                tables.field(field),
+                rep.ty()
+            )));
+        }
         // The crate reads a vector or list operation by its type whatever its
         // array bit says, and arrays and those at their payload whatever the
         // inlined bit says: only other inlined values are skipped.
@@ -127,7 +158,7 @@ pub fn check(path: &Path, len: u64, version: (u8, u8, u8)) -> Result<()> {
         if (rep.is_inlined() && !counted) || (rep.is_array() && rep.payload() == 0) {
             continue;
         }
-        let what = |detail: String| malformed(format!("field {field}'s value (type {}) {detail}", rep.ty()));
+        let what = |detail: String| malformed(format!("{}'s value (type {}) {detail}", tables.field(field), rep.ty()));
         let at = rep.payload();
         let room = |from: u64| len.saturating_sub(from);
         if let Some((item, list_op)) = counted_items(rep.ty()) {
@@ -177,5 +208,119 @@ pub fn check(path: &Path, len: u64, version: (u8, u8, u8)) -> Result<()> {
             return Err(what(format!("starts at byte {at}, past the file's end ({len} bytes)")));
         }
     }
+    for (field, rep) in reps.into_iter().map(ValueRep).enumerate() {
+        check_indices(field, rep, &tables, version, &mut read_at)?;
+    }
     super::usdc_children::check(path, version)
+}
+
+/// The sizes of the tables a value's indices point into.
+struct Tables {
+    tokens: u64,
+    strings: u64,
+    paths: u64,
+    /// Each string's token.
+    string_tokens: Vec<u64>,
+    /// Each field's name.
+    field_names: Vec<String>,
+}
+
+impl Tables {
+    /// Field `field` as an error names it: its index and name.
+    fn field(&self, field: usize) -> String {
+        let name = self.field_names.get(field).map_or("", String::as_str);
+        format!("field {field} ({name:?})")
+    }
+}
+
+/// Which table a value's indices point into.
+#[derive(Clone, Copy)]
+enum Table {
+    Tokens,
+    Strings,
+    Paths,
+}
+
+/// Refuses a value of field `field` holding a token, string or path index
+/// past its table (the crate indexes its tables without checking): single
+/// tokens, strings and asset paths, token and string arrays, token, string
+/// and path vectors and list operations. The counts were bounded by `check`
+/// before. Values inside dictionaries, time samples and references are not
+/// reached.
+fn check_indices(
+    field: usize,
+    rep: ValueRep,
+    tables: &Tables,
+    version: (u8, u8, u8),
+    read_at: &mut dyn FnMut(u64, usize) -> Result<u64>,
+) -> Result<()> {
+    let size = |table| match table {
+        Table::Tokens => tables.tokens,
+        Table::Strings => tables.strings,
+        Table::Paths => tables.paths,
+    };
+    let name = |table| match table {
+        Table::Tokens => "token",
+        Table::Strings => "string",
+        Table::Paths => "path",
+    };
+    let within = |index: u64, table: Table| {
+        if index < size(table) {
+            Ok(())
+        } else {
+            Err(malformed(format!(
+                "{}'s value (type {}) names {} {index} of {}",
+                tables.field(field),
+                rep.ty(),
+                name(table),
+                size(table)
+            )))
+        }
+    };
+    // `count` indices of 4 bytes from byte `at`, each within `table`.
+    let indices = |read_at: &mut dyn FnMut(u64, usize) -> Result<u64>, at: u64, count: u64, table: Table| {
+        for k in 0..count {
+            within(read_at(at + 4 * k, 4)?, table)?;
+        }
+        Ok::<_, Error>(at + 4 * count)
+    };
+    let at = rep.payload();
+    // An inlined value is its payload's low 32 bits; another lies at its payload.
+    let single = |read_at: &mut dyn FnMut(u64, usize) -> Result<u64>, bytes: usize| {
+        if rep.is_inlined() {
+            Ok(at & 0xFFFF_FFFF)
+        } else {
+            read_at(at, bytes)
+        }
+    };
+    match (rep.ty(), rep.is_array()) {
+        (11, false) => within(single(read_at, 8)?, Table::Tokens),
+        (10, false) => within(single(read_at, 4)?, Table::Strings),
+        (12, false) => within(single(read_at, 4)?, if rep.is_inlined() { Table::Tokens } else { Table::Strings }),
+        (11, true) if at != 0 => {
+            let start = at + if version < (0, 5, 0) { 4 } else { 0 };
+            let wide = version >= (0, 7, 0);
+            let count = read_at(start, if wide { 8 } else { 4 })?;
+            indices(read_at, start + if wide { 8 } else { 4 }, count, Table::Tokens).map(|_| ())
+        }
+        (10 | 12, true) | (50, _) if at != 0 => {
+            let count = read_at(at, 8)?;
+            indices(read_at, at + 8, count, Table::Strings).map(|_| ())
+        }
+        (40 | 41, _) => {
+            let count = read_at(at, 8)?;
+            indices(read_at, at + 8, count, if rep.ty() == 40 { Table::Paths } else { Table::Tokens }).map(|_| ())
+        }
+        (32..=34, _) => {
+            let table = [Table::Tokens, Table::Strings, Table::Paths][rep.ty() as usize - 32];
+            let header = read_at(at, 1)? as u8;
+            let mut pos = at + 1;
+            for _ in 0..((header >> 1) & 0x3F).count_ones() {
+                let count = read_at(pos, 8)?;
+                pos = indices(read_at, pos + 8, count, table)?;
+            }
+            Ok(())
+        }
+        _ => Ok(()),
+    }
 }
