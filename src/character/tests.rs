@@ -436,6 +436,14 @@ fn malformed_accessors_and_keys_are_refused_not_read() {
             }),
         ),
         (
+            // The README's bound on a character's vertices, one past it.
+            "POSITION: accessor 0: 4194305 elements (allowed 1..=4194304)",
+            Box::new(move |j| {
+                let a = attribute(j, "POSITION");
+                j["accessors"][a]["count"] = (super::MAX_CHARACTER_VERTICES + 1).into();
+            }),
+        ),
+        (
             "WEIGHTS_0",
             Box::new(move |j| {
                 let a = attribute(j, "WEIGHTS_0");

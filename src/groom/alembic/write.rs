@@ -315,6 +315,26 @@ mod tests {
         assert!(err.contains("/c: objects nest deeper than 256 levels"), "{err}");
     }
 
+    /// An archive reads at most [`super::super::MAX_OBJECTS`] objects: that
+    /// many (empty objects beside one curves object) read, one more is
+    /// refused naming the bound.
+    #[test]
+    fn an_archive_holds_as_many_objects_as_the_limit_and_no_more() {
+        let groom = Groom::from_strands(&[vec![Vec3::X, Vec3::new(1.0, -1.0, 0.0)]]).expect("groom");
+        let archive = |objects: usize| {
+            let mut w = Writer::new();
+            let o = CurvesObject { name: "c", groom: &groom, guides: None, root_uvs: None, transform: None };
+            let mut children = vec![("c".to_owned(), CURVE_META.to_owned(), curves(&mut w, &o))];
+            children.extend((1..objects).map(|k| (format!("e{k}"), String::new(), Node::Group(0))));
+            finish(w, &children)
+        };
+        let limit = super::super::MAX_OBJECTS;
+        let g = super::super::parse(&archive(limit)).expect("as many objects as the limit");
+        assert_eq!(g.groom.strand_count(), 1);
+        let err = super::super::parse(&archive(limit + 1)).expect_err("one more").to_string();
+        assert!(err.contains("more than 1048576 objects"), "{err}");
+    }
+
     #[test]
     fn xform_ops_compose_with_the_first_outermost() {
         let groom = Groom::from_strands(&[vec![Vec3::X, Vec3::new(1.0, -1.0, 0.0)]]).expect("groom");
