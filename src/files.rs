@@ -318,6 +318,17 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 mod tests {
     use super::*;
 
+    /// A panic inside a guarded reader is its error (the message the panic
+    /// carried), and a reader that returns is its value.
+    #[test]
+    fn a_guarded_readers_panic_is_its_error() {
+        let stopped = read_guarded(|| -> u32 { panic!("index out of bounds: the len is 3 but the index is 7") });
+        assert_eq!(stopped, Err("index out of bounds: the len is 3 but the index is 7".to_owned()));
+        let message = format!("{} is {}", "a formatted", "message");
+        assert_eq!(read_guarded(move || -> u32 { panic!("{message}") }), Err("a formatted is message".to_owned()));
+        assert_eq!(read_guarded(|| 42u32), Ok(42));
+    }
+
     #[test]
     fn writes_whole_files_and_names_the_path_on_failure() {
         let dir = tempfile::tempdir().expect("temp dir");

@@ -673,3 +673,36 @@ fn every_one_byte_change_of_a_binary_layer_is_read_or_refused_without_a_library_
     }
     assert!(panics.is_empty(), "{caught} one-byte changes reached a panic inside the USD library");
 }
+
+/// A stage of more prims than [`usda_check::MAX_USD_PRIMS`] is refused before
+/// the USD library composes it (400,000 empty prims took it 42 s): in one
+/// layer, at the line of the prim past the bound; over two sublayers that
+/// each stay within it, naming the root layer.
+#[test]
+fn a_stage_of_too_many_prims_is_refused_before_it_is_composed() {
+    use vkhair::groom::usda_check::MAX_USD_PRIMS;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let curves =
+        "def BasisCurves \"c\" {\n    uniform token type = \"linear\"\n    int[] curveVertexCounts = [2]\n    \
+                  point3f[] points = [(0, 0, 0), (0, -1, 0)]\n}\n";
+    let layer = |name: &str, header: &str, prims: usize| {
+        let mut text = format!("#usda 1.0\n{header}\n{curves}");
+        for k in 0..prims {
+            text.push_str(&format!("def \"{name}{k}\" {{}}\n"));
+        }
+        let path = dir.path().join(format!("{name}.usda"));
+        std::fs::write(&path, text).expect("write");
+        path
+    };
+    let start = std::time::Instant::now();
+    let one = layer("one", "", MAX_USD_PRIMS);
+    let e = usd::open(&one).expect_err("one prim too many").to_string();
+    assert!(e.contains("one.usda") && e.contains(&format!("line {}", MAX_USD_PRIMS + 7)), "{e}");
+    assert!(e.contains(&format!("more than {MAX_USD_PRIMS} prims")), "{e}");
+    layer("a", "", MAX_USD_PRIMS * 3 / 5);
+    layer("b", "", MAX_USD_PRIMS * 3 / 5);
+    let root = layer("root", "(\n    subLayers = [@a.usda@, @b.usda@]\n)", 0);
+    let e = usd::open(&root).expect_err("too many over the layers").to_string();
+    assert!(e.contains("root.usda") && e.contains("the stage's layers declare more than"), "{e}");
+    println!("refused in {:.1} s", start.elapsed().as_secs_f64());
+}

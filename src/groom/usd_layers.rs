@@ -153,6 +153,20 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
     // Per text layer read, what it offers the arcs that name it again.
     let mut seen: HashMap<PathBuf, Option<Targets>> = HashMap::new();
     let mut total = 0u64;
+    // Prims the layers declare, all together.
+    let mut prims = 0usize;
+    let mut count_prims = |targets: &Targets| {
+        prims += targets.prims.len();
+        if prims > super::usda_check::MAX_USD_PRIMS {
+            return Err(malformed(format!(
+                "the stage's layers declare more than {} prims (the USD reader composes about ten thousand a \
+                 second: keep many curves in one BasisCurves prim)",
+                super::usda_check::MAX_USD_PRIMS
+            ))
+            .in_asset(path));
+        }
+        Ok(())
+    };
     while let Some((layer, named_by, takes)) = queue.pop() {
         let named = |e: Error| match &named_by {
             None => e,
@@ -208,6 +222,7 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
             if let Some(why) = targets.missing(&takes) {
                 return Err(named(malformed(why).in_asset(&layer)));
             }
+            count_prims(&targets)?;
             seen.insert(key, Some(targets));
             let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
             for (asset, takes) in assets {
@@ -234,6 +249,7 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
         if let Some(why) = targets.missing(&takes) {
             return Err(named(malformed(why).in_asset(&layer)));
         }
+        count_prims(&targets)?;
         seen.insert(key, Some(targets));
         let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
         for asset in assets {

@@ -9,6 +9,8 @@
 //!   ([`MAX_USDA_DEPTH_WORK`]: the sum of each prim's depth squared, which
 //!   the crate's time follows — many chains each within the depth limit took
 //!   it 12 s at 300 chains of 125 levels);
+//! - at most [`MAX_USD_PRIMS`] prims (the reader's time follows their
+//!   number: 42 s for 400,000 empty prims);
 //! - every layer named by `subLayers` or by a composition arc, wherever the
 //!   arc is written (a prim's metadata or a variant's), is returned for the
 //!   same checks;
@@ -38,6 +40,11 @@ pub const MAX_USDA_DEPTH_WORK: u64 = 4_000_000;
 /// references) may pass through within a layer: the reader's time grows with
 /// the cube of the chain (1,000 links took it 13 s).
 pub const MAX_USDA_ARC_CHAIN: usize = 128;
+
+/// Most prims a USD stage may declare, over all its layers: the USD reader
+/// composes about ten thousand a second (400,000 empty prims took it 42 s),
+/// and a groom keeps many curves in one `BasisCurves` prim.
+pub const MAX_USD_PRIMS: usize = 100_000;
 
 /// Metadata keys whose path values are composition arcs.
 const ARCS: [&str; 4] = ["inherits", "specializes", "references", "payload"];
@@ -211,6 +218,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<LayerAssets> {
     let mut declaring = false;
     let mut arcs: HashMap<String, Vec<(String, usize)>> = HashMap::new();
     let mut count = 0usize;
+    let mut declared = 0usize;
     let mut work = 0u64;
     let mut assets = LayerAssets::new();
     // The names of the prims declared at the root, and the targets (with
@@ -235,6 +243,14 @@ pub fn check(text: &str, sublayer: bool) -> Result<LayerAssets> {
                     }
                     prims.push(format!("{parent}/{name}"));
                     declaring = false;
+                    declared += 1;
+                    if declared > MAX_USD_PRIMS {
+                        return Err(malformed(format!(
+                            "{} more than {MAX_USD_PRIMS} prims (the USD reader composes about ten thousand a \
+                             second: keep many curves in one BasisCurves prim)",
+                            position(text, *at)
+                        )));
+                    }
                     work += (prims.len() as u64).pow(2);
                     if work > MAX_USDA_DEPTH_WORK {
                         return Err(malformed(format!(

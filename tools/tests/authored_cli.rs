@@ -259,21 +259,19 @@ fn followers_take_the_file_colours_or_a_scalp_texture() {
     run_line(&line, LIMIT).assert_error("not a PNG image");
 }
 
-/// A `.usdc` file the USD library panics on (a `todo!()` for chunked LZ4,
-/// indices past the end of its tables) is an error naming the file and what
-/// stopped the reader, with no panic message or backtrace on stderr, and one
-/// the crate's checks see first is refused by them; the files are the test's
-/// own byte edits of the shared fixture.
+/// `.usdc` files the USD library stopped on with a panic (a `todo!()` for
+/// chunked LZ4, a token index past the end of its table) are refused by the
+/// crate's own checks before the library reads them: one error line naming
+/// the file and the value, no panic message or backtrace on stderr; the
+/// files are the test's own byte edits of the shared fixture.
 #[test]
-fn a_usdc_the_usd_library_panics_on_is_an_error_without_a_panic_message() {
+fn a_usdc_the_usd_library_panicked_on_is_refused_first_in_one_line() {
     let dir = tempfile::tempdir().expect("temp dir");
     let original = std::fs::read(data("usd/small_cm_zup.usdc")).expect("read the fixture");
-    // The second edit, a field's value past the file's end, is now refused
-    // by the crate's own value check before the library reads it.
     let edits: [(&str, &[(usize, u8)]); 3] = [
-        ("the USD reader stopped: not yet implemented: Support lz4 chunked", &[(1689, 219)]),
+        ("its section \"SPECS\": a compressed block of 219 chunks", &[(1689, 219)]),
         ("value (type 0) starts at byte 75812, past the file's end", &[(1350, 33)]),
-        ("the USD reader stopped: index out of bounds", &[(203, 36)]),
+        ("field 10 (\"properties\")'s value (type 41) names token 603979799 of 44", &[(203, 36)]),
     ];
     for (k, (what, bytes)) in edits.iter().enumerate() {
         let mut edited = original.clone();
