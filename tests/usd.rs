@@ -706,3 +706,37 @@ fn a_stage_of_too_many_prims_is_refused_before_it_is_composed() {
     assert!(e.contains("root.usda") && e.contains("the stage's layers declare more than"), "{e}");
     println!("refused in {:.1} s", start.elapsed().as_secs_f64());
 }
+
+/// A prim of more properties than [`usda_check::MAX_USD_PROPERTIES`] is
+/// refused before the USD library parses it (its time grows with their
+/// square: 100,000 attributes took it more than two minutes), naming the
+/// prim and the line; one of as many child prims reads.
+#[test]
+fn a_prim_of_too_many_properties_is_refused_before_it_is_parsed() {
+    use vkhair::groom::usda_check::MAX_USD_PROPERTIES;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let curves = "    uniform token type = \"linear\"\n    int[] curveVertexCounts = [2]\n    \
+                  point3f[] points = [(0, 0, 0), (0, -1, 0)]\n";
+    let mut text = format!("#usda 1.0\ndef BasisCurves \"c\" {{\n{curves}");
+    for k in 0..MAX_USD_PROPERTIES {
+        text.push_str(&format!("    float a{k} = 1\n"));
+    }
+    text.push_str("}\n");
+    let path = dir.path().join("attributes.usda");
+    std::fs::write(&path, &text).expect("write");
+    let start = std::time::Instant::now();
+    let e = usd::open(&path).expect_err("one property too many").to_string();
+    let line = MAX_USD_PROPERTIES + 3;
+    assert!(e.contains("attributes.usda") && e.contains("its prim /c declares more than 10000 properties"), "{e}");
+    assert!(e.contains(&format!("line {line}")), "{e}");
+    assert!(start.elapsed().as_secs_f64() < 1.0, "refused in {:?}", start.elapsed());
+    // As many child prims under one parent: not properties.
+    let mut text = format!("#usda 1.0\ndef Xform \"root\" {{\n    def BasisCurves \"c\" {{\n{curves}    }}\n");
+    for k in 0..MAX_USD_PROPERTIES {
+        text.push_str(&format!("    def \"p{k}\" {{}}\n"));
+    }
+    text.push_str("}\n");
+    std::fs::write(&path, &text).expect("write");
+    let read = usd::open(&path).expect("child prims are not properties");
+    assert_eq!(read.groom.strand_count(), 1);
+}

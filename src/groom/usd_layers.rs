@@ -76,9 +76,33 @@ fn parse(text: &str, sublayers: bool) -> std::result::Result<Targets, String> {
             .and_then(|root| root.fields.iter().find(|(key, _)| key == "defaultPrim"))
             .and_then(|(_, value)| value.try_as_token_ref().map(|t| t.as_str().to_owned()));
         let prims = specs.iter().filter(|(_, s)| s.ty == SpecType::Prim).map(|(p, _)| p.as_str().to_owned()).collect();
+        most_properties(specs.iter().map(|(p, s)| (p, s.ty)))?;
         Ok(Targets { sublayers, prims, default })
     })
     .unwrap_or_else(|what| Err(format!("the USD reader stopped: {what}")))
+}
+
+pub use super::usda_check::MAX_USD_PROPERTIES;
+
+/// Refuses a layer of `specs` (path, type) in which a prim declares more than
+/// [`MAX_USD_PROPERTIES`] properties, naming it (text layers are refused
+/// before they are parsed; binary ones here).
+fn most_properties<'a>(specs: impl Iterator<Item = (&'a SdfPath, SpecType)>) -> std::result::Result<(), String> {
+    let mut per_prim: HashMap<String, usize> = HashMap::new();
+    for (path, ty) in specs {
+        if matches!(ty, SpecType::Attribute | SpecType::Relationship) {
+            let count = per_prim.entry(path.prim_path().as_str().to_owned()).or_default();
+            *count += 1;
+            if *count > MAX_USD_PROPERTIES {
+                return Err(format!(
+                    "its prim {} declares more than {MAX_USD_PROPERTIES} properties (the USD reader's time grows \
+                     with the square of their number)",
+                    path.prim_path().as_str()
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// What a binary layer names (asset path, what it takes) and offers, read by
@@ -103,6 +127,9 @@ fn binary(path: &Path) -> std::result::Result<(Vec<(String, Takes)>, Targets), S
             (!asset.is_empty()).then(|| (asset.to_owned(), takes))
         };
         let mut prims = HashSet::new();
+        let typed: Vec<(SdfPath, SpecType)> =
+            data.spec_paths().into_iter().filter_map(|p| data.spec_type(&p).map(|t| (p, t))).collect();
+        most_properties(typed.iter().map(|(p, t)| (p, *t)))?;
         for spec in data.spec_paths() {
             if data.spec_type(&spec) == Some(SpecType::Prim) {
                 prims.insert(spec.as_str().to_owned());

@@ -10,7 +10,9 @@
 //!   the crate's time follows — many chains each within the depth limit took
 //!   it 12 s at 300 chains of 125 levels);
 //! - at most [`MAX_USD_PRIMS`] prims (the reader's time follows their
-//!   number: 42 s for 400,000 empty prims);
+//!   number: 42 s for 400,000 empty prims), and at most
+//!   [`MAX_USD_PROPERTIES`] statements in one prim's body (its time grows
+//!   with the square of a prim's properties);
 //! - every layer named by `subLayers` or by a composition arc, wherever the
 //!   arc is written (a prim's metadata or a variant's), is returned for the
 //!   same checks;
@@ -45,6 +47,12 @@ pub const MAX_USDA_ARC_CHAIN: usize = 128;
 /// composes about ten thousand a second (400,000 empty prims took it 42 s),
 /// and a groom keeps many curves in one `BasisCurves` prim.
 pub const MAX_USD_PRIMS: usize = 100_000;
+
+/// Most statements other than child prims (properties, variant sets) one
+/// prim's body may hold in a USD text layer: the USD reader's time grows with the square of a prim's
+/// properties (20,000 took it 3.8 s, 100,000 more than two minutes); a
+/// groom's curves have a dozen.
+pub const MAX_USD_PROPERTIES: usize = 10_000;
 
 /// Metadata keys whose path values are composition arcs.
 const ARCS: [&str; 4] = ["inherits", "specializes", "references", "payload"];
@@ -225,7 +233,27 @@ pub fn check(text: &str, sublayer: bool) -> Result<LayerAssets> {
     // where they are written) of the references and payloads within the layer.
     let mut roots: HashSet<String> = HashSet::new();
     let mut internal: Vec<(String, usize)> = Vec::new();
+    // Per open prim body, the statements begun on a new line in it other
+    // than its child prims (properties, variant sets).
+    let mut statements: Vec<usize> = Vec::new();
+    let mut previous = 0usize;
     for (k, (at, token)) in tokens.iter().enumerate() {
+        let child_prim = matches!(token, Token::Word("def" | "class" | "over"));
+        if open.last().is_some_and(|&(c, body)| c == b'{' && body) && !child_prim && text[previous..*at].contains('\n')
+        {
+            if let Some(n) = statements.last_mut() {
+                *n += 1;
+                if *n > MAX_USD_PROPERTIES {
+                    return Err(malformed(format!(
+                        "{} its prim {} declares more than {MAX_USD_PROPERTIES} properties (the USD reader's time \
+                         grows with the square of their number)",
+                        position(text, *at),
+                        prims.last().map_or("", String::as_str)
+                    )));
+                }
+            }
+        }
+        previous = *at;
         match token {
             Token::Open(c) => {
                 if open.len() >= MAX_USDA_DEPTH {
@@ -242,6 +270,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<LayerAssets> {
                         roots.insert(name.clone());
                     }
                     prims.push(format!("{parent}/{name}"));
+                    statements.push(0);
                     declaring = false;
                     declared += 1;
                     if declared > MAX_USD_PRIMS {
@@ -272,6 +301,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<LayerAssets> {
                     Some((o, body)) if o == expected => {
                         if body {
                             prims.pop();
+                            statements.pop();
                         }
                     }
                     _ => {
