@@ -40,6 +40,7 @@ pub mod tfx;
 pub mod usd;
 mod usd_layers;
 pub mod usda_check;
+mod usda_tokens;
 mod usdc_blocks;
 pub mod usdc_check;
 mod usdc_children;
