@@ -5,7 +5,7 @@
 
 use ash::vk;
 use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
-use vkhair::headless::Offscreen;
+use vkhair::headless::{Offscreen, Submit};
 use vkhair::render::reference::{hair_motion, hair_motions_at, MotionPick, MotionScene};
 use vkhair::render::{
     Camera, HairMaterial, LodParams, MotionDirection, MotionParams, MotionUnits, Raster, RenderParams, Renderer,
@@ -334,7 +334,8 @@ fn motion_vectors_follow_the_hosts_conventions() {
         }
     }
     println!("NDC, reversed, 32-bit: {hair} pixels, at most {worst} px from the pixels' vectors");
-    // Half floats of up to 8 px hold 1/256 px; 32-bit NDC holds more.
+    // Half floats of up to 8 px hold 1/256 px (the motion is kept as half
+    // floats whatever the image's format).
     assert!(hair > 300 && worst <= 0.01, "NDC and reversed: {worst} px off");
     let reset = pair(&pixels, vk::Format::R16G16_SFLOAT, true);
     let largest = reset.iter().filter(|v| **v != CLEAR).map(|v| v.length()).fold(0.0, f32::max);
@@ -364,6 +365,24 @@ fn motion_vectors_follow_the_hosts_conventions() {
     assert!(largest == 0.0, "renumbered hairs moved {largest} px");
     let mut offscreen = Offscreen::new(gpu.ctx(), 8, 8).expect("offscreen");
     assert!(offscreen.add_velocity(vk::Format::R8G8_UNORM, Vec2::ZERO).is_err(), "an 8-bit velocity image");
+    // A multisampled target with a velocity image (the opaque mode draws into
+    // multisampled targets otherwise): refused before anything is recorded.
+    let mut s = scene(&gpu, &params(Transparency::Off, Raster::Hardware, false), false);
+    let mut multisampled = s.offscreen.target();
+    multisampled.samples = vk::SampleCountFlags::TYPE_4;
+    let mut refused = Ok(());
+    gpu.ctx()
+        .run_commands("a multisampled target with motion vectors", |cmd| {
+            // SAFETY: a recording command buffer of the context's device; refused before recording.
+            refused = unsafe {
+                s.renderer
+                    .record_prepare(cmd, &s.sim, Some(&camera), None)
+                    .and_then(|_| s.renderer.record_draw(cmd, common::next_frame(), &multisampled, &camera, None))
+            };
+        })
+        .expect("submit");
+    let e = refused.expect_err("refused").to_string();
+    assert!(e.contains("single-sample"), "{e}");
 }
 
 /// A host's mesh in front of the hair keeps its own motion: no pixel it covers

@@ -233,6 +233,7 @@ impl Running {
             }
             "v" => {
                 self.taa.motion_vectors = !self.taa.motion_vectors;
+                self.taa.restart();
                 self.hair().renderer.reset_motion();
             }
             _ => return Ok(()),

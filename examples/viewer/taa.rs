@@ -8,7 +8,9 @@
 //!
 //! Where the hair wrote no motion, the host's own: its floor and head stand
 //! still, so their pixels moved with the camera alone, found from the depth
-//! (reprojected by the previous frame's unjittered view and projection).
+//! (reprojected by the previous frame's unjittered view and projection). A
+//! `--gltf` character's skinned body moves and writes no motion of its own
+//! here (an engine's meshes would): under TAA it trails.
 //! Without the hair's motion vectors its pixels are reprojected so too, as if
 //! the hair stood still with the head: simulated hair then smears and ghosts
 //! as it swings.

@@ -16,7 +16,6 @@
 #include "oit.glsl"
 #include "oit_kbuffer.glsl"
 
-
 #ifdef VKHAIR_OVERFLOW_BUFFER
 #include "oit_overflow.glsl"
 #else

@@ -143,7 +143,12 @@ pub fn check(text: &str, sublayer: bool) -> Result<LayerAssets> {
     let mut previous = 0usize;
     for (k, (at, token)) in tokens.iter().enumerate() {
         let child_prim = matches!(token, Token::Word("def" | "class" | "over"));
-        if open.last().is_some_and(|&(c, body)| c == b'{' && body) && !child_prim && text[previous..*at].contains('\n')
+        // Inside a prim's braces: its body, or a variant's (whose
+        // properties the reader parses the same way).
+        if open.last().is_some_and(|&(c, _)| c == b'{')
+            && !prims.is_empty()
+            && !child_prim
+            && text[previous..*at].contains('\n')
         {
             if let Some(n) = statements.last_mut() {
                 *n += 1;

@@ -26,7 +26,7 @@ pub(super) fn encoded_room(count: u64, width: u64) -> u64 {
     if count == 0 {
         0
     } else {
-        width + (count * 2).div_ceil(8) + width * count
+        width.saturating_add(count.saturating_mul(2).div_ceil(8)).saturating_add(width.saturating_mul(count))
     }
 }
 
@@ -93,14 +93,16 @@ fn lz4_size(data: &[u8]) -> Option<u64> {
     Some(size)
 }
 
-/// `count` integers of `width` bytes (4 or 8) decoded from `data` as the
-/// crate's integer coding stores them: a common value, two bits a code for
-/// each integer (common, small, medium, large), then the deltas.
-pub(super) fn decode_ints(data: &[u8], count: u64, width: u64, what: &str) -> Result<Vec<i64>> {
+/// `count` 32-bit integers decoded from `data` as the crate's integer coding
+/// stores them (a common value, two bits a code for each integer — common,
+/// small, medium, large — then the deltas), kept as the crate keeps them
+/// (wrapped to 32 bits): the structure's tables are all of 32-bit integers.
+pub(super) fn decode_ints(data: &[u8], count: u64, what: &str) -> Result<Vec<i32>> {
+    let width = 4u64;
     if count == 0 {
         return Ok(Vec::new());
     }
-    let codes = (count * 2).div_ceil(8);
+    let codes = count.saturating_mul(2).div_ceil(8);
     let short = || malformed(format!("{what}: {} decoded bytes cannot hold {count} integers", data.len()));
     let start = width.checked_add(codes).filter(|&s| s <= data.len() as u64).ok_or_else(short)? as usize;
     let signed = |bytes: &[u8]| -> i64 {
@@ -113,7 +115,8 @@ pub(super) fn decode_ints(data: &[u8], count: u64, width: u64, what: &str) -> Re
     };
     let common = signed(&data[..width as usize]);
     let (mut at, mut prev) = (start, 0i64);
-    let mut out = Vec::with_capacity(count as usize);
+    // At most four integers a code byte, and the code bytes are inside `data`.
+    let mut out = Vec::with_capacity(count.min(data.len() as u64 * 4) as usize);
     for k in 0..count {
         let code = (data[width as usize + (k / 4) as usize] >> (2 * (k % 4))) & 3;
         let size = match code {
@@ -128,7 +131,7 @@ pub(super) fn decode_ints(data: &[u8], count: u64, width: u64, what: &str) -> Re
         };
         at += size;
         prev = prev.wrapping_add(delta);
-        out.push(prev);
+        out.push(prev as i32);
     }
     Ok(out)
 }
@@ -138,7 +141,7 @@ pub(super) fn decode_ints(data: &[u8], count: u64, width: u64, what: &str) -> Re
 /// token below `tokens`, the child and sibling jumps inside the entries, no
 /// entry visited twice.
 pub(super) fn check_paths(
-    (path_indexes, element_tokens, jumps): (&[i64], &[i64], &[i64]),
+    (path_indexes, element_tokens, jumps): (&[i32], &[i32], &[i32]),
     paths: u64,
     tokens: u64,
 ) -> Result<()> {
@@ -160,18 +163,19 @@ pub(super) fn check_paths(
             if std::mem::replace(&mut visited[index], true) {
                 return refuse(format!("the path tree reaches entry {index} twice"));
             }
-            let path = path_indexes[index];
-            if !(0..paths as i64).contains(&path) || (root && index as u64 >= paths) {
+            // Path indices are unsigned.
+            let path = u64::from(path_indexes[index] as u32);
+            if path >= paths || (root && index as u64 >= paths) {
                 return refuse(format!("entry {index} names path {path} of {paths}"));
             }
-            if !root && element_tokens[index].unsigned_abs() >= tokens {
+            if !root && u64::from(element_tokens[index].unsigned_abs()) >= tokens {
                 return refuse(format!("entry {index} names token {} of {tokens}", element_tokens[index]));
             }
             root = false;
             let jump = jumps[index];
             let (child, sibling) = (jump > 0 || jump == -1, jump >= 0);
             if child && sibling {
-                let to = (index as i64).saturating_add(jump);
+                let to = index as i64 + i64::from(jump);
                 if to >= count as i64 {
                     return refuse(format!("entry {index}'s sibling jump {jump} leaves the {count} entries"));
                 }
@@ -197,11 +201,11 @@ mod tests {
         data.push(5);
         data.extend_from_slice(&(-300i16).to_le_bytes());
         data.extend_from_slice(&70000i32.to_le_bytes());
-        let ints = decode_ints(&data, 4, 4, "test").expect("decodes");
+        let ints = decode_ints(&data, 4, "test").expect("decodes");
         assert_eq!(ints, [1, 6, -294, 69706]);
         // One byte short of the last delta: refused, not sliced past.
-        assert!(decode_ints(&data[..data.len() - 1], 4, 4, "test").is_err());
-        assert!(decode_ints(&data[..3], 4, 4, "test").is_err());
+        assert!(decode_ints(&data[..data.len() - 1], 4, "test").is_err());
+        assert!(decode_ints(&data[..3], 4, "test").is_err());
     }
 
     #[test]

@@ -20,7 +20,8 @@
 //!   fields, and a path tree whose tokens, path indices or jumps leave their
 //!   tables or reach an entry twice.
 //!
-//! Each error names the value found and the file's length. Then the values
+//! Each error names the value found (and, for a bound of the file, its
+//! length). Then the values
 //! the fields point at are checked (`groom/usdc_values.rs`).
 
 use std::io::{Read, Seek, SeekFrom};
@@ -170,10 +171,10 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
         super::usdc_blocks::decompress(&bytes, room, &format!("its section {:?}", self.name))
     }
 
-    /// A block of `count` integers of `width` bytes in the crate's coding, decoded.
-    fn ints(&mut self, count: u64, width: u64) -> Result<Vec<i64>> {
-        let data = self.decompressed(super::usdc_blocks::encoded_room(count, width))?;
-        super::usdc_blocks::decode_ints(&data, count, width, &format!("its section {:?}", self.name))
+    /// A block of `count` 32-bit integers in the crate's coding, decoded.
+    fn ints(&mut self, count: u64) -> Result<Vec<i32>> {
+        let data = self.decompressed(super::usdc_blocks::encoded_room(count, 4))?;
+        super::usdc_blocks::decode_ints(&data, count, &format!("its section {:?}", self.name))
     }
 
     /// `count` items `what`, decoded from compressed blocks of `bytes` bytes.
@@ -215,7 +216,7 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
                 let (indices, reps) = (self.block()?, self.block()?);
                 self.bound(count, "fields", indices.min(reps))?;
                 self.at = at;
-                self.ints(count, 4)?;
+                self.ints(count)?;
                 let reps = self.decompressed(count.saturating_mul(8))?;
                 if (reps.len() as u64) < count * 8 {
                     return Err(
@@ -229,7 +230,7 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
                 let bytes = self.block()?;
                 self.bound(count, "field set entries", bytes)?;
                 self.at = at;
-                self.ints(count, 4)?;
+                self.ints(count)?;
             }
             "PATHS" => {
                 let paths = self.u64("the path count")?;
@@ -240,12 +241,8 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
                 self.bound(paths, "paths", least)?;
                 self.bound(encoded, "encoded paths", least)?;
                 self.at = at;
-                let arrays = [self.ints(encoded, 4)?, self.ints(encoded, 4)?, self.ints(encoded, 4)?];
-                // As the crate keeps them: path indices unsigned, tokens and jumps signed, of 32 bits.
-                let indexes: Vec<i64> = arrays[0].iter().map(|&v| i64::from(v as u32)).collect();
-                let [tokens, jumps] =
-                    [&arrays[1], &arrays[2]].map(|a| a.iter().map(|&v| i64::from(v as i32)).collect::<Vec<_>>());
-                super::usdc_blocks::check_paths((&indexes, &tokens, &jumps), paths, self.tokens)?;
+                let arrays = [self.ints(encoded)?, self.ints(encoded)?, self.ints(encoded)?];
+                super::usdc_blocks::check_paths((&arrays[0], &arrays[1], &arrays[2]), paths, self.tokens)?;
             }
             "SPECS" => {
                 let count = self.u64("the spec count")?;
@@ -254,7 +251,7 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
                 self.bound(count, "specs", bytes.into_iter().min().unwrap_or(0))?;
                 self.at = at;
                 for _ in 0..3 {
-                    self.ints(count, 4)?;
+                    self.ints(count)?;
                 }
             }
             _ => {}

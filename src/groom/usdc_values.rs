@@ -12,7 +12,9 @@
 //!   and [`MAX_ITEMS`] in all;
 //! - a token, string, path, double or layer-offset vector, and every list of
 //!   a list operation of tokens, strings, paths or integers: its count times
-//!   its item's size.
+//!   its item's size; a dictionary's and a variant selection map's entries
+//!   (at least 12 and 8 bytes each: the crate loops over a dictionary's
+//!   count, seeking by offsets it reads).
 //!
 //! Then every index a value holds into the layer's tables — single tokens,
 //! strings and asset paths, token and string arrays, token, string and path
@@ -36,6 +38,9 @@ pub const MAX_ITEMS_PER_BYTE: u64 = 1024;
 /// Most items a section may count (what the crate's own bound on strings is):
 /// a gibibyte of 8-byte values.
 pub const MAX_ITEMS: u64 = 1 << 27;
+
+/// Bytes of the file the value checks read at once.
+const WINDOW: u64 = 64 << 10;
 
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }
@@ -90,7 +95,8 @@ fn element_size(ty: u64) -> u64 {
 fn compressible(ty: u64, version: (u8, u8, u8)) -> bool {
     match ty {
         3..=6 => version >= (0, 5, 0),
-        7..=9 => version >= (0, 6, 0),
+        // Time codes are doubles (the crate reads their arrays as it reads floats).
+        7..=9 | 56 => version >= (0, 6, 0),
         _ => false,
     }
 }
@@ -100,6 +106,8 @@ fn compressible(ty: u64, version: (u8, u8, u8)) -> bool {
 fn counted_items(ty: u64) -> Option<(u64, bool)> {
     match ty {
         40 | 41 | 50 => Some((4, false)),          // path, token, string vectors
+        31 => Some((12, false)),                   // dictionary: a string key and a value each
+        45 => Some((8, false)),                    // variant selections: two strings each
         48 => Some((8, false)),                    // double vector
         49 => Some((16, false)),                   // layer offset vector
         32 | 33 | 34 | 36 | 38 => Some((4, true)), // token, string, path, int, uint list ops
@@ -134,9 +142,23 @@ pub fn check(path: &Path, len: u64, version: (u8, u8, u8)) -> Result<()> {
         return Err(malformed(format!("its string {i} names token {token} of {}", tables.tokens)));
     }
     let mut file = std::fs::File::open(path).map_err(io)?;
+    // Reads go through a window of the file, so that the indices of a long
+    // vector cost a read a window, not one each.
+    let (mut window, mut window_at) = (Vec::new(), 0u64);
     let mut read_at = |at: u64, n: usize| -> Result<u64> {
+        let inside = at >= window_at && at + n as u64 <= window_at + window.len() as u64;
+        if !inside {
+            let size = WINDOW.min(len.saturating_sub(at)) as usize;
+            window.resize(size, 0);
+            file.seek(SeekFrom::Start(at)).and_then(|_| file.read_exact(&mut window)).map_err(io)?;
+            window_at = at;
+        }
+        let from = (at - window_at) as usize;
+        let bytes = window.get(from..from + n).ok_or_else(|| {
+            malformed(format!("a value's {n} bytes at byte {at} lie past the file's end ({len} bytes)"))
+        })?;
         let mut b = [0u8; 8];
-        file.seek(SeekFrom::Start(at)).and_then(|_| file.read_exact(&mut b[..n])).map_err(io)?;
+        b[..n].copy_from_slice(bytes);
         Ok(u64::from_le_bytes(b))
     };
     for (field, rep) in reps.iter().copied().map(ValueRep).enumerate() {
@@ -155,7 +177,9 @@ pub fn check(path: &Path, len: u64, version: (u8, u8, u8)) -> Result<()> {
         // array bit says, and arrays and those at their payload whatever the
         // inlined bit says: only other inlined values are skipped.
         let counted = rep.is_array() || counted_items(rep.ty()).is_some();
-        if (rep.is_inlined() && !counted) || (rep.is_array() && rep.payload() == 0) {
+        // (An inlined dictionary is an empty one: nothing to read.)
+        let empty_dictionary = rep.ty() == 31 && rep.is_inlined();
+        if (rep.is_inlined() && !counted) || (rep.is_array() && rep.payload() == 0) || empty_dictionary {
             continue;
         }
         let what = |detail: String| malformed(format!("{}'s value (type {}) {detail}", tables.field(field), rep.ty()));

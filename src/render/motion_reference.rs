@@ -68,6 +68,9 @@ type Fragment = (f32, f32, Vec2, f32);
 /// the hair before, each projected by its frame's camera. `None` where the
 /// fragments never reach the threshold. Segments reaching behind the camera
 /// are left out (test scenes keep in front of it).
+///
+/// # Panics
+/// Where `before` and `along` do not have `now`'s hairs and vertices.
 pub fn hair_motion(scene: &MotionScene<'_>) -> Vec<Option<Vec2>> {
     let (fragments, (w, _)) = fragments_of(scene);
     let picked: Vec<Option<(f32, Vec2)>> = fragments
@@ -100,6 +103,9 @@ pub fn hair_motion(scene: &MotionScene<'_>) -> Vec<Option<Vec2>> {
 /// [`hair_motion`] composites there (of each of its drawn pixels when
 /// supersampled), in no set order: what any choice among a pixel's hairs
 /// could give.
+///
+/// # Panics
+/// As [`hair_motion`].
 pub fn hair_motions_at(scene: &MotionScene<'_>) -> Vec<Vec<Vec2>> {
     let (fragments, (w, _)) = fragments_of(scene);
     let n = scene.samples.max(1);

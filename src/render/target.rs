@@ -31,15 +31,17 @@ pub struct RenderTarget {
     /// none. Where given, each pixel the hair covers gets its motion since the
     /// previous frame ([`super::MotionParams`]: which hair, the units, the
     /// sign), the jitter excluded; every other pixel keeps what the host wrote.
-    /// Written by the transparent modes ([`super::Transparency::Exact`] with
-    /// every rasteriser, [`super::Transparency::Fast`]); refused with
-    /// [`super::Transparency::Off`].
+    /// Written in every transparency mode; the target must be single-sample.
+    /// One draw a frame writes motion vectors: the renderer keeps that draw's
+    /// camera and drawn positions for the next (a second view of the same
+    /// frame would move the history). The motion is kept as half floats
+    /// whatever the image's format.
     pub velocity: vk::ImageView,
     /// Its format: `R16G16_SFLOAT` or `R32G32_SFLOAT` (`UNDEFINED` for none).
     pub velocity_format: vk::Format,
     /// Extent of all three.
     pub extent: vk::Extent2D,
-    /// Sample count of both.
+    /// Sample count of all three (1 where there is a velocity image).
     pub samples: vk::SampleCountFlags,
 }
 

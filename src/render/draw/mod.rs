@@ -337,6 +337,13 @@ impl Renderer {
         let hairs = self.hair_layout();
         let motion = match target.velocity == vk::ImageView::null() {
             true => None,
+            false if target.samples != vk::SampleCountFlags::TYPE_1 => {
+                return Err(Error::incompatible(
+                    "render target",
+                    "motion vectors go into a single-sample target (a multisampled host resolves first, or \
+                     draws the hair supersampled)",
+                ));
+            }
             false => {
                 if self.motion.is_none() {
                     self.motion = Some(MotionHistory::new(&self.device, self.interpolate.hairs().0.size() / 16)?);

@@ -221,7 +221,11 @@ impl MotionHistory {
         let bytes = (u64::from(hairs.hairs) * u64::from(hairs.per_hair) * 16).min(self.previous.size());
         // The walk read the previous positions this copy replaces; the next
         // frame's walk waits for the copy (its barrier waits for any transfer).
-        let to_copy = barrier::memory(&[AccessKind::ComputeRead], &[AccessKind::TransferWrite]);
+        // (And the interpolation's writes of the positions, which the copy reads.)
+        let to_copy = barrier::memory(
+            &[AccessKind::ComputeRead, AccessKind::ComputeWrite, AccessKind::TessellationWrite],
+            &[AccessKind::TransferRead, AccessKind::TransferWrite],
+        );
         // SAFETY: guaranteed by the caller; both buffers hold `bytes`.
         unsafe {
             self.device.cmd_barrier(cmd, &[to_copy], &[], &[]);
@@ -318,6 +322,13 @@ impl MotionPipelines {
             barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::ComputeRead, AccessKind::ComputeWrite]);
         let walked =
             barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::FragmentRead, AccessKind::FragmentUniformRead]);
+        // The host's writes to its velocity and depth images (its clear, its
+        // meshes: with supersampling the draw has not waited for them) and
+        // the opaque draw's depth writes, before the write loads and tests them.
+        let attachments = barrier::memory(
+            &[AccessKind::ColorAttachmentWrite, AccessKind::DepthAttachmentWrite, AccessKind::AnyTransferWrite],
+            barrier::ATTACHMENTS,
+        );
         let color = [rendering::color(motion.velocity, Load::Keep)];
         let depth = motion.host_depth.map(|(view, _)| rendering::depth(view, Load::Keep));
         let info = rendering::info(motion.extent, &color, depth.as_ref());
@@ -339,7 +350,7 @@ impl MotionPipelines {
                     self.walk.dispatch_threads(cmd, [threads, 1, 1]);
                 }
             }
-            device.cmd_barrier(cmd, &[walked], &[], &[]);
+            device.cmd_barrier(cmd, &[walked, attachments], &[], &[]);
             device.raw.cmd_begin_rendering(cmd, &info);
             device.cmd_set_full_viewport(cmd, motion.extent);
             self.write.bind(cmd, &[self.write_set]);
