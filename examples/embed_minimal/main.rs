@@ -34,7 +34,10 @@ const HEAD_RGB: [u8; 3] = [140, 105, 85];
 #[path = "host.rs"]
 mod host;
 
-use host::{allocate, cleared, compile, on_message, transition, BoxError, Memory, HEAD_FRAG, HEAD_VERT};
+use host::{
+    allocate, cleared, graphics_pipeline, on_message, transition, BoxError, Memory, PipelineDesc, HEAD_FRAG, HEAD_VERT,
+    MESH_VERTEX_ATTRIBUTES, MESH_VERTEX_BINDINGS,
+};
 
 /// What a run produced.
 pub struct Outcome {
@@ -256,87 +259,25 @@ fn frames_with(
     )?;
 
     // The head pipeline (the host's own shaders).
-    let vert = compile(HEAD_VERT, shaderc::ShaderKind::Vertex, "head.vert")?;
-    let frag = compile(HEAD_FRAG, shaderc::ShaderKind::Fragment, "head.frag")?;
-    // SAFETY: SPIR-V from shaderc; modules destroyed below.
-    let modules = unsafe {
-        [
-            device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&vert), None)?,
-            device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&frag), None)?,
-        ]
-    };
     let push_range = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::VERTEX, offset: 0, size: 128 }];
     // SAFETY: valid create info; destroyed below.
     let layout = unsafe {
         device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&push_range), None)
     }?;
-    let stages = [
-        vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::VERTEX)
-            .module(modules[0])
-            .name(c"main"),
-        vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::FRAGMENT)
-            .module(modules[1])
-            .name(c"main"),
-    ];
-    let bindings =
-        [vk::VertexInputBindingDescription { binding: 0, stride: 24, input_rate: vk::VertexInputRate::VERTEX }];
-    let attributes = [
-        vk::VertexInputAttributeDescription {
-            location: 0,
-            binding: 0,
-            format: vk::Format::R32G32B32_SFLOAT,
-            offset: 0,
-        },
-        vk::VertexInputAttributeDescription {
-            location: 1,
-            binding: 0,
-            format: vk::Format::R32G32B32_SFLOAT,
-            offset: 12,
-        },
-    ];
-    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
-        .vertex_binding_descriptions(&bindings)
-        .vertex_attribute_descriptions(&attributes);
-    let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-    let viewport =
-        vk::Viewport { x: 0.0, y: 0.0, width: WIDTH as f32, height: HEIGHT as f32, min_depth: 0.0, max_depth: 1.0 };
+    let head = PipelineDesc {
+        vert: HEAD_VERT,
+        frag: HEAD_FRAG,
+        names: ("head.vert", "head.frag"),
+        vertex_input: vk::PipelineVertexInputStateCreateInfo::default()
+            .vertex_binding_descriptions(&MESH_VERTEX_BINDINGS)
+            .vertex_attribute_descriptions(&MESH_VERTEX_ATTRIBUTES),
+        cull: vk::CullModeFlags::BACK,
+        colors: &[COLOR],
+        depth: Some(DEPTH),
+        viewport: Some(vk::Extent2D { width: WIDTH, height: HEIGHT }),
+    };
+    let pipeline = graphics_pipeline(device, layout, &head)?;
     let scissor = vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: WIDTH, height: HEIGHT } };
-    let viewports = [viewport];
-    let scissors = [scissor];
-    let viewport_state = vk::PipelineViewportStateCreateInfo::default().viewports(&viewports).scissors(&scissors);
-    let raster = vk::PipelineRasterizationStateCreateInfo::default()
-        .polygon_mode(vk::PolygonMode::FILL)
-        .cull_mode(vk::CullModeFlags::BACK)
-        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
-        .line_width(1.0);
-    let multisample =
-        vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
-    let depth_state = vk::PipelineDepthStencilStateCreateInfo::default()
-        .depth_test_enable(true)
-        .depth_write_enable(true)
-        .depth_compare_op(vk::CompareOp::LESS);
-    let blend_attachments =
-        [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
-    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
-    let formats = [COLOR];
-    let mut rendering_info =
-        vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats).depth_attachment_format(DEPTH);
-    let pipeline_info = vk::GraphicsPipelineCreateInfo::default()
-        .stages(&stages)
-        .vertex_input_state(&vertex_input)
-        .input_assembly_state(&assembly)
-        .viewport_state(&viewport_state)
-        .rasterization_state(&raster)
-        .multisample_state(&multisample)
-        .depth_stencil_state(&depth_state)
-        .color_blend_state(&blend)
-        .layout(layout)
-        .push_next(&mut rendering_info);
-    // SAFETY: every pointer refers to locals alive for the call.
-    let pipeline = unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[pipeline_info], None) }
-        .map_err(|(_, e)| e)?[0];
 
     // SAFETY: valid create infos; destroyed below.
     let pool = unsafe {
@@ -475,7 +416,6 @@ fn frames_with(
         device.destroy_command_pool(pool, None);
         device.destroy_pipeline(pipeline, None);
         device.destroy_pipeline_layout(layout, None);
-        modules.iter().for_each(|m| device.destroy_shader_module(*m, None));
         device.destroy_image_view(color_view, None);
         device.destroy_image_view(depth_view, None);
         device.destroy_image(color, None);

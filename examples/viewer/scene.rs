@@ -11,7 +11,9 @@ use gpu_allocator::MemoryLocation;
 use vkhair::groom::mesh::TriMesh;
 use vkhair::{ash, gpu_allocator};
 
-use crate::host::{allocate, compile, BoxError, Memory};
+use crate::host::{
+    allocate, graphics_pipeline, BoxError, Memory, PipelineDesc, MESH_VERTEX_ATTRIBUTES, MESH_VERTEX_BINDINGS,
+};
 use crate::swapchain::DEPTH;
 
 const VERT: &str = r#"#version 460
@@ -109,14 +111,7 @@ impl HostScene {
         body: Option<(vk::Buffer, u32)>,
     ) {
         let d = &self.device;
-        let viewport = vk::Viewport {
-            x: 0.0,
-            y: 0.0,
-            width: extent.width as f32,
-            height: extent.height as f32,
-            min_depth: 0.0,
-            max_depth: 1.0,
-        };
+        let viewport = crate::host::full_viewport(extent);
         // SAFETY: guaranteed by the caller; every object here is alive.
         unsafe {
             d.cmd_set_viewport(cmd, 0, &[viewport]);
@@ -176,85 +171,23 @@ impl HostScene {
 
 /// The mesh pipeline for `color_format` and [`DEPTH`].
 fn pipeline(device: &ash::Device, color_format: vk::Format) -> Result<(vk::Pipeline, vk::PipelineLayout), BoxError> {
-    let vert = compile(VERT, shaderc::ShaderKind::Vertex, "scene.vert")?;
-    let frag = compile(FRAG, shaderc::ShaderKind::Fragment, "scene.frag")?;
-    // SAFETY: SPIR-V from shaderc; destroyed below once the pipeline exists.
-    let modules = unsafe {
-        [
-            device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&vert), None)?,
-            device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&frag), None)?,
-        ]
-    };
     let stages_flags = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
     let push = [vk::PushConstantRange { stage_flags: stages_flags, offset: 0, size: 80 }];
     // SAFETY: valid create info; destroyed by `HostScene::destroy`.
     let layout = unsafe {
         device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&push), None)
     }?;
-    let stages = [
-        vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::VERTEX)
-            .module(modules[0])
-            .name(c"main"),
-        vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::FRAGMENT)
-            .module(modules[1])
-            .name(c"main"),
-    ];
-    let bindings =
-        [vk::VertexInputBindingDescription { binding: 0, stride: 24, input_rate: vk::VertexInputRate::VERTEX }];
-    let attributes = [
-        vk::VertexInputAttributeDescription {
-            location: 0,
-            binding: 0,
-            format: vk::Format::R32G32B32_SFLOAT,
-            offset: 0,
-        },
-        vk::VertexInputAttributeDescription {
-            location: 1,
-            binding: 0,
-            format: vk::Format::R32G32B32_SFLOAT,
-            offset: 12,
-        },
-    ];
-    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
-        .vertex_binding_descriptions(&bindings)
-        .vertex_attribute_descriptions(&attributes);
-    let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-    let viewport_state = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
-    let raster = vk::PipelineRasterizationStateCreateInfo::default()
-        .polygon_mode(vk::PolygonMode::FILL)
-        .cull_mode(vk::CullModeFlags::NONE)
-        .line_width(1.0);
-    let multisample =
-        vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
-    let depth_state = vk::PipelineDepthStencilStateCreateInfo::default()
-        .depth_test_enable(true)
-        .depth_write_enable(true)
-        .depth_compare_op(vk::CompareOp::LESS);
-    let blend_attachments =
-        [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
-    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
-    let dynamic = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
-    let dynamic_state = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
-    let formats = [color_format];
-    let mut rendering =
-        vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats).depth_attachment_format(DEPTH);
-    let info = vk::GraphicsPipelineCreateInfo::default()
-        .stages(&stages)
-        .vertex_input_state(&vertex_input)
-        .input_assembly_state(&assembly)
-        .viewport_state(&viewport_state)
-        .rasterization_state(&raster)
-        .multisample_state(&multisample)
-        .depth_stencil_state(&depth_state)
-        .color_blend_state(&blend)
-        .dynamic_state(&dynamic_state)
-        .layout(layout)
-        .push_next(&mut rendering);
-    // SAFETY: every pointer refers to locals alive for the call.
-    let created = unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
-    // SAFETY: the modules are no longer needed once the pipeline exists (or failed).
-    unsafe { modules.iter().for_each(|m| device.destroy_shader_module(*m, None)) };
-    Ok((created.map_err(|(_, e)| e)?[0], layout))
+    let desc = PipelineDesc {
+        vert: VERT,
+        frag: FRAG,
+        names: ("scene.vert", "scene.frag"),
+        vertex_input: vk::PipelineVertexInputStateCreateInfo::default()
+            .vertex_binding_descriptions(&MESH_VERTEX_BINDINGS)
+            .vertex_attribute_descriptions(&MESH_VERTEX_ATTRIBUTES),
+        cull: vk::CullModeFlags::NONE,
+        colors: &[color_format],
+        depth: Some(DEPTH),
+        viewport: None,
+    };
+    Ok((graphics_pipeline(device, layout, &desc)?, layout))
 }

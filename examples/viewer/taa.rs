@@ -24,7 +24,7 @@ use gpu_allocator::MemoryLocation;
 use vkhair::render::Camera;
 use vkhair::{ash, gpu_allocator};
 
-use crate::host::{allocate, compile, transition, BoxError, Memory};
+use crate::host::{allocate, graphics_pipeline, transition, BoxError, Memory, PipelineDesc};
 use crate::swapchain::range;
 
 /// What the host's velocity image holds where the hair wrote no motion
@@ -402,14 +402,7 @@ impl Taa {
         });
         let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: images.extent };
         let rendering = vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&attachments);
-        let viewport = vk::Viewport {
-            x: 0.0,
-            y: 0.0,
-            width: images.extent.width as f32,
-            height: images.extent.height as f32,
-            min_depth: 0.0,
-            max_depth: 1.0,
-        };
+        let viewport = crate::host::full_viewport(images.extent);
         // SAFETY: guaranteed by the caller; every object is alive.
         unsafe {
             d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&barriers));
@@ -458,55 +451,15 @@ impl Taa {
 
 /// The resolve's pipeline: one triangle, into the swapchain's format and the history's.
 fn pipeline(device: &ash::Device, layout: vk::PipelineLayout, format: vk::Format) -> Result<vk::Pipeline, BoxError> {
-    let vert = compile(VERT, shaderc::ShaderKind::Vertex, "taa.vert")?;
-    let frag = compile(FRAG, shaderc::ShaderKind::Fragment, "taa.frag")?;
-    // SAFETY: SPIR-V from shaderc; destroyed below once the pipeline exists.
-    let modules = unsafe {
-        [
-            device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&vert), None)?,
-            device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&frag), None)?,
-        ]
+    let desc = PipelineDesc {
+        vert: VERT,
+        frag: FRAG,
+        names: ("taa.vert", "taa.frag"),
+        vertex_input: vk::PipelineVertexInputStateCreateInfo::default(),
+        cull: vk::CullModeFlags::NONE,
+        colors: &[format, HISTORY],
+        depth: None,
+        viewport: None,
     };
-    let stages = [
-        vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::VERTEX)
-            .module(modules[0])
-            .name(c"main"),
-        vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::FRAGMENT)
-            .module(modules[1])
-            .name(c"main"),
-    ];
-    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
-    let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-    let viewport_state = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
-    let raster = vk::PipelineRasterizationStateCreateInfo::default()
-        .polygon_mode(vk::PolygonMode::FILL)
-        .cull_mode(vk::CullModeFlags::NONE)
-        .line_width(1.0);
-    let multisample =
-        vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
-    let blend_attachments =
-        [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA); 2];
-    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
-    let dynamic = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
-    let dynamic_state = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
-    let formats = [format, HISTORY];
-    let mut rendering = vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats);
-    let info = vk::GraphicsPipelineCreateInfo::default()
-        .stages(&stages)
-        .vertex_input_state(&vertex_input)
-        .input_assembly_state(&assembly)
-        .viewport_state(&viewport_state)
-        .rasterization_state(&raster)
-        .multisample_state(&multisample)
-        .color_blend_state(&blend)
-        .dynamic_state(&dynamic_state)
-        .layout(layout)
-        .push_next(&mut rendering);
-    // SAFETY: every pointer refers to locals alive for the call.
-    let created = unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
-    // SAFETY: the modules are no longer needed once the pipeline exists (or failed).
-    unsafe { modules.iter().for_each(|m| device.destroy_shader_module(*m, None)) };
-    Ok(created.map_err(|(_, e)| e)?[0])
+    graphics_pipeline(device, layout, &desc)
 }
