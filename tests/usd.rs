@@ -741,4 +741,16 @@ fn a_prim_of_too_many_properties_is_refused_before_it_is_parsed() {
     std::fs::write(&path, &text).expect("write");
     let read = usd::open(&path).expect("child prims are not properties");
     assert_eq!(read.groom.strand_count(), 1);
+    // A binary layer of one property too many (written by the USD library's
+    // writer from text): refused once the library has read its structure.
+    let mut text = format!("#usda 1.0\ndef BasisCurves \"c\" {{\n{curves}");
+    for k in 0..MAX_USD_PROPERTIES - 2 {
+        text.push_str(&format!("    float a{k} = 1\n"));
+    }
+    text.push_str("}\n");
+    let data = openusd::usda::parse(&text).expect("text");
+    let binary = dir.path().join("attributes.usdc");
+    openusd::usdc::CrateWriter::write_to_file(&data, &binary).expect("binary");
+    let e = usd::open(&binary).expect_err("one property too many").to_string();
+    assert!(e.contains("attributes.usdc") && e.contains("its prim /c declares more than 10000 properties"), "{e}");
 }
