@@ -246,8 +246,11 @@ fn refused_naming(dir: &Path, cases: &[(&str, &[&str])]) {
 /// Every layer a stage's text layers name is checked before the USD library
 /// opens any: a sublayer that is there loads; a missing one, a FIFO in a
 /// referenced layer's place (which the library would block on forever) and a
-/// sublayer with a cycle of its own are errors naming the layer, and the root
-/// layer and line that named it — never a stage read without them.
+/// sublayer with a cycle of its own, and a reference without a prim path to
+/// a layer of sublayers that names no default prim of its own, are errors
+/// naming the layer, and the root layer and line that named it — never a
+/// stage read without them; a default prim the layer names and a sublayer
+/// holds reads.
 #[test]
 fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -265,9 +268,23 @@ fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
     write("fifo.usda", &format!("#usda 1.0\ndef Xform \"x\" (\n    references = @pipe.usda@</x>\n) {{ }}\n{curves}"));
     write("cyclic.usda", &format!("#usda 1.0\nclass \"A\" (\n    inherits = </A>\n) {{ }}\n{curves}"));
     write("names_cyclic.usda", "#usda 1.0\n(\n    subLayers = [@cyclic.usda@]\n)\n");
+    // A layer of sublayers that names no default prim of its own (the one its
+    // sublayer names does not count), taken by a reference without a prim path.
+    write("defaulted.usda", &format!("#usda 1.0\n(\n    defaultPrim = \"c\"\n)\n{curves}"));
+    write("no_default_over.usda", "#usda 1.0\n(\n    subLayers = [@defaulted.usda@]\n)\n");
+    write("refs_no_default.usda", "#usda 1.0\ndef \"x\" (\n    references = @no_default_over.usda@\n) { }\n");
+    // With its own default prim, found in its sublayer: read.
+    write("default_over.usda", "#usda 1.0\n(\n    defaultPrim = \"c\"\n    subLayers = [@defaulted.usda@]\n)\n");
+    write("refs_default.usda", "#usda 1.0\ndef \"x\" (\n    references = @default_over.usda@\n) { }\n");
+    let g = usd::open(dir.path().join("refs_default.usda")).expect("a default prim from a sublayer");
+    assert_eq!(g.groom.strand_count(), 1);
     refused_naming(
         dir.path(),
         &[
+            (
+                "refs_no_default.usda",
+                &["refs_no_default.usda", "line 3", "no_default_over.usda", "names no default prim"][..],
+            ),
             ("missing.usda", &["missing.usda", "line 3", "gone.usda"][..]),
             ("fifo.usda", &["fifo.usda", "line 3", "pipe.usda", "not a regular file"][..]),
             ("names_cyclic.usda", &["names_cyclic.usda", "line 3", "cyclic.usda", "line 3, column 5", "itself"][..]),

@@ -39,6 +39,13 @@ impl Targets {
             Takes::Prim(p) if !p.starts_with('/') => {
                 Some(format!("a reference or payload takes its prim <{p}>, a relative path (it must be absolute)"))
             }
+            // The prim a default names may come from a sublayer, but the name
+            // is this layer's own metadata (a sublayer's does not stand in).
+            Takes::DefaultPrim if self.sublayers && self.default.is_none() => Some(
+                "it names no default prim (its sublayers' do not count), and a reference or payload without a \
+                 prim path takes it"
+                    .into(),
+            ),
             _ if self.sublayers => None,
             // A malformed path is the library's to judge.
             Takes::Prim(p) if SdfPath::new(p).is_err() => None,
