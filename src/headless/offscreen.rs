@@ -157,22 +157,7 @@ impl Offscreen {
         let mut bytes = Vec::new();
         let layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
         self.device.readback_image_via(&v.image, layout, &v.readback, &mut bytes)?;
-        Ok(match v.format {
-            vk::Format::R16G16_SFLOAT => bytes
-                .chunks_exact(4)
-                .map(|t| {
-                    let c = |i: usize| half::f16::from_le_bytes([t[2 * i], t[2 * i + 1]]).to_f32();
-                    glam::Vec2::new(c(0), c(1))
-                })
-                .collect(),
-            _ => bytes
-                .chunks_exact(8)
-                .map(|t| {
-                    let c = |i: usize| f32::from_le_bytes([t[4 * i], t[4 * i + 1], t[4 * i + 2], t[4 * i + 3]]);
-                    glam::Vec2::new(c(0), c(1))
-                })
-                .collect(),
-        })
+        Ok(super::texels::decode_velocity(v.format, &bytes))
     }
 
     /// Makes the buffer [`Offscreen::record_snapshot`] copies into (as large

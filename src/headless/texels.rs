@@ -28,17 +28,33 @@ fn small_float(bits: u32, mantissa_bits: u32) -> f32 {
     }
 }
 
+/// Half float `i` of texel `t`.
+fn half(t: &[u8], i: usize) -> f32 {
+    half::f16::from_le_bytes([t[2 * i], t[2 * i + 1]]).to_f32()
+}
+
+/// The texels of `bytes`, tightly packed rows of a velocity format (one of
+/// `render::VELOCITY_FORMATS`), as two floats each.
+pub(super) fn decode_velocity(format: vk::Format, bytes: &[u8]) -> Vec<glam::Vec2> {
+    match format {
+        vk::Format::R16G16_SFLOAT => bytes.chunks_exact(4).map(|t| glam::Vec2::new(half(t, 0), half(t, 1))).collect(),
+        _ => bytes
+            .chunks_exact(8)
+            .map(|t| {
+                let c = |i: usize| f32::from_le_bytes([t[4 * i], t[4 * i + 1], t[4 * i + 2], t[4 * i + 3]]);
+                glam::Vec2::new(c(0), c(1))
+            })
+            .collect(),
+    }
+}
+
 /// The texels of `bytes`, tightly packed rows of `format` (one of
 /// `OFFSCREEN_COLOR_FORMATS`), as linear RGBA.
 pub(super) fn decode(format: vk::Format, bytes: &[u8]) -> Vec<Vec4> {
     match format {
-        vk::Format::R16G16B16A16_SFLOAT => bytes
-            .chunks_exact(8)
-            .map(|t| {
-                let c = |i: usize| half::f16::from_le_bytes([t[2 * i], t[2 * i + 1]]).to_f32();
-                Vec4::new(c(0), c(1), c(2), c(3))
-            })
-            .collect(),
+        vk::Format::R16G16B16A16_SFLOAT => {
+            bytes.chunks_exact(8).map(|t| Vec4::new(half(t, 0), half(t, 1), half(t, 2), half(t, 3))).collect()
+        }
         vk::Format::B10G11R11_UFLOAT_PACK32 => bytes
             .chunks_exact(4)
             .map(|t| {
