@@ -137,12 +137,12 @@ fn binary(path: &Path) -> std::result::Result<(Vec<(String, Takes)>, Targets), S
         let typed: Vec<(SdfPath, SpecType)> =
             data.spec_paths().into_iter().filter_map(|p| data.spec_type(&p).map(|t| (p, t))).collect();
         most_properties(typed.iter().map(|(p, t)| (p, *t)))?;
-        for spec in data.spec_paths() {
-            if data.spec_type(&spec) == Some(SpecType::Prim) {
+        for (spec, ty) in &typed {
+            if *ty == SpecType::Prim {
                 prims.insert(spec.as_str().to_owned());
             }
             for field in ["references", "payload"] {
-                let Ok(Some(v)) = data.try_field(&spec, field) else { continue };
+                let Ok(Some(v)) = data.try_field(spec, field) else { continue };
                 match v.as_ref() {
                     Value::ReferenceListOp(op) => named.extend(
                         [&op.explicit_items, &op.added_items, &op.prepended_items, &op.appended_items]

@@ -150,8 +150,8 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
         Ok(value)
     }
 
-    /// A compressed block (its size, then its bytes): its size.
-    fn block(&mut self) -> Result<u64> {
+    /// A compressed block (its size, then its bytes): its bytes.
+    fn block(&mut self) -> Result<Vec<u8>> {
         let size = self.u64("a compressed block's size")?;
         if size > self.end - self.at {
             return Err(self.refuse(format!(
@@ -159,21 +159,19 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
                 self.at, self.end
             )));
         }
+        let bytes = (self.read_at)(self.at, size as usize)?;
         self.at += size;
-        Ok(size)
+        Ok(bytes)
     }
 
-    /// A compressed block's bytes, decompressed into at most `room` bytes.
-    fn decompressed(&mut self, room: u64) -> Result<Vec<u8>> {
-        let start = self.at + 8;
-        let size = self.block()?;
-        let bytes = (self.read_at)(start, size as usize)?;
-        super::usdc_blocks::decompress(&bytes, room, &format!("its section {:?}", self.name))
+    /// A compressed `block`, decompressed into at most `room` bytes.
+    fn decompressed(&self, block: &[u8], room: u64) -> Result<Vec<u8>> {
+        super::usdc_blocks::decompress(block, room, &format!("its section {:?}", self.name))
     }
 
-    /// A block of `count` 32-bit integers in the crate's coding, decoded.
-    fn ints(&mut self, count: u64) -> Result<Vec<i32>> {
-        let data = self.decompressed(super::usdc_blocks::encoded_room(count, 4))?;
+    /// A `block` of `count` 32-bit integers in the crate's coding, decoded.
+    fn ints(&self, block: &[u8], count: u64) -> Result<Vec<i32>> {
+        let data = self.decompressed(block, super::usdc_blocks::encoded_room(count, 4))?;
         super::usdc_blocks::decode_ints(&data, count, &format!("its section {:?}", self.name))
     }
 
@@ -193,11 +191,9 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
             "TOKENS" => {
                 let count = self.u64("the token count")?;
                 let decoded = self.u64("the tokens' decoded size")?;
-                let at = self.at;
-                let bytes = self.block()?;
-                self.bound(decoded, "bytes of tokens", bytes)?;
-                self.at = at;
-                self.decompressed(decoded)?;
+                let block = self.block()?;
+                self.bound(decoded, "bytes of tokens", block.len() as u64)?;
+                self.decompressed(&block, decoded)?;
                 if count > decoded {
                     return Err(self.refuse(format!("{count} tokens in {decoded} bytes")));
                 }
@@ -212,12 +208,10 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
             }
             "FIELDS" => {
                 let count = self.u64("the field count")?;
-                let at = self.at;
                 let (indices, reps) = (self.block()?, self.block()?);
-                self.bound(count, "fields", indices.min(reps))?;
-                self.at = at;
-                self.ints(count)?;
-                let reps = self.decompressed(count.saturating_mul(8))?;
+                self.bound(count, "fields", indices.len().min(reps.len()) as u64)?;
+                self.ints(&indices, count)?;
+                let reps = self.decompressed(&reps, count.saturating_mul(8))?;
                 if (reps.len() as u64) < count * 8 {
                     return Err(
                         self.refuse(format!("{} bytes of value representations for {count} fields", reps.len()))
@@ -226,32 +220,27 @@ impl<F: FnMut(u64, usize) -> Result<Vec<u8>>> Section<'_, F> {
             }
             "FIELDSETS" => {
                 let count = self.u64("the field set count")?;
-                let at = self.at;
-                let bytes = self.block()?;
-                self.bound(count, "field set entries", bytes)?;
-                self.at = at;
-                self.ints(count)?;
+                let block = self.block()?;
+                self.bound(count, "field set entries", block.len() as u64)?;
+                self.ints(&block, count)?;
             }
             "PATHS" => {
                 let paths = self.u64("the path count")?;
                 let encoded = self.u64("the encoded path count")?;
-                let at = self.at;
-                let bytes = [self.block()?, self.block()?, self.block()?];
-                let least = bytes.into_iter().min().unwrap_or(0);
+                let blocks = [self.block()?, self.block()?, self.block()?];
+                let least = blocks.iter().map(Vec::len).min().unwrap_or(0) as u64;
                 self.bound(paths, "paths", least)?;
                 self.bound(encoded, "encoded paths", least)?;
-                self.at = at;
-                let arrays = [self.ints(encoded)?, self.ints(encoded)?, self.ints(encoded)?];
+                let [indexes, tokens, jumps] = &blocks;
+                let arrays = [self.ints(indexes, encoded)?, self.ints(tokens, encoded)?, self.ints(jumps, encoded)?];
                 super::usdc_blocks::check_paths((&arrays[0], &arrays[1], &arrays[2]), paths, self.tokens)?;
             }
             "SPECS" => {
                 let count = self.u64("the spec count")?;
-                let at = self.at;
-                let bytes = [self.block()?, self.block()?, self.block()?];
-                self.bound(count, "specs", bytes.into_iter().min().unwrap_or(0))?;
-                self.at = at;
-                for _ in 0..3 {
-                    self.ints(count)?;
+                let blocks = [self.block()?, self.block()?, self.block()?];
+                self.bound(count, "specs", blocks.iter().map(Vec::len).min().unwrap_or(0) as u64)?;
+                for block in &blocks {
+                    self.ints(block, count)?;
                 }
             }
             _ => {}

@@ -50,58 +50,26 @@ fn bad_name(field: &str, name: &str) -> Option<&'static str> {
 const TOKEN_VECTOR: u64 = 41;
 const TOKEN: u64 = 11;
 
-/// Why value representation `rep` of a crate file of `version` cannot be read
-/// as a list of tokens from a table of `tokens`, if it cannot: not a token
-/// vector or token array stored out of line, a count the file cannot hold, or
-/// an item past the table (the crate indexes its table with each unchecked).
-fn bad_token_list(
-    file: &mut std::fs::File,
-    (rep, version): (u64, (u8, u8, u8)),
-    tokens: usize,
-) -> std::result::Result<Option<String>, String> {
-    use std::io::{Read, Seek, SeekFrom};
+/// Why value representation `rep` cannot be read as a list of tokens, if it
+/// cannot: not a token vector or token array, or one inlined. Its count and
+/// every token it lists were checked against the file and the table by
+/// [`super::usdc_values::check`], which runs first.
+fn not_a_token_list(rep: u64) -> Option<String> {
     let (ty, array, inlined) = ((rep >> 48) & 0xFF, rep & (1 << 63) != 0, rep & (1 << 62) != 0);
-    let at = rep & ((1 << 48) - 1);
-    // Where the count lies and how wide it is: a vector's is 8 bytes; an
-    // array's 8 from crate 0.7.0 (4 before), after 4 bytes of shape before 0.5.0.
-    let (skip, wide) = match (ty, array) {
-        (TOKEN_VECTOR, _) => (0, true),
-        (TOKEN, true) if at == 0 => return Ok(None),
-        (TOKEN, true) => (if version < (0, 5, 0) { 4 } else { 0 }, version >= (0, 7, 0)),
-        _ => return Ok(Some(format!("is not a list of tokens (value type {ty})"))),
-    };
-    if inlined {
-        return Ok(Some(format!("is not a list of tokens stored out of line (value type {ty})")));
+    match (ty, array) {
+        (TOKEN_VECTOR, _) | (TOKEN, true) if inlined => {
+            Some(format!("is not a list of tokens stored out of line (value type {ty})"))
+        }
+        (TOKEN_VECTOR, _) | (TOKEN, true) => None,
+        _ => Some(format!("is not a list of tokens (value type {ty})")),
     }
-    let len = file.metadata().map_err(|e| format!("{e}"))?.len();
-    let width = if wide { 8 } else { 4 };
-    let items_at = at.saturating_add(skip).saturating_add(width);
-    if items_at > len {
-        return Ok(Some(format!("starts at byte {at}, past the file's end ({len} bytes)")));
-    }
-    let mut word = [0u8; 8];
-    file.seek(SeekFrom::Start(at + skip))
-        .and_then(|_| file.read_exact(&mut word[..width as usize]))
-        .map_err(|e| format!("{e}"))?;
-    let count = u64::from_le_bytes(word);
-    if count > (len - items_at) / 4 {
-        return Ok(Some(format!("counts {count} tokens, more than the file holds")));
-    }
-    let mut items = vec![0u8; (count * 4) as usize];
-    file.read_exact(&mut items).map_err(|e| format!("{e}"))?;
-    let past = items
-        .chunks_exact(4)
-        .map(|b| u64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])))
-        .find(|&index| index >= tokens as u64);
-    Ok(past.map(|index| format!("lists token {index} of {tokens}")))
 }
 
-/// Checks the children lists of the crate file at `path`, of crate `version`.
-pub fn check(path: &Path, version: (u8, u8, u8)) -> Result<()> {
+/// Checks the children lists of the crate file at `path`.
+pub fn check(path: &Path) -> Result<()> {
     let found = crate::files::read_guarded(|| -> std::result::Result<Option<String>, String> {
         let file = std::fs::File::open(path).map_err(|e| format!("{e}"))?;
         let mut layer = openusd::usdc::CrateFile::open(std::io::BufReader::new(file)).map_err(|e| format!("{e:#}"))?;
-        let mut raw = std::fs::File::open(path).map_err(|e| format!("{e}"))?;
         let known: HashSet<String> = layer.paths.iter().map(|p| p.as_str().to_owned()).collect();
         let (specs, fieldsets, fields) = (layer.specs.clone(), layer.fieldsets.clone(), layer.fields.clone());
         for spec in &specs {
@@ -112,7 +80,7 @@ pub fn check(path: &Path, version: (u8, u8, u8)) -> Result<()> {
                 if name != "primChildren" && name != "propertyChildren" {
                     continue;
                 }
-                if let Some(why) = bad_token_list(&mut raw, (field.value_rep.0, version), layer.tokens.len())? {
+                if let Some(why) = not_a_token_list(field.value_rep.0) {
                     return Ok(Some(format!("{parent}'s {name} {why}")));
                 }
                 let children = match layer.value(field.value_rep).map_err(|e| format!("{e:#}"))? {

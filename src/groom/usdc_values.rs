@@ -235,7 +235,7 @@ pub fn check(path: &Path, len: u64, version: (u8, u8, u8)) -> Result<()> {
     for (field, rep) in reps.into_iter().map(ValueRep).enumerate() {
         check_indices(field, rep, &tables, version, &mut read_at)?;
     }
-    super::usdc_children::check(path, version)
+    super::usdc_children::check(path)
 }
 
 /// The sizes of the tables a value's indices point into.
