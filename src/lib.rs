@@ -12,6 +12,8 @@
 //!   images, staging, barriers, reflection, pipelines, debug names and labels.
 //! - [`render`]: drawing hair from the simulated key hairs ([`render::Renderer`]).
 //! - [`sim`]: the GPU simulation ([`sim::HairSim`]) and its CPU reference.
+//! - [`crowd`]: many characters' key hairs in one simulation, drawn by one
+//!   renderer ([`crowd::Crowd`]).
 //! - [`schedule`]: where the simulation runs — in order on one queue, on an async
 //!   compute queue, or on a second device with a worker thread — and the per-frame
 //!   hand-off to rendering ([`schedule::FrameScheduler`]).
@@ -82,6 +84,7 @@ pub mod character;
 pub(crate) mod codes;
 pub mod config;
 mod context;
+pub mod crowd;
 mod error;
 pub mod files;
 pub(crate) mod gpu_types;

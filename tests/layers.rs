@@ -14,7 +14,7 @@ const LAYERS: &[&[&str]] = &[
     &["context"],
     &["profiler"],
     &["sim"],
-    &["render", "character"],
+    &["render", "character", "crowd"],
     &["schedule", "config"],
     &["headless"],
 ];

@@ -12,6 +12,8 @@ mod body;
 mod common;
 #[path = "context.rs"]
 mod context;
+#[path = "crowd.rs"]
+mod crowd;
 #[path = "embed_example.rs"]
 mod embed_example;
 #[path = "followers.rs"]

@@ -413,9 +413,7 @@ impl Renderer {
         if sim.bound_buffers() != self.source {
             return Err(Error::incompatible("key hairs", "they are not the ones this renderer was created for"));
         }
-        let head = sim.head;
-        self.placement.head_rotation = head.rotation.normalize();
-        self.placement.head_center = head.matrix().transform_point3(self.placement.rest_center);
+        self.placement.update(&sim);
         let distance = camera.map_or(0.0, |c| (c.position() - self.placement.head_center).length());
         self.detail = self.params.detail_at(distance);
         if let Some(f) = self.followers {

@@ -51,10 +51,14 @@ pub(super) struct Placement {
     /// Centre of the rest shape's bounds, head frame.
     pub(super) rest_center: Vec3,
     /// Radius around `rest_center` that the hair can reach (roots plus strand length).
+    pub(super) rest_radius: f32,
+    /// Radius around `head_center` of the latest prepared frame: `rest_radius`,
+    /// or the key hairs' own bounds ([`crate::sim::KeyHairs::with_bounds`]).
     pub(super) bound_radius: f32,
     /// Head rotation of the latest prepared frame.
     pub(super) head_rotation: Quat,
-    /// `rest_center` in the world at the latest prepared frame.
+    /// `rest_center` in the world at the latest prepared frame, or the centre
+    /// of the key hairs' own bounds.
     pub(super) head_center: Vec3,
 }
 
@@ -67,6 +71,17 @@ impl Placement {
         let bound_radius = (0..rest.strands)
             .map(|s| (rest.rest[s * rest.points].truncate() - rest_center).length() + rest.rest_strand_length(s))
             .fold(0.0f32, f32::max);
-        Placement { rest_center, bound_radius, head_rotation, head_center: rest_center }
+        Placement { rest_center, rest_radius: bound_radius, bound_radius, head_rotation, head_center: rest_center }
+    }
+
+    /// Places the hair for a frame of `sim`: by its own bounds when it has
+    /// them, else the rest bounds moved by its head.
+    pub(super) fn update(&mut self, sim: &crate::sim::KeyHairs<'_>) {
+        let head = sim.head();
+        self.head_rotation = head.rotation.normalize();
+        (self.head_center, self.bound_radius) = match sim.bounds() {
+            Some(bounds) => bounds,
+            None => (head.matrix().transform_point3(self.rest_center), self.rest_radius),
+        };
     }
 }

@@ -173,6 +173,7 @@ impl Mirror {
             alpha: 1.0,
             head: self.meta.head,
             volume: self.meta.grid.zip(self.density.as_ref()),
+            bounds: None,
         }
     }
 

@@ -459,6 +459,7 @@ impl HairSim {
             alpha: 1.0,
             head: self.planner.head,
             volume: self.volume.as_ref().map(|v| (v.grid.describe(&self.planner.head.matrix()), &v.buffers.cells)),
+            bounds: None,
         }
     }
 

@@ -229,6 +229,23 @@ impl ScalpBinding {
         })
     }
 
+    /// The bindings of consecutive runs of key hairs, each to its own scalp,
+    /// as one: the scalps' vertices laid one after another in the order given,
+    /// each part's corners shifted past the vertices of the parts before it.
+    pub(crate) fn concat(parts: Vec<ScalpBinding>) -> ScalpBinding {
+        let mut joined = ScalpBinding { roots: Vec::new(), views: Vec::new(), vertices: 0 };
+        for part in parts {
+            let base = joined.vertices as u32;
+            for mut view in part.views {
+                view.corners = view.corners.map(|c| c + base);
+                joined.roots.push(GpuScalpRoot::from(&view));
+                joined.views.push(view);
+            }
+            joined.vertices += part.vertices;
+        }
+        joined
+    }
+
     /// Key hair `h`'s triangle corners in `vertices`.
     pub(crate) fn corners(&self, h: usize, vertices: &[Vec3]) -> [Vec3; 3] {
         self.views[h].corners.map(|v| vertices[v as usize])

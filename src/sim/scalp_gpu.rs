@@ -87,13 +87,36 @@ impl HairSim {
     /// Uploads and waits.
     pub fn bind_scalp_bones(&mut self, scalp: &Scalp, bones: &[Mat4]) -> Result<()> {
         let binding = ScalpBinding::new(scalp, &self.shape.rest_roots())?;
+        self.bind_scalp_bones_as(scalp, binding, bones, false)
+    }
+
+    /// [`HairSim::bind_scalp_bones`] with the roots already bound (one
+    /// binding per key hair, corners among `scalp`'s vertices). `continuous`:
+    /// the next step moves the roots from the scalp as `bones` place it (the
+    /// state is already there), not from its own end.
+    pub(crate) fn bind_scalp_bones_as(
+        &mut self,
+        scalp: &Scalp,
+        binding: ScalpBinding,
+        bones: &[Mat4],
+        continuous: bool,
+    ) -> Result<()> {
+        if binding.views.len() != self.shape.strands || binding.vertices != scalp.mesh.positions.len() {
+            return Err(Error::incompatible("scalp binding", "it binds other key hairs or another scalp"));
+        }
         if scalp.skin.is_empty() {
             return Err(Error::incompatible("scalp bones", "the scalp has no vertex bones (Scalp::skin)"));
         }
-        let vertices = as_vec4(&scalp.skin(bones)?);
+        let skinned = scalp.skin(bones)?;
+        let corners: Vec<Vec4> =
+            (0..binding.views.len()).flat_map(|h| binding.corners(h, &skinned).map(|c| c.extend(0.0))).collect();
+        let vertices = as_vec4(&skinned);
         let source = VertexSource::Bones { scalp: scalp.clone(), pending: None };
         self.install_scalp(GpuScalp { binding, source }, Some(&vertices))?;
-        self.planner.scalp = Some(ScalpLanes { first: 0, stride: 4, restart: true });
+        if continuous {
+            self.device.upload_pod(&self.gpu.scalp_previous, &corners)?;
+        }
+        self.planner.scalp = Some(ScalpLanes { first: 0, stride: 4, restart: !continuous });
         self.prepare_step()
     }
 

@@ -63,6 +63,10 @@ pub struct KeyHairs<'a> {
     pub(crate) head: RigidTransform,
     /// The volume grid and the density buffer (one vec4 per cell), when present.
     pub(crate) volume: Option<(VolumeGrid, &'a Buffer)>,
+    /// A sphere (world centre, radius) holding every key hair, when the source
+    /// knows one better than the rest shape placed by the head
+    /// ([`KeyHairs::with_bounds`]).
+    pub(crate) bounds: Option<(glam::Vec3, f32)>,
 }
 
 impl std::fmt::Debug for KeyHairs<'_> {
@@ -74,6 +78,7 @@ impl std::fmt::Debug for KeyHairs<'_> {
             .field("alpha", &self.alpha)
             .field("head", &self.head)
             .field("volume", &self.volume.as_ref().map(|(g, _)| g))
+            .field("bounds", &self.bounds)
             .finish()
     }
 }
@@ -91,6 +96,29 @@ impl KeyHairs<'_> {
             return Err(crate::error::Error::param("alpha", alpha, "0..=1 (a fraction of one step)"));
         }
         Ok(KeyHairs { alpha, ..self })
+    }
+
+    /// The view with the hair known to lie within the sphere of `centre`
+    /// (world) and `radius` (meters): a renderer then fits its shadow maps to
+    /// that sphere and picks the level of detail by the camera's distance from
+    /// `centre`, instead of using the rest shape's bounds placed by the head.
+    /// For key hairs that do not ride the head rigidly (a [`crate::crowd::Crowd`]
+    /// of characters, a skinned scalp walking away from the head transform).
+    /// Refuses a centre that is not finite or a radius that is not finite and
+    /// above 0.
+    pub fn with_bounds(self, centre: glam::Vec3, radius: f32) -> crate::error::Result<Self> {
+        if !centre.is_finite() {
+            return Err(crate::error::Error::param("bounds centre", centre, "finite"));
+        }
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(crate::error::Error::param("bounds radius", radius, "finite and above 0 (meters)"));
+        }
+        Ok(KeyHairs { bounds: Some((centre, radius)), ..self })
+    }
+
+    /// The sphere (world centre, radius) given by [`KeyHairs::with_bounds`].
+    pub fn bounds(&self) -> Option<(glam::Vec3, f32)> {
+        self.bounds
     }
 
     /// Where between the two states the view is drawn (1: the latest).

@@ -1,0 +1,343 @@
+//! Many characters in one frame: a [`Crowd`] simulates the key hairs of every
+//! member in one [`HairSim`], so that a step is the same dispatches for one
+//! character or a thousand (its cost follows the total hair), and a
+//! [`crate::render::Renderer`] made from [`Crowd::key_hairs`] draws them all
+//! through one set of per-pixel lists and one composite (two characters'
+//! overlapping hair sorts as one groom's would) with every member's hair in
+//! every light's shadow maps.
+//!
+//! How the members stay apart in one simulation:
+//!
+//! 1. **Key hairs** (`layout.rs`): each member's groom (its head frame) is
+//!    resampled to the crowd's point count (the most any member has) and
+//!    placed by its first pose's head; the members' strands follow one
+//!    another in the order given ([`Crowd::member_strands`]).
+//! 2. **Roots**: every member's roots are bound to a scalp of its own,
+//!    gathered into the simulation's skinned scalp (see [`crate::sim::scalp`]):
+//!    a member with a [`Scalp`] has its roots on the triangles of that scalp
+//!    that carry them, skinned by its bones; a member without one, on one
+//!    triangle its head transform moves rigidly. Each root is bound within its
+//!    own member, never to a neighbour's scalp, however close they stand. The
+//!    shape constraints, the rest-shape spring, the pinned roots and a reset
+//!    all follow each member's own roots.
+//! 3. **Colliders**: each member's head colliders are placed by its head and
+//!    given, with its body colliders, to the simulation as body colliders (in
+//!    the world, moving linearly across the sub-steps); together at most
+//!    [`MAX_COLLIDERS`].
+//! 4. **Bounds**: each member's hair lies within a sphere around its head
+//!    (roots' centre, the farthest root plus its strand's length); the view
+//!    [`Crowd::key_hairs`] carries the sphere around all of them
+//!    ([`crate::sim::KeyHairs::with_bounds`]), which the renderer fits its
+//!    shadow maps to and takes the level of detail's distance from.
+//!
+//! The members share the simulation's [`SimParams`] and the renderer's
+//! parameters (a crowd of other parameters is another crowd). The volume stage
+//! and the mesh collider are not available in a crowd (one grid cannot follow
+//! characters apart; the mesh collider has one head frame): [`Crowd::new`]
+//! and [`Crowd::set_params`] refuse a volume stage.
+//!
+//! ```
+//! use glam::{Quat, Vec3};
+//! use vkhair::crowd::{Crowd, Member, MemberPose};
+//! use vkhair::render::{RenderParams, Renderer};
+//! use vkhair::sim::{RigidTransform, SimParams};
+//! use vkhair::{groom, ContextOptions, GpuContext, ValidationLog};
+//!
+//! let log = ValidationLog::new();
+//! {
+//!     let ctx = GpuContext::headless(&ContextOptions::validated(&log))?;
+//!     let grow = groom::grow::GrowParams { strands: 16, points_per_strand: 6, ..Default::default() };
+//!     let head = groom::grow::grow(&groom::scenes::thesis_scalp(), &grow)?;
+//!     let members = vec![Member::rigid(head.clone()), Member::rigid(head)];
+//!     let at = |x: f32, turn: f32| MemberPose::rigid(RigidTransform {
+//!         rotation: Quat::from_rotation_y(turn),
+//!         translation: Vec3::new(x, 0.0, 0.0),
+//!     });
+//!     let mut crowd = Crowd::new(&ctx, &members, &[at(-0.5, 0.0), at(0.5, 0.0)], &SimParams::default())?;
+//!     let mut renderer = Renderer::new(&ctx, crowd.key_hairs(), &RenderParams::default())?;
+//!     // The second member turns while the first stands still: one step, one dispatch.
+//!     crowd.run(4, |i| vec![at(-0.5, 0.0), at(0.5, 0.1 * (i + 1) as f32)])?;
+//!     renderer.prepare_now(crowd.key_hairs(), None)?;
+//!     // The turned member's first root is where its head put it.
+//!     let state = crowd.sim().read_state()?;
+//!     let first = crowd.member_strands(1).start * state.points;
+//!     let expected = at(0.5, 0.4).head.matrix().transform_point3(members[1].groom.strand(0)[0]);
+//!     assert!(state.positions[first].truncate().distance(expected) < 1e-5);
+//! }
+//! log.assert_clean();
+//! # Ok::<(), vkhair::Error>(())
+//! ```
+
+mod layout;
+#[cfg(test)]
+mod tests;
+
+use std::ops::Range;
+
+use ash::vk;
+use glam::{Mat4, Vec3};
+
+use crate::context::GpuContext;
+use crate::error::{Error, Result};
+use crate::groom::Groom;
+use crate::profiler::GpuProfiler;
+use crate::sim::scalp::{frames_at, Scalp};
+use crate::sim::{Collider, HairSim, KeyHairs, RigidTransform, SimParams, SimState, VolumeMode, MAX_COLLIDERS};
+use layout::Placed;
+
+/// Members a crowd holds at most.
+pub const MAX_CROWD_MEMBERS: usize = 4096;
+
+/// One character of a crowd: its key hairs, what carries their roots and the
+/// colliders that move with its head.
+#[derive(Debug, Clone)]
+pub struct Member {
+    /// Key hairs in the member's head frame (meters), resampled to the
+    /// crowd's point count when they have fewer points.
+    pub groom: Groom,
+    /// Spheres and capsules in the head frame, moved by the member's head.
+    pub colliders: Vec<Collider>,
+    /// A skinned scalp (bind pose, head frame) whose bones
+    /// ([`MemberPose::bones`]) carry the roots, bound within
+    /// `scalp.tolerance` of its triangles; `None`: the roots ride the head.
+    pub scalp: Option<Scalp>,
+}
+
+impl Member {
+    /// A member whose roots ride its head rigidly, without colliders.
+    pub fn rigid(groom: Groom) -> Member {
+        Member { groom, colliders: Vec::new(), scalp: None }
+    }
+}
+
+/// Where a member is at the end of a step.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MemberPose {
+    /// The head transform: places the member's head colliders and, without a
+    /// scalp, carries its roots.
+    pub head: RigidTransform,
+    /// With a scalp: its bone matrices (bind pose, head frame → world), at
+    /// least one past the highest joint the scalp's skin names; else empty.
+    pub bones: Vec<Mat4>,
+    /// The colliders of the member's body in the world (shoulders, arms), as
+    /// [`HairSim::set_body_colliders`] takes them.
+    pub body: Vec<Collider>,
+}
+
+impl MemberPose {
+    /// The pose of a member whose roots ride its head.
+    pub fn rigid(head: RigidTransform) -> MemberPose {
+        MemberPose { head, ..MemberPose::default() }
+    }
+}
+
+/// Many characters' key hairs in one simulation (see the module docs).
+pub struct Crowd {
+    sim: HairSim,
+    members: Vec<Placed>,
+    /// Centre (world) and radius of the sphere holding every member's hair.
+    bounds: (Vec3, f32),
+}
+
+impl Crowd {
+    /// Lays out `members` (at most [`MAX_CROWD_MEMBERS`]) at their `poses`
+    /// (one each) and uploads them at rest: each member's rest shape placed
+    /// by its head, or by its roots' frames on its scalp as the poses' bones
+    /// skin it; the first step moves every root from there. Errors name the member whose
+    /// groom, scalp, colliders or pose is refused; a volume stage in `params`
+    /// is refused (see the module docs). This submits and waits.
+    pub fn new(ctx: &GpuContext, members: &[Member], poses: &[MemberPose], params: &SimParams) -> Result<Crowd> {
+        refuse_volume(params)?;
+        let layout = layout::lay_out(members, poses)?;
+        let Placing { bones, bounds, colliders } = place(&layout.members, poses)?;
+        let head = RigidTransform::default();
+        let mut state = SimState::from_groom(&layout.groom, params, &head)?;
+        if layout.members.iter().any(|m| m.skinned) {
+            // Skinned members start on their scalps as the first bones place them.
+            let skinned = layout.scalp.skin(&bones)?;
+            let frames = frames_at(&layout.binding, &[], &skinned, 1.0, true, &Mat4::IDENTITY);
+            let points = state.points;
+            for member in layout.members.iter().filter(|m| m.skinned) {
+                for (h, frame) in member.strands.clone().zip(&frames[member.strands.clone()]) {
+                    for i in h * points..(h + 1) * points {
+                        let w = state.positions[i].w;
+                        state.positions[i] = frame.transform_point3(state.rest[i].truncate()).extend(w);
+                    }
+                }
+            }
+        }
+        let mut sim = HairSim::from_state(ctx, &state, params, &head)?;
+        sim.bind_scalp_bones_as(&layout.scalp, layout.binding, &bones, true)?;
+        sim.set_body_colliders(&colliders)?;
+        Ok(Crowd { sim, members: layout.members, bounds })
+    }
+
+    /// The simulation of every member (its state, parameters and level of
+    /// detail; key hairs [`Crowd::member_strands`] are one member's).
+    pub fn sim(&self) -> &HairSim {
+        &self.sim
+    }
+
+    /// Members in the crowd.
+    pub fn members(&self) -> usize {
+        self.members.len()
+    }
+
+    /// Member `m`'s key hairs in the simulation (empty past the last member).
+    pub fn member_strands(&self, m: usize) -> Range<usize> {
+        self.members.get(m).map_or(0..0, |p| p.strands.clone())
+    }
+
+    /// The sphere (world centre, radius in meters) holding every member's hair
+    /// at the latest poses.
+    pub fn bounds(&self) -> (Vec3, f32) {
+        self.bounds
+    }
+
+    /// The latest key hairs as a renderer reads them, with the crowd's bounds.
+    pub fn key_hairs(&self) -> KeyHairs<'_> {
+        KeyHairs { bounds: Some(self.bounds), ..self.sim.key_hairs() }
+    }
+
+    /// Where every member is at the end of the next step (one pose per member,
+    /// in the order of [`Crowd::new`]'s members); members keep their poses
+    /// when not set again. Errors name the member whose pose is refused (a
+    /// head that is not finite, too few or non-finite bones) or the colliders'
+    /// total past [`MAX_COLLIDERS`]; nothing changes then.
+    pub fn set_poses(&mut self, poses: &[MemberPose]) -> Result<()> {
+        let Placing { bones, bounds, colliders } = place(&self.members, poses)?;
+        self.sim.set_scalp_bones(&bones)?;
+        self.sim.set_body_colliders(&colliders)?;
+        self.bounds = bounds;
+        Ok(())
+    }
+
+    /// Records one step of every member into `cmd`: [`HairSim::record_step`]
+    /// with the crowd's poses (the same dispatches and barriers, whatever the
+    /// number of members).
+    ///
+    /// # Safety
+    /// As for [`HairSim::record_step`].
+    pub unsafe fn record_step(&mut self, cmd: vk::CommandBuffer, profiler: Option<&mut GpuProfiler>) -> Result<()> {
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.sim.record_step(cmd, &RigidTransform::default(), profiler) }
+    }
+
+    /// Records `steps` steps in one submission and waits (headless use),
+    /// step `i` ending at `poses(i)`.
+    pub fn run(&mut self, steps: usize, mut poses: impl FnMut(usize) -> Vec<MemberPose>) -> Result<()> {
+        let device = self.sim.device().clone();
+        let mut result = Ok(());
+        device.submit_once("vkhair crowd run", |cmd| {
+            for i in 0..steps {
+                // SAFETY: submit_once hands over a recording command buffer of this
+                // device and waits for the previous one.
+                result = self.set_poses(&poses(i)).and_then(|_| unsafe { self.record_step(cmd, None) });
+                if result.is_err() {
+                    return;
+                }
+            }
+        })?;
+        result
+    }
+
+    /// Changes the simulation's parameters from the next step on (validated
+    /// first; a volume stage is refused).
+    pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
+        refuse_volume(params)?;
+        self.sim.set_params(params)
+    }
+
+    /// Simulates only `count` key hairs of the whole crowd (see
+    /// [`HairSim::set_simulated_hairs`]): the others follow a simulated
+    /// neighbour of their own member.
+    pub fn set_simulated_hairs(&mut self, count: usize) -> Result<()> {
+        self.sim.set_simulated_hairs(count)
+    }
+
+    /// The next recorded step starts every member from its rest shape placed
+    /// by its roots, velocities zero.
+    pub fn reset(&mut self) {
+        self.sim.reset();
+    }
+}
+
+/// Checks `poses` (one per member) against `members`: the crowd's bone
+/// matrices (crowd frame → world), the sphere holding every member's hair and
+/// the colliders in the world.
+fn place(members: &[Placed], poses: &[MemberPose]) -> Result<Placing> {
+    if poses.len() != members.len() {
+        return Err(Error::param("crowd poses", poses.len(), format!("{}, one per member", members.len())));
+    }
+    let mut bones = Vec::with_capacity(members.last().map_or(0, |m| m.bones.end));
+    let mut colliders = Vec::new();
+    let mut spheres = Vec::with_capacity(poses.len());
+    for (i, (member, pose)) in members.iter().zip(poses).enumerate() {
+        let named = |e: Error| Error::incompatible("crowd member", format!("member {i}: {e}"));
+        pose.head.validate().map_err(named)?;
+        let head = pose.head.matrix();
+        let wanted = member.bones.len();
+        if member.skinned {
+            if pose.bones.len() < wanted {
+                let e =
+                    Error::param("scalp bones", pose.bones.len(), format!("at least {wanted} (the scalp's joints)"));
+                return Err(named(e));
+            }
+            if let Some(j) = pose.bones[..wanted].iter().position(|m| !m.is_finite()) {
+                return Err(named(Error::param("scalp bone matrix", format!("bone {j}"), "finite")));
+            }
+            bones.extend(pose.bones[..wanted].iter().map(|b| *b * member.unplace));
+        } else {
+            bones.push(head * member.unplace);
+        }
+        pose.body.iter().try_for_each(Collider::validate).map_err(named)?;
+        colliders.extend(member.colliders.iter().map(|c| placed(c, &head)));
+        colliders.extend_from_slice(&pose.body);
+        spheres.push((head.transform_point3(member.sphere.0), member.sphere.1));
+    }
+    if colliders.len() > MAX_COLLIDERS {
+        let allowed = format!("at most {MAX_COLLIDERS} head and body colliders of all members together");
+        return Err(Error::param("crowd colliders", colliders.len(), allowed));
+    }
+    Ok(Placing { bones, bounds: enclosing(&spheres), colliders })
+}
+
+/// What a set of poses places ([`place`]).
+struct Placing {
+    /// The crowd's bone matrices (crowd frame → world).
+    bones: Vec<Mat4>,
+    /// The sphere (world centre, radius) holding every member's hair.
+    bounds: (Vec3, f32),
+    /// Every member's colliders in the world.
+    colliders: Vec<Collider>,
+}
+
+/// Refuses a volume stage in a crowd's parameters.
+fn refuse_volume(params: &SimParams) -> Result<()> {
+    if params.volume.mode != VolumeMode::Off {
+        let mode = format!("{:?}", params.volume.mode);
+        return Err(Error::param("volume.mode", mode, "Off in a crowd (one grid cannot follow characters apart)"));
+    }
+    Ok(())
+}
+
+/// Collider `c` (head frame) placed by `head`.
+fn placed(c: &Collider, head: &Mat4) -> Collider {
+    match *c {
+        Collider::Sphere { center, radius } => Collider::Sphere { center: head.transform_point3(center), radius },
+        Collider::Capsule { a, b, radius } => {
+            Collider::Capsule { a: head.transform_point3(a), b: head.transform_point3(b), radius }
+        }
+    }
+}
+
+/// A sphere holding every sphere of `spheres` (centre, radius): around the
+/// centre of their bounding box.
+fn enclosing(spheres: &[(Vec3, f32)]) -> (Vec3, f32) {
+    let (lo, hi) = spheres
+        .iter()
+        .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), (c, r)| (lo.min(*c - *r), hi.max(*c + *r)));
+    let centre = 0.5 * (lo + hi);
+    let radius = spheres.iter().map(|(c, r)| c.distance(centre) + r).fold(0.0f32, f32::max);
+    (centre, radius)
+}
