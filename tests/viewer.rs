@@ -295,6 +295,68 @@ fn the_viewer_puts_hair_on_a_skinned_character() {
     assert!(share(differs) > 0.01, "the hair covers {:.2} % of the window", 100.0 * share(differs));
 }
 
+/// `--crowd 4 --gltf`: two characters and two thesis heads in one vkhair
+/// simulation and renderer, each drawn by the host at its place: hair shows
+/// on both sides of the window (the members stand apart on a grid seen from
+/// a corner) beside the bodies and heads, the viewer says what the crowd
+/// holds, and the run is validation clean.
+#[test]
+fn the_viewer_draws_a_crowd_of_characters_and_heads() {
+    let (display, _server) = match display() {
+        Ok(d) => d,
+        Err(why) => {
+            println!("SKIPPED the viewer crowd test: {why}");
+            eprintln!("SKIPPED the viewer crowd test: {why}");
+            return;
+        }
+    };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let glb = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
+    let (w, h) = (240u32, 180u32);
+    let (ws, hs) = (w.to_string(), h.to_string());
+    let args = [
+        "--crowd",
+        "4",
+        "--gltf",
+        glb,
+        "--animation",
+        "run",
+        "--moving",
+        "--frames",
+        "6",
+        "--frame-time",
+        "0.02",
+        "--no-overlay",
+        "--width",
+        &ws,
+        "--height",
+        &hs,
+    ];
+    let (_, _, hair, printed) = run_printing(&display, &dir.path().join("crowd.png"), &args);
+    let (_, _, bare) = run(&display, &dir.path().join("bare.png"), &[&args[..], &["--no-hair"]].concat());
+    let body = bare.chunks_exact(4).filter(|p| p[0] > 60 && u32::from(p[0]) > u32::from(p[2]) + 25).count();
+    // The grid seen from a corner: two members left of the middle, two right.
+    let mut halves = [0usize; 2];
+    for (i, (a, b)) in hair.chunks_exact(4).zip(bare.chunks_exact(4)).enumerate() {
+        if a.iter().zip(b.iter()).take(3).any(|(x, y)| x.abs_diff(*y) > 24) {
+            halves[usize::from(i as u32 % w >= w / 2)] += 1;
+        }
+    }
+    let share = |n: usize| n as f64 / f64::from(w * h);
+    let percent = |n: usize| (1000.0 * share(n)).round() / 10.0;
+    println!(
+        "bodies and heads {:.1} %; hair left and right of the middle {:?} %",
+        100.0 * share(body),
+        halves.map(percent)
+    );
+    assert!(share(body) > 0.01, "the bodies and heads cover {:.2} % of the window", 100.0 * share(body));
+    for (half, n) in ["left", "right"].iter().zip(halves) {
+        assert!(share(n) > 0.005, "the {half} half of the window shows {:.2} % hair", 100.0 * share(n));
+    }
+    let line = printed.lines().find(|l| l.starts_with("viewer: crowd of")).unwrap_or_else(|| panic!("{printed}"));
+    assert!(line.contains("4 members") && line.contains("2 characters"), "{line}");
+}
+
 /// Values out of range are refused before any window opens, naming the option.
 #[test]
 fn the_viewer_refuses_bad_options_by_name() {
@@ -305,6 +367,8 @@ fn the_viewer_refuses_bad_options_by_name() {
         (&["--resize", "10x5000"][..], "--resize"),
         (&["--frame-time", "0"][..], "--frame-time"),
         (&["--animation", "run"][..], "--gltf"),
+        (&["--crowd", "0"][..], "--crowd"),
+        (&["--crowd", "65"][..], "--crowd"),
     ] {
         let output = Command::new(viewer()).args(args).env_remove("DISPLAY").output().expect("run the viewer");
         let stderr = String::from_utf8_lossy(&output.stderr);

@@ -128,12 +128,21 @@ impl Running {
         let size = window.inner_size();
         let swapchain = Swapchain::new(&gpu, (size.width.max(1), size.height.max(1)))?;
         let floor_y = scene_data.floor_y;
+        // A crowd is framed on the grid its members stand in.
+        let (center, radius) = match hair.crowd_framing() {
+            // Its hair, and the floor below it (the characters' bodies).
+            Some((_, c, r)) => {
+                let lo = (c - Vec3::splat(r)).min(Vec3::new(c.x, floor_y, c.z));
+                vkhair::groom::bounding_sphere((lo, c + Vec3::splat(r)))
+            }
+            None => (scene_data.center, scene_data.radius),
+        };
         let scene = HostScene::new(
             &gpu.device,
             gpu.allocator(),
             swapchain.format,
             &scene_data.head,
-            (scene_data.center, floor_y, 3.0 * scene_data.radius),
+            (center, floor_y, 3.0 * radius),
         )?;
         let taa = Taa::new(&gpu.device, swapchain.format, args.taa, !args.no_motion_vectors)?;
         let d = &gpu.device;
@@ -157,13 +166,9 @@ impl Running {
         };
         let overlay = if args.no_overlay { None } else { Some(Overlay::new(window, &gpu, swapchain.format)?) };
         let half_fov = 0.5 * FOV_Y;
-        let orbit = Orbit {
-            center: scene_data.center,
-            radius: scene_data.radius,
-            yaw: 0.0,
-            pitch: 0.1,
-            distance: scene_data.radius / half_fov.sin(),
-        };
+        // A crowd is seen from above one corner, its rows apart.
+        let (yaw, pitch, near) = if hair.crowd_framing().is_some() { (-0.35, 0.35, 0.55) } else { (0.0, 0.1, 1.0) };
+        let orbit = Orbit { center, radius, yaw, pitch, distance: near * radius / half_fov.sin() };
         Ok(Running {
             hair: Some(hair),
             ctx: Some(ctx),

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use ash::vk;
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use vkhair::character::{Character, HairRig};
 use vkhair::config::Config;
 use vkhair::groom::binding::RootBinding;
@@ -16,9 +16,10 @@ use vkhair::groom::scenes;
 use vkhair::groom::tfx::TfxFile;
 use vkhair::groom::Groom;
 use vkhair::render::{Camera, Light, RenderTarget, Renderer, ShadingMode, ShadowParams, Transparency};
-use vkhair::sim::{motion, Collider, FixedStepDriver, HairSim, RigidTransform, SimState};
+use vkhair::sim::{motion, Collider, FixedStepDriver, HairSim, KeyHairs, RigidTransform, SimState};
 use vkhair::{ash, GpuContext, GpuProfiler, ProfileReport};
 
+use crate::crowd::CrowdScene;
 use crate::host::BoxError;
 use crate::skin::{GpuSkin, MAX_STEPS, SKINNED_STRIDE};
 use crate::Args;
@@ -43,6 +44,9 @@ pub struct Scene {
     pub floor_y: f32,
     /// The `--gltf` character, skinned by the host and carrying the hair.
     pub rig: Option<HairRig>,
+    /// `--crowd`: members in the crowd (the thesis head, and the character
+    /// when there is one, instead of `groom` alone).
+    pub crowd: Option<usize>,
 }
 
 impl Scene {
@@ -79,7 +83,17 @@ impl Scene {
             return Err(format!("the groom and mesh span no finite volume (radius {radius})").into());
         }
         let floor_y = lo.y - 0.2 * radius;
-        Ok(Scene { groom, head, mesh_collider, colliders, center, radius, floor_y, rig: None })
+        Ok(Scene {
+            groom,
+            head,
+            mesh_collider,
+            colliders,
+            center,
+            radius,
+            floor_y,
+            rig: None,
+            crowd: args.crowd.map(|n| n as usize),
+        })
     }
 
     /// `--gltf`: key hairs grown on the character's head, its head's region
@@ -95,7 +109,14 @@ impl Scene {
             return Err(format!("{}: the hair and head span no finite volume", path.display()).into());
         }
         let floor_y = body.positions.iter().map(|p| p.y).fold(f32::MAX, f32::min);
-        Ok(Scene { groom, head, mesh_collider: true, colliders: Vec::new(), center, radius, floor_y, rig: Some(rig) })
+        let crowd = args.crowd.map(|n| n as usize);
+        // In a crowd the host draws the thesis heads' spheres beside the character's body.
+        let head = match crowd {
+            Some(_) => TriMesh::uv_sphere(scenes::THESIS_HEAD_CENTER, scenes::THESIS_HEAD_RADIUS * 0.97, 24, 32)?,
+            None => head,
+        };
+        let mesh_collider = crowd.is_none();
+        Ok(Scene { groom, head, mesh_collider, colliders: Vec::new(), center, radius, floor_y, rig: Some(rig), crowd })
     }
 }
 
@@ -114,9 +135,16 @@ fn read_groom(path: &Path) -> Result<Groom, BoxError> {
     Ok(groom)
 }
 
+/// The simulation: one groom's, or a crowd's.
+enum Sim {
+    One(Box<HairSim>),
+    /// The crowd and its members' time, seconds.
+    Crowd(Box<CrowdScene>, f32),
+}
+
 /// The simulation, the renderer and the controls.
 pub struct Hair {
-    pub sim: HairSim,
+    sim: Sim,
     pub renderer: Renderer,
     pub profiler: GpuProfiler,
     pub config: Config,
@@ -154,6 +182,16 @@ impl Hair {
     pub fn new(ctx: &GpuContext, scene: &Scene, config: Config, skin: Option<&GpuSkin>) -> Result<Hair, BoxError> {
         let mut config = config;
         config.render.frames_in_flight = FRAMES_IN_FLIGHT;
+        if let Some(count) = scene.crowd {
+            let crowd = CrowdScene::new(ctx, count, scene.rig.as_ref().map(|r| (r, &scene.groom)), &config.sim)?;
+            if config.lights.is_empty() {
+                config.lights = Light::thesis_rig(crowd.center, crowd.radius).to_vec();
+            }
+            config.render.hairs_per_key = crowd_hairs_per_key(ctx, &crowd, &config.render);
+            let initial = crowd.crowd.sim().read_state()?;
+            // Each member's hair is about the thesis head's depth: the maps' layers as for it.
+            return Self::with_sim(ctx, Sim::Crowd(Box::new(crowd), 0.0), config, initial, (None, 1.0));
+        }
         if config.lights.is_empty() {
             config.lights = Light::thesis_rig(scene.center, scene.radius).to_vec();
         }
@@ -182,13 +220,24 @@ impl Hair {
             rig = Some(Riding { rig: r.clone(), time: 0.0, slot_bytes: slot, bound });
         }
         let initial = sim.read_state()?;
-        let mut renderer = Renderer::new(ctx, &sim, &config.render)?;
+        Self::with_sim(ctx, Sim::One(Box::new(sim)), config, initial, (rig, scene.radius / 0.465))
+    }
+
+    /// The renderer, profiler and controls around `sim`.
+    fn with_sim(
+        ctx: &GpuContext,
+        sim: Sim,
+        config: Config,
+        initial: SimState,
+        (rig, k): (Option<Riding>, f32),
+    ) -> Result<Hair, BoxError> {
+        let mut renderer = Renderer::new(ctx, key_hairs(&sim), &config.render)?;
         renderer.set_lights(&config.lights)?;
         renderer.set_material(&config.material)?;
-        let k = scene.radius / 0.465;
         let layers = ShadowParams::default().layers.map(|l| l * k);
         let shadows = ShadowParams { casters: vec![0.into(), 1.into()], layers, ..ShadowParams::default() };
-        renderer.set_shadows(&sim, &shadows)?;
+        renderer.set_shadows(key_hairs(&sim), &shadows)?;
+        let moving = rig.is_some() || matches!(&sim, Sim::Crowd(c, _) if c.has_character());
         let profiler = GpuProfiler::new(ctx, FRAMES_IN_FLIGHT, 64)?;
         let driver = FixedStepDriver::new(f64::from(config.sim.dt), 2)?;
         Ok(Hair {
@@ -201,7 +250,7 @@ impl Hair {
             report: None,
             paused: false,
             pending_steps: 0,
-            moving: scene.rig.is_some(),
+            moving,
             steps_done: 0,
             driver,
             initial,
@@ -239,20 +288,41 @@ impl Hair {
                 self.alpha = plan.alpha;
                 plan.steps
             };
-            match skin {
-                Some(skin) if self.rig.is_some() => self.record_character_steps(cmd, frame, steps, skin)?,
-                _ => {
+            match (skin, &mut self.sim) {
+                (Some(skin), Sim::One(_)) if self.rig.is_some() => {
+                    self.record_character_steps(cmd, frame, steps, skin)?
+                }
+                (skin, Sim::Crowd(crowd, time)) => {
+                    let dt = self.config.sim.dt;
+                    for _ in 0..steps {
+                        self.steps_done += 1;
+                        if self.moving {
+                            *time += dt;
+                        }
+                        crowd.crowd.set_poses(&crowd.poses(*time, self.moving))?;
+                        crowd.crowd.record_step(cmd, Some(&mut self.profiler))?;
+                    }
+                    if let (Some(skin), Some(bones)) =
+                        (skin, crowd.drawn_bones(*time - dt * (1.0 - self.alpha), self.moving))
+                    {
+                        // The character's body as shown: one skinning, drawn at every place.
+                        let frame_slot = (frame % u64::from(FRAMES_IN_FLIGHT)) as u32;
+                        skin.write_bones(frame_slot, &[], &bones)?;
+                        skin.record(cmd, frame_slot, 0);
+                    }
+                }
+                (_, Sim::One(sim)) => {
                     for _ in 0..steps {
                         self.steps_done += 1;
                         let t = self.steps_done as f32 * self.config.sim.dt;
                         let head = if self.moving { motion::reference_motion(t) } else { RigidTransform::default() };
-                        self.sim.record_step(cmd, &head, Some(&mut self.profiler))?;
+                        sim.record_step(cmd, &head, Some(&mut self.profiler))?;
                     }
                 }
             }
-            let key_hairs = self.sim.key_hairs().blended(self.alpha)?;
-            self.renderer.record_prepare(cmd, key_hairs, Some(camera), Some(&mut self.profiler))?;
-            self.renderer.record_shadows(cmd, &self.sim, Some(&mut self.profiler))?;
+            let hairs = key_hairs(&self.sim).blended(self.alpha)?;
+            self.renderer.record_prepare(cmd, hairs, Some(camera), Some(&mut self.profiler))?;
+            self.renderer.record_shadows(cmd, hairs, Some(&mut self.profiler))?;
         }
         Ok(())
     }
@@ -272,7 +342,9 @@ impl Hair {
         steps: u32,
         skin: &mut GpuSkin,
     ) -> Result<(), BoxError> {
-        let Some(Riding { rig, time, slot_bytes, .. }) = &mut self.rig else { return Ok(()) };
+        let (Some(Riding { rig, time, slot_bytes, .. }), Sim::One(sim)) = (&mut self.rig, &mut self.sim) else {
+            return Ok(());
+        };
         let dt = if self.moving { self.config.sim.dt } else { 0.0 };
         let times: Vec<f32> = (1..=steps).map(|k| *time + dt * k as f32).collect();
         *time += dt * steps as f32;
@@ -285,12 +357,25 @@ impl Hair {
             skin.record(cmd, frame_slot, steps);
             for (k, &t) in times.iter().enumerate() {
                 self.steps_done += 1;
-                self.sim.set_scalp_offset(k as u64 * *slot_bytes)?;
-                self.sim.set_body_colliders(&rig.colliders_at(t))?;
-                self.sim.record_step(cmd, &rig.head_at(t), Some(&mut self.profiler))?;
+                sim.set_scalp_offset(k as u64 * *slot_bytes)?;
+                sim.set_body_colliders(&rig.colliders_at(t))?;
+                sim.record_step(cmd, &rig.head_at(t), Some(&mut self.profiler))?;
             }
         }
         Ok(())
+    }
+
+    /// With a crowd: where the host draws the thesis heads' spheres and the
+    /// character's bodies as shown this frame.
+    pub fn crowd_drawn(&self) -> Option<(Vec<Mat4>, Vec<Mat4>)> {
+        let Sim::Crowd(crowd, time) = &self.sim else { return None };
+        Some(crowd.drawn(*time - self.config.sim.dt * (1.0 - self.alpha), self.moving))
+    }
+
+    /// Members and the sphere (centre, radius) they stand in, with a crowd.
+    pub fn crowd_framing(&self) -> Option<(usize, Vec3, f32)> {
+        let Sim::Crowd(crowd, _) = &self.sim else { return None };
+        Some((crowd.members(), crowd.center, crowd.radius))
     }
 
     /// Records the hair into the host's `target`.
@@ -311,15 +396,22 @@ impl Hair {
 
     /// Back to the first state (the device must be idle: the state is uploaded).
     pub fn reset(&mut self) -> Result<(), BoxError> {
-        if let Some(Riding { rig, time, .. }) = &mut self.rig {
-            // The rest pose where the animation starts again: the hair and its
-            // skinned roots start there together (no sweep from the old pose).
-            *time = 0.0;
-            self.sim.teleport(&rig.head_at(0.0))?;
-            self.sim.set_body_colliders(&rig.colliders_at(0.0))?;
-            self.sim.reset();
-        } else {
-            self.sim.write_state(&self.initial)?;
+        match (&mut self.rig, &mut self.sim) {
+            (_, Sim::Crowd(crowd, time)) => {
+                // Every member back to its first pose, its hair at rest there.
+                *time = 0.0;
+                crowd.crowd.set_poses(&crowd.poses(0.0, false))?;
+                crowd.crowd.reset();
+            }
+            (Some(Riding { rig, time, .. }), Sim::One(sim)) => {
+                // The rest pose where the animation starts again: the hair and its
+                // skinned roots start there together (no sweep from the old pose).
+                *time = 0.0;
+                sim.teleport(&rig.head_at(0.0))?;
+                sim.set_body_colliders(&rig.colliders_at(0.0))?;
+                sim.reset();
+            }
+            (None, Sim::One(sim)) => sim.write_state(&self.initial)?,
         }
         self.driver = FixedStepDriver::new(f64::from(self.config.sim.dt), 2)?;
         self.steps_done = 0;
@@ -332,14 +424,17 @@ impl Hair {
     /// largest distance of a key hair's root from its point on the character's
     /// mesh skinned on the CPU at that time (the device must be idle).
     pub fn root_error(&self) -> Result<Option<(f32, f32)>, BoxError> {
-        let Some(Riding { rig, time, bound, .. }) = &self.rig else { return Ok(None) };
+        let (Some(Riding { rig, time, bound, .. }), Sim::One(sim)) = (&self.rig, &self.sim) else { return Ok(None) };
         let skinned = rig.character.skin(&rig.pose(*time));
-        Ok(Some((*time, rig.root_error(&self.sim.read_state()?, bound, &skinned))))
+        Ok(Some((*time, rig.root_error(&sim.read_state()?, bound, &skinned))))
     }
 
     /// Applies `config.sim`, `config.render` and `config.material` after a change.
     pub fn apply(&mut self) -> Result<(), BoxError> {
-        self.sim.set_params(&self.config.sim)?;
+        match &mut self.sim {
+            Sim::One(sim) => sim.set_params(&self.config.sim)?,
+            Sim::Crowd(crowd, _) => crowd.crowd.set_params(&self.config.sim)?,
+        }
         self.renderer.set_params(&self.config.render)?;
         self.renderer.set_material(&self.config.material)?;
         Ok(())
@@ -352,7 +447,7 @@ impl Hair {
         } else {
             ShadowParams { casters: Vec::new(), ..self.shadows.clone() }
         };
-        self.renderer.set_shadows(&self.sim, &params)?;
+        self.renderer.set_shadows(key_hairs(&self.sim), &params)?;
         Ok(())
     }
 
@@ -395,6 +490,32 @@ impl Hair {
             r.transparency,
             if self.paused { " · paused" } else { "" }
         )
+    }
+}
+
+/// The hairs per key hair a crowd is drawn with: the configuration's, or as
+/// many as the device's storage range holds for every member (one buffer
+/// holds the interpolated hairs of the whole crowd).
+fn crowd_hairs_per_key(ctx: &GpuContext, crowd: &CrowdScene, render: &vkhair::render::RenderParams) -> u32 {
+    let state = crowd.crowd.sim();
+    let (strands, points) = (state.key_hairs().size().0 as u64, state.key_hairs().size().1 as u64);
+    let vertices = (points - 1) * u64::from(render.smoothing_level) + 1;
+    let fits = u64::from(ctx.info().max_storage_buffer_range) / (strands * vertices * 16).max(1);
+    let hairs = render.hairs_per_key.min(u32::try_from(fits).unwrap_or(u32::MAX)).max(1);
+    if hairs < render.hairs_per_key {
+        println!(
+            "viewer: {} hairs per key hair for the crowd's {strands} key hairs ({} configured: past the device's storage range)",
+            hairs, render.hairs_per_key
+        );
+    }
+    hairs
+}
+
+/// The key hairs the renderer draws: one groom's, or the crowd's with its bounds.
+fn key_hairs(sim: &Sim) -> KeyHairs<'_> {
+    match sim {
+        Sim::One(sim) => sim.key_hairs(),
+        Sim::Crowd(crowd, _) => crowd.crowd.key_hairs(),
     }
 }
 

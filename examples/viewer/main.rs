@@ -13,7 +13,13 @@
 //! cargo run --release --example viewer
 //! cargo run --release --example viewer -- --input sintel_hair.tfx --obj sintel_bust.obj --scale 0.01
 //! cargo run --release --example viewer -- --gltf tests/data/mannequiny-0.3.0.glb --animation run
+//! cargo run --release --example viewer -- --crowd 16 --gltf tests/data/mannequiny-0.3.0.glb --moving
 //! ```
+//!
+//! With `--crowd N` the viewer is a host with many characters: N members of
+//! one `vkhair::crowd::Crowd` (`crowd.rs`), one simulation step and one
+//! renderer for all of them, each member's head or skinned body drawn by the
+//! host at its place.
 //!
 //! With `--gltf` the viewer is a host with a skinned character: its own
 //! compute pass skins the mesh every frame (`skin.rs`), draws it, and hands
@@ -44,6 +50,7 @@ use winit::window::{Window, WindowId};
 #[allow(dead_code)]
 mod host;
 
+mod crowd;
 mod device;
 mod frame;
 mod hair;
@@ -72,6 +79,11 @@ pub struct Args {
     /// frame, its bones' capsules keep them off the body. Instead of --input.
     #[arg(long, conflicts_with_all = ["input", "obj"])]
     pub gltf: Option<PathBuf>,
+    /// A crowd of this many characters (1..=64) in one vkhair simulation and
+    /// renderer, on a grid: thesis heads swaying each at its own phase and,
+    /// with --gltf, the character at every other place.
+    #[arg(long, conflicts_with_all = ["input", "obj"], value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub crowd: Option<u32>,
     /// The --gltf animation, by name or index [default: the first].
     #[arg(long, requires = "gltf")]
     pub animation: Option<String>,

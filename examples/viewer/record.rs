@@ -93,7 +93,13 @@ impl Running {
                 .depth_attachment(&depth_attachment);
             let view_projection = camera.jittered_projection((extent.width, extent.height)) * camera.view;
             d.cmd_begin_rendering(cmd, &rendering);
-            self.scene.record_head(cmd, extent, view_projection, self.skin.as_ref().map(GpuSkin::drawn));
+            match hair.crowd_drawn() {
+                Some((heads, bodies)) => {
+                    let body = self.skin.as_ref().map(|s| (s.drawn(), bodies.as_slice()));
+                    self.scene.record_crowd(cmd, extent, view_projection, &heads, body);
+                }
+                None => self.scene.record_head(cmd, extent, view_projection, self.skin.as_ref().map(GpuSkin::drawn)),
+            }
             d.cmd_end_rendering(cmd);
             // The velocity image: no motion where the hair writes none (the
             // resolve then reprojects the pixel by its depth).

@@ -127,6 +127,40 @@ impl HostScene {
         }
     }
 
+    /// [`HostScene::record_head`] for a crowd: the head mesh placed by each
+    /// of `heads` (its frame in the world) and, with `body` (a skinned
+    /// character's vertex buffer and count, and its places), that body at each
+    /// place; leaves the scene's own vertex buffer bound.
+    ///
+    /// # Safety
+    /// As for [`HostScene::record_head`].
+    pub unsafe fn record_crowd(
+        &self,
+        cmd: vk::CommandBuffer,
+        extent: vk::Extent2D,
+        view_projection: Mat4,
+        heads: &[Mat4],
+        body: Option<((vk::Buffer, u32), &[Mat4])>,
+    ) {
+        let d = &self.device;
+        let viewport = crate::host::full_viewport(extent);
+        // SAFETY: guaranteed by the caller; every object here is alive.
+        unsafe {
+            d.cmd_set_viewport(cmd, 0, &[viewport]);
+            d.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
+            if let Some(((buffer, count), places)) = body {
+                d.cmd_bind_vertex_buffers(cmd, 0, &[buffer], &[0]);
+                for place in places {
+                    self.draw(cmd, (0, count), HEAD_COLOR, view_projection * *place);
+                }
+            }
+            d.cmd_bind_vertex_buffers(cmd, 0, &[self.buffer], &[0]);
+            for head in heads {
+                self.draw(cmd, self.head, HEAD_COLOR, view_projection * *head);
+            }
+        }
+    }
+
     /// Records the floor after vkhair's hair, inside the caller's rendering of
     /// the same attachments, relying on what vkhair documents about the state it
     /// leaves: the vertex buffer bound by [`HostScene::record_head`] is still

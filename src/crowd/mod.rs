@@ -291,7 +291,7 @@ fn place(members: &[Placed], poses: &[MemberPose]) -> Result<Placing> {
             bones.push(head * member.unplace);
         }
         pose.body.iter().try_for_each(Collider::validate).map_err(named)?;
-        colliders.extend(member.colliders.iter().map(|c| placed(c, &head)));
+        colliders.extend(member.colliders.iter().map(|c| c.moved(&head)));
         colliders.extend_from_slice(&pose.body);
         spheres.push((head.transform_point3(member.sphere.0), member.sphere.1));
     }
@@ -319,16 +319,6 @@ fn refuse_volume(params: &SimParams) -> Result<()> {
         return Err(Error::param("volume.mode", mode, "Off in a crowd (one grid cannot follow characters apart)"));
     }
     Ok(())
-}
-
-/// Collider `c` (head frame) placed by `head`.
-fn placed(c: &Collider, head: &Mat4) -> Collider {
-    match *c {
-        Collider::Sphere { center, radius } => Collider::Sphere { center: head.transform_point3(center), radius },
-        Collider::Capsule { a, b, radius } => {
-            Collider::Capsule { a: head.transform_point3(a), b: head.transform_point3(b), radius }
-        }
-    }
 }
 
 /// A sphere holding every sphere of `spheres` (centre, radius): around the

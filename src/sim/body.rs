@@ -66,6 +66,17 @@ impl Collider {
         Ok(())
     }
 
+    /// The collider moved by `m` (a rigid transform: a head's, or a
+    /// character's place in the world); the radius is kept.
+    pub fn moved(&self, m: &Mat4) -> Collider {
+        match *self {
+            Collider::Sphere { center, radius } => Collider::Sphere { center: m.transform_point3(center), radius },
+            Collider::Capsule { a, b, radius } => {
+                Collider::Capsule { a: m.transform_point3(a), b: m.transform_point3(b), radius }
+            }
+        }
+    }
+
     /// The collider `t` of the way from `self` to `to` (ends and radius
     /// linearly; `to` itself when the two are not the same kind).
     pub(crate) fn lerp(&self, to: &Collider, t: f32) -> Collider {
