@@ -147,6 +147,64 @@ fn each_member_moves_as_it_would_alone() {
     assert!(worst < 1e-4, "a member moved {worst} m away from where it moves alone");
 }
 
+/// Members with parameters of their own (stronger gravity, other damping,
+/// bending and global shape) share the one dispatch and move as they would
+/// alone with those parameters, within 0.1 mm after 12 steps; two members
+/// with the same parameters share a set; a member whose parameters differ in
+/// what the members must share (iterations) is refused, naming both.
+#[test]
+fn members_with_parameters_of_their_own_move_as_they_would_alone() {
+    let gpu = Gpu::new();
+    let ctx = gpu.ctx();
+    let base = SimParams { global_shape_stiffness: 0.02, ..SimParams::default() };
+    let own = SimParams {
+        gravity: Vec3::new(0.0, -19.6, 0.0),
+        damping: 0.2,
+        bending_root: 0.3,
+        global_shape_stiffness: 0.05,
+        ..base.clone()
+    };
+    let grooms = [common::grown_groom(24, 6, 10), common::grown_groom(24, 6, 11), common::grown_groom(24, 6, 12)];
+    let members = [
+        Member::rigid(grooms[0].clone()),
+        Member { params: Some(own.clone()), ..Member::rigid(grooms[1].clone()) },
+        Member { params: Some(own.clone()), ..Member::rigid(grooms[2].clone()) },
+    ];
+    let heads = |i: usize| {
+        let t = i as f32 / 60.0;
+        [at(-1.0, 0.0, 0.0), at(0.0, 0.0, 3.0 * t), at(1.0 + 0.5 * t, 0.0, 0.0)]
+    };
+    let poses = |i: usize| -> Vec<MemberPose> { heads(i).map(MemberPose::rigid).to_vec() };
+    let mut crowd = Crowd::new(ctx, &members, &poses(0), &base).expect("crowd");
+    assert_eq!(crowd.parameter_sets(), 2, "the crowd's and the two members' own");
+    let before = ctx.recorded_work();
+    crowd.run(1, |i| poses(i + 1)).expect("first step");
+    let one_step = ctx.recorded_work() - before;
+    crowd.run(11, |i| poses(i + 2)).expect("crowd run");
+    let together = crowd.sim().read_state().expect("state");
+    let mut worst = [0.0f32; 3];
+    for (m, member) in members.iter().enumerate() {
+        let params = member.params.clone().unwrap_or_else(|| base.clone());
+        let mut alone = HairSim::new(ctx, &member.groom, &params, &heads(0)[m]).expect("alone");
+        alone.run(12, |i| heads(i + 1)[m], None).expect("alone run");
+        worst[m] = distance(&together, crowd.member_strands(m).start, &alone.read_state().expect("state"));
+    }
+    println!("members from where they move alone: {worst:?} m; a step: {one_step:?}");
+    // The member's own parameters matter: with the crowd's it would be elsewhere.
+    let mut with_base = HairSim::new(ctx, &members[1].groom, &base, &heads(0)[1]).expect("alone");
+    with_base.run(12, |i| heads(i + 1)[1], None).expect("alone run");
+    let apart = distance(&together, crowd.member_strands(1).start, &with_base.read_state().expect("state"));
+    println!("member 1 from where the crowd's parameters would take it: {apart:e} m");
+    assert!(apart > 1e-3, "member 1's own parameters made no difference ({apart} m)");
+    assert!(worst.iter().all(|w| *w < 1e-4), "a member moved away from where it moves alone: {worst:?}");
+    assert_eq!(one_step.dispatches, 1, "one dispatch for every set");
+    let other = SimParams { iterations: base.iterations + 1, ..own };
+    let refused =
+        [Member::rigid(grooms[0].clone()), Member { params: Some(other), ..Member::rigid(grooms[1].clone()) }];
+    let e = Crowd::new(ctx, &refused, &poses(0)[..2], &base).err().expect("refused").to_string();
+    assert!(e.contains("member 1") && e.contains("iterations"), "{e}");
+}
+
 /// The largest distance between the particles of `alone` and those of
 /// `together` from key hair `first` on.
 fn distance(together: &SimState, first: usize, alone: &SimState) -> f32 {

@@ -82,7 +82,7 @@ impl CrowdScene {
                     *place *= Mat4::from_translation(Vec3::new(-head.x, 0.0, -head.z));
                     kinds.push(Kind::Character);
                     let scalp = r.scalp()?;
-                    members.push(Member { groom: groom.clone(), colliders: Vec::new(), scalp: Some(scalp) });
+                    members.push(Member { scalp: Some(scalp), ..Member::rigid(groom.clone()) });
                 }
                 _ => {
                     let place = places.last_mut().expect("pushed above");

@@ -167,6 +167,13 @@ void main() {
     bool live = in_sync < per_sync && hair < per_group && slot < simulated;
     uint strand = live ? sim_order[slot] : 0u;
     uint index = strand * points + i;
+    // A crowd member's key hair reads its member's parameter set (the same
+    // switches, iterations and sweeps' knobs as every set: uniform control flow).
+    uint param_base = step_range_first(push);
+    if (live && (step_flags() & SIM_SCALP) != 0u) {
+        param_base += scalp_root_set(scalp_roots[strand]) * step_range_stride(push);
+        params = steps[param_base];
+    }
     // The sequential sweeps (local shape, DFTL) of the sync group's hairs run on
     // its first lanes side by side, lane h for its h-th hair, rather than on each
     // hair's root: neighbouring lanes share a SIMD batch or subgroup.
@@ -198,7 +205,7 @@ void main() {
     for (uint sub = 0u; sub < step_range_count(push); sub++) {
         // The first sub-step's parameters were loaded above.
         if (sub > 0u) {
-            params = steps[step_range_first(push) + sub];
+            params = steps[param_base + sub];
         }
         collider_base = (step_range_first(push) + sub) * SIM_MAX_COLLIDERS;
         uint flags = step_flags();

@@ -40,7 +40,8 @@ pub(super) struct Layout {
 }
 
 /// Lays out `members` placed by their `poses` (see [`super::Crowd::new`]).
-pub(super) fn lay_out(members: &[Member], poses: &[MemberPose]) -> Result<Layout> {
+/// `sets`: each member's parameter set.
+pub(super) fn lay_out(members: &[Member], poses: &[MemberPose], sets: &[u32]) -> Result<Layout> {
     if members.is_empty() {
         return Err(Error::param("crowd members", 0, format!("1 to {MAX_CROWD_MEMBERS}")));
     }
@@ -57,7 +58,7 @@ pub(super) fn lay_out(members: &[Member], poses: &[MemberPose]) -> Result<Layout
     let mut scalps = Vec::with_capacity(members.len());
     let mut placed = Vec::with_capacity(members.len());
     let mut bone_base = 0usize;
-    for (i, (member, pose)) in members.iter().zip(poses).enumerate() {
+    for (i, ((member, pose), &set)) in members.iter().zip(poses).zip(sets).enumerate() {
         let named = |e: Error| Error::incompatible("crowd member", format!("member {i}: {e}"));
         pose.head.validate().map_err(named)?;
         member.colliders.iter().try_for_each(|c| c.validate()).map_err(named)?;
@@ -98,6 +99,9 @@ pub(super) fn lay_out(members: &[Member], poses: &[MemberPose]) -> Result<Layout
                 (scalp, 1)
             }
         };
+        if let Some(part) = parts.last_mut() {
+            part.views.iter_mut().for_each(|v| v.set = set);
+        }
         scalps.push((scalp, bone_base as u32));
         placed.push(Placed {
             strands: first..strands.len(),

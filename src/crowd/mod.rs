@@ -30,8 +30,15 @@
 //!    ([`crate::sim::KeyHairs::with_bounds`]), which the renderer fits its
 //!    shadow maps to and takes the level of detail's distance from.
 //!
-//! The members share the simulation's [`SimParams`] and the renderer's
-//! parameters (a crowd of other parameters is another crowd). The volume stage
+//! 5. **Parameters**: a member may have simulation parameters of its own
+//!    ([`Member::params`]) where they differ from the crowd's only in
+//!    [`MEMBER_PARAMS`] (gravity, wind, spring, damping, bending, global
+//!    shape): each distinct set is one more block of per-sub-step parameters,
+//!    and each key hair reads its member's block in the same dispatch (the
+//!    step kernel's switches, iterations and the sweeps over other hairs stay
+//!    the crowd's).
+//!
+//! The members share the renderer's parameters. The volume stage
 //! and the mesh collider are not available in a crowd (one grid cannot follow
 //! characters apart; the mesh collider has one head frame): [`Crowd::new`]
 //! and [`Crowd::set_params`] refuse a volume stage.
@@ -82,7 +89,9 @@ use crate::error::{Error, Result};
 use crate::groom::Groom;
 use crate::profiler::GpuProfiler;
 use crate::sim::scalp::{frames_at, Scalp};
-use crate::sim::{Collider, HairSim, KeyHairs, RigidTransform, SimParams, SimState, VolumeMode, MAX_COLLIDERS};
+use crate::sim::{
+    check_set, Collider, HairSim, KeyHairs, RigidTransform, SimParams, SimState, VolumeMode, MAX_COLLIDERS,
+};
 use layout::Placed;
 
 /// Members a crowd holds at most.
@@ -101,12 +110,23 @@ pub struct Member {
     /// ([`MemberPose::bones`]) carry the roots, bound within
     /// `scalp.tolerance` of its triangles; `None`: the roots ride the head.
     pub scalp: Option<Scalp>,
+    /// The member's own simulation parameters, `None`: the crowd's. They may
+    /// differ from the crowd's only in [`MEMBER_PARAMS`] (the members still
+    /// share one dispatch); members with equal parameters share a set.
+    pub params: Option<SimParams>,
 }
+
+/// The simulation parameters a member may have of its own: gravity, wind
+/// (its direction, turbulence and frequency), the rest-shape spring, damping,
+/// bending at root and tip, and the global shape's stiffness and range. The
+/// others (time step, sub-steps, iterations, solver, switches, local shape,
+/// stretch limit, friction, pearl radii, the volume stage) are the crowd's.
+pub const MEMBER_PARAMS: [&str; 10] = crate::sim::SET_FIELDS;
 
 impl Member {
     /// A member whose roots ride its head rigidly, without colliders.
     pub fn rigid(groom: Groom) -> Member {
-        Member { groom, colliders: Vec::new(), scalp: None }
+        Member { groom, colliders: Vec::new(), scalp: None, params: None }
     }
 }
 
@@ -135,6 +155,8 @@ impl MemberPose {
 pub struct Crowd {
     sim: HairSim,
     members: Vec<Placed>,
+    /// Each member's own parameters ([`Member::params`]).
+    own: Vec<Option<SimParams>>,
     /// Centre (world) and radius of the sphere holding every member's hair.
     bounds: (Vec3, f32),
 }
@@ -148,7 +170,8 @@ impl Crowd {
     /// is refused (see the module docs). This submits and waits.
     pub fn new(ctx: &GpuContext, members: &[Member], poses: &[MemberPose], params: &SimParams) -> Result<Crowd> {
         refuse_volume(params)?;
-        let layout = layout::lay_out(members, poses)?;
+        let (sets, member_sets) = parameter_sets(params, members)?;
+        let layout = layout::lay_out(members, poses, &member_sets)?;
         let Placing { bones, bounds, colliders } = place(&layout.members, poses)?;
         let head = RigidTransform::default();
         let mut state = SimState::from_groom(&layout.groom, params, &head)?;
@@ -168,8 +191,9 @@ impl Crowd {
         }
         let mut sim = HairSim::from_state(ctx, &state, params, &head)?;
         sim.bind_scalp_bones_as(&layout.scalp, layout.binding, &bones, true)?;
+        sim.set_parameter_sets(sets)?;
         sim.set_body_colliders(&colliders)?;
-        Ok(Crowd { sim, members: layout.members, bounds })
+        Ok(Crowd { sim, members: layout.members, own: members.iter().map(|m| m.params.clone()).collect(), bounds })
     }
 
     /// The simulation of every member (its state, parameters and level of
@@ -181,6 +205,23 @@ impl Crowd {
     /// Members in the crowd.
     pub fn members(&self) -> usize {
         self.members.len()
+    }
+
+    /// Parameter sets the members are simulated with: the crowd's, and one
+    /// more for each distinct [`Member::params`] unlike it.
+    pub fn parameter_sets(&self) -> usize {
+        1 + self
+            .own
+            .iter()
+            .flatten()
+            .filter(|p| *p != self.sim.params())
+            .fold(Vec::new(), |mut v: Vec<&SimParams>, p| {
+                if !v.contains(&p) {
+                    v.push(p);
+                }
+                v
+            })
+            .len()
     }
 
     /// Member `m`'s key hairs in the simulation (empty past the last member).
@@ -241,10 +282,17 @@ impl Crowd {
         result
     }
 
-    /// Changes the simulation's parameters from the next step on (validated
-    /// first; a volume stage is refused).
+    /// Changes the crowd's parameters from the next step on (validated first;
+    /// a volume stage, and a change of what a member with parameters of its
+    /// own must share, are refused, naming the member). Members with their
+    /// own parameters keep them.
     pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
         refuse_volume(params)?;
+        for (m, own) in self.own.iter().enumerate() {
+            if let Some(own) = own {
+                check_set(params, own).map_err(|e| member_error(m, e))?;
+            }
+        }
         self.sim.set_params(params)
     }
 
@@ -310,6 +358,36 @@ struct Placing {
     bounds: (Vec3, f32),
     /// Every member's colliders in the world.
     colliders: Vec<Collider>,
+}
+
+/// The members' parameter sets beyond the crowd's own (`params`, set 0):
+/// one per distinct [`Member::params`], and each member's set.
+fn parameter_sets(params: &SimParams, members: &[Member]) -> Result<(Vec<SimParams>, Vec<u32>)> {
+    let mut sets: Vec<SimParams> = Vec::new();
+    let mut of_member = Vec::with_capacity(members.len());
+    for (m, member) in members.iter().enumerate() {
+        let set = match &member.params {
+            None => 0,
+            Some(own) if own == params => 0,
+            Some(own) => {
+                check_set(params, own).map_err(|e| member_error(m, e))?;
+                match sets.iter().position(|s| s == own) {
+                    Some(s) => s + 1,
+                    None => {
+                        sets.push(own.clone());
+                        sets.len()
+                    }
+                }
+            }
+        };
+        of_member.push(set as u32);
+    }
+    Ok((sets, of_member))
+}
+
+/// `e` said of member `m`.
+fn member_error(m: usize, e: Error) -> Error {
+    Error::incompatible("crowd member", format!("member {m}: {e}"))
 }
 
 /// Refuses a volume stage in a crowd's parameters.

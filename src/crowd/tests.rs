@@ -22,11 +22,14 @@ fn pose(x: f32) -> MemberPose {
 fn members_are_placed_by_their_first_poses_and_resampled_to_one_point_count() {
     let a = Groom::from_strands(&[strand(0.0, 4), strand(0.01, 4)]).expect("a");
     let b = Groom::from_strands(&[strand(0.0, 6)]).expect("b");
-    let layout = lay_out(&[Member::rigid(a.clone()), Member::rigid(b)], &[pose(0.0), pose(2.0)]).expect("layout");
+    let layout =
+        lay_out(&[Member::rigid(a.clone()), Member::rigid(b)], &[pose(0.0), pose(2.0)], &[0, 1]).expect("layout");
     assert_eq!(layout.groom.strand_count(), 3);
     assert_eq!(layout.groom.uniform_points_per_strand(), Some(6), "the most points any member has");
     assert_eq!(layout.members[0].strands, 0..2);
     assert_eq!(layout.members[1].strands, 2..3);
+    let sets: Vec<u32> = layout.binding.views.iter().map(|v| v.set).collect();
+    assert_eq!(sets, [0, 0, 1], "each key hair names its member's parameter set");
     let m = pose(0.0).head.matrix();
     assert!(layout.groom.strand(1)[0].distance(m.transform_point3(a.strand(1)[0])) < 1e-6);
     let m = pose(2.0).head.matrix();
@@ -39,7 +42,8 @@ fn each_root_is_bound_within_its_own_member_even_where_members_overlap() {
     let g = Groom::from_strands(&[strand(0.0, 4), strand(0.01, 4)]).expect("groom");
     // Two members at the same place: a root bound to the other's scalp would
     // follow the wrong head.
-    let layout = lay_out(&[Member::rigid(g.clone()), Member::rigid(g)], &[pose(0.0), pose(0.0)]).expect("layout");
+    let layout =
+        lay_out(&[Member::rigid(g.clone()), Member::rigid(g)], &[pose(0.0), pose(0.0)], &[0, 0]).expect("layout");
     assert_eq!(layout.binding.views.len(), 4);
     assert_eq!(layout.scalp.mesh.positions.len(), 6, "one triangle per rigid member");
     for (h, view) in layout.binding.views.iter().enumerate() {
@@ -72,6 +76,7 @@ fn skinned_member() -> Member {
         groom: Groom::from_strands(&strands).expect("groom"),
         colliders: vec![Collider::Sphere { center: Vec3::ZERO, radius: 0.05 }],
         scalp: Some(Scalp { skin, ..Scalp::new(mesh) }),
+        params: None,
     }
 }
 
@@ -80,7 +85,7 @@ fn a_skinned_member_keeps_only_the_triangles_its_roots_ride_and_its_bones_follow
     let skinned = skinned_member();
     let rigid = Member::rigid(Groom::from_strands(&[strand(0.0, 4)]).expect("rigid"));
     let poses = [pose(0.0), MemberPose { bones: vec![Mat4::IDENTITY; 3], ..pose(1.0) }];
-    let layout = lay_out(&[rigid, skinned], &poses).expect("layout");
+    let layout = lay_out(&[rigid, skinned], &poses, &[0, 0]).expect("layout");
     assert_eq!(layout.scalp.mesh.positions.len(), 3 + 6, "the unused far triangle is left out");
     assert_eq!(layout.members[1].bones, 1..3, "bone 2 skins nothing kept");
     let joints: Vec<u32> = layout.scalp.skin.iter().map(|s| s.joints[0]).collect();
@@ -110,6 +115,7 @@ fn poses_are_refused_naming_the_member_and_the_problem() {
     let layout = lay_out(
         &[Member::rigid(Groom::from_strands(&[strand(0.0, 4)]).expect("g")), skinned_member()],
         &[pose(0.0), MemberPose { bones: vec![Mat4::IDENTITY; 3], ..pose(1.0) }],
+        &[0, 0],
     )
     .expect("layout");
     let refused = |poses: &[MemberPose]| place(&layout.members, poses).err().expect("refused").to_string();
@@ -129,11 +135,34 @@ fn poses_are_refused_naming_the_member_and_the_problem() {
 
 #[test]
 fn a_crowd_of_no_member_or_too_many_is_refused() {
-    let none = lay_out(&[], &[]).err().expect("refused").to_string();
+    let none = lay_out(&[], &[], &[]).err().expect("refused").to_string();
     assert!(none.contains("crowd members"), "{none}");
     let g = Groom::from_strands(&[strand(0.0, 4)]).expect("g");
     let many = vec![Member::rigid(g); super::MAX_CROWD_MEMBERS + 1];
     let poses = vec![pose(0.0); many.len()];
-    let e = lay_out(&many, &poses).err().expect("refused").to_string();
+    let e = lay_out(&many, &poses, &vec![0; poses.len()]).err().expect("refused").to_string();
     assert!(e.contains(&(super::MAX_CROWD_MEMBERS + 1).to_string()), "{e}");
+}
+
+#[test]
+fn members_with_equal_parameters_share_a_set_and_others_are_refused_naming_what_differs() {
+    let g = Groom::from_strands(&[strand(0.0, 4)]).expect("g");
+    let base = crate::sim::SimParams { global_shape_stiffness: 0.1, ..Default::default() };
+    let heavy = crate::sim::SimParams { gravity: Vec3::new(0.0, -20.0, 0.0), ..base.clone() };
+    let stiff = crate::sim::SimParams { global_shape_stiffness: 0.5, damping: 0.3, ..base.clone() };
+    let member = |p: Option<&crate::sim::SimParams>| Member { params: p.cloned(), ..Member::rigid(g.clone()) };
+    let members = [member(None), member(Some(&heavy)), member(Some(&base)), member(Some(&stiff)), member(Some(&heavy))];
+    let (sets, of_member) = super::parameter_sets(&base, &members).expect("sets");
+    assert_eq!(sets, [heavy.clone(), stiff]);
+    assert_eq!(of_member, [0, 1, 0, 2, 1], "the crowd's own parameters are set 0, equal ones share");
+    let refused = |p: crate::sim::SimParams| {
+        super::parameter_sets(&base, &[member(None), member(Some(&p))]).expect_err("refused").to_string()
+    };
+    let e = refused(crate::sim::SimParams { iterations: base.iterations + 1, substeps: 2, ..heavy.clone() });
+    assert!(e.contains("member 1") && e.contains("iterations") && e.contains("substeps"), "{e}");
+    assert!(e.contains("differ in iterations, substeps ("), "only what may not differ is named: {e}");
+    let e = refused(crate::sim::SimParams { global_shape_stiffness: 0.0, ..base.clone() });
+    assert!(e.contains("member 1") && e.contains("switches"), "{e}");
+    let e = refused(crate::sim::SimParams { damping: f32::NAN, ..base.clone() });
+    assert!(e.contains("member 1") && e.contains("damping"), "{e}");
 }

@@ -109,6 +109,9 @@ shader_views! {
         weights: vec3 = weights.xyz,
         /// Bind-pose triangle frame's inverse: head frame → triangle frame.
         unbind: mat4 = unbind,
+        /// The parameter set the key hair is simulated with (a crowd member's,
+        /// [`crate::crowd`]; 0, the simulation's own, otherwise).
+        set: uint = corners.w,
     }
 
     /// Which sub-steps one dispatch of the step kernel runs (`SimPush`).
@@ -120,6 +123,9 @@ shader_views! {
         /// How many key hairs are simulated: the first of the level-of-detail
         /// order (`sim::lod`); the others follow them.
         simulated: uint = range.z,
+        /// Sub-steps per parameter set: a key hair of parameter set `s` reads
+        /// its sub-step `first + k` at entry `s · stride + first + k`.
+        stride: uint = range.w,
     }
 
     /// A cut or teleport applied to the whole state before a step (`MovePush`,

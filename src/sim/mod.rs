@@ -84,6 +84,7 @@ pub use cpu::{CpuHairSim, REFERENCE_STEP_TOLERANCE_M};
 pub use driver::{FixedStepDriver, StepPlan};
 pub use lod::FOLLOW_FADE;
 pub use mesh_collider::{MeshCollider, MeshColliderParams, MESH_COLLIDER_BUILD_LABEL};
+pub(crate) use packing::{check_set, SET_FIELDS};
 pub use params::{SimParams, SolverMode, MAX_SIM_POINTS, MAX_SUBSTEPS};
 pub use state::SimState;
 pub use teleport::MOVE_LABEL;
@@ -337,6 +338,7 @@ impl HairSim {
     /// and waits for the device to be idle first.
     pub fn set_params(&mut self, params: &SimParams) -> Result<()> {
         params.validate()?;
+        self.planner.sets.iter().try_for_each(|set| packing::check_set(params, set))?;
         self.configure_volume(&params.volume)?;
         self.planner.set_params(params)?;
         self.prepare_step()

@@ -63,6 +63,70 @@ macro_rules! sim_constraints {
 
 include!("../gpu_types/constraints.rs");
 
+/// The parameters a set of key hairs may have of its own in one simulation
+/// ([`HairSim::set_parameter_sets`](super::HairSim)): those no control flow of
+/// the step kernel and no sweep over another hair depends on.
+pub(crate) const SET_FIELDS: [&str; 10] = [
+    "gravity",
+    "wind",
+    "wind_turbulence",
+    "wind_frequency",
+    "spring_stiffness",
+    "damping",
+    "bending_root",
+    "bending_tip",
+    "global_shape_stiffness",
+    "global_shape_range",
+];
+
+/// `step` (a sub-step of the simulation's own parameters) for a parameter
+/// set `p`: its [`SET_FIELDS`] in place of the simulation's.
+pub(crate) fn for_set(step: &SimStep, p: &SimParams) -> SimStep {
+    SimStep {
+        gravity: p.gravity,
+        wind: p.wind,
+        wind_turbulence: p.wind_turbulence,
+        wind_frequency: p.wind_frequency,
+        spring_stiffness: p.spring_stiffness,
+        damping: p.damping,
+        knobs: knobs(p),
+        ..*step
+    }
+}
+
+/// Refuses a parameter set `p` that differs from the simulation's `base`
+/// anywhere but in [`SET_FIELDS`], naming the fields.
+pub(crate) fn check_set(base: &SimParams, p: &SimParams) -> crate::error::Result<()> {
+    p.validate()?;
+    let table = |p: &SimParams| toml::Table::try_from(p).unwrap_or_default();
+    let (a, b) = (table(base), table(p));
+    let differ: Vec<&str> = a
+        .keys()
+        .chain(b.keys())
+        .filter(|k| !SET_FIELDS.contains(&k.as_str()) && a.get(*k) != b.get(*k))
+        .map(String::as_str)
+        .collect();
+    let (on, own) = (flags(base, false), flags(p, false));
+    if differ.is_empty() && on == own {
+        return Ok(());
+    }
+    if differ.is_empty() {
+        return Err(crate::error::Error::param(
+            "simulation parameters of a set",
+            format!("switches {own:#x} (a global shape stiffness of 0 turns the constraint off)"),
+            format!("the simulation's switches, {on:#x}"),
+        ));
+    }
+    let mut differ = differ;
+    differ.sort_unstable();
+    differ.dedup();
+    Err(crate::error::Error::param(
+        "simulation parameters of a set",
+        format!("they differ in {}", differ.join(", ")),
+        format!("the simulation's but for {}", SET_FIELDS.join(", ")),
+    ))
+}
+
 /// Where and when one sub-step happens.
 pub(crate) struct SubstepPose {
     /// World-from-head transform at the start of the sub-step.

@@ -19,6 +19,8 @@ use crate::gpu_types::{ColliderShape, SimStep, VolumeStep};
 /// Everything one sub-step needs, identical for the GPU stages and the CPU reference.
 pub(crate) struct SubstepInputs {
     pub params: SimStep,
+    /// The same sub-step for each further parameter set ([`SubstepPlanner::sets`]).
+    pub sets: Vec<SimStep>,
     /// The colliders in the world at the end of the sub-step.
     pub colliders: Vec<ColliderShape>,
 }
@@ -73,6 +75,9 @@ pub(crate) struct SubstepPlanner {
     pub pending: Option<PendingMove>,
     /// With a bound scalp: where the next step's skinned vertices are.
     pub scalp: Option<ScalpLanes>,
+    /// Further parameter sets, 1 onward (set 0 is `params`): key hairs whose
+    /// scalp root names set `s` read `sets[s − 1]`'s sub-steps.
+    pub sets: Vec<SimParams>,
 }
 
 /// Says, through `log`, when the sag-free rest state is asked for but cannot be
@@ -114,6 +119,7 @@ impl SubstepPlanner {
             roots,
             pending: None,
             scalp: None,
+            sets: Vec::new(),
         })
     }
 
@@ -222,7 +228,8 @@ impl SubstepPlanner {
                 if let Some(scalp) = &self.scalp {
                     scalp.apply(&mut params, k, p.substeps, restart);
                 }
-                SubstepInputs { params, colliders: head_colliders.chain(body).collect() }
+                let sets = self.sets.iter().map(|s| packing::for_set(&params, s)).collect();
+                SubstepInputs { params, sets, colliders: head_colliders.chain(body).collect() }
             })
             .collect();
         if let Some(scalp) = &mut self.scalp {

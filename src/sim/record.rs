@@ -100,14 +100,19 @@ impl HairSim {
     /// As [`HairSim::record_step`].
     unsafe fn record_uploads(&self, cmd: vk::CommandBuffer, inputs: &[SubstepInputs], scalp: Option<&[Vec4]>) {
         let d = &self.device;
-        let params: Vec<SimStepParams> = inputs.iter().map(|sub| SimStepParams::from(&sub.params)).collect();
+        // Every sub-step of set 0, then of set 1, … (see `StepRange::stride`).
+        let sets = inputs.first().map_or(0, |sub| sub.sets.len());
+        let params: Vec<SimStepParams> = (0..=sets)
+            .flat_map(|s| inputs.iter().map(move |sub| if s == 0 { &sub.params } else { &sub.sets[s - 1] }))
+            .map(SimStepParams::from)
+            .collect();
         // SAFETY: guaranteed by the caller; sizes are multiples of 4, each update
-        // below 64 KiB (at most MAX_SUBSTEPS parameter blocks of
-        // size_of::<SimStepParams>() bytes, at most MAX_COLLIDERS colliders of
-        // 32 bytes).
+        // below 64 KiB (the parameter blocks in chunks; at most MAX_COLLIDERS
+        // colliders of 32 bytes); the parameters' buffer holds every set's
+        // MAX_SUBSTEPS blocks (`HairSim::set_parameter_sets`).
         unsafe {
             d.cmd_barrier(cmd, &[entry_barrier()], &[], &[]);
-            d.raw.cmd_update_buffer(cmd, self.gpu.params.raw(), 0, bytemuck::cast_slice(&params));
+            update_chunked(d, cmd, self.gpu.params.raw(), 0, bytemuck::cast_slice(&params));
             for (k, sub) in inputs.iter().enumerate().filter(|(_, sub)| !sub.colliders.is_empty()) {
                 let offset = state::collider_offset(k);
                 let colliders = gpu_colliders(&sub.colliders);
@@ -167,7 +172,8 @@ impl HairSim {
     ) {
         let (strands, groups) = (self.planner.strands, self.planner.packing().hairs_per_group);
         let simulated = self.lod.simulated as u32;
-        let push = SimPush::from(&StepRange { first: range[0], count: range[1], simulated });
+        let stride = self.planner.params.substeps;
+        let push = SimPush::from(&StepRange { first: range[0], count: range[1], simulated, stride });
         // SAFETY: guaranteed by the caller.
         unsafe {
             PassScope::record(&self.device, cmd, timing, SimStage::Step.label(), LabelColor::Compute, || {

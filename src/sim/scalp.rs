@@ -266,7 +266,7 @@ fn root_view(mesh: &TriMesh, s: usize, b: &RootBinding) -> Result<ScalpRootView>
     let o = frame.col(3).truncate();
     let unbind =
         Mat4::from_cols(r.col(0).extend(0.0), r.col(1).extend(0.0), r.col(2).extend(0.0), (-(r * o)).extend(1.0));
-    Ok(ScalpRootView { corners: t, weights: w, unbind })
+    Ok(ScalpRootView { corners: t, weights: w, unbind, set: 0 })
 }
 
 /// `scalp_corner` of `glsl/include/scalp.glsl`: a corner at `f` of the step.

@@ -9,11 +9,13 @@
 use ash::vk;
 use glam::{Mat4, Vec4};
 
-use super::packing::ScalpLanes;
+use super::packing::{self, ScalpLanes};
+use super::params::{SimParams, MAX_SUBSTEPS};
 use super::scalp::{as_vec4, check_vertices, Scalp, ScalpBinding, ScalpSource};
 use super::state::binding;
 use super::HairSim;
 use crate::error::{Error, Result};
+use crate::gpu_types::SimStepParams;
 use crate::vk::buffer::Buffer;
 
 /// Where a bound scalp's skinned vertices come from.
@@ -130,6 +132,24 @@ impl HairSim {
         let vertices = scalp.skin(bones)?;
         check_vertices(&vertices, binding.vertices)?;
         *pending = Some(as_vec4(&vertices));
+        Ok(())
+    }
+
+    /// Simulates the key hairs whose scalp roots name parameter set `s ≥ 1`
+    /// with `sets[s − 1]` from the next step on (set 0: the simulation's own
+    /// parameters), in the same dispatch: each set may differ from the
+    /// simulation's parameters only in the fields of `packing::SET_FIELDS`
+    /// (refused otherwise, naming the fields). Waits for the device to be idle
+    /// when the parameters' buffer grows.
+    pub(crate) fn set_parameter_sets(&mut self, sets: Vec<SimParams>) -> Result<()> {
+        sets.iter().try_for_each(|set| packing::check_set(&self.planner.params, set))?;
+        let bytes = (sets.len() as u64 + 1) * u64::from(MAX_SUBSTEPS) * std::mem::size_of::<SimStepParams>() as u64;
+        if self.gpu.params.size() < bytes {
+            self.device.wait_idle()?;
+            self.gpu.params = Buffer::storage(&self.device, "vkhair sim params", bytes)?;
+            self.rewrite_sets()?;
+        }
+        self.planner.sets = sets;
         Ok(())
     }
 
