@@ -205,6 +205,44 @@ fn members_with_parameters_of_their_own_move_as_they_would_alone() {
     assert!(e.contains("member 1") && e.contains("iterations"), "{e}");
 }
 
+/// A member teleported 4 m moves as it would alone after `HairSim::teleport`
+/// (within 0.1 mm, its hair gaining no speed), while a member that jumps as
+/// far without a teleport is dragged across the jump.
+#[test]
+fn a_member_teleports_on_its_own() {
+    let gpu = Gpu::new();
+    let ctx = gpu.ctx();
+    let grooms = [common::grown_groom(24, 6, 13), common::grown_groom(24, 6, 14)];
+    let members = [Member::rigid(grooms[0].clone()), Member::rigid(grooms[1].clone())];
+    let heads = |i: usize| {
+        let t = i as f32 / 60.0;
+        let jump = if i >= 6 { 4.0 } else { 0.0 };
+        [at(-1.0 + jump, 0.0, 0.0), at(1.0 + jump + 0.5 * t, 0.0, 0.0)]
+    };
+    let poses = |i: usize| -> Vec<MemberPose> { heads(i).map(MemberPose::rigid).to_vec() };
+    // Three sub-steps: a root swept across the jump would show between them.
+    let params = SimParams { substeps: 3, ..SimParams::default() };
+    let mut crowd = Crowd::new(ctx, &members, &poses(0), &params).expect("crowd");
+    crowd.run(5, |i| poses(i + 1)).expect("before the jump");
+    crowd.teleport(1, &heads(6)[1]).expect("teleport");
+    crowd.run(3, |i| poses(i + 6)).expect("after the jump");
+    let state = crowd.sim().read_state().expect("state");
+    let mut alone = HairSim::new(ctx, &grooms[1], &params, &heads(0)[1]).expect("alone");
+    alone.run(5, |i| heads(i + 1)[1], None).expect("alone before");
+    alone.teleport(&heads(6)[1]).expect("alone teleport");
+    alone.run(3, |i| heads(i + 6)[1], None).expect("alone after");
+    let apart = distance(&state, crowd.member_strands(1).start, &alone.read_state().expect("state"));
+    let speed = |m: usize| {
+        let points = crowd.member_strands(m).start * state.points..crowd.member_strands(m).end * state.points;
+        state.velocities[points].iter().map(|v| v.truncate().length()).fold(0.0f32, f32::max)
+    };
+    println!("teleported member {apart:e} m from alone, fastest {} m/s; dragged member {} m/s", speed(1), speed(0));
+    assert!(apart < 1e-4, "the teleported member is {apart} m from where it is alone");
+    assert!(speed(1) < 5.0 && speed(0) > 10.0, "speeds {} and {} m/s", speed(1), speed(0));
+    let e = crowd.teleport(2, &heads(0)[0]).expect_err("refused").to_string();
+    assert!(e.contains("crowd member") && e.contains("below 2"), "{e}");
+}
+
 /// The largest distance between the particles of `alone` and those of
 /// `together` from key hair `first` on.
 fn distance(together: &SimState, first: usize, alone: &SimState) -> f32 {

@@ -1,7 +1,8 @@
 #version 460
 // A cut or teleport (src/sim/teleport.rs), recorded before a step when one is
 // pending: every point of every key hair (simulated or following) in the half
-// the step reads, in place. Teleport: x = T·x and v = R·v with T the rigid
+// the step reads, in place — or, for a crowd member's teleport, the points of
+// its key hairs (from state_move_first). Teleport: x = T·x and v = R·v with T the rigid
 // motion from the old head to the new one and R its rotation, so the hair
 // keeps its shape and motion relative to the head and gains no velocity.
 // Reset: x = head·rest (the rest pose placed by the head, or with a bound
@@ -30,10 +31,12 @@ void main() {
     mat4 m = state_move_transform(push);
     bool reset = state_move_reset(push) != 0u;
     uint total = state_move_points(push);
+    uint first_point = state_move_first(push);
     uint stride = gl_NumWorkGroups.x * gl_WorkGroupSize.x;
     SimStepParams first = steps[0];
     bool scalp = reset && (sim_flags(first) & SIM_SCALP) != 0u;
-    for (uint i = gl_GlobalInvocationID.x; i < total; i += stride) {
+    for (uint k = gl_GlobalInvocationID.x; k < total; k += stride) {
+        uint i = first_point + k;
         vec4 x = pos_in[i];
         vec4 v = vel_in[i];
         if (reset) {

@@ -38,6 +38,10 @@
 //!    step kernel's switches, iterations and the sweeps over other hairs stay
 //!    the crowd's).
 //!
+//! A member's cut or respawn is [`Crowd::teleport`]: its key hairs alone
+//! move rigidly before the next step (the move kernel over their points), and
+//! their roots start that step from its scalp.
+//!
 //! The members share the renderer's parameters. The volume stage
 //! and the mesh collider are not available in a crowd (one grid cannot follow
 //! characters apart; the mesh collider has one head frame): [`Crowd::new`]
@@ -157,6 +161,8 @@ pub struct Crowd {
     members: Vec<Placed>,
     /// Each member's own parameters ([`Member::params`]).
     own: Vec<Option<SimParams>>,
+    /// Each member's head at the latest poses.
+    heads: Vec<RigidTransform>,
     /// Centre (world) and radius of the sphere holding every member's hair.
     bounds: (Vec3, f32),
 }
@@ -193,7 +199,9 @@ impl Crowd {
         sim.bind_scalp_bones_as(&layout.scalp, layout.binding, &bones, true)?;
         sim.set_parameter_sets(sets)?;
         sim.set_body_colliders(&colliders)?;
-        Ok(Crowd { sim, members: layout.members, own: members.iter().map(|m| m.params.clone()).collect(), bounds })
+        let own = members.iter().map(|m| m.params.clone()).collect();
+        let heads = poses.iter().map(|p| p.head).collect();
+        Ok(Crowd { sim, members: layout.members, own, heads, bounds })
     }
 
     /// The simulation of every member (its state, parameters and level of
@@ -250,7 +258,24 @@ impl Crowd {
         self.sim.set_scalp_bones(&bones)?;
         self.sim.set_body_colliders(&colliders)?;
         self.bounds = bounds;
+        self.heads = poses.iter().map(|p| p.head).collect();
         Ok(())
+    }
+
+    /// A cut or a respawn of member `m` alone: the next recorded step starts
+    /// with its key hairs moved rigidly from its head at the latest poses to
+    /// `to` (positions, and velocities turned with the head, adding none), and
+    /// its roots start that step from where the step's poses put them, not
+    /// swept across the jump. Call it, then [`Crowd::set_poses`] with member
+    /// `m` at `to` (or wherever it goes next), then record the step. The
+    /// other members move on as usual. Refuses a member past the last or a
+    /// head that is not finite.
+    pub fn teleport(&mut self, m: usize, to: &RigidTransform) -> Result<()> {
+        let (Some(member), Some(from)) = (self.members.get(m), self.heads.get(m)) else {
+            return Err(Error::param("crowd member", m, format!("below {}", self.members.len())));
+        };
+        to.validate().map_err(|e| member_error(m, e))?;
+        self.sim.teleport_hairs(member.strands.clone(), to.matrix() * from.matrix().inverse())
     }
 
     /// Records one step of every member into `cmd`: [`HairSim::record_step`]

@@ -137,8 +137,11 @@ shader_views! {
         transform: mat4 = transform,
         /// 1 for a reset to the rest pose (velocities zero), 0 for a teleport.
         reset: uint = info.x,
-        /// Points of every key hair (strands × points per strand).
+        /// Points moved, from `first` on (every key hair's for a whole move).
         points: uint = info.y,
+        /// The first point moved (0 for a whole move; a crowd member's first
+        /// point for one of its own, [`crate::crowd::Crowd::teleport`]).
+        first: uint = info.z,
     }
 
     /// One collider in world space at one sub-step (`Collider`).

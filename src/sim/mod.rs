@@ -205,6 +205,8 @@ pub struct HairSim {
     shape: SimState,
     /// Particle ranges of `shape` to upload with the next step.
     pending_rest: Vec<std::ops::Range<usize>>,
+    /// Key hairs moved on their own before the next step (a crowd member's teleport).
+    partial_moves: Vec<teleport::PartialMove>,
     /// The half of the double buffer holding the latest state.
     current: usize,
     /// The volume stage, when switched on.
@@ -260,6 +262,7 @@ impl HairSim {
             planner,
             shape: state.clone(),
             pending_rest: Vec::new(),
+            partial_moves: Vec::new(),
             current: 0,
             volume: None,
             mesh: None,

@@ -56,13 +56,21 @@ impl HairSim {
         let features = inputs.iter().fold(0, |f, sub| f | sub.params.flags);
         self.pipeline.prepare_variant(features)?;
         let scalp = self.take_scalp_upload();
+        let partial = std::mem::take(&mut self.partial_moves);
+        let corners = self.moved_corners(&partial, scalp.as_deref());
         // SAFETY (whole body): guaranteed by the caller; all buffers belong to this
         // device, and update sizes are multiples of 4 below 64 KiB (by construction).
         unsafe {
-            self.record_uploads(cmd, &inputs, scalp.as_deref());
+            self.record_uploads(cmd, &inputs, scalp.as_deref(), &corners);
             if let Some(start) = &planned.start {
                 let points = self.planner.strands * self.planner.points;
-                self.mover.record(cmd, self.current, start, points);
+                self.mover.record(cmd, self.current, start, 0..points);
+            }
+            let points = self.planner.points as usize;
+            for mv in &partial {
+                let range = (mv.strands.start * points) as u32..(mv.strands.end * points) as u32;
+                let rigid = super::teleport::Move { transform: mv.transform, reset: false };
+                self.mover.record(cmd, self.current, &rigid, range);
             }
             self.pending_rest.clear();
             self.pending_guides = false;
@@ -98,7 +106,13 @@ impl HairSim {
     ///
     /// # Safety
     /// As [`HairSim::record_step`].
-    unsafe fn record_uploads(&self, cmd: vk::CommandBuffer, inputs: &[SubstepInputs], scalp: Option<&[Vec4]>) {
+    unsafe fn record_uploads(
+        &self,
+        cmd: vk::CommandBuffer,
+        inputs: &[SubstepInputs],
+        scalp: Option<&[Vec4]>,
+        corners: &[(usize, Vec<Vec4>)],
+    ) {
         let d = &self.device;
         // Every sub-step of set 0, then of set 1, … (see `StepRange::stride`).
         let sets = inputs.first().map_or(0, |sub| sub.sets.len());
@@ -130,6 +144,11 @@ impl HairSim {
             }
             if let Some(vertices) = scalp {
                 update_chunked(d, cmd, self.gpu.scalp_vertices.raw(), 0, bytemuck::cast_slice(vertices));
+            }
+            // Teleported key hairs start the step from this step's scalp.
+            for (first, run) in corners {
+                let at = *first as u64 * 48;
+                update_chunked(d, cmd, self.gpu.scalp_previous.raw(), at, bytemuck::cast_slice(run));
             }
             if let (Some(volume), Some(first)) = (&self.volume, inputs.first()) {
                 self.record_volume_uploads(cmd, volume, first);

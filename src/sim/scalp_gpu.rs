@@ -22,8 +22,9 @@ use crate::vk::buffer::Buffer;
 pub(crate) enum VertexSource {
     /// The host's buffer.
     Host(ScalpSource),
-    /// Bone matrices applied by vkhair; the vertices the next step uploads.
-    Bones { scalp: Scalp, pending: Option<Vec<Vec4>> },
+    /// Bone matrices applied by vkhair; the vertices the next step uploads,
+    /// and the latest uploaded.
+    Bones { scalp: Scalp, pending: Option<Vec<Vec4>>, latest: Vec<Vec4> },
 }
 
 /// See the module docs.
@@ -113,7 +114,7 @@ impl HairSim {
         let corners: Vec<Vec4> =
             (0..binding.views.len()).flat_map(|h| binding.corners(h, &skinned).map(|c| c.extend(0.0))).collect();
         let vertices = as_vec4(&skinned);
-        let source = VertexSource::Bones { scalp: scalp.clone(), pending: None };
+        let source = VertexSource::Bones { scalp: scalp.clone(), pending: None, latest: vertices.clone() };
         self.install_scalp(GpuScalp { binding, source }, Some(&vertices))?;
         if continuous {
             self.device.upload_pod(&self.gpu.scalp_previous, &corners)?;
@@ -126,7 +127,7 @@ impl HairSim {
     /// the scalp skinned now, uploaded by the next step's recording. Errors
     /// name a bone that is not finite or a joint past `bones`.
     pub fn set_scalp_bones(&mut self, bones: &[Mat4]) -> Result<()> {
-        let Some(GpuScalp { source: VertexSource::Bones { scalp, pending }, binding }) = &mut self.scalp else {
+        let Some(GpuScalp { source: VertexSource::Bones { scalp, pending, .. }, binding }) = &mut self.scalp else {
             return Err(Error::incompatible("scalp bones", "no scalp skinned from bone matrices is bound"));
         };
         let vertices = scalp.skin(bones)?;
@@ -167,12 +168,55 @@ impl HairSim {
         self.prepare_step()
     }
 
-    /// The vertices the next step uploads (bone path), taken.
+    /// The vertices the next step uploads (bone path), taken (and kept as
+    /// the latest).
     pub(crate) fn take_scalp_upload(&mut self) -> Option<Vec<Vec4>> {
         match &mut self.scalp {
-            Some(GpuScalp { source: VertexSource::Bones { pending, .. }, .. }) => pending.take(),
+            Some(GpuScalp { source: VertexSource::Bones { pending, latest, .. }, .. }) => {
+                let taken = pending.take();
+                if let Some(v) = &taken {
+                    latest.clone_from(v);
+                }
+                taken
+            }
             _ => None,
         }
+    }
+
+    /// Moves key hairs `strands` rigidly by `transform` (new head · old head⁻¹)
+    /// at the start of the next step, adding no velocity, their roots starting
+    /// that step from its scalp (bone path only: their corners come from the
+    /// skinned vertices). After the whole state's move when both are pending.
+    pub(crate) fn teleport_hairs(&mut self, strands: std::ops::Range<usize>, transform: Mat4) -> Result<()> {
+        if !matches!(&self.scalp, Some(GpuScalp { source: VertexSource::Bones { .. }, .. })) {
+            return Err(Error::incompatible("teleport of some key hairs", "no scalp skinned from bones is bound"));
+        }
+        if strands.end > self.shape.strands || strands.is_empty() || !transform.is_finite() {
+            return Err(Error::param("teleported key hairs", format!("{strands:?}"), "a run of the key hairs"));
+        }
+        self.partial_moves.push(super::teleport::PartialMove { strands, transform });
+        Ok(())
+    }
+
+    /// For each move of `moves`: its key hairs' corners on the scalp of the
+    /// step being recorded (`upload`, else the latest vertices), as
+    /// (first key hair, three vec4 a key hair).
+    pub(crate) fn moved_corners(
+        &self,
+        moves: &[super::teleport::PartialMove],
+        upload: Option<&[Vec4]>,
+    ) -> Vec<(usize, Vec<Vec4>)> {
+        let Some(GpuScalp { source: VertexSource::Bones { latest, .. }, binding }) = &self.scalp else {
+            return Vec::new();
+        };
+        let vertices: Vec<glam::Vec3> = upload.unwrap_or(latest).iter().map(|v| v.truncate()).collect();
+        moves
+            .iter()
+            .map(|mv| {
+                let run = mv.strands.clone().flat_map(|h| binding.corners(h, &vertices).map(|c| c.extend(0.0)));
+                (mv.strands.start, run.collect())
+            })
+            .collect()
     }
 
     /// Creates the scalp's buffers (with `vertices` uploaded into ours for the

@@ -10,6 +10,7 @@
 //! the new head (no interpolation across the jump). The CPU reference applies
 //! the same operations ([`super::reference::move_state`]).
 
+use std::ops::Range;
 use std::sync::Arc;
 
 use ash::vk;
@@ -28,6 +29,16 @@ use crate::vk::shaders::SIM_MOVE_COMP;
 
 /// Debug label of the move's dispatch.
 pub const MOVE_LABEL: &str = "vkhair sim: teleport or reset";
+
+/// A rigid move of some key hairs only (a crowd member's teleport), applied
+/// after the whole state's move at the start of the next step.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PartialMove {
+    /// The key hairs moved.
+    pub strands: Range<usize>,
+    /// New head · old head⁻¹.
+    pub transform: Mat4,
+}
 
 /// A move asked for and not yet applied.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,18 +88,20 @@ impl MoveKernel {
         Ok(MoveKernel { device: device.clone(), pipeline, sets })
     }
 
-    /// Records `mv` over `points` points of half `parity`, with a barrier
+    /// Records `mv` over the points `points` of half `parity`, with a barrier
     /// before (earlier reads and writes of the state) and after (the step's
     /// reads). Leaves the move pipeline bound.
     ///
     /// # Safety
     /// `cmd` is recording on this device outside a render pass, after the step's
     /// uploads (the rest positions) in submission order.
-    pub(crate) unsafe fn record(&self, cmd: vk::CommandBuffer, parity: usize, mv: &Move, points: u32) {
-        let push = MovePush::from(&StateMove { transform: mv.transform, reset: u32::from(mv.reset), points });
+    pub(crate) unsafe fn record(&self, cmd: vk::CommandBuffer, parity: usize, mv: &Move, points: Range<u32>) {
+        let (first, count) = (points.start, points.len() as u32);
+        let push =
+            MovePush::from(&StateMove { transform: mv.transform, reset: u32::from(mv.reset), points: count, first });
         let before = barrier::memory(&[AccessKind::AnyWrite], barrier::COMPUTE_READ_WRITE);
         let after = barrier::memory(&[AccessKind::ComputeWrite], barrier::COMPUTE_READ_WRITE);
-        let threads = self.pipeline.grid_stride_threads(points);
+        let threads = self.pipeline.grid_stride_threads(count);
         let d = &self.device;
         // SAFETY: guaranteed by the caller; the sets hold this simulation's buffers.
         unsafe {
