@@ -507,6 +507,33 @@ mod tests {
     }
 
     #[test]
+    fn comments_and_line_ends_are_read_as_the_library_reads_them() {
+        let deep = |end: &str, n: usize| {
+            let mut t = format!("#usda 1.0{end}# a comment{end}");
+            for i in 0..n {
+                t += &format!("def Xform \"p{i}\" {{{end}");
+            }
+            t + CURVES + &"}".repeat(n)
+        };
+        // A lone CR ends a comment (and a line): what follows is read, and the
+        // lines are counted as the library counts them.
+        let err = check(&deep("\r", MAX_USDA_DEPTH + 5), false).expect_err("too deep").to_string();
+        assert!(err.contains("nesting deeper") && err.contains(&format!("line {}", MAX_USDA_DEPTH + 3)), "{err}");
+        let err = check(&deep("\r\n", MAX_USDA_DEPTH + 5), false).expect_err("too deep").to_string();
+        assert!(err.contains(&format!("line {}", MAX_USDA_DEPTH + 3)), "{err}");
+        // A block comment hides what it holds, and only that.
+        let hidden = format!("#usda 1.0\n/* {} */\n{CURVES}", "def Xform \"x\" {".repeat(500));
+        check(&hidden, false).expect("a comment's text is not read");
+        let after = format!("#usda 1.0\n/* {{ */ {}{CURVES}{}", "def Xform \"x\" {".repeat(500), "}".repeat(500));
+        assert!(check(&after, false).expect_err("read").to_string().contains("nesting deeper"));
+        let open = check("#usda 1.0\n/* def Xform \"a\" { }\n", false).expect_err("unterminated").to_string();
+        assert!(open.contains("a comment that never ends"), "{open}");
+        // A string may span lines, as the library's do.
+        let multi = format!("#usda 1.0\n(\n doc = \"two\nlines {{\"\n)\n{CURVES}");
+        check(&multi, false).expect("a string over two lines");
+    }
+
+    #[test]
     fn unbalanced_or_unterminated_text_is_refused() {
         for (text, what) in [
             ("#usda 1.0\ndef Xform \"a\" { ]\n", "closes nothing"),

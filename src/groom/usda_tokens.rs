@@ -1,6 +1,9 @@
 //! USD text as [`super::usda_check`] scans it: brackets, words, strings,
 //! paths, asset paths and `=`, with their byte offsets; strings, comments and
-//! path literals skipped as units, as USD text writes them.
+//! path literals skipped as units, by the rules of the USD library's own
+//! lexer (`#` comments end at `\n` or `\r`, `/* */` comments, strings that
+//! span lines, escapes only in single-quoted strings), so that nothing the
+//! library reads is hidden from the check.
 
 use crate::error::{Error, FileFormat, Result};
 
@@ -31,7 +34,12 @@ pub(super) fn tokens(text: &str) -> Result<Vec<(usize, Token<'_>)>> {
     while i < b.len() {
         let c = b[i];
         match c {
-            b'#' => i = b[i..].iter().position(|&c| c == b'\n').map_or(b.len(), |n| i + n),
+            // A comment ends at either line end, as the library's lexer has it.
+            b'#' => i = b[i..].iter().position(|&c| c == b'\n' || c == b'\r').map_or(b.len(), |n| i + n),
+            b'/' if b[i..].starts_with(b"/*") => {
+                let end = b[i + 2..].windows(2).position(|w| w == b"*/").ok_or_else(|| unterminated(i, "a comment"))?;
+                i += 2 + end + 2;
+            }
             b'"' | b'\'' => {
                 let triple = b[i..].starts_with(&[c, c, c]);
                 let (start, quote) = if triple { (i + 3, 3) } else { (i + 1, 1) };
@@ -40,15 +48,14 @@ pub(super) fn tokens(text: &str) -> Result<Vec<(usize, Token<'_>)>> {
                     if j >= b.len() {
                         return Err(unterminated(i, "a string"));
                     }
-                    if b[j] == b'\\' {
+                    // Escapes in a single-quoted string only (the library's triple
+                    // quotes take every character but the closing three).
+                    if b[j] == b'\\' && !triple {
                         j += 2;
                         continue;
                     }
                     if b[j] == c && (!triple || b[j..].starts_with(&[c, c, c])) {
                         break;
-                    }
-                    if !triple && b[j] == b'\n' {
-                        return Err(unterminated(i, "a string"));
                     }
                     j += 1;
                 }
@@ -98,10 +105,12 @@ pub(super) fn tokens(text: &str) -> Result<Vec<(usize, Token<'_>)>> {
     Ok(out)
 }
 
-/// "line L, column C:" of byte `at` of `text`.
+/// "line L, column C:" of byte `at` of `text` (a line ends at `\n`, `\r\n`
+/// or a lone `\r`).
 pub fn position(text: &str, at: usize) -> String {
-    let before = &text[..at.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let column = before.len() - before.rfind('\n').map_or(0, |n| n + 1) + 1;
-    format!("line {line}, column {column}:")
+    let before = &text.as_bytes()[..at.min(text.len())];
+    let ends = |k: usize| before[k] == b'\n' || (before[k] == b'\r' && before.get(k + 1) != Some(&b'\n'));
+    let line = (0..before.len()).filter(|&k| ends(k)).count() + 1;
+    let start = (0..before.len()).rev().find(|&k| ends(k)).map_or(0, |k| k + 1);
+    format!("line {line}, column {}:", before.len() - start + 1)
 }
