@@ -292,6 +292,50 @@ fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
     );
 }
 
+/// The layers of one layer stack (a layer and its sublayers) share one
+/// namespace: arcs that form a cycle only across two sublayers — classes that
+/// inherit or specialise each other, or a chain through the root — are
+/// refused naming the arc's layer and line (the USD library overflowed its
+/// stack on each), while the same arcs without the cycle read; two stacks
+/// (a reference) are judged apart.
+#[test]
+fn arcs_are_judged_over_the_sublayers_of_a_stack() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
+    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let stage = |subs: &str| format!("#usda 1.0\n(\n    subLayers = [{subs}]\n)\n{curves}");
+    write("a.usda", "#usda 1.0\nclass \"A\" (\n    inherits = </B>\n) { }\n");
+    write("b.usda", "#usda 1.0\nclass \"B\" (\n    inherits = </A>\n) { }\n");
+    write("inherits.usda", &stage("@a.usda@, @b.usda@"));
+    write("sa.usda", "#usda 1.0\nclass \"A\" (\n    specializes = </B>\n) { }\n");
+    write("sb.usda", "#usda 1.0\nclass \"B\" (\n    specializes = </A>\n) { }\n");
+    write("specializes.usda", &stage("@sa.usda@, @sb.usda@"));
+    // The root's own arc closes a cycle through a sublayer of a sublayer.
+    write("deeper.usda", "#usda 1.0\n(\n    subLayers = [@b.usda@]\n)\n");
+    write(
+        "through_root.usda",
+        &format!(
+            "#usda 1.0\n(\n    subLayers = [@deeper.usda@]\n)\nclass \"A\" (\n    inherits = </B>\n) {{ }}\n{curves}"
+        ),
+    );
+    // Without the cycle, and with each half in a stack of its own: read.
+    write("b_plain.usda", "#usda 1.0\nclass \"B\" { }\n");
+    write("plain.usda", &stage("@a.usda@, @b_plain.usda@"));
+    let g = usd::open(dir.path().join("plain.usda")).expect("a chain without a cycle");
+    assert_eq!(g.groom.strand_count(), 1);
+    write("apart.usda", &format!("#usda 1.0\n(\n    subLayers = [@a.usda@]\n)\ndef Xform \"x\" (\n    references = @b.usda@</B>\n) {{ }}\n{curves}"));
+    let g = usd::open(dir.path().join("apart.usda")).expect("a reference is a stack of its own");
+    assert_eq!(g.groom.strand_count(), 1);
+    refused_naming(
+        dir.path(),
+        &[
+            ("inherits.usda", &["a cycle", "line 3", "sublayers of", "inherits.usda"][..]),
+            ("specializes.usda", &["a cycle", "line 3", "specializes.usda"][..]),
+            ("through_root.usda", &["a cycle", "through_root.usda"][..]),
+        ],
+    );
+}
+
 /// The ways round the layer checks a probe found, each closed: a deep layer
 /// led by blank space, a variant's reference to a FIFO, many chains each
 /// within the depth limit, a sublayer the library cannot parse (refused with

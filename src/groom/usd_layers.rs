@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use openusd::sdf::{Path as SdfPath, SpecType};
 
+use super::usda_arcs::Arcs;
 use super::usda_check::Takes;
 use crate::error::{Error, FileFormat, Result};
 
@@ -184,6 +185,11 @@ fn binary(path: &Path) -> std::result::Result<(Vec<(String, Takes)>, Targets), S
 /// name (sublayers, references, payloads), which is checked the same way.
 pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
     let mut queue = vec![(path.to_path_buf(), None::<(PathBuf, String)>, Takes::Layer)];
+    // The layer stacks (a layer and its sublayers, one namespace): per text
+    // layer its arcs between prims and its sublayers, and the layers that
+    // start a stack (the root, and what a reference or payload names).
+    let mut stacks = Stacks::default();
+    stacks.roots.insert(canonical(path));
     // Per text layer read, what it offers the arcs that name it again.
     let mut seen: HashMap<PathBuf, Option<Targets>> = HashMap::new();
     let mut total = 0u64;
@@ -276,20 +282,84 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
                 malformed(format!("not a USD layer: it starts with {what}, not the `#usda` header")).in_asset(&layer),
             ));
         }
-        let assets = super::usda_check::check(text, takes == Takes::Layer && named_by.is_some())
+        let checked = super::usda_check::check(text, takes == Takes::Layer && named_by.is_some())
             .map_err(|e| named(e.in_asset(&layer)))?;
+        let assets = checked.assets;
         let targets = parse(text, assets.iter().any(|a| a.takes == Takes::Layer))
             .map_err(|why| named(malformed(why).in_asset(&layer)))?;
         if let Some(why) = targets.missing(&takes) {
             return Err(named(malformed(why).in_asset(&layer)));
         }
         count_prims(&targets)?;
-        seen.insert(key, Some(targets));
+        seen.insert(key.clone(), Some(targets));
         let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
+        let located = |at: &usize| (layer.clone(), super::usda_check::position(text, *at));
+        let arcs = checked
+            .arcs
+            .into_iter()
+            .map(|(from, to)| (from, to.into_iter().map(|(target, at)| (target, located(&at))).collect()));
+        let mut sublayers = Vec::new();
         for asset in assets {
             let line = super::usda_check::position(text, asset.at);
-            queue.push((dir.join(&asset.path), Some((layer.clone(), line)), asset.takes));
+            let named = dir.join(&asset.path);
+            match asset.takes {
+                Takes::Layer => sublayers.push(canonical(&named)),
+                _ => drop(stacks.roots.insert(canonical(&named))),
+            }
+            queue.push((named, Some((layer.clone(), line)), asset.takes));
         }
+        stacks.layers.insert(key, (arcs.collect(), sublayers));
     }
-    Ok(())
+    stacks.check()
+}
+
+/// A path as the layers are keyed by: canonical where it exists.
+fn canonical(path: &Path) -> PathBuf {
+    std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
+}
+
+/// Where an arc between prims is written: its layer and "line L, column C:".
+type Written = (PathBuf, String);
+
+/// The text layers of a stage as layer stacks (see [`check_layers`]).
+#[derive(Default)]
+struct Stacks {
+    /// Per text layer: its arcs between prims, and its sublayers.
+    layers: HashMap<PathBuf, (Arcs<Written>, Vec<PathBuf>)>,
+    /// The layers that start a layer stack.
+    roots: HashSet<PathBuf>,
+}
+
+impl Stacks {
+    /// The arcs of each layer stack of more than one layer, all together,
+    /// checked as one layer's are (no cycle, no arc into its own namespace, no
+    /// chain too long): two sublayers whose classes inherit each other
+    /// overflowed the library's stack. Named at the arc, in its layer.
+    fn check(&self) -> Result<()> {
+        let mut roots: Vec<&PathBuf> = self.roots.iter().collect();
+        roots.sort();
+        for root in roots {
+            let mut members = vec![root];
+            let mut k = 0;
+            while let Some(layer) = members.get(k).copied() {
+                k += 1;
+                for sub in self.layers.get(layer).map(|(_, s)| s.as_slice()).unwrap_or_default() {
+                    if !members.contains(&sub) {
+                        members.push(sub);
+                    }
+                }
+            }
+            if members.len() < 2 {
+                continue;
+            }
+            let mut arcs: Arcs<&Written> = HashMap::new();
+            for (from, targets) in members.iter().filter_map(|m| self.layers.get(*m)).flat_map(|(a, _)| a) {
+                arcs.entry(from.clone()).or_default().extend(targets.iter().map(|(to, at)| (to.clone(), at)));
+            }
+            super::usda_arcs::check_arcs(&arcs, |(layer, line), why| {
+                malformed(format!("{line} {why} (over the sublayers of {})", root.display())).in_asset(layer)
+            })?;
+        }
+        Ok(())
+    }
 }

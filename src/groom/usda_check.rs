@@ -25,6 +25,8 @@
 
 use std::collections::{HashMap, HashSet};
 
+pub(super) use super::usda_arcs::Arcs;
+use super::usda_arcs::{absolute, arc_targets, check_arcs};
 pub use super::usda_tokens::position;
 use super::usda_tokens::{tokens, Token};
 use crate::error::{Error, FileFormat, Result};
@@ -41,9 +43,9 @@ pub const MAX_USDA_DEPTH: usize = 128;
 pub const MAX_USDA_DEPTH_WORK: u64 = 4_000_000;
 
 /// Most prims a chain of composition arcs (inherits, specializes, internal
-/// references) may pass through within a layer: the reader's time grows with
-/// the cube of the chain (1,000 links took it 13 s).
-pub const MAX_USDA_ARC_CHAIN: usize = 128;
+/// references) may pass through within a layer stack: the reader's time
+/// grows with the cube of the chain (1,000 links took it 13 s).
+pub const MAX_USDA_ARC_CHAIN: usize = super::usda_arcs::MAX_ARC_CHAIN;
 
 /// Most prims a USD stage may declare, over all its layers: the USD reader
 /// composes about ten thousand a second (400,000 empty prims took it 42 s),
@@ -61,31 +63,6 @@ const ARCS: [&str; 4] = ["inherits", "specializes", "references", "payload"];
 
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }
-}
-
-/// `target` (a path literal's text, without its property part) as an
-/// absolute prim path, from the prim at `at`.
-fn absolute(target: &str, at: &str) -> String {
-    let target = target.split('.').next().unwrap_or_default().trim();
-    if target.starts_with('/') {
-        return target.trim_end_matches('/').to_owned();
-    }
-    let mut parts: Vec<&str> = at.split('/').filter(|p| !p.is_empty()).collect();
-    for part in target.split('/').filter(|p| !p.is_empty()) {
-        match part {
-            ".." => {
-                parts.pop();
-            }
-            "." => {}
-            p => parts.push(p),
-        }
-    }
-    format!("/{}", parts.join("/"))
-}
-
-/// Whether `a` is `b` or one of its ancestors.
-fn contains(a: &str, b: &str) -> bool {
-    a == b || (b.starts_with(a) && (a == "/" || b[a.len()..].starts_with('/')))
 }
 
 /// Most composition arcs between a layer's own prims [`check`] follows.
@@ -117,9 +94,20 @@ pub enum Takes {
     Prim(String),
 }
 
-/// Checks the USD text `text` (see the module docs) and returns the other
-/// layers it names ([`LayerAssets`]).
-pub fn check(text: &str, sublayer: bool) -> Result<LayerAssets> {
+/// What [`check`] found in a layer: the other layers it names, and the
+/// composition arcs between prims of its namespace (each with the byte
+/// offset it is written at), which its sublayers share.
+#[derive(Debug, Clone, Default)]
+pub struct Checked {
+    /// The layers it names.
+    pub assets: LayerAssets,
+    /// Its arcs between prims (see [`Arcs`]).
+    pub(super) arcs: Arcs<usize>,
+}
+
+/// Checks the USD text `text` (see the module docs): the other layers it
+/// names and its arcs between prims ([`Checked`]).
+pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
     let tokens = tokens(text)?;
     // Brackets open; for each whether it opened a prim's body.
     let mut open: Vec<(u8, bool)> = Vec::new();
@@ -128,7 +116,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<LayerAssets> {
     // A prim declared (`def`/`class`/`over` … "name") whose body is not open yet.
     let mut pending: Option<String> = None;
     let mut declaring = false;
-    let mut arcs: HashMap<String, Vec<(String, usize)>> = HashMap::new();
+    let mut arcs: Arcs<usize> = HashMap::new();
     let mut count = 0usize;
     let mut declared = 0usize;
     let mut work = 0u64;
@@ -270,7 +258,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<LayerAssets> {
     if let Some((c, _)) = open.last() {
         return Err(malformed(format!("a '{}' is never closed", *c as char)));
     }
-    check_arcs(text, &arcs)?;
+    check_arcs(&arcs, |at, why| malformed(format!("{} {why}", position(text, *at))))?;
     // A reference or payload within the layer whose target's root prim the
     // layer does not declare brings nothing, and the stage says nothing (a
     // sublayer may declare it: then it is left to the stage).
@@ -287,7 +275,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<LayerAssets> {
             }
         }
     }
-    Ok(assets)
+    Ok(Checked { assets, arcs })
 }
 
 /// The asset paths of a value (`tokens` start after its key, at `=` or at
@@ -331,104 +319,11 @@ fn asset_paths<'a>(tokens: &[(usize, Token<'a>)], arc: bool) -> LayerAssets {
     }
 }
 
-/// The prim paths of an arc's value (`tokens` start after its `=`): one path,
-/// or a list of them; a path right after an asset path (`@a.usda@</P>`)
-/// names a prim of another layer and is left out.
-fn arc_targets<'a>(tokens: &[(usize, Token<'a>)]) -> Vec<&'a str> {
-    let internal = |i: usize| i == 0 || !matches!(tokens.get(i - 1), Some((_, Token::Asset(_))));
-    match tokens.first() {
-        Some((_, Token::Path(p))) => vec![*p],
-        Some((_, Token::Open(b'['))) => tokens
-            .iter()
-            .enumerate()
-            .skip(1)
-            .take_while(|(_, (_, t))| !matches!(t, Token::Close(_) | Token::Open(_)))
-            .filter_map(|(i, (_, t))| match t {
-                Token::Path(p) if internal(i) => Some(*p),
-                _ => None,
-            })
-            .collect(),
-        _ => Vec::new(),
-    }
-}
-
 /// Whether the innermost open bracket is a prim's metadata `(`…`)` or a
 /// list/dictionary inside it (not a prim body).
 fn prims_metadata_open(open: &[(u8, bool)]) -> bool {
     open.last().is_some_and(|(c, _)| *c != b'{')
         || open.iter().rev().take_while(|(_, body)| !body).any(|(c, _)| *c == b'(')
-}
-
-/// No arc targets its own prim, an ancestor or a descendant, and the arcs
-/// between prims form no cycle.
-fn check_arcs(text: &str, arcs: &HashMap<String, Vec<(String, usize)>>) -> Result<()> {
-    for (from, targets) in arcs {
-        for (to, at) in targets {
-            if contains(to, from) || contains(from, to) {
-                return Err(malformed(format!(
-                    "{} prim {from} has a composition arc to {to}, {}",
-                    position(text, *at),
-                    if to == from { "itself" } else { "its own namespace" }
-                )));
-            }
-        }
-    }
-    // Depth-first search for a cycle; a prim also composes what arcs of its
-    // ancestors bring, so an arc into a prim that (or whose descendant) leads
-    // back counts.
-    let mut state: HashMap<&str, u8> = HashMap::new();
-    // Per finished prim, the most prims a chain of arcs from it passes.
-    let mut longest: HashMap<&str, usize> = HashMap::new();
-    // The arcs leaving `node`: its own and its descendants' (found once per
-    // node visited).
-    let out_of = |node: &str| -> Vec<&(String, usize)> {
-        arcs.iter().filter(|(from, _)| contains(node, from)).flat_map(|(_, t)| t.iter()).collect()
-    };
-    let mut keys: Vec<&String> = arcs.keys().collect();
-    keys.sort();
-    for start in keys {
-        if state.get(start.as_str()).copied().unwrap_or(0) != 0 {
-            continue;
-        }
-        state.insert(start, 1);
-        let mut stack = vec![(start.as_str(), out_of(start), 0usize)];
-        while let Some((node, out, next)) = stack.last_mut() {
-            let Some((to, at)) = out.get(*next).copied() else {
-                // Every arc out of `node` is finished (no cycle): the longest
-                // chain of arcs from it is one more than its targets' longest.
-                let step = |arc: &&&(String, usize)| longest.get(arc.0.as_str()).copied().unwrap_or(0);
-                let chain = 1 + out.iter().map(|arc| step(&arc)).max().unwrap_or(0);
-                if chain > MAX_USDA_ARC_CHAIN {
-                    // Named at the arc the longest chain leaves by.
-                    let at = out.iter().max_by_key(step).map_or(0, |(_, at)| *at);
-                    return Err(malformed(format!(
-                        "{} the composition arcs from {node} chain through more than {MAX_USDA_ARC_CHAIN} prims \
-                         (the reader's time grows with the cube of the chain)",
-                        position(text, at)
-                    )));
-                }
-                longest.insert(node, chain);
-                state.insert(node, 2);
-                stack.pop();
-                continue;
-            };
-            *next += 1;
-            match state.get(to.as_str()).copied().unwrap_or(0) {
-                1 => {
-                    return Err(malformed(format!(
-                        "{} the composition arcs from {start} come back to {to}: a cycle",
-                        position(text, *at)
-                    )))
-                }
-                0 => {
-                    state.insert(to, 1);
-                    stack.push((to, out_of(to), 0));
-                }
-                _ => {}
-            }
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]
