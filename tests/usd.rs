@@ -297,7 +297,8 @@ fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
 /// inherit or specialise each other, or a chain through the root — are
 /// refused naming the arc's layer and line (the USD library overflowed its
 /// stack on each), while the same arcs without the cycle read; two stacks
-/// (a reference) are judged apart.
+/// (a reference) are judged apart. A USDZ package, or a layer inside one,
+/// is refused naming it (the library would inflate it past every bound).
 #[test]
 fn arcs_are_judged_over_the_sublayers_of_a_stack() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -326,9 +327,19 @@ fn arcs_are_judged_over_the_sublayers_of_a_stack() {
     write("apart.usda", &format!("#usda 1.0\n(\n    subLayers = [@a.usda@]\n)\ndef Xform \"x\" (\n    references = @b.usda@</B>\n) {{ }}\n{curves}"));
     let g = usd::open(dir.path().join("apart.usda")).expect("a reference is a stack of its own");
     assert_eq!(g.groom.strand_count(), 1);
+    // A package, or a layer inside one, which the library would inflate itself.
+    write("pkg.usdz", "PK\u{3}\u{4}");
+    write("pkg.usdz[inner.usda]", &format!("#usda 1.0\n{curves}"));
+    write(
+        "packaged.usda",
+        &format!("#usda 1.0\ndef Xform \"x\" (\n    references = @./pkg.usdz[inner.usda]@</c>\n) {{ }}\n{curves}"),
+    );
+    write("package.usda", &stage("@pkg.usdz@"));
     refused_naming(
         dir.path(),
         &[
+            ("packaged.usda", &["packaged.usda", "line 3", "USDZ package", "pkg.usdz[inner.usda]"][..]),
+            ("package.usda", &["package.usda", "line 3", "USDZ package"][..]),
             ("inherits.usda", &["a cycle", "line 3", "sublayers of", "inherits.usda"][..]),
             ("specializes.usda", &["a cycle", "line 3", "specializes.usda"][..]),
             ("through_root.usda", &["a cycle", "through_root.usda"][..]),

@@ -212,6 +212,16 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
             None => e,
             Some((by, line)) => malformed(format!("{line} a layer it names cannot be used: {e}")).in_asset(by),
         };
+        // The library opens a package (`.usdz`) and a layer inside one
+        // (`pkg.usdz[inner.usda]`) itself, inflating what the package holds
+        // beyond any bound checked here: refused.
+        let text_path = layer.to_string_lossy();
+        let package = layer.extension().is_some_and(|e| e.eq_ignore_ascii_case("usdz"));
+        if package || text_path.contains('[') || text_path.contains(']') {
+            let why = "a USDZ package or a layer inside one (`pkg.usdz[layer.usda]`), which vkhair does not read: \
+                       unpack it and name its .usda or .usdc layer";
+            return Err(named(malformed(why.to_owned()).in_asset(&layer)));
+        }
         crate::files::check_regular(&layer, cap, "a USD layer").map_err(named)?;
         let key = std::fs::canonicalize(&layer).unwrap_or_else(|_| layer.clone());
         if let Some(targets) = seen.get(&key) {
