@@ -297,8 +297,11 @@ fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
 /// inherit or specialise each other, or a chain through the root — are
 /// refused naming the arc's layer and line (the USD library overflowed its
 /// stack on each), while the same arcs without the cycle read; two stacks
-/// (a reference) are judged apart. A USDZ package, or a layer inside one,
-/// is refused naming it (the library would inflate it past every bound).
+/// (a reference) are judged apart; a layer's references to its own prims
+/// through its own file count as arcs within it (a chain of them, a cycle).
+/// A USDZ package, or a layer inside one, and an asset path that is an
+/// expression are refused naming them (the library would inflate the package
+/// past every bound, and evaluate the expression to a layer not checked).
 #[test]
 fn arcs_are_judged_over_the_sublayers_of_a_stack() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -335,9 +338,25 @@ fn arcs_are_judged_over_the_sublayers_of_a_stack() {
         &format!("#usda 1.0\ndef Xform \"x\" (\n    references = @./pkg.usdz[inner.usda]@</c>\n) {{ }}\n{curves}"),
     );
     write("package.usda", &stage("@pkg.usdz@"));
+    // References to prims of the layer itself, through its own file: a chain
+    // of 200 (which took the library past 10 s at 2,000) and a cycle.
+    let mut chain = String::from("#usda 1.0\n");
+    for i in 0..200 {
+        chain += &format!("def Xform \"P{i}\" (\n    references = @./self_chain.usda@</P{}>\n) {{ }}\n", i + 1);
+    }
+    write("self_chain.usda", &format!("{chain}def Xform \"P200\" {{ }}\n{curves}"));
+    let cycle = "def Xform \"P0\" (\n    references = @self_cycle.usda@</P1>\n) { }\ndef Xform \"P1\" (\n    references = @self_cycle.usda@</P0>\n) { }\n";
+    write("self_cycle.usda", &format!("#usda 1.0\n{cycle}{curves}"));
+    // An asset path the library would evaluate as an expression.
+    let expression =
+        "(\n    expressionVariables = {\n        string X = \"a\"\n    }\n    subLayers = [@`\"${X}.usda\"`@]\n)\n";
+    write("expression.usda", &format!("#usda 1.0\n{expression}{curves}"));
     refused_naming(
         dir.path(),
         &[
+            ("self_chain.usda", &["self_chain.usda", "chain through more than 128 prims"][..]),
+            ("self_cycle.usda", &["self_cycle.usda", "line 6", "a cycle"][..]),
+            ("expression.usda", &["expression.usda", "line 6", "an expression"][..]),
             ("packaged.usda", &["packaged.usda", "line 3", "USDZ package", "pkg.usdz[inner.usda]"][..]),
             ("package.usda", &["package.usda", "line 3", "USDZ package"][..]),
             ("inherits.usda", &["a cycle", "line 3", "sublayers of", "inherits.usda"][..]),

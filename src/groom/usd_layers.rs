@@ -216,6 +216,10 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
         // (`pkg.usdz[inner.usda]`) itself, inflating what the package holds
         // beyond any bound checked here: refused.
         let text_path = layer.to_string_lossy();
+        if text_path.contains('`') {
+            let why = "an asset path that is an expression (`\"${VAR}.usda\"`), which vkhair does not evaluate";
+            return Err(named(malformed(why.to_owned()).in_asset(&layer)));
+        }
         let package = layer.extension().is_some_and(|e| e.eq_ignore_ascii_case("usdz"));
         if package || text_path.contains('[') || text_path.contains(']') {
             let why = "a USDZ package or a layer inside one (`pkg.usdz[layer.usda]`), which vkhair does not read: \
@@ -304,10 +308,22 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
         seen.insert(key.clone(), Some(targets));
         let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
         let located = |at: &usize| (layer.clone(), super::usda_check::position(text, *at));
-        let arcs = checked
+        let mut arcs: Arcs<Written> = checked
             .arcs
             .into_iter()
-            .map(|(from, to)| (from, to.into_iter().map(|(target, at)| (target, located(&at))).collect()));
+            .map(|(from, to)| (from, to.into_iter().map(|(target, at)| (target, located(&at))).collect()))
+            .collect();
+        // A reference to a prim of this very layer (`@./self.usda@</P>`) is an
+        // arc within its namespace as much as one without an asset path: its
+        // chains and cycles are judged with the layer's own arcs.
+        for asset in &assets {
+            if let (Takes::Prim(target), Some(from)) = (&asset.takes, &asset.from) {
+                if canonical(&dir.join(&asset.path)) == key {
+                    let to = super::usda_arcs::absolute(target, from);
+                    arcs.entry(from.clone()).or_default().push((to, located(&asset.at)));
+                }
+            }
+        }
         let mut sublayers = Vec::new();
         for asset in assets {
             let line = super::usda_check::position(text, asset.at);
@@ -318,7 +334,7 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
             }
             queue.push((named, Some((layer.clone(), line)), asset.takes));
         }
-        stacks.layers.insert(key, (arcs.collect(), sublayers));
+        stacks.layers.insert(key, (arcs, sublayers));
     }
     stacks.check()
 }
@@ -341,7 +357,8 @@ struct Stacks {
 }
 
 impl Stacks {
-    /// The arcs of each layer stack of more than one layer, all together,
+    /// The arcs of each layer stack, all its layers' together (with a
+    /// layer's references to its own prims),
     /// checked as one layer's are (no cycle, no arc into its own namespace, no
     /// chain too long): two sublayers whose classes inherit each other
     /// overflowed the library's stack. Named at the arc, in its layer.
@@ -359,15 +376,16 @@ impl Stacks {
                     }
                 }
             }
-            if members.len() < 2 {
-                continue;
-            }
             let mut arcs: Arcs<&Written> = HashMap::new();
             for (from, targets) in members.iter().filter_map(|m| self.layers.get(*m)).flat_map(|(a, _)| a) {
                 arcs.entry(from.clone()).or_default().extend(targets.iter().map(|(to, at)| (to.clone(), at)));
             }
+            let over = match members.len() {
+                1 => String::new(),
+                _ => format!(" (over the sublayers of {})", root.display()),
+            };
             super::usda_arcs::check_arcs(&arcs, |(layer, line), why| {
-                malformed(format!("{line} {why} (over the sublayers of {})", root.display())).in_asset(layer)
+                malformed(format!("{line} {why}{over}")).in_asset(layer)
             })?;
         }
         Ok(())

@@ -81,6 +81,9 @@ pub struct LayerAsset {
     pub at: usize,
     /// What of it the naming layer takes.
     pub takes: Takes,
+    /// For a reference or payload, the prim (of the naming layer) whose arc
+    /// it is.
+    pub from: Option<String>,
 }
 
 /// What a layer takes of a layer it names.
@@ -216,11 +219,15 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
                 } else if ARCS.contains(w) && matches!(tokens.get(k + 1), Some((_, Token::Equals))) && !in_metadata {
                     // An arc outside a prim's own metadata (a variant's): its
                     // layers are checked like any other.
-                    assets.extend(asset_paths(&tokens[k + 2..], true));
+                    let from = prims.last().cloned();
+                    assets.extend(
+                        asset_paths(&tokens[k + 2..], true).into_iter().map(|a| LayerAsset { from: from.clone(), ..a }),
+                    );
                 } else if ARCS.contains(w) && in_metadata && matches!(tokens.get(k + 1), Some((_, Token::Equals))) {
-                    assets.extend(asset_paths(&tokens[k + 2..], true));
                     let from =
                         format!("{}/{}", prims.last().map_or("", String::as_str), pending.as_deref().unwrap_or(""));
+                    let named = asset_paths(&tokens[k + 2..], true);
+                    assets.extend(named.into_iter().map(|a| LayerAsset { from: Some(from.clone()), ..a }));
                     for target in arc_targets(&tokens[k + 2..]) {
                         count += 1;
                         if count > MAX_USDA_ARCS {
@@ -292,7 +299,7 @@ fn asset_paths<'a>(tokens: &[(usize, Token<'a>)], arc: bool) -> LayerAssets {
         (true, Some((_, Token::Path(p)))) => Takes::Prim((*p).to_owned()),
         (true, _) => Takes::DefaultPrim,
     };
-    let asset = |i: usize, a: &str, at: usize| LayerAsset { path: a.to_owned(), at, takes: takes(i) };
+    let asset = |i: usize, a: &str, at: usize| LayerAsset { path: a.to_owned(), at, takes: takes(i), from: None };
     match tokens.first() {
         Some((at, Token::Asset(a))) => vec![asset(0, a, *at)],
         Some((_, Token::Open(b'['))) => {
