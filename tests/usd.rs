@@ -471,6 +471,61 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
     );
 }
 
+/// A binary layer's values nested in others — dictionaries in dictionaries,
+/// time samples, references with custom data, payloads — are walked before
+/// the USD library reads them: the library writer's layer of each reads,
+/// while a dictionary entry pointing back at its own dictionary (the library
+/// recursed until its stack ended) and a reference list counting 2⁴⁰ items
+/// are refused naming the field.
+#[test]
+fn values_nested_in_a_binary_layer_are_walked_before_the_library_reads_them() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    std::fs::write(dir.path().join("strand.usda"), format!("#usda 1.0\n{curves}")).expect("write");
+    let text = format!(
+        "#usda 1.0\n(\n    customLayerData = {{\n        dictionary inner = {{\n            string note = \"a\"\n            \
+         double[] values = [1, 2]\n        }}\n        int count = 3\n    }}\n)\n\
+         def Xform \"x\" (\n    references = @strand.usda@</c> (customData = {{ string why = \"test\" }})\n    \
+         payload = @strand.usda@</c>\n) {{\n    double weight.timeSamples = {{ 0: 1, 1: 2 }}\n}}\n{curves}"
+    );
+    let path = dir.path().join("nested.usdc");
+    openusd::usdc::CrateWriter::write_to_file(&openusd::usda::parse(&text).expect("text"), &path).expect("binary");
+    usd::open(&path).expect("the library writer's nested values read");
+    // Each field's value representation, by the field's name.
+    let reps = {
+        let file = std::io::BufReader::new(std::fs::File::open(&path).expect("open"));
+        let crate_file = openusd::usdc::CrateFile::open(file).expect("crate");
+        crate_file.fields.iter().map(|f| (crate_file.tokens[f.token_index].clone(), f.value_rep.0)).collect::<Vec<_>>()
+    };
+    let payload_of = |name: &str| {
+        let rep = reps.iter().find(|(n, _)| n == name).unwrap_or_else(|| panic!("no {name} field: {reps:?}")).1;
+        (rep & ((1 << 48) - 1)) as usize
+    };
+    let bytes = std::fs::read(&path).expect("read");
+    let mutated = |name: &str, change: &dyn Fn(&mut Vec<u8>)| {
+        let mut b = bytes.clone();
+        change(&mut b);
+        let out = dir.path().join(format!("{name}.usdc"));
+        std::fs::write(&out, b).expect("write");
+        out
+    };
+    // The dictionary's first entry's value becomes the dictionary itself.
+    let dict = payload_of("customLayerData");
+    let looped = mutated("looped", &|b| {
+        let offset_at = dict + 8 + 4;
+        let offset = i64::from_le_bytes(b[offset_at..offset_at + 8].try_into().expect("8 bytes"));
+        let rep_at = (offset_at as i64 + offset) as usize;
+        b[rep_at..rep_at + 8].copy_from_slice(&((31u64 << 48) | dict as u64).to_le_bytes());
+    });
+    let e = usd::open(&looped).expect_err("a dictionary holding itself").to_string();
+    assert!(e.contains("looped.usdc") && e.contains("customLayerData") && e.contains("more than 64 deep"), "{e}");
+    // The references' first list counts 2⁴⁰ items.
+    let refs = payload_of("references");
+    let counted = mutated("counted", &|b| b[refs + 1..refs + 9].copy_from_slice(&(1u64 << 40).to_le_bytes()));
+    let e = usd::open(&counted).expect_err("a reference list past the file").to_string();
+    assert!(e.contains("counted.usdc") && e.contains("references") && e.contains("more than the file holds"), "{e}");
+}
+
 /// A binary layer's sublayers, references and payloads are checked like a
 /// text layer's: a FIFO it sublayers is refused (not waited on), a reference
 /// to a prim its layer lacks is refused naming both, and a good reference

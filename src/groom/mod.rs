@@ -45,6 +45,7 @@ mod usda_tokens;
 mod usdc_blocks;
 pub mod usdc_check;
 mod usdc_children;
+mod usdc_nested;
 mod usdc_values;
 
 mod repair;

@@ -21,8 +21,9 @@
 //! vectors and list operations — must lie inside its table, and an array may
 //! not be marked inlined, nor compressed unless its type's arrays are (the
 //! crate indexes and asserts without checking); the crate's own
-//! cross-checks of its tables run first (`CrateFile::validate`). Values
-//! inside dictionaries, time samples and references are not reached. Then the
+//! cross-checks of its tables run first (`CrateFile::validate`). The values
+//! inside dictionaries, time samples, references and payloads are walked the
+//! same way, bounded in depth and number (`groom/usdc_nested.rs`). Then the
 //! prims' children lists are checked against the layer's paths
 //! (`groom/usdc_children.rs`).
 
@@ -48,22 +49,22 @@ fn malformed(reason: String) -> Error {
 
 /// A field's value representation, as the crate format packs it in 64 bits.
 #[derive(Clone, Copy)]
-struct ValueRep(u64);
+pub(super) struct ValueRep(pub(super) u64);
 
 impl ValueRep {
-    fn ty(self) -> u64 {
+    pub(super) fn ty(self) -> u64 {
         (self.0 >> 48) & 0xFF
     }
-    fn payload(self) -> u64 {
+    pub(super) fn payload(self) -> u64 {
         self.0 & ((1 << 48) - 1)
     }
-    fn is_array(self) -> bool {
+    pub(super) fn is_array(self) -> bool {
         self.0 & (1 << 63) != 0
     }
-    fn is_inlined(self) -> bool {
+    pub(super) fn is_inlined(self) -> bool {
         self.0 & (1 << 62) != 0
     }
-    fn is_compressed(self) -> bool {
+    pub(super) fn is_compressed(self) -> bool {
         self.0 & (1 << 61) != 0
     }
 }
@@ -112,6 +113,8 @@ fn counted_items(ty: u64) -> Option<(u64, bool)> {
         49 => Some((16, false)),                   // layer offset vector
         32 | 33 | 34 | 36 | 38 => Some((4, true)), // token, string, path, int, uint list ops
         37 | 39 => Some((8, true)),                // int64, uint64 list ops
+        54 => Some((4, true)),                     // unregistered value list ops: string lists
+        58 => Some((8, false)),                    // relocates: two paths each
         _ => None,
     }
 }
@@ -161,97 +164,129 @@ pub fn check(path: &Path, len: u64, version: (u8, u8, u8)) -> Result<()> {
         b[..n].copy_from_slice(bytes);
         Ok(u64::from_le_bytes(b))
     };
+    let mut visits = 0u64;
     for (field, rep) in reps.iter().copied().map(ValueRep).enumerate() {
-        // The crate asserts what an array's bits may be: never inlined, and
-        // compressed only where its type's arrays are (integers from 0.5.0,
-        // floating point from 0.6.0).
-        if rep.is_array() && (rep.is_inlined() || (rep.is_compressed() && !compressible(rep.ty(), version))) {
-            let bits = if rep.is_inlined() { "inlined" } else { "compressed" };
-            return Err(malformed(format!(
-                "{}'s value (type {}) is an array marked {bits}",
-                tables.field(field),
-                rep.ty()
-            )));
-        }
-        // The crate reads a vector or list operation by its type whatever its
-        // array bit says, and arrays and those at their payload whatever the
-        // inlined bit says: only other inlined values are skipped.
-        let counted = rep.is_array() || counted_items(rep.ty()).is_some();
-        // (An inlined dictionary is an empty one: nothing to read.)
-        let empty_dictionary = rep.ty() == 31 && rep.is_inlined();
-        if (rep.is_inlined() && !counted) || (rep.is_array() && rep.payload() == 0) || empty_dictionary {
-            continue;
-        }
-        let what = |detail: String| malformed(format!("{}'s value (type {}) {detail}", tables.field(field), rep.ty()));
-        let at = rep.payload();
-        let room = |from: u64| len.saturating_sub(from);
-        if let Some((item, list_op)) = counted_items(rep.ty()) {
-            let mut pos = at;
-            let lists = if list_op {
-                if pos + 1 > len {
-                    return Err(what(format!("starts at byte {at}, past the file's end ({len} bytes)")));
-                }
-                let header = read_at(pos, 1)? as u8;
-                pos += 1;
-                // One list for each of the header's bits after the first.
-                ((header >> 1) & 0x3F).count_ones()
-            } else {
-                1
-            };
-            for _ in 0..lists {
-                if pos + 8 > len {
-                    return Err(what(format!("has a count past the file's end ({len} bytes)")));
-                }
-                let count = read_at(pos, 8)?;
-                pos += 8;
-                if count > room(pos) / item {
-                    return Err(what(format!("counts {count} items at byte {at}, more than the file holds")));
-                }
-                pos += count * item;
-            }
-        } else if rep.is_array() && (rep.ty() <= 30 || matches!(rep.ty(), 56 | 57)) {
-            let mut pos = at + if version < (0, 5, 0) { 4 } else { 0 };
-            let wide = version >= (0, 7, 0);
-            if pos + if wide { 8 } else { 4 } > len {
-                return Err(what(format!("starts at byte {at}, past the file's end ({len} bytes)")));
-            }
-            let count = read_at(pos, if wide { 8 } else { 4 })?;
-            pos += if wide { 8 } else { 4 };
-            let compressed = rep.is_compressed() && count >= 4 && compressible(rep.ty(), version);
-            let most = if compressed {
-                room(pos).saturating_mul(MAX_ITEMS_PER_BYTE).min(MAX_ITEMS)
-            } else {
-                room(pos) / element_size(rep.ty())
-            };
-            if count > most {
-                return Err(what(format!(
-                    "is an array of {count} elements at byte {at}, more than the file holds (at most {most})"
-                )));
-            }
-        } else if at >= len {
-            return Err(what(format!("starts at byte {at}, past the file's end ({len} bytes)")));
-        }
-    }
-    for (field, rep) in reps.into_iter().map(ValueRep).enumerate() {
-        check_indices(field, rep, &tables, version, &mut read_at)?;
+        let mut walk = Walk { field, tables: &tables, version, len, read_at: &mut read_at, visits: &mut visits };
+        check_value(&mut walk, rep, 0)?;
     }
     super::usdc_children::check(path)
 }
 
+/// One field's value being checked, and what the walk of values nested in
+/// others needs ([`super::usdc_nested`]).
+pub(super) struct Walk<'a> {
+    /// The field whose value (or a value nested in it) is checked.
+    pub field: usize,
+    pub tables: &'a Tables,
+    pub version: (u8, u8, u8),
+    /// The file's length.
+    pub len: u64,
+    /// Up to 8 bytes of the file at a byte offset, little-endian.
+    pub read_at: &'a mut dyn FnMut(u64, usize) -> Result<u64>,
+    /// Values visited so far over the whole layer (nested ones included).
+    pub visits: &'a mut u64,
+}
+
+/// Checks value `rep` of `walk`'s field (at nesting `depth`): an array's
+/// bits, every count against the room the file has, every index against its
+/// table, and what values it holds ([`super::usdc_nested`]).
+pub(super) fn check_value(walk: &mut Walk<'_>, rep: ValueRep, depth: u32) -> Result<()> {
+    check_counts(walk, rep)?;
+    check_indices(walk.field, rep, walk.tables, walk.version, walk.read_at)?;
+    super::usdc_nested::check(walk, rep, depth)
+}
+
+/// The counts of value `rep` against the room the file has (nothing for a
+/// value the crate does not read at its payload).
+fn check_counts(walk: &mut Walk<'_>, rep: ValueRep) -> Result<()> {
+    let (field, tables, version, len) = (walk.field, walk.tables, walk.version, walk.len);
+    let read_at = &mut *walk.read_at;
+    // The crate asserts what an array's bits may be: never inlined, and
+    // compressed only where its type's arrays are (integers from 0.5.0,
+    // floating point from 0.6.0).
+    if rep.is_array() && (rep.is_inlined() || (rep.is_compressed() && !compressible(rep.ty(), version))) {
+        let bits = if rep.is_inlined() { "inlined" } else { "compressed" };
+        return Err(malformed(format!(
+            "{}'s value (type {}) is an array marked {bits}",
+            tables.field(field),
+            rep.ty()
+        )));
+    }
+    // The crate reads a vector or list operation by its type whatever its
+    // array bit says, and arrays and those at their payload whatever the
+    // inlined bit says: only other inlined values are skipped.
+    let counted = rep.is_array() || counted_items(rep.ty()).is_some();
+    // (An inlined dictionary is an empty one: nothing to read.)
+    let empty_dictionary = rep.ty() == 31 && rep.is_inlined();
+    if (rep.is_inlined() && !counted) || (rep.is_array() && rep.payload() == 0) || empty_dictionary {
+        return Ok(());
+    }
+    let what = |detail: String| malformed(format!("{}'s value (type {}) {detail}", tables.field(field), rep.ty()));
+    let at = rep.payload();
+    let room = |from: u64| len.saturating_sub(from);
+    if let Some((item, list_op)) = counted_items(rep.ty()) {
+        let mut pos = at;
+        let lists = if list_op {
+            if pos + 1 > len {
+                return Err(what(format!("starts at byte {at}, past the file's end ({len} bytes)")));
+            }
+            let header = read_at(pos, 1)? as u8;
+            pos += 1;
+            // One list for each of the header's bits after the first.
+            ((header >> 1) & 0x3F).count_ones()
+        } else {
+            1
+        };
+        for _ in 0..lists {
+            if pos + 8 > len {
+                return Err(what(format!("has a count past the file's end ({len} bytes)")));
+            }
+            let count = read_at(pos, 8)?;
+            pos += 8;
+            if count > room(pos) / item {
+                return Err(what(format!("counts {count} items at byte {at}, more than the file holds")));
+            }
+            pos += count * item;
+        }
+    } else if rep.is_array() && (rep.ty() <= 30 || matches!(rep.ty(), 56 | 57)) {
+        let mut pos = at + if version < (0, 5, 0) { 4 } else { 0 };
+        let wide = version >= (0, 7, 0);
+        if pos + if wide { 8 } else { 4 } > len {
+            return Err(what(format!("starts at byte {at}, past the file's end ({len} bytes)")));
+        }
+        let count = read_at(pos, if wide { 8 } else { 4 })?;
+        pos += if wide { 8 } else { 4 };
+        let compressed = rep.is_compressed() && count >= 4 && compressible(rep.ty(), version);
+        let most = if compressed {
+            room(pos).saturating_mul(MAX_ITEMS_PER_BYTE).min(MAX_ITEMS)
+        } else {
+            room(pos) / element_size(rep.ty())
+        };
+        if count > most {
+            return Err(what(format!(
+                "is an array of {count} elements at byte {at}, more than the file holds (at most {most})"
+            )));
+        }
+    } else if at >= len {
+        return Err(what(format!("starts at byte {at}, past the file's end ({len} bytes)")));
+    }
+    Ok(())
+}
+
 /// The sizes of the tables a value's indices point into.
-struct Tables {
-    tokens: u64,
-    strings: u64,
-    paths: u64,
+pub(super) struct Tables {
+    pub tokens: u64,
+    pub strings: u64,
+    pub paths: u64,
     /// Each string's token.
-    string_tokens: Vec<u64>,
+    pub string_tokens: Vec<u64>,
     /// Each field's name.
-    field_names: Vec<String>,
+    pub field_names: Vec<String>,
 }
 
 impl Tables {
     /// Field `field` as an error names it: its index and name.
-    fn field(&self, field: usize) -> String {
+    pub(super) fn field(&self, field: usize) -> String {
         let name = self.field_names.get(field).map_or("", String::as_str);
         format!("field {field} ({name:?})")
     }
@@ -268,9 +303,9 @@ enum Table {
 /// Refuses a value of field `field` holding a token, string or path index
 /// past its table (the crate indexes its tables without checking): single
 /// tokens, strings and asset paths, token and string arrays, token, string
-/// and path vectors and list operations. The counts were bounded by `check`
-/// before. Values inside dictionaries, time samples and references are not
-/// reached.
+/// and path vectors and list operations, relocates. The counts were bounded
+/// before ([`check_counts`]); values nested in others are walked by
+/// [`super::usdc_nested`].
 fn check_indices(
     field: usize,
     rep: ValueRep,
@@ -335,8 +370,17 @@ fn check_indices(
             let count = read_at(at, 8)?;
             indices(read_at, at + 8, count, if rep.ty() == 40 { Table::Paths } else { Table::Tokens }).map(|_| ())
         }
-        (32..=34, _) => {
-            let table = [Table::Tokens, Table::Strings, Table::Paths][rep.ty() as usize - 32];
+        (58, _) => {
+            // Relocates: pairs of paths.
+            let count = read_at(at, 8)?;
+            indices(read_at, at + 8, count.saturating_mul(2), Table::Paths).map(|_| ())
+        }
+        (32..=34 | 54, _) => {
+            let table = match rep.ty() {
+                32 => Table::Tokens,
+                34 => Table::Paths,
+                _ => Table::Strings,
+            };
             let header = read_at(at, 1)? as u8;
             let mut pos = at + 1;
             for _ in 0..((header >> 1) & 0x3F).count_ones() {
