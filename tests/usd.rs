@@ -351,9 +351,26 @@ fn arcs_are_judged_over_the_sublayers_of_a_stack() {
     let expression =
         "(\n    expressionVariables = {\n        string X = \"a\"\n    }\n    subLayers = [@`\"${X}.usda\"`@]\n)\n";
     write("expression.usda", &format!("#usda 1.0\n{expression}{curves}"));
+    // A chain of layers each referencing the next: the library builds a prim
+    // nested past 100 arcs empty, without a word.
+    let chain = |name: &str, n: usize| {
+        for i in 0..n {
+            let next = if i + 1 < n { format!("{name}{}.usda", i + 1) } else { "strand_g.usda".into() };
+            write(
+                &format!("{name}{i}.usda"),
+                &format!("#usda 1.0\ndef Xform \"G\" (\n    references = @{next}@</G>\n) {{ }}\n"),
+            );
+        }
+    };
+    write("strand_g.usda", &format!("#usda 1.0\ndef Xform \"G\" {{\n{curves}}}\n"));
+    chain("long", 99);
+    chain("short", 40);
+    let g = usd::open(dir.path().join("short0.usda")).expect("40 layers of references");
+    assert_eq!(g.groom.strand_count(), 1, "the hair at the chain's end");
     refused_naming(
         dir.path(),
         &[
+            ("long0.usda", &["long0.usda", "nest 100 arcs deep", "99 references", "without a word"][..]),
             ("self_chain.usda", &["self_chain.usda", "chain through more than 128 prims"][..]),
             ("self_cycle.usda", &["self_cycle.usda", "line 6", "a cycle"][..]),
             ("expression.usda", &["expression.usda", "line 6", "an expression"][..]),

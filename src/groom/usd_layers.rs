@@ -17,6 +17,14 @@ use crate::error::{Error, FileFormat, Result};
 /// `references` and `payload`, the root included.
 pub const MAX_USD_LAYERS: usize = 256;
 
+/// Most arcs a prim's composition may nest, bounded from the stage's layers:
+/// (the most references and payloads one chain of layers passes + 1) × (the
+/// most arcs one chain between prims of a layer stack passes + 1). The USD
+/// library abandons a prim whose composition nests more than 100 arcs and
+/// builds it empty, without a word (a chain of 99 referencing layers lost
+/// the hair at its end).
+pub const MAX_USD_COMPOSITION_DEPTH: usize = 96;
+
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }
 }
@@ -188,7 +196,7 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
     // The layer stacks (a layer and its sublayers, one namespace): per text
     // layer its arcs between prims and its sublayers, and the layers that
     // start a stack (the root, and what a reference or payload names).
-    let mut stacks = Stacks::default();
+    let mut stacks = Stacks { stage: canonical(path), ..Stacks::default() };
     stacks.roots.insert(canonical(path));
     // Per text layer read, what it offers the arcs that name it again.
     let mut seen: HashMap<PathBuf, Option<Targets>> = HashMap::new();
@@ -277,11 +285,14 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
                 return Err(named(malformed(why).in_asset(&layer)));
             }
             count_prims(&targets)?;
-            seen.insert(key, Some(targets));
+            seen.insert(key.clone(), Some(targets));
             let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
+            let mut links = Links::default();
             for (asset, takes) in assets {
+                links.add(&mut stacks, &dir.join(&asset), &takes);
                 queue.push((dir.join(&asset), Some((layer.clone(), format!("its arc to {asset:?}:"))), takes));
             }
+            stacks.layers.insert(key, (Arcs::new(), links));
             continue;
         }
         // Every other layer is read as text, whatever it starts with (the
@@ -324,19 +335,38 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
                 }
             }
         }
-        let mut sublayers = Vec::new();
+        let mut links = Links::default();
         for asset in assets {
             let line = super::usda_check::position(text, asset.at);
             let named = dir.join(&asset.path);
-            match asset.takes {
-                Takes::Layer => sublayers.push(canonical(&named)),
-                _ => drop(stacks.roots.insert(canonical(&named))),
-            }
+            links.add(&mut stacks, &named, &asset.takes);
             queue.push((named, Some((layer.clone(), line)), asset.takes));
         }
-        stacks.layers.insert(key, (arcs, sublayers));
+        stacks.layers.insert(key, (arcs, links));
     }
     stacks.check()
+}
+
+/// The layers one layer names: its sublayers, and what its references and
+/// payloads take (each a layer stack of its own).
+#[derive(Default)]
+struct Links {
+    sublayers: Vec<PathBuf>,
+    references: Vec<PathBuf>,
+}
+
+impl Links {
+    /// Layer `named`, taken as `takes`; a reference's layer starts a stack.
+    fn add(&mut self, stacks: &mut Stacks, named: &Path, takes: &Takes) {
+        let key = canonical(named);
+        match takes {
+            Takes::Layer => self.sublayers.push(key),
+            _ => {
+                stacks.roots.insert(key.clone());
+                self.references.push(key);
+            }
+        }
+    }
 }
 
 /// A path as the layers are keyed by: canonical where it exists.
@@ -350,10 +380,12 @@ type Written = (PathBuf, String);
 /// The text layers of a stage as layer stacks (see [`check_layers`]).
 #[derive(Default)]
 struct Stacks {
-    /// Per text layer: its arcs between prims, and its sublayers.
-    layers: HashMap<PathBuf, (Arcs<Written>, Vec<PathBuf>)>,
+    /// Per layer: its arcs between prims (a text layer's), and the layers it names.
+    layers: HashMap<PathBuf, (Arcs<Written>, Links)>,
     /// The layers that start a layer stack.
     roots: HashSet<PathBuf>,
+    /// The stage's root layer.
+    stage: PathBuf,
 }
 
 impl Stacks {
@@ -365,12 +397,13 @@ impl Stacks {
     fn check(&self) -> Result<()> {
         let mut roots: Vec<&PathBuf> = self.roots.iter().collect();
         roots.sort();
+        let mut deepest_chain = 0usize;
         for root in roots {
             let mut members = vec![root];
             let mut k = 0;
             while let Some(layer) = members.get(k).copied() {
                 k += 1;
-                for sub in self.layers.get(layer).map(|(_, s)| s.as_slice()).unwrap_or_default() {
+                for sub in self.layers.get(layer).map(|(_, l)| l.sublayers.as_slice()).unwrap_or_default() {
                     if !members.contains(&sub) {
                         members.push(sub);
                     }
@@ -384,10 +417,40 @@ impl Stacks {
                 1 => String::new(),
                 _ => format!(" (over the sublayers of {})", root.display()),
             };
-            super::usda_arcs::check_arcs(&arcs, |(layer, line), why| {
+            let chain = super::usda_arcs::check_arcs(&arcs, |(layer, line), why| {
                 malformed(format!("{line} {why}{over}")).in_asset(layer)
             })?;
+            deepest_chain = deepest_chain.max(chain);
+        }
+        let layers = self.reference_depth(&self.stage, &mut HashMap::new());
+        let depth = (layers + 1) * (deepest_chain + 1);
+        if depth > MAX_USD_COMPOSITION_DEPTH {
+            return Err(malformed(format!(
+                "its composition may nest {depth} arcs deep ({layers} references or payloads in a chain of layers, \
+                 and chains of up to {deepest_chain} arcs between prims): the USD library builds a prim nested more \
+                 than 100 deep empty, without a word (at most {MAX_USD_COMPOSITION_DEPTH} here)"
+            ))
+            .in_asset(&self.stage));
         }
         Ok(())
+    }
+
+    /// The most references and payloads one chain of layers from `layer`
+    /// passes (sublayers add none; a layer met again on the chain ends it).
+    fn reference_depth<'a>(&'a self, layer: &'a PathBuf, memo: &mut HashMap<&'a PathBuf, Option<usize>>) -> usize {
+        match memo.get(layer) {
+            Some(Some(depth)) => return *depth,
+            Some(None) => return 0,
+            None => {}
+        }
+        memo.insert(layer, None);
+        let Some((_, links)) = self.layers.get(layer) else {
+            memo.insert(layer, Some(0));
+            return 0;
+        };
+        let steps = links.sublayers.iter().map(|l| (l, 0)).chain(links.references.iter().map(|l| (l, 1)));
+        let depth = steps.map(|(l, step)| step + self.reference_depth(l, memo)).max().unwrap_or(0);
+        memo.insert(layer, Some(depth));
+        depth
     }
 }

@@ -265,7 +265,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
     if let Some((c, _)) = open.last() {
         return Err(malformed(format!("a '{}' is never closed", *c as char)));
     }
-    check_arcs(&arcs, |at, why| malformed(format!("{} {why}", position(text, *at))))?;
+    check_arcs(&arcs, |at, why| malformed(format!("{} {why}", position(text, *at)))).map(drop)?;
     // A reference or payload within the layer whose target's root prim the
     // layer does not declare brings nothing, and the stage says nothing (a
     // sublayer may declare it: then it is left to the stage).
