@@ -383,6 +383,51 @@ fn arcs_are_judged_over_the_sublayers_of_a_stack() {
     );
 }
 
+/// A reference or payload to a prim that cannot be there — below an existing
+/// root prim, in a layer of sublayers, a reference without an asset path —
+/// is refused naming the arc (the library went without it in silence: 2 of
+/// 4 strands), while a prim a sublayer declares or an ancestor's variant
+/// brings reads.
+#[test]
+fn an_arc_to_a_prim_that_cannot_be_there_is_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
+    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    write("b.usda", &format!("#usda 1.0\ndef Xform \"G\" {{\n{curves}}}\n"));
+    write("e.usda", &format!("#usda 1.0\ndef Xform \"E\" {{\n{curves}}}\n"));
+    write("stacked.usda", "#usda 1.0\n(\n    subLayers = [@e.usda@]\n)\n");
+    let look = format!(
+        "#usda 1.0\ndef Xform \"V\" (\n    variants = {{ string look = \"a\" }}\n    prepend variantSets = \"look\"\n) {{\n    \
+         variantSet \"look\" = {{\n        \"a\" {{\n{curves}        }}\n    }}\n}}\n"
+    );
+    write("variant.usda", &look);
+    let referencing = |name: &str, arc: &str| {
+        // A typeless prim takes its type, BasisCurves, from what it references.
+        write(name, &format!("#usda 1.0\ndef \"R\" (\n    references = {arc}\n) {{ }}\n{curves}"));
+    };
+    referencing("nested.usda", "@b.usda@</G/nope>");
+    referencing("nested_ok.usda", "@b.usda@</G/c>");
+    referencing("sublayered.usda", "@stacked.usda@</Nope>");
+    referencing("sublayered_ok.usda", "@stacked.usda@</E/c>");
+    referencing("variant_ok.usda", "@variant.usda@</V/c>");
+    write(
+        "internal.usda",
+        &format!("#usda 1.0\ndef Xform \"G\" {{\n{curves}}}\ndef Xform \"R\" (\n    references = </G/nope>\n) {{ }}\n"),
+    );
+    for ok in ["nested_ok.usda", "sublayered_ok.usda", "variant_ok.usda"] {
+        let g = usd::open(dir.path().join(ok)).unwrap_or_else(|e| panic!("{ok}: {e}"));
+        assert_eq!(g.groom.strand_count(), 2, "{ok}: the root's strand and the referenced one");
+    }
+    refused_naming(
+        dir.path(),
+        &[
+            ("nested.usda", &["nested.usda", "line 3", "/G/nope", "b.usda"][..]),
+            ("sublayered.usda", &["sublayered.usda", "line 3", "/Nope", "stacked.usda", "sublayers"][..]),
+            ("internal.usda", &["internal.usda", "line 7", "/G/nope"][..]),
+        ],
+    );
+}
+
 /// The ways round the layer checks a probe found, each closed: a deep layer
 /// led by blank space, a variant's reference to a FIFO, many chains each
 /// within the depth limit, a sublayer the library cannot parse (refused with

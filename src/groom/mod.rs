@@ -39,6 +39,7 @@ pub mod sdf;
 pub mod tfx;
 pub mod usd;
 mod usd_layers;
+mod usd_stacks;
 mod usda_arcs;
 pub mod usda_check;
 mod usda_tokens;

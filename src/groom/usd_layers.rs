@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use openusd::sdf::{Path as SdfPath, SpecType};
 
+use super::usd_stacks::{canonical, Links, Stacks, Written};
 use super::usda_arcs::Arcs;
 use super::usda_check::Takes;
 use crate::error::{Error, FileFormat, Result};
@@ -17,17 +18,12 @@ use crate::error::{Error, FileFormat, Result};
 /// `references` and `payload`, the root included.
 pub const MAX_USD_LAYERS: usize = 256;
 
-/// Most arcs a prim's composition may nest, bounded from the stage's layers:
-/// (the most references and payloads one chain of layers passes + 1) × (the
-/// most arcs one chain between prims of a layer stack passes + 1). The USD
-/// library abandons a prim whose composition nests more than 100 arcs and
-/// builds it empty, without a word (a chain of 99 referencing layers lost
-/// the hair at its end).
-pub const MAX_USD_COMPOSITION_DEPTH: usize = 96;
-
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }
 }
+
+/// A prim's fields that may bring prims under it no layer declares.
+const COMPOSING: [&str; 5] = ["references", "payload", "inheritPaths", "specializes", "variantSetNames"];
 
 /// What a text layer offers a reference or payload.
 struct Targets {
@@ -38,6 +34,9 @@ struct Targets {
     prims: HashSet<String>,
     /// The default prim it names.
     default: Option<String>,
+    /// Its prims with composition arcs or variant sets of their own (which
+    /// may bring prims under them that no layer declares).
+    composing: HashSet<String>,
 }
 
 impl Targets {
@@ -91,9 +90,14 @@ fn parse(text: &str, sublayers: bool) -> std::result::Result<Targets, String> {
             .get(&SdfPath::abs_root())
             .and_then(|root| root.fields.iter().find(|(key, _)| key == "defaultPrim"))
             .and_then(|(_, value)| value.try_as_token_ref().map(|t| t.as_str().to_owned()));
-        let prims = specs.iter().filter(|(_, s)| s.ty == SpecType::Prim).map(|(p, _)| p.as_str().to_owned()).collect();
+        let prim_specs = || specs.iter().filter(|(_, s)| s.ty == SpecType::Prim);
+        let prims = prim_specs().map(|(p, _)| p.as_str().to_owned()).collect();
+        let composing = prim_specs()
+            .filter(|(_, s)| s.fields.iter().any(|(key, _)| COMPOSING.contains(&key.as_str())))
+            .map(|(p, _)| p.as_str().to_owned())
+            .collect();
         most_properties(specs.iter().map(|(p, s)| (p, s.ty)))?;
-        Ok(Targets { sublayers, prims, default })
+        Ok(Targets { sublayers, prims, default, composing })
     })
     .unwrap_or_else(|what| Err(format!("the USD reader stopped: {what}")))
 }
@@ -143,12 +147,16 @@ fn binary(path: &Path) -> std::result::Result<(Vec<(String, Takes)>, Targets), S
             (!asset.is_empty()).then(|| (asset.to_owned(), takes))
         };
         let mut prims = HashSet::new();
+        let mut composing = HashSet::new();
         let typed: Vec<(SdfPath, SpecType)> =
             data.spec_paths().into_iter().filter_map(|p| data.spec_type(&p).map(|t| (p, t))).collect();
         most_properties(typed.iter().map(|(p, t)| (p, *t)))?;
         for (spec, ty) in &typed {
             if *ty == SpecType::Prim {
                 prims.insert(spec.as_str().to_owned());
+                if COMPOSING.iter().any(|f| matches!(data.try_field(spec, f), Ok(Some(_)))) {
+                    composing.insert(spec.as_str().to_owned());
+                }
             }
             for field in ["references", "payload"] {
                 let Ok(Some(v)) = data.try_field(spec, field) else { continue };
@@ -175,7 +183,7 @@ fn binary(path: &Path) -> std::result::Result<(Vec<(String, Takes)>, Targets), S
             .ok()
             .flatten()
             .and_then(|v| v.try_as_token_ref().map(|t| t.as_str().to_owned()));
-        Ok((named, Targets { sublayers, prims, default }))
+        Ok((named, Targets { sublayers, prims, default, composing }))
     })
     .unwrap_or_else(|what| Err(format!("the USD reader stopped: {what}")))
 }
@@ -285,11 +293,13 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
                 return Err(named(malformed(why).in_asset(&layer)));
             }
             count_prims(&targets)?;
+            stacks.offers.insert(key.clone(), (targets.prims.clone(), targets.composing.clone()));
             seen.insert(key.clone(), Some(targets));
             let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
             let mut links = Links::default();
             for (asset, takes) in assets {
-                links.add(&mut stacks, &dir.join(&asset), &takes);
+                let by = (layer.clone(), format!("its arc to {asset:?}:"));
+                links.add(&mut stacks, &dir.join(&asset), &takes, by);
                 queue.push((dir.join(&asset), Some((layer.clone(), format!("its arc to {asset:?}:"))), takes));
             }
             stacks.layers.insert(key, (Arcs::new(), links));
@@ -316,6 +326,7 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
             return Err(named(malformed(why).in_asset(&layer)));
         }
         count_prims(&targets)?;
+        stacks.offers.insert(key.clone(), (targets.prims.clone(), targets.composing.clone()));
         seen.insert(key.clone(), Some(targets));
         let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
         let located = |at: &usize| (layer.clone(), super::usda_check::position(text, *at));
@@ -339,118 +350,14 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
         for asset in assets {
             let line = super::usda_check::position(text, asset.at);
             let named = dir.join(&asset.path);
-            links.add(&mut stacks, &named, &asset.takes);
+            links.add(&mut stacks, &named, &asset.takes, (layer.clone(), line.clone()));
             queue.push((named, Some((layer.clone(), line)), asset.takes));
+        }
+        for (target, at) in &checked.internal {
+            stacks.internal.push((key.clone(), target.clone(), located(at)));
         }
         stacks.layers.insert(key, (arcs, links));
     }
-    stacks.check()
-}
-
-/// The layers one layer names: its sublayers, and what its references and
-/// payloads take (each a layer stack of its own).
-#[derive(Default)]
-struct Links {
-    sublayers: Vec<PathBuf>,
-    references: Vec<PathBuf>,
-}
-
-impl Links {
-    /// Layer `named`, taken as `takes`; a reference's layer starts a stack.
-    fn add(&mut self, stacks: &mut Stacks, named: &Path, takes: &Takes) {
-        let key = canonical(named);
-        match takes {
-            Takes::Layer => self.sublayers.push(key),
-            _ => {
-                stacks.roots.insert(key.clone());
-                self.references.push(key);
-            }
-        }
-    }
-}
-
-/// A path as the layers are keyed by: canonical where it exists.
-fn canonical(path: &Path) -> PathBuf {
-    std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
-}
-
-/// Where an arc between prims is written: its layer and "line L, column C:".
-type Written = (PathBuf, String);
-
-/// The text layers of a stage as layer stacks (see [`check_layers`]).
-#[derive(Default)]
-struct Stacks {
-    /// Per layer: its arcs between prims (a text layer's), and the layers it names.
-    layers: HashMap<PathBuf, (Arcs<Written>, Links)>,
-    /// The layers that start a layer stack.
-    roots: HashSet<PathBuf>,
-    /// The stage's root layer.
-    stage: PathBuf,
-}
-
-impl Stacks {
-    /// The arcs of each layer stack, all its layers' together (with a
-    /// layer's references to its own prims),
-    /// checked as one layer's are (no cycle, no arc into its own namespace, no
-    /// chain too long): two sublayers whose classes inherit each other
-    /// overflowed the library's stack. Named at the arc, in its layer.
-    fn check(&self) -> Result<()> {
-        let mut roots: Vec<&PathBuf> = self.roots.iter().collect();
-        roots.sort();
-        let mut deepest_chain = 0usize;
-        for root in roots {
-            let mut members = vec![root];
-            let mut k = 0;
-            while let Some(layer) = members.get(k).copied() {
-                k += 1;
-                for sub in self.layers.get(layer).map(|(_, l)| l.sublayers.as_slice()).unwrap_or_default() {
-                    if !members.contains(&sub) {
-                        members.push(sub);
-                    }
-                }
-            }
-            let mut arcs: Arcs<&Written> = HashMap::new();
-            for (from, targets) in members.iter().filter_map(|m| self.layers.get(*m)).flat_map(|(a, _)| a) {
-                arcs.entry(from.clone()).or_default().extend(targets.iter().map(|(to, at)| (to.clone(), at)));
-            }
-            let over = match members.len() {
-                1 => String::new(),
-                _ => format!(" (over the sublayers of {})", root.display()),
-            };
-            let chain = super::usda_arcs::check_arcs(&arcs, |(layer, line), why| {
-                malformed(format!("{line} {why}{over}")).in_asset(layer)
-            })?;
-            deepest_chain = deepest_chain.max(chain);
-        }
-        let layers = self.reference_depth(&self.stage, &mut HashMap::new());
-        let depth = (layers + 1) * (deepest_chain + 1);
-        if depth > MAX_USD_COMPOSITION_DEPTH {
-            return Err(malformed(format!(
-                "its composition may nest {depth} arcs deep ({layers} references or payloads in a chain of layers, \
-                 and chains of up to {deepest_chain} arcs between prims): the USD library builds a prim nested more \
-                 than 100 deep empty, without a word (at most {MAX_USD_COMPOSITION_DEPTH} here)"
-            ))
-            .in_asset(&self.stage));
-        }
-        Ok(())
-    }
-
-    /// The most references and payloads one chain of layers from `layer`
-    /// passes (sublayers add none; a layer met again on the chain ends it).
-    fn reference_depth<'a>(&'a self, layer: &'a PathBuf, memo: &mut HashMap<&'a PathBuf, Option<usize>>) -> usize {
-        match memo.get(layer) {
-            Some(Some(depth)) => return *depth,
-            Some(None) => return 0,
-            None => {}
-        }
-        memo.insert(layer, None);
-        let Some((_, links)) = self.layers.get(layer) else {
-            memo.insert(layer, Some(0));
-            return 0;
-        };
-        let steps = links.sublayers.iter().map(|l| (l, 0)).chain(links.references.iter().map(|l| (l, 1)));
-        let depth = steps.map(|(l, step)| step + self.reference_depth(l, memo)).max().unwrap_or(0);
-        memo.insert(layer, Some(depth));
-        depth
-    }
+    stacks.check()?;
+    stacks.check_targets()
 }

@@ -106,6 +106,9 @@ pub struct Checked {
     pub assets: LayerAssets,
     /// Its arcs between prims (see [`Arcs`]).
     pub(super) arcs: Arcs<usize>,
+    /// The prims its references and payloads without an asset path take,
+    /// each with where it is written.
+    pub(super) internal: Vec<(String, usize)>,
 }
 
 /// Checks the USD text `text` (see the module docs): the other layers it
@@ -282,7 +285,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
             }
         }
     }
-    Ok(Checked { assets, arcs })
+    Ok(Checked { assets, arcs, internal })
 }
 
 /// The asset paths of a value (`tokens` start after its key, at `=` or at
