@@ -243,6 +243,36 @@ pub fn hold_fifo_output(path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Writes `bytes` to `file` (a pipe, a device) with SIGPIPE blocked on this
+/// thread: a reader that closes a pipe before the output is written makes
+/// the write an error naming that, not a signal that ends the process
+/// without a word (the signal the write raised is taken before SIGPIPE is
+/// unblocked).
+fn write_without_sigpipe(file: &mut std::fs::File, bytes: &[u8]) -> std::io::Result<()> {
+    // SAFETY: plain libc calls on a local signal set; the mask is this
+    // thread's and is restored before returning.
+    unsafe {
+        let mut pipe: libc::sigset_t = std::mem::zeroed();
+        let mut old: libc::sigset_t = std::mem::zeroed();
+        libc::sigemptyset(&mut pipe);
+        libc::sigaddset(&mut pipe, libc::SIGPIPE);
+        libc::pthread_sigmask(libc::SIG_BLOCK, &pipe, &mut old);
+        let written = file.write_all(bytes).and_then(|_| file.flush());
+        if written.as_ref().is_err_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe) {
+            let now = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+            libc::sigtimedwait(&pipe, std::ptr::null_mut(), &now);
+        }
+        libc::pthread_sigmask(libc::SIG_SETMASK, &old, std::ptr::null_mut());
+        written.map_err(|e| match e.kind() {
+            std::io::ErrorKind::BrokenPipe => std::io::Error::new(
+                e.kind(),
+                "the process reading this pipe closed it before the whole output was written",
+            ),
+            _ => e,
+        })
+    }
+}
+
 /// Writes `bytes` to `path` through a temporary file in the same folder that then
 /// replaces `path`: a failed write, a full disk or a killed process leaves either
 /// the old file or none, never a truncated one (a process that handles its
@@ -275,8 +305,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
                 None if is_fifo(path) => open_fifo_for_writing(path)?,
                 None => std::fs::OpenOptions::new().write(true).open(path).map_err(io)?,
             };
-            file.write_all(bytes).map_err(io)?;
-            return file.flush().map_err(io);
+            return write_without_sigpipe(&mut file, bytes).map_err(io);
         }
         _ => {}
     }
@@ -316,6 +345,33 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
+    /// A reader that opens a FIFO output and closes it before the write: the
+    /// write is an error naming that, and the process lives on (SIGPIPE, at
+    /// its default disposition as the tool sets it, would have ended it).
+    #[test]
+    fn a_pipe_closed_before_the_write_is_an_error_not_a_signal() {
+        use std::os::unix::fs::OpenOptionsExt;
+        let dir = tempfile::tempdir().expect("tempdir");
+        let fifo = dir.path().join("out.json");
+        let c = std::ffi::CString::new(fifo.to_str().expect("utf-8")).expect("path");
+        // SAFETY: valid NUL-terminated path; signal() with the default disposition.
+        unsafe {
+            assert_eq!(libc::mkfifo(c.as_ptr(), 0o600), 0, "mkfifo");
+            libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+        }
+        let reader = std::fs::OpenOptions::new()
+            .read(true)
+            .custom_flags(libc::O_NONBLOCK)
+            .open(&fifo)
+            .expect("reader");
+        super::hold_fifo_output(&fifo).expect("a reader is there");
+        drop(reader);
+        let e = super::write_atomic(&fifo, &[7u8; 1 << 20]).expect_err("the reader is gone").to_string();
+        // SAFETY: back to the disposition Rust's runtime gives tests.
+        unsafe { libc::signal(libc::SIGPIPE, libc::SIG_IGN) };
+        assert!(e.contains("out.json") && e.contains("closed it before the whole output"), "{e}");
+    }
+
     use super::*;
 
     /// A panic inside a guarded reader is its error (the message the panic
