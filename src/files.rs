@@ -359,11 +359,7 @@ mod tests {
             assert_eq!(libc::mkfifo(c.as_ptr(), 0o600), 0, "mkfifo");
             libc::signal(libc::SIGPIPE, libc::SIG_DFL);
         }
-        let reader = std::fs::OpenOptions::new()
-            .read(true)
-            .custom_flags(libc::O_NONBLOCK)
-            .open(&fifo)
-            .expect("reader");
+        let reader = std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK).open(&fifo).expect("reader");
         super::hold_fifo_output(&fifo).expect("a reader is there");
         drop(reader);
         let e = super::write_atomic(&fifo, &[7u8; 1 << 20]).expect_err("the reader is gone").to_string();

@@ -145,7 +145,7 @@ pub enum Light {
     Point {
         /// Position, meters (each within ±1e6).
         position: Vec3,
-        /// Linear RGB intensity (radiance at 1 m; each 0..=1e6).
+        /// Linear RGB intensity (radiance at 1 m; each 0..=1e9).
         color: Vec3,
     },
     /// A spot light: a point light within a cone.
@@ -158,7 +158,9 @@ pub enum Light {
         outer_angle: f32,
         /// Half-angle of full intensity, radians (0..=outer_angle).
         inner_angle: f32,
-        /// Linear RGB intensity (radiance at 1 m; each 0..=1e6).
+        /// Linear RGB intensity (radiance at 1 m; each 0..=1e9: a light
+        /// 10 km away lighting a scene as one 1 m away does needs 1e8 times
+        /// its intensity).
         color: Vec3,
     },
 }
@@ -188,15 +190,19 @@ impl Light {
         ]
     }
 
-    /// Checks the light: a colour of finite components in 0..=1e6, a position
+    /// Checks the light: a colour of finite components in 0..=1e6 (a
+    /// directional light's radiance; a point or spot light's intensity at
+    /// 1 m in 0..=1e9, since it falls off with the squared distance), a position
     /// within 1e6 m of the origin on every axis, a finite non-zero direction,
     /// and 0 ≤ inner ≤ outer < π for a spot; the error names the field.
     pub fn validate(&self) -> Result<()> {
-        let color = match *self {
-            Light::Directional { color, .. } | Light::Point { color, .. } | Light::Spot { color, .. } => color,
+        let (color, most) = match *self {
+            Light::Directional { color, .. } => (color, "1e6"),
+            Light::Point { color, .. } | Light::Spot { color, .. } => (color, "1e9"),
         };
-        if !(color.is_finite() && color.min_element() >= 0.0 && color.max_element() <= 1e6) {
-            return Err(Error::param("light color", color, "finite, each component 0..=1e6"));
+        let bound: f32 = if most == "1e6" { 1e6 } else { 1e9 };
+        if !(color.is_finite() && color.min_element() >= 0.0 && color.max_element() <= bound) {
+            return Err(Error::param("light color", color, format!("finite, each component 0..={most}")));
         }
         if let Light::Point { position, .. } | Light::Spot { position, .. } = *self {
             if !(position.is_finite() && position.abs().max_element() <= 1e6) {
@@ -449,5 +455,9 @@ mod tests {
         assert!((position - (center + 2.0 * Vec3::new(-0.6, 0.5, 0.8))).length() < 1e-6);
         assert_eq!(direction, Vec3::new(0.6, -0.5, -0.8));
         assert!((color - Vec3::splat(4.4)).length() < 1e-5);
+        // The rig of the largest scene the tool draws (1e4 m from its centre) is valid.
+        for light in Light::thesis_rig(center, 1e4) {
+            light.validate().expect("a valid light");
+        }
     }
 }

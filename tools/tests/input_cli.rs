@@ -497,7 +497,9 @@ fn inspect_drawn_reports_how_the_hairs_cover_the_scalp() {
 
 /// A groom whose size is absurd for the tool's scene (a nanometre across, or
 /// 10⁸ units) is refused at load naming the file, its size and `--scale`,
-/// not by an internal parameter derived from it.
+/// not by an internal parameter derived from it; one large but within the
+/// bound (600 units across, whose lights and scalp once failed as
+/// `light color` and `scalp.density`) is drawn.
 #[test]
 fn an_absurdly_sized_groom_is_refused_naming_the_file_and_its_size() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -512,4 +514,18 @@ fn an_absurdly_sized_groom_is_refused_naming_the_file_and_its_size() {
         }
         assert!(!out.stderr.contains("invalid parameter"), "{name}: an internal parameter named: {}", out.stderr);
     }
+    // Large but within the bound (a groom 600 units across: its lights 1,300
+    // times as far as the thesis', its scalp too large to root): drawn, its
+    // hairs grown around the key hairs, with a warning naming --scale.
+    let groom = dir.path().join("large.hair");
+    common::write_groom(&groom, &common::cap_groom(20, 6, 300.0));
+    let args = format!(
+        "render --input {} --frames 1 --width 32 --height 32 --out {}",
+        groom.display(),
+        dir.path().join("l").display()
+    );
+    let out = run_line(&args, LIMIT);
+    out.assert_ok();
+    assert!(out.stderr.contains("--scale") && out.stderr.contains("in clumps"), "{}", out.stderr);
+    assert!(!out.stderr.contains("invalid parameter"), "an internal parameter named: {}", out.stderr);
 }
