@@ -164,6 +164,14 @@ pub(super) fn parse(bytes: &[u8], dir: Option<&Path>) -> Result<Character> {
             joints.len()
         )));
     }
+    // A bind pose is where a character stands: its matrices' translations
+    // and scales are a character's too (1e30 put every vertex out of reach).
+    for (j, m) in inverse_bind.iter().enumerate() {
+        let (scale, _, translation) = m.to_scale_rotation_translation();
+        if let Some(why) = absurd(translation, scale) {
+            return Err(malformed(format!("skin {} joint {j}'s inverse bind matrix: its {why}", skin.index())));
+        }
+    }
 
     let mut positions = Vec::new();
     let mut weights = Vec::new();

@@ -253,7 +253,8 @@ fn a_small_document_cannot_ask_for_copies_without_bound() {
 }
 
 /// A translation or scale no character has (10³⁰ m, a node scaled 10⁶×),
-/// on a node or in an animation key, is refused naming where it is.
+/// on a node, in an animation key or in a joint's inverse bind matrix, is
+/// refused naming where it is.
 #[test]
 fn absurd_transforms_are_refused_naming_the_node_or_channel() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
@@ -272,6 +273,22 @@ fn absurd_transforms_are_refused_naming_the_node_or_channel() {
     let doc = with_translation_keys(&bytes, dir.path(), "keys.bin", &[0.0, 1.0], &far, 1);
     let err = gltf_read::parse(&doc, Some(dir.path())).expect_err("a far key").to_string();
     assert!(err.contains("channel") && err.contains("a key's translation") && err.contains("beyond"), "{err}");
+    // The first joint's inverse bind matrix translated 10³⁰ m (its column 3's
+    // x, in the binary chunk after the JSON chunk and the chunk header).
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().expect("length")) as usize;
+    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).expect("json");
+    let accessor = &json["accessors"][json["skins"][0]["inverseBindMatrices"].as_u64().expect("ibm") as usize];
+    let view = &json["bufferViews"][accessor["bufferView"].as_u64().expect("view") as usize];
+    let offset = 20
+        + json_len
+        + 8
+        + view["byteOffset"].as_u64().unwrap_or(0) as usize
+        + accessor["byteOffset"].as_u64().unwrap_or(0) as usize
+        + 12 * 4;
+    let mut far = bytes.clone();
+    far[offset..offset + 4].copy_from_slice(&1e30f32.to_le_bytes());
+    let err = Character::parse(&far).expect_err("a far bind pose").to_string();
+    assert!(err.contains("skin 0 joint 0") && err.contains("inverse bind") && err.contains("beyond"), "{err}");
 }
 
 /// A vertex far beyond any character is refused naming the mesh's

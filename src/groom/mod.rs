@@ -70,27 +70,65 @@ pub const MAX_POINTS_PER_STRAND: usize = 1 << 16;
 /// units alike; judged per strand, so a far point elsewhere in the groom
 /// changes nothing).
 pub const MIN_SEGMENT_FRACTION: f32 = 1e-6;
-/// A segment longer than this many times its strand's median segment marks an
-/// outlier point (a strand of three segments or more): a point far from where
-/// its strand runs, which no zero-length judgement should be scaled by.
+/// A segment longer than this many times its strand's median segment (a
+/// strand of three segments or more), or the groom's median segment, marks an
+/// outlier point: a point far from where its strand runs, which no
+/// zero-length judgement should be scaled by. (The groom's median judges a
+/// strand too short to judge itself, and one whose far middle point makes
+/// half its segments long.)
 pub const OUTLIER_SEGMENT_RATIO: f32 = 1e4;
 
-/// The first outlier point of the strand `points` ([`OUTLIER_SEGMENT_RATIO`]):
+/// Most segments [`groom_median_segment`] samples.
+const MEDIAN_SAMPLES: usize = 1 << 20;
+
+/// The median length of the segments of `strands` (ranges of `positions`),
+/// from at most [`MEDIAN_SAMPLES`] of them spread over the groom; `None`
+/// without a segment.
+pub(crate) fn groom_median_segment(
+    positions: &[Vec3],
+    strands: impl Iterator<Item = std::ops::Range<usize>>,
+) -> Option<f32> {
+    let segments: Vec<(usize, usize)> =
+        strands.flat_map(|r| (r.start..r.end.saturating_sub(1)).map(|i| (i, i + 1))).collect();
+    let every = segments.len().div_ceil(MEDIAN_SAMPLES).max(1);
+    let mut lengths: Vec<f32> =
+        segments.iter().step_by(every).map(|&(a, b)| (positions[b] - positions[a]).length()).collect();
+    if lengths.is_empty() {
+        return None;
+    }
+    let middle = lengths.len() / 2;
+    Some(*lengths.select_nth_unstable_by(middle, f32::total_cmp).1)
+}
+
+/// The first outlier point of the strand `points` ([`OUTLIER_SEGMENT_RATIO`]
+/// times the shorter of its median segment and `groom_median`, the groom's):
 /// its index and position. Of a too-long segment, the point it leads to is
-/// the outlier, or the root where only the first segment is too long.
-/// `scratch` is reused memory for the segments' lengths.
-pub(crate) fn outlier_point(points: &[Vec3], scratch: &mut Vec<f32>) -> Option<(usize, Vec3)> {
-    if points.len() < 4 {
+/// the outlier, or the root where only the first of two or more segments is
+/// too long. `scratch` is reused memory for the segments' lengths.
+pub(crate) fn outlier_point(
+    points: &[Vec3],
+    groom_median: Option<f32>,
+    scratch: &mut Vec<f32>,
+) -> Option<(usize, Vec3)> {
+    if points.len() < 2 {
         return None;
     }
     let length = |i: usize| (points[i + 1] - points[i]).length();
     scratch.clear();
     scratch.extend((0..points.len() - 1).map(length));
     let middle = scratch.len() / 2;
-    let most = *scratch.select_nth_unstable_by(middle, f32::total_cmp).1 * OUTLIER_SEGMENT_RATIO;
+    // A strand of fewer than three segments has no median of its own to trust.
+    let own = (scratch.len() >= 3).then(|| *scratch.select_nth_unstable_by(middle, f32::total_cmp).1);
+    let reference = match (own, groom_median) {
+        (Some(a), Some(b)) => a.min(b),
+        (a, b) => a.or(b)?,
+    };
+    let most = reference * OUTLIER_SEGMENT_RATIO;
     let long = |i: usize| i + 1 < points.len() && length(i) > most;
     let first = (0..points.len() - 1).find(|&i| long(i))?;
-    let point = if first == 0 && !long(1) { 0 } else { first + 1 };
+    // (A single segment gives no second to tell which end strayed: the tip,
+    // where a root is the end a groom places on its scalp.)
+    let point = if first == 0 && points.len() > 2 && !long(1) { 0 } else { first + 1 };
     Some((point, points[point]))
 }
 
@@ -263,14 +301,17 @@ impl Groom {
                 }
             }
         }
-        let (lo, hi) = self.bounds();
-        check_extent(lo, hi)?;
         let mut scratch = Vec::new();
+        let median = groom_median_segment(&self.positions, (0..self.strand_count()).map(|s| self.strand_range(s)));
         for strand in 0..self.strand_count() {
-            let points = self.strand(strand);
-            if let Some((point, position)) = outlier_point(points, &mut scratch) {
+            if let Some((point, position)) = outlier_point(self.strand(strand), median, &mut scratch) {
                 return Err(Error::OutlierPoint { strand, point, position: position.to_array() });
             }
+        }
+        let (lo, hi) = self.bounds();
+        check_extent(lo, hi)?;
+        for strand in 0..self.strand_count() {
+            let points = self.strand(strand);
             let min_segment = min_segment(points);
             for (segment, pair) in points.windows(2).enumerate() {
                 let length = (pair[1] - pair[0]).length();

@@ -19,6 +19,8 @@ use crate::error::{Error, Result};
 pub struct Repairs {
     /// Strands dropped for a NaN or infinite position or attribute.
     pub non_finite_strands: usize,
+    /// The first of them: strand (in the input), point and what was not finite.
+    pub first_non_finite: Option<(usize, usize, &'static str)>,
     /// Strands dropped for an outlier point.
     pub outlier_strands: usize,
     /// The first outlier dropped: strand (in the input), point and position.
@@ -59,7 +61,11 @@ impl std::fmt::Display for Repairs {
         let parts: Vec<String> = [
             (
                 self.non_finite_strands,
-                plural(self.non_finite_strands, "strand", "strands") + " with NaN or infinite values",
+                plural(self.non_finite_strands, "strand", "strands")
+                    + " with NaN or infinite values"
+                    + &self.first_non_finite.map_or(String::new(), |(s, p, what)| {
+                        format!(" (the first: strand {s} point {p}, its {what})")
+                    }),
             ),
             (
                 self.outlier_strands,
@@ -142,11 +148,19 @@ impl Groom {
         check("thickness", attributes.thickness.as_ref().map(Vec::len))?;
         check("transparency", attributes.transparency.as_ref().map(Vec::len))?;
         check("colors", attributes.colors.as_ref().map(Vec::len))?;
-        let finite = |i: usize| {
-            positions[i].is_finite()
-                && attributes.thickness.as_ref().is_none_or(|t| t[i].is_finite())
-                && attributes.transparency.as_ref().is_none_or(|t| t[i].is_finite())
-                && attributes.colors.as_ref().is_none_or(|c| c[i].is_finite())
+        // What of point `i` is not finite, if anything.
+        let not_finite = |i: usize| {
+            if !positions[i].is_finite() {
+                Some("position")
+            } else if attributes.thickness.as_ref().is_some_and(|t| !t[i].is_finite()) {
+                Some("thickness (width)")
+            } else if attributes.transparency.as_ref().is_some_and(|t| !t[i].is_finite()) {
+                Some("transparency")
+            } else if attributes.colors.as_ref().is_some_and(|c| !c[i].is_finite()) {
+                Some("colour")
+            } else {
+                None
+            }
         };
         let mut repairs = Repairs::default();
         let mut strands = Vec::new(); // (strand, first point) of finite strands with 2+ points
@@ -156,8 +170,9 @@ impl Groom {
             start = range.end;
             if n < 2 {
                 repairs.short_strands += 1;
-            } else if !range.clone().all(finite) {
+            } else if let Some((i, what)) = range.clone().find_map(|i| not_finite(i).map(|w| (i, w))) {
                 repairs.non_finite_strands += 1;
+                repairs.first_non_finite.get_or_insert((strand, i - range.start, what));
             } else {
                 strands.push((strand, range));
             }
@@ -165,16 +180,25 @@ impl Groom {
         if strands.is_empty() {
             return Err(Error::NothingLeft { repairs: repairs.to_string() });
         }
+        // Outliers first, judged by their strand and the groom's median segment:
+        // one far point must not make the groom's extent overflow for all.
+        let median = super::groom_median_segment(&positions, strands.iter().map(|(_, r)| r.clone()));
+        let mut scratch = Vec::new();
+        strands.retain(|(strand, range)| match super::outlier_point(&positions[range.clone()], median, &mut scratch) {
+            Some((point, at)) => {
+                repairs.outlier_strands += 1;
+                repairs.first_outlier.get_or_insert((*strand, point, at.to_array()));
+                false
+            }
+            None => true,
+        });
+        if strands.is_empty() {
+            return Err(Error::NothingLeft { repairs: repairs.to_string() });
+        }
         let (lo, hi) = super::bounding_box(strands.iter().flat_map(|(_, r)| positions[r.clone()].iter().copied()));
         super::check_extent(lo, hi)?;
         let mut counts = Vec::with_capacity(strands.len());
-        let mut scratch = Vec::new();
         for (strand, range) in strands {
-            if let Some((point, at)) = super::outlier_point(&positions[range.clone()], &mut scratch) {
-                repairs.outlier_strands += 1;
-                repairs.first_outlier.get_or_insert((strand, point, at.to_array()));
-                continue;
-            }
             let min_segment = super::min_segment(&positions[range.clone()]);
             let first = range.start;
             let mut kept = vec![first];
@@ -241,8 +265,43 @@ mod tests {
         assert_eq!(repairs.kept_strands(), &[0, 1]);
         assert_eq!(
             repairs.to_string(),
-            "dropped 1 strand with NaN or infinite values, 3 zero-length segments, 2 strands with fewer than two points"
+            "dropped 1 strand with NaN or infinite values (the first: strand 2 point 1, its position), 3 zero-length \
+             segments, 2 strands with fewer than two points"
         );
+        // A NaN width is named as such.
+        let thickness = Some(vec![0.001, f32::NAN, 0.001, 0.001, 0.001]);
+        let (_, repairs) = Groom::repaired(
+            [line(2, 0.0), line(3, 0.1)].concat(),
+            &[2, 3],
+            Attributes { thickness, ..Default::default() },
+        )
+        .expect("one strand left");
+        assert!(repairs.to_string().contains("strand 0 point 1, its thickness (width)"), "{repairs}");
+    }
+
+    /// Strands too short to judge themselves, a far middle point that makes
+    /// half a short strand's segments long, and a point at 3e38 are outliers
+    /// by the groom's median segment: those strands are dropped and named,
+    /// the others kept (the 3e38 point had made the whole groom's extent
+    /// overflow).
+    #[test]
+    fn short_strands_and_far_points_are_judged_by_the_groom_too() {
+        let mut two = line(2, 0.0);
+        two[1] = Vec3::new(0.0, 1e5, 0.0);
+        let mut three = line(3, 0.1);
+        three[2] = Vec3::new(0.1, 1e3, 0.0);
+        let mut four = line(4, 0.2);
+        four[1] = Vec3::new(3e3, 0.0, 0.0);
+        let mut huge = line(5, 0.3);
+        huge[2] = Vec3::new(3e38, 0.0, 0.0);
+        let good: Vec<Vec<Vec3>> = (0..6).map(|k| line(5, 0.5 + 0.1 * k as f32)).collect();
+        let strands: Vec<Vec<Vec3>> = [vec![two, three, four, huge], good].concat();
+        let counts: Vec<u32> = strands.iter().map(|s| s.len() as u32).collect();
+        let (groom, repairs) = Groom::repaired(strands.concat(), &counts, Attributes::default()).expect("repaired");
+        assert_eq!((repairs.outlier_strands, repairs.zero_length_segments), (4, 0), "{repairs}");
+        assert_eq!(groom.strand_count(), 6, "the good strands kept");
+        assert_eq!(repairs.first_outlier.map(|(s, p, _)| (s, p)), Some((0, 1)), "{repairs}");
+        assert!(Groom::new(strands.concat(), &counts).is_err(), "the strict constructor refuses them");
     }
 
     /// One far point in one strand is an outlier of that strand: the strict
@@ -277,7 +336,7 @@ mod tests {
         tip[4] = Vec3::splat(1e4);
         let mut root = line(5, 0.0);
         root[0] = Vec3::splat(-1e4);
-        let outlier = |points: &[Vec3]| crate::groom::outlier_point(points, &mut Vec::new());
+        let outlier = |points: &[Vec3]| crate::groom::outlier_point(points, None, &mut Vec::new());
         assert_eq!(outlier(&tip).map(|o| o.0), Some(4));
         assert_eq!(outlier(&root).map(|o| o.0), Some(0));
         assert_eq!(outlier(&line(5, 0.0)), None);

@@ -7,12 +7,11 @@
 //! nested value as it reads a field's own, allocating by counts the file
 //! gives and recursing without a limit (a dictionary whose entry points back
 //! at itself recursed until the stack ended). [`check`] walks the same
-//! offsets and checks every nested value as [`super::usdc_values`] checks a
+//! offsets and checks every nested value as `usdc_values` checks a
 //! field's (counts against the room the file has, indices against their
 //! tables), at most [`MAX_VALUE_NESTING`] deep and [`MAX_NESTED_VALUES`] in
 //! all.
 
-use super::usdc_values::{check_value, ValueRep, Walk};
 use crate::error::{Error, FileFormat, Result};
 
 /// Deepest a value may lie inside others (dictionaries in dictionaries, time
@@ -26,6 +25,65 @@ pub const MAX_NESTED_VALUES: u64 = 1 << 20;
 /// Smallest a dictionary entry may be: a key's string index, an offset and
 /// the value's representation.
 const ENTRY_BYTES: u64 = 4 + 8 + 8;
+
+/// A field's value representation, as the crate format packs it in 64 bits.
+#[derive(Clone, Copy)]
+pub(super) struct ValueRep(pub(super) u64);
+
+impl ValueRep {
+    pub(super) fn ty(self) -> u64 {
+        (self.0 >> 48) & 0xFF
+    }
+    pub(super) fn payload(self) -> u64 {
+        self.0 & ((1 << 48) - 1)
+    }
+    pub(super) fn is_array(self) -> bool {
+        self.0 & (1 << 63) != 0
+    }
+    pub(super) fn is_inlined(self) -> bool {
+        self.0 & (1 << 62) != 0
+    }
+    pub(super) fn is_compressed(self) -> bool {
+        self.0 & (1 << 61) != 0
+    }
+}
+
+/// One field's value being checked, and what the walk of values nested in
+/// others needs ([`super::usdc_nested`]).
+pub(super) struct Walk<'a> {
+    /// The field whose value (or a value nested in it) is checked.
+    pub field: usize,
+    pub tables: &'a Tables,
+    pub version: (u8, u8, u8),
+    /// The file's length.
+    pub len: u64,
+    /// Up to 8 bytes of the file at a byte offset, little-endian.
+    pub read_at: &'a mut dyn FnMut(u64, usize) -> Result<u64>,
+    /// Values visited so far over the whole layer (nested ones included).
+    pub visits: &'a mut u64,
+    /// What checks a value (and, through this walk, what it holds):
+    /// `usdc_values::check_value`.
+    pub check: fn(&mut Walk<'_>, ValueRep, u32) -> Result<()>,
+}
+
+/// The sizes of the tables a value's indices point into.
+pub(super) struct Tables {
+    pub tokens: u64,
+    pub strings: u64,
+    pub paths: u64,
+    /// Each string's token.
+    pub string_tokens: Vec<u64>,
+    /// Each field's name.
+    pub field_names: Vec<String>,
+}
+
+impl Tables {
+    /// Field `field` as an error names it: its index and name.
+    pub(super) fn field(&self, field: usize) -> String {
+        let name = self.field_names.get(field).map_or("", String::as_str);
+        format!("field {field} ({name:?})")
+    }
+}
 
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }
@@ -129,7 +187,7 @@ fn dictionary(walk: &mut Walk<'_>, at: u64, depth: u32) -> Result<u64> {
             return Err(refused(walk, format!("holds an entry of no type at byte {rep_at}")));
         }
         visit(walk, depth + 1)?;
-        check_value(walk, rep, depth + 1)?;
+        (walk.check)(walk, rep, depth + 1)?;
         pos = rep_at + 8;
     }
     Ok(pos)
@@ -179,13 +237,13 @@ fn time_samples(walk: &mut Walk<'_>, at: u64, depth: u32) -> Result<()> {
     if !(times.ty() == 48 || (times.ty() == 9 && times.is_array())) {
         return Err(refused(walk, format!("has times of type {} (not doubles) at byte {times_at}", times.ty())));
     }
-    check_value(walk, times, depth + 1)?;
+    (walk.check)(walk, times, depth + 1)?;
     let count_at = follow(walk, times_at + 8)?;
     let samples = count(walk, count_at, 8)?;
     for k in 0..samples {
         let rep = ValueRep(read(walk, count_at + 8 + 8 * k, 8)?);
         visit(walk, depth + 1)?;
-        check_value(walk, rep, depth + 1)?;
+        (walk.check)(walk, rep, depth + 1)?;
     }
     Ok(())
 }

@@ -30,6 +30,7 @@
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
+use super::usdc_nested::{Tables, ValueRep, Walk};
 use crate::error::{Error, FileFormat, Result};
 
 /// Most items (tokens, fields, paths, specs) a compressed byte can decode to:
@@ -45,28 +46,6 @@ const WINDOW: u64 = 64 << 10;
 
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }
-}
-
-/// A field's value representation, as the crate format packs it in 64 bits.
-#[derive(Clone, Copy)]
-pub(super) struct ValueRep(pub(super) u64);
-
-impl ValueRep {
-    pub(super) fn ty(self) -> u64 {
-        (self.0 >> 48) & 0xFF
-    }
-    pub(super) fn payload(self) -> u64 {
-        self.0 & ((1 << 48) - 1)
-    }
-    pub(super) fn is_array(self) -> bool {
-        self.0 & (1 << 63) != 0
-    }
-    pub(super) fn is_inlined(self) -> bool {
-        self.0 & (1 << 62) != 0
-    }
-    pub(super) fn is_compressed(self) -> bool {
-        self.0 & (1 << 61) != 0
-    }
 }
 
 /// Bytes of one element of an array of crate type `ty` (1 for a type this
@@ -166,25 +145,18 @@ pub fn check(path: &Path, len: u64, version: (u8, u8, u8)) -> Result<()> {
     };
     let mut visits = 0u64;
     for (field, rep) in reps.iter().copied().map(ValueRep).enumerate() {
-        let mut walk = Walk { field, tables: &tables, version, len, read_at: &mut read_at, visits: &mut visits };
+        let mut walk = Walk {
+            field,
+            tables: &tables,
+            version,
+            len,
+            read_at: &mut read_at,
+            visits: &mut visits,
+            check: check_value,
+        };
         check_value(&mut walk, rep, 0)?;
     }
     super::usdc_children::check(path)
-}
-
-/// One field's value being checked, and what the walk of values nested in
-/// others needs ([`super::usdc_nested`]).
-pub(super) struct Walk<'a> {
-    /// The field whose value (or a value nested in it) is checked.
-    pub field: usize,
-    pub tables: &'a Tables,
-    pub version: (u8, u8, u8),
-    /// The file's length.
-    pub len: u64,
-    /// Up to 8 bytes of the file at a byte offset, little-endian.
-    pub read_at: &'a mut dyn FnMut(u64, usize) -> Result<u64>,
-    /// Values visited so far over the whole layer (nested ones included).
-    pub visits: &'a mut u64,
 }
 
 /// Checks value `rep` of `walk`'s field (at nesting `depth`): an array's
@@ -271,25 +243,6 @@ fn check_counts(walk: &mut Walk<'_>, rep: ValueRep) -> Result<()> {
         return Err(what(format!("starts at byte {at}, past the file's end ({len} bytes)")));
     }
     Ok(())
-}
-
-/// The sizes of the tables a value's indices point into.
-pub(super) struct Tables {
-    pub tokens: u64,
-    pub strings: u64,
-    pub paths: u64,
-    /// Each string's token.
-    pub string_tokens: Vec<u64>,
-    /// Each field's name.
-    pub field_names: Vec<String>,
-}
-
-impl Tables {
-    /// Field `field` as an error names it: its index and name.
-    pub(super) fn field(&self, field: usize) -> String {
-        let name = self.field_names.get(field).map_or("", String::as_str);
-        format!("field {field} ({name:?})")
-    }
 }
 
 /// Which table a value's indices point into.
