@@ -772,7 +772,8 @@ fn counts_inside_binary_sections_are_bounded_before_the_reader_allocates() {
 }
 
 /// A point thrown beyond 10 km from the origin by the stage's values and
-/// units is refused naming the prim, the strand and the point.
+/// units is refused naming the prim, the strand and the point; a curve
+/// object its units shrink below 0.1 µm is refused naming it and the units.
 #[test]
 fn a_point_far_beyond_any_scene_is_refused_naming_it() {
     let text = std::fs::read_to_string(data("usd/small_cm_zup.usda")).expect("fixture");
@@ -788,6 +789,13 @@ fn a_point_far_beyond_any_scene_is_refused_naming_it() {
     std::fs::write(&path, text.replace("(0, 0, 100)", "(0, 0, 1e300)")).expect("write");
     let e = usd::open(&path).expect_err("refused").to_string();
     assert!(e.contains("e298") && e.contains("within 1e4 m of the origin") && !e.contains("NaN"), "{e}");
+    // Shrunk to nothing by a units value: named with the span and the units,
+    // not left to the repairs to drop every segment as zero-length.
+    let tiny = text.replace("metersPerUnit = 0.01", "metersPerUnit = 1e-30");
+    assert_ne!(tiny, text);
+    std::fs::write(&path, tiny).expect("write");
+    let e = usd::open(&path).expect_err("refused").to_string();
+    assert!(e.contains("far.usda") && e.contains("its curves span") && e.contains("metersPerUnit"), "{e}");
 }
 
 /// A binary layer's children lists are checked against its paths before the

@@ -444,6 +444,25 @@ pub(crate) fn assemble(
         );
         return Err(in_object(&objects[object].path, Error::Malformed { format: frame.format, reason }));
     }
+    // An object its transforms and the stage's units shrink to nothing (a
+    // scale of 0, metersPerUnit 1e-30) is named, not left to the repairs to
+    // drop every segment as zero-length.
+    for o in &objects {
+        let (lo, hi) = o
+            .points
+            .iter()
+            .map(|&p| to_y_up(p) * k)
+            .filter(|q| q.is_finite())
+            .fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), q| (lo.min(q), hi.max(q)));
+        let extent = (hi - lo).max_element();
+        if o.points.len() > 1 && extent.is_finite() && extent < MIN_OBJECT_EXTENT_M {
+            let reason = format!(
+                "its curves span {extent:e} m after its transforms and the stage's units (metersPerUnit {k}): \
+                 a scale of 0 or units that shrink a groom below {MIN_OBJECT_EXTENT_M:e} m leave no hair"
+            );
+            return Err(in_object(&o.path, Error::Malformed { format: frame.format, reason }));
+        }
+    }
     let all = |what: &str, has: &dyn Fn(&RawCurves) -> bool, skipped: &mut Vec<String>| {
         let n = objects.iter().filter(|o| has(o)).count();
         if n > 0 && n < objects.len() {
@@ -528,6 +547,11 @@ pub const MAX_WIDTH_M: f64 = 1.0;
 /// far beyond any character, near enough that single-precision positions and
 /// the renderer's framing stay meaningful.
 pub const MAX_COORDINATE_M: f32 = 1e4;
+
+/// Least extent a curve object may span after its transforms and the
+/// stage's units, meters: a tenth of a micrometre (a hair is tens of
+/// micrometres wide).
+pub const MIN_OBJECT_EXTENT_M: f64 = 1e-7;
 
 /// `source` as an error of the object at `path`.
 pub(crate) fn in_object(path: &str, source: Error) -> Error {
