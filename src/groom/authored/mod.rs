@@ -444,9 +444,7 @@ pub(crate) fn assemble(
         );
         return Err(in_object(&objects[object].path, Error::Malformed { format: frame.format, reason }));
     }
-    // An object its transforms and the stage's units shrink to nothing (a
-    // scale of 0, metersPerUnit 1e-30) is named, not left to the repairs to
-    // drop every segment as zero-length.
+    // An object shrunk to nothing (a scale of 0, metersPerUnit 1e-30) is named.
     for o in &objects {
         let (lo, hi) = o
             .points
@@ -548,9 +546,7 @@ pub const MAX_WIDTH_M: f64 = 1.0;
 /// the renderer's framing stay meaningful.
 pub const MAX_COORDINATE_M: f32 = 1e4;
 
-/// Least extent a curve object may span after its transforms and the
-/// stage's units, meters: a tenth of a micrometre (a hair is tens of
-/// micrometres wide).
+/// Least extent a curve object may span after its transforms and the stage's units, meters.
 pub const MIN_OBJECT_EXTENT_M: f64 = 1e-7;
 
 /// `source` as an error of the object at `path`.
