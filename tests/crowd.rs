@@ -350,7 +350,8 @@ fn a_crowd_refuses_a_volume_stage_and_names_a_bad_member() {
 /// A renderer fits its shadow maps to the bounds a view carries
 /// ([`KeyHairs::with_bounds`]): the rest shape's own sphere gives the frame
 /// drawn without bounds, bit for bit; a sphere elsewhere leaves the hair out
-/// of the maps. Bounds that are not finite or not above 0 are refused.
+/// of the maps, and, 5 m from the camera, lowers the level of detail. Bounds
+/// that are not finite or not above 0 are refused.
 #[test]
 fn a_renderer_fits_its_shadows_to_the_bounds_of_the_view() {
     let gpu = Gpu::new();
@@ -388,6 +389,16 @@ fn a_renderer_fits_its_shadows_to_the_bounds_of_the_view() {
     );
     assert!(plain == same, "the rest shape's own sphere changed the frame");
     assert!(sum(&away) > sum(&plain), "shadow maps fitted 5 m aside still shadow the hair");
+    // The level of detail follows the bounds' distance from the camera too.
+    renderer.set_params(&RenderParams::default()).expect("with a level of detail");
+    let hairs = |view: KeyHairs<'_>, renderer: &mut Renderer| {
+        renderer.prepare_now(view, Some(&camera)).expect("prepare");
+        renderer.hair_counts().0
+    };
+    let near = hairs(sim.key_hairs().with_bounds(centre, radius).expect("bounds"), &mut renderer);
+    let far = hairs(sim.key_hairs().with_bounds(centre + Vec3::Z * 5.0, radius).expect("bounds"), &mut renderer);
+    println!("hairs drawn: {near} with the rest sphere, {far} with a sphere 5 m away");
+    assert!(far < near, "a sphere 5 m away kept the detail ({far} of {near} hairs)");
     for (c, r) in [(Vec3::NAN, 1.0), (Vec3::ZERO, 0.0), (Vec3::ZERO, f32::INFINITY)] {
         let e = sim.key_hairs().with_bounds(c, r).expect_err("refused").to_string();
         assert!(e.contains("bounds"), "{e}");
