@@ -529,3 +529,22 @@ fn an_absurdly_sized_groom_is_refused_naming_the_file_and_its_size() {
     assert!(out.stderr.contains("--scale") && out.stderr.contains("in clumps"), "{}", out.stderr);
     assert!(!out.stderr.contains("invalid parameter"), "an internal parameter named: {}", out.stderr);
 }
+
+/// `grow` without `--scalp` grows the reference scene, whatever the strand
+/// flags say: it says so when they are given, rather than writing 1,750
+/// strands of 6 points to someone who asked for 300 of 12.
+#[test]
+fn grow_says_when_the_reference_scene_ignores_its_strand_flags() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("g.hair");
+    let run = run(&["grow", "--strands", "300", "--points", "12", "--out", out.to_str().expect("utf-8")], LIMIT);
+    run.assert_ok();
+    assert!(run.stderr.contains("--strands, --points and --length are ignored"), "{}", run.stderr);
+    assert!(run.stdout.contains("1750 strands"), "{}", run.stdout);
+    let sphere = dir.path().join("s.hair");
+    let args =
+        ["grow", "--scalp", "sphere", "--strands", "300", "--points", "12", "--out", sphere.to_str().expect("utf-8")];
+    let run = common::run(&args, LIMIT);
+    run.assert_ok();
+    assert!(!run.stderr.contains("ignored") && run.stdout.contains("300 strands"), "{}", run.stdout);
+}

@@ -105,7 +105,16 @@ pub fn grow_groom(a: &GrowArgs) -> CliResult {
     let inputs: Vec<&std::path::Path> = a.obj.iter().chain(&a.gltf).map(|p| p.as_path()).collect();
     destinations::check(&inputs, &[Output { flag: "--out", path: &a.out, kind: Kind::File(&["hair"]) }])?;
     let groom = match a.scalp {
-        ScalpKind::Thesis => scenes::thesis()?,
+        ScalpKind::Thesis => {
+            if a.strands != 1000 || a.points != 16 || a.length.is_some() {
+                crate::say_err!(
+                    "vkhair: warning: --scalp thesis (the default) is the reference scene, 1750 strands of 6 points: \
+                     --strands, --points and --length are ignored (give --scalp sphere, ellipsoid, obj or gltf to \
+                     grow your own)"
+                );
+            }
+            scenes::thesis()?
+        }
         ScalpKind::Gltf => {
             let path = a.gltf.as_ref().ok_or("--scalp gltf needs --gltf FILE.glb")?;
             let character = vkhair::character::Character::load(path)?;
