@@ -7,6 +7,10 @@ use std::ops::Range;
 use glam::{Mat4, Vec3};
 
 use super::{Member, MemberPose, MAX_CROWD_MEMBERS};
+
+/// Most bones one member's scalp may name (its skin's highest weighted
+/// joint below this).
+pub const MAX_MEMBER_BONES: usize = 1 << 16;
 use crate::error::{Error, Result};
 use crate::groom::mesh::TriMesh;
 use crate::groom::{Attributes, Groom};
@@ -89,12 +93,19 @@ pub(super) fn lay_out(members: &[Member], poses: &[MemberPose], sets: &[u32]) ->
                 }
                 let binding = ScalpBinding::new(&scalp, &roots).map_err(named)?;
                 let (scalp, binding) = compact(&scalp, binding).map_err(named)?;
-                let bones = scalp.skin.iter().flat_map(|v| v.joints).max().map_or(1, |j| j as usize + 1);
+                // Bones the skin weights (a joint of weight 0 moves nothing).
+                let weighted = scalp.skin.iter().flat_map(|v| v.joints.into_iter().zip(v.weights));
+                let highest = weighted.filter(|&(_, w)| w != 0.0).map(|(j, _)| j).max().unwrap_or(0);
+                if highest as usize >= MAX_MEMBER_BONES {
+                    let e = Error::param("scalp joint", highest, format!("below {MAX_MEMBER_BONES} bones a member"));
+                    return Err(named(e));
+                }
+                let bones = highest as usize + 1;
                 parts.push(binding);
                 (scalp, bones)
             }
             None => {
-                let scalp = rigid_scalp(place.transform_point3(sphere.0), sphere.1, &roots)?;
+                let scalp = rigid_scalp(place.transform_point3(sphere.0), sphere.1, &roots).map_err(named)?;
                 parts.push(ScalpBinding::new(&scalp, &roots).map_err(named)?);
                 (scalp, 1)
             }
@@ -194,7 +205,18 @@ fn merged_scalp(parts: &[(Scalp, u32)]) -> Result<Scalp> {
         let first = positions.len() as u32;
         positions.extend_from_slice(&scalp.mesh.positions);
         triangles.extend(scalp.mesh.triangles.iter().map(|t| t.map(|v| v + first)));
-        skin.extend(scalp.skin.iter().map(|v| VertexSkin { joints: v.joints.map(|j| j + base), weights: v.weights }));
+        // Weighted joints move past the bones of the members before; a joint
+        // of weight 0 moves nothing and is set to the member's first bone.
+        let moved = |v: &VertexSkin| {
+            let mut joints = [*base; 4];
+            for (k, (&j, &w)) in v.joints.iter().zip(&v.weights).enumerate() {
+                if w != 0.0 {
+                    joints[k] = j + base;
+                }
+            }
+            VertexSkin { joints, weights: v.weights }
+        };
+        skin.extend(scalp.skin.iter().map(moved));
     }
     let tolerance = parts.iter().map(|(s, _)| s.tolerance).fold(0.0f32, f32::max);
     Ok(Scalp { mesh: TriMesh::new(positions, triangles)?, skin, tolerance })

@@ -42,6 +42,9 @@
 //! move rigidly before the next step (the move kernel over their points), and
 //! their roots start that step from its scalp.
 //!
+//! The crowd's head is the identity, so [`SimParams::teleport_distance`]
+//! never takes a member's jump for a teleport: call [`Crowd::teleport`].
+//!
 //! The members share the renderer's parameters. The volume stage
 //! and the mesh collider are not available in a crowd (one grid cannot follow
 //! characters apart; the mesh collider has one head frame): [`Crowd::new`]
@@ -108,7 +111,8 @@ pub struct Member {
     /// Key hairs in the member's head frame (meters), resampled to the
     /// crowd's point count when they have fewer points.
     pub groom: Groom,
-    /// Spheres and capsules in the head frame, moved by the member's head.
+    /// Spheres and capsules in the head frame (meters), moved by the
+    /// member's head.
     pub colliders: Vec<Collider>,
     /// A skinned scalp (bind pose, head frame) whose bones
     /// ([`MemberPose::bones`]) carry the roots, bound within
@@ -122,9 +126,12 @@ pub struct Member {
 
 /// The simulation parameters a member may have of its own: gravity, wind
 /// (its direction, turbulence and frequency), the rest-shape spring, damping,
-/// bending at root and tip, and the global shape's stiffness and range. The
-/// others (time step, sub-steps, iterations, solver, switches, local shape,
-/// stretch limit, friction, pearl radii, the volume stage) are the crowd's.
+/// bending at root and tip, and the global shape's stiffness and range — as
+/// long as the switches stay the crowd's (a global shape stiffness of 0
+/// turns the constraint off, so 0 against a stiffness above 0 is refused).
+/// The others (time step, sub-steps, iterations, solver, switches, local
+/// shape, stretch limit, friction, pearl radii, the volume stage) are the
+/// crowd's.
 pub const MEMBER_PARAMS: [&str; 10] = crate::sim::SET_FIELDS;
 
 impl Member {
@@ -137,14 +144,15 @@ impl Member {
 /// Where a member is at the end of a step.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct MemberPose {
-    /// The head transform: places the member's head colliders and, without a
-    /// scalp, carries its roots.
+    /// The head transform: places the member's head colliders and where its
+    /// hair is taken to be for the crowd's bounds (for a skinned member, its
+    /// head joint's transform) and, without a scalp, carries its roots.
     pub head: RigidTransform,
     /// With a scalp: its bone matrices (bind pose, head frame → world), at
     /// least one past the highest joint the scalp's skin names; else empty.
     pub bones: Vec<Mat4>,
-    /// The colliders of the member's body in the world (shoulders, arms), as
-    /// [`HairSim::set_body_colliders`] takes them.
+    /// The colliders of the member's body in the world (meters; shoulders,
+    /// arms), as [`HairSim::set_body_colliders`] takes them.
     pub body: Vec<Collider>,
 }
 
@@ -216,20 +224,16 @@ impl Crowd {
     }
 
     /// Parameter sets the members are simulated with: the crowd's, and one
-    /// more for each distinct [`Member::params`] unlike it.
+    /// more for each distinct [`Member::params`] (a member with parameters
+    /// of its own keeps them whatever [`Crowd::set_params`] gives the crowd).
     pub fn parameter_sets(&self) -> usize {
-        1 + self
-            .own
-            .iter()
-            .flatten()
-            .filter(|p| *p != self.sim.params())
-            .fold(Vec::new(), |mut v: Vec<&SimParams>, p| {
-                if !v.contains(&p) {
-                    v.push(p);
-                }
-                v
-            })
-            .len()
+        let mut distinct: Vec<&SimParams> = Vec::new();
+        for own in self.own.iter().flatten() {
+            if !distinct.contains(&own) {
+                distinct.push(own);
+            }
+        }
+        1 + distinct.len()
     }
 
     /// Member `m`'s key hairs in the simulation (empty past the last member).
@@ -275,7 +279,10 @@ impl Crowd {
             return Err(Error::param("crowd member", m, format!("below {}", self.members.len())));
         };
         to.validate().map_err(|e| member_error(m, e))?;
-        self.sim.teleport_hairs(member.strands.clone(), to.matrix() * from.matrix().inverse())
+        self.sim.teleport_hairs(member.strands.clone(), to.matrix() * from.matrix().inverse())?;
+        // A second teleport before the step moves on from here.
+        self.heads[m] = *to;
+        Ok(())
     }
 
     /// Records one step of every member into `cmd`: [`HairSim::record_step`]
@@ -290,7 +297,8 @@ impl Crowd {
     }
 
     /// Records `steps` steps in one submission and waits (headless use),
-    /// step `i` ending at `poses(i)`.
+    /// step `i` ending at `poses(i)`. A pose refused part way ends the
+    /// recording there: the steps recorded before it are still submitted.
     pub fn run(&mut self, steps: usize, mut poses: impl FnMut(usize) -> Vec<MemberPose>) -> Result<()> {
         let device = self.sim.device().clone();
         let mut result = Ok(());
@@ -322,8 +330,10 @@ impl Crowd {
     }
 
     /// Simulates only `count` key hairs of the whole crowd (see
-    /// [`HairSim::set_simulated_hairs`]): the others follow a simulated
-    /// neighbour of their own member.
+    /// [`HairSim::set_simulated_hairs`]): the others follow the nearest
+    /// simulated key hair at rest — in a crowd of members standing apart,
+    /// one of their own member's; members laid out within reach of each
+    /// other may lend each other guides.
     pub fn set_simulated_hairs(&mut self, count: usize) -> Result<()> {
         self.sim.set_simulated_hairs(count)
     }
@@ -393,7 +403,6 @@ fn parameter_sets(params: &SimParams, members: &[Member]) -> Result<(Vec<SimPara
     for (m, member) in members.iter().enumerate() {
         let set = match &member.params {
             None => 0,
-            Some(own) if own == params => 0,
             Some(own) => {
                 check_set(params, own).map_err(|e| member_error(m, e))?;
                 match sets.iter().position(|s| s == own) {

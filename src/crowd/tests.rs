@@ -153,8 +153,12 @@ fn members_with_equal_parameters_share_a_set_and_others_are_refused_naming_what_
     let member = |p: Option<&crate::sim::SimParams>| Member { params: p.cloned(), ..Member::rigid(g.clone()) };
     let members = [member(None), member(Some(&heavy)), member(Some(&base)), member(Some(&stiff)), member(Some(&heavy))];
     let (sets, of_member) = super::parameter_sets(&base, &members).expect("sets");
-    assert_eq!(sets, [heavy.clone(), stiff]);
-    assert_eq!(of_member, [0, 1, 0, 2, 1], "the crowd's own parameters are set 0, equal ones share");
+    assert_eq!(sets, [heavy.clone(), base.clone(), stiff]);
+    assert_eq!(
+        of_member,
+        [0, 1, 2, 3, 1],
+        "a member's own parameters a set of theirs (kept through the crowd's changes), equal ones share"
+    );
     let refused = |p: crate::sim::SimParams| {
         super::parameter_sets(&base, &[member(None), member(Some(&p))]).expect_err("refused").to_string()
     };

@@ -98,8 +98,10 @@ pub(crate) fn for_set(step: &SimStep, p: &SimParams) -> SimStep {
 /// anywhere but in [`SET_FIELDS`], naming the fields.
 pub(crate) fn check_set(base: &SimParams, p: &SimParams) -> crate::error::Result<()> {
     p.validate()?;
-    let table = |p: &SimParams| toml::Table::try_from(p).unwrap_or_default();
-    let (a, b) = (table(base), table(p));
+    let table = |p: &SimParams| {
+        toml::Table::try_from(p).map_err(|e| crate::error::Error::param("simulation parameters", e, "serialisable"))
+    };
+    let (a, b) = (table(base)?, table(p)?);
     let differ: Vec<&str> = a
         .keys()
         .chain(b.keys())

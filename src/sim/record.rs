@@ -56,7 +56,11 @@ impl HairSim {
         let features = inputs.iter().fold(0, |f, sub| f | sub.params.flags);
         self.pipeline.prepare_variant(features)?;
         let scalp = self.take_scalp_upload();
-        let partial = std::mem::take(&mut self.partial_moves);
+        let mut partial = std::mem::take(&mut self.partial_moves);
+        if planned.start.as_ref().is_some_and(|start| start.reset) {
+            // A reset places every key hair on its scalp already.
+            partial.clear();
+        }
         let corners = self.moved_corners(&partial, scalp.as_deref());
         // SAFETY (whole body): guaranteed by the caller; all buffers belong to this
         // device, and update sizes are multiples of 4 below 64 KiB (by construction).

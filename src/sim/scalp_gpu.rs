@@ -194,13 +194,17 @@ impl HairSim {
         if strands.end > self.shape.strands || strands.is_empty() || !transform.is_finite() {
             return Err(Error::param("teleported key hairs", format!("{strands:?}"), "a run of the key hairs"));
         }
-        self.partial_moves.push(super::teleport::PartialMove { strands, transform });
+        // A second move of the same key hairs before the step composes with the first.
+        match self.partial_moves.iter_mut().find(|mv| mv.strands == strands) {
+            Some(pending) => pending.transform = transform * pending.transform,
+            None => self.partial_moves.push(super::teleport::PartialMove { strands, transform }),
+        }
         Ok(())
     }
 
-    /// For each move of `moves`: its key hairs' corners on the scalp of the
-    /// step being recorded (`upload`, else the latest vertices), as
-    /// (first key hair, three vec4 a key hair).
+    /// The corners of the key hairs `moves` move on the scalp of the step
+    /// being recorded (`upload`, else the latest vertices), per run of
+    /// consecutive key hairs: (first key hair, three vec4 a key hair).
     pub(crate) fn moved_corners(
         &self,
         moves: &[super::teleport::PartialMove],
@@ -210,11 +214,22 @@ impl HairSim {
             return Vec::new();
         };
         let vertices: Vec<glam::Vec3> = upload.unwrap_or(latest).iter().map(|v| v.truncate()).collect();
-        moves
-            .iter()
-            .map(|mv| {
-                let run = mv.strands.clone().flat_map(|h| binding.corners(h, &vertices).map(|c| c.extend(0.0)));
-                (mv.strands.start, run.collect())
+        // Overlapping moves' key hairs uploaded once (two writes of one range
+        // in one upload would race).
+        let mut ranges: Vec<std::ops::Range<usize>> = moves.iter().map(|mv| mv.strands.clone()).collect();
+        ranges.sort_by_key(|r| r.start);
+        let mut merged: Vec<std::ops::Range<usize>> = Vec::new();
+        for r in ranges {
+            match merged.last_mut() {
+                Some(last) if r.start <= last.end => last.end = last.end.max(r.end),
+                _ => merged.push(r),
+            }
+        }
+        merged
+            .into_iter()
+            .map(|r| {
+                let run = r.clone().flat_map(|h| binding.corners(h, &vertices).map(|c| c.extend(0.0)));
+                (r.start, run.collect())
             })
             .collect()
     }
