@@ -132,6 +132,29 @@ pub(crate) fn outlier_point(
     Some((point, points[point]))
 }
 
+/// A groom's optional per-point thickness, transparency and colours.
+pub(crate) type PointAttributes<'a> = (Option<&'a [f32]>, Option<&'a [f32]>, Option<&'a [Vec3]>);
+
+/// What of point `i` is not finite — its "position", "thickness",
+/// "transparency" or "color" (of `attributes`, in that order) — if anything.
+pub(crate) fn not_finite(
+    positions: &[Vec3],
+    (thickness, transparency, colors): PointAttributes<'_>,
+    i: usize,
+) -> Option<&'static str> {
+    if !positions[i].is_finite() {
+        Some("position")
+    } else if thickness.is_some_and(|t| !t[i].is_finite()) {
+        Some("thickness")
+    } else if transparency.is_some_and(|t| !t[i].is_finite()) {
+        Some("transparency")
+    } else if colors.is_some_and(|c| !c[i].is_finite()) {
+        Some("color")
+    } else {
+        None
+    }
+}
+
 /// The shortest segment of the strand `points` that is not zero-length
 /// ([`MIN_SEGMENT_FRACTION`] of its bounding-box diagonal).
 pub(crate) fn min_segment(points: &[Vec3]) -> f32 {
@@ -286,18 +309,9 @@ impl Groom {
             let range = self.strand_range(strand);
             let start = range.start;
             for i in range {
-                let nonfinite = |what| Error::NonFinite { strand, point: i - start, what };
-                if !self.positions[i].is_finite() {
-                    return Err(nonfinite("position"));
-                }
-                if self.thickness.as_ref().is_some_and(|t| !t[i].is_finite()) {
-                    return Err(nonfinite("thickness"));
-                }
-                if self.transparency.as_ref().is_some_and(|t| !t[i].is_finite()) {
-                    return Err(nonfinite("transparency"));
-                }
-                if self.colors.as_ref().is_some_and(|c| !c[i].is_finite()) {
-                    return Err(nonfinite("color"));
+                let attributes = (self.thickness.as_deref(), self.transparency.as_deref(), self.colors.as_deref());
+                if let Some(what) = not_finite(&self.positions, attributes, i) {
+                    return Err(Error::NonFinite { strand, point: i - start, what });
                 }
             }
         }

@@ -148,20 +148,8 @@ impl Groom {
         check("thickness", attributes.thickness.as_ref().map(Vec::len))?;
         check("transparency", attributes.transparency.as_ref().map(Vec::len))?;
         check("colors", attributes.colors.as_ref().map(Vec::len))?;
-        // What of point `i` is not finite, if anything.
-        let not_finite = |i: usize| {
-            if !positions[i].is_finite() {
-                Some("position")
-            } else if attributes.thickness.as_ref().is_some_and(|t| !t[i].is_finite()) {
-                Some("thickness (width)")
-            } else if attributes.transparency.as_ref().is_some_and(|t| !t[i].is_finite()) {
-                Some("transparency")
-            } else if attributes.colors.as_ref().is_some_and(|c| !c[i].is_finite()) {
-                Some("colour")
-            } else {
-                None
-            }
-        };
+        let given = (attributes.thickness.as_deref(), attributes.transparency.as_deref(), attributes.colors.as_deref());
+        let not_finite = |i: usize| super::not_finite(&positions, given, i);
         let mut repairs = Repairs::default();
         let mut strands = Vec::new(); // (strand, first point) of finite strands with 2+ points
         let mut start = 0usize;
@@ -276,7 +264,7 @@ mod tests {
             Attributes { thickness, ..Default::default() },
         )
         .expect("one strand left");
-        assert!(repairs.to_string().contains("strand 0 point 1, its thickness (width)"), "{repairs}");
+        assert!(repairs.to_string().contains("(the first: strand 0 point 1, its thickness)"), "{repairs}");
     }
 
     /// Strands too short to judge themselves, a far middle point that makes

@@ -82,13 +82,16 @@ impl Stacks {
     /// layer's references to its own prims),
     /// checked as one layer's are (no cycle, no arc into its own namespace, no
     /// chain too long): two sublayers whose classes inherit each other
-    /// overflowed the library's stack. Named at the arc, in its layer.
+    /// overflowed the library's stack. Named at the arc, in its layer. Then
+    /// the composition's depth and the arcs' targets ([`Stacks::check_targets`]).
     pub(super) fn check(&self) -> Result<()> {
         let mut roots: Vec<&PathBuf> = self.roots.iter().collect();
         roots.sort();
+        // Each stack's layers, found once for every check below.
+        let stacks: HashMap<&PathBuf, Vec<&PathBuf>> = roots.iter().map(|&r| (r, self.members(r))).collect();
         let mut deepest_chain = 0usize;
         for root in roots {
-            let members = self.members(root);
+            let members = &stacks[root];
             let mut arcs: Arcs<&Written> = HashMap::new();
             for (from, targets) in members.iter().filter_map(|m| self.layers.get(*m)).flat_map(|(a, _)| a) {
                 arcs.entry(from.clone()).or_default().extend(targets.iter().map(|(to, at)| (to.clone(), at)));
@@ -112,7 +115,7 @@ impl Stacks {
             ))
             .in_asset(&self.stage));
         }
-        Ok(())
+        self.check_targets(&stacks)
     }
 
     /// The most references and payloads one chain of layers from `layer`
@@ -164,11 +167,13 @@ impl Stacks {
     /// names (judged over its sublayers too, and below the root prim), and
     /// every prim one without an asset path takes in some stack its layer is
     /// part of: the USD library goes without an arc to a prim that is not
-    /// there in silence. Named at the arc.
-    pub(super) fn check_targets(&self) -> Result<()> {
+    /// there in silence. Named at the arc. `stacks`: each stack root's layers
+    /// (every layer an arc takes a prim of is one).
+    fn check_targets(&self, stacks: &HashMap<&PathBuf, Vec<&PathBuf>>) -> Result<()> {
         let missing = |(layer, line): &Written, why: String| malformed(format!("{line} {why}")).in_asset(layer);
         for (target, prim, by) in &self.wanted {
-            if self.offers.contains_key(target) && !self.offers(&self.members(target), prim) {
+            let members = stacks.get(target).map(Vec::as_slice).unwrap_or_default();
+            if self.offers.contains_key(target) && !self.offers(members, prim) {
                 let why = format!(
                     "a reference or payload takes {prim} of {}, which neither it nor its sublayers has (nor an \
                      ancestor whose arcs or variants could bring it)",
@@ -177,11 +182,8 @@ impl Stacks {
                 return Err(missing(by, why));
             }
         }
-        let mut roots: Vec<&PathBuf> = self.roots.iter().collect();
-        roots.sort();
-        let stacks: Vec<Vec<&PathBuf>> = roots.into_iter().map(|r| self.members(r)).collect();
         for (layer, prim, by) in &self.internal {
-            let within = stacks.iter().filter(|members| members.contains(&layer));
+            let within = stacks.values().filter(|members| members.contains(&layer));
             if within.clone().next().is_some() && !within.clone().any(|members| self.offers(members, prim)) {
                 let why = format!(
                     "a reference or payload takes {prim}, which the layer and the layers it is composed with do \

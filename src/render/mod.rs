@@ -54,7 +54,7 @@ pub use params::{
 };
 pub use pass::RenderPass;
 pub use scalp_coverage::{scalp_coverage, ScalpCoverage, MAX_COVERAGE_PROBES};
-pub use scalp_hair::{scalp_area_cm2, ScalpHairParams};
+pub use scalp_hair::{scalp_area_cm2, ScalpHairParams, SCALP_DENSITY_RANGE};
 pub use shading::{Camera, DepthConvention, HairMaterial, Light, ShadingMode, MAX_LIGHTS};
 pub use shadow::{
     layer_of, layer_opacity, ShadowCaster, ShadowMethod, ShadowParams, MAX_SHADOW_MAPS, SHADOW_ATLAS_FORMAT,

@@ -90,11 +90,15 @@ impl Default for ScalpHairParams {
     }
 }
 
+/// The densities [`ScalpHairParams::density`] takes, hairs per cm²: from
+/// the sparsest rooting to ten times a human scalp's.
+pub const SCALP_DENSITY_RANGE: std::ops::RangeInclusive<f32> = 0.01..=1000.0;
+
 impl ScalpHairParams {
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<()> {
         let ranges = [
-            ("scalp.density", self.density, 0.01, 1000.0),
+            ("scalp.density", self.density, *SCALP_DENSITY_RANGE.start(), *SCALP_DENSITY_RANGE.end()),
             ("scalp.parting_angle", self.parting_angle, 0.0, 180.0),
             ("scalp.clumping", self.clumping, 0.0, 1.0),
             ("scalp.length_variation", self.length_variation, 0.0, 0.9),

@@ -197,12 +197,11 @@ impl Light {
     /// and 0 ≤ inner ≤ outer < π for a spot; the error names the field.
     pub fn validate(&self) -> Result<()> {
         let (color, most) = match *self {
-            Light::Directional { color, .. } => (color, "1e6"),
-            Light::Point { color, .. } | Light::Spot { color, .. } => (color, "1e9"),
+            Light::Directional { color, .. } => (color, 1e6f32),
+            Light::Point { color, .. } | Light::Spot { color, .. } => (color, 1e9),
         };
-        let bound: f32 = if most == "1e6" { 1e6 } else { 1e9 };
-        if !(color.is_finite() && color.min_element() >= 0.0 && color.max_element() <= bound) {
-            return Err(Error::param("light color", color, format!("finite, each component 0..={most}")));
+        if !(color.is_finite() && color.min_element() >= 0.0 && color.max_element() <= most) {
+            return Err(Error::param("light color", color, format!("finite, each component 0..={most:e}")));
         }
         if let Light::Point { position, .. } | Light::Spot { position, .. } = *self {
             if !(position.is_finite() && position.abs().max_element() <= 1e6) {

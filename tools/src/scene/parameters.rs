@@ -3,6 +3,7 @@
 use vkhair::config::Config;
 use vkhair::render::{
     Followers, InterpolationMode, Light, Primitive, Renderer, ShadingMode, ShadowCaster, ShadowParams, Transparency,
+    SCALP_DENSITY_RANGE,
 };
 use vkhair::sim::{KeyHairs, RigidTransform, SimParams, SimState, VolumeMode, VolumeParams};
 use vkhair::GpuContext;
@@ -12,10 +13,6 @@ use crate::args::input::{strand_widths, Dense};
 use crate::args::scene::SceneArgs;
 use crate::say;
 use crate::say_err;
-
-/// The sparsest rooting over the scalp the parameters take, hairs per cm²
-/// (`ScalpHairParams::density`'s lower bound).
-const MIN_SCALP_DENSITY: f32 = 0.01;
 
 /// The parameters: vkhair's defaults (an `--input` groom held in its authored
 /// style, [`SimParams::styled`]; strands as wide as the groom file says when it
@@ -105,11 +102,13 @@ pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
         // many, within the parameter's range (checked as given first).
         config.scalp.validate()?;
         let scaled = config.scalp.density / (k * k);
-        config.scalp.density = scaled.clamp(MIN_SCALP_DENSITY, 1000.0);
+        config.scalp.density = scaled.clamp(*SCALP_DENSITY_RANGE.start(), *SCALP_DENSITY_RANGE.end());
         if config.scalp.density != scaled {
             say_err!(
-                "vkhair: warning: {scaled} hairs per cm² of the groom's units is outside 0.01..=1000; rooting {} \
-                 per cm² (give --scale to convert the groom to meters)",
+                "vkhair: warning: {scaled} hairs per cm² of the groom's units is outside {}..={}; rooting {} per \
+                 cm² (give --scale to convert the groom to meters)",
+                SCALP_DENSITY_RANGE.start(),
+                SCALP_DENSITY_RANGE.end(),
                 config.scalp.density
             );
         }
@@ -280,12 +279,13 @@ pub fn scalp_followers(
     }
     if f64::from(area) * f64::from(params.density) > f64::from(params.max_hairs) {
         let density = 0.999 * params.max_hairs as f32 / area;
-        if density < MIN_SCALP_DENSITY {
+        let sparsest = *SCALP_DENSITY_RANGE.start();
+        if density < sparsest {
             // Even the sparsest rooting is more than the device holds: a groom
             // far larger than a head (its units read as meters).
             say_err!(
                 "vkhair: warning: the key hairs' roots cover {area:.0} cm² (the groom's units read as meters: give \
-                 --scale to convert them); even {MIN_SCALP_DENSITY} hairs per cm² would be more than the {} hairs \
+                 --scale to convert them); even {sparsest} hairs per cm² would be more than the {} hairs \
                  of {points} points this device holds; growing hairs in clumps around each key hair instead",
                 params.max_hairs
             );
