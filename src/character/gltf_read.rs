@@ -365,9 +365,11 @@ fn nodes(doc: &gltf::Document) -> Result<Vec<Node>> {
         }
     }
     for (i, n) in nodes.iter().enumerate() {
-        let finite = n.translation.is_finite() && n.rotation.is_finite() && n.scale.is_finite();
-        if !finite || n.rotation.length_squared() < 1e-12 {
+        if !(n.translation.is_finite() && n.rotation.is_finite() && n.scale.is_finite()) {
             return Err(malformed(format!("node {i} ({:?}) has a transform that is not finite", n.name)));
+        }
+        if let Some(why) = super::skeleton::not_a_rotation(n.rotation) {
+            return Err(malformed(format!("node {i} ({:?}): its rotation {why}", n.name)));
         }
         if let Some(why) = absurd(n.translation, n.scale) {
             return Err(malformed(format!("node {i} ({:?}): {why}", n.name)));

@@ -8,6 +8,21 @@ use glam::{Mat4, Quat, Vec3};
 
 use crate::error::{Error, Result};
 
+/// Latest (and earliest) key time an animation may have, seconds (about 11.6
+/// days): a key past it is a broken file, not an animation.
+pub const MAX_KEY_TIME_S: f32 = 1e6;
+
+/// Why `q` is no rotation, if it is not: a quaternion is normalised before
+/// use, so any length in 10⁻⁶..=10⁶ is taken (files store slightly
+/// unnormalised ones), and one outside (zero, or so long that normalising it
+/// overflows) is refused.
+pub(crate) fn not_a_rotation(q: Quat) -> Option<String> {
+    let length = q.as_dquat().length();
+    let fine = q.is_finite() && (1e-6..=1e6).contains(&length);
+    let shown = format!("[{:?}, {:?}, {:?}, {:?}]", q.x, q.y, q.z, q.w);
+    (!fine).then(|| format!("{shown} is not a rotation (a quaternion of length {length:.3e}, normalised to use)"))
+}
+
 /// A node of the hierarchy with its rest transform.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Node {
@@ -85,16 +100,27 @@ impl Channel {
         if self.times.iter().any(|t| !t.is_finite()) || self.times.windows(2).any(|w| w[1] < w[0]) {
             return Err("key times are not finite and increasing".into());
         }
+        if let Some(t) = self.times.iter().find(|t| t.abs() > MAX_KEY_TIME_S) {
+            return Err(format!("a key time of {t:?} s is beyond ±{MAX_KEY_TIME_S:?} s"));
+        }
         let per_key = if self.sampling == Sampling::CubicSpline { 3 } else { 1 };
         let (values, finite) = match &self.keys {
             Keys::Translation(v) | Keys::Scale(v) => (v.len(), v.iter().all(|x| x.is_finite())),
-            Keys::Rotation(q) => (q.len(), q.iter().all(|x| x.is_finite() && x.length_squared() >= 1e-12)),
+            Keys::Rotation(q) => (q.len(), q.iter().all(|x| x.is_finite())),
         };
         if values != n * per_key {
             return Err(format!("{values} values for {n} keys"));
         }
         if !finite {
-            return Err("a value is not finite (or a rotation is not a rotation)".into());
+            return Err("a value is not finite".into());
+        }
+        if let Keys::Rotation(q) = &self.keys {
+            // Cubic-spline tangents (the first and third of each key's three
+            // values) may be zero or long; the values themselves are rotations.
+            let mut values = q.iter().enumerate().filter(|(i, _)| per_key == 1 || i % 3 == 1);
+            if let Some((i, why)) = values.find_map(|(i, &r)| not_a_rotation(r).map(|why| (i / per_key, why))) {
+                return Err(format!("rotation key {i}: {why}"));
+            }
         }
         Ok(())
     }

@@ -486,6 +486,12 @@ fn malformed_accessors_and_keys_are_refused_not_read() {
                 j["accessors"][a]["type"] = "VEC4".into();
             }),
         ),
+        (
+            // Finite, but its length overflows when squared: normalising it
+            // would give a zero quaternion (a node scaled to nothing).
+            "node 8 (\"head\"): its rotation [1e30, 0.0, 0.0, 1e30] is not a rotation",
+            Box::new(|j| j["nodes"][8]["rotation"] = serde_json::json!([1e30, 0.0, 0.0, 1e30])),
+        ),
     ];
     for (k, (what, edit)) in cases.into_iter().enumerate() {
         let err = Character::parse(&mutated(&bytes, edit)).expect_err("refused");
@@ -552,6 +558,22 @@ fn hostile_parts_are_refused_or_harmless() {
     )
     .expect_err("zero rotation");
     assert!(err.to_string().contains("channel 0"), "{err}");
+    // A rotation key too long to normalise, a key time past the bound: each
+    // refused naming it; a cubic spline's zero tangents are no rotations and
+    // are taken.
+    let skeleton_with = |times: Vec<f32>, keys: Vec<Quat>, sampling: Sampling| {
+        let channel = Channel { node: 0, times, keys: Keys::Rotation(keys), sampling };
+        let animation = Animation { name: "a".into(), channels: vec![channel] };
+        Skeleton::new(vec![node("a", None, Vec3::ZERO)], vec![0], vec![Mat4::IDENTITY], vec![animation])
+    };
+    let long = Quat::from_xyzw(1e30, 0.0, 0.0, 1e30);
+    let err = skeleton_with(vec![0.0, 1.0], vec![Quat::IDENTITY, long], Sampling::Linear).expect_err("long");
+    assert!(err.to_string().contains("rotation key 1: [1e30, 0.0, 0.0, 1e30] is not a rotation"), "{err}");
+    let err = skeleton_with(vec![0.0, 3e38], vec![Quat::IDENTITY; 2], Sampling::Linear).expect_err("time");
+    assert!(err.to_string().contains("key time of 3e38 s is beyond ±1000000.0 s"), "{err}");
+    let zero = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0);
+    let spline = vec![zero, Quat::IDENTITY, zero, zero, Quat::from_rotation_y(1.0), zero];
+    skeleton_with(vec![0.0, 1.0], spline, Sampling::CubicSpline).expect("zero tangents are taken");
     let mut weights = c.weights.clone();
     weights[3].1 = [0.0; 4];
     let err =

@@ -354,7 +354,13 @@ impl Followers {
                         let ahead = shapes.position_at((g, w), (s + 1.0 / (points - 1) as f32).min(1.0));
                         own += curl.next(blend, ahead, along);
                     }
-                    *x = own.lerp(shapes.position_at(alone, s), params.clumping * along);
+                    // Without clumping the lerp keeps `own`: the clump's
+                    // position is not even looked up.
+                    *x = if params.clumping == 0.0 {
+                        own
+                    } else {
+                        own.lerp(shapes.position_at(alone, s), params.clumping * along)
+                    };
                 }
                 let ((g, w), point_offsets) = shapes.bind_strand(&strand, (g, w));
                 offsets.extend(point_offsets.iter().flat_map(|o| o.to_array()));

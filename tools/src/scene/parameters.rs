@@ -299,7 +299,7 @@ pub fn scalp_followers(
         );
         params.density = density;
     }
-    let followers = Followers::over_scalp(&rest, &params, level, points)?;
+    let followers = bound_over_scalp(&rest, &params, level, points)?;
     say!(
         "scalp: {} hairs rooted over the scalp the {} key hairs' roots cover ({} per cm², a root every {:.2} mm), \
          each blended from its nearest key hairs, {} points each, {:.1} MiB of bindings",
@@ -311,6 +311,33 @@ pub fn scalp_followers(
         followers.gpu_bytes() as f64 / (1 << 20) as f64
     );
     Ok(Some(followers))
+}
+
+/// The last scalp binding made, by a hash of what it was made from: `bench`
+/// draws one groom in several modes, and binding a full head (96,609 hairs
+/// on the thesis scalp) was the largest fixed cost of each.
+static LAST_SCALP_BINDING: std::sync::Mutex<Option<(u64, Followers)>> = std::sync::Mutex::new(None);
+
+/// [`Followers::over_scalp`], or a copy of the last one where its inputs
+/// were the same.
+fn bound_over_scalp(
+    rest: &SimState,
+    params: &vkhair::render::ScalpHairParams,
+    level: u32,
+    points: usize,
+) -> Result<Followers, vkhair::Error> {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    rest.rest.iter().for_each(|p| p.to_array().map(f32::to_bits).hash(&mut hasher));
+    (rest.strands, rest.points, format!("{params:?}"), level, points).hash(&mut hasher);
+    let key = hasher.finish();
+    let mut last = LAST_SCALP_BINDING.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    if let Some((_, followers)) = last.as_ref().filter(|(k, _)| *k == key) {
+        return Ok(followers.clone());
+    }
+    let followers = Followers::over_scalp(rest, params, level, points)?;
+    *last = Some((key, followers.clone()));
+    Ok(followers)
 }
 
 /// Hairs on a full head of real hair, for the tool's default of
