@@ -630,6 +630,56 @@ fn the_layers_a_binary_layer_names_are_checked_too() {
     );
 }
 
+/// A binary layer's arcs between its own prims are judged as a text layer's:
+/// a class inheriting itself, two classes specializing each other, an
+/// internal reference cycle, a reference to its own prims through its own
+/// file, and a cycle closed across a text and a binary sublayer are refused
+/// naming the binary layer and the prim (the library overflowed its stack on
+/// the first); an internal reference to a prim it lacks is refused; a chain
+/// without a cycle reads.
+#[test]
+fn a_binary_layers_arcs_between_its_prims_are_judged_as_a_text_layers() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
+    let binary = |name: &str, text: &str| {
+        let data = openusd::usda::parse(text).expect("text");
+        openusd::usdc::CrateWriter::write_to_file(&data, dir.path().join(name)).expect("binary");
+    };
+    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let layer = |body: &str| format!("#usda 1.0\n{body}{curves}");
+    binary("self.usdc", &layer("class \"A\" (\n    inherits = </A>\n) { }\n"));
+    binary(
+        "mutual.usdc",
+        &layer("class \"A\" (\n    specializes = </B>\n) { }\nclass \"B\" (\n    specializes = </A>\n) { }\n"),
+    );
+    binary(
+        "internal.usdc",
+        &layer("def Xform \"P\" (\n    references = </Q>\n) { }\ndef Xform \"Q\" (\n    references = </P>\n) { }\n"),
+    );
+    binary(
+        "own_file.usdc",
+        &layer("def Xform \"P\" (\n    references = @./own_file.usdc@</Q>\n) { }\ndef Xform \"Q\" (\n    references = @own_file.usdc@</P>\n) { }\n"),
+    );
+    binary("missing.usdc", &layer("def Xform \"P\" (\n    references = </Nowhere>\n) { }\n"));
+    binary("half.usdc", "#usda 1.0\nclass \"B\" (\n    inherits = </A>\n) { }\n");
+    write("half.usda", "#usda 1.0\nclass \"A\" (\n    inherits = </B>\n) { }\n");
+    write("across.usda", &format!("#usda 1.0\n(\n    subLayers = [@half.usda@, @half.usdc@]\n)\n{curves}"));
+    binary("chain.usdc", &layer("class \"A\" (\n    inherits = </B>\n) { }\nclass \"B\" { }\n"));
+    let g = usd::open(dir.path().join("chain.usdc")).expect("a chain of arcs without a cycle");
+    assert_eq!(g.groom.strand_count(), 1);
+    refused_naming(
+        dir.path(),
+        &[
+            ("self.usdc", &["self.usdc", "prim /A's inheritPaths", "itself"][..]),
+            ("mutual.usdc", &["mutual.usdc", "specializes", "a cycle"][..]),
+            ("internal.usdc", &["internal.usdc", "references", "a cycle"][..]),
+            ("own_file.usdc", &["own_file.usdc", "own_file.usdc\"", "a cycle"][..]),
+            ("missing.usdc", &["missing.usdc", "prim /P's references", "/Nowhere"][..]),
+            ("across.usda", &["a cycle", "sublayers of", "across.usda"][..]),
+        ],
+    );
+}
+
 /// A negative width (a diameter) is a defect: refused strictly, naming the
 /// prim and strand; when repairing, the widths are passed over and said, the
 /// strands kept.

@@ -125,55 +125,74 @@ fn most_properties<'a>(specs: impl Iterator<Item = (&'a SdfPath, SpecType)>) -> 
     Ok(())
 }
 
-/// What a binary layer names (asset path, what it takes) and offers, read by
-/// the library after [`super::usdc_check`] has bounded it: its sublayers and
-/// every spec's references and payloads.
-fn binary(path: &Path) -> std::result::Result<(Vec<(String, Takes)>, Targets), String> {
+/// What a binary layer names and holds, read by the library after
+/// [`super::usdc_check`] has bounded it.
+struct Binary {
+    /// Its sublayers and every spec's references and payloads to other
+    /// files: the asset path, what it takes, the prim whose arc it is.
+    named: Vec<(String, Takes, String)>,
+    /// What it offers an arc.
+    targets: Targets,
+    /// Its arcs between its own prims (`inheritPaths`, `specializes`, and
+    /// references and payloads without an asset path): from, to, the field.
+    arcs: Vec<(String, String, &'static str)>,
+}
+
+/// The paths of a list operation's items (a deletion or an ordering brings
+/// none).
+fn list_items<T: Default + Clone + PartialEq>(op: &openusd::sdf::ListOp<T>) -> impl Iterator<Item = &T> {
+    [&op.explicit_items, &op.added_items, &op.prepended_items, &op.appended_items].into_iter().flatten()
+}
+
+/// Reads what a binary layer names, offers and composes between its own
+/// prims (see [`Binary`]).
+fn binary(path: &Path) -> std::result::Result<Binary, String> {
     use openusd::sdf::{AbstractData, Value};
     crate::files::read_guarded(|| {
         let data = openusd::usdc::read_file(path).map_err(|e| format!("the USD reader cannot read it: {e:#}"))?;
         let mut named = Vec::new();
         if let Ok(Some(v)) = data.try_field(&SdfPath::abs_root(), "subLayers") {
             if let Value::StringVec(layers) = v.as_ref() {
-                named.extend(layers.iter().map(|l| (l.clone(), Takes::Layer)));
+                named.extend(layers.iter().map(|l| (l.clone(), Takes::Layer, String::new())));
             }
         }
         let sublayers = !named.is_empty();
-        let takes = |asset: &str, prim: &SdfPath| {
-            let takes = match prim.as_str() {
-                "" => Takes::DefaultPrim,
-                p => Takes::Prim(p.to_owned()),
-            };
-            (!asset.is_empty()).then(|| (asset.to_owned(), takes))
-        };
+        let mut arcs = Vec::new();
         let mut prims = HashSet::new();
         let mut composing = HashSet::new();
         let typed: Vec<(SdfPath, SpecType)> =
             data.spec_paths().into_iter().filter_map(|p| data.spec_type(&p).map(|t| (p, t))).collect();
         most_properties(typed.iter().map(|(p, t)| (p, *t)))?;
         for (spec, ty) in &typed {
+            let from = spec.as_str();
             if *ty == SpecType::Prim {
-                prims.insert(spec.as_str().to_owned());
+                prims.insert(from.to_owned());
                 if COMPOSING.iter().any(|f| matches!(data.try_field(spec, f), Ok(Some(_)))) {
-                    composing.insert(spec.as_str().to_owned());
+                    composing.insert(from.to_owned());
                 }
             }
-            for field in ["references", "payload"] {
+            // An arc to `prim` of `asset`: to another file, or (no asset
+            // path) between this layer's prims.
+            let mut take = |asset: &str, prim: &SdfPath, field: &'static str| match (asset, prim.as_str()) {
+                ("", "") => {}
+                ("", to) => arcs.push((from.to_owned(), super::usda_arcs::absolute(to, from), field)),
+                (asset, "") => named.push((asset.to_owned(), Takes::DefaultPrim, from.to_owned())),
+                (asset, to) => named.push((asset.to_owned(), Takes::Prim(to.to_owned()), from.to_owned())),
+            };
+            for field in ["references", "payload", "inheritPaths", "specializes"] {
                 let Ok(Some(v)) = data.try_field(spec, field) else { continue };
                 match v.as_ref() {
-                    Value::ReferenceListOp(op) => named.extend(
-                        [&op.explicit_items, &op.added_items, &op.prepended_items, &op.appended_items]
-                            .into_iter()
-                            .flatten()
-                            .filter_map(|r| takes(&r.asset_path, &r.prim_path)),
-                    ),
-                    Value::PayloadListOp(op) => named.extend(
-                        [&op.explicit_items, &op.added_items, &op.prepended_items, &op.appended_items]
-                            .into_iter()
-                            .flatten()
-                            .filter_map(|p| takes(&p.asset_path, &p.prim_path)),
-                    ),
-                    Value::Payload(p) => named.extend(takes(&p.asset_path, &p.prim_path)),
+                    Value::ReferenceListOp(op) => {
+                        list_items(op).for_each(|r| take(&r.asset_path, &r.prim_path, "references"))
+                    }
+                    Value::PayloadListOp(op) => {
+                        list_items(op).for_each(|p| take(&p.asset_path, &p.prim_path, "payload"))
+                    }
+                    Value::Payload(p) => take(&p.asset_path, &p.prim_path, "payload"),
+                    Value::PathListOp(op) if field != "references" && field != "payload" => {
+                        let field = if field == "specializes" { "specializes" } else { "inheritPaths" };
+                        list_items(op).for_each(|to| take("", to, field))
+                    }
                     _ => {}
                 }
             }
@@ -183,7 +202,7 @@ fn binary(path: &Path) -> std::result::Result<(Vec<(String, Takes)>, Targets), S
             .ok()
             .flatten()
             .and_then(|v| v.try_as_token_ref().map(|t| t.as_str().to_owned()));
-        Ok((named, Targets { sublayers, prims, default, composing }))
+        Ok(Binary { named, targets: Targets { sublayers, prims, default, composing }, arcs })
     })
     .unwrap_or_else(|what| Err(format!("the USD reader stopped: {what}")))
 }
@@ -288,7 +307,8 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
             // Its bootstrap, table of contents, section heads and values,
             // before the library trusts them; then what it names.
             super::usdc_check::check(&layer, len).map_err(|e| named(e.in_asset(&layer)))?;
-            let (assets, targets) = binary(&layer).map_err(|why| named(malformed(why).in_asset(&layer)))?;
+            let Binary { named: assets, targets, arcs: own } =
+                binary(&layer).map_err(|why| named(malformed(why).in_asset(&layer)))?;
             if let Some(why) = targets.missing(&takes) {
                 return Err(named(malformed(why).in_asset(&layer)));
             }
@@ -296,13 +316,31 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
             stacks.offers.insert(key.clone(), (targets.prims.clone(), targets.composing.clone()));
             seen.insert(key.clone(), Some(targets));
             let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
+            // Its arcs between its own prims are judged with its layer
+            // stack's (a cycle among them overflows the library's stack as a
+            // text layer's does), a reference to its own file among them.
+            let mut arcs: Arcs<Written> = Arcs::new();
+            for (from, to, field) in own {
+                let at = (layer.clone(), format!("prim {from}'s {field}:"));
+                if field == "references" || field == "payload" {
+                    stacks.internal.push((key.clone(), to.clone(), at.clone()));
+                }
+                arcs.entry(from).or_default().push((to, at));
+            }
             let mut links = Links::default();
-            for (asset, takes) in assets {
+            for (asset, takes, from) in assets {
+                if let (Takes::Prim(target), false) = (&takes, from.is_empty()) {
+                    if canonical(&dir.join(&asset)) == key {
+                        let to = super::usda_arcs::absolute(target, &from);
+                        let at = (layer.clone(), format!("prim {from}'s arc to {asset:?}:"));
+                        arcs.entry(from.clone()).or_default().push((to, at));
+                    }
+                }
                 let by = (layer.clone(), format!("its arc to {asset:?}:"));
                 links.add(&mut stacks, &dir.join(&asset), &takes, by);
                 queue.push((dir.join(&asset), Some((layer.clone(), format!("its arc to {asset:?}:"))), takes));
             }
-            stacks.layers.insert(key, (Arcs::new(), links));
+            stacks.layers.insert(key, (arcs, links));
             continue;
         }
         // Every other layer is read as text, whatever it starts with (the
