@@ -230,6 +230,12 @@ fn text_layers_that_recurse_without_bound_are_refused_before_reading() {
     }
 }
 
+/// Writes USD text `text` as a binary layer at `path` (the library's own writer).
+fn write_binary(path: &Path, text: &str) {
+    let data = openusd::usda::parse(text).expect("text");
+    openusd::usdc::CrateWriter::write_to_file(&data, path).expect("binary");
+}
+
 /// Opens each `(root, parts)` stage under `dir`: refused, with every part in
 /// the error (printed with the time it took).
 fn refused_naming(dir: &Path, cases: &[(&str, &[&str])]) {
@@ -596,10 +602,7 @@ fn values_nested_in_a_binary_layer_are_walked_before_the_library_reads_them() {
 fn the_layers_a_binary_layer_names_are_checked_too() {
     let dir = tempfile::tempdir().expect("tempdir");
     let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
-    let binary = |name: &str, text: &str| {
-        let data = openusd::usda::parse(text).expect("text");
-        openusd::usdc::CrateWriter::write_to_file(&data, dir.path().join(name)).expect("binary");
-    };
+    let binary = |name: &str, text: &str| write_binary(&dir.path().join(name), text);
     let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
     write("strand.usda", &format!("#usda 1.0\n(\n    defaultPrim = \"c\"\n)\n{curves}"));
     let c = std::ffi::CString::new(dir.path().join("pipe.usda").to_str().expect("utf-8")).expect("path");
@@ -641,10 +644,7 @@ fn the_layers_a_binary_layer_names_are_checked_too() {
 fn a_binary_layers_arcs_between_its_prims_are_judged_as_a_text_layers() {
     let dir = tempfile::tempdir().expect("tempdir");
     let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
-    let binary = |name: &str, text: &str| {
-        let data = openusd::usda::parse(text).expect("text");
-        openusd::usdc::CrateWriter::write_to_file(&data, dir.path().join(name)).expect("binary");
-    };
+    let binary = |name: &str, text: &str| write_binary(&dir.path().join(name), text);
     let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
     let layer = |body: &str| format!("#usda 1.0\n{body}{curves}");
     binary("self.usdc", &layer("class \"A\" (\n    inherits = </A>\n) { }\n"));
