@@ -680,6 +680,82 @@ fn a_binary_layers_arcs_between_its_prims_are_judged_as_a_text_layers() {
     );
 }
 
+/// What the USD library would open unchecked or go without in silence is
+/// refused naming it: value clips in a text or a binary layer, in the
+/// dictionary form and the older one (a clip naming a FIFO had blocked
+/// forever, one naming an 8 GiB file aborted the process asking for it);
+/// relocates in a text or a binary layer (the relocated prims were dropped);
+/// a layer named other than .usd, .usda or .usdc (dropped); a binary layer
+/// nesting prims past 128 deep (2,000 took the library past 10 s, 500 about
+/// 10 s). Curves under instanceable prims are read, once per instance (they
+/// were dropped).
+#[test]
+fn clips_relocates_odd_names_and_deep_binary_nesting_are_refused_and_instances_read() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
+    let binary = |name: &str, text: &str| write_binary(&dir.path().join(name), text);
+    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let c = std::ffi::CString::new(dir.path().join("pipe.usda").to_str().expect("utf-8")).expect("path");
+    // SAFETY: mkfifo with a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    let clipped = |clips: &str| {
+        format!("#usda 1.0\n{curves}def BasisCurves \"k\" (\n    {clips}\n) {{\n    int[] curveVertexCounts\n}}\n")
+    };
+    let clips =
+        "clips = {\n        dictionary default = {\n            asset[] assetPaths = [@pipe.usda@]\n            \
+                 string primPath = \"/k\"\n        }\n    }";
+    write("clips.usda", &clipped(clips));
+    write("legacy_clips.usda", &clipped("clipAssetPaths = [@pipe.usda@]"));
+    binary("clips.usdc", &clipped(clips));
+    let relocates = format!(
+        "#usda 1.0\n(\n    relocates = {{\n        </g/a>: </g/b>\n    }}\n)\ndef Xform \"g\" {{\n{curves}}}\n"
+    );
+    write("relocates.usda", &relocates);
+    binary("relocates.usdc", &relocates);
+    write("strand.txt", &format!("#usda 1.0\n{curves}"));
+    write("noext", &format!("#usda 1.0\n{curves}"));
+    write("sub_txt.usda", &format!("#usda 1.0\n(\n    subLayers = [@strand.txt@]\n)\n{curves}"));
+    write("ref_noext.usda", &format!("#usda 1.0\ndef Xform \"x\" (\n    references = @noext@</c>\n) {{ }}\n{curves}"));
+    let nested = |depth: usize| {
+        let open: String = (0..depth).map(|i| format!("def Xform \"p{i}\" {{\n")).collect();
+        format!("#usda 1.0\n{curves}{open}{}", "}\n".repeat(depth))
+    };
+    binary("deep.usdc", &nested(200));
+    // Seven chains of 125, each within the depth bound: 4.6 M depths squared.
+    let chains: String = (0..7)
+        .map(|c| {
+            let open: String = (0..125).map(|i| format!("def Xform \"c{c}p{i}\" {{\n")).collect();
+            format!("{open}{}", "}\n".repeat(125))
+        })
+        .collect();
+    binary("chains.usdc", &format!("#usda 1.0\n{curves}{chains}"));
+    binary("nested.usdc", &nested(100));
+    let g = usd::open(dir.path().join("nested.usdc")).expect("100 nested prims");
+    assert_eq!(g.groom.strand_count(), 1);
+    refused_naming(
+        dir.path(),
+        &[
+            ("clips.usda", &["clips.usda", "line 5", "`clips`", "value clips"][..]),
+            ("legacy_clips.usda", &["legacy_clips.usda", "`clipAssetPaths`", "value clips"][..]),
+            ("clips.usdc", &["clips.usdc", "prim /k", "value clips"][..]),
+            ("relocates.usda", &["relocates.usda", "line 3", "relocates, which vkhair does not read"][..]),
+            ("relocates.usdc", &["relocates.usdc", "relocates, which vkhair does not read"][..]),
+            ("sub_txt.usda", &["sub_txt.usda", "line 3", "strand.txt", "a layer named .txt"][..]),
+            ("ref_noext.usda", &["ref_noext.usda", "noext", "without an extension"][..]),
+            ("deep.usdc", &["deep.usdc", "nests 129 deep (at most 128)", "…"][..]),
+            ("chains.usdc", &["chains.usdc", "depths squared passes 4000000"][..]),
+        ],
+    );
+    // Instances: each instanceable prim's referenced curves, read once per instance.
+    write("group.usda", "#usda 1.0\ndef Xform \"g\" {\n    def BasisCurves \"c\" { int[] curveVertexCounts = [2, 2, 2]\n point3f[] points = [(0,0,0),(0,1,0),(1,0,0),(1,1,0),(2,0,0),(2,1,0)] }\n}\n");
+    let instance = |name: &str| {
+        format!("def Xform \"{name}\" (\n    instanceable = true\n    references = @group.usda@</g>\n) {{ }}\n")
+    };
+    write("instances.usda", &format!("#usda 1.0\n{curves}{}{}", instance("a"), instance("b")));
+    let g = usd::open(dir.path().join("instances.usda")).expect("instances");
+    assert_eq!(g.groom.strand_count(), 1 + 3 + 3, "the root's strand and three of each instance");
+}
+
 /// A negative width (a diameter) is a defect: refused strictly, naming the
 /// prim and strand; when repairing, the widths are passed over and said, the
 /// strands kept.

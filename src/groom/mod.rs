@@ -47,6 +47,7 @@ mod usdc_blocks;
 pub mod usdc_check;
 mod usdc_children;
 mod usdc_nested;
+mod usdc_specs;
 mod usdc_values;
 
 mod repair;

@@ -94,7 +94,9 @@ fn read_stage(path: &str, load: Load) -> Result<Read> {
     let stage = Stage::open(path).map_err(usd_error)?;
     let frame = stage_frame(&stage)?;
     let mut paths = Vec::new();
-    stage.traverse(PrimPredicate::DEFAULT, |p| paths.push(p.clone())).map_err(usd_error)?;
+    // Into instances too: an instanceable prim's curves are the groom's as
+    // much as any (the default traversal stops at it, and they were dropped).
+    stage.traverse(PrimPredicate::DEFAULT_PROXIES, |p| paths.push(p.clone())).map_err(usd_error)?;
     let (mut raw, mut skipped) = (Vec::new(), Vec::new());
     for p in paths {
         let prim = stage.prim(p.clone());

@@ -163,6 +163,7 @@ fn binary(path: &Path) -> std::result::Result<Binary, String> {
         let typed: Vec<(SdfPath, SpecType)> =
             data.spec_paths().into_iter().filter_map(|p| data.spec_type(&p).map(|t| (p, t))).collect();
         most_properties(typed.iter().map(|(p, t)| (p, *t)))?;
+        super::usdc_specs::check(&data, &typed)?;
         for (spec, ty) in &typed {
             let from = spec.as_str();
             if *ty == SpecType::Prim {
@@ -261,6 +262,16 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
                        unpack it and name its .usda or .usdc layer";
             return Err(named(malformed(why.to_owned()).in_asset(&layer)));
         }
+        // The library picks a layer's reader by its name's extension and goes
+        // without a layer it has none for (`.txt`, none at all) in silence.
+        let extension = layer.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+        if !matches!(extension.as_str(), "usd" | "usda" | "usdc") {
+            let why = format!(
+                "a layer named {}: the USD library reads only layers named .usd, .usda or .usdc and goes without                  any other in silence",
+                if extension.is_empty() { "without an extension".to_owned() } else { format!(".{extension}") }
+            );
+            return Err(named(malformed(why).in_asset(&layer)));
+        }
         crate::files::check_regular(&layer, cap, "a USD layer").map_err(named)?;
         let key = std::fs::canonicalize(&layer).unwrap_or_else(|_| layer.clone());
         if let Some(targets) = seen.get(&key) {
@@ -288,7 +299,6 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
         let magic = &head[..head.len().min(8)];
         // The library picks a layer's reader by its name: a binary layer named
         // `.usda` or a text one named `.usdc` would be dropped in silence.
-        let extension = layer.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
         let binary_bytes = magic == b"PXR-USDC";
         let text_head =
             head.iter().position(|b| !b" \t\r\n".contains(b)).is_some_and(|at| head[at..].starts_with(b"#usda"));

@@ -217,6 +217,17 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
                 if matches!(*w, "def" | "class" | "over") && !prims_metadata_open(&open) {
                     declaring = true;
                     pending = None;
+                } else if matches!(tokens.get(k + 1), Some((_, Token::Equals)))
+                    && (in_metadata || (open.len() == 1 && prims.is_empty() && pending.is_none()))
+                    && (super::usdc_specs::CLIP_FIELDS.contains(w) || *w == "relocates")
+                {
+                    // Value clips name layers the library opens itself;
+                    // relocates it went without in silence.
+                    let why = match *w {
+                        "relocates" => super::usdc_specs::RELOCATES_REFUSED,
+                        _ => super::usdc_specs::CLIPS_REFUSED,
+                    };
+                    return Err(malformed(format!("{} `{w}`: {why}", position(text, *at))));
                 } else if *w == "subLayers" && open.len() == 1 && prims.is_empty() && pending.is_none() {
                     assets.extend(asset_paths(&tokens[k + 1..], false));
                 } else if ARCS.contains(w) && matches!(tokens.get(k + 1), Some((_, Token::Equals))) && !in_metadata {
