@@ -756,6 +756,80 @@ fn clips_relocates_odd_names_and_deep_binary_nesting_are_refused_and_instances_r
     assert_eq!(g.groom.strand_count(), 1 + 3 + 3, "the root's strand and three of each instance");
 }
 
+/// Composition that multiplies or hides its arcs is bounded: a class
+/// inheriting 40 others that each inherit those after them (paths of arcs
+/// past 10,000: the reader composes along each and never finished), layers
+/// referencing the next one twice, 20 deep (2²⁰ prims), chains of arcs
+/// written in variants, in a text and in a binary layer (the check had
+/// counted only a prim's own arcs: 300 took the reader past 10 s), and a
+/// binary layer of more than 10,000 arcs — each refused naming the file.
+/// A fan of 10 and a diamond 5 deep read.
+#[test]
+fn composition_that_multiplies_or_hides_its_arcs_is_bounded() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
+    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let fan = |n: usize| {
+        let classes: String = (0..n)
+            .map(|i| {
+                let targets: Vec<String> = (i + 1..n).map(|j| format!("</C{j}>")).collect();
+                format!("class \"C{i}\" (\n    inherits = [{}]\n) {{ }}\n", targets.join(", "))
+            })
+            .collect();
+        format!("#usda 1.0\n{classes}{curves}")
+    };
+    write("fan.usda", &fan(40));
+    write("small_fan.usda", &fan(10));
+    let diamond = |name: &str, depth: usize| {
+        for i in 0..depth {
+            let next = format!("{name}{}.usda", i + 1);
+            let child = |c: &str| format!("    def \"{c}\" (\n        references = @{next}@\n    ) {{ }}\n");
+            write(
+                &format!("{name}{i}.usda"),
+                &format!("#usda 1.0\n(\n    defaultPrim = \"d\"\n)\ndef \"d\" {{\n{}{}}}\n", child("l"), child("r")),
+            );
+        }
+        write(
+            &format!("{name}{depth}.usda"),
+            &format!("#usda 1.0\n(\n    defaultPrim = \"d\"\n)\ndef \"d\" {{\n{curves}}}\n"),
+        );
+        write(&format!("{name}.usda"), &format!("#usda 1.0\ndef \"x\" (\n    references = @{name}0.usda@\n) {{ }}\n"));
+    };
+    diamond("wide", 20);
+    diamond("narrow", 5);
+    let variant_chain = |n: usize| {
+        let prims: String = (0..n)
+            .map(|i| {
+                format!(
+                    "def Xform \"A{i}\" (\n    variants = {{\n        string v = \"a\"\n    }}\n    prepend variantSets = \"v\"\n)\n\
+                     {{\n    variantSet \"v\" = {{\n        \"a\" (\n            inherits = </A{}>\n        ) {{ }}\n    }}\n}}\n",
+                    i + 1
+                )
+            })
+            .collect();
+        format!("#usda 1.0\n{prims}def Xform \"A{n}\" {{ }}\n{curves}")
+    };
+    write("variants.usda", &variant_chain(200));
+    write_binary(&dir.path().join("variants.usdc"), &variant_chain(200));
+    let many: String = (0..10_001).map(|i| format!("class \"K{i}\" (\n    inherits = </B>\n) {{ }}\n")).collect();
+    write_binary(&dir.path().join("many.usdc"), &format!("#usda 1.0\nclass \"B\" {{ }}\n{many}{curves}"));
+    for readable in ["small_fan.usda", "narrow.usda"] {
+        let g = usd::open(dir.path().join(readable)).expect(readable);
+        assert!(g.groom.strand_count() >= 1, "{readable}");
+    }
+    assert_eq!(usd::open(dir.path().join("narrow.usda")).expect("narrow").groom.strand_count(), 32, "2⁵ strands");
+    refused_naming(
+        dir.path(),
+        &[
+            ("fan.usda", &["fan.usda", "more than 10000 paths"][..]),
+            ("wide.usda", &["wide.usda", "composes more than 100000 prims"][..]),
+            ("variants.usda", &["variants.usda", "chain through more than 128 prims"][..]),
+            ("variants.usdc", &["variants.usdc", "inheritPaths", "chain through more than 128 prims"][..]),
+            ("many.usdc", &["many.usdc", "more than 10000 composition arcs"][..]),
+        ],
+    );
+}
+
 /// A negative width (a diameter) is a defect: refused strictly, naming the
 /// prim and strand; when repairing, the widths are passed over and said, the
 /// strands kept.

@@ -144,6 +144,30 @@ fn list_items<T: Default + Clone + PartialEq>(op: &openusd::sdf::ListOp<T>) -> i
     [&op.explicit_items, &op.added_items, &op.prepended_items, &op.appended_items].into_iter().flatten()
 }
 
+/// `path` without its variant selections: the prim a variant's spec is of.
+fn without_variants(path: &str) -> String {
+    let mut out = String::with_capacity(path.len());
+    let mut depth = 0usize;
+    for c in path.chars() {
+        match c {
+            '{' => depth += 1,
+            '}' => {
+                depth = depth.saturating_sub(1);
+                if depth == 0 {
+                    out.push('/');
+                }
+            }
+            c if depth == 0 => out.push(c),
+            _ => {}
+        }
+    }
+    let trimmed = out.replace("//", "/");
+    match trimmed.trim_end_matches('/') {
+        "" => "/".to_owned(),
+        p => p.to_owned(),
+    }
+}
+
 /// Reads what a binary layer names, offers and composes between its own
 /// prims (see [`Binary`]).
 fn binary(path: &Path) -> std::result::Result<Binary, String> {
@@ -165,7 +189,9 @@ fn binary(path: &Path) -> std::result::Result<Binary, String> {
         most_properties(typed.iter().map(|(p, t)| (p, *t)))?;
         super::usdc_specs::check(&data, &typed)?;
         for (spec, ty) in &typed {
-            let from = spec.as_str();
+            // A variant's arcs are its prim's (`/P{v=a}C` → `/P/C`).
+            let owner = without_variants(spec.as_str());
+            let from = owner.as_str();
             if *ty == SpecType::Prim {
                 prims.insert(from.to_owned());
                 if COMPOSING.iter().any(|f| matches!(data.try_field(spec, f), Ok(Some(_)))) {
@@ -197,6 +223,13 @@ fn binary(path: &Path) -> std::result::Result<Binary, String> {
                     _ => {}
                 }
             }
+        }
+        let most = super::usda_check::MAX_USDA_ARCS;
+        if arcs.len() > most {
+            return Err(format!(
+                "more than {most} composition arcs between the layer's prims ({}; the reader's time grows with them)",
+                arcs.len()
+            ));
         }
         let default = data
             .try_field(&SdfPath::abs_root(), "defaultPrim")

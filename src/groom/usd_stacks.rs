@@ -115,7 +115,38 @@ impl Stacks {
             ))
             .in_asset(&self.stage));
         }
+        let composed = self.composed_prims(&self.stage, &mut HashMap::new());
+        let most = super::usda_check::MAX_USD_PRIMS;
+        if composed > most {
+            return Err(malformed(format!(
+                "the stage composes more than {most} prims: its references and payloads bring their layers' prims \
+                 again each time (up to {composed} here; the USD reader composes about ten thousand a second)"
+            ))
+            .in_asset(&self.stage));
+        }
         self.check_targets(&stacks)
+    }
+
+    /// At most how many prims the stack `layer` starts composes: its
+    /// layers' own, and again every layer a reference or payload of theirs
+    /// takes (all of its prims, whichever one it takes: a bound, not a count);
+    /// a layer met again on the chain counts nothing more.
+    fn composed_prims<'a>(&'a self, layer: &'a PathBuf, memo: &mut HashMap<&'a PathBuf, Option<usize>>) -> usize {
+        match memo.get(layer) {
+            Some(Some(n)) => return *n,
+            Some(None) => return 0,
+            None => {}
+        }
+        memo.insert(layer, None);
+        let mut total = 0usize;
+        for member in self.members(layer) {
+            total = total.saturating_add(self.offers.get(member).map_or(0, |(prims, _)| prims.len()));
+            for reference in self.layers.get(member).map(|(_, l)| l.references.as_slice()).unwrap_or_default() {
+                total = total.saturating_add(self.composed_prims(reference, memo));
+            }
+        }
+        memo.insert(layer, Some(total));
+        total
     }
 
     /// The most references and payloads one chain of layers from `layer`

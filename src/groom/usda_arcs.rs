@@ -16,6 +16,11 @@ use crate::error::{Error, Result};
 /// Most prims a chain of composition arcs may pass through in one namespace.
 pub const MAX_ARC_CHAIN: usize = 128;
 
+/// Most paths of composition arcs from one prim within a namespace: the
+/// reader composes a prim once along every path (a class inheriting 59
+/// others, each inheriting those after it, never finished).
+pub const MAX_ARC_PATHS: usize = 10_000;
+
 /// Per prim path, the prims its arcs target and where each arc is written (`L`).
 pub(crate) type Arcs<L> = HashMap<String, Vec<(String, L)>>;
 
@@ -86,6 +91,8 @@ pub(super) fn check_arcs<L>(arcs: &Arcs<L>, fail: impl Fn(&L, String) -> Error) 
     let mut state: HashMap<&str, u8> = HashMap::new();
     // Per finished prim, the most prims a chain of arcs from it passes.
     let mut longest: HashMap<&str, usize> = HashMap::new();
+    // Per finished prim, the paths of arcs from it (itself counts one).
+    let mut paths: HashMap<&str, usize> = HashMap::new();
     // The arcs leaving `node`: its own and its descendants' (found once per
     // node visited).
     let out_of = |node: &str| -> Vec<&(String, L)> {
@@ -115,6 +122,20 @@ pub(super) fn check_arcs<L>(arcs: &Arcs<L>, fail: impl Fn(&L, String) -> Error) 
                         ));
                     }
                 }
+                let reached =
+                    out.iter().fold(1usize, |n, arc| n.saturating_add(paths.get(arc.0.as_str()).copied().unwrap_or(1)));
+                if reached > MAX_ARC_PATHS {
+                    if let Some((_, at)) = out.first().copied() {
+                        return Err(fail(
+                            at,
+                            format!(
+                                "the composition arcs from {node} reach other prims along more than {MAX_ARC_PATHS} \
+                                 paths (the reader composes a prim once along each)"
+                            ),
+                        ));
+                    }
+                }
+                paths.insert(node, reached);
                 longest.insert(node, chain);
                 state.insert(node, 2);
                 stack.pop();

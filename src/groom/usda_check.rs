@@ -233,10 +233,25 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
                 } else if ARCS.contains(w) && matches!(tokens.get(k + 1), Some((_, Token::Equals))) && !in_metadata {
                     // An arc outside a prim's own metadata (a variant's): its
                     // layers are checked like any other.
+                    // Its arcs between the layer's prims are the owning
+                    // prim's: a chain of them through variants is as slow to
+                    // compose, and a cycle as fatal.
                     let from = prims.last().cloned();
                     assets.extend(
                         asset_paths(&tokens[k + 2..], true).into_iter().map(|a| LayerAsset { from: from.clone(), ..a }),
                     );
+                    if let Some(from) = from {
+                        for target in arc_targets(&tokens[k + 2..]) {
+                            count += 1;
+                            if count > MAX_USDA_ARCS {
+                                return Err(malformed(format!(
+                                    "{} more than {MAX_USDA_ARCS} composition arcs between the layer's prims",
+                                    position(text, *at)
+                                )));
+                            }
+                            arcs.entry(from.clone()).or_default().push((absolute(target, &from), *at));
+                        }
+                    }
                 } else if ARCS.contains(w) && in_metadata && matches!(tokens.get(k + 1), Some((_, Token::Equals))) {
                     let from =
                         format!("{}/{}", prims.last().map_or("", String::as_str), pending.as_deref().unwrap_or(""));
