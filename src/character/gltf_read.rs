@@ -115,12 +115,71 @@ fn check_indices(root: &gltf::json::Root) -> Result<()> {
             }
         }
     }
+    use gltf::json::validation::Checked;
     for (a, animation) in root.animations.iter().enumerate() {
         for (c, channel) in animation.channels.iter().enumerate() {
             let node = channel.target.node.value();
             if node >= nodes {
                 return Err(past(format!("animations[{a}].channels[{c}].target"), node, nodes, "node"));
             }
+            // The crate's readers unwrap the target's property.
+            if matches!(channel.target.path, Checked::Invalid) {
+                return Err(malformed(format!(
+                    "animations[{a}].channels[{c}].target.path is none of translation, rotation, scale, weights"
+                )));
+            }
+            let samplers = animation.samplers.len();
+            if channel.sampler.value() >= samplers {
+                let what = format!("animations[{a}].channels[{c}].sampler");
+                return Err(past(what, channel.sampler.value(), samplers, "sampler"));
+            }
+        }
+        for (k, sampler) in animation.samplers.iter().enumerate() {
+            if matches!(sampler.interpolation, Checked::Invalid) {
+                return Err(malformed(format!(
+                    "animations[{a}].samplers[{k}].interpolation is none of LINEAR, STEP, CUBICSPLINE"
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Most JSON objects a glTF document may hold (nodes, accessors, keys of
+/// every kind together): the `gltf` crate builds a structure of each before
+/// any can be judged (3,000,000 empty nodes took it past 10 s, 15,000,000
+/// asked for gigabytes; a million took 6.5 s more than the mannequin's 6,895
+/// objects, released).
+pub const MAX_GLTF_JSON_OBJECTS: usize = 1 << 18;
+
+/// The JSON of a glTF document in `bytes` (a `.glb`'s first chunk, or the
+/// whole of a `.gltf`) holds at most [`MAX_GLTF_JSON_OBJECTS`] objects:
+/// counted as the `{` outside strings, before the crate parses it.
+fn check_json_size(bytes: &[u8]) -> Result<()> {
+    let json = match bytes {
+        [b'g', b'l', b'T', b'F', ..] if bytes.len() >= 20 => {
+            let length = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as usize;
+            &bytes[20..bytes.len().min(20usize.saturating_add(length))]
+        }
+        _ => bytes,
+    };
+    let (mut objects, mut in_string, mut escaped) = (0usize, false, false);
+    for &b in json {
+        match (in_string, escaped, b) {
+            (true, true, _) => escaped = false,
+            (true, false, b'\\') => escaped = true,
+            (true, false, b'"') => in_string = false,
+            (false, _, b'"') => in_string = true,
+            (false, _, b'{') => {
+                objects += 1;
+                if objects > MAX_GLTF_JSON_OBJECTS {
+                    return Err(malformed(format!(
+                        "its JSON holds more than {MAX_GLTF_JSON_OBJECTS} objects (nodes, accessors and the rest \
+                         together)"
+                    )));
+                }
+            }
+            _ => {}
         }
     }
     Ok(())
@@ -131,6 +190,7 @@ fn check_indices(root: &gltf::json::Root) -> Result<()> {
 pub(super) fn parse(bytes: &[u8], dir: Option<&Path>) -> Result<Character> {
     // The crate's own validation indexes with some indices before checking
     // them: those are checked first.
+    check_json_size(bytes)?;
     let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| malformed(e.to_string()))?;
     check_indices(raw.document.as_json())?;
     let document = gltf::Document::from_json(raw.document.into_json()).map_err(|e| malformed(e.to_string()))?;

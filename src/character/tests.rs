@@ -487,6 +487,27 @@ fn malformed_accessors_and_keys_are_refused_not_read() {
             }),
         ),
         (
+            // The crate's reader unwrapped it: a caught panic, not an error.
+            "animations[0].channels[0].target.path is none of",
+            Box::new(|j| j["animations"][0]["channels"][0]["target"]["path"] = "colour".into()),
+        ),
+        (
+            "animations[0].samplers[0].interpolation is none of",
+            Box::new(|j| j["animations"][0]["samplers"][0]["interpolation"] = "SMOOTH".into()),
+        ),
+        (
+            "animations[0].channels[0].sampler names sampler 9999",
+            Box::new(|j| j["animations"][0]["channels"][0]["sampler"] = 9999.into()),
+        ),
+        (
+            // Empty nodes, past the bound with the document's own objects.
+            "its JSON holds more than 262144 objects",
+            Box::new(|j| {
+                let nodes = j["nodes"].as_array_mut().expect("nodes");
+                nodes.extend(std::iter::repeat_n(serde_json::json!({}), super::MAX_GLTF_JSON_OBJECTS));
+            }),
+        ),
+        (
             // Finite, but its length overflows when squared: normalising it
             // would give a zero quaternion (a node scaled to nothing).
             "node 8 (\"head\"): its rotation [1e30, 0.0, 0.0, 1e30] is not a rotation",
