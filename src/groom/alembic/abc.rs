@@ -226,6 +226,9 @@ impl<'a> Archive<'a> {
         let headers = &block[..block.len().saturating_sub(32)];
         let mut c = Cursor { b: headers, at: 0, what: "object headers" };
         let mut out: Vec<(ObjectHeader, u64, Vec<Child>)> = Vec::new();
+        // The groups of the children so far (a set: a list searched once per
+        // child made 100,000 children take 12 s).
+        let mut seen: std::collections::HashSet<u64> = std::collections::HashSet::new();
         while c.at < headers.len() {
             let n = c.u32()? as usize;
             if n == 0 {
@@ -245,7 +248,7 @@ impl<'a> Archive<'a> {
             let (Child::Group(at) | Child::Data(at)) = child;
             // Two children in one group are a cycle (or a fan-out) refused
             // before their group is read again.
-            if at != 0 && out.iter().any(|(_, seen, _)| *seen == at) {
+            if at != 0 && !seen.insert(at) {
                 return Err(malformed(format!("object {name}'s group belongs to another object too")));
             }
             let group = self.file.group_of(child, &format!("object {name}"))?;
