@@ -762,7 +762,9 @@ fn clips_relocates_odd_names_and_deep_binary_nesting_are_refused_and_instances_r
 /// referencing the next one twice, 20 deep (2²⁰ prims), chains of arcs
 /// written in variants, in a text and in a binary layer (the check had
 /// counted only a prim's own arcs: 300 took the reader past 10 s), and a
-/// binary layer of more than 10,000 arcs — each refused naming the file.
+/// binary layer of more than 10,000 arcs, and layers of more than 10,000
+/// references to other layers (20,000 took the reader about 10 s) — each
+/// refused naming the file.
 /// A fan of 10 and a diamond 5 deep read.
 #[test]
 fn composition_that_multiplies_or_hides_its_arcs_is_bounded() {
@@ -813,6 +815,10 @@ fn composition_that_multiplies_or_hides_its_arcs_is_bounded() {
     write_binary(&dir.path().join("variants.usdc"), &variant_chain(200));
     let many: String = (0..10_001).map(|i| format!("class \"K{i}\" (\n    inherits = </B>\n) {{ }}\n")).collect();
     write_binary(&dir.path().join("many.usdc"), &format!("#usda 1.0\nclass \"B\" {{ }}\n{many}{curves}"));
+    write("strand_default.usda", &format!("#usda 1.0\n(\n    defaultPrim = \"c\"\n)\n{curves}"));
+    let refs: String =
+        (0..10_001).map(|i| format!("def \"x{i}\" (\n    references = @strand_default.usda@\n) {{ }}\n")).collect();
+    write("references.usda", &format!("#usda 1.0\n{refs}"));
     for readable in ["small_fan.usda", "narrow.usda"] {
         let g = usd::open(dir.path().join(readable)).expect(readable);
         assert!(g.groom.strand_count() >= 1, "{readable}");
@@ -826,6 +832,7 @@ fn composition_that_multiplies_or_hides_its_arcs_is_bounded() {
             ("variants.usda", &["variants.usda", "chain through more than 128 prims"][..]),
             ("variants.usdc", &["variants.usdc", "inheritPaths", "chain through more than 128 prims"][..]),
             ("many.usdc", &["many.usdc", "more than 10000 composition arcs"][..]),
+            ("references.usda", &["references.usda", "more than 10000 references and payloads"][..]),
         ],
     );
 }

@@ -18,6 +18,11 @@ use crate::error::{Error, FileFormat, Result};
 /// `references` and `payload`, the root included.
 pub const MAX_USD_LAYERS: usize = 256;
 
+/// Most references and payloads to other layers a stage's layers may hold
+/// together: the library composes the layer each takes again every time
+/// (20,000 took it about 10 s).
+pub const MAX_USD_REFERENCES: usize = 10_000;
+
 fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }
 }
@@ -276,6 +281,18 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
         }
         Ok(())
     };
+    let mut references = 0usize;
+    let mut count_references = |n: usize| {
+        references += n;
+        if references > MAX_USD_REFERENCES {
+            return Err(malformed(format!(
+                "the stage's layers hold more than {MAX_USD_REFERENCES} references and payloads to other layers (the \
+                 USD reader composes the layer each takes again every time)"
+            ))
+            .in_asset(path));
+        }
+        Ok(())
+    };
     while let Some((layer, named_by, takes)) = queue.pop() {
         let named = |e: Error| match &named_by {
             None => e,
@@ -300,7 +317,8 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
         let extension = layer.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
         if !matches!(extension.as_str(), "usd" | "usda" | "usdc") {
             let why = format!(
-                "a layer named {}: the USD library reads only layers named .usd, .usda or .usdc and goes without                  any other in silence",
+                "a layer named {}: the USD library reads only layers named .usd, .usda or .usdc and goes without \
+                 any other in silence",
                 if extension.is_empty() { "without an extension".to_owned() } else { format!(".{extension}") }
             );
             return Err(named(malformed(why).in_asset(&layer)));
@@ -356,6 +374,7 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
                 return Err(named(malformed(why).in_asset(&layer)));
             }
             count_prims(&targets)?;
+            count_references(assets.iter().filter(|(_, takes, _)| *takes != Takes::Layer).count())?;
             stacks.offers.insert(key.clone(), (targets.prims.clone(), targets.composing.clone()));
             seen.insert(key.clone(), Some(targets));
             let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
@@ -407,6 +426,7 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
             return Err(named(malformed(why).in_asset(&layer)));
         }
         count_prims(&targets)?;
+        count_references(assets.iter().filter(|a| a.takes != Takes::Layer).count())?;
         stacks.offers.insert(key.clone(), (targets.prims.clone(), targets.composing.clone()));
         seen.insert(key.clone(), Some(targets));
         let dir = layer.parent().map(Path::to_path_buf).unwrap_or_default();
