@@ -764,8 +764,10 @@ fn clips_relocates_odd_names_and_deep_binary_nesting_are_refused_and_instances_r
 /// counted only a prim's own arcs: 300 took the reader past 10 s), and a
 /// binary layer of more than 10,000 arcs, and layers of more than 10,000
 /// references to other layers (20,000 took the reader about 10 s) — each
-/// refused naming the file.
-/// A fan of 10 and a diamond 5 deep read.
+/// refused naming the file; so is what the library reports it could not
+/// compose (a cycle of references through two files, a layer sublayering
+/// itself: it dropped the arc and went on). A fan of 10 and a diamond 5 deep
+/// read.
 #[test]
 fn composition_that_multiplies_or_hides_its_arcs_is_bounded() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -819,6 +821,14 @@ fn composition_that_multiplies_or_hides_its_arcs_is_bounded() {
     let refs: String =
         (0..10_001).map(|i| format!("def \"x{i}\" (\n    references = @strand_default.usda@\n) {{ }}\n")).collect();
     write("references.usda", &format!("#usda 1.0\n{refs}"));
+    // A cycle through two files' references, and a layer sublayering itself:
+    // past the checks, the library drops the arc and says so only when asked.
+    write(
+        "cycle_a.usda",
+        &format!("#usda 1.0\n{curves}def Xform \"A\" (\n    references = @./cycle_b.usda@</B>\n) {{ }}\n"),
+    );
+    write("cycle_b.usda", "#usda 1.0\ndef Xform \"B\" (\n    references = @./cycle_a.usda@</A>\n) { }\n");
+    write("sub_self.usda", &format!("#usda 1.0\n(\n    subLayers = [@./sub_self.usda@]\n)\n{curves}"));
     for readable in ["small_fan.usda", "narrow.usda"] {
         let g = usd::open(dir.path().join(readable)).expect(readable);
         assert!(g.groom.strand_count() >= 1, "{readable}");
@@ -833,6 +843,8 @@ fn composition_that_multiplies_or_hides_its_arcs_is_bounded() {
             ("variants.usdc", &["variants.usdc", "inheritPaths", "chain through more than 128 prims"][..]),
             ("many.usdc", &["many.usdc", "more than 10000 composition arcs"][..]),
             ("references.usda", &["references.usda", "more than 10000 references and payloads"][..]),
+            ("cycle_a.usda", &["cycle_a.usda", "could not compose the stage", "cycle"][..]),
+            ("sub_self.usda", &["sub_self.usda", "could not compose the stage", "sublayer cycle"][..]),
         ],
     );
 }

@@ -76,13 +76,23 @@ impl HairRig {
             let time = duration * k as f32 / HEAD_FRAME_SAMPLES as f32;
             let m = character.joint_transform(&character.pose(Some(animation), time), head);
             let scales = [m.x_axis, m.y_axis, m.z_axis].map(|a| a.truncate().length());
-            if !m.is_finite() || scales.iter().any(|&s| s.is_nan() || s <= 1e-4) {
+            let most = super::gltf_read::MAX_TRANSFORM_COMPONENT;
+            let (collapsed, grown) =
+                (scales.iter().any(|&s| s.is_nan() || s <= 1e-4), scales.iter().any(|&s| s > most));
+            if !m.is_finite() || collapsed || grown {
                 let name = &sk.nodes[sk.joints[head]].name;
+                // Scales within the bound at every node may multiply past it
+                // on the way to the head (9,000 at six nodes: 5e23).
+                let why = if grown {
+                    format!("scales past {most} multiplied on the way to it")
+                } else {
+                    "a scale of zero on the way to it".to_owned()
+                };
                 return Err(Error::incompatible(
                     "character",
                     format!(
                         "the head joint {head} ({name:?}) has no frame at {time} s of animation {:?}: its \
-                         transform scales by {scales:?} (a scale of zero on the way to it)",
+                         transform scales by {scales:?} ({why})",
                         sk.animations[animation].name
                     ),
                 ));

@@ -292,8 +292,9 @@ fn absurd_transforms_are_refused_naming_the_node_or_channel() {
 }
 
 /// A vertex far beyond any character is refused naming the mesh's
-/// position, and a head joint that an animation scales to nothing has no frame:
-/// refused naming the joint, the time and the animation, not a NaN head.
+/// position, and a head joint that an animation scales to nothing (or past
+/// 10⁴, multiplied along its ancestors) has no frame: refused naming the
+/// joint, the time and the animation, not a NaN or infinite head.
 #[test]
 fn a_far_vertex_and_a_head_scaled_to_nothing_are_refused_naming_them() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
@@ -323,6 +324,20 @@ fn a_far_vertex_and_a_head_scaled_to_nothing_are_refused_naming_them() {
     let character = Character::parse(&flat).expect("a zero scale is a pose, not a broken file");
     let err = HairRig::new(character, None, None).map(|_| ()).expect_err("a head without a frame").to_string();
     assert!(err.contains("head joint") && err.contains("no frame at 0 s") && err.contains("scale"), "{err}");
+
+    // Scales each within the bound that multiply past it on the way to the
+    // head (9,000 at every node; the renderer was handed an infinite head).
+    let mut character = Character::parse(&bytes).expect("the character");
+    for node in &mut character.skeleton.nodes {
+        node.scale = Vec3::splat(9000.0);
+    }
+    for channel in &mut character.skeleton.animations[0].channels {
+        if let Keys::Scale(keys) = &mut channel.keys {
+            keys.iter_mut().for_each(|k| *k = Vec3::splat(9000.0));
+        }
+    }
+    let err = HairRig::new(character, None, None).map(|_| ()).expect_err("a head grown past the bound").to_string();
+    assert!(err.contains("head joint") && err.contains("scales past 10000 multiplied"), "{err}");
 
     // A scale through zero between two keys, at 1/3 s, between the samples.
     let mut character = Character::parse(&bytes).expect("the character");

@@ -97,6 +97,16 @@ fn read_stage(path: &str, load: Load) -> Result<Read> {
     // Into instances too: an instanceable prim's curves are the groom's as
     // much as any (the default traversal stops at it, and they were dropped).
     stage.traverse(PrimPredicate::DEFAULT_PROXIES, |p| paths.push(p.clone())).map_err(usd_error)?;
+    // What the library dropped while composing (an arc it could not follow,
+    // a layer it could not use) is an error, never a stage read without it.
+    let errors = stage.composition_errors();
+    if let Some(first) = errors.first() {
+        let more = match errors.len() {
+            1 => String::new(),
+            n => format!(" (and {} more)", n - 1),
+        };
+        return Err(malformed(format!("the USD library could not compose the stage: {first}{more}")));
+    }
     let (mut raw, mut skipped) = (Vec::new(), Vec::new());
     for p in paths {
         let prim = stage.prim(p.clone());

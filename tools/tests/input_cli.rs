@@ -336,6 +336,9 @@ fn bad_values_name_their_option() {
         (&["simulate", "--input", g, "--points", "100"], "--points must be 2..=64 (got 100)"),
         (&["render", "--input", g, "--points", "1"], "--points must be 2..=64 (got 1)"),
         (&["render", "--distance", "inf"], "--distance must be a finite number above 0"),
+        (&["render", "--distance", "1e30"], "--distance must be at most 1e6"),
+        (&["render", "--input", g, "--scale", "1e30"], "--scale must be within 1e-6..=1e6 (got 1e30)"),
+        (&["simulate", "--input", g, "--scale", "1e-30"], "--scale must be within 1e-6..=1e6 (got 1e-30)"),
         (&["render", "--frames", "0"], "--frames must be at least 1"),
         (&["simulate", "--steps", "0"], "--steps must be at least 1"),
     ];

@@ -35,7 +35,7 @@ pub struct InputArgs {
     #[arg(long)]
     pub no_mesh_collider: bool,
     /// Multiply input positions (groom and mesh) by this (0.01: Blender units →
-    /// m) [default: 1].
+    /// m; 1e-6..=1e6) [default: 1].
     #[arg(long)]
     pub scale: Option<f32>,
     /// Resample input strands to this many points (2..=64) [default: 16].
@@ -357,12 +357,21 @@ const CYHAIR_DEFAULT_THICKNESS: f32 = 1.0;
 
 /// `--scale`'s value checked: a finite number above 0.
 pub fn check_scale(scale: f32) -> Result<(), String> {
-    if scale.is_finite() && scale > 0.0 {
-        Ok(())
-    } else {
-        Err(format!("--scale must be a finite number above 0 (got {scale})"))
+    if !(scale.is_finite() && scale > 0.0) {
+        return Err(format!("--scale must be a finite number above 0 (got {scale})"));
     }
+    // A unit conversion, not a way to the edge of f32 (1e30 overflowed the
+    // groom's bounds, 1e-30 made every segment zero-length).
+    if !(MIN_SCALE..=MAX_SCALE).contains(&scale) {
+        return Err(format!("--scale must be within {MIN_SCALE:e}..={MAX_SCALE:e} (got {scale:e})"));
+    }
+    Ok(())
 }
+
+/// The smallest and largest `--scale`: from micrometres to kilometres.
+pub const MIN_SCALE: f32 = 1e-6;
+/// See [`MIN_SCALE`].
+pub const MAX_SCALE: f32 = 1e6;
 
 /// [`load`], and the thickness a cyHair file gives every point in its header when
 /// it has no thickness array and the header says something other than the

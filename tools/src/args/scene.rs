@@ -121,6 +121,9 @@ impl SceneArgs {
             if !(d.is_finite() && d > 0.0) {
                 return Err(format!("--distance must be a finite number above 0 (got {d})"));
             }
+            if d > 1e6 {
+                return Err(format!("--distance must be at most 1e6 (in the groom's units; got {d:e})"));
+            }
         }
         Ok(())
     }
