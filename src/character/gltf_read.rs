@@ -185,15 +185,29 @@ fn check_json_size(bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
+/// Longest message of the `gltf` crate's passed on: it lists every invalid
+/// item of a document (3,000,000 accessors without a buffer view made 134 MB
+/// of it).
+const MAX_MESSAGE_CHARS: usize = 2000;
+
+/// `message` cut to [`MAX_MESSAGE_CHARS`], saying how much was left out.
+pub(super) fn shortened(message: String) -> String {
+    match message.char_indices().nth(MAX_MESSAGE_CHARS) {
+        Some((at, _)) => format!("{} … ({} more bytes of the same)", &message[..at], message.len() - at),
+        None => message,
+    }
+}
+
 /// Parses a glTF document held in memory; external buffers are read from `dir`
 /// (refused without one).
 pub(super) fn parse(bytes: &[u8], dir: Option<&Path>) -> Result<Character> {
     // The crate's own validation indexes with some indices before checking
     // them: those are checked first.
     check_json_size(bytes)?;
-    let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| malformed(e.to_string()))?;
+    let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| malformed(shortened(e.to_string())))?;
     check_indices(raw.document.as_json())?;
-    let document = gltf::Document::from_json(raw.document.into_json()).map_err(|e| malformed(e.to_string()))?;
+    let document =
+        gltf::Document::from_json(raw.document.into_json()).map_err(|e| malformed(shortened(e.to_string())))?;
     let gltf = gltf::Gltf { document, blob: raw.blob };
     let buffers = buffers(&gltf, dir)?;
     let get = |b: gltf::Buffer<'_>| buffers.get(b.index()).map(Vec::as_slice);

@@ -42,6 +42,29 @@ pub const MAX_USDA_DEPTH: usize = 128;
 /// 700,000; 300 chains of 125 levels for 198,000,000.
 pub const MAX_USDA_DEPTH_WORK: u64 = 4_000_000;
 
+/// The prim metadata of value clips (the `clips` dictionary, its sets, and
+/// the fields of the older form): the library opens the layers they name
+/// itself, unchecked, and vkhair reads no clip.
+pub(super) const CLIP_FIELDS: [&str; 11] = [
+    "clips",
+    "clipSets",
+    "clipAssetPaths",
+    "clipManifestAssetPath",
+    "clipTemplateAssetPath",
+    "clipPrimPath",
+    "clipActive",
+    "clipTimes",
+    "clipTemplateStartTime",
+    "clipTemplateEndTime",
+    "clipTemplateStride",
+];
+
+/// Why value clips and relocates are refused, for both kinds of layer.
+pub(super) const CLIPS_REFUSED: &str = "value clips, which vkhair does not read (the USD library would open the \
+     layers they name unchecked): flatten the stage (usdcat --flatten) and read that";
+pub(super) const RELOCATES_REFUSED: &str = "relocates, which vkhair does not read (the USD library went without \
+     the relocated prims in silence): flatten the stage (usdcat --flatten) and read that";
+
 /// Most prims a chain of composition arcs (inherits, specializes, internal
 /// references) may pass through within a layer stack: the reader's time
 /// grows with the cube of the chain (1,000 links took it 13 s).
@@ -219,13 +242,13 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
                     pending = None;
                 } else if matches!(tokens.get(k + 1), Some((_, Token::Equals)))
                     && (in_metadata || (open.len() == 1 && prims.is_empty() && pending.is_none()))
-                    && (super::usdc_specs::CLIP_FIELDS.contains(w) || *w == "relocates")
+                    && (CLIP_FIELDS.contains(w) || *w == "relocates")
                 {
                     // Value clips name layers the library opens itself;
                     // relocates it went without in silence.
                     let why = match *w {
-                        "relocates" => super::usdc_specs::RELOCATES_REFUSED,
-                        _ => super::usdc_specs::CLIPS_REFUSED,
+                        "relocates" => RELOCATES_REFUSED,
+                        _ => CLIPS_REFUSED,
                     };
                     return Err(malformed(format!("{} `{w}`: {why}", position(text, *at))));
                 } else if *w == "subLayers" && open.len() == 1 && prims.is_empty() && pending.is_none() {

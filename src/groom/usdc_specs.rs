@@ -5,30 +5,7 @@
 
 use openusd::sdf::{AbstractData, Path as SdfPath, SpecType};
 
-use super::usda_check::{MAX_USDA_DEPTH, MAX_USDA_DEPTH_WORK};
-
-/// The prim metadata of value clips (the `clips` dictionary, its sets, and
-/// the fields of the older form): the library opens the layers they name
-/// itself, unchecked, and vkhair reads no clip.
-pub(super) const CLIP_FIELDS: [&str; 11] = [
-    "clips",
-    "clipSets",
-    "clipAssetPaths",
-    "clipManifestAssetPath",
-    "clipTemplateAssetPath",
-    "clipPrimPath",
-    "clipActive",
-    "clipTimes",
-    "clipTemplateStartTime",
-    "clipTemplateEndTime",
-    "clipTemplateStride",
-];
-
-/// Why value clips and relocates are refused, for both kinds of layer.
-pub(super) const CLIPS_REFUSED: &str = "value clips, which vkhair does not read (the USD library would open the \
-     layers they name unchecked): flatten the stage (usdcat --flatten) and read that";
-pub(super) const RELOCATES_REFUSED: &str = "relocates, which vkhair does not read (the USD library went without \
-     the relocated prims in silence): flatten the stage (usdcat --flatten) and read that";
+use super::usda_check::{CLIPS_REFUSED, CLIP_FIELDS, MAX_USDA_DEPTH, MAX_USDA_DEPTH_WORK, RELOCATES_REFUSED};
 
 /// Checks the prims of a binary layer's specs `typed` (in `data`): each at
 /// most [`MAX_USDA_DEPTH`] deep and their depths squared summing to at most
