@@ -265,13 +265,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
                     );
                     if let Some(from) = from {
                         for target in arc_targets(&tokens[k + 2..]) {
-                            count += 1;
-                            if count > MAX_USDA_ARCS {
-                                return Err(malformed(format!(
-                                    "{} more than {MAX_USDA_ARCS} composition arcs between the layer's prims",
-                                    position(text, *at)
-                                )));
-                            }
+                            count_arc(&mut count, text, *at)?;
                             arcs.entry(from.clone()).or_default().push((absolute(target, &from), *at));
                         }
                     }
@@ -281,13 +275,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
                     let named = asset_paths(&tokens[k + 2..], true);
                     assets.extend(named.into_iter().map(|a| LayerAsset { from: Some(from.clone()), ..a }));
                     for target in arc_targets(&tokens[k + 2..]) {
-                        count += 1;
-                        if count > MAX_USDA_ARCS {
-                            return Err(malformed(format!(
-                                "{} more than {MAX_USDA_ARCS} composition arcs between the layer's prims",
-                                position(text, *at)
-                            )));
-                        }
+                        count_arc(&mut count, text, *at)?;
                         let target = absolute(target, &from);
                         if matches!(*w, "references" | "payload") {
                             internal.push((target.clone(), *at));
@@ -335,6 +323,19 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
         }
     }
     Ok(Checked { assets, arcs, internal })
+}
+
+/// One more arc between the layer's prims, written at `at`: refused past
+/// [`MAX_USDA_ARCS`].
+fn count_arc(count: &mut usize, text: &str, at: usize) -> Result<()> {
+    *count += 1;
+    if *count > MAX_USDA_ARCS {
+        return Err(malformed(format!(
+            "{} more than {MAX_USDA_ARCS} composition arcs between the layer's prims",
+            position(text, at)
+        )));
+    }
+    Ok(())
 }
 
 /// The asset paths of a value (`tokens` start after its key, at `=` or at
