@@ -149,30 +149,6 @@ fn list_items<T: Default + Clone + PartialEq>(op: &openusd::sdf::ListOp<T>) -> i
     [&op.explicit_items, &op.added_items, &op.prepended_items, &op.appended_items].into_iter().flatten()
 }
 
-/// `path` without its variant selections: the prim a variant's spec is of.
-fn without_variants(path: &str) -> String {
-    let mut out = String::with_capacity(path.len());
-    let mut depth = 0usize;
-    for c in path.chars() {
-        match c {
-            '{' => depth += 1,
-            '}' => {
-                depth = depth.saturating_sub(1);
-                if depth == 0 {
-                    out.push('/');
-                }
-            }
-            c if depth == 0 => out.push(c),
-            _ => {}
-        }
-    }
-    let trimmed = out.replace("//", "/");
-    match trimmed.trim_end_matches('/') {
-        "" => "/".to_owned(),
-        p => p.to_owned(),
-    }
-}
-
 /// Reads what a binary layer names, offers and composes between its own
 /// prims (see [`Binary`]).
 fn binary(path: &Path) -> std::result::Result<Binary, String> {
@@ -195,7 +171,7 @@ fn binary(path: &Path) -> std::result::Result<Binary, String> {
         super::usdc_specs::check(&data, &typed)?;
         for (spec, ty) in &typed {
             // A variant's arcs are its prim's (`/P{v=a}C` → `/P/C`).
-            let owner = without_variants(spec.as_str());
+            let owner = spec.strip_all_variant_selections();
             let from = owner.as_str();
             if *ty == SpecType::Prim {
                 prims.insert(from.to_owned());
@@ -214,15 +190,10 @@ fn binary(path: &Path) -> std::result::Result<Binary, String> {
             for field in ["references", "payload", "inheritPaths", "specializes"] {
                 let Ok(Some(v)) = data.try_field(spec, field) else { continue };
                 match v.as_ref() {
-                    Value::ReferenceListOp(op) => {
-                        list_items(op).for_each(|r| take(&r.asset_path, &r.prim_path, "references"))
-                    }
-                    Value::PayloadListOp(op) => {
-                        list_items(op).for_each(|p| take(&p.asset_path, &p.prim_path, "payload"))
-                    }
-                    Value::Payload(p) => take(&p.asset_path, &p.prim_path, "payload"),
+                    Value::ReferenceListOp(op) => list_items(op).for_each(|r| take(&r.asset_path, &r.prim_path, field)),
+                    Value::PayloadListOp(op) => list_items(op).for_each(|p| take(&p.asset_path, &p.prim_path, field)),
+                    Value::Payload(p) => take(&p.asset_path, &p.prim_path, field),
                     Value::PathListOp(op) if field != "references" && field != "payload" => {
-                        let field = if field == "specializes" { "specializes" } else { "inheritPaths" };
                         list_items(op).for_each(|to| take("", to, field))
                     }
                     _ => {}

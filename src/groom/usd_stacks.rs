@@ -23,6 +23,25 @@ fn malformed(reason: String) -> Error {
     Error::Malformed { format: FileFormat::Usd, reason }
 }
 
+/// Per layer, a value computed from the layers it names: `None` while its
+/// own is being computed.
+type Memo<'a> = HashMap<&'a PathBuf, Option<usize>>;
+
+/// `layer`'s value in `memo`, computed once by `compute` (which recurses
+/// through the memo); a layer met again while its own value is being
+/// computed (a cycle of layers) counts 0.
+fn memoized<'a>(layer: &'a PathBuf, memo: &mut Memo<'a>, compute: impl FnOnce(&mut Memo<'a>) -> usize) -> usize {
+    match memo.get(layer) {
+        Some(Some(n)) => return *n,
+        Some(None) => return 0,
+        None => {}
+    }
+    memo.insert(layer, None);
+    let n = compute(memo);
+    memo.insert(layer, Some(n));
+    n
+}
+
 /// The layers one layer names: its sublayers, and what its references and
 /// payloads take (each a layer stack of its own).
 #[derive(Default)]
@@ -115,7 +134,7 @@ impl Stacks {
             ))
             .in_asset(&self.stage));
         }
-        let composed = self.composed_prims(&self.stage, &mut HashMap::new());
+        let composed = self.composed_prims(&self.stage, &stacks, &mut HashMap::new());
         let most = super::usda_check::MAX_USD_PRIMS;
         if composed > most {
             return Err(malformed(format!(
@@ -130,42 +149,42 @@ impl Stacks {
     /// At most how many prims the stack `layer` starts composes: its
     /// layers' own, and again every layer a reference or payload of theirs
     /// takes (all of its prims, whichever one it takes: a bound, not a count);
-    /// a layer met again on the chain counts nothing more.
-    fn composed_prims<'a>(&'a self, layer: &'a PathBuf, memo: &mut HashMap<&'a PathBuf, Option<usize>>) -> usize {
-        match memo.get(layer) {
-            Some(Some(n)) => return *n,
-            Some(None) => return 0,
-            None => {}
-        }
-        memo.insert(layer, None);
-        let mut total = 0usize;
-        for member in self.members(layer) {
-            total = total.saturating_add(self.offers.get(member).map_or(0, |(prims, _)| prims.len()));
-            for reference in self.layers.get(member).map(|(_, l)| l.references.as_slice()).unwrap_or_default() {
-                total = total.saturating_add(self.composed_prims(reference, memo));
+    /// a layer met again on the chain counts nothing more. `stacks`: each
+    /// stack root's layers.
+    fn composed_prims<'a>(
+        &'a self,
+        layer: &'a PathBuf,
+        stacks: &HashMap<&'a PathBuf, Vec<&'a PathBuf>>,
+        memo: &mut Memo<'a>,
+    ) -> usize {
+        memoized(layer, memo, |memo| {
+            let own;
+            let members = match stacks.get(layer) {
+                Some(members) => members.as_slice(),
+                None => {
+                    own = self.members(layer);
+                    own.as_slice()
+                }
+            };
+            let mut total = 0usize;
+            for &member in members {
+                total = total.saturating_add(self.offers.get(member).map_or(0, |(prims, _)| prims.len()));
+                for reference in self.layers.get(member).map(|(_, l)| l.references.as_slice()).unwrap_or_default() {
+                    total = total.saturating_add(self.composed_prims(reference, stacks, memo));
+                }
             }
-        }
-        memo.insert(layer, Some(total));
-        total
+            total
+        })
     }
 
     /// The most references and payloads one chain of layers from `layer`
     /// passes (sublayers add none; a layer met again on the chain ends it).
-    fn reference_depth<'a>(&'a self, layer: &'a PathBuf, memo: &mut HashMap<&'a PathBuf, Option<usize>>) -> usize {
-        match memo.get(layer) {
-            Some(Some(depth)) => return *depth,
-            Some(None) => return 0,
-            None => {}
-        }
-        memo.insert(layer, None);
-        let Some((_, links)) = self.layers.get(layer) else {
-            memo.insert(layer, Some(0));
-            return 0;
-        };
-        let steps = links.sublayers.iter().map(|l| (l, 0)).chain(links.references.iter().map(|l| (l, 1)));
-        let depth = steps.map(|(l, step)| step + self.reference_depth(l, memo)).max().unwrap_or(0);
-        memo.insert(layer, Some(depth));
-        depth
+    fn reference_depth<'a>(&'a self, layer: &'a PathBuf, memo: &mut Memo<'a>) -> usize {
+        memoized(layer, memo, |memo| {
+            let Some((_, links)) = self.layers.get(layer) else { return 0 };
+            let steps = links.sublayers.iter().map(|l| (l, 0)).chain(links.references.iter().map(|l| (l, 1)));
+            steps.map(|(l, step)| step + self.reference_depth(l, memo)).max().unwrap_or(0)
+        })
     }
 
     /// The layers of the stack `root` starts: it and its sublayers, all the way down.
