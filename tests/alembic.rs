@@ -334,9 +334,7 @@ fn an_empty_file_and_a_silent_fifo_are_named_as_such() {
     let e = alembic::open(&empty).expect_err("empty").to_string();
     assert!(e.contains("empty.abc") && e.contains("the file is empty"), "{e}");
     let fifo = dir.path().join("pipe.abc");
-    let c = std::ffi::CString::new(fifo.to_str().expect("utf-8")).expect("path");
-    // SAFETY: mkfifo with a valid NUL-terminated path.
-    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    crate::common::mkfifo(&fifo);
     let e = alembic::open(&fifo).expect_err("a silent FIFO").to_string();
     assert!(e.contains("pipe.abc") && e.contains("a FIFO nothing wrote to"), "{e}");
 }

@@ -268,9 +268,7 @@ fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
     assert_eq!(g.groom.strand_count(), 1);
 
     write("missing.usda", "#usda 1.0\n(\n    subLayers = [@./curves.usda@, @./gone.usda@]\n)\n");
-    let c = std::ffi::CString::new(dir.path().join("pipe.usda").to_str().expect("utf-8")).expect("path");
-    // SAFETY: mkfifo with a valid NUL-terminated path.
-    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    crate::common::mkfifo(&dir.path().join("pipe.usda"));
     write("fifo.usda", &format!("#usda 1.0\ndef Xform \"x\" (\n    references = @pipe.usda@</x>\n) {{ }}\n{curves}"));
     write("cyclic.usda", &format!("#usda 1.0\nclass \"A\" (\n    inherits = </A>\n) {{ }}\n{curves}"));
     write("names_cyclic.usda", "#usda 1.0\n(\n    subLayers = [@cyclic.usda@]\n)\n");
@@ -455,9 +453,7 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
         format!("{open}{}", "}\n".repeat(levels))
     };
     write("blank_led.usda", &format!("\n  #usda 1.0\n{}", deep(1500)));
-    let c = std::ffi::CString::new(dir.path().join("pipe.usda").to_str().expect("utf-8")).expect("path");
-    // SAFETY: mkfifo with a valid NUL-terminated path.
-    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    crate::common::mkfifo(&dir.path().join("pipe.usda"));
     write(
         "variant.usda",
         &format!(
@@ -605,9 +601,7 @@ fn the_layers_a_binary_layer_names_are_checked_too() {
     let binary = |name: &str, text: &str| write_binary(&dir.path().join(name), text);
     let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
     write("strand.usda", &format!("#usda 1.0\n(\n    defaultPrim = \"c\"\n)\n{curves}"));
-    let c = std::ffi::CString::new(dir.path().join("pipe.usda").to_str().expect("utf-8")).expect("path");
-    // SAFETY: mkfifo with a valid NUL-terminated path.
-    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    crate::common::mkfifo(&dir.path().join("pipe.usda"));
     binary("fifo.usdc", &format!("#usda 1.0\n(\n    subLayers = [@pipe.usda@]\n)\n{curves}"));
     let arc = |arc: &str| format!("#usda 1.0\ndef Xform \"x\" (\n    {arc}\n) {{ }}\n");
     binary("missing.usdc", &arc("references = @strand.usda@</gone>"));
@@ -637,8 +631,8 @@ fn the_layers_a_binary_layer_names_are_checked_too() {
 /// a class inheriting itself, two classes specializing each other, an
 /// internal reference cycle, a reference to its own prims through its own
 /// file, and a cycle closed across a text and a binary sublayer are refused
-/// naming the binary layer and the prim (the library overflowed its stack on
-/// the first); an internal reference to a prim it lacks is refused; a chain
+/// naming the binary layer and the prim (the first had read without a
+/// word); an internal reference to a prim it lacks is refused; a chain
 /// without a cycle reads.
 #[test]
 fn a_binary_layers_arcs_between_its_prims_are_judged_as_a_text_layers() {
@@ -695,9 +689,7 @@ fn clips_relocates_odd_names_and_deep_binary_nesting_are_refused_and_instances_r
     let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
     let binary = |name: &str, text: &str| write_binary(&dir.path().join(name), text);
     let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
-    let c = std::ffi::CString::new(dir.path().join("pipe.usda").to_str().expect("utf-8")).expect("path");
-    // SAFETY: mkfifo with a valid NUL-terminated path.
-    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    crate::common::mkfifo(&dir.path().join("pipe.usda"));
     let clipped = |clips: &str| {
         format!("#usda 1.0\n{curves}def BasisCurves \"k\" (\n    {clips}\n) {{\n    int[] curveVertexCounts\n}}\n")
     };

@@ -279,3 +279,10 @@ pub fn draw_frame(
     record_frame(gpu, (sim, renderer), offscreen, camera, host);
     offscreen.read_rgba8().expect("readback")
 }
+
+/// Makes a FIFO at `path` (no process writes it: a reader of it waits forever).
+pub fn mkfifo(path: &std::path::Path) {
+    let c = std::ffi::CString::new(path.to_str().expect("utf-8")).expect("path");
+    // SAFETY: mkfifo with a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo {}", path.display());
+}
