@@ -18,9 +18,13 @@ pub const MAX_KEY_TIME_S: f32 = 1e6;
 /// overflows) is refused.
 pub(crate) fn not_a_rotation(q: Quat) -> Option<String> {
     let length = q.as_dquat().length();
-    let fine = q.is_finite() && (1e-6..=1e6).contains(&length);
-    let shown = format!("[{:?}, {:?}, {:?}, {:?}]", q.x, q.y, q.z, q.w);
-    (!fine).then(|| format!("{shown} is not a rotation (a quaternion of length {length:.3e}, normalised to use)"))
+    // The bounds as the f32 values a file holds (1e-6 in f32 lies just below
+    // 1e-6 in f64).
+    let fine = q.is_finite() && (f64::from(1e-6f32)..=f64::from(1e6f32)).contains(&length);
+    (!fine).then(|| {
+        let shown = format!("[{:?}, {:?}, {:?}, {:?}]", q.x, q.y, q.z, q.w);
+        format!("{shown} is not a rotation (a quaternion of length {length:.3e}, normalised to use)")
+    })
 }
 
 /// A node of the hierarchy with its rest transform.

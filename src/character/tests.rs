@@ -610,6 +610,11 @@ fn hostile_parts_are_refused_or_harmless() {
     let zero = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0);
     let spline = vec![zero, Quat::IDENTITY, zero, zero, Quat::from_rotation_y(1.0), zero];
     skeleton_with(vec![0.0, 1.0], spline, Sampling::CubicSpline).expect("zero tangents are taken");
+    // Unnormalised but normalisable rotations are taken, to the bounds' ends.
+    for length in [1e-6, 100.0, 1e6] {
+        let q = Quat::from_xyzw(0.0, 0.0, 0.0, length);
+        skeleton_with(vec![0.0, 1.0], vec![Quat::IDENTITY, q], Sampling::Linear).expect("a normalisable rotation");
+    }
     let mut weights = c.weights.clone();
     weights[3].1 = [0.0; 4];
     let err =
