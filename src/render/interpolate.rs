@@ -26,6 +26,7 @@ use ash::vk;
 use glam::{Vec3, Vec4};
 
 use super::followers::Followers;
+use super::graph::{FrameGraph, Use};
 use super::pass::{self, RenderPass};
 use super::smooth::SmoothPass;
 use super::{InterpolationMode, Interpolator};
@@ -34,7 +35,7 @@ use crate::error::{Error, Result};
 use crate::gpu_types::InterpolatePush;
 use crate::profiler::Timing;
 use crate::sim::SimState;
-use crate::vk::barrier::{self, AccessKind};
+use crate::vk::barrier::AccessKind;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::pipeline::{ComputePipeline, GraphicsPipeline};
@@ -118,10 +119,6 @@ struct Pipeline {
     compute: ComputePipeline,
     compute_set: vk::DescriptorSet,
 }
-
-/// Shader stages that read the grown hairs.
-const HAIR_READERS: &[AccessKind] =
-    &[AccessKind::VertexRead, AccessKind::TessellationRead, AccessKind::FragmentRead, AccessKind::ComputeRead];
 
 /// Workgroups of one row of the compute dispatch: within
 /// `maxComputeWorkGroupCount`'s least x (65,535) on every device.
@@ -275,8 +272,9 @@ impl InterpolatePass {
 
     /// Records the pass in its own scope, through the tessellation stages (a
     /// capture instance) or a compute dispatch as `interpolator` says
-    /// ([`Interpolator::Auto`] is taken as [`Interpolator::Compute`]); its
-    /// stores are visible to every later shader stage after it.
+    /// ([`Interpolator::Auto`] is taken as [`Interpolator::Compute`]),
+    /// declaring to `graph` that it reads `smoothed` (the smoothing pass's
+    /// output) and writes the hairs.
     ///
     /// # Safety
     /// `cmd` is a recording command buffer of this device outside a render pass,
@@ -290,9 +288,20 @@ impl InterpolatePass {
         mode: InterpolationMode,
         interpolator: Interpolator,
         push: &InterpolatePush,
+        (graph, smoothed): (&mut FrameGraph, (&Buffer, &Buffer)),
         timing: Timing<'_>,
     ) {
         let d = &self.device;
+        let (read, write) = match interpolator {
+            Interpolator::Tessellation => (AccessKind::TessellationRead, AccessKind::TessellationWrite),
+            _ => (AccessKind::ComputeRead, AccessKind::ComputeWrite),
+        };
+        let uses = [
+            Use::buffer(smoothed.0, &[read]),
+            Use::buffer(smoothed.1, &[read]),
+            Use::buffer(&self.positions, &[write]),
+            Use::buffer(&self.tangents, &[write]),
+        ];
         let p = match (&self.follow, mode) {
             (Some(f), _) => &f.pipeline,
             (None, InterpolationMode::SingleStrand) => &self.single_strand,
@@ -307,15 +316,14 @@ impl InterpolatePass {
             let vertices = u64::from(push.strands) * u64::from(push.hairs) * u64::from(per_hair);
             let vertices = u32::try_from(vertices).unwrap_or(u32::MAX);
             let (x, y) = dispatch_grid(vertices.div_ceil(p.compute.workgroup_size()[0]));
-            let written = barrier::memory(&[AccessKind::ComputeWrite], HAIR_READERS);
             // SAFETY: guaranteed by the caller; the dispatch covers every vertex
             // (interpolate.comp returns past the last).
             unsafe {
                 let scope = RenderPass::Interpolate.open(d, cmd, timing);
+                graph.record(d, cmd, &uses);
                 p.compute.bind(cmd, &[p.compute_set]);
                 p.compute.push(cmd, push);
                 p.compute.dispatch_groups(cmd, [x, y, 1], 1);
-                d.cmd_barrier(cmd, &[written], &[], &[]);
                 scope.close(d, cmd, timing);
             }
             return;
@@ -323,7 +331,7 @@ impl InterpolatePass {
         // SAFETY: guaranteed by the caller: one patch per key segment of each
         // unit (per follower segment, one line each, with followers).
         unsafe {
-            pass::record_capture(d, cmd, RenderPass::Interpolate, timing, |cmd| {
+            pass::record_capture(d, cmd, (RenderPass::Interpolate, timing), (graph, &uses), |cmd| {
                 p.pipeline.bind(cmd, &[p.set]);
                 p.pipeline.push(cmd, push);
                 let instances = push.hairs.div_ceil(codes::interpolate::LINES_PER_INSTANCE);

@@ -8,8 +8,10 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Vec4;
 
+use super::graph::{FrameGraph, Use};
 use crate::error::{Error, Result};
 use crate::gpu_types::MarschnerPush;
+use crate::vk::barrier::AccessKind;
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc, Sampler};
 use crate::vk::pipeline::ComputePipeline;
@@ -161,39 +163,43 @@ impl MarschnerTables {
         })
     }
 
-    /// Records a rebuild when `params` differ from what the tables hold; leaves both
-    /// tables in SHADER_READ_ONLY_OPTIMAL, visible to fragment and compute shaders.
+    /// Records a rebuild when `params` differ from what the tables hold,
+    /// declaring the tables' writes to `graph` (whose later uses, or settling,
+    /// return them to SHADER_READ_ONLY_OPTIMAL, their layout at rest).
     ///
     /// # Safety
-    /// `cmd` is recording outside a render pass; earlier reads of the tables were
-    /// submitted before it on the same queue.
-    pub(super) unsafe fn record_update(&mut self, device: &Device, cmd: vk::CommandBuffer, params: &MarschnerParams) {
+    /// `cmd` is recording outside a render pass; every earlier command on the
+    /// tables since `graph` was made was declared to it.
+    pub(super) unsafe fn record_update(
+        &mut self,
+        device: &Device,
+        cmd: vk::CommandBuffer,
+        graph: &mut FrameGraph,
+        params: &MarschnerParams,
+    ) {
         if self.built.as_ref() == Some(params) {
             return;
         }
-        use crate::vk::barrier::{self, AccessKind};
-        // The draw's fragment stages and the transparent modes' vertex shading sample them.
-        let sampled = &[AccessKind::FragmentSampledRead, AccessKind::ComputeSampledRead];
-        let write = &[AccessKind::ComputeWrite];
-        let before: Vec<_> = [&self.m, &self.n]
-            .iter()
-            .map(|t| barrier::image(t, sampled, write, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL))
-            .collect();
-        let after: Vec<_> = [&self.m, &self.n]
-            .iter()
-            .map(|t| {
-                barrier::image(t, write, sampled, vk::ImageLayout::GENERAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)
-            })
-            .collect();
+        let writes = [&self.m, &self.n].map(|t| {
+            let sampled = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+            Use::image(t, &[AccessKind::ComputeWrite], vk::ImageLayout::GENERAL, sampled).discarding()
+        });
         // SAFETY: guaranteed by the caller.
         unsafe {
-            device.cmd_barrier(cmd, &[], &[], &before);
+            graph.record(device, cmd, &writes);
             self.pipeline.bind(cmd, &[self.set]);
             self.pipeline.push(cmd, &params.push());
             self.pipeline.dispatch_threads(cmd, [TABLE_SIZE, TABLE_SIZE, 1]);
-            device.cmd_barrier(cmd, &[], &[], &after);
         }
         self.built = Some(*params);
+    }
+
+    /// The tables as the draw samples them (fragment stages; the transparent
+    /// modes' vertex shading, a compute dispatch).
+    pub(super) fn sampled_uses(&self) -> [Use; 2] {
+        let sampled = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+        let kinds = &[AccessKind::FragmentSampledRead, AccessKind::ComputeSampledRead];
+        [&self.m, &self.n].map(|t| Use::image(t, kinds, sampled, sampled))
     }
 
     /// Reads a table back as RGBA f32 texels, row by row (tests; submits and waits).

@@ -23,11 +23,15 @@
 //!    the host's target.
 //!
 //! Passes 1–2 are recorded by [`Renderer::record_prepare`], 3 by
-//! [`Renderer::record_shadows`], 4–5 by [`Renderer::record_draw`].
+//! [`Renderer::record_shadows`], 4–5 by [`Renderer::record_draw`]. Each
+//! entry point keeps a frame graph (`graph.rs`): every pass declares the
+//! buffers and images it reads and writes, and the barriers between passes
+//! are derived from those declarations.
 
 mod draw;
 pub mod followers;
 mod frame;
+pub(crate) mod graph;
 mod interpolate;
 pub mod marschner;
 mod motion_reference;
@@ -69,10 +73,10 @@ use crate::error::{Error, Result};
 use crate::gpu_types::GpuLight;
 use crate::profiler::{GpuProfiler, Timing};
 use crate::sim::KeyHairs;
-use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use draw::DrawPass;
+use graph::FrameGraph;
 use interpolate::InterpolatePass;
 use resolve::ResolvePass;
 use shadow::{Bounds, DrawnHairs, ShadowFootprint, Shadows};
@@ -420,24 +424,17 @@ impl Renderer {
             // Followers' offsets hold against guides smoothed at their level.
             self.detail.smoothing_level = f.level;
         }
-        let entry = barrier::memory(
-            &[AccessKind::AnyWrite],
-            &[
-                AccessKind::VertexRead,
-                AccessKind::TessellationRead,
-                AccessKind::TessellationWrite,
-                AccessKind::ComputeRead,
-                AccessKind::ComputeWrite,
-            ],
-        );
         let (smooth_push, interpolate_push) = (self.smooth_push(sim.alpha), self.interpolate_push());
         let timing = Timing::of(profiler.as_deref());
+        let keys = (sim.current, [sim.halves[sim.current], sim.before[sim.current]]);
+        let mut graph = FrameGraph::new();
         // SAFETY: guaranteed by the caller.
         unsafe {
-            self.device.cmd_barrier(cmd, &[entry], &[], &[]);
-            self.smooth.record(cmd, sim.current, &smooth_push, timing);
+            self.smooth.record(cmd, keys, &smooth_push, &mut graph, timing);
             let interpolator = self.interpolator();
-            self.interpolate.record(cmd, self.params.interpolation, interpolator, &interpolate_push, timing);
+            let inputs = (&mut graph, self.smooth.outputs());
+            self.interpolate.record(cmd, self.params.interpolation, interpolator, &interpolate_push, inputs, timing);
+            graph.settle(&self.device, cmd);
         }
         Ok(())
     }
@@ -495,8 +492,13 @@ impl Renderer {
         let footprint = ShadowFootprint { hairs: self.strand_hairs(), spacing: 0.5 * (root + tip) };
         let drawn = DrawnHairs { counts: self.hair_counts(), footprint };
         let raster = (self.shadow_raster(), self.interpolate.hairs().0);
+        let mut graph = FrameGraph::new();
         // SAFETY: guaranteed by the caller.
-        unsafe { self.shadows.record(cmd, &sim, &self.lights, bounds, drawn, raster, timing) }
+        unsafe {
+            let recorded = self.shadows.record(cmd, &sim, &self.lights, bounds, drawn, raster, &mut graph, timing);
+            graph.settle(&self.device, cmd);
+            recorded
+        }
     }
 
     /// The rasteriser the current parameters draw the deep opacity maps with on

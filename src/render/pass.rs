@@ -11,7 +11,12 @@
 //!   in `new`, and owns them (a later pass borrows what it reads through an
 //!   accessor of the pass that wrote it);
 //! - records itself in `unsafe fn record(…)`, inside its own [`PassScope`] named
-//!   by its [`RenderPass`], with the barriers that make its inputs visible to it;
+//!   by its [`RenderPass`], declaring before each step every resource the step
+//!   reads or writes ([`super::graph::Use`]) to the entry point's
+//!   [`super::graph::FrameGraph`], which records the barriers those uses need
+//!   after the earlier passes' declared uses: no pass places a barrier for
+//!   its neighbour (only the steps within the transparency pass, the tiled
+//!   rasteriser and the motion vectors order their private buffers by hand);
 //! - states in its `# Safety` section what must have been recorded before.
 //!
 //! There is no `Pass` trait: the passes take different inputs each frame
@@ -23,9 +28,9 @@ use std::sync::Arc;
 
 use ash::vk;
 
+use super::graph::{FrameGraph, Use};
 use crate::error::Result;
 use crate::profiler::{PassScope, Timing};
-use crate::vk::barrier::{self, AccessKind};
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
@@ -133,35 +138,31 @@ pub(super) fn capture_pipeline(
     )
 }
 
-/// Shader stages that read what a capture pass stored.
-const CAPTURE_READERS: &[AccessKind] =
-    &[AccessKind::VertexRead, AccessKind::TessellationRead, AccessKind::FragmentRead, AccessKind::ComputeRead];
-
-/// Records one storing pass: its scope, an attachment-less rendering instance
-/// around `record`, then a barrier making its tessellation-stage storage writes
-/// visible to every later shader stage.
+/// Records one storing pass: its scope, the barriers `graph` derives for
+/// `uses` (what the pass reads and writes), and an attachment-less rendering
+/// instance around `record`. Later passes declare what they read of its output.
 ///
 /// # Safety
 /// `cmd` is a recording command buffer of `device`, outside a render pass;
-/// `record` records draws of capture pipelines only.
+/// `record` records draws of capture pipelines only, touching no resource that
+/// `uses` leaves out.
 pub(super) unsafe fn record_capture(
     device: &Device,
     cmd: vk::CommandBuffer,
-    pass: RenderPass,
-    timing: Timing<'_>,
+    (pass, timing): (RenderPass, Timing<'_>),
+    (graph, uses): (&mut FrameGraph, &[Use]),
     record: impl FnOnce(vk::CommandBuffer),
 ) {
-    let written = barrier::memory(&[AccessKind::TessellationWrite], CAPTURE_READERS);
     let extent = vk::Extent2D { width: 1, height: 1 };
     let rendering = rendering::info(extent, &[], None);
     // SAFETY: guaranteed by the caller; every object belongs to this device.
     unsafe {
         let scope = pass.open(device, cmd, timing);
+        graph.record(device, cmd, uses);
         device.raw.cmd_begin_rendering(cmd, &rendering);
         device.cmd_set_full_viewport(cmd, extent);
         record(cmd);
         device.raw.cmd_end_rendering(cmd);
-        device.cmd_barrier(cmd, &[written], &[], &[]);
         scope.close(device, cmd, timing);
     }
 }

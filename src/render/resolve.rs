@@ -14,11 +14,12 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::draw::{DrawTarget, TargetKey};
+use super::graph::{FrameGraph, Use};
 use super::pass::RenderPass;
 use super::Primitive;
 use crate::error::Result;
 use crate::profiler::Timing;
-use crate::vk::barrier::{self, AccessKind, Barriers};
+use crate::vk::barrier::{self, AccessKind};
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc, Sampler};
 use crate::vk::pipeline::{Blend, GraphicsDesc, GraphicsPipeline};
@@ -136,53 +137,29 @@ impl Supersampling {
             // Cleared to the far depth of the convention.
             depth: Some((self.depth.view(), Load::depth(if reverse_z { 0.0 } else { 1.0 }))),
             depth_image: None,
-            before: Barriers { images: self.to_attachments().to_vec(), ..Barriers::default() },
+            uses: self.attachment_uses().to_vec(),
         }
     }
 
-    /// Barriers before the draw: both images from the last resolve's sampling to
-    /// attachments (contents discarded).
-    fn to_attachments(&self) -> [vk::ImageMemoryBarrier2<'static>; 2] {
-        let sampled = &[AccessKind::FragmentSampledRead];
+    /// Both images as the draw's attachments (their contents discarded:
+    /// cleared by the draw's first rendering instance).
+    fn attachment_uses(&self) -> [Use; 2] {
+        let color = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+        let depth = vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL;
         [
-            barrier::image(
-                &self.color,
-                sampled,
-                barrier::COLOR_ATTACHMENT,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-            ),
-            barrier::image(
-                &self.depth,
-                sampled,
-                barrier::DEPTH_ATTACHMENT,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
-            ),
+            Use::image(&self.color, barrier::COLOR_ATTACHMENT, color, SAMPLED).discarding(),
+            Use::image(&self.depth, barrier::DEPTH_ATTACHMENT, depth, SAMPLED).discarding(),
         ]
     }
 
-    /// Barriers after the draw: both images to fragment-shader sampling.
-    fn to_sampled(&self) -> [vk::ImageMemoryBarrier2<'static>; 2] {
-        let sampled = &[AccessKind::FragmentSampledRead];
-        [
-            barrier::image(
-                &self.color,
-                barrier::COLOR_ATTACHMENT,
-                sampled,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            ),
-            barrier::image(
-                &self.depth,
-                barrier::DEPTH_ATTACHMENT,
-                sampled,
-                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            ),
-        ]
+    /// Both images as the resolve samples them (their layout at rest).
+    fn sampled_uses(&self) -> [Use; 2] {
+        [&self.color, &self.depth].map(|i| Use::image(i, &[AccessKind::FragmentSampledRead], SAMPLED, SAMPLED))
     }
 }
+
+/// The layout the supersampling images rest in: sampled by the resolve.
+const SAMPLED: vk::ImageLayout = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
 
 /// The resolve pass: the supersampling images of the current target size and
 /// those of earlier sizes still in use by frames in flight.
@@ -230,8 +207,7 @@ impl ResolvePass {
     }
 
     /// Records the resolve of `images` into the host's `target` in its own scope,
-    /// after the target's barriers (which order the host's earlier attachment
-    /// writes).
+    /// declaring both to `graph`.
     ///
     /// # Safety
     /// `cmd` is a recording command buffer of this device outside a render pass,
@@ -240,12 +216,13 @@ impl ResolvePass {
     pub(super) unsafe fn record(
         &self,
         cmd: vk::CommandBuffer,
+        graph: &mut FrameGraph,
         images: &mut Supersampling,
         target: &DrawTarget,
         timing: Timing<'_>,
     ) -> Result<()> {
         let d = &self.device;
-        let to_sampled = images.to_sampled();
+        let uses = [&images.sampled_uses()[..], &target.uses].concat();
         let color = [rendering::color(target.color.0, target.color.1)];
         let depth = target.depth.map(|(view, load)| rendering::depth(view, load));
         let info = rendering::info(target.extent, &color, depth.as_ref());
@@ -254,7 +231,7 @@ impl ResolvePass {
         // SAFETY: guaranteed by the caller; the images are this pass's.
         unsafe {
             let scope = RenderPass::Resolve.open(d, cmd, timing);
-            d.cmd_barrier(cmd, &target.before.memory, &[], &to_sampled);
+            graph.record(d, cmd, &uses);
             d.raw.cmd_begin_rendering(cmd, &info);
             d.cmd_set_full_viewport(cmd, target.extent);
             pipeline.bind(cmd, &[*set]);

@@ -15,10 +15,12 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Vec4;
 
+use super::graph::{FrameGraph, Use};
 use super::pass::{self, RenderPass};
 use crate::error::Result;
 use crate::gpu_types::SmoothPush;
 use crate::profiler::Timing;
+use crate::vk::barrier::AccessKind;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::pipeline::GraphicsPipeline;
@@ -63,19 +65,33 @@ impl SmoothPass {
         (&self.positions, &self.tangents)
     }
 
-    /// Records the pass in its own capture instance and scope; its stores are
-    /// visible to every later shader stage after it.
+    /// Records the pass in its own capture instance and scope: it reads the
+    /// key hairs of `keys` (the simulation's latest half and the positions
+    /// before its step) in the vertex stage and writes the smoothed positions
+    /// and tangents in the evaluation stage.
     ///
     /// # Safety
-    /// `cmd` is a recording command buffer of this device outside a render pass,
-    /// the simulation's writes to half `half` (the latest state) made visible to
-    /// vertex shaders before.
-    pub(super) unsafe fn record(&self, cmd: vk::CommandBuffer, half: usize, push: &SmoothPush, timing: Timing<'_>) {
+    /// `cmd` is a recording command buffer of this device outside a render pass;
+    /// `keys` are the buffers of half `half` the pass was made with.
+    pub(super) unsafe fn record(
+        &self,
+        cmd: vk::CommandBuffer,
+        (half, keys): (usize, [&Buffer; 2]),
+        push: &SmoothPush,
+        graph: &mut FrameGraph,
+        timing: Timing<'_>,
+    ) {
         let d = &self.device;
         let vertices = push.strands * (push.points - 1) * 4;
+        let uses = [
+            Use::buffer(keys[0], &[AccessKind::VertexRead]),
+            Use::buffer(keys[1], &[AccessKind::VertexRead]),
+            Use::buffer(&self.positions, &[AccessKind::TessellationWrite]),
+            Use::buffer(&self.tangents, &[AccessKind::TessellationWrite]),
+        ];
         // SAFETY: guaranteed by the caller.
         unsafe {
-            pass::record_capture(d, cmd, RenderPass::Smooth, timing, |cmd| {
+            pass::record_capture(d, cmd, (RenderPass::Smooth, timing), (graph, &uses), |cmd| {
                 self.pipeline.bind(cmd, &[self.sets[half]]);
                 self.pipeline.push(cmd, push);
                 d.raw.cmd_draw(cmd, vertices, 1, 0, 0);

@@ -105,6 +105,42 @@ impl AccessKind {
         }
     }
 
+    /// Every kind, in declaration order (its index is its bit in a [`KindSet`]).
+    pub(crate) const ALL: [AccessKind; 24] = {
+        use AccessKind::*;
+        [
+            ComputeRead,
+            ComputeWrite,
+            ComputeUniformRead,
+            IndirectRead,
+            VertexRead,
+            VertexUniformRead,
+            TessellationRead,
+            TessellationWrite,
+            FragmentRead,
+            FragmentWrite,
+            FragmentUniformRead,
+            FragmentSampledRead,
+            ComputeSampledRead,
+            ColorAttachmentRead,
+            ColorAttachmentWrite,
+            DepthAttachmentRead,
+            DepthAttachmentWrite,
+            TransferRead,
+            TransferWrite,
+            ClearWrite,
+            AnyTransferWrite,
+            HostRead,
+            AnyWrite,
+            AnyRead,
+        ]
+    };
+
+    /// Whether the kind writes memory (a later access of any kind waits for it).
+    pub(crate) const fn writes(self) -> bool {
+        self.parts().1.as_raw() & WRITE_ACCESS.as_raw() != 0
+    }
+
     /// The stage and access masks of `kinds` together (none for an empty list).
     pub(crate) const fn mask(kinds: &[AccessKind]) -> (Stage, Acc) {
         let (mut stage, mut access) = (0u64, 0u64);
@@ -116,6 +152,70 @@ impl AccessKind {
             i += 1;
         }
         (Stage::from_raw(stage), Acc::from_raw(access))
+    }
+}
+
+/// Every access flag that writes memory.
+const WRITE_ACCESS: Acc = Acc::from_raw(
+    Acc::SHADER_STORAGE_WRITE.as_raw()
+        | Acc::COLOR_ATTACHMENT_WRITE.as_raw()
+        | Acc::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw()
+        | Acc::TRANSFER_WRITE.as_raw()
+        | Acc::MEMORY_WRITE.as_raw(),
+);
+
+/// A set of [`AccessKind`]s, one bit each (its index in [`AccessKind::ALL`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) struct KindSet(u32);
+
+impl KindSet {
+    /// No kind.
+    pub(crate) const EMPTY: KindSet = KindSet(0);
+
+    /// The set of `kinds`.
+    pub(crate) fn of(kinds: &[AccessKind]) -> KindSet {
+        KindSet(kinds.iter().fold(0, |bits, &k| bits | 1 << k as u32))
+    }
+
+    /// Whether no kind is in the set.
+    pub(crate) fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// The kinds of both sets.
+    pub(crate) fn union(self, other: KindSet) -> KindSet {
+        KindSet(self.0 | other.0)
+    }
+
+    /// The kinds of this set not in `other`.
+    pub(crate) fn minus(self, other: KindSet) -> KindSet {
+        KindSet(self.0 & !other.0)
+    }
+
+    /// The kinds of the set that write.
+    pub(crate) fn writes(self) -> KindSet {
+        self.filter(AccessKind::writes)
+    }
+
+    /// The kinds of the set that only read.
+    pub(crate) fn reads(self) -> KindSet {
+        self.minus(self.writes())
+    }
+
+    fn filter(self, keep: impl Fn(AccessKind) -> bool) -> KindSet {
+        let kept: Vec<AccessKind> = self.kinds().filter(|&k| keep(k)).collect();
+        KindSet::of(&kept)
+    }
+
+    /// The kinds in the set.
+    pub(crate) fn kinds(self) -> impl Iterator<Item = AccessKind> {
+        AccessKind::ALL.into_iter().filter(move |&k| self.0 & 1 << k as u32 != 0)
+    }
+
+    /// The stage and access masks of the set's kinds.
+    pub(crate) fn mask(self) -> (Stage, Acc) {
+        let kinds: Vec<AccessKind> = self.kinds().collect();
+        AccessKind::mask(&kinds)
     }
 }
 
@@ -268,6 +368,34 @@ impl Device {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_kind_has_its_own_bit_and_writes_are_told_from_reads() {
+        for (i, kind) in AccessKind::ALL.into_iter().enumerate() {
+            assert_eq!(kind as usize, i, "{kind:?} is at its index");
+            assert_eq!(KindSet::of(&[kind]).kinds().collect::<Vec<_>>(), [kind]);
+        }
+        let writes: Vec<AccessKind> = AccessKind::ALL.into_iter().filter(|k| k.writes()).collect();
+        use AccessKind::*;
+        assert_eq!(
+            writes,
+            [
+                ComputeWrite,
+                TessellationWrite,
+                FragmentWrite,
+                ColorAttachmentWrite,
+                DepthAttachmentWrite,
+                TransferWrite,
+                ClearWrite,
+                AnyTransferWrite,
+                AnyWrite
+            ]
+        );
+        let both = KindSet::of(&[ComputeRead, ComputeWrite, ColorAttachmentRead]);
+        assert_eq!(both.writes(), KindSet::of(&[ComputeWrite]));
+        assert_eq!(both.reads(), KindSet::of(&[ComputeRead, ColorAttachmentRead]));
+        assert_eq!(both.mask(), AccessKind::mask(&[ComputeRead, ComputeWrite, ColorAttachmentRead]));
+    }
 
     #[test]
     fn kinds_combine_into_masks() {

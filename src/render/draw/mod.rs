@@ -44,7 +44,8 @@ use super::{OitParams, Primitive, Raster, RenderTarget, Renderer, Transparency};
 use crate::error::{Error, Result};
 use crate::gpu_types::{DrawParams, GpuLight};
 use crate::profiler::{GpuProfiler, Timing};
-use crate::vk::barrier::{self, AccessKind, Barriers};
+use crate::render::graph::{FrameGraph, Use};
+use crate::vk::barrier;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::rendering::{self, Load};
@@ -88,7 +89,7 @@ pub(super) struct TargetKey {
 
 /// Where a frame's hair goes: images with `key`'s formats, how each
 /// attachment's earlier contents are loaded the first time the frame uses it,
-/// and the barriers that make them ready.
+/// and the frame graph's uses of them as attachments.
 #[derive(Clone)]
 pub(super) struct DrawTarget {
     pub key: TargetKey,
@@ -98,7 +99,8 @@ pub(super) struct DrawTarget {
     /// The image behind a kept depth attachment, for the compute rasteriser's
     /// copy ([`RenderTarget::depth_image`]); `None` when not given.
     pub depth_image: Option<vk::Image>,
-    pub before: Barriers,
+    /// The attachments as the draw uses them ([`FrameGraph`] declarations).
+    pub uses: Vec<Use>,
 }
 
 impl DrawTarget {
@@ -126,6 +128,8 @@ pub(super) struct DrawInputs<'a> {
     pub shadow_uniforms: &'a Buffer,
     /// The opacity atlas and its sampler.
     pub atlas: (vk::ImageView, vk::Sampler),
+    /// The opacity atlas as the draw samples it.
+    pub atlas_use: Use,
     /// Per-cell transmittance of density-volume lights.
     pub transmittance: &'a Buffer,
     /// Per hair its own albedo at the root and the tip (read when the draw
@@ -201,14 +205,14 @@ impl DrawPass {
     ///
     /// # Safety
     /// `frame.cmd` is a recording command buffer of this device outside a render
-    /// pass; after `frame.target.before`, the target's attachments are in
-    /// attachment layouts with earlier writes visible; the inputs were written
-    /// earlier in submission order with barriers to the draw's stages (the
-    /// capture and shadow passes leave them so); the frames `frames_in_flight`
-    /// before `frame.frame` completed.
+    /// pass; the target's attachments are in the layouts `frame.target.uses`
+    /// name as their rest; every earlier command on the resources since `graph`
+    /// was made was declared to it; the frames `frames_in_flight` before
+    /// `frame.frame` completed.
     unsafe fn record(
         &mut self,
         frame: &DrawFrame<'_>,
+        graph: &mut FrameGraph,
         mode: Transparency,
         oit: &OitParams,
         raster: Raster,
@@ -218,9 +222,9 @@ impl DrawPass {
             match mode {
                 Transparency::Off => self
                     .opaque
-                    .record(frame, &mut self.shading, &self.ribbons)
+                    .record(frame, graph, &mut self.shading, &self.ribbons)
                     .and_then(|_| self.opaque_motion.record(frame, &self.shading)),
-                _ => self.transparent.record(frame, mode, oit, raster, &mut self.shading, &self.ribbons),
+                _ => self.transparent.record(frame, graph, (mode, oit, raster), &mut self.shading, &self.ribbons),
             }
         }
     }
@@ -303,11 +307,6 @@ impl Renderer {
         if !camera.jitter.is_finite() || camera.jitter.abs().max_element() > 1.0 {
             return Err(Error::param("camera jitter", camera.jitter, "finite, within ±1 pixel on each axis"));
         }
-        // The host's earlier attachment writes (its head, its clear) before ours.
-        let host_writes = Barriers {
-            memory: vec![barrier::memory(HOST_ATTACHMENT_WRITES, barrier::ATTACHMENTS)],
-            ..Barriers::default()
-        };
         let has_depth = target.depth_format != vk::Format::UNDEFINED;
         let reverse_z = camera.depth_reversed();
         let host = DrawTarget {
@@ -322,7 +321,9 @@ impl Renderer {
             color: (target.color, Load::Keep),
             depth: has_depth.then_some((target.depth, Load::Keep)),
             depth_image: (has_depth && target.depth_image != vk::Image::null()).then_some(target.depth_image),
-            before: host_writes,
+            // The host's earlier writes (its head, its clear) are unknown to the
+            // graph: the first use waits for any.
+            uses: vec![Use::host_attachments(barrier::ATTACHMENTS)],
         };
         // With supersampling, the hair goes into the renderer's own images first.
         let mut images = match self.params.supersampling {
@@ -391,20 +392,25 @@ impl Renderer {
                 hairs: self.interpolate.hairs(),
                 shadow_uniforms: self.shadows.uniforms(),
                 atlas: self.shadows.atlas(),
+                atlas_use: self.shadows.atlas_use(),
                 transmittance: self.shadows.transmittance(),
                 looks: self.interpolate.looks().0,
             },
             marschner: self.material.marschner,
             motion,
         };
+        let mut graph = FrameGraph::new();
         // SAFETY: guaranteed by the caller; the supersampling images are this
-        // renderer's and earlier resolves that sampled them are ordered by the barriers.
+        // renderer's and earlier resolves that sampled them are ordered by the
+        // graph's first uses.
         let result = unsafe {
-            let drawn = self.draw.record(&frame, mode, &self.params.oit, self.raster());
-            match &mut images {
-                Some(images) => drawn.and_then(|_| self.resolve.record(cmd, images, &host, frame.timing)),
+            let drawn = self.draw.record(&frame, &mut graph, mode, &self.params.oit, self.raster());
+            let resolved = match &mut images {
+                Some(images) => drawn.and_then(|_| self.resolve.record(cmd, &mut graph, images, &host, frame.timing)),
                 None => drawn,
-            }
+            };
+            graph.settle(&self.device, cmd);
+            resolved
         };
         if let Some(images) = images {
             self.resolve.restore(images);
@@ -498,10 +504,6 @@ impl Renderer {
         Some(OitPool::plan(&self.device.info, &self.params.oit, self.drawn_extent(extent)))
     }
 }
-
-/// Writes a host may have made to its attachments before the draw.
-const HOST_ATTACHMENT_WRITES: &[AccessKind] =
-    &[AccessKind::ColorAttachmentWrite, AccessKind::DepthAttachmentWrite, AccessKind::AnyTransferWrite];
 
 /// How the frame's drawn strands stand for the real hairs.
 #[derive(Debug, Clone, Copy)]

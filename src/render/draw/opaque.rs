@@ -18,6 +18,7 @@ use super::ribbons::RibbonIndices;
 use super::shading::ShadingResources;
 use super::{DrawFrame, TargetKey};
 use crate::error::Result;
+use crate::render::graph::FrameGraph;
 use crate::render::pass::RenderPass;
 use crate::render::Primitive;
 use crate::vk::device::Device;
@@ -107,8 +108,8 @@ impl OpaquePipelines {
         Ok(())
     }
 
-    /// Records `frame` in the draw's scope: the target's barriers, the shading
-    /// updates and one draw of the frame's ribbons or lines (twice with a depth
+    /// Records `frame` in the draw's scope: the shading updates, the barriers
+    /// `graph` derives for what the draw reads and its target, and one draw of the frame's ribbons or lines (twice with a depth
     /// pre-pass). Leaves the ribbons' index buffer bound.
     ///
     /// # Safety
@@ -116,6 +117,7 @@ impl OpaquePipelines {
     pub(super) unsafe fn record(
         &mut self,
         frame: &DrawFrame<'_>,
+        graph: &mut FrameGraph,
         shading: &mut ShadingResources,
         ribbons: &RibbonIndices,
     ) -> Result<()> {
@@ -128,7 +130,8 @@ impl OpaquePipelines {
         // SAFETY: guaranteed by the caller; all objects belong to this device.
         unsafe {
             let scope = RenderPass::Draw.open(d, cmd, frame.timing);
-            shading.record_updates(cmd, &target.before, &frame.params, &frame.marschner);
+            shading.record_updates(cmd, graph, &frame.params, &frame.marschner);
+            graph.record(d, cmd, &[shading.uses(&frame.inputs), target.uses.clone()].concat());
             let pipelines = &self.pipelines[&target.key];
             let shade = &pipelines.shade[&frame.features];
             d.raw.cmd_begin_rendering(cmd, &info);

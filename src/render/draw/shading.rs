@@ -10,9 +10,10 @@ use glam::Vec4;
 use super::DrawInputs;
 use crate::error::Result;
 use crate::gpu_types::DrawParams;
+use crate::render::graph::{FrameGraph, Use};
 use crate::render::marschner::{MarschnerParams, MarschnerTables};
 use crate::render::shading::{noise_texels, NOISE_SIZE};
-use crate::vk::barrier::{self, AccessKind, Barriers};
+use crate::vk::barrier::AccessKind;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc, Sampler};
@@ -74,33 +75,48 @@ impl ShadingResources {
         )
     }
 
-    /// Records `before` (the barriers that make the target ready), the Marschner
-    /// tables' rebuild if `marschner` changed and the update of the uniform block
-    /// to `params`, with the barriers that make both visible to the draw's stages.
+    /// Records the Marschner tables' rebuild if `marschner` changed and the
+    /// update of the uniform block to `params`, declaring both to `graph`; the
+    /// draw then declares what it reads ([`ShadingResources::uses`]).
     ///
     /// # Safety
     /// `cmd` is a recording command buffer of this device outside a render pass;
-    /// draws recorded earlier that read the uniform block are ordered before by the
-    /// recorded barrier.
+    /// every earlier command on the resources since `graph` was made was declared to it.
     pub(super) unsafe fn record_updates(
         &mut self,
         cmd: vk::CommandBuffer,
-        before: &Barriers,
+        graph: &mut FrameGraph,
         params: &DrawParams,
         marschner: &MarschnerParams,
     ) {
         let d = &self.device;
-        let before_update = barrier::memory(&[AccessKind::AnyWrite], &[AccessKind::TransferWrite]);
-        let updated = barrier::memory(&[AccessKind::TransferWrite], UNIFORM_READERS);
         // SAFETY: guaranteed by the caller; all objects belong to this device.
         unsafe {
-            d.cmd_barriers(cmd, before);
             // The draw pipeline may sample the Marschner tables: build them first.
-            self.marschner.record_update(d, cmd, marschner);
-            d.cmd_barrier(cmd, &[before_update], &[], &[]);
+            self.marschner.record_update(d, cmd, graph, marschner);
+            graph.record(d, cmd, &[Use::buffer(&self.params, &[AccessKind::AnyTransferWrite])]);
             d.raw.cmd_update_buffer(cmd, self.params.raw(), 0, bytemuck::bytes_of(params));
-            d.cmd_barrier(cmd, &[updated], &[], &[]);
         }
+    }
+
+    /// What the draw's stages read of the shading's own resources (the uniform
+    /// block, the Marschner tables) and of `inputs`, with every kind of
+    /// access a mode may make of them (the ribbons' vertex stage, the fragment
+    /// stages, the transparent modes' compute shading and rasterisers).
+    pub(super) fn uses(&self, inputs: &DrawInputs<'_>) -> Vec<Use> {
+        use AccessKind::*;
+        let uniform = &[VertexUniformRead, FragmentUniformRead, ComputeUniformRead];
+        let storage = &[VertexRead, FragmentRead, ComputeRead];
+        let mut uses = vec![
+            Use::buffer(&self.params, uniform),
+            Use::buffer(inputs.hairs.0, storage),
+            Use::buffer(inputs.hairs.1, storage),
+            Use::buffer(inputs.shadow_uniforms, uniform),
+            Use::buffer(inputs.transmittance, storage),
+            inputs.atlas_use,
+        ];
+        uses.extend(self.marschner.sampled_uses());
+        uses
     }
 
     /// Builds the Marschner tables for `params` and reads them back (M, then N;
@@ -109,13 +125,12 @@ impl ShadingResources {
         let device = self.device.clone();
         device.submit_once("vkhair marschner tables", |cmd| {
             // SAFETY: a recording command buffer of this device; earlier work completed.
-            unsafe { self.marschner.record_update(&device, cmd, params) };
+            unsafe {
+                let mut graph = FrameGraph::new();
+                self.marschner.record_update(&device, cmd, &mut graph, params);
+                graph.settle(&device, cmd);
+            }
         })?;
         Ok((self.marschner.read(&device, false)?, self.marschner.read(&device, true)?))
     }
 }
-
-/// Stages that read the draw's uniform block (the transparent modes' vertex
-/// shading is a compute dispatch).
-const UNIFORM_READERS: &[AccessKind] =
-    &[AccessKind::VertexUniformRead, AccessKind::FragmentUniformRead, AccessKind::ComputeUniformRead];

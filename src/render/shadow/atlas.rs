@@ -8,6 +8,7 @@ use ash::vk;
 
 use super::{ShadowParams, SHADOW_ATLAS_FORMAT};
 use crate::error::{Error, Result};
+use crate::render::graph::{FrameGraph, Use};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc, Sampler};
@@ -95,29 +96,16 @@ impl ShadowAtlas {
         self.atlas.view()
     }
 
-    /// Barrier before the compute rasteriser writes the opacity atlas: from the
-    /// last frame's sampling to GENERAL for compute-shader writes (contents
-    /// discarded).
-    pub(super) fn to_storage(&self) -> vk::ImageMemoryBarrier2<'static> {
-        barrier::image(
-            &self.atlas,
-            FRAGMENT_SAMPLED,
-            &[AccessKind::ComputeWrite],
-            vk::ImageLayout::UNDEFINED,
-            vk::ImageLayout::GENERAL,
-        )
+    /// The opacity atlas as the compute rasteriser's resolve writes it
+    /// (storage, GENERAL; its earlier contents discarded).
+    pub(super) fn storage_write(&self) -> Use {
+        Use::image(&self.atlas, &[AccessKind::ComputeWrite], vk::ImageLayout::GENERAL, SAMPLED).discarding()
     }
 
-    /// Barrier after the compute rasteriser wrote the opacity atlas: to
-    /// fragment- and compute-shader sampling.
-    pub(super) fn storage_to_sampled(&self) -> vk::ImageMemoryBarrier2<'static> {
-        barrier::image(
-            &self.atlas,
-            &[AccessKind::ComputeWrite],
-            FRAGMENT_SAMPLED,
-            vk::ImageLayout::GENERAL,
-            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-        )
+    /// The opacity atlas as the draw, the compute rasterisers and a host's
+    /// shading sample it: its layout between entry points.
+    pub(super) fn sampled_use(&self) -> Use {
+        Use::image(&self.atlas, FRAGMENT_SAMPLED, SAMPLED, SAMPLED)
     }
 
     /// The z0 atlas's view and the nearest sampler (what the opacity pass reads).
@@ -133,33 +121,21 @@ impl ShadowAtlas {
     /// Clears the opacity atlas (no hair anywhere) and leaves it ready for sampling.
     fn clear(&self) -> Result<()> {
         let d = &self.device;
-        let clear = &[AccessKind::ClearWrite];
+        let dst = vk::ImageLayout::TRANSFER_DST_OPTIMAL;
+        let clear = Use::image(&self.atlas, &[AccessKind::ClearWrite], dst, SAMPLED).discarding();
         d.submit_once("vkhair shadow atlas clear", |cmd| {
-            let to_clear = barrier::image(
-                &self.atlas,
-                barrier::NOTHING,
-                clear,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-            );
-            let to_read = barrier::image(
-                &self.atlas,
-                clear,
-                barrier::ANY,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            );
+            let mut graph = FrameGraph::new();
             // SAFETY: a recording command buffer of this device; the atlas is new.
             unsafe {
-                d.cmd_barrier(cmd, &[], &[], &[to_clear]);
+                graph.record(d, cmd, &[clear]);
                 d.raw.cmd_clear_color_image(
                     cmd,
                     self.atlas.raw(),
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    dst,
                     &vk::ClearColorValue { float32: [0.0; 4] },
                     &[self.atlas.full_range()],
                 );
-                d.cmd_barrier(cmd, &[], &[], &[to_read]);
+                graph.settle(d, cmd);
             }
         })
     }
@@ -175,57 +151,22 @@ impl ShadowAtlas {
         Ok((self.atlas.extent, texels))
     }
 
-    /// Barriers before the depth pass: z0 and depth from the last frame's use to
-    /// attachments (contents discarded).
-    pub(super) fn to_depth_pass(&self) -> [vk::ImageMemoryBarrier2<'static>; 2] {
-        [
-            barrier::image(
-                &self.z0,
-                FRAGMENT_SAMPLED,
-                barrier::COLOR_ATTACHMENT,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-            ),
-            barrier::image(
-                &self.depth,
-                barrier::DEPTH_ATTACHMENT,
-                barrier::DEPTH_ATTACHMENT,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
-            ),
-        ]
+    /// The depth pass's attachments as it uses them (earlier contents discarded).
+    pub(super) fn depth_pass_uses(&self) -> [Use; 2] {
+        let z0 = Use::image(&self.z0, barrier::COLOR_ATTACHMENT, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, SAMPLED);
+        let depth_layout = vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL;
+        let depth = Use::image(&self.depth, barrier::DEPTH_ATTACHMENT, depth_layout, depth_layout);
+        [z0.discarding(), depth.discarding()]
     }
 
-    /// Barriers between the passes: z0 to sampling, the opacity atlas from the
-    /// last frame's sampling to an attachment (contents discarded).
-    pub(super) fn to_opacity_pass(&self) -> [vk::ImageMemoryBarrier2<'static>; 2] {
+    /// The opacity pass's images as it uses them: z0 sampled, the atlas an
+    /// attachment (its earlier contents discarded).
+    pub(super) fn opacity_pass_uses(&self) -> [Use; 2] {
+        let atlas_layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
         [
-            barrier::image(
-                &self.z0,
-                barrier::COLOR_ATTACHMENT,
-                FRAGMENT_SAMPLED,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            ),
-            barrier::image(
-                &self.atlas,
-                FRAGMENT_SAMPLED,
-                barrier::COLOR_ATTACHMENT,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-            ),
+            Use::image(&self.z0, &[AccessKind::FragmentSampledRead], SAMPLED, SAMPLED),
+            Use::image(&self.atlas, barrier::COLOR_ATTACHMENT, atlas_layout, SAMPLED).discarding(),
         ]
-    }
-
-    /// Barrier after the opacity pass: the atlas to fragment- and compute-shader sampling.
-    pub(super) fn to_sampled(&self) -> vk::ImageMemoryBarrier2<'static> {
-        barrier::image(
-            &self.atlas,
-            barrier::COLOR_ATTACHMENT,
-            FRAGMENT_SAMPLED,
-            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-        )
     }
 
     /// The depth pass's attachments: z0 cleared to 0, depth to 1 (not stored).
@@ -243,6 +184,9 @@ impl ShadowAtlas {
         [rendering::color(self.atlas.view(), Load::color([0.0; 4]))]
     }
 }
+
+/// The layout the sampled images (the opacity atlas, z0) rest in.
+const SAMPLED: vk::ImageLayout = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
 
 /// How the draw (fragment stages; the transparent modes' vertex shading, a
 /// compute dispatch) and the opacity pass read the images.

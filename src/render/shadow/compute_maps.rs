@@ -21,8 +21,9 @@ use super::atlas::ShadowAtlas;
 use crate::error::{Error, Result};
 use crate::gpu_types::GpuShadowParams;
 use crate::profiler::{PassScope, Timing};
+use crate::render::graph::{FrameGraph, Use};
 use crate::render::pass::RenderPass;
-use crate::vk::barrier::{self, AccessKind};
+use crate::vk::barrier::AccessKind;
 use crate::vk::buffer::Buffer;
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
@@ -100,45 +101,45 @@ impl ComputeMaps {
     }
 
     /// Records both passes for the maps of `uniforms` into `atlas`, each in its
-    /// scope, leaving the atlas in SHADER_READ_ONLY_OPTIMAL for fragment and
-    /// compute shaders. `before` (the uniform update's barrier) is recorded
-    /// first, together with the atlas's own transition.
+    /// scope, declaring to `graph` what each dispatch reads and writes
+    /// (`inputs`: the uniform buffer and the hair positions the passes were made with).
     ///
     /// # Safety
     /// As `OpacityMaps::record`; `atlas` is the one the passes were made for.
     pub(super) unsafe fn record(
         &self,
         cmd: vk::CommandBuffer,
-        before: vk::MemoryBarrier2<'_>,
+        graph: &mut FrameGraph,
         uniforms: &GpuShadowParams,
         atlas: &ShadowAtlas,
+        (uniform_buffer, hairs): (&Buffer, &Buffer),
         timing: Timing<'_>,
     ) {
+        use AccessKind::{AnyTransferWrite, ComputeRead, ComputeUniformRead, ComputeWrite};
         let d = &self.device;
         let extent = atlas.extent();
-        let storage = &[AccessKind::ComputeRead, AccessKind::ComputeWrite];
-        // The previous frame's passes and resolve read and wrote the sums; the
-        // fills run in the clear stage (any transfer write).
-        let to_clear = barrier::memory(storage, &[AccessKind::AnyTransferWrite]);
-        let cleared = barrier::memory(&[AccessKind::AnyTransferWrite], storage);
-        let between = barrier::memory(&[AccessKind::ComputeWrite], storage);
+        let inputs = [Use::buffer(hairs, &[ComputeRead]), Use::buffer(uniform_buffer, &[ComputeUniformRead])];
+        let (z0, layers) = (&self.z0, &self.layers);
+        let cleared = [Use::buffer(z0, &[AnyTransferWrite]), Use::buffer(layers, &[AnyTransferWrite])];
+        let depth = [Use::buffer(z0, &[ComputeRead, ComputeWrite])];
+        let opacity = [Use::buffer(z0, &[ComputeRead]), Use::buffer(layers, &[ComputeRead, ComputeWrite])];
+        let resolve = [Use::buffer(z0, &[ComputeRead]), Use::buffer(layers, &[ComputeRead]), atlas.storage_write()];
         // SAFETY: guaranteed by the caller; every object belongs to this device.
         unsafe {
-            d.cmd_barrier(cmd, &[before, to_clear], &[], &[atlas.to_storage()]);
+            graph.record(d, cmd, &cleared);
             d.raw.cmd_fill_buffer(cmd, self.z0.raw(), 0, vk::WHOLE_SIZE, NO_HAIR);
             d.raw.cmd_fill_buffer(cmd, self.layers.raw(), 0, vk::WHOLE_SIZE, 0);
-            d.cmd_barrier(cmd, &[cleared], &[], &[]);
             let scope = RenderPass::ShadowDepth.open(d, cmd, timing);
+            graph.record(d, cmd, &[&inputs[..], &depth].concat());
             self.run(cmd, &self.depth_pass, RenderPass::ShadowDepth, uniforms, extent.width, timing);
-            d.cmd_barrier(cmd, &[between], &[], &[]);
             scope.close(d, cmd, timing);
             let scope = RenderPass::ShadowOpacity.open(d, cmd, timing);
+            graph.record(d, cmd, &[&inputs[..], &opacity].concat());
             self.run(cmd, &self.opacity_pass, RenderPass::ShadowOpacity, uniforms, extent.width, timing);
-            d.cmd_barrier(cmd, &[between], &[], &[]);
+            graph.record(d, cmd, &[&inputs[..], &resolve].concat());
             let (resolve, sets) = &self.resolve;
             resolve.bind(cmd, sets);
             resolve.dispatch_threads(cmd, [extent.width, extent.height, 1]);
-            d.cmd_barrier(cmd, &[], &[], &[atlas.storage_to_sampled()]);
             scope.close(d, cmd, timing);
         }
     }

@@ -24,13 +24,14 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Vec3;
 
+use super::graph::{FrameGraph, Use};
 use super::shading::MAX_LIGHTS;
 use super::Raster;
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuLight, GpuShadowParams};
 use crate::profiler::Timing;
 use crate::sim::KeyHairs;
-use crate::vk::barrier::{self, AccessKind};
+use crate::vk::barrier::AccessKind;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use opacity_maps::OpacityMaps;
@@ -230,16 +231,6 @@ pub(crate) fn no_shadows() -> GpuShadowParams {
     GpuShadowParams { light_map: [[u32::MAX; 4]; 2], ..GpuShadowParams::default() }
 }
 
-/// Stages that read the shadow uniforms and the atlas: the draw, a host's
-/// shaded surfaces, the density-volume pass.
-const SHADOW_READERS: &[AccessKind] = &[
-    AccessKind::VertexUniformRead,
-    AccessKind::FragmentUniformRead,
-    AccessKind::FragmentSampledRead,
-    AccessKind::ComputeUniformRead,
-    AccessKind::ComputeSampledRead,
-];
-
 /// The hairs a frame draws: how many, of how many vertices, and what each
 /// stands for.
 #[derive(Debug, Clone, Copy)]
@@ -337,6 +328,7 @@ impl Shadows {
         bounds: Bounds,
         drawn: DrawnHairs,
         (raster, hair_positions): (Raster, &Buffer),
+        graph: &mut FrameGraph,
         timing: Timing<'_>,
     ) -> Result<()> {
         let DrawnHairs { counts: (hairs, per_hair), footprint } = drawn;
@@ -384,23 +376,28 @@ impl Shadows {
             copy = Some((buffer, u64::from(cells) * 16));
         }
         let d = &self.device;
-        let before_update = barrier::memory(SHADOW_READERS, &[AccessKind::TransferWrite]);
-        let updated = barrier::memory(&[AccessKind::TransferWrite], SHADOW_READERS);
         let any_map = uniforms.maps.iter().take(params.casters.len()).any(|m| !m.is_density_volume());
         // SAFETY: guaranteed by the caller.
         unsafe {
-            d.cmd_barrier(cmd, &[before_update], &[], &[]);
+            graph.record(d, cmd, &[Use::buffer(&self.uniforms, &[AccessKind::TransferWrite])]);
             d.raw.cmd_update_buffer(cmd, self.uniforms.raw(), 0, bytemuck::bytes_of(&uniforms));
             if any_map {
                 let vertices = hairs * (per_hair - 1) * 2;
                 let inputs = (raster, (&self.uniforms, hair_positions));
-                self.maps.record_with(cmd, updated, &uniforms, vertices, inputs, timing)?;
-            } else {
-                d.cmd_barrier(cmd, &[updated], &[], &[]);
+                self.maps.record_with(cmd, graph, &uniforms, vertices, inputs, timing)?;
             }
-            if let Some((source, bytes)) = copy {
-                self.volume.record(cmd, source, bytes, &volume_maps, timing);
+            if let Some(source) = copy {
+                self.volume.record(cmd, graph, source, (&self.uniforms, &volume_maps), timing);
             }
+            // What the draw and a host read, as `Renderer::record_shadows` promises.
+            let uniform_readers =
+                [AccessKind::VertexUniformRead, AccessKind::FragmentUniformRead, AccessKind::ComputeUniformRead];
+            let exports = [
+                Use::buffer(&self.uniforms, &uniform_readers),
+                self.maps.atlas.sampled_use(),
+                Use::buffer(&self.volume.transmittance, &[AccessKind::FragmentRead, AccessKind::ComputeRead]),
+            ];
+            graph.record(d, cmd, &exports);
         }
         Ok(())
     }
@@ -408,6 +405,11 @@ impl Shadows {
     /// The opacity atlas's view and nearest sampler.
     pub(super) fn atlas(&self) -> (vk::ImageView, vk::Sampler) {
         self.maps.atlas.sampled()
+    }
+
+    /// The opacity atlas as the draw samples it.
+    pub(super) fn atlas_use(&self) -> Use {
+        self.maps.atlas.sampled_use()
     }
 
     /// Reads the opacity atlas back (submits and waits).

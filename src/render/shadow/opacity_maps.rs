@@ -24,8 +24,10 @@ use crate::codes::shadow_kind;
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuLight, GpuShadowMap, GpuShadowParams};
 use crate::profiler::{PassScope, Timing};
+use crate::render::graph::{FrameGraph, Use};
 use crate::render::pass::RenderPass;
 use crate::render::Raster;
+use crate::vk::barrier::AccessKind;
 use crate::vk::buffer::Buffer;
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
@@ -108,7 +110,7 @@ impl OpacityMaps {
     pub(super) unsafe fn record_with(
         &mut self,
         cmd: vk::CommandBuffer,
-        before: vk::MemoryBarrier2<'_>,
+        graph: &mut FrameGraph,
         uniforms: &GpuShadowParams,
         vertices: u32,
         (raster, inputs): (Raster, (&Buffer, &Buffer)),
@@ -116,7 +118,7 @@ impl OpacityMaps {
     ) -> Result<()> {
         if raster != Raster::Compute {
             // SAFETY: guaranteed by the caller.
-            unsafe { self.record(cmd, before, uniforms, vertices, timing) };
+            unsafe { self.record(cmd, graph, uniforms, vertices, inputs, timing) };
             return Ok(());
         }
         if self.compute.is_none() {
@@ -124,30 +126,34 @@ impl OpacityMaps {
         }
         if let Some(compute) = &self.compute {
             // SAFETY: guaranteed by the caller; the passes were made for this atlas.
-            unsafe { compute.record(cmd, before, uniforms, &self.atlas, timing) };
+            unsafe { compute.record(cmd, graph, uniforms, &self.atlas, inputs, timing) };
         }
         Ok(())
     }
 
     /// Records both passes for the maps of `uniforms` over `vertices` line
-    /// vertices, each in its scope, leaving the atlas in SHADER_READ_ONLY_OPTIMAL
-    /// for fragment shaders. `before` (the uniform update's barrier) is recorded
-    /// first, together with the atlas's own transitions.
+    /// vertices, each in its scope, declaring to `graph` what they read
+    /// (`inputs`: the uniform buffer and the hair positions the passes were
+    /// made with) and the atlas images they draw.
     ///
     /// # Safety
-    /// `cmd` is recording outside a render pass on this device; the hair positions
-    /// were written before with a barrier to vertex-shader reads and `uniforms`
-    /// were written to the uniform buffer the passes read before `before`.
+    /// `cmd` is recording outside a render pass on this device; every earlier
+    /// command on the resources since `graph` was made was declared to it.
     pub(super) unsafe fn record(
         &self,
         cmd: vk::CommandBuffer,
-        before: vk::MemoryBarrier2<'_>,
+        graph: &mut FrameGraph,
         uniforms: &GpuShadowParams,
         vertices: u32,
+        (uniform_buffer, hairs): (&Buffer, &Buffer),
         timing: Timing<'_>,
     ) {
         let d = &self.device;
         let maps = uniforms.map_count();
+        let inputs = [
+            Use::buffer(hairs, &[AccessKind::VertexRead]),
+            Use::buffer(uniform_buffer, &[AccessKind::VertexUniformRead, AccessKind::FragmentUniformRead]),
+        ];
         let extent = self.atlas.extent();
         let (z0_attachment, depth_attachment) = self.atlas.depth_pass_attachments();
         let depth_rendering = rendering::info(extent, &z0_attachment, Some(&depth_attachment));
@@ -184,18 +190,17 @@ impl OpacityMaps {
         };
         // SAFETY: guaranteed by the caller; every object belongs to this device.
         unsafe {
-            d.cmd_barrier(cmd, &[before], &[], &self.atlas.to_depth_pass());
             let scope = RenderPass::ShadowDepth.open(d, cmd, timing);
+            graph.record(d, cmd, &[&inputs[..], &self.atlas.depth_pass_uses()].concat());
             d.raw.cmd_begin_rendering(cmd, &depth_rendering);
             draw_tiles(cmd, &self.depth_pass, RenderPass::ShadowDepth, timing);
             d.raw.cmd_end_rendering(cmd);
-            d.cmd_barrier(cmd, &[], &[], &self.atlas.to_opacity_pass());
             scope.close(d, cmd, timing);
             let scope = RenderPass::ShadowOpacity.open(d, cmd, timing);
+            graph.record(d, cmd, &[&inputs[..], &self.atlas.opacity_pass_uses()].concat());
             d.raw.cmd_begin_rendering(cmd, &opacity_rendering);
             draw_tiles(cmd, &self.opacity_pass, RenderPass::ShadowOpacity, timing);
             d.raw.cmd_end_rendering(cmd);
-            d.cmd_barrier(cmd, &[], &[], &[self.atlas.to_sampled()]);
             scope.close(d, cmd, timing);
         }
     }

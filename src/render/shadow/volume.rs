@@ -12,8 +12,9 @@ use crate::codes::shadow_kind;
 use crate::error::Result;
 use crate::gpu_types::{GpuLight, GpuShadowMap};
 use crate::profiler::Timing;
+use crate::render::graph::{FrameGraph, Use};
 use crate::render::pass::RenderPass;
-use crate::vk::barrier::{self, AccessKind};
+use crate::vk::barrier::AccessKind;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 use crate::vk::pipeline::ComputePipeline;
@@ -65,42 +66,41 @@ impl VolumeShadows {
     }
 
     /// Copies `bytes` of the simulation's density from `source`, then computes the
-    /// transmittance of volume maps `maps` (indices into the uniforms, written
-    /// before with a barrier to compute reads), visible to fragment and compute shaders after.
+    /// transmittance of volume maps `maps` (indices into `uniforms`), declaring
+    /// to `graph` what the copy and the dispatches read and write.
     ///
     /// # Safety
     /// `cmd` is recording outside a render pass; `source` is the simulation's cell
-    /// buffer of this device holding at least `bytes`, last written by its compute
-    /// stage earlier in submission order.
+    /// buffer of this device holding at least `bytes`; `uniforms` is the buffer
+    /// the pass was made with.
     pub(super) unsafe fn record(
         &self,
         cmd: vk::CommandBuffer,
-        source: vk::Buffer,
-        bytes: u64,
-        maps: &[u32],
+        graph: &mut FrameGraph,
+        (source, bytes): (vk::Buffer, u64),
+        (uniforms, maps): (&Buffer, &[u32]),
         timing: Timing<'_>,
     ) {
+        use AccessKind::{ComputeRead, ComputeUniformRead, ComputeWrite, TransferRead, TransferWrite};
         let d = &self.device;
-        let before = barrier::memory(
-            &[AccessKind::ComputeWrite, AccessKind::ComputeRead, AccessKind::FragmentWrite, AccessKind::FragmentRead],
-            &[AccessKind::TransferRead, AccessKind::TransferWrite],
-        );
-        let copied = barrier::memory(&[AccessKind::TransferWrite], &[AccessKind::ComputeRead]);
-        let computed =
-            barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::FragmentRead, AccessKind::ComputeRead]);
+        let copy = [Use::raw_buffer(source, &[TransferRead]), Use::buffer(&self.density, &[TransferWrite])];
+        let compute = [
+            Use::buffer(uniforms, &[ComputeUniformRead]),
+            Use::buffer(&self.density, &[ComputeRead]),
+            Use::buffer(&self.transmittance, &[ComputeWrite]),
+        ];
         // SAFETY: guaranteed by the caller; the buffers belong to this device.
         unsafe {
             let scope = RenderPass::ShadowVolume.open(d, cmd, timing);
-            d.cmd_barrier(cmd, &[before], &[], &[]);
+            graph.record(d, cmd, &copy);
             let region = vk::BufferCopy { src_offset: 0, dst_offset: 0, size: bytes };
             d.raw.cmd_copy_buffer(cmd, source, self.density.raw(), &[region]);
-            d.cmd_barrier(cmd, &[copied], &[], &[]);
+            graph.record(d, cmd, &compute);
             self.pipeline.bind(cmd, &[self.set]);
             for &map in maps {
                 self.pipeline.push(cmd, &map);
                 self.pipeline.dispatch_threads(cmd, [self.cells, 1, 1]);
             }
-            d.cmd_barrier(cmd, &[computed], &[], &[]);
             scope.close(d, cmd, timing);
         }
     }

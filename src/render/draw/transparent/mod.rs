@@ -52,6 +52,7 @@ use crate::codes::sentinel::OIT_END;
 use crate::error::{Error, Result};
 use crate::gpu_types::OitCounters;
 use crate::profiler::PassScope;
+use crate::render::graph::FrameGraph;
 use crate::render::pass::RenderPass;
 use crate::render::{OitParams, Raster, Transparency};
 use crate::vk::barrier::{self, AccessKind};
@@ -364,9 +365,8 @@ impl TransparentPass {
     pub(super) unsafe fn record(
         &mut self,
         frame: &DrawFrame<'_>,
-        mode: Transparency,
-        params: &OitParams,
-        raster: Raster,
+        graph: &mut FrameGraph,
+        (mode, params, raster): (Transparency, &OitParams, Raster),
         shading: &mut ShadingResources,
         ribbons: &RibbonIndices,
     ) -> Result<()> {
@@ -454,7 +454,6 @@ impl TransparentPass {
             ],
         );
         let (hairs, per_hair) = (frame.params.counts[0], frame.params.counts[1]);
-        let depth_order = barrier::memory(barrier::ATTACHMENTS, barrier::ATTACHMENTS);
         let to_host = barrier::memory(WRITTEN_BY_ANY, &[AccessKind::HostRead]);
         let (to_sums, from_sums) = match &res.sums {
             Some(sums) => {
@@ -472,7 +471,11 @@ impl TransparentPass {
         // SAFETY: guaranteed by the caller; every object belongs to this device.
         unsafe {
             let scope = RenderPass::Draw.open(d, cmd, timing);
-            shading.record_updates(cmd, &target.before, &frame.params, &frame.marschner);
+            shading.record_updates(cmd, graph, &frame.params, &frame.marschner);
+            // What the pass reads of the earlier passes, and the target it
+            // tests against (the build) and blends into (the composite).
+            graph.record(d, cmd, &[shading.uses(&frame.inputs), target.uses.clone()].concat());
+            // Its own buffers' steps: ordered here, within the pass.
             d.cmd_barrier(cmd, &[to_clear, to_shade], &[], &to_sums);
             d.raw.cmd_update_buffer(cmd, self.counters.raw(), 0, bytemuck::bytes_of(&counters));
             d.cmd_barrier(cmd, &[counters_ready], &[], &[]);
@@ -529,7 +532,9 @@ impl TransparentPass {
             scope.close(d, cmd, timing);
 
             let scope = RenderPass::Composite.open(d, cmd, timing);
-            d.cmd_barrier(cmd, &[built, depth_order], &[], &from_sums);
+            d.cmd_barrier(cmd, &[built], &[], &from_sums);
+            // The build's depth tests before the composite's writes.
+            graph.record(d, cmd, &target.uses);
             if let Some((pipeline, set)) = &pipelines.resolve {
                 let what = if res.tiles.is_some() { "tiles drawn and resolved" } else { "resolve in compute" };
                 let resolve_label = format!("{}, {what}", RenderPass::Composite.label());
