@@ -14,128 +14,86 @@ use super::image::Image;
 type Stage = vk::PipelineStageFlags2;
 type Acc = vk::AccessFlags2;
 
-/// One kind of access: a pipeline stage and what it does to memory there.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum AccessKind {
+/// Both fragment-test stages (depth attachments are read and written in either).
+const FRAGMENT_TESTS: Stage =
+    Stage::from_raw(Stage::EARLY_FRAGMENT_TESTS.as_raw() | Stage::LATE_FRAGMENT_TESTS.as_raw());
+
+/// Defines [`AccessKind`], its list and its stage and access masks from one
+/// table: each kind once, with its documentation and its parts.
+macro_rules! access_kinds {
+    ($($(#[$doc:meta])* $kind:ident => $parts:expr,)*) => {
+        /// One kind of access: a pipeline stage and what it does to memory there.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        pub(crate) enum AccessKind {
+            $($(#[$doc])* $kind,)*
+        }
+
+        impl AccessKind {
+            /// Every kind, in declaration order (its index is its bit in a [`KindSet`]).
+            pub(crate) const ALL: &'static [AccessKind] = &[$(AccessKind::$kind),*];
+
+            /// The stage and access of this kind.
+            const fn parts(self) -> (Stage, Acc) {
+                match self {
+                    $(AccessKind::$kind => $parts,)*
+                }
+            }
+        }
+    };
+}
+
+access_kinds! {
     /// Storage-buffer or storage-image reads in compute shaders.
-    ComputeRead,
+    ComputeRead => (Stage::COMPUTE_SHADER, Acc::SHADER_STORAGE_READ),
     /// Storage writes in compute shaders.
-    ComputeWrite,
+    ComputeWrite => (Stage::COMPUTE_SHADER, Acc::SHADER_STORAGE_WRITE),
     /// Uniform-buffer reads in compute shaders.
-    ComputeUniformRead,
+    ComputeUniformRead => (Stage::COMPUTE_SHADER, Acc::UNIFORM_READ),
     /// Indirect dispatch or draw arguments.
-    IndirectRead,
+    IndirectRead => (Stage::DRAW_INDIRECT, Acc::INDIRECT_COMMAND_READ),
     /// Storage reads in vertex shaders.
-    VertexRead,
+    VertexRead => (Stage::VERTEX_SHADER, Acc::SHADER_STORAGE_READ),
     /// Uniform reads in vertex shaders.
-    VertexUniformRead,
+    VertexUniformRead => (Stage::VERTEX_SHADER, Acc::UNIFORM_READ),
     /// Storage reads in tessellation evaluation shaders.
-    TessellationRead,
+    TessellationRead => (Stage::TESSELLATION_EVALUATION_SHADER, Acc::SHADER_STORAGE_READ),
     /// Storage writes in tessellation evaluation shaders (the capture passes).
-    TessellationWrite,
+    TessellationWrite => (Stage::TESSELLATION_EVALUATION_SHADER, Acc::SHADER_STORAGE_WRITE),
     /// Storage reads in fragment shaders.
-    FragmentRead,
+    FragmentRead => (Stage::FRAGMENT_SHADER, Acc::SHADER_STORAGE_READ),
     /// Storage writes in fragment shaders.
-    FragmentWrite,
+    FragmentWrite => (Stage::FRAGMENT_SHADER, Acc::SHADER_STORAGE_WRITE),
     /// Uniform reads in fragment shaders.
-    FragmentUniformRead,
+    FragmentUniformRead => (Stage::FRAGMENT_SHADER, Acc::UNIFORM_READ),
     /// Sampled-image reads in fragment shaders.
-    FragmentSampledRead,
+    FragmentSampledRead => (Stage::FRAGMENT_SHADER, Acc::SHADER_SAMPLED_READ),
     /// Sampled-image reads in compute shaders.
-    ComputeSampledRead,
+    ComputeSampledRead => (Stage::COMPUTE_SHADER, Acc::SHADER_SAMPLED_READ),
     /// Colour attachment reads (blending, load).
-    ColorAttachmentRead,
+    ColorAttachmentRead => (Stage::COLOR_ATTACHMENT_OUTPUT, Acc::COLOR_ATTACHMENT_READ),
     /// Colour attachment writes.
-    ColorAttachmentWrite,
+    ColorAttachmentWrite => (Stage::COLOR_ATTACHMENT_OUTPUT, Acc::COLOR_ATTACHMENT_WRITE),
     /// Depth attachment reads (tests, load).
-    DepthAttachmentRead,
+    DepthAttachmentRead => (FRAGMENT_TESTS, Acc::DEPTH_STENCIL_ATTACHMENT_READ),
     /// Depth attachment writes.
-    DepthAttachmentWrite,
+    DepthAttachmentWrite => (FRAGMENT_TESTS, Acc::DEPTH_STENCIL_ATTACHMENT_WRITE),
     /// Copy sources.
-    TransferRead,
+    TransferRead => (Stage::COPY, Acc::TRANSFER_READ),
     /// Copy destinations.
-    TransferWrite,
+    TransferWrite => (Stage::COPY, Acc::TRANSFER_WRITE),
     /// Clear destinations (`vkCmdClear*Image`, `vkCmdFillBuffer`).
-    ClearWrite,
+    ClearWrite => (Stage::CLEAR, Acc::TRANSFER_WRITE),
     /// Writes by any transfer command (copies, clears, updates, blits).
-    AnyTransferWrite,
+    AnyTransferWrite => (Stage::ALL_TRANSFER, Acc::TRANSFER_WRITE),
     /// Host reads of mapped memory.
-    HostRead,
+    HostRead => (Stage::HOST, Acc::HOST_READ),
     /// Every earlier write, for one-shot submissions that know nothing of prior use.
-    AnyWrite,
+    AnyWrite => (Stage::ALL_COMMANDS, Acc::MEMORY_WRITE),
     /// Every later read, for one-shot submissions that know nothing of later use.
-    AnyRead,
+    AnyRead => (Stage::ALL_COMMANDS, Acc::MEMORY_READ),
 }
 
 impl AccessKind {
-    /// The stage and access of this kind.
-    const fn parts(self) -> (Stage, Acc) {
-        use AccessKind::*;
-        match self {
-            ComputeRead => (Stage::COMPUTE_SHADER, Acc::SHADER_STORAGE_READ),
-            ComputeWrite => (Stage::COMPUTE_SHADER, Acc::SHADER_STORAGE_WRITE),
-            ComputeUniformRead => (Stage::COMPUTE_SHADER, Acc::UNIFORM_READ),
-            ComputeSampledRead => (Stage::COMPUTE_SHADER, Acc::SHADER_SAMPLED_READ),
-            IndirectRead => (Stage::DRAW_INDIRECT, Acc::INDIRECT_COMMAND_READ),
-            VertexRead => (Stage::VERTEX_SHADER, Acc::SHADER_STORAGE_READ),
-            VertexUniformRead => (Stage::VERTEX_SHADER, Acc::UNIFORM_READ),
-            TessellationRead => (Stage::TESSELLATION_EVALUATION_SHADER, Acc::SHADER_STORAGE_READ),
-            TessellationWrite => (Stage::TESSELLATION_EVALUATION_SHADER, Acc::SHADER_STORAGE_WRITE),
-            FragmentRead => (Stage::FRAGMENT_SHADER, Acc::SHADER_STORAGE_READ),
-            FragmentWrite => (Stage::FRAGMENT_SHADER, Acc::SHADER_STORAGE_WRITE),
-            FragmentUniformRead => (Stage::FRAGMENT_SHADER, Acc::UNIFORM_READ),
-            FragmentSampledRead => (Stage::FRAGMENT_SHADER, Acc::SHADER_SAMPLED_READ),
-            ColorAttachmentRead => (Stage::COLOR_ATTACHMENT_OUTPUT, Acc::COLOR_ATTACHMENT_READ),
-            ColorAttachmentWrite => (Stage::COLOR_ATTACHMENT_OUTPUT, Acc::COLOR_ATTACHMENT_WRITE),
-            DepthAttachmentRead => (
-                Stage::from_raw(Stage::EARLY_FRAGMENT_TESTS.as_raw() | Stage::LATE_FRAGMENT_TESTS.as_raw()),
-                Acc::DEPTH_STENCIL_ATTACHMENT_READ,
-            ),
-            DepthAttachmentWrite => (
-                Stage::from_raw(Stage::EARLY_FRAGMENT_TESTS.as_raw() | Stage::LATE_FRAGMENT_TESTS.as_raw()),
-                Acc::DEPTH_STENCIL_ATTACHMENT_WRITE,
-            ),
-            TransferRead => (Stage::COPY, Acc::TRANSFER_READ),
-            TransferWrite => (Stage::COPY, Acc::TRANSFER_WRITE),
-            ClearWrite => (Stage::CLEAR, Acc::TRANSFER_WRITE),
-            AnyTransferWrite => (Stage::ALL_TRANSFER, Acc::TRANSFER_WRITE),
-            HostRead => (Stage::HOST, Acc::HOST_READ),
-            AnyWrite => (Stage::ALL_COMMANDS, Acc::MEMORY_WRITE),
-            AnyRead => (Stage::ALL_COMMANDS, Acc::MEMORY_READ),
-        }
-    }
-
-    /// Every kind, in declaration order (its index is its bit in a [`KindSet`]).
-    pub(crate) const ALL: [AccessKind; 24] = {
-        use AccessKind::*;
-        [
-            ComputeRead,
-            ComputeWrite,
-            ComputeUniformRead,
-            IndirectRead,
-            VertexRead,
-            VertexUniformRead,
-            TessellationRead,
-            TessellationWrite,
-            FragmentRead,
-            FragmentWrite,
-            FragmentUniformRead,
-            FragmentSampledRead,
-            ComputeSampledRead,
-            ColorAttachmentRead,
-            ColorAttachmentWrite,
-            DepthAttachmentRead,
-            DepthAttachmentWrite,
-            TransferRead,
-            TransferWrite,
-            ClearWrite,
-            AnyTransferWrite,
-            HostRead,
-            AnyWrite,
-            AnyRead,
-        ]
-    };
-
     /// Whether the kind writes memory (a later access of any kind waits for it).
     pub(crate) const fn writes(self) -> bool {
         self.parts().1.as_raw() & WRITE_ACCESS.as_raw() != 0
@@ -209,7 +167,7 @@ impl KindSet {
 
     /// The kinds in the set.
     pub(crate) fn kinds(self) -> impl Iterator<Item = AccessKind> {
-        AccessKind::ALL.into_iter().filter(move |&k| self.0 & 1 << k as u32 != 0)
+        AccessKind::ALL.iter().copied().filter(move |&k| self.0 & 1 << k as u32 != 0)
     }
 
     /// The stage and access masks of the set's kinds.
@@ -371,11 +329,11 @@ mod tests {
 
     #[test]
     fn every_kind_has_its_own_bit_and_writes_are_told_from_reads() {
-        for (i, kind) in AccessKind::ALL.into_iter().enumerate() {
+        for (i, &kind) in AccessKind::ALL.iter().enumerate() {
             assert_eq!(kind as usize, i, "{kind:?} is at its index");
             assert_eq!(KindSet::of(&[kind]).kinds().collect::<Vec<_>>(), [kind]);
         }
-        let writes: Vec<AccessKind> = AccessKind::ALL.into_iter().filter(|k| k.writes()).collect();
+        let writes: Vec<AccessKind> = AccessKind::ALL.iter().copied().filter(|k| k.writes()).collect();
         use AccessKind::*;
         assert_eq!(
             writes,
