@@ -636,3 +636,46 @@ fn production_code_does_not_import_the_references() {
     assert!(oracle_users.is_empty(), "production code importing a reference:\n{}", oracle_users.join("\n"));
     assert!(graph.keys().filter(|f| is_reference(f)).count() >= 4, "the scan found no reference file");
 }
+
+/// What records or builds a barrier by hand (not through the frame graph).
+const HAND_BARRIERS: &[&str] = &[
+    "cmd_barrier",
+    "cmd_transition",
+    "cmd_pipeline_barrier",
+    "barrier::memory(",
+    "barrier::image(",
+    "barrier::subresources(",
+    "barrier::buffer(",
+];
+
+/// The lines of `source`'s production code that place a barrier by hand.
+fn hand_barriers(source: &str) -> Vec<String> {
+    production_code(source)
+        .lines()
+        .filter(|line| HAND_BARRIERS.iter().any(|h| line.contains(h)))
+        .map(|line| line.trim().to_string())
+        .collect()
+}
+
+/// `render/pass.rs` promises that every barrier the render passes record is
+/// one their frame graph derived from the declared uses (`render/graph.rs`
+/// is the one place that records them).
+#[test]
+fn the_render_passes_record_only_barriers_their_frame_graph_derives() {
+    let render = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/render");
+    let mut files = Vec::new();
+    rust_files(&render, &mut files);
+    let mut found = Vec::new();
+    for path in files.iter().filter(|p| !is_test_file(p) && !p.ends_with("graph.rs")) {
+        let source = std::fs::read_to_string(path).expect("source file");
+        found.extend(hand_barriers(&source).into_iter().map(|line| format!("{}: {line}", path.display())));
+    }
+    assert!(found.is_empty(), "barriers placed by hand under src/render:\n{}", found.join("\n"));
+}
+
+#[test]
+fn the_hand_barrier_check_sees_one() {
+    assert_eq!(hand_barriers("    unsafe { d.cmd_barrier(cmd, &[m], &[], &[]) };").len(), 1);
+    assert_eq!(hand_barriers("let b = barrier::memory(&[A], &[B]);").len(), 1);
+    assert!(hand_barriers("// d.cmd_barrier(cmd, …)\ngraph.record(d, cmd, &uses);").is_empty());
+}

@@ -15,8 +15,8 @@
 //!   reads or writes ([`super::graph::Use`]) to the entry point's
 //!   [`super::graph::FrameGraph`], which records the barriers those uses need
 //!   after the earlier passes' declared uses: no pass places a barrier for
-//!   its neighbour (only the steps within the transparency pass, the tiled
-//!   rasteriser and the motion vectors order their private buffers by hand);
+//!   its neighbour, nor between its own steps (every barrier under `render/`
+//!   is one the graph derived);
 //! - states in its `# Safety` section what must have been recorded before.
 //!
 //! There is no `Pass` trait: the passes take different inputs each frame

@@ -180,6 +180,16 @@ impl Lists {
         out
     }
 
+    /// Every buffer of the lists: the heads and the pool's.
+    pub(super) fn buffers(&self) -> impl Iterator<Item = &Buffer> {
+        std::iter::once(&self.heads).chain(&self.nodes)
+    }
+
+    /// What [`Lists::record_clear`] fills: the heads.
+    pub(super) fn cleared(&self) -> &Buffer {
+        &self.heads
+    }
+
     /// Records every list emptied (transfer writes).
     ///
     /// # Safety

@@ -10,6 +10,7 @@ use ash::vk;
 
 use super::ModeShaders;
 use crate::error::Result;
+use crate::render::graph::Use;
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::device::Device;
 use crate::vk::image::{Image, ImageDesc};
@@ -60,29 +61,17 @@ impl WeightedSums {
         [&self.sum, &self.absorbance].map(|i| rendering::color(i.view(), Load::color([0.0; 4])))
     }
 
-    /// Barriers before the build (from the last composite's sampling to
-    /// attachments, contents discarded) and after it (to sampling).
-    pub(super) fn barriers(&self) -> ([vk::ImageMemoryBarrier2<'static>; 2], [vk::ImageMemoryBarrier2<'static>; 2]) {
-        let sampled = &[AccessKind::FragmentSampledRead];
-        let images = [&self.sum, &self.absorbance];
-        let to_attachments = images.map(|image| {
-            barrier::image(
-                image,
-                sampled,
-                barrier::COLOR_ATTACHMENT,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-            )
-        });
-        let to_sampled = images.map(|image| {
-            barrier::image(
-                image,
-                barrier::COLOR_ATTACHMENT,
-                sampled,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            )
-        });
-        (to_attachments, to_sampled)
+    /// Both images as the build's attachments (their contents discarded: cleared).
+    pub(super) fn attachment_uses(&self) -> [Use; 2] {
+        let layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+        [&self.sum, &self.absorbance].map(|i| Use::image(i, barrier::COLOR_ATTACHMENT, layout, SAMPLED).discarding())
+    }
+
+    /// Both images as the composite samples them (their layout at rest).
+    pub(super) fn sampled_uses(&self) -> [Use; 2] {
+        [&self.sum, &self.absorbance].map(|i| Use::image(i, &[AccessKind::FragmentSampledRead], SAMPLED, SAMPLED))
     }
 }
+
+/// The layout the sums rest in: sampled by the composite.
+const SAMPLED: vk::ImageLayout = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;

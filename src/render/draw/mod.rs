@@ -223,7 +223,7 @@ impl DrawPass {
                 Transparency::Off => self
                     .opaque
                     .record(frame, graph, &mut self.shading, &self.ribbons)
-                    .and_then(|_| self.opaque_motion.record(frame, &self.shading)),
+                    .and_then(|_| self.opaque_motion.record(frame, graph, &self.shading)),
                 _ => self.transparent.record(frame, graph, (mode, oit, raster), &mut self.shading, &self.ribbons),
             }
         }

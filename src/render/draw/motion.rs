@@ -32,6 +32,7 @@ use glam::Mat4;
 use super::super::{Camera, MotionDirection, MotionParams, MotionUnits};
 use crate::error::{Error, Result};
 use crate::gpu_types::GpuMotion;
+use crate::render::graph::{FrameGraph, Use};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::device::Device;
@@ -219,16 +220,16 @@ impl MotionHistory {
         hairs: HairLayout,
     ) {
         let bytes = (u64::from(hairs.hairs) * u64::from(hairs.per_hair) * 16).min(self.previous.size());
-        // The walk read the previous positions this copy replaces; the next
-        // frame's walk waits for the copy (its barrier waits for any transfer).
-        // (And the interpolation's writes of the positions, which the copy reads.)
-        let to_copy = barrier::memory(
-            &[AccessKind::ComputeRead, AccessKind::ComputeWrite, AccessKind::TessellationWrite],
-            &[AccessKind::TransferRead, AccessKind::TransferWrite],
-        );
+        // The walk read the previous positions this copy replaces, the
+        // interpolation wrote the positions it reads: a graph of its own (the
+        // draw's has settled) waits for any earlier use of either.
+        let copy = [
+            Use::buffer(positions, &[AccessKind::TransferRead]),
+            Use::buffer(&self.previous, &[AccessKind::TransferWrite]),
+        ];
         // SAFETY: guaranteed by the caller; both buffers hold `bytes`.
         unsafe {
-            self.device.cmd_barrier(cmd, &[to_copy], &[], &[]);
+            FrameGraph::new().record(&self.device, cmd, &copy);
             if bytes > 0 {
                 let region = vk::BufferCopy { src_offset: 0, dst_offset: 0, size: bytes };
                 self.device.raw.cmd_copy_buffer(cmd, positions.raw(), self.previous.raw(), &[region]);
@@ -292,65 +293,66 @@ impl MotionPipelines {
     }
 
     /// Records the frame's motion vectors: the block, the walk over `segments`
-    /// segments and the write into the velocity image. `keys` were filled with
-    /// [`MOTION_NONE`] and the depths to match written earlier in submission
-    /// order (the barrier here waits for any transfer, compute or fragment
-    /// write). Leaves the write's graphics pipeline bound and the viewport
+    /// segments and the write into the velocity image, each declared to
+    /// `graph`: the walk reads `words.0` (the drawn positions, the pass's
+    /// per-pixel words) and reads and writes `words.1` (the picks), the write
+    /// reads both. Leaves the write's graphics pipeline bound and the viewport
     /// and scissor set to the velocity image.
     ///
     /// # Safety
     /// `cmd` is a recording command buffer of this device outside a render
-    /// pass; the velocity image is in `COLOR_ATTACHMENT_OPTIMAL` with the
-    /// host's writes before it.
+    /// pass; the velocity image is in `COLOR_ATTACHMENT_OPTIMAL`; the picks
+    /// were filled with [`MOTION_NONE`] and the depths to match written
+    /// earlier, declared to `graph` like every command on the buffers since it was made.
     pub(super) unsafe fn record(
         &self,
         device: &Device,
         cmd: vk::CommandBuffer,
+        graph: &mut FrameGraph,
         motion: &MotionFrame<'_>,
-        segments: u32,
+        (segments, words): (u32, (&[&Buffer], &[&Buffer])),
     ) {
-        // The previous frame's walk and write read the block this update replaces.
-        let to_update = barrier::memory(
-            &[AccessKind::ComputeUniformRead, AccessKind::FragmentUniformRead],
-            &[AccessKind::TransferWrite],
-        );
-        let ready = barrier::memory(
-            &[AccessKind::AnyTransferWrite, AccessKind::ComputeWrite, AccessKind::FragmentWrite],
-            &[AccessKind::ComputeRead, AccessKind::ComputeWrite, AccessKind::ComputeUniformRead],
-        );
-        let between =
-            barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::ComputeRead, AccessKind::ComputeWrite]);
-        let walked =
-            barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::FragmentRead, AccessKind::FragmentUniformRead]);
-        // The host's writes to its velocity and depth images (its clear, its
-        // meshes: with supersampling the draw has not waited for them) and
-        // the opaque draw's depth writes, before the write loads and tests them.
-        let attachments = barrier::memory(
-            &[AccessKind::ColorAttachmentWrite, AccessKind::DepthAttachmentWrite, AccessKind::AnyTransferWrite],
-            barrier::ATTACHMENTS,
-        );
+        use AccessKind::*;
+        let reads = |kinds: &[AccessKind]| -> Vec<Use> { words.0.iter().map(|b| Use::buffer(b, kinds)).collect() };
+        let picks = |kinds: &[AccessKind]| -> Vec<Use> { words.1.iter().map(|b| Use::buffer(b, kinds)).collect() };
+        let update = [Use::buffer(motion.uniforms, &[TransferWrite])];
+        let walk = [
+            vec![Use::buffer(motion.uniforms, &[ComputeUniformRead]), Use::buffer(motion.previous, &[ComputeRead])],
+            reads(&[ComputeRead]),
+            picks(&[ComputeRead, ComputeWrite]),
+        ]
+        .concat();
+        // The host's velocity and depth images (its clear, its meshes: with
+        // supersampling the draw has not used them) and the opaque draw's
+        // depth writes, before the write loads and tests them.
+        let write = [
+            vec![Use::buffer(motion.uniforms, &[FragmentUniformRead]), Use::host_attachments(barrier::ATTACHMENTS)],
+            reads(&[FragmentRead]),
+            picks(&[FragmentRead]),
+        ]
+        .concat();
         let color = [rendering::color(motion.velocity, Load::Keep)];
         let depth = motion.host_depth.map(|(view, _)| rendering::depth(view, Load::Keep));
         let info = rendering::info(motion.extent, &color, depth.as_ref());
         let threads = self.walk.grid_stride_threads(segments);
         // SAFETY: guaranteed by the caller.
         unsafe {
-            device.cmd_barrier(cmd, &[to_update], &[], &[]);
+            graph.record(device, cmd, &update);
             device.raw.cmd_update_buffer(cmd, motion.uniforms.raw(), 0, bytemuck::bytes_of(&motion.block));
-            device.cmd_barrier(cmd, &[ready], &[], &[]);
+            graph.record(device, cmd, &walk);
             self.walk.bind(cmd, &[self.walk_set]);
             if self.int64 {
                 self.walk.dispatch_threads(cmd, [threads, 1, 1]);
             } else {
-                for walk in 0u32..2 {
-                    if walk == 1 {
-                        device.cmd_barrier(cmd, &[between], &[], &[]);
+                for round in 0u32..2 {
+                    if round == 1 {
+                        graph.record(device, cmd, &walk);
                     }
-                    self.walk.push(cmd, &walk);
+                    self.walk.push(cmd, &round);
                     self.walk.dispatch_threads(cmd, [threads, 1, 1]);
                 }
             }
-            device.cmd_barrier(cmd, &[walked, attachments], &[], &[]);
+            graph.record(device, cmd, &write);
             device.raw.cmd_begin_rendering(cmd, &info);
             device.cmd_set_full_viewport(cmd, motion.extent);
             self.write.bind(cmd, &[self.write_set]);
@@ -405,6 +407,11 @@ impl MotionBuffers {
     /// mode's nearest half-opaque depths) where the mode keeps none of its own.
     pub(super) fn bindings<'a>(&'a self, fallback: &'a Buffer) -> [(u32, &'a Buffer); 2] {
         [(KEYS_BINDING, &self.keys), (DEPTH_BINDING, self.depth.as_ref().unwrap_or(fallback))]
+    }
+
+    /// The picks and the depths to match (what [`MotionBuffers::record_clear`] fills).
+    pub(super) fn buffers(&self) -> impl Iterator<Item = &Buffer> {
+        std::iter::once(&self.keys).chain(&self.depth)
     }
 
     /// Records the fills that start a frame: no picks, no depth to match.

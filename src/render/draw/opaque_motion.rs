@@ -14,8 +14,9 @@ use super::shading::ShadingResources;
 use super::{DrawFrame, TargetKey};
 use crate::error::Result;
 use crate::gpu_types::OitCounters;
+use crate::render::graph::{FrameGraph, Use};
 use crate::render::pass::RenderPass;
-use crate::vk::barrier::{self, AccessKind};
+use crate::vk::barrier::AccessKind;
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
 
@@ -67,7 +68,12 @@ impl OpaqueMotion {
     ///
     /// # Safety
     /// As for `DrawPass::record`, after the frame's opaque draw.
-    pub(super) unsafe fn record(&mut self, frame: &DrawFrame<'_>, shading: &ShadingResources) -> Result<()> {
+    pub(super) unsafe fn record(
+        &mut self,
+        frame: &DrawFrame<'_>,
+        graph: &mut FrameGraph,
+        shading: &ShadingResources,
+    ) -> Result<()> {
         let Some(motion) = &frame.motion else {
             return Ok(());
         };
@@ -116,18 +122,18 @@ impl OpaqueMotion {
             reverse_z: u32::from(frame.target.key.reverse_z),
             ..OitCounters::default()
         };
-        // The previous frame's walk and write read the words these writes replace.
-        let to_clear = barrier::memory(
-            &[AccessKind::ComputeRead, AccessKind::ComputeWrite, AccessKind::FragmentRead],
-            &[AccessKind::AnyTransferWrite],
-        );
-        // SAFETY: guaranteed by the caller; the walk's barrier waits for these transfers.
+        let fills = [
+            Use::buffer(&words.counters, &[AccessKind::AnyTransferWrite]),
+            Use::buffer(&words.keys, &[AccessKind::AnyTransferWrite]),
+        ];
+        let (reads, picks) = ([frame.inputs.hairs.0, &words.counters], [&words.keys]);
+        // SAFETY: guaranteed by the caller.
         unsafe {
             let scope = RenderPass::Motion.open(&d, frame.cmd, frame.timing);
-            d.cmd_barrier(frame.cmd, &[to_clear], &[], &[]);
+            graph.record(&d, frame.cmd, &fills);
             d.raw.cmd_update_buffer(frame.cmd, words.counters.raw(), 0, bytemuck::bytes_of(&counters));
             d.raw.cmd_fill_buffer(frame.cmd, words.keys.raw(), 0, vk::WHOLE_SIZE, MOTION_NONE);
-            walk.record(&d, frame.cmd, motion, frame.segments);
+            walk.record(&d, frame.cmd, graph, motion, (frame.segments, (&reads, &picks)));
             scope.close(&d, frame.cmd, frame.timing);
         }
         Ok(())

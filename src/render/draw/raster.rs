@@ -24,6 +24,7 @@ use ash::vk;
 use super::DrawTarget;
 use crate::codes::scene_depth;
 use crate::error::{Error, Result};
+use crate::render::graph::{FrameGraph, Use};
 use crate::vk::barrier::{self, AccessKind};
 use crate::vk::buffer::Buffer;
 use crate::vk::device::Device;
@@ -148,21 +149,33 @@ impl DepthSource {
 }
 
 impl RasterBuffers {
-    /// Records the copy of the target's depth (if any) into the buffer the
-    /// rasteriser reads: the host's image from `DEPTH_ATTACHMENT_OPTIMAL` to
+    /// The buffers: the depth copy and the overflow sums.
+    pub(super) fn buffers(&self) -> impl Iterator<Item = &Buffer> {
+        std::iter::once(&self.scene_depth).chain(self.overflow.iter().flatten())
+    }
+
+    /// What [`RasterBuffers::record_inputs`] fills (transfer writes the
+    /// caller declares): the overflow sums.
+    pub(super) fn cleared(&self) -> impl Iterator<Item = &Buffer> {
+        self.overflow.iter().flatten()
+    }
+
+    /// Records the overflow sums zeroed ([`RasterBuffers::cleared`]) and the
+    /// copy of the target's depth (if any) into the buffer the rasteriser
+    /// reads: the host's image from `DEPTH_ATTACHMENT_OPTIMAL` to
     /// `TRANSFER_SRC_OPTIMAL`, copied, and back for the composite's depth test
-    /// and write; then the overflow sums zeroed. Transfer writes: the caller's
-    /// barrier makes them visible to the rasteriser.
+    /// and write, the copy declared to `graph`.
     ///
     /// # Safety
     /// `cmd` is a recording command buffer of `device` outside a render pass;
     /// `source`'s image is `extent` large (or larger), in
-    /// `DEPTH_ATTACHMENT_OPTIMAL` with the host's writes before it; earlier
-    /// reads of the buffers are ordered before by the caller's barrier.
+    /// `DEPTH_ATTACHMENT_OPTIMAL`; the fills of the sums were declared to
+    /// `graph`, like every earlier command on the buffers since it was made.
     pub(super) unsafe fn record_inputs(
         &self,
         device: &Device,
         cmd: vk::CommandBuffer,
+        graph: &mut FrameGraph,
         source: DepthSource,
         extent: vk::Extent2D,
     ) {
@@ -182,22 +195,13 @@ impl RasterBuffers {
             base_array_layer: 0,
             layer_count: 1,
         };
-        let to_copy = barrier::subresources(
-            image,
-            range,
-            barrier::DEPTH_ATTACHMENT,
-            &[AccessKind::TransferRead],
-            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
-            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-        );
-        let back = barrier::subresources(
-            image,
-            range,
-            &[AccessKind::TransferRead],
-            barrier::DEPTH_ATTACHMENT,
-            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
-        );
+        let attachment = vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL;
+        let source = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+        let copy = [
+            Use::subresources(image, range, &[AccessKind::TransferRead], (source, attachment)),
+            Use::buffer(&self.scene_depth, &[AccessKind::TransferWrite]),
+        ];
+        let back = [Use::subresources(image, range, barrier::DEPTH_ATTACHMENT, (attachment, attachment))];
         let region = vk::BufferImageCopy {
             buffer_offset: 0,
             buffer_row_length: 0,
@@ -213,15 +217,9 @@ impl RasterBuffers {
         };
         // SAFETY: guaranteed by the caller; the buffer holds a word a pixel.
         unsafe {
-            device.cmd_barrier(cmd, &[], &[], &[to_copy]);
-            device.raw.cmd_copy_image_to_buffer(
-                cmd,
-                image,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                self.scene_depth.raw(),
-                &[region],
-            );
-            device.cmd_barrier(cmd, &[], &[], &[back]);
+            graph.record(device, cmd, &copy);
+            device.raw.cmd_copy_image_to_buffer(cmd, image, source, self.scene_depth.raw(), &[region]);
+            graph.record(device, cmd, &back);
         }
     }
 }

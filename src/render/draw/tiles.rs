@@ -37,8 +37,9 @@ use gpu_allocator::MemoryLocation;
 use crate::codes::tile::{FRAGMENTS, SCAN_GROUP, SIZE as TILE_SIZE};
 use crate::error::{Error, Result};
 use crate::gpu_types::TileCounters;
+use crate::render::graph::{FrameGraph, Use};
 use crate::render::OitParams;
-use crate::vk::barrier::{self, AccessKind};
+use crate::vk::barrier::AccessKind;
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::device::{Device, DeviceInfo};
 use crate::vk::pipeline::ComputePipeline;
@@ -206,7 +207,19 @@ impl TileBins {
         ]
     }
 
-    /// Records the counts zeroed and the counters set for the frame (transfer writes).
+    /// The buffers the build and the fine pass use: the counters, the
+    /// per-tile words and the list.
+    pub(super) fn buffers(&self) -> [&Buffer; 5] {
+        [&self.counters, &self.per_tile[0], &self.per_tile[1], &self.per_tile[2], &self.list]
+    }
+
+    /// What [`TileBins::record_clear`] writes: the counters and the counts.
+    pub(super) fn cleared(&self) -> [&Buffer; 2] {
+        [&self.counters, &self.per_tile[0]]
+    }
+
+    /// Records the counts zeroed and the counters set for the frame (transfer
+    /// writes of [`TileBins::cleared`], which the caller declares).
     ///
     /// # Safety
     /// `cmd` is a recording command buffer of `device` outside a render pass;
@@ -229,13 +242,19 @@ impl TileBins {
 
 impl TileBins {
     /// Records the copy of what frame `frame` asked for into its slot, after
-    /// the scan wrote it (compute writes made visible to the copy here; the
-    /// copy made visible to the host).
+    /// the scan wrote it, then makes it visible to the host, each declared to `graph`.
     ///
     /// # Safety
     /// `cmd` is a recording command buffer of `device` outside a render pass,
-    /// after this frame's scan.
-    pub(super) unsafe fn record_readback(&self, device: &Device, cmd: vk::CommandBuffer, frame: u64) {
+    /// after this frame's scan; every earlier command on the bins since
+    /// `graph` was made was declared to it.
+    pub(super) unsafe fn record_readback(
+        &self,
+        device: &Device,
+        cmd: vk::CommandBuffer,
+        graph: &mut FrameGraph,
+        frame: u64,
+    ) {
         // A slot the frames in flight do not use: the one after the newest's,
         // the oldest of READBACK_SLOTS.
         let slot = match self.recorded.lock() {
@@ -249,14 +268,16 @@ impl TileBins {
             }
             Err(_) => return,
         };
-        let to_copy = barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::TransferRead]);
-        let to_host = barrier::memory(&[AccessKind::AnyTransferWrite], &[AccessKind::HostRead]);
+        let copy = [
+            Use::buffer(&self.counters, &[AccessKind::TransferRead]),
+            Use::buffer(&self.readback, &[AccessKind::TransferWrite]),
+        ];
         let region = vk::BufferCopy { src_offset: 0, dst_offset: 4 * slot, size: 4 };
         // SAFETY: guaranteed by the caller; both ranges lie in their buffers.
         unsafe {
-            device.cmd_barrier(cmd, &[to_copy], &[], &[]);
+            graph.record(device, cmd, &copy);
             device.raw.cmd_copy_buffer(cmd, self.counters.raw(), self.readback.raw(), &[region]);
-            device.cmd_barrier(cmd, &[to_host], &[], &[]);
+            graph.record(device, cmd, &[Use::buffer(&self.readback, &[AccessKind::HostRead])]);
         }
     }
 }
@@ -288,27 +309,33 @@ impl BinPipelines {
         })
     }
 
-    /// Records the count, the scan and the fill of `segments` segments, each
-    /// after the last (compute writes; the caller's barrier makes the fill's
-    /// visible to the fine pass).
+    /// Records the count, the scan and the fill of `segments` segments into
+    /// `bins`, each declaring to `graph` that it reads and writes the bins,
+    /// the count also the build's other uses `first` (the frame's inputs, the
+    /// per-pixel buffers).
     ///
     /// # Safety
     /// `cmd` is a recording command buffer of `device` outside a render pass;
-    /// the bins were cleared ([`TileBins::record_clear`]) and the hair's
-    /// vertices and colours written, each made visible to compute reads.
-    pub(super) unsafe fn record(&self, device: &Device, cmd: vk::CommandBuffer, segments: u32) {
-        let after = barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::ComputeRead, AccessKind::ComputeWrite]);
+    /// the bins are the ones the pipelines were made with; every earlier
+    /// command on them since `graph` was made was declared to it.
+    pub(super) unsafe fn record(
+        &self,
+        device: &Device,
+        cmd: vk::CommandBuffer,
+        (graph, bins, first): (&mut FrameGraph, &TileBins, &[Use]),
+        segments: u32,
+    ) {
+        let uses = bins.buffers().map(|b| Use::buffer(b, &[AccessKind::ComputeRead, AccessKind::ComputeWrite]));
         let threads = self.count.0.grid_stride_threads(segments);
         // SAFETY: guaranteed by the caller.
         unsafe {
-            self.count.0.bind(cmd, &[self.count.1]);
-            self.count.0.dispatch_threads(cmd, [threads, 1, 1]);
-            device.cmd_barrier(cmd, &[after], &[], &[]);
-            self.scan.0.bind(cmd, &[self.scan.1]);
-            self.scan.0.dispatch_threads(cmd, [SCAN_GROUP, 1, 1]);
-            device.cmd_barrier(cmd, &[after], &[], &[]);
-            self.fill.0.bind(cmd, &[self.fill.1]);
-            self.fill.0.dispatch_threads(cmd, [threads, 1, 1]);
+            let passes = [(&self.count, threads), (&self.scan, SCAN_GROUP), (&self.fill, threads)];
+            for (i, (pass, groups)) in passes.into_iter().enumerate() {
+                let declared = if i == 0 { [first, &uses].concat() } else { uses.to_vec() };
+                graph.record(device, cmd, &declared);
+                pass.0.bind(cmd, &[pass.1]);
+                pass.0.dispatch_threads(cmd, [groups, 1, 1]);
+            }
         }
     }
 }

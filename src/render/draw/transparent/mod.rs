@@ -52,22 +52,16 @@ use crate::codes::sentinel::OIT_END;
 use crate::error::{Error, Result};
 use crate::gpu_types::OitCounters;
 use crate::profiler::PassScope;
-use crate::render::graph::FrameGraph;
+use crate::render::graph::{FrameGraph, Use};
 use crate::render::pass::RenderPass;
 use crate::render::{OitParams, Raster, Transparency};
-use crate::vk::barrier::{self, AccessKind};
+use crate::vk::barrier::AccessKind;
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::debug::LabelColor;
 use crate::vk::device::{Device, DeviceInfo};
 use crate::vk::image::Sampler;
 use crate::vk::pipeline::{ComputePipeline, GraphicsPipeline};
 use crate::vk::rendering;
-
-/// Reads of the pass's buffers by its stages (the ribbons, the vertex shading,
-/// the build and the composite).
-const READ_BY_ANY: &[AccessKind] = &[AccessKind::VertexRead, AccessKind::ComputeRead, AccessKind::FragmentRead];
-/// Writes to the pass's buffers by its stages.
-const WRITTEN_BY_ANY: &[AccessKind] = &[AccessKind::ComputeWrite, AccessKind::FragmentWrite];
 
 /// Bytes per pixel of the compute resolve's output (four half floats).
 const RESOLVED_BYTES_PER_PIXEL: u64 = 8;
@@ -415,53 +409,57 @@ impl TransparentPass {
                 _ => 0.0,
             },
         };
-        // Where the build's fragments are made and stored.
-        let storage: &[AccessKind] = match compute {
-            true => &[AccessKind::ComputeRead, AccessKind::ComputeWrite],
-            false => &[AccessKind::FragmentRead, AccessKind::FragmentWrite],
+        // The steps' uses of the pass's own buffers: the build's stage reads
+        // and writes them all (fragment or compute), the compute resolve and
+        // the composite after it.
+        use AccessKind::*;
+        let (build_rw, build_read): (&[AccessKind], AccessKind) = match compute {
+            true => (&[ComputeRead, ComputeWrite], ComputeRead),
+            false => (&[FragmentRead, FragmentWrite], VertexRead),
         };
-        let build_write = storage[1];
-        // The previous frame's passes used the lists and counters (and the host read them).
-        // Fills and the depth copy: any transfer write (fills run in the clear stage).
-        let to_clear = barrier::memory(&[READ_BY_ANY, WRITTEN_BY_ANY].concat(), &[AccessKind::AnyTransferWrite]);
-        let counters_ready =
-            barrier::memory(&[AccessKind::AnyTransferWrite], &[AccessKind::ComputeRead, AccessKind::ComputeWrite]);
-        let cleared = barrier::memory(&[AccessKind::AnyTransferWrite], storage);
-        // The lists, the counters and the overflow to the composite (its rectangle's vertex stage reads the counters).
-        // (The compute rasteriser's are read by the compute resolve first.)
-        let built = barrier::memory(
-            &[build_write],
-            &[AccessKind::VertexRead, AccessKind::FragmentRead, AccessKind::ComputeRead],
-        );
-        // The compute resolve's pixels to the composite's fragment stage. (The
-        // previous frame's composite read them in its fragment stage before
-        // this frame's resolve writes them: `to_clear` waits for that stage,
-        // `cleared` and `built` carry the wait on to the resolve.)
-        let resolved = barrier::memory(&[AccessKind::ComputeWrite], &[AccessKind::FragmentRead]);
-        // The previous frame's ribbons (or rasteriser) read the colours this frame's dispatch writes.
-        let to_shade = barrier::memory(&[AccessKind::VertexRead, AccessKind::ComputeRead], &[AccessKind::ComputeWrite]);
-        // The colours and the rectangle (its atomics on the counters) to the
-        // ribbons or the rasteriser (which add to the counters too), the build
-        // and the composite.
-        let shaded = barrier::memory(
-            &[AccessKind::ComputeWrite],
-            &[
-                AccessKind::VertexRead,
-                AccessKind::FragmentRead,
-                AccessKind::FragmentWrite,
-                AccessKind::ComputeRead,
-                AccessKind::ComputeWrite,
-            ],
-        );
+        let uses = |buffers: &[&Buffer], kinds: &[AccessKind]| -> Vec<Use> {
+            buffers.iter().map(|b| Use::buffer(b, kinds)).collect()
+        };
+        // Every per-pixel buffer but the bins, which the tiled build declares itself.
+        let mut pixels: Vec<&Buffer> = vec![&res.opaque];
+        pixels.extend(res.lists.iter().flat_map(Lists::buffers));
+        pixels.extend(res.raster_buffers.iter().flat_map(RasterBuffers::buffers));
+        pixels.extend(&res.resolved);
+        pixels.extend(res.motion.iter().flat_map(MotionBuffers::buffers));
+        let bins: Vec<&Buffer> = res.tiles.iter().flat_map(TileBins::buffers).collect();
+        let mut cleared: Vec<&Buffer> = vec![&res.opaque];
+        cleared.extend(res.lists.as_ref().map(Lists::cleared));
+        cleared.extend(res.tiles.iter().flat_map(TileBins::cleared));
+        cleared.extend(res.raster_buffers.iter().flat_map(RasterBuffers::cleared));
+        if frame.motion.is_some() {
+            cleared.extend(res.motion.iter().flat_map(MotionBuffers::buffers));
+        }
+        let sums_attached = res.sums.as_ref().map_or(Vec::new(), |s| s.attachment_uses().to_vec());
+        let sums_sampled = res.sums.as_ref().map_or(Vec::new(), |s| s.sampled_uses().to_vec());
+        let counters_update = [Use::buffer(&self.counters, &[AnyTransferWrite])];
+        let shade =
+            [Use::buffer(&self.colors, &[ComputeWrite]), Use::buffer(&self.counters, &[ComputeRead, ComputeWrite])];
+        let clear = uses(&cleared, &[AnyTransferWrite]);
+        let build = [
+            vec![Use::buffer(&self.colors, &[build_read]), Use::buffer(&self.counters, build_rw)],
+            uses(&pixels, build_rw),
+            sums_attached,
+        ]
+        .concat();
+        let resolve = [
+            vec![Use::buffer(&self.counters, &[ComputeRead, ComputeWrite])],
+            uses(&pixels, &[ComputeRead, ComputeWrite]),
+            uses(&bins, &[ComputeRead, ComputeWrite]),
+        ]
+        .concat();
+        let composite = [
+            vec![Use::buffer(&self.counters, &[VertexRead, FragmentRead])],
+            uses(&pixels, &[FragmentRead, FragmentWrite]),
+            sums_sampled,
+            target.uses.clone(),
+        ]
+        .concat();
         let (hairs, per_hair) = (frame.params.counts[0], frame.params.counts[1]);
-        let to_host = barrier::memory(WRITTEN_BY_ANY, &[AccessKind::HostRead]);
-        let (to_sums, from_sums) = match &res.sums {
-            Some(sums) => {
-                let (to, from) = sums.barriers();
-                (to.to_vec(), from.to_vec())
-            }
-            None => (Vec::new(), Vec::new()),
-        };
         let depth_first = target.depth_attachment();
         let depth_again = target.depth_kept();
         let color = target.color_attachment();
@@ -475,10 +473,9 @@ impl TransparentPass {
             // What the pass reads of the earlier passes, and the target it
             // tests against (the build) and blends into (the composite).
             graph.record(d, cmd, &[shading.uses(&frame.inputs), target.uses.clone()].concat());
-            // Its own buffers' steps: ordered here, within the pass.
-            d.cmd_barrier(cmd, &[to_clear, to_shade], &[], &to_sums);
+            graph.record(d, cmd, &counters_update);
             d.raw.cmd_update_buffer(cmd, self.counters.raw(), 0, bytemuck::bytes_of(&counters));
-            d.cmd_barrier(cmd, &[counters_ready], &[], &[]);
+            graph.record(d, cmd, &shade);
             let shading_label = format!("{}, vertex shading", RenderPass::Draw.label());
             let inner = PassScope::open(d, cmd, timing, &shading_label, LabelColor::Compute);
             pipelines.points.0.bind_variant(cmd, frame.features, &[pipelines.points.1]);
@@ -490,22 +487,26 @@ impl TransparentPass {
             pipelines.rect.0.bind(cmd, &[pipelines.rect.1]);
             pipelines.rect.0.dispatch_threads(cmd, [threads, 1, 1]);
             inner.close(d, cmd, timing);
+            graph.record(d, cmd, &clear);
             if let Some(lists) = &res.lists {
                 lists.record_clear(d, cmd);
             }
             d.raw.cmd_fill_buffer(cmd, res.opaque.raw(), 0, vk::WHOLE_SIZE, OIT_END);
-            if let Some(buffers) = &res.raster_buffers {
-                buffers.record_inputs(d, cmd, depth_source, target.extent);
-            }
             if let Some(bins) = &res.tiles {
                 bins.record_clear(d, cmd);
             }
             if let (Some(words), Some(_)) = (&res.motion, &frame.motion) {
                 words.record_clear(d, cmd);
             }
-            d.cmd_barrier(cmd, &[cleared, shaded], &[], &[]);
+            if let Some(buffers) = &res.raster_buffers {
+                buffers.record_inputs(d, cmd, graph, depth_source, target.extent);
+            }
             let build_label = format!("{}, build", RenderPass::Draw.label());
             let inner = PassScope::open(d, cmd, timing, &build_label, LabelColor::Graphics);
+            // The tiled build declares its first dispatch's uses with the bins.
+            if res.tiles.is_none() {
+                graph.record(d, cmd, &build);
+            }
             match &pipelines.build {
                 Build::Ribbons(pipeline, set) => {
                     let sums = res.sums.as_ref().map(WeightedSums::attachments);
@@ -522,9 +523,9 @@ impl TransparentPass {
                     pipeline.dispatch_threads(cmd, [pipeline.grid_stride_threads(frame.segments), 1, 1]);
                 }
                 Build::Tiles(passes) => {
-                    passes.record(d, cmd, frame.segments);
                     if let Some(bins) = &res.tiles {
-                        bins.record_readback(d, cmd, frame.frame);
+                        passes.record(d, cmd, (graph, bins, &build), frame.segments);
+                        bins.record_readback(d, cmd, graph, frame.frame);
                     }
                 }
             }
@@ -532,13 +533,11 @@ impl TransparentPass {
             scope.close(d, cmd, timing);
 
             let scope = RenderPass::Composite.open(d, cmd, timing);
-            d.cmd_barrier(cmd, &[built], &[], &from_sums);
-            // The build's depth tests before the composite's writes.
-            graph.record(d, cmd, &target.uses);
             if let Some((pipeline, set)) = &pipelines.resolve {
                 let what = if res.tiles.is_some() { "tiles drawn and resolved" } else { "resolve in compute" };
                 let resolve_label = format!("{}, {what}", RenderPass::Composite.label());
                 let inner = PassScope::open(d, cmd, timing, &resolve_label, LabelColor::Compute);
+                graph.record(d, cmd, &resolve);
                 match &res.tiles {
                     // One workgroup a tile: its size is the tile's.
                     Some(bins) => {
@@ -551,9 +550,10 @@ impl TransparentPass {
                         pipeline.dispatch_threads(cmd, [target.extent.width, target.extent.height, 1]);
                     }
                 }
-                d.cmd_barrier(cmd, &[resolved], &[], &[]);
                 inner.close(d, cmd, timing);
             }
+            // (The build's depth tests before the composite's writes: the target's uses.)
+            graph.record(d, cmd, &composite);
             d.raw.cmd_begin_rendering(cmd, &composite_rendering);
             d.cmd_set_full_viewport(cmd, target.extent);
             for (pipeline, set) in [&pipelines.composite].into_iter().chain(&pipelines.depth) {
@@ -564,10 +564,12 @@ impl TransparentPass {
             scope.close(d, cmd, timing);
             if let (Some(motion), Some(walk)) = (&frame.motion, &pipelines.motion) {
                 let scope = RenderPass::Motion.open(d, cmd, timing);
-                walk.record(d, cmd, motion, frame.segments);
+                let reads = [&[frame.inputs.hairs.0, &self.counters][..], &pixels].concat();
+                let picks: Vec<&Buffer> = res.motion.iter().flat_map(MotionBuffers::buffers).collect();
+                walk.record(d, cmd, graph, motion, (frame.segments, (&reads, &picks)));
                 scope.close(d, cmd, timing);
             }
-            d.cmd_barrier(cmd, &[to_host], &[], &[]);
+            graph.record(d, cmd, &[Use::buffer(&self.counters, &[HostRead])]);
         }
         Ok(())
     }
