@@ -10,17 +10,22 @@
 //! (`hair_shading.glsl`, [`shading::ShadingResources`]) and differs only in
 //! where the shading runs (per fragment when opaque; per hair vertex in a
 //! compute dispatch, `shade_points.comp`, for the transparent modes, whose
-//! fragments only add coverage) and how fragments reach the target, one file each:
+//! fragments only add coverage) and how fragments reach the target, one file
+//! each, selected by one value a frame, the [`DrawMethod`] (`method.rs`) that
+//! [`super::Transparency`] and the resolved [`Raster`] make together:
 //!
-//! - [`Transparency::Off`] — `opaque.rs`: a depth pre-pass and a shaded draw
-//!   of the nearest layer;
-//! - [`Transparency::Exact`] — `transparent/` with `exact.rs`: per-pixel
-//!   fragment lists, the nearest sorted;
-//! - [`Transparency::Fast`] — `transparent/` with `fast.rs`: weighted blended
-//!   sums.
+//! - [`DrawMethod::Opaque`] ([`super::Transparency::Off`]) — `opaque.rs`: a
+//!   depth pre-pass and a shaded draw of the nearest layer;
+//! - [`DrawMethod::HardwareLists`], [`DrawMethod::ComputeLists`],
+//!   [`DrawMethod::Tiles`] ([`super::Transparency::Exact`]) — `transparent/`
+//!   with `exact.rs` (per-pixel fragment lists, the nearest sorted, built by
+//!   the hardware raster pipeline or `raster.rs`) or `tiles.rs`;
+//! - [`DrawMethod::Weighted`] ([`super::Transparency::Fast`]) — `transparent/`
+//!   with `fast.rs`: weighted blended sums.
 
 mod exact;
 mod fast;
+mod method;
 mod motion;
 mod opaque;
 mod opaque_motion;
@@ -35,12 +40,13 @@ use std::sync::Arc;
 use ash::vk;
 
 pub use exact::OitPool;
+pub(super) use method::DrawMethod;
 pub use transparent::OitStats;
 
 use super::marschner::MarschnerParams;
 use super::shading::{Camera, HairMaterial, ShadingMode, MAX_LIGHTS};
 use super::shadow::ShadowParams;
-use super::{OitParams, Primitive, Raster, RenderTarget, Renderer, Transparency};
+use super::{OitParams, Primitive, Raster, RenderTarget, Renderer};
 use crate::error::{Error, Result};
 use crate::gpu_types::{DrawParams, GpuLight};
 use crate::profiler::{GpuProfiler, Timing};
@@ -201,7 +207,7 @@ impl DrawPass {
         self.transparent.forget();
     }
 
-    /// Records `frame` in `mode` (`oit` its transparency parameters).
+    /// Records `frame` by `method` (`oit` its transparency parameters).
     ///
     /// # Safety
     /// `frame.cmd` is a recording command buffer of this device outside a render
@@ -213,18 +219,17 @@ impl DrawPass {
         &mut self,
         frame: &DrawFrame<'_>,
         graph: &mut FrameGraph,
-        mode: Transparency,
+        method: DrawMethod,
         oit: &OitParams,
-        raster: Raster,
     ) -> Result<()> {
         // SAFETY: guaranteed by the caller.
         unsafe {
-            match mode {
-                Transparency::Off => self
+            match method {
+                DrawMethod::Opaque => self
                     .opaque
                     .record(frame, graph, &mut self.shading, &self.ribbons)
                     .and_then(|_| self.opaque_motion.record(frame, graph, &self.shading)),
-                _ => self.transparent.record(frame, graph, (mode, oit, raster), &mut self.shading, &self.ribbons),
+                _ => self.transparent.record(frame, graph, (method, oit), &mut self.shading, &self.ribbons),
             }
         }
     }
@@ -334,7 +339,7 @@ impl Renderer {
             Some(images) => images.draw_target(self.params.primitive, reverse_z),
             None => host.clone(),
         };
-        let mode = self.params.transparency;
+        let method = self.draw_method();
         let hairs = self.hair_layout();
         let motion = match target.velocity == vk::ImageView::null() {
             true => None,
@@ -353,8 +358,8 @@ impl Renderer {
                 let images = (target.velocity, target.velocity_format);
                 // Opaque hair is tested against the host's depth when written
                 // (the walk's nearest ribbon may lie behind the host's meshes).
-                let opaque = match mode {
-                    Transparency::Off => Some(has_depth.then_some((target.depth, target.depth_format))),
+                let opaque = match method {
+                    DrawMethod::Opaque => Some(has_depth.then_some((target.depth, target.depth_format))),
                     _ => None,
                 };
                 Some(history.frame(
@@ -371,7 +376,7 @@ impl Renderer {
             timing: Timing::of(profiler.as_deref()),
             params: own_looks(
                 draw_params(
-                    mode != Transparency::Off,
+                    method != DrawMethod::Opaque,
                     &self.material,
                     &self.lights,
                     StrandFootprint {
@@ -404,7 +409,7 @@ impl Renderer {
         // renderer's and earlier resolves that sampled them are ordered by the
         // graph's first uses.
         let result = unsafe {
-            let drawn = self.draw.record(&frame, &mut graph, mode, &self.params.oit, self.raster());
+            let drawn = self.draw.record(&frame, &mut graph, method, &self.params.oit);
             let resolved = match &mut images {
                 Some(images) => drawn.and_then(|_| self.resolve.record(cmd, &mut graph, images, &host, frame.timing)),
                 None => drawn,
@@ -454,10 +459,14 @@ impl Renderer {
     /// [`Raster::Hardware`] in the other modes, which draw only through the
     /// hardware raster pipeline.
     pub fn raster(&self) -> Raster {
-        match self.params.transparency {
-            Transparency::Exact => self.params.raster.resolve(self.device.info.device_type),
-            _ => Raster::Hardware,
-        }
+        self.draw_method().raster()
+    }
+
+    /// How the current parameters draw on this device: the transparency mode
+    /// with [`RenderParams::raster`](super::RenderParams::raster) resolved.
+    pub(super) fn draw_method(&self) -> DrawMethod {
+        let raster = self.params.raster.resolve(self.device.info.device_type);
+        DrawMethod::of(self.params.transparency, raster)
     }
 
     /// Sets of size-dependent images waiting for their frames to complete
@@ -487,8 +496,7 @@ impl Renderer {
     /// target of `extent` (the supersampled extent where supersampling is on), bytes.
     pub fn transparency_memory(&self, extent: vk::Extent2D) -> u64 {
         let drawn = self.drawn_extent(extent);
-        let raster = self.raster();
-        self.draw.transparent.memory_bytes(&self.device.info, self.params.transparency, &self.params.oit, raster, drawn)
+        self.draw.transparent.memory_bytes(&self.device.info, self.draw_method(), &self.params.oit, drawn)
     }
 
     /// The exact mode's fragment pool for a target of `extent` (the
@@ -498,7 +506,7 @@ impl Renderer {
     /// is [`Transparency::Exact`] with per-pixel lists (the tiled rasteriser,
     /// [`Raster::Tiles`], keeps none).
     pub fn transparency_pool(&self, extent: vk::Extent2D) -> Option<OitPool> {
-        if self.params.transparency != Transparency::Exact || self.raster() == Raster::Tiles {
+        if !self.draw_method().lists() {
             return None;
         }
         Some(OitPool::plan(&self.device.info, &self.params.oit, self.drawn_extent(extent)))

@@ -47,14 +47,14 @@ use super::raster::{DepthSource, RasterBuffers};
 use super::ribbons::RibbonIndices;
 use super::shading::ShadingResources;
 use super::tiles::{self, BinPipelines, TileBins};
-use super::{DrawFrame, TargetKey};
+use super::{DrawFrame, DrawMethod, TargetKey};
 use crate::codes::sentinel::OIT_END;
 use crate::error::{Error, Result};
 use crate::gpu_types::OitCounters;
 use crate::profiler::PassScope;
 use crate::render::graph::{FrameGraph, Use};
 use crate::render::pass::RenderPass;
-use crate::render::{OitParams, Raster, Transparency};
+use crate::render::OitParams;
 use crate::vk::barrier::AccessKind;
 use crate::vk::buffer::{Buffer, BufferDesc};
 use crate::vk::debug::LabelColor;
@@ -97,10 +97,10 @@ struct Pipelines {
 /// (`UNDEFINED` for none).
 type PipelineKey = (TargetKey, &'static str, vk::Format);
 
-/// The buffers and images of one extent and mode, and the pipelines bound to them.
+/// The buffers and images of one extent and method, and the pipelines bound to them.
 struct Resources {
     extent: vk::Extent2D,
-    mode: Transparency,
+    method: DrawMethod,
     /// Per pixel: the nearest half-opaque depth.
     opaque: Buffer,
     /// Exact mode: the lists.
@@ -126,16 +126,6 @@ impl Resources {
     /// The exact mode's pool (fast mode: none).
     fn pool(&self) -> Option<OitPool> {
         self.lists.as_ref().map(|l| l.pool)
-    }
-
-    /// Who makes the fragments: the tiled rasteriser where its bins are, the
-    /// compute rasteriser where its buffers are.
-    fn raster(&self) -> Raster {
-        match (&self.tiles, &self.raster_buffers) {
-            (Some(_), _) => Raster::Tiles,
-            (None, Some(_)) => Raster::Compute,
-            (None, None) => Raster::Hardware,
-        }
     }
 
     /// The tiled rasteriser's entries: those it holds.
@@ -192,36 +182,32 @@ impl TransparentPass {
         })
     }
 
-    /// Bytes of GPU memory the exact or fast mode needs at `extent` on a device with `info`'s limits.
+    /// Bytes of GPU memory `method` needs at `extent` on a device with `info`'s limits.
     pub(super) fn memory_bytes(
         &self,
         info: &DeviceInfo,
-        mode: Transparency,
+        method: DrawMethod,
         params: &OitParams,
-        raster: Raster,
         extent: vk::Extent2D,
     ) -> u64 {
         let pixels = u64::from(extent.width) * u64::from(extent.height);
         // All: the counters, the vertex colours, a depth word per pixel and
         // the overflow: the weighted sums, or the compute rasterisers' buffers.
-        let overflow = match (mode, raster) {
-            (Transparency::Exact, Raster::Compute) => RasterBuffers::memory_bytes(extent, true),
-            (Transparency::Exact, Raster::Tiles) => RasterBuffers::memory_bytes(extent, false),
-            _ => fast::BYTES_PER_PIXEL * pixels,
+        let overflow = match method.compute() {
+            true => RasterBuffers::memory_bytes(extent, method.lists()),
+            false => fast::BYTES_PER_PIXEL * pixels,
         };
         let shared = std::mem::size_of::<OitCounters>() as u64 + self.colors.size() + 4 * pixels + overflow;
         // The compute rasterisers' exact mode resolves into a buffer first.
         let resolved = RESOLVED_BYTES_PER_PIXEL * pixels;
-        match (mode, raster) {
-            (Transparency::Off, _) => 0,
-            (Transparency::Exact, Raster::Tiles) => {
+        match method {
+            DrawMethod::Opaque => 0,
+            DrawMethod::Weighted => shared,
+            DrawMethod::Tiles => {
                 shared + resolved + TileBins::memory_bytes(extent, self.tile_capacity(info, params, extent))
             }
-            (Transparency::Exact, Raster::Compute) => {
-                shared + resolved + Lists::memory_bytes(&OitPool::plan(info, params, extent))
-            }
-            (Transparency::Exact, _) => shared + Lists::memory_bytes(&OitPool::plan(info, params, extent)),
-            (Transparency::Fast, _) => shared,
+            DrawMethod::ComputeLists => shared + resolved + Lists::memory_bytes(&OitPool::plan(info, params, extent)),
+            DrawMethod::HardwareLists => shared + Lists::memory_bytes(&OitPool::plan(info, params, extent)),
         }
     }
 
@@ -253,23 +239,12 @@ impl TransparentPass {
     }
 }
 
-/// Resources: made for an extent and mode, kept while they stay.
+/// Resources: made for an extent and method, kept while they stay.
 impl TransparentPass {
-    /// Makes the resources for `mode` drawn by `raster` at `extent` the current
-    /// ones (retiring others).
-    fn prepare(
-        &mut self,
-        frame: u64,
-        mode: Transparency,
-        params: &OitParams,
-        raster: Raster,
-        extent: vk::Extent2D,
-    ) -> Result<()> {
-        let tiled = mode == Transparency::Exact && raster == Raster::Tiles;
-        let pool = match mode {
-            Transparency::Exact if !tiled => Some(OitPool::plan(&self.device.info, params, extent)),
-            _ => None,
-        };
+    /// Makes the resources for `method` at `extent` the current ones (retiring others).
+    fn prepare(&mut self, frame: u64, method: DrawMethod, params: &OitParams, extent: vk::Extent2D) -> Result<()> {
+        let tiled = method == DrawMethod::Tiles;
+        let pool = method.lists().then(|| OitPool::plan(&self.device.info, params, extent));
         // The bins grow to what a completed frame asked for: the one
         // `frames_in_flight` before this one (its own copy in the bins).
         let done = self.frames_in_flight.and_then(|f| frame.checked_sub(u64::from(f)));
@@ -283,13 +258,8 @@ impl TransparentPass {
             tiles::check_device(&self.device.info)?;
         }
         let bins = tiled.then(|| self.tile_capacity(&self.device.info, params, extent));
-        let fits = |r: &Resources| {
-            r.extent == extent
-                && r.mode == mode
-                && r.pool() == pool
-                && r.raster() == raster
-                && r.tile_capacity() == bins
-        };
+        let fits =
+            |r: &Resources| r.extent == extent && r.method == method && r.pool() == pool && r.tile_capacity() == bins;
         if let Some(old) = self.current.take_if(|r| !fits(r)) {
             // Frames up to the previous one may still be using them.
             self.retired.push((frame.saturating_sub(1), old));
@@ -314,10 +284,10 @@ impl TransparentPass {
             None => None,
         };
         let pixels = u64::from(extent.width) * u64::from(extent.height);
-        let compute = raster == Raster::Compute || tiled;
+        let compute = method.compute();
         self.current = Some(Resources {
             extent,
-            mode,
+            method,
             opaque: Buffer::storage(d, "vkhair transparency opaque depth", 4 * pixels)?,
             lists,
             sums: if compute { None } else { Some(WeightedSums::new(d, extent)?) },
@@ -326,11 +296,11 @@ impl TransparentPass {
                 Some(capacity) => Some(TileBins::new(d, extent, capacity)?),
                 None => None,
             },
-            resolved: match (compute, mode) {
-                (true, Transparency::Exact) => {
+            resolved: match compute {
+                true => {
                     Some(Buffer::storage(d, "vkhair transparency resolved pixels", RESOLVED_BYTES_PER_PIXEL * pixels)?)
                 }
-                _ => None,
+                false => None,
             },
             motion: None,
             pipelines: HashMap::new(),
@@ -344,15 +314,15 @@ impl TransparentPass {
         let Some(res) = self.current.as_mut().filter(|r| r.motion.is_none() && frame.motion.is_some()) else {
             return Ok(());
         };
-        res.motion = Some(MotionBuffers::new(&self.device, res.extent, res.mode == Transparency::Exact)?);
+        res.motion = Some(MotionBuffers::new(&self.device, res.extent, res.method.exact())?);
         Ok(())
     }
 }
 
 /// Recording.
 impl TransparentPass {
-    /// Records `frame` in `mode` with fragments made by `raster`: the build in
-    /// the draw's scope and the composite in its own.
+    /// Records `frame` by `method` (a transparent one): the build in the
+    /// draw's scope and the composite in its own.
     ///
     /// # Safety
     /// As for `DrawPass::record`.
@@ -360,7 +330,7 @@ impl TransparentPass {
         &mut self,
         frame: &DrawFrame<'_>,
         graph: &mut FrameGraph,
-        (mode, params, raster): (Transparency, &OitParams, Raster),
+        (method, params): (DrawMethod, &OitParams),
         shading: &mut ShadingResources,
         ribbons: &RibbonIndices,
     ) -> Result<()> {
@@ -371,13 +341,13 @@ impl TransparentPass {
                 "transparent hair needs a single-sample target (use supersampling for more samples)",
             ));
         }
-        let compute = raster != Raster::Hardware;
+        let compute = method.compute();
         // Checked, made (or found) before anything is recorded: a failure leaves `cmd` as it was.
         let depth_source = if compute { DepthSource::of(target)? } else { DepthSource::None };
-        self.prepare(frame.frame, mode, params, raster, target.extent)?;
+        self.prepare(frame.frame, method, params, target.extent)?;
         self.prepare_motion(frame)?;
-        let shaders = match mode {
-            Transparency::Exact => exact::shaders(params.sorted_fragments, raster),
+        let shaders = match method.exact() {
+            true => exact::shaders(params.sorted_fragments, method.raster()),
             _ => fast::SHADERS,
         };
         self.make_pipelines(frame, &shaders, shading)?;
@@ -404,8 +374,8 @@ impl TransparentPass {
             hair_y1: 0,
             scene_depth: depth_source.code(),
             reverse_z: u32::from(target.key.reverse_z),
-            motion_threshold: match (&frame.motion, mode) {
-                (Some(motion), Transparency::Exact) => motion.threshold,
+            motion_threshold: match &frame.motion {
+                Some(motion) if method.exact() => motion.threshold,
                 _ => 0.0,
             },
         };

@@ -88,7 +88,7 @@ impl TransparentPass {
         let rect = ComputePipeline::new(d, &RENDER_HAIR_RECT_COMP, 1)?;
         let rect_set = rect.declared_resource_set(0, &buffers, &[])?;
         let build_stages = [&RENDER_RIBBON_VERT_COVERAGE, shaders.build];
-        let build = match res.raster() {
+        let build = match res.method.raster() {
             Raster::Tiles => Build::Tiles(Box::new(BinPipelines::new(d, &buffers, &shading_images)?)),
             Raster::Compute => {
                 // Constant 0: the pool's buffers (oit.glsl), as the hardware build's.

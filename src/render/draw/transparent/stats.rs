@@ -2,7 +2,6 @@
 
 use super::TransparentPass;
 use crate::gpu_types::OitCounters;
-use crate::render::Transparency;
 
 /// What the last exact-mode frame stored, read by
 /// [`crate::render::Renderer::transparency_stats`].
@@ -42,7 +41,7 @@ impl TransparentPass {
     /// valid once that frame completed and before the next one is submitted.
     pub(in crate::render::draw) fn stats(&self) -> Option<OitStats> {
         // The current resources are those of the latest transparent frame.
-        let res = self.current.as_ref().filter(|r| r.mode == Transparency::Exact)?;
+        let res = self.current.as_ref().filter(|r| r.method.exact())?;
         let bytes = self.counters.mapped()?;
         let counters: OitCounters = bytemuck::pod_read_unaligned(bytes.get(..std::mem::size_of::<OitCounters>())?);
         let rect = [counters.hair_x0, counters.hair_y0, counters.hair_x1, counters.hair_y1];
