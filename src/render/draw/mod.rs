@@ -482,7 +482,7 @@ impl Renderer {
         vk::Extent2D { width: extent.width.saturating_mul(scale), height: extent.height.saturating_mul(scale) }
     }
 
-    /// What the latest frame drawn with [`Transparency::Exact`] stored: fragments
+    /// What the latest frame drawn with [`super::Transparency::Exact`] stored: fragments
     /// offered, stored, and overflowed because the pool was full (those are
     /// composited unsorted behind the stored ones). Read from
     /// host-visible memory: valid once that frame's commands completed and before
@@ -503,7 +503,7 @@ impl Renderer {
     /// supersampled extent where supersampling is on) on this device: what
     /// [`OitParams::fragments_per_pixel`] asks for and what the device's buffers
     /// hold ([`OitPool::is_capped`] when fewer). `None` unless the current mode
-    /// is [`Transparency::Exact`] with per-pixel lists (the tiled rasteriser,
+    /// is [`super::Transparency::Exact`] with per-pixel lists (the tiled rasteriser,
     /// [`Raster::Tiles`], keeps none).
     pub fn transparency_pool(&self, extent: vk::Extent2D) -> Option<OitPool> {
         if !self.draw_method().lists() {

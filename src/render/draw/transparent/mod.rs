@@ -1,7 +1,7 @@
-//! Pass 4 with transparency ([`Transparency::Exact`] and [`Transparency::Fast`],
-//! `glsl/render/oit_*`): the hair as transparent strands composited over the
-//! target. What both modes share lives here; what differs, in `exact.rs` and
-//! `fast.rs`.
+//! Pass 4 with transparency ([`crate::render::Transparency::Exact`] and
+//! [`crate::render::Transparency::Fast`], `glsl/render/oit_*`): the hair as
+//! transparent strands composited over the target. What both modes share
+//! lives here; what differs, in `exact.rs` and `fast.rs`.
 //!
 //! 1. **Build** (in the [`RenderPass::Draw`] scope): every vertex of the hairs
 //!    shaded once (`shade_points.comp`, a dispatch); then the ribbons of the draw
