@@ -4,15 +4,18 @@
 //! touches as a [`Use`]: a buffer or image, the [`AccessKind`]s it makes of it
 //! and, for an image, the layout it needs. [`FrameGraph::record`] compares each
 //! use with the resource's last ones and records one `vkCmdPipelineBarrier2`
-//! holding exactly the dependencies they need:
+//! holding the dependencies they need (one global barrier folding every
+//! buffer's together):
 //!
 //! - a read after a write waits for that write and makes it visible to the
-//!   reading kinds (once: a later read of the same kinds needs nothing);
+//!   reading kinds (once: a later read of the same kinds needs nothing, until
+//!   the next write or layout transition);
 //! - a write waits for the last write (its memory) and for every read since
 //!   (execution only);
 //! - an image whose layout changes is transitioned, from `UNDEFINED` where the
-//!   use discards its contents (always on its first use in the graph, so that
-//!   a new image needs no transition of its own).
+//!   use discards its contents; a discarding first use in the graph is
+//!   transitioned from `UNDEFINED` even when it needs the rest layout, so that
+//!   a new image needs no transition of its own.
 //!
 //! Buffer dependencies fold into one global memory barrier; image transitions
 //! are image barriers. No pass places a barrier against its neighbour: the
@@ -184,9 +187,14 @@ impl FrameGraph {
                     }
                 }
             }
-            if writes.is_empty() {
-                let transitioned = u.image.is_some_and(|i| Some(i.layout) != old || (first && i.discard));
-                if after_write || transitioned {
+            let transitioned = u.image.is_some_and(|i| Some(i.layout) != old || (first && i.discard));
+            if writes.is_empty() && transitioned {
+                // A transition writes the image: only this use's kinds see it,
+                // and earlier readers are ordered before it.
+                state.visible = reads;
+                state.readers = reads;
+            } else if writes.is_empty() {
+                if after_write {
                     state.visible = state.visible.union(reads);
                 }
                 state.readers = state.readers.union(reads);

@@ -137,6 +137,21 @@ fn images_change_layout_by_transitions_and_settle_at_rest() {
     assert!(g.derive(&[depth.discarding()]).images.is_empty());
     // At rest already: settling adds nothing.
     assert!(g.settle_barriers().images.is_empty());
+    // Written, read in one layout, transitioned for another reader, then
+    // transitioned back and read by the first kind: each transition is a
+    // write, waited for again.
+    let mut g = FrameGraph::new();
+    g.derive(&[image(8, &[ComputeWrite], L::GENERAL, rest).discarding()]);
+    assert!(!g.derive(&[image(8, &[ComputeRead], L::GENERAL, rest)]).memory.is_empty());
+    assert_eq!(g.derive(&[image(8, &[FragmentSampledRead], rest, rest)]).images.len(), 1);
+    assert_eq!(g.derive(&[image(8, &[ComputeRead], L::GENERAL, rest)]).images.len(), 1);
+    // Read by the fragment stage in GENERAL now: the transition back was not
+    // made visible to it, so it waits, though it read the image before.
+    let b = g.derive(&[image(8, &[FragmentSampledRead], L::GENERAL, rest)]);
+    assert_eq!(b.memory.len(), 1, "the fragment read waits for the transition");
+    assert_eq!(b.memory[0].dst_stage_mask, S::FRAGMENT_SHADER);
+    // A second read of the same kind in the same layout: nothing.
+    assert!(g.derive(&[image(8, &[FragmentSampledRead], L::GENERAL, rest)]).memory.is_empty());
     // Left in another layout: settling returns it.
     let mut g = FrameGraph::new();
     g.derive(&[image(6, &[ComputeWrite], L::GENERAL, rest).discarding()]);

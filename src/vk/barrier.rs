@@ -81,7 +81,7 @@ access_kinds! {
     TransferRead => (Stage::COPY, Acc::TRANSFER_READ),
     /// Copy destinations.
     TransferWrite => (Stage::COPY, Acc::TRANSFER_WRITE),
-    /// Clear destinations (`vkCmdClear*Image`, `vkCmdFillBuffer`).
+    /// Clear destinations (`vkCmdClear*Image`, `vkCmdFillBuffer`, `vkCmdUpdateBuffer`).
     ClearWrite => (Stage::CLEAR, Acc::TRANSFER_WRITE),
     /// Writes by any transfer command (copies, clears, updates, blits).
     AnyTransferWrite => (Stage::ALL_TRANSFER, Acc::TRANSFER_WRITE),

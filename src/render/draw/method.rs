@@ -28,6 +28,7 @@ impl DrawMethod {
     /// The method of `transparency` with `raster` (resolved for the device;
     /// only the exact mode has a choice of rasteriser).
     pub(in crate::render) fn of(transparency: Transparency, raster: Raster) -> DrawMethod {
+        debug_assert_ne!(raster, Raster::Auto, "the raster is resolved for the device first");
         match (transparency, raster) {
             (Transparency::Off, _) => DrawMethod::Opaque,
             (Transparency::Fast, _) => DrawMethod::Weighted,
@@ -67,7 +68,8 @@ impl DrawMethod {
 mod tests {
     use super::*;
 
-    /// Every pair of settings maps to the method that draws it, and back.
+    /// Each transparency mode with each resolved rasteriser that matters to it
+    /// maps to the method that draws it, and each method answers for itself.
     #[test]
     fn settings_select_one_method() {
         let cases = [

@@ -315,7 +315,8 @@ impl MotionPipelines {
         use AccessKind::*;
         let reads = |kinds: &[AccessKind]| -> Vec<Use> { words.0.iter().map(|b| Use::buffer(b, kinds)).collect() };
         let picks = |kinds: &[AccessKind]| -> Vec<Use> { words.1.iter().map(|b| Use::buffer(b, kinds)).collect() };
-        let update = [Use::buffer(motion.uniforms, &[TransferWrite])];
+        // `vkCmdUpdateBuffer` runs in the clear stage: any transfer write.
+        let update = [Use::buffer(motion.uniforms, &[AnyTransferWrite])];
         let walk = [
             vec![Use::buffer(motion.uniforms, &[ComputeUniformRead]), Use::buffer(motion.previous, &[ComputeRead])],
             reads(&[ComputeRead]),

@@ -126,7 +126,7 @@ impl OpaqueMotion {
             Use::buffer(&words.counters, &[AccessKind::AnyTransferWrite]),
             Use::buffer(&words.keys, &[AccessKind::AnyTransferWrite]),
         ];
-        let (reads, picks) = ([frame.inputs.hairs.0, &words.counters], [&words.keys]);
+        let (reads, picks) = ([frame.inputs.hairs.0, frame.inputs.hairs.1, &words.counters], [&words.keys]);
         // SAFETY: guaranteed by the caller.
         unsafe {
             let scope = RenderPass::Motion.open(&d, frame.cmd, frame.timing);

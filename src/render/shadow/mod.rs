@@ -379,7 +379,8 @@ impl Shadows {
         let any_map = uniforms.maps.iter().take(params.casters.len()).any(|m| !m.is_density_volume());
         // SAFETY: guaranteed by the caller.
         unsafe {
-            graph.record(d, cmd, &[Use::buffer(&self.uniforms, &[AccessKind::TransferWrite])]);
+            // `vkCmdUpdateBuffer` runs in the clear stage: any transfer write.
+            graph.record(d, cmd, &[Use::buffer(&self.uniforms, &[AccessKind::AnyTransferWrite])]);
             d.raw.cmd_update_buffer(cmd, self.uniforms.raw(), 0, bytemuck::bytes_of(&uniforms));
             if any_map {
                 let vertices = hairs * (per_hair - 1) * 2;

@@ -416,8 +416,14 @@ impl TransparentPass {
             sums_attached,
         ]
         .concat();
+        // (The tiled rasteriser's fine pass reads the hairs and their colours too.)
         let resolve = [
-            vec![Use::buffer(&self.counters, &[ComputeRead, ComputeWrite])],
+            vec![
+                Use::buffer(&self.counters, &[ComputeRead, ComputeWrite]),
+                Use::buffer(&self.colors, &[ComputeRead]),
+                Use::buffer(frame.inputs.hairs.0, &[ComputeRead]),
+                Use::buffer(frame.inputs.hairs.1, &[ComputeRead]),
+            ],
             uses(&pixels, &[ComputeRead, ComputeWrite]),
             uses(&bins, &[ComputeRead, ComputeWrite]),
         ]
@@ -534,7 +540,8 @@ impl TransparentPass {
             scope.close(d, cmd, timing);
             if let (Some(motion), Some(walk)) = (&frame.motion, &pipelines.motion) {
                 let scope = RenderPass::Motion.open(d, cmd, timing);
-                let reads = [&[frame.inputs.hairs.0, &self.counters][..], &pixels].concat();
+                let hairs = frame.inputs.hairs;
+                let reads = [&[hairs.0, hairs.1, &self.counters][..], &pixels].concat();
                 let picks: Vec<&Buffer> = res.motion.iter().flat_map(MotionBuffers::buffers).collect();
                 walk.record(d, cmd, graph, motion, (frame.segments, (&reads, &picks)));
                 scope.close(d, cmd, timing);
