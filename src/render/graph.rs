@@ -75,6 +75,11 @@ impl Use {
         Use::raw_buffer(buffer.raw(), kinds)
     }
 
+    /// Each of `buffers` accessed as `kinds`.
+    pub(crate) fn buffers<'a>(buffers: impl IntoIterator<Item = &'a Buffer>, kinds: &[AccessKind]) -> Vec<Use> {
+        buffers.into_iter().map(|b| Use::buffer(b, kinds)).collect()
+    }
+
     /// A buffer vkhair may not own (the simulation's, a host's) accessed as `kinds`.
     pub(crate) fn raw_buffer(buffer: vk::Buffer, kinds: &[AccessKind]) -> Use {
         Use { resource: Resource::Buffer(buffer), kinds: KindSet::of(kinds), image: None }
@@ -165,12 +170,13 @@ impl FrameGraph {
             let after_write = !state.write.is_empty() && (!writes.is_empty() || unseen);
             let after_reads = !writes.is_empty() && !state.readers.is_empty();
             let old = state.layout.map(|(layout, _, _)| layout);
-            match (u.image, old) {
-                // A discarding first use transitions from UNDEFINED even into
-                // the rest layout: the image may be new, its layout never set.
-                (Some(image), Some(old)) if image.layout != old || (first && image.discard) => {
+            // A discarding first use transitions from UNDEFINED even into the
+            // rest layout: the image may be new, its layout never set.
+            let transitioned = u.image.filter(|i| Some(i.layout) != old || (first && i.discard));
+            match (u.resource, transitioned, old) {
+                (Resource::Image(raw), Some(image), Some(old)) => {
                     let old = if image.discard { vk::ImageLayout::UNDEFINED } else { old };
-                    images.push(transition(image, state, u.resource, u.kinds, old));
+                    images.push(transition(raw, image.range, (old, image.layout), state, u.kinds));
                     state.layout = Some((image.layout, image.rest, image.range));
                 }
                 _ => {
@@ -187,8 +193,7 @@ impl FrameGraph {
                     }
                 }
             }
-            let transitioned = u.image.is_some_and(|i| Some(i.layout) != old || (first && i.discard));
-            if writes.is_empty() && transitioned {
+            if writes.is_empty() && transitioned.is_some() {
                 // A transition writes the image: only this use's kinds see it,
                 // and earlier readers are ordered before it.
                 state.visible = reads;
@@ -217,10 +222,8 @@ impl FrameGraph {
     /// made that touches them was declared to it.
     pub(crate) unsafe fn record(&mut self, device: &Device, cmd: vk::CommandBuffer, uses: &[Use]) {
         let barriers = self.derive(uses);
-        if !barriers.memory.is_empty() || !barriers.images.is_empty() {
-            // SAFETY: guaranteed by the caller.
-            unsafe { device.cmd_barriers(cmd, &barriers) };
-        }
+        // SAFETY: guaranteed by the caller.
+        unsafe { record_any(device, cmd, &barriers) };
     }
 
     /// The transitions that return every image the graph moved to its rest
@@ -230,16 +233,7 @@ impl FrameGraph {
         for (resource, state) in &self.states {
             let (Resource::Image(raw), Some((layout, rest, range))) = (resource, state.layout) else { continue };
             if layout != rest {
-                let (src_stage, src_access) = state.write.mask();
-                let (readers, _) = state.readers.mask();
-                let (dst_stage, dst_access) = AccessKind::mask(barrier::ANY);
-                images.push(
-                    barrier::subresources(*raw, range, &[], barrier::ANY, layout, rest)
-                        .src_stage_mask(src_stage | readers)
-                        .src_access_mask(src_access)
-                        .dst_stage_mask(dst_stage)
-                        .dst_access_mask(dst_access),
-                );
+                images.push(transition(*raw, range, (layout, rest), state, KindSet::of(barrier::ANY)));
             }
         }
         self.states.clear();
@@ -252,10 +246,19 @@ impl FrameGraph {
     /// As for [`FrameGraph::record`].
     pub(crate) unsafe fn settle(&mut self, device: &Device, cmd: vk::CommandBuffer) {
         let barriers = self.settle_barriers();
-        if !barriers.images.is_empty() {
-            // SAFETY: guaranteed by the caller.
-            unsafe { device.cmd_barriers(cmd, &barriers) };
-        }
+        // SAFETY: guaranteed by the caller.
+        unsafe { record_any(device, cmd, &barriers) };
+    }
+}
+
+/// Records `barriers` unless there are none.
+///
+/// # Safety
+/// As for [`FrameGraph::record`].
+unsafe fn record_any(device: &Device, cmd: vk::CommandBuffer, barriers: &Barriers) {
+    if !barriers.memory.is_empty() || !barriers.images.is_empty() {
+        // SAFETY: guaranteed by the caller.
+        unsafe { device.cmd_barriers(cmd, barriers) };
     }
 }
 
@@ -272,21 +275,17 @@ fn memory_barrier(src: KindSet, src_stages: KindSet, dst: KindSet) -> vk::Memory
         .dst_access_mask(dst_access)
 }
 
-/// The transition of `image` from `old` to its use's layout, after the
-/// resource's last write and reads.
+/// The transition of `range` of `raw` between `layouts` (old, new), after
+/// `state`'s last write and reads, before `dst`.
 fn transition(
-    image: ImageUse,
+    raw: vk::Image,
+    range: vk::ImageSubresourceRange,
+    (old, new): (vk::ImageLayout, vk::ImageLayout),
     state: &State,
-    resource: Resource,
-    kinds: KindSet,
-    old: vk::ImageLayout,
+    dst: KindSet,
 ) -> vk::ImageMemoryBarrier2<'static> {
-    let raw = match resource {
-        Resource::Image(raw) => raw,
-        Resource::Buffer(_) | Resource::HostAttachments => vk::Image::null(),
-    };
-    let dependency = memory_barrier(state.write, state.readers, kinds);
-    barrier::subresources(raw, image.range, &[], &[], old, image.layout)
+    let dependency = memory_barrier(state.write, state.readers, dst);
+    barrier::subresources(raw, range, &[], &[], old, new)
         .src_stage_mask(dependency.src_stage_mask)
         .src_access_mask(dependency.src_access_mask)
         .dst_stage_mask(dependency.dst_stage_mask)

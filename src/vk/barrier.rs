@@ -132,7 +132,7 @@ impl KindSet {
 
     /// The set of `kinds`.
     pub(crate) fn of(kinds: &[AccessKind]) -> KindSet {
-        KindSet(kinds.iter().fold(0, |bits, &k| bits | 1 << k as u32))
+        kinds.iter().copied().collect()
     }
 
     /// Whether no kind is in the set.
@@ -152,17 +152,12 @@ impl KindSet {
 
     /// The kinds of the set that write.
     pub(crate) fn writes(self) -> KindSet {
-        self.filter(AccessKind::writes)
+        self.kinds().filter(|k| k.writes()).collect()
     }
 
     /// The kinds of the set that only read.
     pub(crate) fn reads(self) -> KindSet {
         self.minus(self.writes())
-    }
-
-    fn filter(self, keep: impl Fn(AccessKind) -> bool) -> KindSet {
-        let kept: Vec<AccessKind> = self.kinds().filter(|&k| keep(k)).collect();
-        KindSet::of(&kept)
     }
 
     /// The kinds in the set.
@@ -172,8 +167,16 @@ impl KindSet {
 
     /// The stage and access masks of the set's kinds.
     pub(crate) fn mask(self) -> (Stage, Acc) {
-        let kinds: Vec<AccessKind> = self.kinds().collect();
-        AccessKind::mask(&kinds)
+        self.kinds().fold((Stage::NONE, Acc::NONE), |(stage, access), kind| {
+            let (s, a) = kind.parts();
+            (stage | s, access | a)
+        })
+    }
+}
+
+impl FromIterator<AccessKind> for KindSet {
+    fn from_iter<I: IntoIterator<Item = AccessKind>>(kinds: I) -> KindSet {
+        KindSet(kinds.into_iter().fold(0, |bits, k| bits | 1 << k as u32))
     }
 }
 

@@ -313,14 +313,12 @@ impl MotionPipelines {
         (segments, words): (u32, (&[&Buffer], &[&Buffer])),
     ) {
         use AccessKind::*;
-        let reads = |kinds: &[AccessKind]| -> Vec<Use> { words.0.iter().map(|b| Use::buffer(b, kinds)).collect() };
-        let picks = |kinds: &[AccessKind]| -> Vec<Use> { words.1.iter().map(|b| Use::buffer(b, kinds)).collect() };
         // `vkCmdUpdateBuffer` runs in the clear stage: any transfer write.
         let update = [Use::buffer(motion.uniforms, &[AnyTransferWrite])];
         let walk = [
             vec![Use::buffer(motion.uniforms, &[ComputeUniformRead]), Use::buffer(motion.previous, &[ComputeRead])],
-            reads(&[ComputeRead]),
-            picks(&[ComputeRead, ComputeWrite]),
+            Use::buffers(words.0.iter().copied(), &[ComputeRead]),
+            Use::buffers(words.1.iter().copied(), &[ComputeRead, ComputeWrite]),
         ]
         .concat();
         // The host's velocity and depth images (its clear, its meshes: with
@@ -328,8 +326,8 @@ impl MotionPipelines {
         // depth writes, before the write loads and tests them.
         let write = [
             vec![Use::buffer(motion.uniforms, &[FragmentUniformRead]), Use::host_attachments(barrier::ATTACHMENTS)],
-            reads(&[FragmentRead]),
-            picks(&[FragmentRead]),
+            Use::buffers(words.0.iter().copied(), &[FragmentRead]),
+            Use::buffers(words.1.iter().copied(), &[FragmentRead]),
         ]
         .concat();
         let color = [rendering::color(motion.velocity, Load::Keep)];

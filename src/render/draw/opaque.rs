@@ -130,8 +130,7 @@ impl OpaquePipelines {
         // SAFETY: guaranteed by the caller; all objects belong to this device.
         unsafe {
             let scope = RenderPass::Draw.open(d, cmd, frame.timing);
-            shading.record_updates(cmd, graph, &frame.params, &frame.marschner);
-            graph.record(d, cmd, &[shading.uses(&frame.inputs), target.uses.clone()].concat());
+            shading.record_updates(graph, frame);
             let pipelines = &self.pipelines[&target.key];
             let shade = &pipelines.shade[&frame.features];
             d.raw.cmd_begin_rendering(cmd, &info);

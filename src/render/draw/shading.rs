@@ -7,7 +7,7 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Vec4;
 
-use super::DrawInputs;
+use super::{DrawFrame, DrawInputs};
 use crate::error::Result;
 use crate::gpu_types::DrawParams;
 use crate::render::graph::{FrameGraph, Use};
@@ -75,27 +75,24 @@ impl ShadingResources {
         )
     }
 
-    /// Records the Marschner tables' rebuild if `marschner` changed and the
-    /// update of the uniform block to `params`, declaring both to `graph`; the
-    /// draw then declares what it reads ([`ShadingResources::uses`]).
+    /// Records the start of `frame`'s draw: the Marschner tables' rebuild if
+    /// they changed and the update of the uniform block, then the barriers for
+    /// what the draw reads ([`ShadingResources::uses`]) and for its target's
+    /// attachments, each declared to `graph`.
     ///
     /// # Safety
-    /// `cmd` is a recording command buffer of this device outside a render pass;
-    /// every earlier command on the resources since `graph` was made was declared to it.
-    pub(super) unsafe fn record_updates(
-        &mut self,
-        cmd: vk::CommandBuffer,
-        graph: &mut FrameGraph,
-        params: &DrawParams,
-        marschner: &MarschnerParams,
-    ) {
-        let d = &self.device;
+    /// `frame.cmd` is a recording command buffer of this device outside a
+    /// render pass; every earlier command on the resources since `graph` was
+    /// made was declared to it.
+    pub(super) unsafe fn record_updates(&mut self, graph: &mut FrameGraph, frame: &DrawFrame<'_>) {
+        let (d, cmd) = (&self.device, frame.cmd);
         // SAFETY: guaranteed by the caller; all objects belong to this device.
         unsafe {
             // The draw pipeline may sample the Marschner tables: build them first.
-            self.marschner.record_update(d, cmd, graph, marschner);
+            self.marschner.record_update(d, cmd, graph, &frame.marschner);
             graph.record(d, cmd, &[Use::buffer(&self.params, &[AccessKind::AnyTransferWrite])]);
-            d.raw.cmd_update_buffer(cmd, self.params.raw(), 0, bytemuck::bytes_of(params));
+            d.raw.cmd_update_buffer(cmd, self.params.raw(), 0, bytemuck::bytes_of(&frame.params));
+            graph.record(d, cmd, &[self.uses(&frame.inputs), frame.target.uses.clone()].concat());
         }
     }
 
@@ -103,7 +100,7 @@ impl ShadingResources {
     /// block, the Marschner tables) and of `inputs`, with every kind of
     /// access a mode may make of them (the ribbons' vertex stage, the fragment
     /// stages, the transparent modes' compute shading and rasterisers).
-    pub(super) fn uses(&self, inputs: &DrawInputs<'_>) -> Vec<Use> {
+    fn uses(&self, inputs: &DrawInputs<'_>) -> Vec<Use> {
         use AccessKind::*;
         let uniform = &[VertexUniformRead, FragmentUniformRead, ComputeUniformRead];
         let storage = &[VertexRead, FragmentRead, ComputeRead];

@@ -325,13 +325,13 @@ impl BinPipelines {
         (graph, bins, first): (&mut FrameGraph, &TileBins, &[Use]),
         segments: u32,
     ) {
-        let uses = bins.buffers().map(|b| Use::buffer(b, &[AccessKind::ComputeRead, AccessKind::ComputeWrite]));
+        let uses = Use::buffers(bins.buffers(), &[AccessKind::ComputeRead, AccessKind::ComputeWrite]);
         let threads = self.count.0.grid_stride_threads(segments);
         // SAFETY: guaranteed by the caller.
         unsafe {
             let passes = [(&self.count, threads), (&self.scan, SCAN_GROUP), (&self.fill, threads)];
             for (i, (pass, groups)) in passes.into_iter().enumerate() {
-                let declared = if i == 0 { [first, &uses].concat() } else { uses.to_vec() };
+                let declared = if i == 0 { [first, &uses].concat() } else { uses.clone() };
                 graph.record(device, cmd, &declared);
                 pass.0.bind(cmd, &[pass.1]);
                 pass.0.dispatch_threads(cmd, [groups, 1, 1]);

@@ -387,16 +387,12 @@ impl TransparentPass {
             true => (&[ComputeRead, ComputeWrite], ComputeRead),
             false => (&[FragmentRead, FragmentWrite], VertexRead),
         };
-        let uses = |buffers: &[&Buffer], kinds: &[AccessKind]| -> Vec<Use> {
-            buffers.iter().map(|b| Use::buffer(b, kinds)).collect()
-        };
         // Every per-pixel buffer but the bins, which the tiled build declares itself.
         let mut pixels: Vec<&Buffer> = vec![&res.opaque];
         pixels.extend(res.lists.iter().flat_map(Lists::buffers));
         pixels.extend(res.raster_buffers.iter().flat_map(RasterBuffers::buffers));
         pixels.extend(&res.resolved);
         pixels.extend(res.motion.iter().flat_map(MotionBuffers::buffers));
-        let bins: Vec<&Buffer> = res.tiles.iter().flat_map(TileBins::buffers).collect();
         let mut cleared: Vec<&Buffer> = vec![&res.opaque];
         cleared.extend(res.lists.as_ref().map(Lists::cleared));
         cleared.extend(res.tiles.iter().flat_map(TileBins::cleared));
@@ -409,10 +405,10 @@ impl TransparentPass {
         let counters_update = [Use::buffer(&self.counters, &[AnyTransferWrite])];
         let shade =
             [Use::buffer(&self.colors, &[ComputeWrite]), Use::buffer(&self.counters, &[ComputeRead, ComputeWrite])];
-        let clear = uses(&cleared, &[AnyTransferWrite]);
+        let clear = Use::buffers(cleared, &[AnyTransferWrite]);
         let build = [
             vec![Use::buffer(&self.colors, &[build_read]), Use::buffer(&self.counters, build_rw)],
-            uses(&pixels, build_rw),
+            Use::buffers(pixels.iter().copied(), build_rw),
             sums_attached,
         ]
         .concat();
@@ -424,13 +420,13 @@ impl TransparentPass {
                 Use::buffer(frame.inputs.hairs.0, &[ComputeRead]),
                 Use::buffer(frame.inputs.hairs.1, &[ComputeRead]),
             ],
-            uses(&pixels, &[ComputeRead, ComputeWrite]),
-            uses(&bins, &[ComputeRead, ComputeWrite]),
+            Use::buffers(pixels.iter().copied(), &[ComputeRead, ComputeWrite]),
+            Use::buffers(res.tiles.iter().flat_map(TileBins::buffers), &[ComputeRead, ComputeWrite]),
         ]
         .concat();
         let composite = [
             vec![Use::buffer(&self.counters, &[VertexRead, FragmentRead])],
-            uses(&pixels, &[FragmentRead, FragmentWrite]),
+            Use::buffers(pixels.iter().copied(), &[FragmentRead, FragmentWrite]),
             sums_sampled,
             target.uses.clone(),
         ]
@@ -445,10 +441,9 @@ impl TransparentPass {
         // SAFETY: guaranteed by the caller; every object belongs to this device.
         unsafe {
             let scope = RenderPass::Draw.open(d, cmd, timing);
-            shading.record_updates(cmd, graph, &frame.params, &frame.marschner);
             // What the pass reads of the earlier passes, and the target it
             // tests against (the build) and blends into (the composite).
-            graph.record(d, cmd, &[shading.uses(&frame.inputs), target.uses.clone()].concat());
+            shading.record_updates(graph, frame);
             graph.record(d, cmd, &counters_update);
             d.raw.cmd_update_buffer(cmd, self.counters.raw(), 0, bytemuck::bytes_of(&counters));
             graph.record(d, cmd, &shade);
