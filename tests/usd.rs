@@ -199,7 +199,7 @@ fn nested_rotations_scales_and_translations_compose_as_usd_core_does() {
 #[test]
 fn text_layers_that_recurse_without_bound_are_refused_before_reading() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let curves = STRAND;
     let deep_prims = format!(
         "{}{curves}{}",
         (0..5000).map(|i| format!("def Xform \"p{i}\" {{\n")).collect::<String>(),
@@ -236,6 +236,19 @@ fn write_binary(path: &Path, text: &str) {
     openusd::usdc::CrateWriter::write_to_file(&data, path).expect("binary");
 }
 
+/// One straight two-point strand: the curves of many of these tests' layers.
+const STRAND: &str = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+
+/// Writes text files under `dir` by name.
+fn text_writer(dir: &Path) -> impl Fn(&str, &str) + '_ {
+    move |name, text| std::fs::write(dir.join(name), text).expect("write")
+}
+
+/// Writes binary layers under `dir` by name, from their text.
+fn binary_writer(dir: &Path) -> impl Fn(&str, &str) + '_ {
+    move |name, text| write_binary(&dir.join(name), text)
+}
+
 /// Opens each `(root, parts)` stage under `dir`: refused, with every part in
 /// the error (printed with the time it took).
 fn refused_naming(dir: &Path, cases: &[(&str, &[&str])]) {
@@ -260,8 +273,8 @@ fn refused_naming(dir: &Path, cases: &[(&str, &[&str])]) {
 #[test]
 fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
-    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let write = text_writer(dir.path());
+    let curves = STRAND;
     write("curves.usda", &format!("#usda 1.0\n{curves}"));
     write("root.usda", "#usda 1.0\n(\n    subLayers = [\n        @./curves.usda@\n    ]\n)\n");
     let g = usd::open(dir.path().join("root.usda")).expect("a stage of a sublayer");
@@ -309,8 +322,8 @@ fn every_layer_a_stage_names_is_checked_and_none_is_dropped() {
 #[test]
 fn arcs_are_judged_over_the_sublayers_of_a_stack() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
-    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let write = text_writer(dir.path());
+    let curves = STRAND;
     let stage = |subs: &str| format!("#usda 1.0\n(\n    subLayers = [{subs}]\n)\n{curves}");
     write("a.usda", "#usda 1.0\nclass \"A\" (\n    inherits = </B>\n) { }\n");
     write("b.usda", "#usda 1.0\nclass \"B\" (\n    inherits = </A>\n) { }\n");
@@ -395,8 +408,8 @@ fn arcs_are_judged_over_the_sublayers_of_a_stack() {
 #[test]
 fn an_arc_to_a_prim_that_cannot_be_there_is_refused() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
-    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let write = text_writer(dir.path());
+    let curves = STRAND;
     write("b.usda", &format!("#usda 1.0\ndef Xform \"G\" {{\n{curves}}}\n"));
     write("e.usda", &format!("#usda 1.0\ndef Xform \"E\" {{\n{curves}}}\n"));
     write("stacked.usda", "#usda 1.0\n(\n    subLayers = [@e.usda@]\n)\n");
@@ -445,8 +458,8 @@ fn an_arc_to_a_prim_that_cannot_be_there_is_refused() {
 #[test]
 fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
-    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let write = text_writer(dir.path());
+    let curves = STRAND;
     write("curves.usda", &format!("#usda 1.0\n{curves}"));
     let deep = |levels: usize| {
         let open: String = (0..levels).map(|i| format!("def Xform \"p{i}\" {{\n")).collect();
@@ -544,7 +557,7 @@ fn layers_that_slipped_past_the_checks_are_refused_naming_them() {
 #[test]
 fn values_nested_in_a_binary_layer_are_walked_before_the_library_reads_them() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let curves = STRAND;
     std::fs::write(dir.path().join("strand.usda"), format!("#usda 1.0\n{curves}")).expect("write");
     let text = format!(
         "#usda 1.0\n(\n    customLayerData = {{\n        dictionary inner = {{\n            string note = \"a\"\n            \
@@ -597,9 +610,9 @@ fn values_nested_in_a_binary_layer_are_walked_before_the_library_reads_them() {
 #[test]
 fn the_layers_a_binary_layer_names_are_checked_too() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
-    let binary = |name: &str, text: &str| write_binary(&dir.path().join(name), text);
-    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let write = text_writer(dir.path());
+    let binary = binary_writer(dir.path());
+    let curves = STRAND;
     write("strand.usda", &format!("#usda 1.0\n(\n    defaultPrim = \"c\"\n)\n{curves}"));
     crate::common::mkfifo(&dir.path().join("pipe.usda"));
     binary("fifo.usdc", &format!("#usda 1.0\n(\n    subLayers = [@pipe.usda@]\n)\n{curves}"));
@@ -637,9 +650,9 @@ fn the_layers_a_binary_layer_names_are_checked_too() {
 #[test]
 fn a_binary_layers_arcs_between_its_prims_are_judged_as_a_text_layers() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
-    let binary = |name: &str, text: &str| write_binary(&dir.path().join(name), text);
-    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let write = text_writer(dir.path());
+    let binary = binary_writer(dir.path());
+    let curves = STRAND;
     let layer = |body: &str| format!("#usda 1.0\n{body}{curves}");
     binary("self.usdc", &layer("class \"A\" (\n    inherits = </A>\n) { }\n"));
     binary(
@@ -686,9 +699,9 @@ fn a_binary_layers_arcs_between_its_prims_are_judged_as_a_text_layers() {
 #[test]
 fn clips_relocates_odd_names_and_deep_binary_nesting_are_refused_and_instances_read() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
-    let binary = |name: &str, text: &str| write_binary(&dir.path().join(name), text);
-    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let write = text_writer(dir.path());
+    let binary = binary_writer(dir.path());
+    let curves = STRAND;
     crate::common::mkfifo(&dir.path().join("pipe.usda"));
     let clipped = |clips: &str| {
         format!("#usda 1.0\n{curves}def BasisCurves \"k\" (\n    {clips}\n) {{\n    int[] curveVertexCounts\n}}\n")
@@ -763,8 +776,8 @@ fn clips_relocates_odd_names_and_deep_binary_nesting_are_refused_and_instances_r
 #[test]
 fn composition_that_multiplies_or_hides_its_arcs_is_bounded() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
-    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let write = text_writer(dir.path());
+    let curves = STRAND;
     let fan = |n: usize| {
         let classes: String = (0..n)
             .map(|i| {
@@ -878,7 +891,7 @@ fn a_negative_width_is_refused_strictly_and_passed_over_when_repairing() {
 #[test]
 fn a_stage_of_too_many_layers_is_refused() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let curves = "def BasisCurves \"c\" { int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0),(0,1,0)] }\n";
+    let curves = STRAND;
     let chain = |n: usize| {
         for i in 0..n {
             let text = if i + 1 < n {
