@@ -943,6 +943,32 @@ fn binary_layers_are_checked_before_the_reader_trusts_them() {
     }
 }
 
+/// A compressed array's block is checked against the file before the USD
+/// library allocates it: the dense fixture relabelled as crate version 0.5.0
+/// or 0.6.0 (whose arrays count their elements in 32 bits, not 64) has the
+/// library read a compressed size of 80 GiB from the count's high bytes —
+/// it aborted the process — and is refused naming the field and the size;
+/// as 0.7.0, the layout it has, it reads.
+#[test]
+fn a_compressed_array_block_past_the_file_is_refused_before_the_reader_allocates_it() {
+    let bytes = std::fs::read(data("usd/dense_curly.usdc")).expect("fixture");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("v.usdc");
+    for (version, refused) in [([0u8, 5, 0], true), ([0, 6, 0], true), ([0, 7, 0], false)] {
+        let mut b = bytes.clone();
+        b[8..11].copy_from_slice(&version);
+        std::fs::write(&path, &b).expect("write");
+        match usd::open(&path) {
+            Err(e) if refused => {
+                let e = e.to_string();
+                assert!(e.contains("v.usdc") && e.contains("has a compressed block of 85899345920 bytes"), "{e}");
+            }
+            Ok(g) if !refused => assert_eq!(g.groom.strand_count(), 1500, "{version:?}"),
+            other => panic!("crate version {version:?}: {:?}", other.map(|g| g.groom.strand_count())),
+        }
+    }
+}
+
 /// The counts and block sizes at the head of the sections the USD library
 /// reads first, each byte set to 0xFF, 0x7F and 0x20 in turn (the bytes a
 /// probe's sweep found aborting the process with a request for up to 9 × 10¹⁸

@@ -239,8 +239,63 @@ fn check_counts(walk: &mut Walk<'_>, rep: ValueRep) -> Result<()> {
                 "is an array of {count} elements at byte {at}, more than the file holds (at most {most})"
             )));
         }
+        if compressed {
+            check_compressed_block(read_at, pos, len, rep.ty()).map_err(what)?;
+        }
     } else if at >= len {
         return Err(what(format!("starts at byte {at}, past the file's end ({len} bytes)")));
+    }
+    Ok(())
+}
+
+/// The block of a compressed array of crate type `ty` whose elements start
+/// at byte `pos` of a file `len` bytes long: the crate allocates its
+/// compressed size (and a floating-point array's lookup table) as the file
+/// states them before it reads them (a file of another version's layout had
+/// it ask for 80 GiB). An integer array is that size and the block; a
+/// floating-point one a code byte, then either that (`i`, integers) or a
+/// 32-bit table length, the table and that (`t`). Each must fit in the file;
+/// `Err` says how it does not.
+fn check_compressed_block(
+    read_at: &mut dyn FnMut(u64, usize) -> Result<u64>,
+    pos: u64,
+    len: u64,
+    ty: u64,
+) -> std::result::Result<(), String> {
+    let room = |from: u64| len.saturating_sub(from);
+    let past = || format!("has its compressed block past the file's end ({len} bytes)");
+    let io = |e: Error| format!("cannot be read: {e}");
+    let mut pos = pos;
+    if !(3..=6).contains(&ty) {
+        // Floating point: a code byte first.
+        if room(pos) < 1 {
+            return Err(past());
+        }
+        let code = read_at(pos, 1).map_err(io)? as u8;
+        pos += 1;
+        match code {
+            b'i' => {}
+            b't' => {
+                if room(pos) < 4 {
+                    return Err(past());
+                }
+                let table = read_at(pos, 4).map_err(io)?;
+                pos += 4;
+                let bytes = table.saturating_mul(element_size(ty));
+                if bytes > room(pos) {
+                    return Err(format!("has a lookup table of {table} values, more than the file holds"));
+                }
+                pos += bytes;
+            }
+            other => return Err(format!("has an unknown compression code {other}")),
+        }
+    }
+    if room(pos) < 8 {
+        return Err(past());
+    }
+    let size = read_at(pos, 8).map_err(io)?;
+    if size > room(pos + 8) {
+        return Err(format!("has a compressed block of {size} bytes, more than the file holds"));
     }
     Ok(())
 }
