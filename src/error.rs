@@ -305,6 +305,20 @@ pub enum Error {
         /// Segment index within the strand.
         segment: usize,
     },
+    /// A strand is a point, not a hair: its bounding box is under
+    /// [`crate::groom::MIN_STRAND_FRACTION`] of the groom's median strand's.
+    #[error(
+        "strand {strand} is {size:e} across, under a millionth of the groom's median strand ({median:e}): a \
+         point, not a hair"
+    )]
+    DegenerateStrand {
+        /// Strand index.
+        strand: usize,
+        /// Its bounding-box diagonal, in the groom's units.
+        size: f32,
+        /// The groom's median strand bounding-box diagonal, in the groom's units.
+        median: f32,
+    },
     /// A point lies far from where its strand runs: a segment to it is over
     /// [`crate::groom::OUTLIER_SEGMENT_RATIO`] times the strand's median.
     #[error(

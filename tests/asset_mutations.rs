@@ -27,6 +27,7 @@ fn is_file_error(e: &Error) -> bool {
             | Error::NonFinite { .. }
             | Error::ZeroLengthSegment { .. }
             | Error::OutlierPoint { .. }
+            | Error::DegenerateStrand { .. }
             | Error::AttributeLength { .. }
             | Error::GroomExtent { .. }
             | Error::BadScalp(_)

@@ -14,6 +14,7 @@
 //! | a bounding-box diagonal that f32 can hold | [`Error::GroomExtent`] |
 //! | no outlier point: no segment over [`OUTLIER_SEGMENT_RATIO`] × its strand's median | [`Error::OutlierPoint`] |
 //! | no segment shorter than [`MIN_SEGMENT_FRACTION`] × its strand's bounding-box diagonal | [`Error::ZeroLengthSegment`] |
+//! | no strand under [`MIN_STRAND_FRACTION`] × the groom's median strand (bounding-box diagonals) | [`Error::DegenerateStrand`] |
 //! | attribute arrays of the right length | [`Error::AttributeLength`] |
 //!
 //! Sources: [`cyhair`] (`.hair` read/write), [`tfx`] (TressFX `.tfx` read),
@@ -71,6 +72,11 @@ pub const MAX_POINTS_PER_STRAND: usize = 1 << 16;
 /// units alike; judged per strand, so a far point elsewhere in the groom
 /// changes nothing).
 pub const MIN_SEGMENT_FRACTION: f32 = 1e-6;
+/// A strand whose bounding-box diagonal is under this fraction of the
+/// groom's median strand's is degenerate: a point, not a hair (judged by the
+/// median, so one far strand changes nothing; a strand judged by its own
+/// size alone would keep every segment of a strand a few picometres long).
+pub const MIN_STRAND_FRACTION: f32 = 1e-6;
 /// A segment longer than this many times its strand's median segment (a
 /// strand of three segments or more), or the groom's median segment, marks an
 /// outlier point: a point far from where its strand runs, which no
@@ -82,18 +88,27 @@ pub const OUTLIER_SEGMENT_RATIO: f32 = 1e4;
 /// Most segments [`groom_median_segment`] samples.
 const MEDIAN_SAMPLES: usize = 1 << 20;
 
-/// The median length of the segments of `strands` (ranges of `positions`),
-/// from at most [`MEDIAN_SAMPLES`] of them spread over the groom; `None`
-/// without a segment.
+/// The median length of the segments of `strands` (ranges of `positions`)
+/// between distinct points ([`segment_lengths`]), from at most
+/// [`MEDIAN_SAMPLES`] of them spread over the groom; `None` without one.
 pub(crate) fn groom_median_segment(
     positions: &[Vec3],
-    strands: impl Iterator<Item = std::ops::Range<usize>>,
+    strands: impl Iterator<Item = std::ops::Range<usize>> + Clone,
 ) -> Option<f32> {
-    let segments: Vec<(usize, usize)> =
-        strands.flat_map(|r| (r.start..r.end.saturating_sub(1)).map(|i| (i, i + 1))).collect();
-    let every = segments.len().div_ceil(MEDIAN_SAMPLES).max(1);
-    let mut lengths: Vec<f32> =
-        segments.iter().step_by(every).map(|&(a, b)| (positions[b] - positions[a]).length()).collect();
+    let total: usize = strands.clone().map(|r| r.len().saturating_sub(1)).sum();
+    let every = total.div_ceil(MEDIAN_SAMPLES).max(1);
+    let mut lengths = Vec::with_capacity(total.div_ceil(every));
+    let mut scratch = Vec::new();
+    let mut k = 0usize;
+    for r in strands {
+        segment_lengths(&positions[r], &mut scratch);
+        for &length in &scratch {
+            if k % every == 0 {
+                lengths.push(length);
+            }
+            k += 1;
+        }
+    }
     if lengths.is_empty() {
         return None;
     }
@@ -101,8 +116,19 @@ pub(crate) fn groom_median_segment(
     Some(*lengths.select_nth_unstable_by(middle, f32::total_cmp).1)
 }
 
+/// The lengths of the segments of the strand `points` between distinct
+/// points into `out` (cleared first): the medians an outlier is judged by
+/// leave out repeated points, which a run of them would otherwise make zero.
+/// (Exactly zero: a threshold relative to the strand's size would grow with
+/// the outlier it is to find, and make its strand's real segments vanish.)
+fn segment_lengths(points: &[Vec3], out: &mut Vec<f32>) {
+    out.clear();
+    out.extend(points.windows(2).map(|p| (p[1] - p[0]).length()).filter(|&l| l > 0.0));
+}
+
 /// The first outlier point of the strand `points` ([`OUTLIER_SEGMENT_RATIO`]
-/// times the shorter of its median segment and `groom_median`, the groom's):
+/// times the shorter of its median segment and `groom_median`, the groom's,
+/// both leaving out repeated points):
 /// its index and position. Of a too-long segment, the point it leads to is
 /// the outlier, or the root where only the first of two or more segments is
 /// too long. `scratch` is reused memory for the segments' lengths.
@@ -115,8 +141,7 @@ pub(crate) fn outlier_point(
         return None;
     }
     let length = |i: usize| (points[i + 1] - points[i]).length();
-    scratch.clear();
-    scratch.extend((0..points.len() - 1).map(length));
+    segment_lengths(points, scratch);
     let middle = scratch.len() / 2;
     // A strand of fewer than three segments has no median of its own to trust.
     let own = (scratch.len() >= 3).then(|| *scratch.select_nth_unstable_by(middle, f32::total_cmp).1);
@@ -154,6 +179,28 @@ pub(crate) fn not_finite(
     } else {
         None
     }
+}
+
+/// The bounding-box diagonal of the strand `points`.
+pub(crate) fn strand_size(points: &[Vec3]) -> f32 {
+    let (lo, hi) = bounding_box(points.iter().copied());
+    (hi - lo).length()
+}
+
+/// The median of `sizes` ([`strand_size`]s), `None` for none.
+pub(crate) fn median_size(sizes: impl Iterator<Item = f32>) -> Option<f32> {
+    let mut sizes: Vec<f32> = sizes.collect();
+    if sizes.is_empty() {
+        return None;
+    }
+    let middle = sizes.len() / 2;
+    Some(*sizes.select_nth_unstable_by(middle, f32::total_cmp).1)
+}
+
+/// Whether a strand of bounding-box diagonal `size` is degenerate in a groom
+/// whose median strand's is `median` ([`MIN_STRAND_FRACTION`]).
+pub(crate) fn degenerate(size: f32, median: f32) -> bool {
+    size < median * MIN_STRAND_FRACTION
 }
 
 /// The shortest segment of the strand `points` that is not zero-length
@@ -333,6 +380,12 @@ impl Groom {
                 if length <= min_segment || length == 0.0 {
                     return Err(Error::ZeroLengthSegment { strand, segment });
                 }
+            }
+        }
+        let sizes: Vec<f32> = (0..self.strand_count()).map(|s| strand_size(self.strand(s))).collect();
+        if let Some(median) = median_size(sizes.iter().copied()) {
+            if let Some(strand) = sizes.iter().position(|&size| degenerate(size, median)) {
+                return Err(Error::DegenerateStrand { strand, size: sizes[strand], median });
             }
         }
         Ok(())

@@ -25,6 +25,11 @@ pub struct Repairs {
     pub outlier_strands: usize,
     /// The first outlier dropped: strand (in the input), point and position.
     pub first_outlier: Option<(usize, usize, [f32; 3])>,
+    /// Strands dropped for being a point, not a hair (see
+    /// [`crate::groom::MIN_STRAND_FRACTION`]).
+    pub degenerate_strands: usize,
+    /// The first of them: strand (in the input) and its bounding-box diagonal.
+    pub first_degenerate: Option<(usize, f32)>,
     /// Points dropped because they coincided with the previous kept point.
     pub zero_length_segments: usize,
     /// Strands dropped for having fewer than two points (left or given).
@@ -40,6 +45,7 @@ impl Repairs {
     pub fn is_empty(&self) -> bool {
         self.non_finite_strands == 0
             && self.outlier_strands == 0
+            && self.degenerate_strands == 0
             && self.zero_length_segments == 0
             && self.short_strands == 0
     }
@@ -73,6 +79,14 @@ impl std::fmt::Display for Repairs {
                     + " with an outlier point"
                     + &self.first_outlier.map_or(String::new(), |(s, p, [x, y, z])| {
                         format!(" (the first: strand {s} point {p} at ({x}, {y}, {z}))")
+                    }),
+            ),
+            (
+                self.degenerate_strands,
+                plural(self.degenerate_strands, "strand", "strands")
+                    + " collapsed to a point"
+                    + &self.first_degenerate.map_or(String::new(), |(s, size)| {
+                        format!(" (the first: strand {s}, {size:e} across, under a millionth of the median strand)")
                     }),
             ),
             (
@@ -185,7 +199,7 @@ impl Groom {
         }
         let (lo, hi) = super::bounding_box(strands.iter().flat_map(|(_, r)| positions[r.clone()].iter().copied()));
         super::check_extent(lo, hi)?;
-        let mut counts = Vec::with_capacity(strands.len());
+        let mut survivors = Vec::with_capacity(strands.len()); // (strand, kept points, size)
         for (strand, range) in strands {
             let min_segment = super::min_segment(&positions[range.clone()]);
             let first = range.start;
@@ -203,6 +217,28 @@ impl Groom {
                 repairs.short_strands += 1;
                 continue;
             }
+            let size = super::strand_size(&kept.iter().map(|&i| positions[i]).collect::<Vec<_>>());
+            survivors.push((strand, kept, size));
+        }
+        // Degenerate strands, judged by the median of what is left until none
+        // is (dropping the smallest can only raise the median), so that the
+        // groom built below has none by its own median either.
+        while let Some(median) = super::median_size(survivors.iter().map(|s| s.2)) {
+            let before = survivors.len();
+            survivors.retain(|(strand, _, size)| {
+                let keep = !super::degenerate(*size, median);
+                if !keep {
+                    repairs.degenerate_strands += 1;
+                    repairs.first_degenerate.get_or_insert((*strand, *size));
+                }
+                keep
+            });
+            if survivors.len() == before {
+                break;
+            }
+        }
+        let mut counts = Vec::with_capacity(survivors.len());
+        for (strand, kept, _) in survivors {
             counts.push(kept.len() as u32);
             repairs.kept_strands.push(strand);
             repairs.kept_points.extend(kept);
@@ -362,5 +398,66 @@ mod tests {
         let text = err.to_string();
         assert!(text.contains("2 strands with NaN or infinite values"), "{text}");
         assert!(text.contains("1 strand with fewer than two points"), "{text}");
+    }
+
+    /// A run of repeated points inside a strand is zero-length segments to
+    /// drop, not an outlier: with four repeats of seven segments, the strand's
+    /// median segment had been zero and the strand dropped, its root named
+    /// the outlier.
+    #[test]
+    fn a_run_of_repeated_points_loses_its_repeats_and_keeps_its_strand() {
+        let mut repeated = line(4, 0.2);
+        for _ in 0..4 {
+            repeated.insert(2, repeated[1]);
+        }
+        let strands = [line(8, 0.0), line(8, 0.1), repeated, line(8, 0.3)];
+        let counts: Vec<u32> = strands.iter().map(|s| s.len() as u32).collect();
+        match Groom::new(strands.concat(), &counts) {
+            Err(Error::ZeroLengthSegment { strand: 2, segment: 1 }) => {}
+            other => panic!("expected the zero-length segment named, got {other:?}"),
+        }
+        let (groom, repairs) = Groom::repaired(strands.concat(), &counts, Attributes::default()).expect("repaired");
+        assert_eq!((repairs.outlier_strands, repairs.zero_length_segments), (0, 4), "{repairs}");
+        assert_eq!(groom.strand(2), &line(4, 0.2)[..], "the strand keeps its distinct points");
+    }
+
+    /// A strand a few picometres across beside 7 cm ones is a point, not a
+    /// hair: named by the strict constructor, dropped and named by repairing,
+    /// judged by the groom's median (so strands of 1 mm beside 50 cm ones,
+    /// real eyebrows beside real hair, are kept), and judged again until none
+    /// is left, so that the groom built has none by its own median either.
+    #[test]
+    fn a_strand_that_is_a_point_is_dropped_by_the_grooms_median() {
+        let tiny: Vec<Vec3> = (0..8).map(|i| Vec3::new(0.5, -1e-12 * i as f32, 0.0)).collect();
+        let strands = [line(8, 0.0), line(8, 0.1), tiny.clone(), line(8, 0.3)];
+        match Groom::new(strands.concat(), &[8; 4]) {
+            Err(e @ Error::DegenerateStrand { strand: 2, .. }) => {
+                assert!(e.to_string().contains("a point, not a hair"), "{e}")
+            }
+            other => panic!("expected the degenerate strand named, got {other:?}"),
+        }
+        let (groom, repairs) = Groom::repaired(strands.concat(), &[8; 4], Attributes::default()).expect("repaired");
+        assert_eq!((repairs.degenerate_strands, groom.strand_count()), (1, 3), "{repairs}");
+        assert!(repairs.to_string().contains("1 strand collapsed to a point (the first: strand 2, 7e-12"), "{repairs}");
+        // Real sizes apart: kept.
+        let short: Vec<Vec3> = (0..8).map(|i| Vec3::new(0.6, -1.4e-4 * i as f32, 0.0)).collect();
+        let long: Vec<Vec3> = (0..8).map(|i| Vec3::new(0.7, -0.07 * i as f32, 0.0)).collect();
+        let groom = Groom::new([short, long.clone(), long].concat(), &[8; 3]).expect("1 mm beside 50 cm");
+        assert_eq!(groom.strand_count(), 3);
+        // Three strands of 5e-14 and two of 1e-7 beside two of 0.5 (999
+        // segments each, so that no segment is an outlier by the groom's
+        // median): the first median (1e-7) drops the first three, the next
+        // (0.5) the two.
+        let strand = |x: f32, points: usize, length: f32| {
+            (0..points).map(|i| Vec3::new(x, -length * i as f32 / (points - 1) as f32, 0.0)).collect::<Vec<_>>()
+        };
+        let strands: Vec<Vec<Vec3>> = (0..3)
+            .map(|k| strand(k as f32, 2, 5e-14))
+            .chain((0..2).map(|k| strand(10.0 + k as f32, 2, 1e-7)))
+            .chain((0..2).map(|k| strand(20.0 + k as f32, 1000, 0.5)))
+            .collect();
+        let counts: Vec<u32> = strands.iter().map(|s| s.len() as u32).collect();
+        let (groom, repairs) = Groom::repaired(strands.concat(), &counts, Attributes::default()).expect("repaired");
+        assert_eq!((repairs.degenerate_strands, groom.strand_count()), (5, 2), "{repairs}");
     }
 }

@@ -580,6 +580,7 @@ fn locate(e: Error, objects: &[RawCurves], starts: &[usize]) -> Error {
         Error::NonFinite { strand, .. }
         | Error::ZeroLengthSegment { strand, .. }
         | Error::OutlierPoint { strand, .. }
+        | Error::DegenerateStrand { strand, .. }
         | Error::StrandPointCount { strand, .. } => *strand,
         _ => return e,
     };
@@ -588,6 +589,7 @@ fn locate(e: Error, objects: &[RawCurves], starts: &[usize]) -> Error {
         Error::NonFinite { point, what, .. } => Error::NonFinite { strand: local, point, what },
         Error::ZeroLengthSegment { segment, .. } => Error::ZeroLengthSegment { strand: local, segment },
         Error::OutlierPoint { point, position, .. } => Error::OutlierPoint { strand: local, point, position },
+        Error::DegenerateStrand { size, median, .. } => Error::DegenerateStrand { strand: local, size, median },
         Error::StrandPointCount { points, max, .. } => Error::StrandPointCount { strand: local, points, max },
         e => e,
     };
