@@ -203,6 +203,45 @@ fn a_cycle_of_objects_is_refused() {
     assert!(text.contains("belongs to another object too"), "{text}");
 }
 
+/// An archive whose top object's children are `children` (after its empty
+/// properties group), with the headers of `names` last — or, with
+/// `headers_as_group`, a group offset in the headers' place.
+fn archive_with_children(names: &[&str], children: usize, headers_as_group: Option<u64>) -> Vec<u8> {
+    let mut f = b"Ogawa\xff\x00\x01".to_vec();
+    f.extend_from_slice(&[0u8; 8]);
+    let headers_at = f.len() as u64;
+    append_object_headers(&mut f, names);
+    let top = f.len() as u64;
+    f.extend_from_slice(&(children as u64 + 2).to_le_bytes());
+    // The properties, then empty groups for the children, then the headers.
+    f.extend(std::iter::repeat_n(0u8, 8 * (children + 1)));
+    f.extend_from_slice(&headers_as_group.unwrap_or(headers_at | 1 << 63).to_le_bytes());
+    let root = f.len() as u64;
+    for v in [6u64, 1 << 63, 1 << 63, top, 1 << 63, 1 << 63, 1 << 63] {
+        f.extend_from_slice(&v.to_le_bytes());
+    }
+    f[8..16].copy_from_slice(&root.to_le_bytes());
+    f
+}
+
+/// Child objects the reader cannot name are an error, never dropped: a group
+/// where the children's headers belong (an offset past the file, or the empty
+/// group 0; the reader had read "no children" and gone on without them), and
+/// more child groups than headers. Two groups with their two headers read.
+#[test]
+fn child_objects_without_their_headers_are_refused_not_dropped() {
+    for offset in [1_000_000u64, 0] {
+        let e = alembic::parse(&archive_with_children(&["a", "b"], 2, Some(offset))).expect_err("refused");
+        let text = e.to_string();
+        assert!(text.contains(&format!("headers are a group (byte {offset}) where a data block belongs")), "{text}");
+    }
+    let e = alembic::parse(&archive_with_children(&["a", "b"], 3, None)).expect_err("refused").to_string();
+    assert!(e.contains("it has 3 child object groups but headers for 2"), "{e}");
+    // Named as they should be, they read: no curves, said as such.
+    let e = alembic::parse(&archive_with_children(&["a", "b"], 2, None)).expect_err("no curves").to_string();
+    assert!(e.contains("no curves object"), "{e}");
+}
+
 /// A thousand child objects naming one group of 150,000 children (1.2 MB)
 /// would have the reader copy that list a thousand times (2.4 GB, past the
 /// decoding budget) before the cycle check saw them: refused at the second,

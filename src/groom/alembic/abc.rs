@@ -214,7 +214,17 @@ impl<'a> Archive<'a> {
     /// The child objects of an object group: header, group position and
     /// group each.
     pub fn children(&self, object: &[Child]) -> Result<Vec<(ObjectHeader, u64, Vec<Child>)>> {
-        let Some((&Child::Data(at), groups)) = object.split_last() else { return Ok(Vec::new()) };
+        let (at, groups) = match object.split_last() {
+            None => return Ok(Vec::new()),
+            Some((&Child::Data(at), groups)) => (at, groups),
+            // The headers' place holds a group: the children it names would
+            // be dropped without a word (a changed offset did that).
+            Some((&Child::Group(at), _)) => {
+                return Err(malformed(format!(
+                    "its child objects' headers are a group (byte {at}) where a data block belongs"
+                )));
+            }
+        };
         let block = self.file.data(at)?;
         // Their names and metadata are copied out: a block many objects
         // share is charged each time.
@@ -253,6 +263,14 @@ impl<'a> Archive<'a> {
             }
             let group = self.file.group_of(child, &format!("object {name}"))?;
             out.push((ObjectHeader { name, metadata }, at, group));
+        }
+        // Every child group has its header (group 0 holds the properties).
+        let named = out.len();
+        if named + 1 < groups.len() {
+            return Err(malformed(format!(
+                "it has {} child object groups but headers for {named}: the others would be dropped",
+                groups.len() - 1
+            )));
         }
         Ok(out)
     }
