@@ -297,6 +297,20 @@ pub enum Error {
         /// Largest extent of the bounding box along an axis, in the groom's units.
         extent: f64,
     },
+    /// The groom lies so far from the origin, for the size of its strands,
+    /// that f32 positions cannot hold their shape: its farthest point is over
+    /// [`crate::groom::MAX_DISTANCE_IN_STRANDS`] times its median strand.
+    #[error(
+        "the groom lies {distance:e} from the origin, over {} times its median strand ({median:e} across): f32 \
+         positions there would round its strands' points by over a hundredth of a strand (move it nearer the origin)",
+        crate::groom::MAX_DISTANCE_IN_STRANDS
+    )]
+    GroomFarAway {
+        /// The distance of its farthest point from the origin, in the groom's units.
+        distance: f64,
+        /// Its median strand's bounding-box diagonal, in the groom's units.
+        median: f32,
+    },
     /// Two consecutive points of a strand coincide.
     #[error("strand {strand} segment {segment} has zero length")]
     ZeroLengthSegment {

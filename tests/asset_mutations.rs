@@ -30,6 +30,7 @@ fn is_file_error(e: &Error) -> bool {
             | Error::DegenerateStrand { .. }
             | Error::AttributeLength { .. }
             | Error::GroomExtent { .. }
+            | Error::GroomFarAway { .. }
             | Error::BadScalp(_)
     )
 }

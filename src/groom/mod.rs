@@ -15,6 +15,7 @@
 //! | no outlier point: no segment over [`OUTLIER_SEGMENT_RATIO`] × its strand's median | [`Error::OutlierPoint`] |
 //! | no segment shorter than [`MIN_SEGMENT_FRACTION`] × its strand's bounding-box diagonal | [`Error::ZeroLengthSegment`] |
 //! | no strand under [`MIN_STRAND_FRACTION`] × the groom's median strand (bounding-box diagonals) | [`Error::DegenerateStrand`] |
+//! | no point over [`MAX_DISTANCE_IN_STRANDS`] × the median strand from the origin | [`Error::GroomFarAway`] |
 //! | attribute arrays of the right length | [`Error::AttributeLength`] |
 //!
 //! Sources: [`cyhair`] (`.hair` read/write), [`tfx`] (TressFX `.tfx` read),
@@ -77,6 +78,11 @@ pub const MIN_SEGMENT_FRACTION: f32 = 1e-6;
 /// median, so one far strand changes nothing; a strand judged by its own
 /// size alone would keep every segment of a strand a few picometres long).
 pub const MIN_STRAND_FRACTION: f32 = 1e-6;
+/// The farthest a groom's point may lie from the origin, in median strands
+/// (bounding-box diagonals): f32's spacing there is 1.2 % of a strand, its
+/// segments' shape already coarse (at 10⁶, 12 %). A head near the origin lies
+/// about ten strands from it, a character a hundred metres away a thousand.
+pub const MAX_DISTANCE_IN_STRANDS: f32 = 1e5;
 /// A segment longer than this many times its strand's median segment (a
 /// strand of three segments or more), or the groom's median segment, marks an
 /// outlier point: a point far from where its strand runs, which no
@@ -386,6 +392,10 @@ impl Groom {
         if let Some(median) = median_size(sizes.iter().copied()) {
             if let Some(strand) = sizes.iter().position(|&size| degenerate(size, median)) {
                 return Err(Error::DegenerateStrand { strand, size: sizes[strand], median });
+            }
+            let distance = self.positions.iter().map(|p| p.as_dvec3().length()).fold(0.0, f64::max);
+            if distance > f64::from(median * MAX_DISTANCE_IN_STRANDS) {
+                return Err(Error::GroomFarAway { distance, median });
             }
         }
         Ok(())

@@ -460,4 +460,30 @@ mod tests {
         let (groom, repairs) = Groom::repaired(strands.concat(), &counts, Attributes::default()).expect("repaired");
         assert_eq!((repairs.degenerate_strands, groom.strand_count()), (5, 2), "{repairs}");
     }
+
+    /// A groom whose points lie past 10⁵ median strands from the origin is
+    /// refused whole, repaired or not (f32 would round its points by over a
+    /// hundredth of a strand; a `.hair` file at 3·10³⁸ had been read as it
+    /// came); at 10⁴ strands it is taken.
+    #[test]
+    fn a_groom_far_from_the_origin_for_its_size_is_refused() {
+        let at = |offset: f32| -> Vec<Vec3> {
+            (0..4).flat_map(|k| line(8, 0.1 * k as f32)).map(|p| p + Vec3::new(offset, 0.0, 0.0)).collect()
+        };
+        // Strands 0.07 across: 10⁴ of them is 700, 10⁵ is 7,000.
+        assert!(Groom::new(at(700.0), &[8; 4]).is_ok());
+        for offset in [7_100.0, 3e38] {
+            for result in [
+                Groom::new(at(offset), &[8; 4]).map(drop),
+                Groom::repaired(at(offset), &[8; 4], Attributes::default()).map(drop),
+            ] {
+                match result {
+                    Err(e @ Error::GroomFarAway { .. }) => {
+                        assert!(e.to_string().contains("over 100000 times its median strand (7e-2 across)"), "{e}")
+                    }
+                    other => panic!("{offset}: expected GroomFarAway, got {other:?}"),
+                }
+            }
+        }
+    }
 }
