@@ -333,6 +333,24 @@ pub enum Error {
         /// The groom's median strand bounding-box diagonal, in the groom's units.
         median: f32,
     },
+    /// A point's thickness is not a diameter its strand could have: below
+    /// zero, or more than [`crate::groom::MAX_THICKNESS_IN_SIZES`] times the
+    /// strand's bounding-box diagonal.
+    #[error(
+        "strand {strand} point {point} has a thickness of {value:e}, not a diameter of a strand {size:e} across \
+         (at least 0, at most {} times that)",
+        crate::groom::MAX_THICKNESS_IN_SIZES
+    )]
+    BadThickness {
+        /// Strand index.
+        strand: usize,
+        /// Point index within the strand.
+        point: usize,
+        /// The thickness, in the groom's units.
+        value: f32,
+        /// The strand's bounding-box diagonal, in the groom's units.
+        size: f32,
+    },
     /// A point lies far from where its strand runs: a segment to it is over
     /// [`crate::groom::OUTLIER_SEGMENT_RATIO`] times the strand's median.
     #[error(

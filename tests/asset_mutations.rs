@@ -31,6 +31,7 @@ fn is_file_error(e: &Error) -> bool {
             | Error::AttributeLength { .. }
             | Error::GroomExtent { .. }
             | Error::GroomFarAway { .. }
+            | Error::BadThickness { .. }
             | Error::BadScalp(_)
     )
 }

@@ -15,6 +15,7 @@
 //! | no outlier point: no segment over [`OUTLIER_SEGMENT_RATIO`] × its strand's median | [`Error::OutlierPoint`] |
 //! | no segment shorter than [`MIN_SEGMENT_FRACTION`] × its strand's bounding-box diagonal | [`Error::ZeroLengthSegment`] |
 //! | no strand under [`MIN_STRAND_FRACTION`] × the groom's median strand (bounding-box diagonals) | [`Error::DegenerateStrand`] |
+//! | a thickness of at least 0 and at most [`MAX_THICKNESS_IN_SIZES`] × its strand's bounding-box diagonal | [`Error::BadThickness`] |
 //! | no point over [`MAX_DISTANCE_IN_STRANDS`] × the median strand from the origin | [`Error::GroomFarAway`] |
 //! | attribute arrays of the right length | [`Error::AttributeLength`] |
 //!
@@ -78,6 +79,10 @@ pub const MIN_SEGMENT_FRACTION: f32 = 1e-6;
 /// median, so one far strand changes nothing; a strand judged by its own
 /// size alone would keep every segment of a strand a few picometres long).
 pub const MIN_STRAND_FRACTION: f32 = 1e-6;
+/// The thickest a strand's point may be, in its strand's bounding-box
+/// diagonals: a strand ten times as wide as it is long is no hair (a
+/// thickness of 10⁶ on strands of 14 cm had been read as it came).
+pub const MAX_THICKNESS_IN_SIZES: f32 = 10.0;
 /// The farthest a groom's point may lie from the origin, in median strands
 /// (bounding-box diagonals): f32's spacing there is 1.2 % of a strand, its
 /// segments' shape already coarse (at 10⁶, 12 %). A head near the origin lies
@@ -207,6 +212,12 @@ pub(crate) fn median_size(sizes: impl Iterator<Item = f32>) -> Option<f32> {
 /// whose median strand's is `median` ([`MIN_STRAND_FRACTION`]).
 pub(crate) fn degenerate(size: f32, median: f32) -> bool {
     size < median * MIN_STRAND_FRACTION
+}
+
+/// Whether `thickness` is a diameter a strand `size` across could have: at
+/// least 0 and at most [`MAX_THICKNESS_IN_SIZES`] times its size.
+pub(crate) fn thickness_fits(thickness: f32, size: f32) -> bool {
+    (0.0..=size * MAX_THICKNESS_IN_SIZES).contains(&thickness)
 }
 
 /// The shortest segment of the strand `points` that is not zero-length
@@ -392,6 +403,15 @@ impl Groom {
         if let Some(median) = median_size(sizes.iter().copied()) {
             if let Some(strand) = sizes.iter().position(|&size| degenerate(size, median)) {
                 return Err(Error::DegenerateStrand { strand, size: sizes[strand], median });
+            }
+            if let Some(t) = &self.thickness {
+                for (strand, &size) in sizes.iter().enumerate() {
+                    let range = self.strand_range(strand);
+                    let start = range.start;
+                    if let Some(i) = range.into_iter().find(|&i| !thickness_fits(t[i], size)) {
+                        return Err(Error::BadThickness { strand, point: i - start, value: t[i], size });
+                    }
+                }
             }
             let distance = self.positions.iter().map(|p| p.as_dvec3().length()).fold(0.0, f64::max);
             if distance > f64::from(median * MAX_DISTANCE_IN_STRANDS) {

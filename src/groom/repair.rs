@@ -30,6 +30,9 @@ pub struct Repairs {
     pub degenerate_strands: usize,
     /// The first of them: strand (in the input) and its bounding-box diagonal.
     pub first_degenerate: Option<(usize, f32)>,
+    /// The thickness array, dropped for a value no diameter of its strand:
+    /// the first such strand (in the input), point, value and strand size.
+    pub bad_thickness: Option<(usize, usize, f32, f32)>,
     /// Points dropped because they coincided with the previous kept point.
     pub zero_length_segments: usize,
     /// Strands dropped for having fewer than two points (left or given).
@@ -46,6 +49,7 @@ impl Repairs {
         self.non_finite_strands == 0
             && self.outlier_strands == 0
             && self.degenerate_strands == 0
+            && self.bad_thickness.is_none()
             && self.zero_length_segments == 0
             && self.short_strands == 0
     }
@@ -98,6 +102,12 @@ impl std::fmt::Display for Repairs {
         .into_iter()
         .filter(|(n, _)| *n > 0)
         .map(|(_, s)| s)
+        .chain(self.bad_thickness.map(|(s, p, value, size)| {
+            format!(
+                "the thickness (strand {s} point {p} has {value:e}, not a diameter of a strand {size:e} across; \
+                 the default widths are drawn)"
+            )
+        }))
         .collect();
         if parts.is_empty() {
             write!(f, "nothing to repair")
@@ -237,6 +247,20 @@ impl Groom {
                 break;
             }
         }
+        // A thickness that is no diameter of its strand makes the whole array
+        // suspect: it is dropped (the default widths drawn), the first named.
+        let mut thickness = attributes.thickness;
+        if let Some(t) = &thickness {
+            let bad = survivors.iter().find_map(|(strand, kept, size)| {
+                kept.iter()
+                    .find(|&&i| !super::thickness_fits(t[i], *size))
+                    .map(|&i| (*strand, i - kept[0], t[i], *size))
+            });
+            if bad.is_some() {
+                repairs.bad_thickness = bad;
+                thickness = None;
+            }
+        }
         let mut counts = Vec::with_capacity(survivors.len());
         for (strand, kept, _) in survivors {
             counts.push(kept.len() as u32);
@@ -248,7 +272,7 @@ impl Groom {
         }
         let pick = |v: &Vec<f32>| repairs.kept_points.iter().map(|&i| v[i]).collect();
         let attributes = Attributes {
-            thickness: attributes.thickness.as_ref().map(pick),
+            thickness: thickness.as_ref().map(pick),
             transparency: attributes.transparency.as_ref().map(pick),
             colors: attributes.colors.as_ref().map(|c| repairs.kept_points.iter().map(|&i| c[i]).collect()),
         };
@@ -484,6 +508,36 @@ mod tests {
                     other => panic!("{offset}: expected GroomFarAway, got {other:?}"),
                 }
             }
+        }
+    }
+
+    /// A thickness below zero or over ten times its strand's size is no
+    /// diameter: the
+    /// strict constructor names it, repairing drops the thickness array and
+    /// says so (a `.hair` file's negative thickness had been read even with
+    /// `--strict`); a real one (0.1 mm on 7 cm strands) is kept, and so is
+    /// 0.7 (ten times the strand).
+    #[test]
+    fn a_thickness_that_is_no_diameter_drops_the_array() {
+        let strands = [line(8, 0.0), line(8, 0.1)].concat();
+        for (value, named) in [(-1e-4, "has a thickness of -1e-4"), (0.8, "has a thickness of 8e-1")] {
+            let mut t = vec![1e-4; 16];
+            t[11] = value;
+            let attributes = || Attributes { thickness: Some(t.clone()), ..Default::default() };
+            match Groom::with_attributes(strands.clone(), &[8, 8], attributes()) {
+                Err(e @ Error::BadThickness { strand: 1, point: 3, .. }) => {
+                    assert!(e.to_string().contains(named), "{e}")
+                }
+                other => panic!("{value}: expected BadThickness, got {other:?}"),
+            }
+            let (groom, repairs) = Groom::repaired(strands.clone(), &[8, 8], attributes()).expect("repaired");
+            assert!(groom.thickness().is_none() && groom.strand_count() == 2, "{value}: the strands kept, not it");
+            assert!(repairs.to_string().contains("the thickness (strand 1 point 3 has"), "{repairs}");
+        }
+        for value in [1e-4, 0.7] {
+            let attributes = Attributes { thickness: Some(vec![value; 16]), ..Default::default() };
+            let groom = Groom::with_attributes(strands.clone(), &[8, 8], attributes).expect("a thickness");
+            assert_eq!(groom.thickness().map(<[f32]>::len), Some(16));
         }
     }
 }

@@ -581,6 +581,7 @@ fn locate(e: Error, objects: &[RawCurves], starts: &[usize]) -> Error {
         | Error::ZeroLengthSegment { strand, .. }
         | Error::OutlierPoint { strand, .. }
         | Error::DegenerateStrand { strand, .. }
+        | Error::BadThickness { strand, .. }
         | Error::StrandPointCount { strand, .. } => *strand,
         _ => return e,
     };
@@ -590,6 +591,7 @@ fn locate(e: Error, objects: &[RawCurves], starts: &[usize]) -> Error {
         Error::ZeroLengthSegment { segment, .. } => Error::ZeroLengthSegment { strand: local, segment },
         Error::OutlierPoint { point, position, .. } => Error::OutlierPoint { strand: local, point, position },
         Error::DegenerateStrand { size, median, .. } => Error::DegenerateStrand { strand: local, size, median },
+        Error::BadThickness { point, value, size, .. } => Error::BadThickness { strand: local, point, value, size },
         Error::StrandPointCount { points, max, .. } => Error::StrandPointCount { strand: local, points, max },
         e => e,
     };
