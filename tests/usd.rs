@@ -1175,6 +1175,47 @@ fn a_stage_of_too_many_prims_is_refused_before_it_is_composed() {
     assert!(took < 5.0, "writing and refusing took {took:.1} s");
 }
 
+/// A stage's text layers hold at most
+/// [`usda_check::MAX_USD_STAGE_PROPERTIES`] properties all together, each
+/// prim within its own bound: eleven prims of 9,999 in one layer are refused
+/// at the line of the property past the bound (twenty had taken the library
+/// 10 s), two sublayers of 60,000 each naming the root layer; ten prims of
+/// 9,999 read.
+#[test]
+fn a_stage_of_too_many_properties_all_together_is_refused() {
+    use vkhair::groom::usda_check::MAX_USD_STAGE_PROPERTIES;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let prims = |n: usize, per: usize| {
+        let mut text = String::from("#usda 1.0\n");
+        for p in 0..n {
+            text.push_str(&format!("def \"p{p}\" {{\n"));
+            for k in 0..per {
+                text.push_str(&format!("    float a{k} = 1\n"));
+            }
+            text.push_str("}\n");
+        }
+        text
+    };
+    let path = dir.path().join("many.usda");
+    std::fs::write(&path, prims(11, 9_999) + STRAND).expect("write");
+    let start = std::time::Instant::now();
+    let e = usd::open(&path).expect_err("past the stage's bound").to_string();
+    // The 100,001st property: prim 10 (lines of 10,001 each), its 11th.
+    let line = 1 + 10 * 10_001 + 1 + 11;
+    assert!(e.contains("many.usda") && e.contains(&format!("line {line},")), "{e}");
+    assert!(e.contains(&format!("more than {MAX_USD_STAGE_PROPERTIES} properties in the layer")), "{e}");
+    assert!(start.elapsed().as_secs_f64() < 1.0, "refused in {:?}", start.elapsed());
+    for k in 0..2 {
+        std::fs::write(dir.path().join(format!("s{k}.usda")), prims(6, 10_000)).expect("write");
+    }
+    let root = dir.path().join("root.usda");
+    std::fs::write(&root, format!("#usda 1.0\n(\n    subLayers = [@s0.usda@, @s1.usda@]\n)\n{STRAND}")).expect("write");
+    let e = usd::open(&root).expect_err("past the stage's bound").to_string();
+    assert!(e.contains("root.usda") && e.contains("text layers hold more than 100000 properties"), "{e}");
+    std::fs::write(&path, prims(10, 9_999) + STRAND).expect("write");
+    assert_eq!(usd::open(&path).expect("within the bound").groom.strand_count(), 1);
+}
+
 /// A prim of more properties than [`usda_check::MAX_USD_PROPERTIES`] is
 /// refused before the USD library parses it (its time grows with their
 /// square: 100,000 attributes took it more than two minutes), naming the

@@ -252,6 +252,20 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
         }
         Ok(())
     };
+    // Property statements of the text layers, all together.
+    let mut properties = 0usize;
+    let mut count_properties = |n: usize| {
+        properties += n;
+        if properties > super::usda_check::MAX_USD_STAGE_PROPERTIES {
+            return Err(malformed(format!(
+                "the stage's text layers hold more than {} properties (the USD reader's time follows their \
+                 number: a groom's curves have a dozen)",
+                super::usda_check::MAX_USD_STAGE_PROPERTIES
+            ))
+            .in_asset(path));
+        }
+        Ok(())
+    };
     let mut references = 0usize;
     let mut count_references = |n: usize| {
         references += n;
@@ -390,6 +404,7 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
         }
         let checked = super::usda_check::check(text, takes == Takes::Layer && named_by.is_some())
             .map_err(|e| named(e.in_asset(&layer)))?;
+        count_properties(checked.properties)?;
         let assets = checked.assets;
         let targets = parse(text, assets.iter().any(|a| a.takes == Takes::Layer))
             .map_err(|why| named(malformed(why).in_asset(&layer)))?;

@@ -81,6 +81,11 @@ pub const MAX_USD_PRIMS: usize = 100_000;
 /// groom's curves have a dozen.
 pub const MAX_USD_PROPERTIES: usize = 10_000;
 
+/// Most such statements a stage's text layers may hold all together: each
+/// prim within [`MAX_USD_PROPERTIES`], twenty of them (200,000) took the
+/// reader 10 s.
+pub const MAX_USD_STAGE_PROPERTIES: usize = 100_000;
+
 /// Metadata keys whose path values are composition arcs.
 const ARCS: [&str; 4] = ["inherits", "specializes", "references", "payload"];
 
@@ -132,6 +137,8 @@ pub struct Checked {
     /// The prims its references and payloads without an asset path take,
     /// each with where it is written.
     pub(super) internal: Vec<(String, usize)>,
+    /// Its property statements (at most [`MAX_USD_STAGE_PROPERTIES`]).
+    pub properties: usize,
 }
 
 /// Checks the USD text `text` (see the module docs): the other layers it
@@ -157,6 +164,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
     // Per open prim body, the statements begun on a new line in it other
     // than its child prims (properties, variant sets).
     let mut statements: Vec<usize> = Vec::new();
+    let mut properties = 0usize;
     let mut previous = 0usize;
     for (k, (at, token)) in tokens.iter().enumerate() {
         let child_prim = matches!(token, Token::Word("def" | "class" | "over"));
@@ -165,10 +173,19 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
         if open.last().is_some_and(|&(c, _)| c == b'{')
             && !prims.is_empty()
             && !child_prim
+            && !matches!(token, Token::Close(_))
             && text[previous..*at].contains('\n')
         {
             if let Some(n) = statements.last_mut() {
                 *n += 1;
+                properties += 1;
+                if properties > MAX_USD_STAGE_PROPERTIES {
+                    return Err(malformed(format!(
+                        "{} more than {MAX_USD_STAGE_PROPERTIES} properties in the layer (the USD reader's time \
+                         follows their number: a groom's curves have a dozen)",
+                        position(text, *at)
+                    )));
+                }
                 if *n > MAX_USD_PROPERTIES {
                     return Err(malformed(format!(
                         "{} its prim {} declares more than {MAX_USD_PROPERTIES} properties (the USD reader's time \
@@ -322,7 +339,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
             }
         }
     }
-    Ok(Checked { assets, arcs, internal })
+    Ok(Checked { assets, arcs, internal, properties })
 }
 
 /// One more arc between the layer's prims, written at `at`: refused past
