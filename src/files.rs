@@ -30,7 +30,51 @@ pub fn input_cap(default: u64) -> Result<u64> {
     }
 }
 
-fn open_input(path: &Path) -> Result<(File, Option<u64>)> {
+/// How long an input that is not a regular file (a FIFO, a device) may go
+/// without giving a byte before it is refused: a FIFO whose writer holds it
+/// open and writes nothing had the reader wait for as long as the writer
+/// lived.
+pub const INPUT_STALL: std::time::Duration = std::time::Duration::from_secs(10);
+
+/// An input file: a regular file read as it is, or a stream (a FIFO, a
+/// device) each of whose reads waits at most `stall` for data.
+enum Input {
+    Regular(File),
+    Stream { file: File, stall: std::time::Duration },
+}
+
+impl Read for Input {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        match self {
+            Input::Regular(file) => file.read(buf),
+            Input::Stream { file, stall } => {
+                use std::os::fd::AsRawFd;
+                let mut fd = libc::pollfd { fd: file.as_raw_fd(), events: libc::POLLIN, revents: 0 };
+                let ms = libc::c_int::try_from(stall.as_millis()).unwrap_or(libc::c_int::MAX);
+                // SAFETY: poll on one descriptor this reader owns, for `ms`.
+                let ready = unsafe { libc::poll(&mut fd, 1, ms) };
+                match ready {
+                    0 => Err(std::io::Error::new(
+                        std::io::ErrorKind::TimedOut,
+                        format!(
+                            "not a regular file, and it gave no data for {} s (a FIFO whose writer writes nothing)",
+                            stall.as_secs_f32()
+                        ),
+                    )),
+                    r if r < 0 => Err(std::io::Error::last_os_error()),
+                    // Data, or the writer gone (the read then ends the input).
+                    _ => file.read(buf),
+                }
+            }
+        }
+    }
+}
+
+fn open_input(path: &Path) -> Result<(Input, Option<u64>)> {
+    open_input_within(path, INPUT_STALL)
+}
+
+fn open_input_within(path: &Path, stall: std::time::Duration) -> Result<(Input, Option<u64>)> {
     use std::os::unix::fs::OpenOptionsExt;
     let io = |source| Error::Io { path: path.into(), source };
     // Opened without blocking: a FIFO no process writes to reads as empty
@@ -52,21 +96,32 @@ fn open_input(path: &Path) -> Result<(File, Option<u64>)> {
     if meta.is_dir() {
         return Err(Error::Io { path: path.into(), source: std::io::Error::other("a folder, not a file") });
     }
-    // The length of a regular file; devices and FIFOs have none to trust.
-    Ok((file, meta.is_file().then_some(meta.len())))
+    // The length of a regular file; devices and FIFOs have none to trust,
+    // and are read with a deadline for each read.
+    if meta.is_file() {
+        Ok((Input::Regular(file), Some(meta.len())))
+    } else {
+        Ok((Input::Stream { file, stall }, None))
+    }
 }
 
 /// Reads all of `path`, a `what` of at most `cap` bytes: a regular file larger
 /// than `cap` is refused before reading, and anything else (a device, a FIFO)
-/// is read up to `cap` bytes and refused beyond.
+/// is read up to `cap` bytes and refused beyond, and refused when a read
+/// waits [`INPUT_STALL`] for data.
 pub fn read_capped(path: &Path, cap: u64, what: &'static str) -> Result<Vec<u8>> {
+    read_capped_within(path, cap, what, INPUT_STALL)
+}
+
+/// [`read_capped`], a stream's reads each waiting at most `stall`.
+fn read_capped_within(path: &Path, cap: u64, what: &'static str, stall: std::time::Duration) -> Result<Vec<u8>> {
     let too_large = || Error::InputTooLarge {
         path: path.into(),
         what,
         cap,
         hint: " (set VKHAIR_MAX_INPUT_BYTES to read a larger one)",
     };
-    let (file, len) = open_input(path)?;
+    let (file, len) = open_input_within(path, stall)?;
     if len.is_some_and(|len| len > cap) {
         return Err(too_large());
     }
@@ -366,6 +421,45 @@ mod tests {
         // SAFETY: back to the disposition Rust's runtime gives tests.
         unsafe { libc::signal(libc::SIGPIPE, libc::SIG_IGN) };
         assert!(e.contains("out.json") && e.contains("closed it before the whole output"), "{e}");
+    }
+
+    /// A FIFO whose writer holds it open and writes nothing is refused once
+    /// a read has waited its deadline (it had the reader wait as long as the
+    /// writer lived); one whose writer writes slowly, each piece within the
+    /// deadline, reads whole.
+    #[test]
+    fn a_stream_that_gives_no_data_is_refused_after_its_deadline() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let fifo = dir.path().join("in.hair");
+        let c = std::ffi::CString::new(fifo.to_str().expect("utf-8")).expect("path");
+        // SAFETY: valid NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+        let stall = std::time::Duration::from_millis(300);
+        let writer = |pieces: Vec<&'static [u8]>, pause: std::time::Duration| {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || {
+                let mut file = std::fs::OpenOptions::new().write(true).open(&fifo).expect("writer");
+                for piece in pieces {
+                    std::thread::sleep(pause);
+                    file.write_all(piece).expect("write");
+                }
+                std::thread::sleep(pause);
+            })
+        };
+        // Silent for 3 deadlines, then gone.
+        let silent = writer(vec![], 3 * stall);
+        std::thread::sleep(stall / 3);
+        let start = std::time::Instant::now();
+        let e = super::read_capped_within(&fifo, 1 << 20, "a groom", stall).expect_err("no data").to_string();
+        assert!(e.contains("in.hair") && e.contains("gave no data for 0.3 s"), "{e}");
+        assert!(start.elapsed() < 2 * stall, "refused after {:?}", start.elapsed());
+        silent.join().expect("writer");
+        // Three pieces, each after half a deadline.
+        let slow = writer(vec![b"ab", b"cd", b"ef"], stall / 2);
+        std::thread::sleep(stall / 3);
+        let data = super::read_capped_within(&fifo, 1 << 20, "a groom", stall).expect("read whole");
+        assert_eq!(data, b"abcdef");
+        slow.join().expect("writer");
     }
 
     use super::*;
