@@ -214,20 +214,35 @@ fn key_at(text: &str, offset: usize) -> String {
     }
 }
 
-/// Where the parameter a validation error names is set in `text`: its last
-/// word is the field (`"volume resolution"` → `resolution`). The byte offset of
-/// the first line setting it, and its dotted key.
+/// Where the parameter a validation error names is set in `text`: the first
+/// line whose dotted key (table included) ends with the name, its words
+/// joined by dots (`"volume resolution"` → `sim.volume.resolution`,
+/// `lod.full_detail_distance` → `render.lod.full_detail_distance`). The byte
+/// offset of that line, and its dotted key.
 fn find_key(text: &str, name: &str) -> (Option<usize>, String) {
-    let field = name.rsplit(' ').next().unwrap_or(name);
+    // Parameter names are dotted below their table (`lod.full_detail_distance`)
+    // or spaced (`volume max_iterations`); the file's key holds them at its end.
+    let mut dotted = name.replace(' ', ".");
+    // Parameters whose name is their type's, not their table's.
+    for (named, table) in [("light.", "lights."), ("sdf.", "mesh_collider.")] {
+        if let Some(rest) = dotted.strip_prefix(named) {
+            dotted = format!("{table}{rest}");
+        }
+    }
+    let ends = |key: &str, tail: &str| key == tail || key.ends_with(&format!(".{tail}"));
+    let field = dotted.rsplit('.').next().unwrap_or(&dotted).to_owned();
     let mut offset = 0;
     for line in text.split_inclusive('\n') {
         let key = line.split('=').next().unwrap_or_default().trim();
-        if line.contains('=') && key == field {
-            return (Some(offset), key_at(text, offset));
+        if line.contains('=') && ends(key, &field) {
+            let full = key_at(text, offset);
+            if ends(&full, &dotted) {
+                return (Some(offset), full);
+            }
         }
         offset += line.len();
     }
-    (None, field.to_owned())
+    (None, dotted)
 }
 
 #[cfg(test)]
@@ -309,6 +324,34 @@ mod tests {
         assert_eq!((line, key.as_str()), (Some(2), "material.ambient"));
         let (line, key, _) = config_error("[sim.volume]\nresolution = [8, 8, 300]\n");
         assert_eq!((line, key.as_str()), (Some(2), "sim.volume.resolution"));
+    }
+
+    /// Keys in nested tables, in arrays of tables and in tables whose
+    /// parameters carry their type's name are named as the file writes them,
+    /// with their line (`lod.full_detail_distance` in `[render.lod]` had been
+    /// named without a line, as a key the file does not have).
+    #[test]
+    fn nested_keys_name_their_line_and_table() {
+        let cases = [
+            (
+                "[render]\nclump_width = 0.01\n[render.lod]\nfull_detail_distance = -1\n",
+                4,
+                "render.lod.full_detail_distance",
+            ),
+            ("[render.oit]\ntile_entries_per_vertex = 0\n", 2, "render.oit.tile_entries_per_vertex"),
+            ("[render]\nmotion.threshold = nan\n", 2, "render.motion.threshold"),
+            ("[scalp]\ndensity = 1e9\n", 2, "scalp.density"),
+            ("[mesh_collider]\nresolution = 1000000\n", 2, "mesh_collider.resolution"),
+            (
+                "[[lights]]\nkind = \"directional\"\ndirection = [0.0, -1.0, 0.0]\ncolor = [inf, 1.0, 1.0]\n",
+                4,
+                "lights.color",
+            ),
+        ];
+        for (text, expected_line, expected_key) in cases {
+            let (line, key, _) = config_error(text);
+            assert_eq!((line, key.as_str()), (Some(expected_line), expected_key), "{text}");
+        }
     }
 
     #[test]
