@@ -330,6 +330,8 @@ fn bad_values_name_their_option() {
     let groom = dir.path().join("g.hair");
     common::write_groom(&groom, &common::cap_groom(20, 6, 0.1));
     let g = groom.to_str().expect("utf-8");
+    let grown = dir.path().join("grown.hair");
+    let o = grown.to_str().expect("utf-8");
     let cases: &[(&[&str], &str)] = &[
         (&["render", "--input", g, "--scale", "nan"], "--scale must be a finite number above 0 (got NaN)"),
         (&["simulate", "--input", g, "--scale=-1"], "--scale must be a finite number above 0 (got -1)"),
@@ -341,6 +343,20 @@ fn bad_values_name_their_option() {
         (&["simulate", "--input", g, "--scale", "1e-30"], "--scale must be within 1e-6..=1e6 (got 1e-30)"),
         (&["render", "--frames", "0"], "--frames must be at least 1"),
         (&["simulate", "--steps", "0"], "--steps must be at least 1"),
+        (&["render", "--distance", "1e-30"], "--distance must be at least 1e-6"),
+        (&["simulate", "--steps", "18446744073709551615"], "--steps must be at most 10000000"),
+        (&["render", "--frames", "1000001"], "--frames must be at most 1000000"),
+        // Parameters a flag sets are named by the flag, not by the library's name.
+        (&["render", "--input", g, "--hairs-per-key", "0", "--clumps"], "invalid parameter --hairs-per-key: 0"),
+        (&["render", "--input", g, "--level", "0"], "invalid parameter --level: 0 (allowed: 1..=64)"),
+        (&["render", "--input", g, "--sorted-fragments", "33"], "invalid parameter --sorted-fragments: 33"),
+        (&["render", "--input", g, "--fragments-per-pixel", "0"], "invalid parameter --fragments-per-pixel: 0"),
+        (&["render", "--input", g, "--grid", "0"], "invalid parameter --grid: 0 cells"),
+        (&["simulate", "--input", g, "--max-iterations", "0"], "invalid parameter --max-iterations: 0"),
+        (&["simulate", "--input", g, "--iterations", "0"], "invalid parameter --iterations: 0"),
+        (&["render", "--input", g, "--density", "1e9"], "invalid parameter --density: 1000000000"),
+        (&["grow", "--scalp", "sphere", "--points", "0", "--out", o], "invalid parameter --points: 0"),
+        (&["grow", "--scalp", "sphere", "--radius", "1e30", "--out", o], "--radius \"1e30\": each"),
     ];
     for (args, message) in cases {
         let out = run(args, LIMIT);

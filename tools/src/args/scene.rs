@@ -124,6 +124,10 @@ impl SceneArgs {
             if d > 1e6 {
                 return Err(format!("--distance must be at most 1e6 (in the groom's units; got {d:e})"));
             }
+            // Closer, the camera's matrices are no longer finite (1e-9 made them so).
+            if d < 1e-6 {
+                return Err(format!("--distance must be at least 1e-6 (in the groom's units; got {d:e})"));
+            }
         }
         Ok(())
     }

@@ -100,7 +100,7 @@ pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
         config.material.tip_width *= k;
         // Hairs per cm² of a head in meters: the groom's own units count k² as
         // many, within the parameter's range (checked as given first).
-        config.scalp.validate()?;
+        config.scalp.validate().map_err(crate::args::flag_error)?;
         let scaled = config.scalp.density / (k * k);
         config.scalp.density = scaled.clamp(*SCALP_DENSITY_RANGE.start(), *SCALP_DENSITY_RANGE.end());
         if config.scalp.density != scaled {
@@ -113,7 +113,7 @@ pub fn parameters(a: &SceneArgs, s: &Scene) -> Result<Config, vkhair::Error> {
             );
         }
     }
-    config.validate()?;
+    config.validate().map_err(crate::args::flag_error)?;
     Ok(config)
 }
 

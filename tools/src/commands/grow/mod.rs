@@ -129,7 +129,7 @@ pub fn grow_groom(a: &GrowArgs) -> CliResult {
                 seed: a.seed,
                 ..GrowParams::default()
             };
-            let (groom, _) = rig.grow_with(&params)?;
+            let (groom, _) = rig.grow_with(&params).map_err(crate::args::flag_error)?;
             say!("grown on joint {:?} of {}", rig.joint_name(rig.head), path.display());
             groom.rigidly_moved(&rig.bind_frame())?
         }
@@ -147,6 +147,9 @@ pub fn grow_groom(a: &GrowArgs) -> CliResult {
                 }
                 _ => {
                     let radii = parse_vec3("radius", &a.radius)?;
+                    if !(radii.is_finite() && radii.min_element() > 0.0 && radii.max_element() <= 1e6) {
+                        return Err(format!("--radius {:?}: each semi-axis within (0, 1e6]", a.radius).into());
+                    }
                     let center = parse_vec3("center", &a.center)?;
                     let mut scalp = Scalp::sphere_cap(center, radii.x, a.max_angle.to_radians());
                     if let Scalp::Ellipsoid { radii: r, .. } = &mut scalp {
@@ -173,7 +176,7 @@ pub fn grow_groom(a: &GrowArgs) -> CliResult {
                 },
                 ..GrowParams::default()
             };
-            grow(&scalp, &params)?
+            grow(&scalp, &params).map_err(crate::args::flag_error)?
         }
     };
     let s = groom.stats();

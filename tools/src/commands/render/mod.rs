@@ -21,7 +21,7 @@ use crate::scene::{self, framing, make_renderer, parameters};
 pub struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
-    /// Frames to render (30 per second of motion).
+    /// Frames to render (30 per second of motion; 1..=1,000,000).
     #[arg(long, default_value_t = 24)]
     frames: usize,
     /// Output folder for frame PNGs and the contact sheet.
@@ -47,12 +47,19 @@ pub struct RenderArgs {
     profile_out: ProfileArgs,
 }
 
+/// The most frames `--frames` takes (a PNG each: 4.6 hours at 60 frames a
+/// second), not the edge of its integer type.
+const MAX_FRAMES: usize = 1_000_000;
+
 /// The flags `render` adds to the scene's: values out of range and options that
 /// need others, before any file is read or GPU work done.
 fn check_options(a: &RenderArgs) -> Result<(), String> {
     a.scene.check()?;
     if a.frames == 0 {
         return Err("--frames must be at least 1".into());
+    }
+    if a.frames > MAX_FRAMES {
+        return Err(format!("--frames must be at most {MAX_FRAMES} (got {})", a.frames));
     }
     if a.schedule != Some(ScheduleMode::SecondDevice) {
         let given = [("--hand-off", a.hand_off.is_some()), ("--sim-device", a.sim_device.is_some())];

@@ -29,7 +29,7 @@ use check::{share_inside, tip_drift, write_final, Reference, StepCheck};
 pub struct SimulateArgs {
     #[command(flatten)]
     input: InputArgs,
-    /// Simulation steps (1/60 s each, at least 1).
+    /// Simulation steps (1/60 s each, 1..=10,000,000).
     #[arg(long, default_value_t = 120)]
     steps: usize,
     /// Parameter file (TOML, see `vkhair config`); the flags below win over it.
@@ -76,7 +76,7 @@ fn simulate_params(a: &SimulateArgs) -> Result<Config, vkhair::Error> {
         None => base,
     };
     a.sim.apply(&mut config.sim);
-    config.validate()?;
+    config.validate().map_err(crate::args::flag_error)?;
     Ok(config)
 }
 
@@ -139,6 +139,10 @@ fn apply_simulated(sim: &mut HairSim, count: Option<usize>, strands: usize) -> C
     Ok(())
 }
 
+/// The most steps `--steps` takes: a soak run's length, not the edge of
+/// `usize` (2⁶⁴ − 1 was taken and ran until killed).
+const MAX_STEPS: usize = 10_000_000;
+
 /// The profile's track: `simulate` records on the graphics queue.
 const TRACK: &str = "graphics queue";
 
@@ -147,6 +151,9 @@ const TRACK: &str = "graphics queue";
 fn check_options(a: &SimulateArgs) -> Result<(), String> {
     if a.steps == 0 {
         return Err("--steps must be at least 1".into());
+    }
+    if a.steps > MAX_STEPS {
+        return Err(format!("--steps must be at most {MAX_STEPS} (46 hours of simulated time; got {})", a.steps));
     }
     a.input.check()?;
     if a.input.gltf.is_some() && a.check {
