@@ -884,6 +884,15 @@ fn a_negative_width_is_refused_strictly_and_passed_over_when_repairing() {
     );
     let (g, _) = usd::open_repairing(&path).expect("repairing");
     assert!(g.groom.end_thickness().is_none() && g.groom.strand_count() == 2, "the absurd widths were read");
+    // An infinite width is not a width: its strand is judged as any
+    // non-finite value (it had been called "thicker than any hair, inf m").
+    let text = std::fs::read_to_string(&path).expect("read").replace("1e30", "inf");
+    std::fs::write(&path, text).expect("write");
+    let err = usd::open(&path).expect_err("strict").to_string();
+    assert!(err.contains("/hair: strand 1 point 1: thickness is not finite") && !err.contains("inf m"), "{err}");
+    let (g, repairs) = usd::open_repairing(&path).expect("repairing");
+    assert_eq!(g.groom.strand_count(), 1);
+    assert!(repairs.to_string().contains("strand 1 point 1, its thickness"), "{repairs}");
 }
 
 /// A stage pulls in at most `usd::MAX_USD_LAYERS` layers: a chain of

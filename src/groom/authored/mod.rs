@@ -472,8 +472,10 @@ pub(crate) fn assemble(
         .then(|| objects.iter().flat_map(|o| o.widths.iter().flatten().map(|&w| (f64::from(w) * k) as f32)).collect());
     // A width is a diameter: a negative one, or one thicker than any hair
     // (MAX_WIDTH_M in metres), is a defect, refused (strict) or the widths
-    // passed over, with the first named (repairing).
-    let absurd = |w: f32| w < 0.0 || f64::from(w) * k > MAX_WIDTH_M;
+    // passed over, with the first named (repairing). A NaN or infinite one
+    // is not a width at all: its strand is judged as any non-finite value
+    // (dropped and named, or refused), not called "too thick".
+    let absurd = |w: f32| w.is_finite() && (w < 0.0 || f64::from(w) * k > MAX_WIDTH_M);
     let negative = objects.iter().find_map(|o| {
         let widths = o.widths.as_ref()?;
         let at = widths.iter().position(|&w| absurd(w))?;
