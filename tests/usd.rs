@@ -355,6 +355,17 @@ fn arcs_are_judged_over_the_sublayers_of_a_stack() {
         &format!("#usda 1.0\ndef Xform \"x\" (\n    references = @./pkg.usdz[inner.usda]@</c>\n) {{ }}\n{curves}"),
     );
     write("package.usda", &stage("@pkg.usdz@"));
+    // Brackets in a plain file's name or folder are no package (the library
+    // takes a path as package-relative when it also ends with `]`): read.
+    std::fs::create_dir(dir.path().join("a[1]b")).expect("folder");
+    write("a[1]b/take[2].usda", &format!("#usda 1.0\n{curves}"));
+    write("bracketed.usda", &format!("#usda 1.0\ndef \"x\" (\n    references = @./a[1]b/take[2].usda@</c>\n) {{ }}\n"));
+    let g = usd::open(dir.path().join("bracketed.usda")).expect("brackets in plain names");
+    assert_eq!(g.groom.strand_count(), 1);
+    assert_eq!(usd::open(dir.path().join("a[1]b/take[2].usda")).expect("a bracketed root").groom.strand_count(), 1);
+    // An empty asset path with a prim path (`@@</c>`): the arc's line, not
+    // "a layer named without an extension" at the layer's folder.
+    write("empty_asset.usda", &format!("#usda 1.0\ndef Xform \"x\" (\n    references = @@</c>\n) {{ }}\n{curves}"));
     // References to prims of the layer itself, through its own file: a chain
     // of 200 (which took the library past 10 s at 2,000) and a cycle.
     let mut chain = String::from("#usda 1.0\n");
@@ -393,6 +404,7 @@ fn arcs_are_judged_over_the_sublayers_of_a_stack() {
             ("expression.usda", &["expression.usda", "line 6", "an expression"][..]),
             ("packaged.usda", &["packaged.usda", "line 3", "USDZ package", "pkg.usdz[inner.usda]"][..]),
             ("package.usda", &["package.usda", "line 3", "USDZ package"][..]),
+            ("empty_asset.usda", &["empty_asset.usda", "line 3", "an empty asset path"][..]),
             ("inherits.usda", &["a cycle", "line 3", "sublayers of", "inherits.usda"][..]),
             ("specializes.usda", &["a cycle", "line 3", "specializes.usda"][..]),
             ("through_root.usda", &["a cycle", "through_root.usda"][..]),

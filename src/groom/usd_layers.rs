@@ -291,8 +291,10 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
             let why = "an asset path that is an expression (`\"${VAR}.usda\"`), which vkhair does not evaluate";
             return Err(named(malformed(why.to_owned()).in_asset(&layer)));
         }
+        // (A path is package-relative to the library when it holds a `[` and
+        // ends with `]`; `take[2].usda` is a plain file.)
         let package = layer.extension().is_some_and(|e| e.eq_ignore_ascii_case("usdz"));
-        if package || text_path.contains('[') || text_path.contains(']') {
+        if package || (text_path.contains('[') && text_path.ends_with(']')) {
             let why = "a USDZ package or a layer inside one (`pkg.usdz[layer.usda]`), which vkhair does not read: \
                        unpack it and name its .usda or .usdc layer";
             return Err(named(malformed(why.to_owned()).in_asset(&layer)));
@@ -385,6 +387,11 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
                 }
                 let by = (layer.clone(), format!("its arc to {asset:?}:"));
                 links.add(&mut stacks, &dir.join(&asset), &takes, by);
+                if asset.is_empty() {
+                    let whose = if from.is_empty() { "its subLayers".to_owned() } else { format!("prim {from}") };
+                    let why = format!("{whose}: an empty asset path (`@@`)");
+                    return Err(malformed(why).in_asset(&layer));
+                }
                 queue.push((dir.join(&asset), Some((layer.clone(), format!("its arc to {asset:?}:"))), takes));
             }
             stacks.layers.insert(key, (arcs, links));
@@ -436,6 +443,13 @@ pub(super) fn check_layers(path: &Path, cap: u64) -> Result<()> {
         let mut links = Links::default();
         for asset in assets {
             let line = super::usda_check::position(text, asset.at);
+            if asset.path.is_empty() {
+                let why = format!(
+                    "{line} an empty asset path (`@@`): a reference to a prim of this layer is written without one \
+                     (`</Prim>`)"
+                );
+                return Err(malformed(why).in_asset(&layer));
+            }
             let named = dir.join(&asset.path);
             links.add(&mut stacks, &named, &asset.takes, (layer.clone(), line.clone()));
             queue.push((named, Some((layer.clone(), line)), asset.takes));
