@@ -47,25 +47,34 @@ impl Read for Input {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         match self {
             Input::Regular(file) => file.read(buf),
-            Input::Stream { file, stall } => {
+            Input::Stream { file, stall } => loop {
+                // Non-blocking: data, the end (no writer, or the writer gone),
+                // or nothing yet, when it waits for data at most `stall`.
+                match file.read(buf) {
+                    Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+                    other => return other,
+                }
                 use std::os::fd::AsRawFd;
                 let mut fd = libc::pollfd { fd: file.as_raw_fd(), events: libc::POLLIN, revents: 0 };
                 let ms = libc::c_int::try_from(stall.as_millis()).unwrap_or(libc::c_int::MAX);
                 // SAFETY: poll on one descriptor this reader owns, for `ms`.
                 let ready = unsafe { libc::poll(&mut fd, 1, ms) };
-                match ready {
-                    0 => Err(std::io::Error::new(
+                if ready == 0 {
+                    return Err(std::io::Error::new(
                         std::io::ErrorKind::TimedOut,
                         format!(
                             "not a regular file, and it gave no data for {} s (a FIFO whose writer writes nothing)",
                             stall.as_secs_f32()
                         ),
-                    )),
-                    r if r < 0 => Err(std::io::Error::last_os_error()),
-                    // Data, or the writer gone (the read then ends the input).
-                    _ => file.read(buf),
+                    ));
                 }
-            }
+                if ready < 0 {
+                    let e = std::io::Error::last_os_error();
+                    if e.kind() != std::io::ErrorKind::Interrupted {
+                        return Err(e);
+                    }
+                }
+            },
         }
     }
 }
@@ -78,8 +87,17 @@ fn open_input_within(path: &Path, stall: std::time::Duration) -> Result<(Input, 
     use std::os::unix::fs::OpenOptionsExt;
     let io = |source| Error::Io { path: path.into(), source };
     // Opened without blocking: a FIFO no process writes to reads as empty
-    // instead of blocking forever. Reads then block as usual.
+    // instead of blocking forever. A regular file's reads then block as
+    // usual; a stream's stay non-blocking, each waiting for data by `poll`.
     let file = std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK).open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    if meta.is_dir() {
+        return Err(Error::Io { path: path.into(), source: std::io::Error::other("a folder, not a file") });
+    }
+    if !meta.is_file() {
+        // Devices and FIFOs have no length to trust.
+        return Ok((Input::Stream { file, stall }, None));
+    }
     {
         use std::os::fd::AsRawFd;
         let fd = file.as_raw_fd();
@@ -92,17 +110,7 @@ fn open_input_within(path: &Path, stall: std::time::Duration) -> Result<(Input, 
             return Err(io(std::io::Error::last_os_error()));
         }
     }
-    let meta = file.metadata().map_err(io)?;
-    if meta.is_dir() {
-        return Err(Error::Io { path: path.into(), source: std::io::Error::other("a folder, not a file") });
-    }
-    // The length of a regular file; devices and FIFOs have none to trust,
-    // and are read with a deadline for each read.
-    if meta.is_file() {
-        Ok((Input::Regular(file), Some(meta.len())))
-    } else {
-        Ok((Input::Stream { file, stall }, None))
-    }
+    Ok((Input::Regular(file), Some(meta.len())))
 }
 
 /// Reads all of `path`, a `what` of at most `cap` bytes: a regular file larger

@@ -124,6 +124,23 @@ fn defects_are_named_with_the_prim() {
     assert!(text.contains("/hair") && text.contains("add up to 5 points but points holds 4"), "{text}");
     let text = refused("usd/nan.usda");
     assert!(text.contains("/hair") && text.contains("strand 0") && text.contains("point 1"), "{text}");
+    // A curve object without curves (empty vertex counts and points: what a
+    // binary layer relabelled as crate version 0.4 reads as) is said to hold
+    // none, not "nothing left after repairing: nothing to repair".
+    let dir = tempfile::tempdir().expect("tempdir");
+    let empty = dir.path().join("empty.usda");
+    std::fs::write(
+        &empty,
+        "#usda 1.0\ndef BasisCurves \"hair\" {\n    int[] curveVertexCounts = []\n    point3f[] points = []\n}\n",
+    )
+    .expect("write");
+    for e in [usd::open(&empty).map(drop), usd::open_repairing(&empty).map(drop)] {
+        let text = e.expect_err("no curves").to_string();
+        assert!(
+            text.contains("empty.usda") && text.contains("hold no curves (/hair: no curve vertex counts)"),
+            "{text}"
+        );
+    }
     // Repairing passes over the loop, and then nothing is left to read.
     let e = usd::open_repairing(data("usd/periodic.usda")).expect_err("only a loop");
     assert!(e.to_string().contains("no BasisCurves prim") && e.to_string().contains("periodic"), "{e}");

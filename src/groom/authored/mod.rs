@@ -364,6 +364,14 @@ pub(crate) fn assemble(
     if strands > MAX_STRANDS as u64 {
         return Err(Error::TooManyStrands { count: strands, max: MAX_STRANDS as u64 });
     }
+    if strands == 0 {
+        // (Not "nothing left after repairing": there was nothing to repair.)
+        let paths: Vec<&str> = objects.iter().map(|o| o.path.as_str()).collect();
+        return Err(Error::Malformed {
+            format: frame.format,
+            reason: format!("its curve objects hold no curves ({}: no curve vertex counts)", paths.join(", ")),
+        });
+    }
     let points: u64 = objects.iter().map(|o| o.points.len() as u64).sum();
     if points > MAX_POINTS as u64 {
         return Err(Error::TooManyPoints { count: points, max: MAX_POINTS as u64 });
