@@ -417,20 +417,43 @@ fn buffers(gltf: &gltf::Gltf, dir: Option<&Path>) -> Result<Vec<Vec<u8>>> {
 }
 
 /// The node hierarchy with each node's rest transform.
+/// A node's translation, rotation and scale: as given, or decomposed from
+/// its matrix in f64 (a matrix entry of 1e30 overflowed f32's decomposition
+/// into NaN, named "not finite"); a matrix that has none is refused saying
+/// why.
+fn decomposed(n: &gltf::Node) -> Result<([f32; 3], [f32; 4], [f32; 3])> {
+    let gltf::scene::Transform::Matrix { matrix } = n.transform() else { return Ok(n.transform().decomposed()) };
+    let m = glam::DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)));
+    let why = if !m.is_finite() {
+        Some("a matrix that is not finite".to_owned())
+    } else if m.determinant().abs() < 1e-18 {
+        Some(format!("a singular matrix (determinant {:e}): no rotation and scale", m.determinant()))
+    } else if m.row(3) != glam::DVec4::W {
+        Some(format!("a projective matrix (its last row is {:?}, not 0, 0, 0, 1)", m.row(3).to_array()))
+    } else {
+        None
+    };
+    if let Some(why) = why {
+        return Err(malformed(format!("node {} ({:?}) has {why}", n.index(), n.name().unwrap_or_default())));
+    }
+    let (s, r, t) = m.to_scale_rotation_translation();
+    Ok((t.as_vec3().to_array(), r.as_quat().to_array(), s.as_vec3().to_array()))
+}
+
 fn nodes(doc: &gltf::Document) -> Result<Vec<Node>> {
     let mut nodes: Vec<Node> = doc
         .nodes()
         .map(|n| {
-            let (t, r, s) = n.transform().decomposed();
-            Node {
+            let (t, r, s) = decomposed(&n)?;
+            Ok(Node {
                 name: n.name().unwrap_or_default().to_owned(),
                 parent: None,
                 translation: Vec3::from(t),
                 rotation: Quat::from_array(r),
                 scale: Vec3::from(s),
-            }
+            })
         })
-        .collect();
+        .collect::<Result<_>>()?;
     for n in doc.nodes() {
         for c in n.children() {
             if nodes[c.index()].parent.replace(n.index()).is_some() {

@@ -267,6 +267,31 @@ fn absurd_transforms_are_refused_naming_the_node_or_channel() {
         .expect_err("huge")
         .to_string();
     assert!(err.contains("node 0") && err.contains("scale"), "{err}");
+    // Node matrices: one with an entry of 10³⁰ is decomposed in f64 and its
+    // scale named (f32's decomposition had made it NaN, "not finite"); a
+    // singular and a projective one say so; a plain one reads.
+    let matrix = |m: [f64; 16]| {
+        Character::parse(&mutated(&bytes, |j| {
+            let n = &mut j["nodes"][0];
+            for key in ["translation", "rotation", "scale"] {
+                n.as_object_mut().map(|o| o.remove(key));
+            }
+            n["matrix"] = serde_json::json!(m);
+        }))
+        .map(drop)
+        .map_err(|e| e.to_string())
+    };
+    let mut m = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+    assert!(matrix(m).is_ok(), "{:?}", matrix(m));
+    m[0] = 1e30;
+    let err = matrix(m).expect_err("a huge scale");
+    assert!(err.contains("node 0") && err.contains("scale [1000000000000000000000000000000, 1, 1]"), "{err}");
+    let err = matrix([0.0; 16]).expect_err("singular");
+    assert!(err.contains("node 0") && err.contains("a singular matrix (determinant 0e0)"), "{err}");
+    m[0] = 1.0;
+    m[3] = 0.5;
+    let err = matrix(m).expect_err("projective");
+    assert!(err.contains("node 0") && err.contains("a projective matrix"), "{err}");
     // An animation key 10³⁰ m away, from a buffer of its own.
     let dir = tempfile::tempdir().expect("temp dir");
     let far = [0.0, 0.0, 0.0, 1e30, 0.0, 0.0];
