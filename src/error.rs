@@ -301,9 +301,8 @@ pub enum Error {
     /// that f32 positions cannot hold their shape: its farthest point is over
     /// [`crate::groom::MAX_DISTANCE_IN_STRANDS`] times its median strand.
     #[error(
-        "the groom lies {distance:e} from the origin, over {} times its median strand ({median:e} across): f32 \
-         positions there would round its strands' points by over a hundredth of a strand (move it nearer the origin)",
-        crate::groom::MAX_DISTANCE_IN_STRANDS
+        "the groom lies {distance:e} from the origin, over 100000 times its median strand ({median:e} across): f32 \
+         positions there would round its strands' points by over a hundredth of a strand (move it nearer the origin)"
     )]
     GroomFarAway {
         /// The distance of its farthest point from the origin, in the groom's units.
@@ -338,8 +337,7 @@ pub enum Error {
     /// strand's bounding-box diagonal.
     #[error(
         "strand {strand} point {point} has a thickness of {value:e}, not a diameter of a strand {size:e} across \
-         (at least 0, at most {} times that)",
-        crate::groom::MAX_THICKNESS_IN_SIZES
+         (at least 0, at most 10 times that)"
     )]
     BadThickness {
         /// Strand index.

@@ -28,6 +28,10 @@ use super::repair::Load;
 use super::{Attributes, Groom, Repairs, MAX_POINTS, MAX_STRANDS};
 use crate::error::{Error, Result};
 
+mod locate;
+pub(crate) use locate::in_object;
+use locate::{locate, object_of, strand_of_point};
+
 /// The axis a file calls up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum UpAxis {
@@ -558,55 +562,6 @@ pub const MAX_COORDINATE_M: f32 = 1e4;
 
 /// Least extent a curve object may span after its transforms and the stage's units, meters.
 pub const MIN_OBJECT_EXTENT_M: f64 = 1e-7;
-
-/// `source` as an error of the object at `path`.
-pub(crate) fn in_object(path: &str, source: Error) -> Error {
-    Error::CurveObject { object: path.to_owned(), source: Box::new(source) }
-}
-
-/// The strand of `counts` (points per strand) holding point `point`, and the
-/// strand's first point; `None` past the last.
-fn strand_of_point(counts: &[u32], point: usize) -> Option<(usize, usize)> {
-    let mut first = 0usize;
-    for (strand, &c) in counts.iter().enumerate() {
-        if point < first + c as usize {
-            return Some((strand, first));
-        }
-        first += c as usize;
-    }
-    None
-}
-
-/// The object holding strand `strand` of the whole groom (objects starting at
-/// `starts`), and the strand's index within it.
-fn object_of(starts: &[usize], strand: usize) -> (usize, usize) {
-    let object = starts.partition_point(|&s| s <= strand).saturating_sub(1);
-    (object, strand - starts[object])
-}
-
-/// A groom check's error with its strand counted within its object.
-fn locate(e: Error, objects: &[RawCurves], starts: &[usize]) -> Error {
-    let strand = match &e {
-        Error::NonFinite { strand, .. }
-        | Error::ZeroLengthSegment { strand, .. }
-        | Error::OutlierPoint { strand, .. }
-        | Error::DegenerateStrand { strand, .. }
-        | Error::BadThickness { strand, .. }
-        | Error::StrandPointCount { strand, .. } => *strand,
-        _ => return e,
-    };
-    let (object, local) = object_of(starts, strand);
-    let e = match e {
-        Error::NonFinite { point, what, .. } => Error::NonFinite { strand: local, point, what },
-        Error::ZeroLengthSegment { segment, .. } => Error::ZeroLengthSegment { strand: local, segment },
-        Error::OutlierPoint { point, position, .. } => Error::OutlierPoint { strand: local, point, position },
-        Error::DegenerateStrand { size, median, .. } => Error::DegenerateStrand { strand: local, size, median },
-        Error::BadThickness { point, value, size, .. } => Error::BadThickness { strand: local, point, value, size },
-        Error::StrandPointCount { points, max, .. } => Error::StrandPointCount { strand: local, points, max },
-        e => e,
-    };
-    in_object(&objects[object].path, e)
-}
 
 #[cfg(test)]
 mod tests;
