@@ -376,7 +376,7 @@ fn arcs_are_judged_over_the_sublayers_of_a_stack() {
     // takes a path as package-relative when it also ends with `]`): read.
     std::fs::create_dir(dir.path().join("a[1]b")).expect("folder");
     write("a[1]b/take[2].usda", &format!("#usda 1.0\n{curves}"));
-    write("bracketed.usda", &format!("#usda 1.0\ndef \"x\" (\n    references = @./a[1]b/take[2].usda@</c>\n) {{ }}\n"));
+    write("bracketed.usda", "#usda 1.0\ndef \"x\" (\n    references = @./a[1]b/take[2].usda@</c>\n) { }\n");
     let g = usd::open(dir.path().join("bracketed.usda")).expect("brackets in plain names");
     assert_eq!(g.groom.strand_count(), 1);
     assert_eq!(usd::open(dir.path().join("a[1]b/take[2].usda")).expect("a bracketed root").groom.strand_count(), 1);

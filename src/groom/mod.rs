@@ -114,7 +114,7 @@ pub(crate) fn groom_median_segment(
     for r in strands {
         segment_lengths(&positions[r], &mut scratch);
         for &length in &scratch {
-            if k % every == 0 {
+            if k.is_multiple_of(every) {
                 lengths.push(length);
             }
             k += 1;
