@@ -144,6 +144,10 @@ impl Load {
     }
 }
 
+/// Most rounds of judging strands by the median of those left
+/// ([`Groom::repaired`]).
+const MAX_DEGENERATE_ROUNDS: usize = 64;
+
 impl Groom {
     /// A groom from concatenated positions, per-strand point counts and optional
     /// attributes, repairing what can be repaired (see the module docs of
@@ -227,13 +231,16 @@ impl Groom {
                 repairs.short_strands += 1;
                 continue;
             }
-            let size = super::strand_size(&kept.iter().map(|&i| positions[i]).collect::<Vec<_>>());
-            survivors.push((strand, kept, size));
+            let (lo, hi) = super::bounding_box(kept.iter().map(|&i| positions[i]));
+            survivors.push((strand, kept, (hi - lo).length()));
         }
         // Degenerate strands, judged by the median of what is left until none
         // is (dropping the smallest can only raise the median), so that the
-        // groom built below has none by its own median either.
-        while let Some(median) = super::median_size(survivors.iter().map(|s| s.2)) {
+        // groom built below has none by its own median either. (Rounds are
+        // bounded: a file built to creep the median up round after round is
+        // refused by the groom's own check instead.)
+        for _ in 0..MAX_DEGENERATE_ROUNDS {
+            let Some(median) = super::median_size(survivors.iter().map(|s| s.2)) else { break };
             let before = survivors.len();
             survivors.retain(|(strand, _, size)| {
                 let keep = !super::degenerate(*size, median);
