@@ -98,7 +98,13 @@ fn lz4_size(data: &[u8]) -> Option<u64> {
 /// small, medium, large — then the deltas), kept as the crate keeps them
 /// (wrapped to 32 bits): the structure's tables are all of 32-bit integers.
 pub(super) fn decode_ints(data: &[u8], count: u64, what: &str) -> Result<Vec<i32>> {
-    let width = 4u64;
+    decode_ints_of(data, count, 4, what).map(|v| v.into_iter().map(|i| i as i32).collect())
+}
+
+/// `count` integers of `width` bytes (4 or 8) decoded from `data` as the
+/// crate's integer coding stores them (see [`decode_ints`]), each as an
+/// `i64` (a 32-bit one wrapped to 32 bits first, as the crate keeps it).
+pub(super) fn decode_ints_of(data: &[u8], count: u64, width: u64, what: &str) -> Result<Vec<i64>> {
     if count == 0 {
         return Ok(Vec::new());
     }
@@ -131,7 +137,7 @@ pub(super) fn decode_ints(data: &[u8], count: u64, what: &str) -> Result<Vec<i32
         };
         at += size;
         prev = prev.wrapping_add(delta);
-        out.push(prev as i32);
+        out.push(if width == 4 { i64::from(prev as i32) } else { prev });
     }
     Ok(out)
 }

@@ -240,7 +240,7 @@ fn check_counts(walk: &mut Walk<'_>, rep: ValueRep) -> Result<()> {
             )));
         }
         if compressed {
-            check_compressed_block(read_at, pos, len, rep.ty()).map_err(what)?;
+            check_compressed_block(read_at, pos, len, rep.ty(), count).map_err(what)?;
         }
     } else if at >= len {
         return Err(what(format!("starts at byte {at}, past the file's end ({len} bytes)")));
@@ -254,18 +254,24 @@ fn check_counts(walk: &mut Walk<'_>, rep: ValueRep) -> Result<()> {
 /// states them before it reads them (a file of another version's layout had
 /// it ask for 80 GiB). An integer array is that size and the block; a
 /// floating-point one a code byte, then either that (`i`, integers) or a
-/// 32-bit table length, the table and that (`t`). Each must fit in the file;
-/// `Err` says how it does not.
+/// 32-bit table length, the table and that (`t`). Each must fit in the file,
+/// and the block must decode as the crate decodes it — LZ4 into the room it
+/// gives (sized for 32-bit integers, whatever the type), then `count`
+/// integers of the type's width, a table's indices inside it — since the
+/// crate slices and indexes what it decodes without checking (a block size
+/// changed to 7 stopped it with a panic). `Err` says how it does not.
 fn check_compressed_block(
     read_at: &mut dyn FnMut(u64, usize) -> Result<u64>,
     pos: u64,
     len: u64,
     ty: u64,
+    count: u64,
 ) -> std::result::Result<(), String> {
     let room = |from: u64| len.saturating_sub(from);
     let past = || format!("has its compressed block past the file's end ({len} bytes)");
     let io = |e: Error| format!("cannot be read: {e}");
     let mut pos = pos;
+    let mut table = None;
     if !(3..=6).contains(&ty) {
         // Floating point: a code byte first.
         if room(pos) < 1 {
@@ -279,13 +285,14 @@ fn check_compressed_block(
                 if room(pos) < 4 {
                     return Err(past());
                 }
-                let table = read_at(pos, 4).map_err(io)?;
+                let values = read_at(pos, 4).map_err(io)?;
                 pos += 4;
-                let bytes = table.saturating_mul(element_size(ty));
+                let bytes = values.saturating_mul(element_size(ty));
                 if bytes > room(pos) {
-                    return Err(format!("has a lookup table of {table} values, more than the file holds"));
+                    return Err(format!("has a lookup table of {values} values, more than the file holds"));
                 }
                 pos += bytes;
+                table = Some(values);
             }
             other => return Err(format!("has an unknown compression code {other}")),
         }
@@ -296,6 +303,25 @@ fn check_compressed_block(
     let size = read_at(pos, 8).map_err(io)?;
     if size > room(pos + 8) {
         return Err(format!("has a compressed block of {size} bytes, more than the file holds"));
+    }
+    let mut block = Vec::with_capacity(size as usize);
+    for at in (pos + 8..pos + 8 + size).step_by(8) {
+        let n = (pos + 8 + size - at).min(8) as usize;
+        block.extend_from_slice(&read_at(at, n).map_err(io)?.to_le_bytes()[..n]);
+    }
+    let reason = |e: Error| match e {
+        Error::Malformed { reason, .. } => reason,
+        e => e.to_string(),
+    };
+    let what = "has a compressed block that does not decode";
+    let room_bytes = super::usdc_blocks::encoded_room(count, 4);
+    let decoded = super::usdc_blocks::decompress(&block, room_bytes, what).map_err(reason)?;
+    let width = if matches!(ty, 5 | 6) { 8 } else { 4 };
+    let ints = super::usdc_blocks::decode_ints_of(&decoded, count, width, what).map_err(reason)?;
+    if let Some(values) = table {
+        if let Some(index) = ints.iter().find(|&&i| (i as u32 as u64) >= values) {
+            return Err(format!("names value {} of a lookup table of {values}", *index as u32));
+        }
     }
     Ok(())
 }
@@ -398,5 +424,69 @@ fn check_indices(
             Ok(())
         }
         _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::check_compressed_block;
+
+    /// A compressed array's block as the crate stores it, from byte 0: for a
+    /// float type (`ty` 8) the code byte and, with `table`, a lookup table of
+    /// that many floats; then the block's size and the block (the chunk
+    /// count 0, then LZ4 of `count` integers all the common value `common`:
+    /// it, in the type's width, and a code byte of zeros a four).
+    fn block(ty: u64, table: Option<u32>, common: i32, count: usize, size: Option<u64>) -> Vec<u8> {
+        let mut encoded = match ty {
+            5 | 6 => i64::from(common).to_le_bytes().to_vec(),
+            _ => common.to_le_bytes().to_vec(),
+        };
+        encoded.extend(std::iter::repeat_n(0u8, (count * 2).div_ceil(8)));
+        let mut lz4 = vec![0u8];
+        lz4.extend(lz4_flex::block::compress(&encoded));
+        let mut out = Vec::new();
+        if ty == 8 {
+            match table {
+                Some(n) => {
+                    out.push(b't');
+                    out.extend(n.to_le_bytes());
+                    out.extend(std::iter::repeat_n(0u8, 4 * n as usize));
+                }
+                None => out.push(b'i'),
+            }
+        }
+        out.extend(size.unwrap_or(lz4.len() as u64).to_le_bytes());
+        out.extend(lz4);
+        out
+    }
+
+    fn check(bytes: &[u8], ty: u64, count: u64) -> Result<(), String> {
+        let mut read_at = |at: u64, n: usize| -> crate::error::Result<u64> {
+            let mut b = [0u8; 8];
+            b[..n].copy_from_slice(&bytes[at as usize..at as usize + n]);
+            Ok(u64::from_le_bytes(b))
+        };
+        check_compressed_block(&mut read_at, 0, bytes.len() as u64, ty, count)
+    }
+
+    /// Blocks that decode as the crate decodes them pass; a block cut short
+    /// (its size changed to 7: the crate sliced past what it decoded and
+    /// stopped with a panic), a block past the file and a lookup table's
+    /// index past the table are refused, each saying what.
+    #[test]
+    fn compressed_blocks_are_decoded_before_the_reader_trusts_them() {
+        assert_eq!(check(&block(3, None, 1, 400, None), 3, 400), Ok(()));
+        assert_eq!(check(&block(5, None, 1, 400, None), 5, 400), Ok(()), "64-bit integers");
+        assert_eq!(check(&block(8, None, 1, 400, None), 8, 400), Ok(()), "floats as integers");
+        assert_eq!(check(&block(8, Some(4), 0, 400, None), 8, 400), Ok(()), "a lookup table's index 0");
+        let cut = block(3, None, 1, 400, Some(7));
+        let e = check(&cut, 3, 400).expect_err("cut short");
+        assert!(e.contains("does not decode"), "{e}");
+        let e = check(&block(3, None, 1, 400, Some(1 << 40)), 3, 400).expect_err("past the file");
+        assert!(e.contains("a compressed block of 1099511627776 bytes, more than the file holds"), "{e}");
+        let e = check(&block(8, Some(4), 1, 400, None), 8, 400).expect_err("an index past the table");
+        assert!(e.contains("names value 4 of a lookup table of 4"), "{e}");
+        let e = check(&block(8, None, 1, 400, None)[..1], 8, 400).expect_err("no size");
+        assert!(e.contains("past the file's end"), "{e}");
     }
 }
