@@ -37,6 +37,8 @@ pub struct Repairs {
     pub zero_length_segments: usize,
     /// Strands dropped for having fewer than two points (left or given).
     pub short_strands: usize,
+    /// The first of them (in the input).
+    pub first_short: Option<usize>,
     /// Original index of every kept point, in order.
     kept_points: Vec<usize>,
     /// Original index of every kept strand, in order.
@@ -97,7 +99,12 @@ impl std::fmt::Display for Repairs {
                 self.zero_length_segments,
                 plural(self.zero_length_segments, "zero-length segment", "zero-length segments"),
             ),
-            (self.short_strands, plural(self.short_strands, "strand", "strands") + " with fewer than two points"),
+            (
+                self.short_strands,
+                plural(self.short_strands, "strand", "strands")
+                    + " with fewer than two points"
+                    + &self.first_short.map_or(String::new(), |s| format!(" (the first: strand {s})")),
+            ),
         ]
         .into_iter()
         .filter(|(n, _)| *n > 0)
@@ -186,6 +193,7 @@ impl Groom {
             start = range.end;
             if n < 2 {
                 repairs.short_strands += 1;
+                repairs.first_short = Some(repairs.first_short.map_or(strand, |s| s.min(strand)));
             } else if let Some((i, what)) = range.clone().find_map(|i| not_finite(i).map(|w| (i, w))) {
                 repairs.non_finite_strands += 1;
                 repairs.first_non_finite.get_or_insert((strand, i - range.start, what));
@@ -229,6 +237,7 @@ impl Groom {
             }
             if kept.len() < 2 {
                 repairs.short_strands += 1;
+                repairs.first_short = Some(repairs.first_short.map_or(strand, |s| s.min(strand)));
                 continue;
             }
             let (lo, hi) = super::bounding_box(kept.iter().map(|&i| positions[i]));
@@ -321,7 +330,7 @@ mod tests {
         assert_eq!(
             repairs.to_string(),
             "dropped 1 strand with NaN or infinite values (the first: strand 2 point 1, its position), 3 zero-length \
-             segments, 2 strands with fewer than two points"
+             segments, 2 strands with fewer than two points (the first: strand 3)"
         );
         // A NaN width is named as such.
         let thickness = Some(vec![0.001, f32::NAN, 0.001, 0.001, 0.001]);
