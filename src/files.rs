@@ -63,7 +63,7 @@ impl Read for Input {
                     return Err(std::io::Error::new(
                         std::io::ErrorKind::TimedOut,
                         format!(
-                            "not a regular file, and it gave no data for {} s (a FIFO whose writer writes nothing)",
+                            "not a regular file, and it gave no data for {} s (a FIFO whose writer has stopped writing)",
                             stall.as_secs_f32()
                         ),
                     ));

@@ -1252,6 +1252,12 @@ fn a_stage_of_too_many_properties_all_together_is_refused() {
     assert!(e.contains("root.usda") && e.contains("text layers hold more than 100000 properties"), "{e}");
     std::fs::write(&path, prims(10, 9_999) + STRAND).expect("write");
     assert_eq!(usd::open(&path).expect("within the bound").groom.strand_count(), 1);
+    // Braces on lines of their own are not properties (ten child prims so
+    // written had made 99,991 properties count past 100,000).
+    let braced = prims(10, 9_999).replace("def \"", "    def \"").replace("\" {\n", "\"\n    {\n");
+    let text = format!("#usda 1.0\ndef Xform \"root\"\n{{\n{}}}\n{STRAND}", braced.trim_start_matches("#usda 1.0\n"));
+    std::fs::write(&path, text).expect("write");
+    assert_eq!(usd::open(&path).expect("braces on their own lines").groom.strand_count(), 1);
 }
 
 /// A prim of more properties than [`usda_check::MAX_USD_PROPERTIES`] is

@@ -173,7 +173,7 @@ pub fn check(text: &str, sublayer: bool) -> Result<Checked> {
         if open.last().is_some_and(|&(c, _)| c == b'{')
             && !prims.is_empty()
             && !child_prim
-            && !matches!(token, Token::Close(_))
+            && !matches!(token, Token::Close(_) | Token::Open(_))
             && text[previous..*at].contains('\n')
         {
             if let Some(n) = statements.last_mut() {
