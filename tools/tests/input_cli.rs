@@ -357,6 +357,12 @@ fn bad_values_name_their_option() {
         (&["render", "--input", g, "--density", "1e9"], "invalid parameter --density: 1000000000"),
         (&["grow", "--scalp", "sphere", "--points", "0", "--out", o], "invalid parameter --points: 0"),
         (&["grow", "--scalp", "sphere", "--radius", "1e30", "--out", o], "--radius \"1e30\": each"),
+        (&["grow", "--scalp", "sphere", "--center=NaN,0,0", "--out", o], "--center \"NaN,0,0\": each component"),
+        (&["grow", "--scalp", "sphere", "--face=NaN,0,0", "--out", o], "invalid parameter --face: [NaN, 0, 0]"),
+        (&["convert", g, "--points", "1", "--out", o], "invalid parameter --points: 1"),
+        (&["convert", g, "--key-hairs", "21", "--out", o], "invalid parameter --key-hairs: 21"),
+        (&["bench", "--quick", "--grid", "0", "--out", o], "invalid parameter --grid: 0 cells"),
+        (&["bench", "--quick", "--large", "0", "--out", o], "--large must be at least 1"),
     ];
     for (args, message) in cases {
         let out = run(args, LIMIT);

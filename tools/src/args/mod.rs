@@ -26,6 +26,9 @@ const FLAG_OF: &[(&str, &str)] = &[
     ("droop", "--droop"),
     ("min_height", "--min-height"),
     ("min_up_dot", "--min-up-dot"),
+    ("face", "--face"),
+    ("points per strand", "--points"),
+    ("key hair count", "--key-hairs"),
 ];
 
 /// `e` as the error of the flag that set the parameter it names

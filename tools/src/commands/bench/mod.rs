@@ -350,8 +350,16 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     if !(a.figure_seconds.is_finite() && a.figure_seconds > 0.0 && a.figure_seconds <= 1e6) {
         return Err(format!("--figure-seconds must be a number of seconds above 0 (got {})", a.figure_seconds).into());
     }
-    // A bad --simulated share is refused before any GPU work.
+    // A bad --simulated share, and the simulation flags with the volume stage
+    // on (every row's modes), are refused before any GPU work.
     a.sim.simulated_count(1)?;
+    let mut flags = SimParams::default();
+    a.sim.apply(&mut flags);
+    flags.volume.mode = VolumeMode::Flip;
+    flags.validate().map_err(crate::args::flag_error)?;
+    if a.large == 0 {
+        return Err("--large must be at least 1 (key hairs of the large generated groom)".into());
+    }
     if a.scaling_samples == 0 {
         return Err("--scaling-samples must be at least 1 (each point of a curve is a median of 5 by default)".into());
     }

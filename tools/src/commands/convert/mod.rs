@@ -44,10 +44,10 @@ fn write_converted(
 ) -> CliResult {
     let (mut groom, _) = load(input, strict)?;
     if let Some(n) = key_hairs {
-        groom = groom.select_evenly(n)?;
+        groom = groom.select_evenly(n).map_err(crate::args::flag_error)?;
     }
     if let Some(n) = points {
-        groom = groom.resampled(n)?;
+        groom = groom.resampled(n).map_err(crate::args::flag_error)?;
     }
     let s = groom.stats();
     if out.extension().is_some_and(|e| e.eq_ignore_ascii_case("abc")) {

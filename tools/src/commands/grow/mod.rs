@@ -151,6 +151,9 @@ pub fn grow_groom(a: &GrowArgs) -> CliResult {
                         return Err(format!("--radius {:?}: each semi-axis within (0, 1e6]", a.radius).into());
                     }
                     let center = parse_vec3("center", &a.center)?;
+                    if !(center.is_finite() && center.abs().max_element() <= 1e6) {
+                        return Err(format!("--center {:?}: each component within ±1e6", a.center).into());
+                    }
                     let mut scalp = Scalp::sphere_cap(center, radii.x, a.max_angle.to_radians());
                     if let Scalp::Ellipsoid { radii: r, .. } = &mut scalp {
                         *r = radii;
