@@ -302,7 +302,8 @@ pub enum Error {
     /// [`crate::groom::MAX_DISTANCE_IN_STRANDS`] times its median strand.
     #[error(
         "the groom lies {distance:e} from the origin, over 100000 times its median strand ({median:e} across): f32 \
-         positions there would round its strands' points by over a hundredth of a strand (move it nearer the origin)"
+         positions there would round its strands' points by over a hundredth of a strand (move it nearer the origin; or, if \
+         most of its strands are tiny, drop them: they make the median)"
     )]
     GroomFarAway {
         /// The distance of its farthest point from the origin, in the groom's units.
