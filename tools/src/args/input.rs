@@ -381,7 +381,7 @@ pub fn load_with_defaults(path: &Path, strict: bool) -> Result<Loaded, Error> {
     let refused = |e: vkhair::Error| -> Error {
         match e {
             vkhair::Error::Asset { .. } if strict => {
-                format!("{e} (--strict: without it, vkhair drops such segments, strands and curve objects and says so)")
+                format!("{e} (--strict: without it, vkhair drops such segments, strands, curve objects or thickness and says so)")
                     .into()
             }
             e => e.into(),
