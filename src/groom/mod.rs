@@ -120,11 +120,7 @@ pub(crate) fn groom_median_segment(
             k += 1;
         }
     }
-    if lengths.is_empty() {
-        return None;
-    }
-    let middle = lengths.len() / 2;
-    Some(*lengths.select_nth_unstable_by(middle, f32::total_cmp).1)
+    median(&mut lengths)
 }
 
 /// The lengths of the segments of the strand `points` between distinct
@@ -153,9 +149,8 @@ pub(crate) fn outlier_point(
     }
     let length = |i: usize| (points[i + 1] - points[i]).length();
     segment_lengths(points, scratch);
-    let middle = scratch.len() / 2;
     // A strand of fewer than three segments has no median of its own to trust.
-    let own = (scratch.len() >= 3).then(|| *scratch.select_nth_unstable_by(middle, f32::total_cmp).1);
+    let own = if scratch.len() >= 3 { median(scratch) } else { None };
     let reference = match (own, groom_median) {
         (Some(a), Some(b)) => a.min(b),
         (a, b) => a.or(b)?,
@@ -198,14 +193,14 @@ pub(crate) fn strand_size(points: &[Vec3]) -> f32 {
     (hi - lo).length()
 }
 
-/// The median of `sizes` ([`strand_size`]s), `None` for none.
-pub(crate) fn median_size(sizes: impl Iterator<Item = f32>) -> Option<f32> {
-    let mut sizes: Vec<f32> = sizes.collect();
-    if sizes.is_empty() {
+/// The median of `values` (the upper one of an even count; reordered in
+/// place), `None` for none.
+pub(crate) fn median(values: &mut [f32]) -> Option<f32> {
+    if values.is_empty() {
         return None;
     }
-    let middle = sizes.len() / 2;
-    Some(*sizes.select_nth_unstable_by(middle, f32::total_cmp).1)
+    let middle = values.len() / 2;
+    Some(*values.select_nth_unstable_by(middle, f32::total_cmp).1)
 }
 
 /// Whether a strand of bounding-box diagonal `size` is degenerate in a groom
@@ -223,8 +218,7 @@ pub(crate) fn thickness_fits(thickness: f32, size: f32) -> bool {
 /// The shortest segment of the strand `points` that is not zero-length
 /// ([`MIN_SEGMENT_FRACTION`] of its bounding-box diagonal).
 pub(crate) fn min_segment(points: &[Vec3]) -> f32 {
-    let (lo, hi) = bounding_box(points.iter().copied());
-    (hi - lo).length() * MIN_SEGMENT_FRACTION
+    strand_size(points) * MIN_SEGMENT_FRACTION
 }
 
 /// The axis-aligned bounding box (min, max) of `points`; (+∞, −∞) for none.
@@ -381,26 +375,25 @@ impl Groom {
             }
         }
         let mut scratch = Vec::new();
-        let median = groom_median_segment(&self.positions, (0..self.strand_count()).map(|s| self.strand_range(s)));
+        let segment = groom_median_segment(&self.positions, (0..self.strand_count()).map(|s| self.strand_range(s)));
         for strand in 0..self.strand_count() {
-            if let Some((point, position)) = outlier_point(self.strand(strand), median, &mut scratch) {
+            if let Some((point, position)) = outlier_point(self.strand(strand), segment, &mut scratch) {
                 return Err(Error::OutlierPoint { strand, point, position: position.to_array() });
             }
         }
         let (lo, hi) = self.bounds();
         check_extent(lo, hi)?;
-        for strand in 0..self.strand_count() {
-            let points = self.strand(strand);
-            let min_segment = min_segment(points);
-            for (segment, pair) in points.windows(2).enumerate() {
+        let sizes: Vec<f32> = (0..self.strand_count()).map(|s| strand_size(self.strand(s))).collect();
+        for (strand, &size) in sizes.iter().enumerate() {
+            let min_segment = size * MIN_SEGMENT_FRACTION;
+            for (segment, pair) in self.strand(strand).windows(2).enumerate() {
                 let length = (pair[1] - pair[0]).length();
                 if length <= min_segment || length == 0.0 {
                     return Err(Error::ZeroLengthSegment { strand, segment });
                 }
             }
         }
-        let sizes: Vec<f32> = (0..self.strand_count()).map(|s| strand_size(self.strand(s))).collect();
-        if let Some(median) = median_size(sizes.iter().copied()) {
+        if let Some(median) = median(&mut sizes.clone()) {
             if let Some(strand) = sizes.iter().position(|&size| degenerate(size, median)) {
                 return Err(Error::DegenerateStrand { strand, size: sizes[strand], median });
             }

@@ -249,7 +249,7 @@ impl Groom {
         // bounded: a file built to creep the median up round after round is
         // refused by the groom's own check instead.)
         for _ in 0..MAX_DEGENERATE_ROUNDS {
-            let Some(median) = super::median_size(survivors.iter().map(|s| s.2)) else { break };
+            let Some(median) = super::median(&mut survivors.iter().map(|s| s.2).collect::<Vec<_>>()) else { break };
             let before = survivors.len();
             survivors.retain(|(strand, _, size)| {
                 let keep = !super::degenerate(*size, median);
