@@ -157,12 +157,12 @@ fn assert_same(a: &Shown, b: &Shown, what: &str) {
     assert!(a.final_state == b.final_state, "{what}: final simulation state differs");
 }
 
-/// 200 frames in SINGLE QUEUE and in SECOND DEVICE mode with both hand-offs show
+/// 100 frames in SINGLE QUEUE and in SECOND DEVICE mode with both hand-offs show
 /// the same bits and the same images at every frame, for each pipelining choice;
 /// throughput shows at frame N what latency showed at frame N−1.
 #[test]
 fn single_queue_and_second_device_show_identical_frames() {
-    const FRAMES: usize = 200;
+    const FRAMES: usize = 100;
     let render = Gpu::new();
     let sim = Gpu::new();
     let mut latency_positions = None;

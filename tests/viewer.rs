@@ -1,5 +1,5 @@
 //! The windowed viewer example (`examples/viewer`) under a virtual X server:
-//! 120 frames through a real swapchain with validation and synchronization
+//! 60 frames through a real swapchain with validation and synchronization
 //! validation on and a resize half way, the screenshot showing hair, the
 //! overlay present, and the floor the host draws after vkhair's hair relying on
 //! the state vkhair documents it leaves (opaque, exact transparency and
@@ -128,12 +128,12 @@ fn the_viewer_runs_clean_in_a_window_and_shows_hair_overlay_and_floor() {
     };
     let dir = tempfile::tempdir().expect("temp dir");
     let shot = |name: &str| dir.path().join(name);
-    // 120 frames with validation, the window resized at frame 40: the screenshot
+    // 60 frames with validation, the window resized at frame 20: the screenshot
     // has the new size, so the swapchain was recreated.
     let (w, h, full) = run(
         &display,
         &shot("full.png"),
-        &["--frames", "120", "--width", "320", "--height", "240", "--resize", "400x300", "--resize-frame", "40"],
+        &["--frames", "60", "--width", "320", "--height", "240", "--resize", "400x300", "--resize-frame", "20"],
     );
     assert_eq!((w, h), (400, 300), "the resize did not reach the swapchain");
     let size = ["--width", "400", "--height", "300"];

@@ -39,7 +39,8 @@
 # building one. VKHAIR_FRAMES sets the frames and steps each goal runs
 # (default 120); VKHAIR_BENCH=0 leaves out the bench (part 3), for a run that
 # fits a short lease. `--smoke` (first argument) runs the goals' commands at
-# toy sizes on any device and skips the bench: it checks this script, not a GPU.
+# toy sizes (hairs over the scalp at a tenth of its density) on any device and
+# skips the bench: it checks this script, not a GPU.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 smoke=0
@@ -59,7 +60,9 @@ goals="$out/goals"
 mkdir -p "$goals"
 if [ "$smoke" = 1 ]; then
   width=160 height=120 frames=2 steps=3 guides=300 grid=16 per_key=4 peer_width=160 peer_height=120
+  scalp=(--density 15)
 else
+  scalp=()
   frames=${VKHAIR_FRAMES:-120}
   if ! [[ $frames =~ ^[1-9][0-9]*$ ]]; then
     echo "gpu-bench: VKHAIR_FRAMES must be a whole number of frames, at least 1 (got '$frames')" >&2
@@ -101,7 +104,8 @@ run_goal() {
   echo
 } >"$report"
 run_goal "a. thesis full frame, ${width}×${height}, two shadowed spot lights" \
-  render --width "$width" --height "$height" --frames "$frames" --out "$goals/thesis" --json "$goals/thesis_frame.json"
+  render --width "$width" --height "$height" --frames "$frames" "${scalp[@]}" --out "$goals/thesis" \
+  --json "$goals/thesis_frame.json"
 # The simulation's goals, each figure beside its bound (mean GPU ms a step).
 step_goal() {
   local name=$1 bound=$2
@@ -171,9 +175,9 @@ size=(--width "$width" --height "$height" --frames "$frames")
 for raster in hardware compute tiles; do
   echo " --raster $raster" >>"$report"
   # The opaque frame's strands always go through the hardware; its maps by --raster.
-  frame_goal "thesis_off_$raster" "thesis ${width}×${height}, opaque" 1.5 ".*" "${size[@]}" --raster "$raster" \
-    --transparency off
-  frame_goal "thesis_$raster" "thesis ${width}×${height}, exact" 1.5 ".*" "${size[@]}" --raster "$raster"
+  frame_goal "thesis_off_$raster" "thesis ${width}×${height}, opaque" 1.5 ".*" "${size[@]}" "${scalp[@]}" \
+    --raster "$raster" --transparency off
+  frame_goal "thesis_$raster" "thesis ${width}×${height}, exact" 1.5 ".*" "${size[@]}" "${scalp[@]}" --raster "$raster"
   ratio=$(awk -v e="$(cat "$frame/thesis_$raster.ms")" -v o="$(cat "$frame/thesis_off_$raster.ms")" \
     'BEGIN { printf "%.2f", (o > 0) ? e / o : 0 }')
   printf '  %-62s %9s ×    goal ≤ 1.2 ×: %s\n' "exact / opaque, the thesis frame above" "$ratio" \
@@ -193,7 +197,7 @@ for raster in hardware compute tiles; do
     echo "  Sintel: skipped, no $sintel/sintel_hair.tfx (set VKHAIR_SINTEL)" >>"$report"
   fi
   big=(--width "$((smoke == 1 ? 320 : 3840))" --height "$((smoke == 1 ? 180 : 2160))")
-  "$vkhair" render "${big[@]}" --frames 2 --raster "$raster" --out "$frame/memory_$raster" \
+  "$vkhair" render "${big[@]}" "${scalp[@]}" --frames 2 --raster "$raster" --out "$frame/memory_$raster" \
     >"$frame/memory_$raster.txt" 2>&1
   mib=$(sed -n 's/^transparency: .*, \([0-9.]*\) MiB of .*/\1/p' "$frame/memory_$raster.txt")
   printf '  %-62s %9s MiB  goal ≤ 512 MiB: %s\n' "transparency memory at ${big[1]}×${big[3]}" "${mib:-?}" \
@@ -201,7 +205,8 @@ for raster in hardware compute tiles; do
 done
 # Interpolation per segment (issue: no costlier at 1,001,000 hairs than at the
 # thesis' count), for the default compute dispatch and the tessellation stages.
-"$vkhair" render "${size[@]}" --interpolator tessellation --out "$frame/thesis_tess" >"$frame/thesis_tess.txt" 2>&1 || {
+"$vkhair" render "${size[@]}" "${scalp[@]}" --interpolator tessellation --out "$frame/thesis_tess" \
+  >"$frame/thesis_tess.txt" 2>&1 || {
   cat "$frame/thesis_tess.txt" >&2
   echo "gpu-bench: the thesis through the tessellation stages failed: vkhair render ${size[*]} --interpolator tessellation" >&2
   exit 1

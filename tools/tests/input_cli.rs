@@ -146,12 +146,19 @@ fn options_that_need_others_say_so() {
 }
 
 /// Over the scalp the drawn count follows the density: a per-key count there
-/// is refused, naming the flag and what it needs, not ignored.
+/// is refused, naming the flag and what it needs, not ignored; so is a
+/// density where hairs are not rooted over the scalp.
 #[test]
 fn hairs_per_key_over_the_scalp_is_refused_not_ignored() {
     let out = run(&["render", "--frames", "1", "--width", "32", "--height", "32", "--hairs-per-key", "4"], LIMIT);
     out.assert_error("--hairs-per-key: 4");
     assert!(out.stderr.contains("--clumps") && out.stderr.contains("--density"), "{}", out.stderr);
+    for other in [&["--clumps"][..], &["--barycentric"]] {
+        let args = [&["render", "--frames", "1", "--width", "32", "--height", "32", "--density", "15"][..], other];
+        let out = run(&args.concat(), LIMIT);
+        out.assert_error("--density: 15");
+        assert!(out.stderr.contains("--hairs-per-key"), "{other:?}: {}", out.stderr);
+    }
 }
 
 /// `--interpolator` picks who grows the hairs and the tool says which: on this

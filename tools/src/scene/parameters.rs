@@ -128,6 +128,15 @@ pub fn make_renderer(
 ) -> Result<Renderer, vkhair::Error> {
     let radius = s.radius;
     let over_scalp = !a.clumps && config.render.interpolation == InterpolationMode::SingleStrand;
+    if let (Some(density), false) = (a.density, s.dense.is_none() && over_scalp) {
+        return Err(vkhair::Error::InvalidParameter {
+            name: "--density",
+            value: density.to_string(),
+            allowed: "only with hairs rooted over the scalp: with --clumps, --barycentric or followers (--guides) \
+                      the count follows --hairs-per-key"
+                .into(),
+        });
+    }
     let scalp = match (&s.dense, over_scalp) {
         (None, true) => scalp_followers(&s.groom, config, ctx)?,
         _ => None,

@@ -91,7 +91,9 @@ pub fn scaling(b: &Bench<'_>) -> Result<Vec<Curve>, Error> {
     let mut curve = Curve { axis: "resolution (render frame; thesis)", unit: "pixels", points: Vec::new() };
     for &(w, h) in sizes {
         let (w, h) = (w.to_string(), h.to_string());
-        let f = bench_frames(ctx, &["--width", &w, "--height", &h], &a.sim, n, Keep::Figures)?;
+        let args: Vec<&str> =
+            ["--width", &w, "--height", &h].into_iter().chain(super::quick_args(a).iter().copied()).collect();
+        let f = bench_frames(ctx, &args, &a.sim, n, Keep::Figures)?;
         curve.points.push((f.pixels as f64, clock.figure(&f.gpu, &f.wall).median(), f64::NAN));
     }
     curves.push(curve);
