@@ -238,7 +238,7 @@ fn memory_stays_flat_however_many_frames_are_rendered() {
             "64",
             "--clumps",
             "--hairs-per-key",
-            "2",
+            "1",
         ];
         let mut command = common::vkhair();
         command

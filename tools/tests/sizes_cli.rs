@@ -29,7 +29,22 @@ fn full_hd_and_4k_render_in_the_default_mode_and_a_capped_pool_is_reported() {
     for (w, h, config) in cases {
         let out = dir.path().join(format!("{w}x{h}{}", if config.is_some() { "-16" } else { "" }));
         let (ws, hs, o) = (w.to_string(), h.to_string(), out.display().to_string());
-        let mut args = vec!["render", "--input", g, "--frames", "1", "--width", &ws, "--height", &hs, "--out", &o];
+        // A tenth of a scalp's hairs: the pool's size follows the pixels.
+        let mut args = vec![
+            "render",
+            "--input",
+            g,
+            "--density",
+            "15",
+            "--frames",
+            "1",
+            "--width",
+            &ws,
+            "--height",
+            &hs,
+            "--out",
+            &o,
+        ];
         if let Some(c) = config {
             args.extend(["--config", c]);
         }
