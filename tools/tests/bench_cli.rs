@@ -79,6 +79,9 @@ fn a_quick_bench_reports_every_stage_with_its_reference_and_writes_json_and_a_ch
         let row = frames.iter().find(|f| f["stage"].as_str().is_some_and(|s| s.contains(stage))).expect(stage);
         row["error_vs_reference_srgb_steps"].as_f64().unwrap_or(f64::NAN)
     };
+    // --quick draws a tenth of a scalp's hairs: 15 a cm², 9,661 over the thesis' scalp.
+    let default_frame = frames.iter().find_map(|f| f["stage"].as_str().filter(|s| s.contains("segments")));
+    assert!(default_frame.is_some_and(|s| s.contains(" 9661 hairs")), "{default_frame:?}");
     let (default, off) = (error("segments"), error("transparency off"));
     assert!(default < 0.5 * off, "the default (exact) frame's error {default} is not below half of off's {off}");
     let csv = std::fs::read_to_string(out.join("transparency.csv")).expect("transparency.csv");
