@@ -24,6 +24,49 @@ uint sdf_index(uvec3 g, uvec3 dims) {
     return (g.z * dims.y + g.y) * dims.x + g.x;
 }
 
+// Words of a grid line's crossing marks (sign_mark.comp, sign.comp): a bit
+// per point of the longest axis. Twin: MeshCollider::build's marks buffer.
+uint sdf_mark_words(uvec3 dims) {
+    return (max(dims.x, max(dims.y, dims.z)) + 31u) / 32u;
+}
+
+// The ray of grid line (i, j) of the (u, v) plane: its u and v coordinates,
+// nudged off the lattice by 0.001 and 0.002 cells so that it misses edges
+// and vertices.
+vec2 sdf_ray(uint i, uint j, uint u, uint v, vec3 origin, float cell) {
+    precise float ou = origin[u] + (float(i) + 1e-3) * cell;
+    precise float ov = origin[v] + (float(j) + 2e-3) * cell;
+    return vec2(ou, ov);
+}
+
+// The first point of a line beyond the crossing of its ray with triangle
+// (a, b, c) along `axis` (w · cell > depth − ow), or nw where the ray misses
+// the triangle or crosses it beyond the last point. Twin: MeshSdf's ray parity.
+uint sdf_crossing(vec3 a, vec3 b, vec3 c, vec2 ray, uint axis, uint u, uint v, float ow, float cell, uint nw) {
+    float ou = ray.x;
+    float ov = ray.y;
+    // Edge functions of the projection onto the (u, v) plane.
+    precise float w0 = (c[u] - b[u]) * (ov - b[v]) - (c[v] - b[v]) * (ou - b[u]);
+    precise float w1 = (a[u] - c[u]) * (ov - c[v]) - (a[v] - c[v]) * (ou - c[u]);
+    precise float w2 = (b[u] - a[u]) * (ov - a[v]) - (b[v] - a[v]) * (ou - a[u]);
+    bool positive = w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0;
+    bool negative = w0 <= 0.0 && w1 <= 0.0 && w2 <= 0.0;
+    precise float area = w0 + w1 + w2;
+    if (!(positive || negative) || area == 0.0) {
+        return nw;
+    }
+    precise float depth = (w0 * a[axis] + w1 * b[axis] + w2 * c[axis]) / area;
+    precise float h = depth - ow;
+    int first = int(clamp(floor(h / cell), 0.0, float(nw)));
+    while (first > 0 && float(first - 1) * cell > h) {
+        first--;
+    }
+    while (first < int(nw) && !(float(first) * cell > h)) {
+        first++;
+    }
+    return uint(first);
+}
+
 vec3 sdf_point(uvec3 g, vec3 origin, float cell) {
     precise vec3 p = origin + vec3(g) * cell;
     return p;

@@ -13,6 +13,11 @@
 //! 3. **Sign**: ray parity along each axis, one ray per grid line; a point is
 //!    inside when two of its three rays say so (robust to open meshes such as a
 //!    bust cut at the chest, whose opening misleads the rays that leave by it).
+//!    Per axis, each triangle tests the rays its box reaches and marks each
+//!    crossing on its line, then each line turns its marks into parities (the
+//!    same crossings as testing every triangle per line: 3 × 64² × 5,952 edge
+//!    tests for Sintel's bust, about 0.9 s on lavapipe, against a few per
+//!    triangle).
 //! 4. **Finalize**: the signed distance to each point's triangle.
 //!
 //! The field lives in a storage buffer (x fastest) and the solver samples it
@@ -40,7 +45,9 @@ use crate::vk::buffer::Buffer;
 use crate::vk::debug::LabelColor;
 use crate::vk::device::Device;
 use crate::vk::pipeline::ComputePipeline;
-use crate::vk::shaders::{SIM_SDF_FINALIZE_COMP, SIM_SDF_FLOOD_COMP, SIM_SDF_SEED_COMP, SIM_SDF_SIGN_COMP};
+use crate::vk::shaders::{
+    SIM_SDF_FINALIZE_COMP, SIM_SDF_FLOOD_COMP, SIM_SDF_SEED_COMP, SIM_SDF_SIGN_COMP, SIM_SDF_SIGN_MARK_COMP,
+};
 
 /// How a mesh collider's field is built.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -186,17 +193,32 @@ impl MeshCollider {
         ];
         let votes = storage("vkhair mesh collider votes", points * 4)?;
         let field = storage("vkhair mesh collider field", points * 4)?;
+        // A line's crossing marks: a bit per point of the longest axis
+        // (sdf_mark_words), for the axis with the most lines.
+        let words = u64::from(dims.iter().max().copied().unwrap_or(1).div_ceil(32));
+        let lines = (0..3).map(|a| u64::from(dims[(a + 1) % 3]) * u64::from(dims[(a + 2) % 3])).max().unwrap_or(1);
+        let marks = storage("vkhair mesh collider crossing marks", lines * words * 4)?;
         device.upload_pod(&corner_buffer, &corners)?;
 
         let seed = ComputePipeline::new(&device, &SIM_SDF_SEED_COMP, 1)?;
         let flood = ComputePipeline::new(&device, &SIM_SDF_FLOOD_COMP, 2)?;
+        let sign_mark = ComputePipeline::new(&device, &SIM_SDF_SIGN_MARK_COMP, 1)?;
         let sign = ComputePipeline::new(&device, &SIM_SDF_SIGN_COMP, 1)?;
         let finalize = ComputePipeline::new(&device, &SIM_SDF_FINALIZE_COMP, 1)?;
         let table = |from: usize| {
-            [(0, &corner_buffer), (1, &distance), (2, &ids[from]), (3, &ids[1 - from]), (4, &votes), (5, &field)]
+            [
+                (0, &corner_buffer),
+                (1, &distance),
+                (2, &ids[from]),
+                (3, &ids[1 - from]),
+                (4, &votes),
+                (5, &field),
+                (6, &marks),
+            ]
         };
         let seed_set = seed.declared_buffer_set(0, &table(0))?;
         let flood_sets = [flood.declared_buffer_set(0, &table(0))?, flood.declared_buffer_set(0, &table(1))?];
+        let sign_mark_set = sign_mark.declared_buffer_set(0, &table(0))?;
         let sign_set = sign.declared_buffer_set(0, &table(0))?;
         let steps = MeshSdf::flood_steps(dims);
         // After the floods the choices sit in buffer `result`.
@@ -228,6 +250,7 @@ impl MeshCollider {
                         d.raw.cmd_fill_buffer(cmd, distance.raw(), 0, vk::WHOLE_SIZE, sentinel::SDF_NONE);
                         d.raw.cmd_fill_buffer(cmd, ids[0].raw(), 0, vk::WHOLE_SIZE, sentinel::SDF_NONE);
                         d.raw.cmd_fill_buffer(cmd, votes.raw(), 0, vk::WHOLE_SIZE, 0);
+                        d.raw.cmd_fill_buffer(cmd, marks.raw(), 0, vk::WHOLE_SIZE, 0);
                         d.cmd_barrier(cmd, &[filled], &[], &[]);
                         seed.bind(cmd, &[seed_set]);
                         for mode in 0..2 {
@@ -241,10 +264,15 @@ impl MeshCollider {
                             flood.dispatch_threads(cmd, [points, 1, 1]);
                             d.cmd_barrier(cmd, &[between], &[], &[]);
                         }
-                        sign.bind(cmd, &[sign_set]);
                         for axis in 0..3usize {
                             let lines = dims[(axis + 1) % 3] * dims[(axis + 2) % 3];
-                            sign.push(cmd, &with(SdfPass { ray_axis: axis as u32, ..base }));
+                            let pass = with(SdfPass { ray_axis: axis as u32, ..base });
+                            sign_mark.bind(cmd, &[sign_mark_set]);
+                            sign_mark.push(cmd, &pass);
+                            sign_mark.dispatch_threads(cmd, [triangles as u32, 1, 1]);
+                            d.cmd_barrier(cmd, &[between], &[], &[]);
+                            sign.bind(cmd, &[sign_set]);
+                            sign.push(cmd, &pass);
                             sign.dispatch_threads(cmd, [lines, 1, 1]);
                             d.cmd_barrier(cmd, &[between], &[], &[]);
                         }
