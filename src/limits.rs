@@ -45,7 +45,9 @@ pub const OIT_MAX_SORTED: u32 = 32;
 /// 16-bit indices.
 pub const RIBBON_CHUNK: u32 = 16_384;
 
-/// Every constant above with the name the shaders see it by.
+/// The constants above that shaders use, with the name they see each by
+/// ([`SDF_MAX_RESOLUTION`] is the host's alone: the mesh collider's kernels
+/// size a line's marks from the grid they are given).
 #[cfg_attr(not(test), allow(dead_code))] // used by build.rs and the tests
 pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
     ("SIM_MAX_COLLIDERS", SIM_MAX_COLLIDERS),
@@ -57,7 +59,6 @@ pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
     ("VOL_FACE_WORDS", VOL_FACE_WORDS),
     ("VOL_COARSEST_SWEEPS", VOL_COARSEST_SWEEPS),
     ("ITEM_GROUP", ITEM_GROUP),
-    ("SDF_MAX_RESOLUTION", SDF_MAX_RESOLUTION),
     ("OIT_MAX_SORTED", OIT_MAX_SORTED),
     ("RIBBON_CHUNK", RIBBON_CHUNK),
 ];

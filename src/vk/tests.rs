@@ -585,8 +585,9 @@ fn shaders_are_built_with_the_shared_constants() {
         checked += 1;
     }
     assert_eq!(
-        checked, 31,
-        "1 simulation, 7 per-item and 23 volume kernels (17, 5 shared-memory variants and the scatter's 64-bit one)"
+        checked, 32,
+        "1 simulation, 8 per-item (5 of them the mesh collider's) and 23 volume kernels (17, 5 shared-memory \
+         variants and the scatter's 64-bit one)"
     );
     let sources: String = glsl_sources().into_iter().map(|(_, text)| text).collect();
     for (name, _) in limits::SHADER_CONSTANTS {
