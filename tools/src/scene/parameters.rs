@@ -127,8 +127,10 @@ pub fn make_renderer(
     s: &Scene,
 ) -> Result<Renderer, vkhair::Error> {
     let radius = s.radius;
-    let over_scalp = !a.clumps && config.render.interpolation == InterpolationMode::SingleStrand;
-    if let (Some(density), false) = (a.density, s.dense.is_none() && over_scalp) {
+    // Hairs rooted over the scalp: not a dense groom's followers, not clumps
+    // or barycentric hairs.
+    let over_scalp = s.dense.is_none() && !a.clumps && config.render.interpolation == InterpolationMode::SingleStrand;
+    if let (Some(density), false) = (a.density, over_scalp) {
         return Err(vkhair::Error::InvalidParameter {
             name: "--density",
             value: density.to_string(),
@@ -137,10 +139,7 @@ pub fn make_renderer(
                 .into(),
         });
     }
-    let scalp = match (&s.dense, over_scalp) {
-        (None, true) => scalp_followers(&s.groom, config, ctx)?,
-        _ => None,
-    };
+    let scalp = if over_scalp { scalp_followers(&s.groom, config, ctx)? } else { None };
     let mut renderer = match (&s.dense, scalp) {
         (None, Some(followers)) => {
             if let Some(hairs) = a.hairs_per_key {

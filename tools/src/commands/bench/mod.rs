@@ -101,14 +101,19 @@ impl Bench<'_> {
         std::time::Duration::from_secs_f64(self.args.figure_seconds)
     }
 
-    /// The simulation parameters of a row: vkhair's defaults, the --sim flags,
-    /// then the row's volume `mode` on a `grid`³ grid.
+    /// The simulation parameters of a row ([`row_params`]).
     fn params(&self, mode: VolumeMode, grid: u32) -> SimParams {
-        let mut params = SimParams::default();
-        self.args.sim.apply(&mut params);
-        params.volume = VolumeParams { mode, resolution: [grid; 3], ..params.volume };
-        params
+        row_params(&self.args.sim, mode, grid)
     }
+}
+
+/// The simulation parameters of a row: vkhair's defaults, the simulation
+/// flags `sim`, then the row's volume `mode` on a `grid`³ grid.
+fn row_params(sim: &SimArgs, mode: VolumeMode, grid: u32) -> SimParams {
+    let mut params = SimParams::default();
+    sim.apply(&mut params);
+    params.volume = VolumeParams { mode, resolution: [grid; 3], ..params.volume };
+    params
 }
 
 /// One stage's figures on one scene.
@@ -370,10 +375,7 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     // A bad --simulated share, and the simulation flags with the volume stage
     // on (every row's modes), are refused before any GPU work.
     a.sim.simulated_count(1)?;
-    let mut flags = SimParams::default();
-    a.sim.apply(&mut flags);
-    flags.volume.mode = VolumeMode::Flip;
-    flags.validate().map_err(crate::args::flag_error)?;
+    row_params(&a.sim, VolumeMode::Flip, 32).validate().map_err(crate::args::flag_error)?;
     if a.large == 0 {
         return Err("--large must be at least 1 (key hairs of the large generated groom)".into());
     }
