@@ -519,7 +519,13 @@ mod tests {
             ] {
                 match result {
                     Err(e @ Error::GroomFarAway { .. }) => {
-                        assert!(e.to_string().contains("over 100000 times its median strand (7e-2 across)"), "{e}")
+                        // The message states the bound the check applies (error.rs, below
+                        // groom, spells it out).
+                        let bound = format!(
+                            "over {} times its median strand (7e-2 across)",
+                            crate::groom::MAX_DISTANCE_IN_STRANDS
+                        );
+                        assert!(e.to_string().contains(&bound), "{e}")
                     }
                     other => panic!("{offset}: expected GroomFarAway, got {other:?}"),
                 }
@@ -542,7 +548,9 @@ mod tests {
             let attributes = || Attributes { thickness: Some(t.clone()), ..Default::default() };
             match Groom::with_attributes(strands.clone(), &[8, 8], attributes()) {
                 Err(e @ Error::BadThickness { strand: 1, point: 3, .. }) => {
-                    assert!(e.to_string().contains(named), "{e}")
+                    assert!(e.to_string().contains(named), "{e}");
+                    let bound = format!("(at least 0, at most {} times that)", crate::groom::MAX_THICKNESS_IN_SIZES);
+                    assert!(e.to_string().contains(&bound), "{e}");
                 }
                 other => panic!("{value}: expected BadThickness, got {other:?}"),
             }
