@@ -129,9 +129,12 @@ fn a_quick_bench_reports_every_stage_with_its_reference_and_writes_json_and_a_ch
 
 #[test]
 fn require_gpu_refuses_a_cpu_device() {
-    let r = run(&["bench", "--require-gpu", "--quick"], LIMIT);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("never");
+    let r = run(&["bench", "--require-gpu", "--quick", "--out", out.to_str().expect("utf-8")], LIMIT);
     if r.stdout.contains("llvmpipe") || r.stderr.contains("CPU implementation") {
         r.assert_error("--require-gpu");
+        assert!(!out.exists(), "the refused run left its --out folder behind");
     } else {
         eprintln!("a GPU is present: --require-gpu accepted it (nothing to refuse here)");
     }

@@ -382,9 +382,6 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     if a.scaling_samples == 0 {
         return Err("--scaling-samples must be at least 1 (each point of a curve is a median of 5 by default)".into());
     }
-    let mut outputs = vec![Output { flag: "--out", path: &a.out, kind: Kind::Folder }];
-    outputs.extend(a.json.as_deref().map(|path| Output { flag: "--json", path, kind: Kind::File(&["json"]) }));
-    destinations::check(&[], &outputs)?;
     let ctx = GpuContext::headless(&ContextOptions::default())?;
     let info = ctx.info();
     if a.require_gpu && info.device_type == vkhair::ash::vk::PhysicalDeviceType::CPU {
@@ -394,6 +391,11 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
         )
         .into());
     }
+    // After the device is known: the check makes the --out folder, which a
+    // refused run must not leave behind.
+    let mut outputs = vec![Output { flag: "--out", path: &a.out, kind: Kind::Folder }];
+    outputs.extend(a.json.as_deref().map(|path| Output { flag: "--json", path, kind: Kind::File(&["json"]) }));
+    destinations::check(&[], &outputs)?;
     say!("{} ({}): {} samples per figure, GPU and CPU reference interleaved", info.name, info.driver, a.samples);
     let clock = Clocking::new(&ctx)?;
     say!("{}", clock.describe());
