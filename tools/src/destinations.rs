@@ -8,6 +8,9 @@
 //! - A symbolic link in an output's place is refused (the files are written
 //!   through `vkhair::files::write_atomic`, which refuses it too).
 //! - No output is also an input of the run, and no two outputs share a path.
+//! - An output folder the check creates is removed again, with the folders it
+//!   created above it, if it is still empty when the returned [`Made`] is
+//!   dropped: a run refused after the check leaves nothing behind.
 
 use std::os::unix::fs::{FileTypeExt, MetadataExt};
 use std::path::{Path, PathBuf};
@@ -29,13 +32,31 @@ pub struct Output<'a> {
     pub kind: Kind,
 }
 
+/// The folders a [`check`] created, deepest first: each is removed when this
+/// is dropped if it is empty then (a run that wrote into it keeps it).
+#[must_use = "the folders made are removed when this is dropped: hold it until the run ends"]
+pub struct Made(Vec<PathBuf>);
+
+impl Drop for Made {
+    fn drop(&mut self) {
+        for folder in &self.0 {
+            // Fails, leaving the folder, when the run wrote into it.
+            if std::fs::remove_dir(folder).is_err() {
+                break;
+            }
+        }
+    }
+}
+
 /// Checks `outputs` against each other, against `inputs` and against the file
-/// system (see the module docs); creates a missing output folder.
-pub fn check(inputs: &[&Path], outputs: &[Output<'_>]) -> Result<(), Error> {
+/// system (see the module docs); creates a missing output folder, returning
+/// what it made.
+pub fn check(inputs: &[&Path], outputs: &[Output<'_>]) -> Result<Made, Error> {
+    let mut made = Made(Vec::new());
     for (k, out) in outputs.iter().enumerate() {
         match out.kind {
             Kind::File(formats) => check_file(out, formats)?,
-            Kind::Folder => check_folder(out)?,
+            Kind::Folder => check_folder(out, &mut made)?,
         }
         if let Some(input) = inputs.iter().find(|input| same_file(input, out.path)) {
             return Err(format!(
@@ -56,7 +77,7 @@ pub fn check(inputs: &[&Path], outputs: &[Output<'_>]) -> Result<(), Error> {
             .into());
         }
     }
-    Ok(())
+    Ok(made)
 }
 
 fn check_file(out: &Output<'_>, formats: &[&str]) -> Result<(), Error> {
@@ -94,12 +115,17 @@ fn check_file(out: &Output<'_>, formats: &[&str]) -> Result<(), Error> {
     probe_folder(flag, folder)
 }
 
-fn check_folder(out: &Output<'_>) -> Result<(), Error> {
+fn check_folder(out: &Output<'_>, made: &mut Made) -> Result<(), Error> {
     let (flag, path) = (out.flag, out.path.display());
     if std::fs::symlink_metadata(out.path).is_ok_and(|m| !m.is_dir() && !m.file_type().is_symlink()) {
         return Err(format!("{flag} {path} is a file, not a folder").into());
     }
-    std::fs::create_dir_all(out.path).map_err(|e| format!("{flag}: cannot create {path}: {e}"))?;
+    // The folders missing now, deepest first: the ones create_dir_all makes.
+    let missing = out.path.ancestors().take_while(|f| !f.as_os_str().is_empty() && !f.exists());
+    let missing: Vec<PathBuf> = missing.map(Path::to_path_buf).collect();
+    let created = std::fs::create_dir_all(out.path);
+    made.0.extend(missing.into_iter().filter(|f| f.is_dir()));
+    created.map_err(|e| format!("{flag}: cannot create {path}: {e}"))?;
     probe_folder(flag, out.path)
 }
 

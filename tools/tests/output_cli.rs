@@ -274,3 +274,35 @@ fn a_folder_in_a_frames_place_is_refused_before_rendering() {
     assert!(!run.stdout.contains("key hairs"), "GPU work started: {}", run.stdout);
     assert!(!out.join("frame_0000.png").exists(), "a frame was written");
 }
+
+/// A run refused after its outputs were checked leaves no folder it made:
+/// `render` and `bench` make a missing `--out` folder (and the folders above
+/// it) during the check, and take them away again when the run is refused
+/// later; a folder that was there before stays, and so does one a run wrote into.
+#[test]
+fn a_refused_run_leaves_no_folder_it_made() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let made = dir.path().join("new");
+    let deep = made.join("deeper").join("frames");
+    let d = deep.to_str().expect("utf-8");
+    // Refused by the library's parameter check, after the outputs' check.
+    run(&["render", "--level", "0", "--out", d], LIMIT).assert_error("invalid parameter --level: 0");
+    assert!(!made.exists(), "render left {} behind", made.display());
+    // Refused reading a damaged Sintel, after the outputs' check.
+    let sintel = dir.path().join("sintel");
+    std::fs::create_dir(&sintel).expect("mkdir");
+    std::fs::write(sintel.join("sintel_hair.tfx"), b"not a groom").expect("write");
+    std::fs::write(sintel.join("sintel_bust.obj"), b"v 0 0 0\n").expect("write");
+    let s = sintel.to_str().expect("utf-8");
+    run(&["bench", "--quick", "--sintel", s, "--out", d], LIMIT).assert_error("sintel_hair.tfx");
+    assert!(!made.exists(), "bench left {} behind", made.display());
+    // A folder that existed stays, empty or not.
+    std::fs::create_dir_all(&deep).expect("mkdir");
+    run(&["render", "--level", "0", "--out", d], LIMIT).assert_error("invalid parameter --level: 0");
+    assert!(deep.is_dir(), "render removed a folder it did not make");
+    // A run that writes keeps the folder it made.
+    std::fs::remove_dir_all(&made).expect("rm");
+    let ok = run(&["render", "--frames", "1", "--width", "32", "--height", "24", "--density", "5", "--out", d], LIMIT);
+    ok.assert_ok();
+    assert!(deep.join("frame_0000.png").is_file(), "the frame is missing: {}", ok.stdout);
+}

@@ -31,7 +31,10 @@ pub struct ConvertArgs {
 }
 
 pub fn convert(a: &ConvertArgs) -> CliResult {
-    destinations::check(&[&a.input], &[Output { flag: "--out", path: &a.out, kind: Kind::File(&["hair", "abc"]) }])?;
+    let _made = destinations::check(
+        &[&a.input],
+        &[Output { flag: "--out", path: &a.out, kind: Kind::File(&["hair", "abc"]) }],
+    )?;
     write_converted(&a.input, a.points, a.key_hairs, &a.out, a.strict)
 }
 

@@ -20,6 +20,6 @@ pub struct PlotArgs {
 
 pub fn plot(a: &PlotArgs) -> CliResult {
     let out = a.out.clone().unwrap_or_else(|| a.csv.with_extension("png"));
-    destinations::check(&[&a.csv], &[Output { flag: "--out", path: &out, kind: Kind::File(&["png"]) }])?;
+    let _made = destinations::check(&[&a.csv], &[Output { flag: "--out", path: &out, kind: Kind::File(&["png"]) }])?;
     plot_file(&a.csv, &out)
 }

@@ -96,7 +96,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
     inputs.extend(sa.config.as_deref());
     let mut outputs = vec![Output { flag: "--out", path: &a.out, kind: Kind::Folder }];
     outputs.extend(a.profile_out.outputs());
-    destinations::check(&inputs, &outputs)?;
+    let _made = destinations::check(&inputs, &outputs)?;
     let stale = clear_stale_frames(&a.out, a.frames)?;
     if stale > 0 {
         say!("removed {stale} frames of an earlier run from {} (this run writes {})", a.out.display(), a.frames);

@@ -174,7 +174,7 @@ pub fn simulate(a: &SimulateArgs) -> CliResult {
         kind: Kind::File(&["hair"]),
     }));
     outputs.extend(a.profile_out.outputs());
-    destinations::check(&inputs, &outputs)?;
+    let _made = destinations::check(&inputs, &outputs)?;
     if let Some(ch) = crate::scene::load_character(&a.input)? {
         return character::simulate_character(a, ch);
     }
