@@ -376,6 +376,10 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     // on (every row's modes), are refused before any GPU work.
     a.sim.simulated_count(1)?;
     row_params(&a.sim, VolumeMode::Flip, 32).validate().map_err(crate::args::flag_error)?;
+    // The frames' rows take the flags as they are (`--grid` included).
+    let mut frames = SimParams::default();
+    a.sim.apply(&mut frames);
+    frames.validate().map_err(crate::args::flag_error)?;
     if a.large == 0 {
         return Err("--large must be at least 1 (key hairs of the large generated groom)".into());
     }
@@ -395,7 +399,7 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     // refused run must not leave behind.
     let mut outputs = vec![Output { flag: "--out", path: &a.out, kind: Kind::Folder }];
     outputs.extend(a.json.as_deref().map(|path| Output { flag: "--json", path, kind: Kind::File(&["json"]) }));
-    destinations::check(&[], &outputs)?;
+    let _made = destinations::check(&[], &outputs)?;
     say!("{} ({}): {} samples per figure, GPU and CPU reference interleaved", info.name, info.driver, a.samples);
     let clock = Clocking::new(&ctx)?;
     say!("{}", clock.describe());
