@@ -103,7 +103,7 @@ pub fn grow_groom(a: &GrowArgs) -> CliResult {
         return Err(format!("--max-angle must be within (0, 180] degrees (got {})", a.max_angle).into());
     }
     let inputs: Vec<&std::path::Path> = a.obj.iter().chain(&a.gltf).map(|p| p.as_path()).collect();
-    destinations::check(&inputs, &[Output { flag: "--out", path: &a.out, kind: Kind::File(&["hair"]) }])?;
+    let _made = destinations::check(&inputs, &[Output { flag: "--out", path: &a.out, kind: Kind::File(&["hair"]) }])?;
     let groom = match a.scalp {
         ScalpKind::Thesis => {
             if a.strands != 1000 || a.points != 16 || a.length.is_some() {
@@ -179,7 +179,24 @@ pub fn grow_groom(a: &GrowArgs) -> CliResult {
                 },
                 ..GrowParams::default()
             };
-            grow(&scalp, &params).map_err(crate::args::flag_error)?
+            grow(&scalp, &params).map_err(|e| -> crate::output::Error {
+                match e {
+                    // The scalp's place and the strands' length are the flags'.
+                    vkhair::Error::GroomFarAway { distance, median } => {
+                        let place = match kind {
+                            ScalpKind::Obj => "the OBJ's scalp",
+                            _ => "--radius and --center",
+                        };
+                        format!(
+                            "{place} put the hair {distance:.3e} from the origin, over 100000 times the size of its \
+                         strands ({median:.3e} across, --length {length}): vkhair keeps a groom within that \
+                         (grow a smaller scalp nearer the origin, or longer strands)"
+                        )
+                        .into()
+                    }
+                    e => crate::args::flag_error(e).into(),
+                }
+            })?
         }
     };
     let s = groom.stats();
