@@ -102,8 +102,17 @@ impl Config {
             merged.try_into().map_err(|e: toml::de::Error| error(None, None, e.message().trim().to_owned()))?;
         config.validate().map_err(|e| match e {
             Error::InvalidParameter { name, value, allowed } => {
-                let (offset, key) = find_key(text, name);
-                error(offset, Some(key), format!("{value} is not allowed ({allowed})"))
+                // A light's field is looked for from its own `[[lights]]`
+                // table on (the file's list replaces the lights whole).
+                let from = config
+                    .lights
+                    .iter()
+                    .position(|l| l.validate().is_err())
+                    .filter(|_| name.starts_with("light ") || name.starts_with("light."))
+                    .and_then(|i| nth_array_table(text, "lights", i))
+                    .unwrap_or(0);
+                let (offset, key) = find_key(&text[from..], name);
+                error(offset.map(|o| from + o), Some(key), format!("{value} is not allowed ({allowed})"))
             }
             other => error(None, None, other.to_string()),
         })?;
@@ -197,21 +206,43 @@ fn key_at(text: &str, offset: usize) -> String {
     let line = line_of(text, offset);
     let lines: Vec<&str> = text.lines().collect();
     let own = lines.get(line - 1).copied().unwrap_or_default();
-    if own.trim_start().starts_with('[') {
+    if let Some(table) = header_name(own) {
         // A table header names itself, whatever table came before it.
-        return own.trim().trim_matches(['[', ']']).trim().to_owned();
+        return table;
     }
     let key = own.split('=').next().unwrap_or_default().trim().trim_matches(['[', ']']).trim();
-    let section = lines[..line.saturating_sub(1).min(lines.len())]
-        .iter()
-        .rev()
-        .map(|l| l.trim())
-        .find(|l| l.starts_with('['))
-        .map(|l| l.trim_matches(['[', ']']).trim().to_owned());
+    let section = lines[..line.saturating_sub(1).min(lines.len())].iter().rev().find_map(|l| header_name(l));
     match section {
         Some(s) if !s.is_empty() && !key.starts_with(&s) => format!("{s}.{key}"),
         _ => key.to_owned(),
     }
+}
+
+/// The table a header line opens (`[render.lod]`, `[[ lights ]] # note`),
+/// or None for any other line.
+fn header_name(line: &str) -> Option<String> {
+    let header = line.split('#').next().unwrap_or_default().trim();
+    let inner = header.strip_prefix('[')?.strip_suffix(']')?;
+    let inner = inner.strip_prefix('[').and_then(|i| i.strip_suffix(']')).unwrap_or(inner);
+    Some(inner.trim().to_owned())
+}
+
+/// The byte offset of the line opening the `n`-th (0-based) `[[table]]` of
+/// `text`, if it has that many.
+fn nth_array_table(text: &str, table: &str, n: usize) -> Option<usize> {
+    let mut offset = 0;
+    let mut seen = 0;
+    for line in text.split_inclusive('\n') {
+        let array = line.trim_start().starts_with("[[");
+        if array && header_name(line).as_deref() == Some(table) {
+            if seen == n {
+                return Some(offset);
+            }
+            seen += 1;
+        }
+        offset += line.len();
+    }
+    None
 }
 
 /// Where the parameter a validation error names is set in `text`: the first
@@ -352,6 +383,23 @@ mod tests {
             let (line, key, _) = config_error(text);
             assert_eq!((line, key.as_str()), (Some(expected_line), expected_key), "{text}");
         }
+    }
+
+    /// A bad field of a later light is named at that light's line, not at the
+    /// first light's line of the same key.
+    #[test]
+    fn a_later_lights_bad_field_names_its_own_line() {
+        let light = |color: &str| {
+            format!("[[lights]]\nkind = \"directional\"\ndirection = [0.0, -1.0, 0.0]\ncolor = {color}\n")
+        };
+        let good = light("[1.0, 1.0, 1.0]");
+        let text = format!(
+            "{good}{good}\n[[ lights ]] # the third\n{}",
+            light("[1.0, -1.0, 1.0]").replacen("[[lights]]\n", "", 1)
+        );
+        let (line, key, _) = config_error(&text);
+        assert_eq!((line, key.as_str()), (Some(13), "lights.color"), "{text}");
+        assert_eq!(nth_array_table(&text, "lights", 3), None);
     }
 
     #[test]
