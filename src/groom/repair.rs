@@ -65,6 +65,12 @@ impl Repairs {
     pub(crate) fn kept_strands(&self) -> &[usize] {
         &self.kept_strands
     }
+
+    /// Counts `strand` (its index in the input) as dropped for too few points.
+    fn short(&mut self, strand: usize) {
+        self.short_strands += 1;
+        self.first_short = Some(self.first_short.map_or(strand, |s| s.min(strand)));
+    }
 }
 
 impl std::fmt::Display for Repairs {
@@ -192,8 +198,7 @@ impl Groom {
             let range = start..start + n as usize;
             start = range.end;
             if n < 2 {
-                repairs.short_strands += 1;
-                repairs.first_short = Some(repairs.first_short.map_or(strand, |s| s.min(strand)));
+                repairs.short(strand);
             } else if let Some((i, what)) = range.clone().find_map(|i| not_finite(i).map(|w| (i, w))) {
                 repairs.non_finite_strands += 1;
                 repairs.first_non_finite.get_or_insert((strand, i - range.start, what));
@@ -236,8 +241,7 @@ impl Groom {
                 }
             }
             if kept.len() < 2 {
-                repairs.short_strands += 1;
-                repairs.first_short = Some(repairs.first_short.map_or(strand, |s| s.min(strand)));
+                repairs.short(strand);
                 continue;
             }
             let (lo, hi) = super::bounding_box(kept.iter().map(|&i| positions[i]));
