@@ -120,6 +120,36 @@ fn work_of_three_steps(ctx: &GpuContext, sim: &mut HairSim, params: &SimParams) 
     four - one
 }
 
+/// What three steps record, counted as [`work_of_three_steps`] counts it, but
+/// recorded into a command buffer that is never submitted: for counts of
+/// recording alone, without lavapipe running the steps.
+fn recorded_work_of_three_steps(ctx: &GpuContext, sim: &mut HairSim, params: &SimParams) -> vkhair::RecordedWork {
+    use vkhair::ash::vk;
+    let device = ctx.raw_device();
+    let info = vk::CommandPoolCreateInfo::default().queue_family_index(ctx.graphics_queue_family());
+    // SAFETY: a pool and a buffer of the context's device, recorded here and
+    // destroyed before the function returns; nothing is submitted.
+    unsafe {
+        let pool = device.create_command_pool(&info, None).expect("pool");
+        let allocate = vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1);
+        let cmd = device.allocate_command_buffers(&allocate).expect("command buffer")[0];
+        device.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default()).expect("begin");
+        let mut step = 0;
+        let mut run = |steps: usize| {
+            let before = ctx.recorded_work();
+            for _ in 0..steps {
+                sim.record_step(cmd, &head_at(step, params), None).expect("record");
+                step += 1;
+            }
+            ctx.recorded_work() - before
+        };
+        let (one, four) = (run(1), run(4));
+        device.end_command_buffer(cmd).expect("end");
+        device.destroy_command_pool(pool, None);
+        four - one
+    }
+}
+
 /// The step is one dispatch however many sub-steps it has (with the volume stage
 /// off), between two barriers (uploads, then the kernel), and it writes each
 /// particle's position and velocity once; with a level of detail a second
@@ -201,7 +231,7 @@ fn a_flip_step_is_at_most_twenty_dispatches_at_32_and_64_cells_per_axis() {
     let work = |volume: vkhair::sim::VolumeParams| {
         let params = SimParams { volume, ..SimParams::default() };
         let mut sim = HairSim::new(gpu.ctx(), &groom, &params, &RigidTransform::default()).expect("sim");
-        work_of_three_steps(gpu.ctx(), &mut sim, &params).dispatches / 3
+        recorded_work_of_three_steps(gpu.ctx(), &mut sim, &params).dispatches / 3
     };
     let step = work(vkhair::sim::VolumeParams::default());
     assert_eq!(step, 1);
