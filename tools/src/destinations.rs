@@ -10,7 +10,7 @@
 //! - No output is also an input of the run, and no two outputs share a path.
 //! - An output folder the check creates is removed again, with the folders it
 //!   created above it, if it is still empty when the returned [`Made`] is
-//!   dropped: a run refused after the check leaves nothing behind.
+//!   dropped: a run refused after the check leaves no folder it made.
 
 use std::os::unix::fs::{FileTypeExt, MetadataExt};
 use std::path::{Path, PathBuf};
@@ -32,18 +32,17 @@ pub struct Output<'a> {
     pub kind: Kind,
 }
 
-/// The folders a [`check`] created, deepest first: each is removed when this
-/// is dropped if it is empty then (a run that wrote into it keeps it).
+/// The folders a [`check`] created, in the order it created them: each is
+/// removed when this is dropped if it is empty then (a run that wrote into it
+/// keeps it).
 #[must_use = "the folders made are removed when this is dropped: hold it until the run ends"]
 pub struct Made(Vec<PathBuf>);
 
 impl Drop for Made {
     fn drop(&mut self) {
-        for folder in &self.0 {
-            // Fails, leaving the folder, when the run wrote into it.
-            if std::fs::remove_dir(folder).is_err() {
-                break;
-            }
+        // Deepest first; each fails, leaving the folder, when the run wrote into it.
+        for folder in self.0.iter().rev() {
+            let _ = std::fs::remove_dir(folder);
         }
     }
 }
@@ -120,12 +119,20 @@ fn check_folder(out: &Output<'_>, made: &mut Made) -> Result<(), Error> {
     if std::fs::symlink_metadata(out.path).is_ok_and(|m| !m.is_dir() && !m.file_type().is_symlink()) {
         return Err(format!("{flag} {path} is a file, not a folder").into());
     }
-    // The folders missing now, deepest first: the ones create_dir_all makes.
-    let missing = out.path.ancestors().take_while(|f| !f.as_os_str().is_empty() && !f.exists());
-    let missing: Vec<PathBuf> = missing.map(Path::to_path_buf).collect();
-    let created = std::fs::create_dir_all(out.path);
-    made.0.extend(missing.into_iter().filter(|f| f.is_dir()));
-    created.map_err(|e| format!("{flag}: cannot create {path}: {e}"))?;
+    // Each prefix of the path in turn: only the folders this call creates are
+    // recorded (one that exists, or that another process makes meanwhile, is not).
+    let mut prefix = PathBuf::new();
+    for part in out.path.components() {
+        prefix.push(part);
+        match std::fs::create_dir(&prefix) {
+            Ok(()) => made.0.push(prefix.clone()),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists || prefix.is_dir() => {}
+            Err(e) => return Err(format!("{flag}: cannot create {}: {e}", prefix.display()).into()),
+        }
+    }
+    if !out.path.is_dir() {
+        return Err(format!("{flag}: cannot create {path}: not a folder").into());
+    }
     probe_folder(flag, out.path)
 }
 

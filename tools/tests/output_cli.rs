@@ -296,7 +296,15 @@ fn a_refused_run_leaves_no_folder_it_made() {
     let s = sintel.to_str().expect("utf-8");
     run(&["bench", "--quick", "--sintel", s, "--out", d], LIMIT).assert_error("sintel_hair.tfx");
     assert!(!made.exists(), "bench left {} behind", made.display());
-    // A folder that existed stays, empty or not.
+    // A folder that existed stays, empty or not; the ones made below it go.
+    std::fs::create_dir(&made).expect("mkdir");
+    run(&["render", "--level", "0", "--out", d], LIMIT).assert_error("invalid parameter --level: 0");
+    assert!(made.is_dir() && !made.join("deeper").exists(), "render removed too much or too little");
+    // A path through `..`: the existing folder it names stays.
+    let through = dir.path().join("nowhere").join("..").join("new");
+    run(&["render", "--level", "0", "--out", through.to_str().expect("utf-8")], LIMIT)
+        .assert_error("invalid parameter --level: 0");
+    assert!(made.is_dir(), "render removed a folder it did not make through ..");
     std::fs::create_dir_all(&deep).expect("mkdir");
     run(&["render", "--level", "0", "--out", d], LIMIT).assert_error("invalid parameter --level: 0");
     assert!(deep.is_dir(), "render removed a folder it did not make");
