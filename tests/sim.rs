@@ -122,7 +122,8 @@ fn work_of_three_steps(ctx: &GpuContext, sim: &mut HairSim, params: &SimParams) 
 
 /// What three steps record, counted as [`work_of_three_steps`] counts it, but
 /// recorded into a command buffer that is never submitted: for counts of
-/// recording alone, without lavapipe running the steps.
+/// recording alone, without lavapipe running the steps. The simulation has
+/// then recorded steps that never ran: use it for nothing else afterwards.
 fn recorded_work_of_three_steps(ctx: &GpuContext, sim: &mut HairSim, params: &SimParams) -> vkhair::RecordedWork {
     use vkhair::ash::vk;
     let device = ctx.raw_device();
