@@ -187,8 +187,9 @@ pub fn grow_groom(a: &GrowArgs) -> CliResult {
                             ScalpKind::Obj => "the OBJ's scalp",
                             _ => "--radius and --center",
                         };
+                        let most = vkhair::groom::MAX_DISTANCE_IN_STRANDS;
                         format!(
-                            "{place} put the hair {distance:.3e} from the origin, over 100000 times the size of its \
+                            "{place} put the hair {distance:.3e} from the origin, over {most} times the size of its \
                          strands ({median:.3e} across, --length {length}): vkhair keeps a groom within that \
                          (grow a smaller scalp nearer the origin, or longer strands)"
                         )
