@@ -112,7 +112,9 @@ impl Config {
                     .and_then(|i| nth_array_table(text, "lights", i))
                     .unwrap_or(0);
                 let (offset, key) = find_key(&text[from..], name);
-                error(offset.map(|o| from + o), Some(key), format!("{value} is not allowed ({allowed})"))
+                // A rule over two fields names no one key: the light's table then.
+                let offset = offset.map(|o| from + o).or((from > 0).then_some(from));
+                error(offset, Some(key), format!("{value} is not allowed ({allowed})"))
             }
             other => error(None, None, other.to_string()),
         })?;
@@ -400,6 +402,11 @@ mod tests {
         let (line, key, _) = config_error(&text);
         assert_eq!((line, key.as_str()), (Some(13), "lights.color"), "{text}");
         assert_eq!(nth_array_table(&text, "lights", 3), None);
+        // A rule over two of a later light's fields: named at that light's table.
+        let spot = "[[lights]]\nkind = \"spot\"\nposition = [0.0, 2.0, 1.0]\ndirection = [0.0, -1.0, -0.5]\n\
+                    outer_angle = 0.3\ninner_angle = 0.5\ncolor = [2.0, 2.0, 2.0]\n";
+        let (line, _, reason) = config_error(&format!("{good}{spot}"));
+        assert_eq!(line, Some(5), "{reason}");
     }
 
     #[test]
