@@ -108,22 +108,30 @@ fn gpu_matches_cpu_with_substeps_in_dftl_mode_and_with_local_shape() {
     compare(gpu.ctx(), &groom, &local, &[1, 20]);
 }
 
-/// The work three steps of `sim` record: a run of four less a run of one, so
-/// that what a submission adds besides its steps cancels out.
-fn work_of_three_steps(ctx: &GpuContext, sim: &mut HairSim, params: &SimParams) -> vkhair::RecordedWork {
-    let mut run = |steps| {
+/// The work three steps record: `steps(n)` runs or records n steps; a run of
+/// four less a run of one, so that what a submission adds besides its steps
+/// cancels out.
+fn three_steps(ctx: &GpuContext, mut steps: impl FnMut(usize)) -> vkhair::RecordedWork {
+    let mut run = |n| {
         let before = ctx.recorded_work();
-        sim.run(steps, |i| head_at(i, params), None).expect("run");
+        steps(n);
         ctx.recorded_work() - before
     };
     let (one, four) = (run(1), run(4));
     four - one
 }
 
-/// What three steps record, counted as [`work_of_three_steps`] counts it, but
-/// recorded into a command buffer that is never submitted: for counts of
-/// recording alone, without lavapipe running the steps. The simulation has
-/// then recorded steps that never ran: use it for nothing else afterwards.
+/// The work three steps of `sim` record ([`three_steps`]), run on the GPU.
+fn work_of_three_steps(ctx: &GpuContext, sim: &mut HairSim, params: &SimParams) -> vkhair::RecordedWork {
+    three_steps(ctx, |n| {
+        sim.run(n, |i| head_at(i, params), None).expect("run");
+    })
+}
+
+/// What three steps record ([`three_steps`]) into a command buffer that is
+/// never submitted: for counts of recording alone, without lavapipe running
+/// the steps. The simulation has then recorded steps that never ran: use it
+/// for nothing else afterwards.
 fn recorded_work_of_three_steps(ctx: &GpuContext, sim: &mut HairSim, params: &SimParams) -> vkhair::RecordedWork {
     use vkhair::ash::vk;
     let device = ctx.raw_device();
@@ -136,18 +144,15 @@ fn recorded_work_of_three_steps(ctx: &GpuContext, sim: &mut HairSim, params: &Si
         let cmd = device.allocate_command_buffers(&allocate).expect("command buffer")[0];
         device.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default()).expect("begin");
         let mut step = 0;
-        let mut run = |steps: usize| {
-            let before = ctx.recorded_work();
-            for _ in 0..steps {
+        let work = three_steps(ctx, |n| {
+            for _ in 0..n {
                 sim.record_step(cmd, &head_at(step, params), None).expect("record");
                 step += 1;
             }
-            ctx.recorded_work() - before
-        };
-        let (one, four) = (run(1), run(4));
+        });
         device.end_command_buffer(cmd).expect("end");
         device.destroy_command_pool(pool, None);
-        four - one
+        work
     }
 }
 

@@ -110,9 +110,16 @@ impl Bench<'_> {
 /// The simulation parameters of a row: vkhair's defaults, the simulation
 /// flags `sim`, then the row's volume `mode` on a `grid`³ grid.
 fn row_params(sim: &SimArgs, mode: VolumeMode, grid: u32) -> SimParams {
+    let mut params = flag_params(sim);
+    params.volume = VolumeParams { mode, resolution: [grid; 3], ..params.volume };
+    params
+}
+
+/// vkhair's defaults with the simulation flags `sim` (as the frames' rows
+/// take them).
+fn flag_params(sim: &SimArgs) -> SimParams {
     let mut params = SimParams::default();
     sim.apply(&mut params);
-    params.volume = VolumeParams { mode, resolution: [grid; 3], ..params.volume };
     params
 }
 
@@ -377,9 +384,7 @@ pub fn bench(a: &BenchArgs) -> Result<(), Error> {
     a.sim.simulated_count(1)?;
     row_params(&a.sim, VolumeMode::Flip, 32).validate().map_err(crate::args::flag_error)?;
     // The frames' rows take the flags as they are (`--grid` included).
-    let mut frames = SimParams::default();
-    a.sim.apply(&mut frames);
-    frames.validate().map_err(crate::args::flag_error)?;
+    flag_params(&a.sim).validate().map_err(crate::args::flag_error)?;
     if a.large == 0 {
         return Err("--large must be at least 1 (key hairs of the large generated groom)".into());
     }
