@@ -60,6 +60,9 @@ shader_codes! {
         /// Each key hair's root follows its bound triangle of a skinned scalp
         /// (`sim::scalp`): the rest pose is placed per hair by its root's frame.
         SCALP = 1 << 10,
+        /// The mesh collider's field follows bones (`sim::MeshCollider::skinned`):
+        /// each point is taken to the bind pose by the bones of its grid point.
+        MESH_SKIN = 1 << 11,
     }
 
     /// A collider's shape (`collider_kind(c)`, stored as a float).

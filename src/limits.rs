@@ -9,6 +9,8 @@
 
 /// Most colliders (spheres and capsules) a simulation takes.
 pub const SIM_MAX_COLLIDERS: u32 = 64;
+/// Most bones a skinned mesh collider's field follows (`sim::MeshCollider::skinned`).
+pub const SIM_MESH_MAX_BONES: u32 = 32;
 /// Invocations of a simulation workgroup (predict, solve, integrate); the
 /// constraint solver holds one strand point per invocation, so this is also the
 /// most points a simulated strand can have.
@@ -34,6 +36,11 @@ const _: () = assert!(VOL_COARSEST_SWEEPS.is_multiple_of(2));
 #[cfg_attr(not(test), allow(dead_code))] // the pipelines read it back from the SPIR-V
 pub const ITEM_GROUP: u32 = 64;
 
+/// How near its closest triangle's face, in cells, a mesh collider's grid
+/// point takes its sign from the side of that face (farther, and where the
+/// closest point is on an edge or a corner: from the axis rays' vote).
+pub const SDF_FACE_BAND_CELLS: u32 = 2;
+
 /// Most grid points per axis of a mesh collider's distance field.
 pub const SDF_MAX_RESOLUTION: u32 = 256;
 
@@ -52,6 +59,8 @@ pub const RIBBON_CHUNK: u32 = 16_384;
 pub const SHADER_CONSTANTS: &[(&str, u32)] = &[
     ("SIM_MAX_COLLIDERS", SIM_MAX_COLLIDERS),
     ("SIM_WORKGROUP", SIM_WORKGROUP),
+    ("SIM_MESH_MAX_BONES", SIM_MESH_MAX_BONES),
+    ("SDF_FACE_BAND_CELLS", SDF_FACE_BAND_CELLS),
     ("MAX_LIGHTS", MAX_LIGHTS),
     ("MAX_SHADOW_MAPS", MAX_SHADOW_MAPS),
     ("VOL_GROUP", VOL_GROUP),

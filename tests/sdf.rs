@@ -149,3 +149,65 @@ fn the_sintel_bust_has_an_inside() {
     let worst = mesh.positions.iter().map(|p| sdf.sample(*p).abs()).fold(0.0f32, f32::max);
     assert!(worst <= sdf.cell * 3f32.sqrt(), "a vertex {worst} away from the surface (cell {})", sdf.cell);
 }
+
+/// A sphere with two open cards inside it (planes x = 0 and y = 0, one-sided,
+/// as a character's inner mouth or eyelashes are): the cards flip the parity
+/// of two of the three axis rays of points beside them.
+pub fn sphere_with_cards() -> TriMesh {
+    let sphere = TriMesh::uv_sphere(Vec3::ZERO, 0.1, 24, 32).expect("sphere");
+    let mut positions = sphere.positions.clone();
+    let mut triangles = sphere.triangles.clone();
+    let mut card = |corners: [Vec3; 4]| {
+        let base = positions.len() as u32;
+        positions.extend(corners);
+        triangles.push([base, base + 1, base + 2]);
+        triangles.push([base, base + 2, base + 3]);
+    };
+    card([
+        Vec3::new(0.0, -0.05, -0.05),
+        Vec3::new(0.0, 0.05, -0.05),
+        Vec3::new(0.0, 0.05, 0.05),
+        Vec3::new(0.0, -0.05, 0.05),
+    ]);
+    card([
+        Vec3::new(-0.05, 0.0, -0.03),
+        Vec3::new(0.093, 0.0, -0.03),
+        Vec3::new(0.093, 0.0, 0.03),
+        Vec3::new(-0.05, 0.0, 0.03),
+    ]);
+    TriMesh::new(positions, triangles).expect("sphere with cards")
+}
+
+/// Points just under the sphere's skin beside the cards are inside: within
+/// `SDF_FACE_BAND_CELLS` of the skin the field takes the side of its face,
+/// where two of the three axis rays (crossing a card) vote outside. (Farther
+/// in, the vote decides, and the cards do mislead it there.) The same sphere
+/// wound the other way has the same field.
+#[test]
+fn cards_inside_a_mesh_do_not_turn_its_skin_inside_out() {
+    let mesh = sphere_with_cards();
+    let sdf = MeshSdf::build(&mesh, 48, 0.03).expect("sdf");
+    // Under the skin on the +x side, 4 to 7 mm deep: the -x ray crosses the
+    // x = 0 card, the -y ray the y = 0 card.
+    for p in [Vec3::new(0.09, 0.02, 0.02), Vec3::new(0.088, 0.03, 0.01), Vec3::new(0.093, 0.015, -0.02)] {
+        let depth = 0.1 - p.length();
+        assert!(depth > 0.003, "{p} is {depth} deep");
+        let value = sdf.sample(p);
+        assert!(value < 0.0, "{p}, {depth:.4} under the skin, has field value {value}");
+    }
+    // Just outside, the same points pushed out.
+    for p in [Vec3::new(0.1, 0.022, 0.022), Vec3::new(0.098, 0.033, 0.011)] {
+        assert!(sdf.sample(p) > 0.0, "{p} outside has field value {}", sdf.sample(p));
+    }
+    let flipped = TriMesh::new(mesh.positions.clone(), mesh.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect())
+        .expect("flipped");
+    let other = MeshSdf::build(&flipped, 48, 0.03).expect("sdf of the flipped mesh");
+    // The corners in another order round the distances differently (grid
+    // points on a card, at distance 0, may take either sign)
+    let sides = |v: f32| (v.abs() > 1e-6).then_some(v < 0.0);
+    let differ = sdf.values.iter().zip(&other.values).filter(|(a, b)| sides(**a) != sides(**b)).count();
+    assert_eq!(differ, 0, "{differ} grid points change sides with the faces wound the other way");
+    let worst = sdf.values.iter().zip(&other.values).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    // (and jump flooding may then settle on another triangle as near).
+    assert!(worst < 0.01 * sdf.cell, "the fields differ by {worst}");
+}

@@ -48,6 +48,8 @@ mod schedule;
 mod sdf;
 #[path = "sim.rs"]
 mod sim;
+#[path = "skinned_collider.rs"]
+mod skinned_collider;
 #[path = "teleport.rs"]
 mod teleport;
 #[path = "transparency.rs"]

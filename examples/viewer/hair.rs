@@ -198,8 +198,14 @@ impl Hair {
         let head = scene.rig.as_ref().map_or(RigidTransform::default(), |r| r.head_at(0.0));
         let mut sim = HairSim::new(ctx, &scene.groom, &config.sim, &head)?;
         sim.set_colliders(&scene.colliders)?;
-        if scene.mesh_collider {
-            sim.set_mesh(Some(&scene.head), &config.mesh_collider)?;
+        match &scene.rig {
+            // The character's body near the head, following its bones.
+            Some(r) if scene.mesh_collider => {
+                let (body, skin) = r.body_region()?;
+                sim.set_skinned_mesh(&body, &skin, &r.scalp_bones(0.0), &config.mesh_collider)?;
+            }
+            _ if scene.mesh_collider => sim.set_mesh(Some(&scene.head), &config.mesh_collider)?,
+            _ => {}
         }
         let mut rig = None;
         if let (Some(r), Some(skin)) = (&scene.rig, skin) {
@@ -359,6 +365,7 @@ impl Hair {
                 self.steps_done += 1;
                 sim.set_scalp_offset(k as u64 * *slot_bytes)?;
                 sim.set_body_colliders(&rig.colliders_at(t))?;
+                sim.set_mesh_bones(&rig.scalp_bones(t))?;
                 sim.record_step(cmd, &rig.head_at(t), Some(&mut self.profiler))?;
             }
         }
@@ -409,6 +416,7 @@ impl Hair {
                 *time = 0.0;
                 sim.teleport(&rig.head_at(0.0))?;
                 sim.set_body_colliders(&rig.colliders_at(0.0))?;
+                sim.set_mesh_bones(&rig.scalp_bones(0.0))?;
                 sim.reset();
             }
             (None, Sim::One(sim)) => sim.write_state(&self.initial)?,

@@ -126,4 +126,30 @@ float sdf_triangle_distance(vec3 p, vec3 a, vec3 b, vec3 c) {
     return sdf_length(p - (a + ab * v + ac * w));
 }
 
+// Which side of triangle (a, b, c) p lies on when its closest point is inside
+// the face, not on an edge or a corner: -1 behind it (against the normal of
+// its winding), 1 in front, 0 otherwise. As `face_side` in src/groom/sdf.rs.
+float sdf_face_side(vec3 p, vec3 a, vec3 b, vec3 c) {
+    precise vec3 ab = b - a;
+    precise vec3 ac = c - a;
+    precise vec3 ap = p - a;
+    precise vec3 bp = p - b;
+    precise vec3 cp = p - c;
+    precise float d1 = sdf_dot(ab, ap);
+    precise float d2 = sdf_dot(ac, ap);
+    precise float d3 = sdf_dot(ab, bp);
+    precise float d4 = sdf_dot(ac, bp);
+    precise float d5 = sdf_dot(ab, cp);
+    precise float d6 = sdf_dot(ac, cp);
+    precise float va = d3 * d6 - d5 * d4;
+    precise float vb = d5 * d2 - d1 * d6;
+    precise float vc = d1 * d4 - d3 * d2;
+    if (!(va > 0.0 && vb > 0.0 && vc > 0.0)) {
+        return 0.0;
+    }
+    precise vec3 n = vec3(ab.y * ac.z - ab.z * ac.y, ab.z * ac.x - ab.x * ac.z, ab.x * ac.y - ab.y * ac.x);
+    precise float s = sdf_dot(n, ap);
+    return s < 0.0 ? -1.0 : (s > 0.0 ? 1.0 : 0.0);
+}
+
 #endif

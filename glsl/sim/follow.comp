@@ -44,6 +44,11 @@ layout(std430, set = 0, binding = 10) readonly buffer MeshField { float mesh_fie
 layout(std430, set = 0, binding = 14) readonly buffer ScalpRoots { ScalpRoot scalp_roots[]; };
 layout(std430, set = 0, binding = 15) buffer ScalpPrevious { vec4 scalp_previous[]; };
 layout(std430, set = 0, binding = 16) readonly buffer ScalpSource { float scalp_source[]; };
+// A skinned mesh collider's grid points' bones and each sub-step's bone rows
+// (glsl/include/mesh_sdf.glsl).
+layout(std430, set = 0, binding = 17) readonly buffer MeshSkin { uint mesh_skin[]; };
+layout(std430, set = 0, binding = 18) readonly buffer MeshBones { vec4 mesh_bones[]; };
+#define VKHAIR_MESH_SKIN
 #include "sim_bodies.glsl"
 #include "scalp.glsl"
 

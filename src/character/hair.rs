@@ -28,6 +28,10 @@ pub const FACE_HALF_WIDTH: f32 = 0.6;
 /// Where [`HairRig::grow_with`] roots no hair: triangles below the crown whose
 /// normal · the character's forward is at least this (within 75.5°).
 pub const NO_ROOT_FACING: f32 = 0.25;
+/// How far from the head joint, in the bind pose, the body of
+/// [`HairRig::body_region`] reaches: 0.36 m (hair of [`RIG_HAIR_LENGTH`]
+/// hanging from the crown reaches the shoulders and upper back, not past them).
+pub const BODY_REACH: f32 = 0.36;
 /// Capsules a rig keeps: the nearest the head, up to half the simulation's
 /// collider limit (the rest is left to a host's own colliders).
 pub const RIG_CAPSULES: usize = MAX_COLLIDERS / 2;
@@ -218,6 +222,40 @@ impl HairRig {
     /// The whole character at `time`, in the world.
     pub fn body_at(&self, time: f32) -> Result<TriMesh> {
         self.character.mesh(&self.pose(time))
+    }
+
+    /// The character's body within [`BODY_REACH`] of the head joint at rest
+    /// (the triangles whose corners all lie within it: head, neck, shoulders,
+    /// upper back and chest), in the head's frame, with each vertex's bones:
+    /// the skinned mesh collider (`MeshCollider::skinned`), moved by
+    /// [`HairRig::scalp_bones`].
+    pub fn body_region(&self) -> Result<(TriMesh, Vec<VertexSkin>)> {
+        let bind = self.bind_frame();
+        let to_head = bind.inverse();
+        let origin = bind.transform_point3(Vec3::ZERO);
+        let c = &self.character;
+        let near: Vec<bool> = c.positions.iter().map(|p| p.distance(origin) <= BODY_REACH).collect();
+        let mut index = vec![u32::MAX; c.positions.len()];
+        let (mut positions, mut skin, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
+        for t in c.triangles.iter().filter(|t| t.iter().all(|&v| near[v as usize])) {
+            triangles.push(t.map(|v| {
+                let v = v as usize;
+                if index[v] == u32::MAX {
+                    index[v] = positions.len() as u32;
+                    positions.push(to_head.transform_point3(c.positions[v]));
+                    let (j, w) = c.weights[v];
+                    skin.push(VertexSkin { joints: j.map(u32::from), weights: w });
+                }
+                index[v]
+            }));
+        }
+        if triangles.is_empty() {
+            return Err(Error::incompatible(
+                "character",
+                format!("no triangle lies within {BODY_REACH} m of the head"),
+            ));
+        }
+        Ok((TriMesh::new(positions, triangles)?, skin))
     }
 
     /// The head's region at rest, in the head's frame: the mesh collider.

@@ -29,7 +29,9 @@ use glam::{Mat4, Vec3};
 
 pub use fit::{BoneCapsule, MIN_CAPSULE_VERTICES};
 pub use gltf_read::{MAX_CHARACTER_VERTICES, MAX_GLTF_BYTES, MAX_GLTF_JSON_OBJECTS};
-pub use hair::{HairRig, FACE_FACING, FACE_HALF_WIDTH, NO_ROOT_FACING, RIG_CAPSULES, RIG_HAIR_LENGTH, RIG_KEY_HAIRS};
+pub use hair::{
+    HairRig, BODY_REACH, FACE_FACING, FACE_HALF_WIDTH, NO_ROOT_FACING, RIG_CAPSULES, RIG_HAIR_LENGTH, RIG_KEY_HAIRS,
+};
 use skeleton::Skeleton;
 
 use crate::error::{Error, FileFormat, Result};

@@ -687,3 +687,36 @@ fn the_gltf_crates_long_messages_are_cut() {
     assert!(cut.ends_with(&format!("({} more bytes of the same)", long.len() - 2000)), "{}", &cut[cut.len() - 60..]);
     assert_eq!(super::gltf_read::shortened("short".into()), "short");
 }
+
+/// The mannequin's body region (the skinned mesh collider): the head, neck,
+/// shoulders and upper back, every vertex within `BODY_REACH` of the head
+/// joint in the bind pose, its bones within the collider's limit, its mesh
+/// the character's own vertices carried into the head's frame.
+#[test]
+fn the_body_region_reaches_the_shoulders_and_no_farther() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mannequiny-0.3.0.glb");
+    let rig = HairRig::new(Character::load(path).expect("mannequin"), Some("run"), None).expect("rig");
+    let (body, skin) = rig.body_region().expect("body region");
+    assert_eq!(body.positions.len(), skin.len());
+    let bind = rig.bind_frame();
+    let names: std::collections::BTreeSet<&str> = skin
+        .iter()
+        .flat_map(|s| {
+            s.joints.iter().zip(&s.weights).filter(|(_, w)| **w >= 0.5).map(|(j, _)| rig.joint_name(*j as usize))
+        })
+        .collect();
+    for bone in ["head", "neck_01", "clavicle.l", "clavicle.r", "spine_02"] {
+        assert!(names.contains(bone), "{bone} is missing from {names:?}");
+    }
+    assert!(!names.iter().any(|n| n.contains("hand") || n.contains("thigh")), "{names:?}");
+    for p in &body.positions {
+        let world = bind.transform_point3(*p);
+        assert!(world.distance(bind.transform_point3(Vec3::ZERO)) <= BODY_REACH + 1e-5, "{world} beyond reach");
+        assert!(
+            rig.character.positions.iter().any(|v| v.distance(world) < 1e-5),
+            "{world} is no vertex of the character"
+        );
+    }
+    crate::sim::MeshSkin::fit(&crate::groom::sdf::MeshSdf::build(&body, 24, 0.02).expect("field"), &body, &skin)
+        .expect("the region's bones fit a collider");
+}

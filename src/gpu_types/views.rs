@@ -178,6 +178,9 @@ shader_views! {
         ray_axis: uint = pass_info.y,
         /// Jump flooding: the jump, in grid points.
         jump: uint = pass_info.z,
+        /// Finalize: 1 when the mesh's faces wind inward (a negative signed
+        /// volume), so that the side of a face is read the other way.
+        inward: uint = pass_info.w,
     }
 
     /// The volume stage's parameters of one sub-step (`VolumeParams`).

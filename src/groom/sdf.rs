@@ -17,7 +17,13 @@
 //! - **Sign:** ray parity along each of the three axes, with a majority vote.
 //!   One ray per grid line and axis counts the crossings on each side of every
 //!   point. An open mesh, such as a bust cut at the chest, misleads the rays
-//!   that leave through its opening; the two other axes outvote them.
+//!   that leave through its opening; the two other axes outvote them. A point
+//!   within `SDF_FACE_BAND_CELLS` cells of
+//!   its triangle whose closest point lies inside the face (not on an edge or
+//!   a corner) takes the side of that face instead (read by the mesh's overall
+//!   winding: its signed volume's sign): near the skin the rays
+//!   also cross a character's inner parts (mouth, eyes, open cards), which
+//!   mislead two axes as easily as one.
 //!
 //! Negative values are inside the mesh.
 
@@ -51,15 +57,20 @@ impl MeshSdf {
         let mut sdf = MeshSdf { origin, cell, dims, values: Vec::new() };
         let closest = sdf.closest_triangles(mesh);
         let inside = sdf.inside(mesh);
+        let facing = if winds_inward(mesh) { -1.0 } else { 1.0 };
         let mut values = Vec::with_capacity(closest.len());
         for (k, (&t, &inside)) in closest.iter().zip(&inside).enumerate() {
             // Unreachable: the seeds cover the mesh and the floods reach every point.
-            let d = if t == u32::MAX {
-                f32::MAX
+            let (d, side) = if t == u32::MAX {
+                (f32::MAX, 0.0)
             } else {
                 let [a, b, c] = mesh.corners(t as usize);
-                triangle_distance(sdf.point(sdf.grid_point(k)), a, b, c)
+                let p = sdf.point(sdf.grid_point(k));
+                let d = triangle_distance(p, a, b, c);
+                let near = d < crate::limits::SDF_FACE_BAND_CELLS as f32 * sdf.cell;
+                (d, if near { face_side(p, a, b, c) * facing } else { 0.0 })
             };
+            let inside = if side != 0.0 { side < 0.0 } else { inside };
             values.push(if inside { -d } else { d });
         }
         sdf.values = values;
@@ -114,11 +125,11 @@ impl MeshSdf {
         steps
     }
 
-    fn point(&self, [x, y, z]: [u32; 3]) -> Vec3 {
+    pub(crate) fn point(&self, [x, y, z]: [u32; 3]) -> Vec3 {
         self.origin + Vec3::new(x as f32, y as f32, z as f32) * self.cell
     }
 
-    fn grid_point(&self, k: usize) -> [u32; 3] {
+    pub(crate) fn grid_point(&self, k: usize) -> [u32; 3] {
         let k = k as u32;
         let [nx, ny, _] = self.dims;
         [k % nx, (k / nx) % ny, k / (nx * ny)]
@@ -130,7 +141,7 @@ impl MeshSdf {
 
     /// Per grid point, the closest triangle found by jump flooding (see the module
     /// docs). Every point has one: the seeds cover the mesh and floods reach all.
-    fn closest_triangles(&self, mesh: &TriMesh) -> Vec<u32> {
+    pub(crate) fn closest_triangles(&self, mesh: &TriMesh) -> Vec<u32> {
         let [nx, ny, nz] = self.dims;
         let mut best = vec![(f32::INFINITY, u32::MAX); self.values_len()];
         // Seeds: the grid points within 1.5 cells of each triangle's box.
@@ -333,4 +344,39 @@ pub fn triangle_distance(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
     let denom = 1.0 / (va + vb + vc);
     let (v, w) = (vb * denom, vc * denom);
     (p - (a + ab * v + ac * w)).length()
+}
+
+/// Whether `mesh`'s faces wind inward as a whole: its signed volume (the sum
+/// over its triangles of a · (b × c), in f64) is negative.
+pub(crate) fn winds_inward(mesh: &TriMesh) -> bool {
+    let volume: f64 = (0..mesh.triangles.len())
+        .map(|t| {
+            let [a, b, c] = mesh.corners(t).map(|v| v.as_dvec3());
+            a.dot(b.cross(c))
+        })
+        .sum();
+    volume < 0.0
+}
+
+/// Which side of triangle (a, b, c) `p` lies on when its closest point is
+/// inside the face, not on an edge or a corner: -1 behind it (against the
+/// normal of its winding), 1 in front, 0 otherwise (`sdf_face_side` of
+/// `glsl/include/sdf.glsl`).
+pub(crate) fn face_side(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
+    let (ab, ac) = (b - a, c - a);
+    let (ap, bp, cp) = (p - a, p - b, p - c);
+    let (d1, d2, d3, d4, d5, d6) = (ab.dot(ap), ac.dot(ap), ab.dot(bp), ac.dot(bp), ab.dot(cp), ac.dot(cp));
+    let (va, vb, vc) = (d3 * d6 - d5 * d4, d5 * d2 - d1 * d6, d1 * d4 - d3 * d2);
+    let in_face = va > 0.0 && vb > 0.0 && vc > 0.0;
+    if !in_face {
+        return 0.0;
+    }
+    let s = ab.cross(ac).dot(ap);
+    if s < 0.0 {
+        -1.0
+    } else if s > 0.0 {
+        1.0
+    } else {
+        0.0
+    }
 }

@@ -5,7 +5,8 @@ use super::update::SimUpdate;
 use super::{Backend, FrameScheduler};
 use crate::error::{Error, Result};
 use crate::groom::mesh::TriMesh;
-use crate::sim::scalp::{Scalp, ScalpBinding};
+use crate::sim::mesh_skin::{bone_rows, check_skinned};
+use crate::sim::scalp::{Scalp, ScalpBinding, VertexSkin};
 use crate::sim::{Collider, MeshCollider, MeshColliderParams, RigidTransform, SimParams};
 use glam::Mat4;
 
@@ -76,7 +77,38 @@ impl FrameScheduler {
         if let Some(m) = mesh {
             MeshCollider::validate(m, params)?;
         }
-        self.forward(SimUpdate::Mesh(mesh.map(|m| Box::new((m.clone(), params.clone())))))
+        self.forward(SimUpdate::Mesh(mesh.map(|m| Box::new((m.clone(), params.clone())))))?;
+        self.mesh_joints = None;
+        Ok(())
+    }
+
+    /// A mesh collider that follows bones (see
+    /// [`crate::sim::HairSim::set_skinned_mesh`]) with its bones at the end of
+    /// the next frame's steps; the mesh, its skin and the bones checked now.
+    pub fn set_skinned_mesh_collider(
+        &mut self,
+        mesh: &TriMesh,
+        skin: &[VertexSkin],
+        bones: &[Mat4],
+        params: &MeshColliderParams,
+    ) -> Result<()> {
+        MeshCollider::validate(mesh, params)?;
+        let joints = check_skinned(mesh, skin, bones)?;
+        let update = (mesh.clone(), skin.to_vec(), bones.to_vec(), params.clone());
+        self.forward(SimUpdate::SkinnedMesh(Box::new(update)))?;
+        self.mesh_joints = Some(joints);
+        Ok(())
+    }
+
+    /// A skinned mesh collider's bones at the end of the next frame's steps
+    /// (see [`crate::sim::HairSim::set_mesh_bones`]; checked now), taken per
+    /// frame as the body's colliders are.
+    pub fn set_mesh_bones(&mut self, bones: &[Mat4]) -> Result<()> {
+        let Some(joints) = &self.mesh_joints else {
+            return Err(Error::incompatible("mesh collider bones", "no skinned mesh collider is set"));
+        };
+        bone_rows(joints, bones)?;
+        self.forward(SimUpdate::MeshBones(bones.to_vec()))
     }
 
     /// Binds the key hairs' roots to `scalp`, skinned by vkhair from `bones`

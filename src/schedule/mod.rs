@@ -141,6 +141,8 @@ pub struct FrameScheduler {
     colliders: (usize, usize),
     /// The scalp skinned from bone matrices, when bound (to check bones against).
     scalp: Option<crate::sim::scalp::Scalp>,
+    /// The bones a skinned mesh collider follows, when one is set (to check bones against).
+    mesh_joints: Option<Vec<u32>>,
 }
 
 impl std::fmt::Debug for FrameScheduler {
@@ -235,6 +237,7 @@ impl FrameScheduler {
             sim_device: (mode == ScheduleMode::SecondDevice).then_some(sim_ctx),
             colliders: (colliders.len(), 0),
             scalp: None,
+            mesh_joints: None,
         })
     }
 

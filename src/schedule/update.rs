@@ -9,7 +9,7 @@ use glam::Mat4;
 
 use crate::error::Result;
 use crate::groom::mesh::TriMesh;
-use crate::sim::scalp::Scalp;
+use crate::sim::scalp::{Scalp, VertexSkin};
 use crate::sim::{Collider, HairSim, MeshColliderParams, RigidTransform, SimParams};
 
 /// A change to the simulation, applied before its next step.
@@ -22,6 +22,8 @@ pub(crate) enum SimUpdate {
     Teleport(RigidTransform),
     Reset,
     Mesh(Option<Box<(TriMesh, MeshColliderParams)>>),
+    SkinnedMesh(Box<(TriMesh, Vec<VertexSkin>, Vec<Mat4>, MeshColliderParams)>),
+    MeshBones(Vec<Mat4>),
     /// Key hairs simulated (checked by the sender).
     Simulated(usize),
 }
@@ -45,6 +47,8 @@ impl SimUpdate {
                 Some((mesh, params)) => sim.set_mesh(Some(mesh), params),
                 None => sim.set_mesh(None, &MeshColliderParams::default()),
             },
+            SimUpdate::SkinnedMesh(m) => sim.set_skinned_mesh(&m.0, &m.1, &m.2, &m.3),
+            SimUpdate::MeshBones(bones) => sim.set_mesh_bones(&bones),
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The CPU reference simulation.
 
 use super::lod::SimLod;
+use super::mesh_skin::MeshSkin;
 use super::packing::ScalpLanes;
 use super::planner::SubstepPlanner;
 use super::scalp::{check_vertices, CpuScalp, Scalp, ScalpBinding};
@@ -40,8 +41,9 @@ pub struct CpuHairSim {
     volume: Option<volume::grid::GridLayout>,
     /// Intermediate results of the latest volume step.
     last_volume: Option<volume::reference::VolumeSnapshot>,
-    /// The mesh collider's field, when set.
+    /// The mesh collider's field, when set, and a skinned one's grid points' bones.
     mesh: Option<MeshSdf>,
+    mesh_skin: Option<MeshSkin>,
     /// Wall time of the volume stage in the latest step.
     volume_time: std::time::Duration,
     /// Which key hairs are simulated, and whom the others follow.
@@ -69,6 +71,7 @@ impl CpuHairSim {
             volume,
             last_volume: None,
             mesh: None,
+            mesh_skin: None,
             volume_time: Default::default(),
             lod,
             scalp: None,
@@ -92,7 +95,36 @@ impl CpuHairSim {
     pub fn set_mesh_collider(&mut self, mesh: Option<MeshSdf>) -> Option<MeshSdf> {
         self.planner.mesh =
             mesh.as_ref().map(|m| super::mesh_collider::MeshGrid { origin: m.origin, cell: m.cell, dims: m.dims });
+        self.planner.mesh_bones = None;
+        self.mesh_skin = None;
         std::mem::replace(&mut self.mesh, mesh)
+    }
+
+    /// See [`MeshCollider::skinned`](super::MeshCollider::skinned) and
+    /// [`HairSim::set_mesh_collider`](super::HairSim::set_mesh_collider): the
+    /// field `mesh` following bones by `skin` (e.g. a GPU collider's
+    /// [`MeshCollider::skin`](super::MeshCollider::skin), or [`MeshSkin::fit`]).
+    /// Refuses a skin of another grid.
+    pub fn set_skinned_mesh_collider(&mut self, mesh: MeshSdf, skin: MeshSkin) -> Result<()> {
+        if skin.words.len() != mesh.values.len() {
+            return Err(Error::incompatible(
+                "mesh collider bones",
+                format!("{} grid points have bones, the field has {}", skin.words.len(), mesh.values.len()),
+            ));
+        }
+        self.set_mesh_collider(Some(mesh));
+        self.planner.mesh_bones = Some(Default::default());
+        self.mesh_skin = Some(skin);
+        Ok(())
+    }
+
+    /// See [`HairSim::set_mesh_bones`](super::HairSim::set_mesh_bones).
+    pub fn set_mesh_bones(&mut self, bones: &[Mat4]) -> Result<()> {
+        let Some(skin) = &self.mesh_skin else {
+            return Err(Error::incompatible("mesh collider bones", "no skinned mesh collider is set"));
+        };
+        let rows = skin.rows(bones)?;
+        self.planner.set_mesh_bones(rows)
     }
 
     /// See [`HairSim::set_body_colliders`](super::HairSim::set_body_colliders).
@@ -155,7 +187,8 @@ impl CpuHairSim {
         // of each sub-step with it.
         let mut before = active.map(|_| self.state.positions.clone());
         for (k, sub) in inputs.iter().enumerate() {
-            let mesh = self.mesh.as_ref().map(reference::MeshField::new);
+            let words = self.mesh_skin.as_ref().map(|s| s.words.as_slice());
+            let mesh = self.mesh.as_ref().map(|m| reference::MeshField::new(m).with_skin(words));
             reference::step(&mut self.state, std::slice::from_ref(sub), mesh, active, scalp);
             if let Some(before) = &mut before {
                 if self.volume.is_some() {
@@ -227,7 +260,7 @@ impl CpuHairSim {
             || state.positions.len() != self.state.positions.len()
             || state.velocities.len() != self.state.velocities.len()
         {
-            return Err(crate::error::Error::incompatible("state", "its size differs from the simulation's"));
+            return Err(Error::incompatible("state", "its size differs from the simulation's"));
         }
         self.state.positions.clone_from(&state.positions);
         self.state.velocities.clone_from(&state.velocities);

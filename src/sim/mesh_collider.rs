@@ -1,6 +1,8 @@
 //! The mesh collider: a signed distance field of a triangle mesh (the
 //! character's head and body), built on the GPU, kept in the head frame and
-//! moved rigidly with the head transform.
+//! moved rigidly with the head transform — or, built with
+//! [`MeshCollider::skinned`], carried by the bones that skin the mesh
+//! (`mesh_skin.rs`).
 //!
 //! Build (`glsl/sim/sdf/*.comp`, one submission; the CPU reference is
 //! [`MeshSdf::build`], which makes the same choices):
@@ -18,7 +20,10 @@
 //!    same crossings as testing every triangle per line, which made 3 × 64² ×
 //!    5,952 edge tests for Sintel's bust (0.9 s on lavapipe, where marking
 //!    takes a few tests per triangle).
-//! 4. **Finalize**: the signed distance to each point's triangle.
+//! 4. **Finalize**: the signed distance to each point's triangle, its sign
+//!    from the side of that triangle's face where the point lies within
+//!    `SDF_FACE_BAND_CELLS` cells of it and its closest point inside the face
+//!    (the mesh's winding read by its signed volume), else from the vote.
 //!
 //! The field lives in a storage buffer (x fastest) and the solver samples it
 //! trilinearly in the shader, with the gradient of the same trilinear
@@ -33,6 +38,8 @@ use ash::vk;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use super::mesh_skin::MeshSkin;
+use super::scalp::VertexSkin;
 use crate::codes::sentinel;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
@@ -96,6 +103,8 @@ pub struct MeshCollider {
     origin: Vec3,
     cell: f32,
     dims: [u32; 3],
+    /// A skinned collider's grid points' bones, and their GPU copy.
+    skin: Option<(MeshSkin, Buffer)>,
     pub(crate) device: Arc<Device>,
 }
 
@@ -105,6 +114,7 @@ impl std::fmt::Debug for MeshCollider {
             .field("origin", &self.origin)
             .field("cell", &self.cell)
             .field("dims", &self.dims)
+            .field("bones", &self.skin.as_ref().map(|(s, _)| s.joints.len()))
             .finish()
     }
 }
@@ -113,7 +123,7 @@ impl MeshCollider {
     /// Builds the field of `mesh` (in the head frame, the groom's units) on the GPU.
     /// This submits and waits.
     pub fn new(ctx: &GpuContext, mesh: &TriMesh, params: &MeshColliderParams) -> Result<Self> {
-        Self::build(&ctx.device, mesh, params, None)
+        Self::build(&ctx.device, mesh, params, None, false).map(|(c, _)| c)
     }
 
     /// Checks `mesh` and `params` as [`MeshCollider::new`] does, without GPU work.
@@ -123,7 +133,32 @@ impl MeshCollider {
 
     /// As [`MeshCollider::new`], on `device`.
     pub(crate) fn on_device(device: &Arc<Device>, mesh: &TriMesh, params: &MeshColliderParams) -> Result<Self> {
-        Self::build(device, mesh, params, None)
+        Self::build(device, mesh, params, None, false).map(|(c, _)| c)
+    }
+
+    /// As [`MeshCollider::skinned`], on `device` (the skin checked).
+    pub(crate) fn build_skinned(
+        device: &Arc<Device>,
+        mesh: &TriMesh,
+        skin: &[VertexSkin],
+        params: &MeshColliderParams,
+    ) -> Result<Self> {
+        let (mut collider, closest) = Self::build(device, mesh, params, None, true)?;
+        let sdf = MeshSdf { origin: collider.origin, cell: collider.cell, dims: collider.dims, values: Vec::new() };
+        let fitted = MeshSkin::from_closest(&sdf, mesh, skin, &closest)?;
+        let buffer = Buffer::storage(device, "vkhair mesh collider grid bones", fitted.words.len() as u64 * 4)?;
+        device.upload_pod(&buffer, &fitted.words)?;
+        collider.skin = Some((fitted, buffer));
+        Ok(collider)
+    }
+
+    /// A skinned collider's grid points' bones (none for a rigid one).
+    pub fn skin(&self) -> Option<&MeshSkin> {
+        self.skin.as_ref().map(|(s, _)| s)
+    }
+
+    pub(crate) fn skin_buffer(&self) -> Option<&Buffer> {
+        self.skin.as_ref().map(|(_, b)| b)
     }
 
     /// As [`MeshCollider::new`], timing the build with `profiler` (one scope,
@@ -134,7 +169,7 @@ impl MeshCollider {
         params: &MeshColliderParams,
         profiler: &mut GpuProfiler,
     ) -> Result<(Self, Option<ProfileReport>)> {
-        let collider = Self::build(&ctx.device, mesh, params, Some(&mut *profiler))?;
+        let (collider, _) = Self::build(&ctx.device, mesh, params, Some(&mut *profiler), false)?;
         Ok((collider, profiler.drain().pop()))
     }
 
@@ -170,7 +205,8 @@ impl MeshCollider {
         mesh: &TriMesh,
         params: &MeshColliderParams,
         mut profiler: Option<&mut GpuProfiler>,
-    ) -> Result<Self> {
+        keep_closest: bool,
+    ) -> Result<(Self, Vec<u32>)> {
         let (origin, cell, dims) = MeshSdf::placement(mesh, params.resolution, params.margin)?;
         let device = device.clone();
         let triangles = mesh.triangles.len();
@@ -225,7 +261,8 @@ impl MeshCollider {
         let result = steps.len() % 2;
         let finalize_set = finalize.declared_buffer_set(0, &table(result))?;
 
-        let base = SdfPass { origin, cell, dims, triangles: triangles as u32, ..SdfPass::default() };
+        let inward = u32::from(crate::groom::sdf::winds_inward(mesh));
+        let base = SdfPass { origin, cell, dims, triangles: triangles as u32, inward, ..SdfPass::default() };
         let with = |pass: SdfPass| SdfPush::from(&pass);
         let filled = barrier::memory(&[AccessKind::TransferWrite], barrier::COMPUTE_READ_WRITE);
         let between = barrier::memory(&[AccessKind::ComputeWrite], barrier::COMPUTE_READ_WRITE);
@@ -283,6 +320,8 @@ impl MeshCollider {
                 );
             }
         })?;
-        Ok(MeshCollider { field, origin, cell, dims, device })
+        // Each grid point's closest triangle, for a skinned collider's bones.
+        let closest = if keep_closest { device.readback_pod(&ids[result], points as usize)? } else { Vec::new() };
+        Ok((MeshCollider { field, origin, cell, dims, skin: None, device }, closest))
     }
 }

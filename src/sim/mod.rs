@@ -20,7 +20,8 @@
 //!       [`SimParams::local_shape_stiffness`]), the global shape constraint
 //!       (each particle pulled toward its rest position in the head frame,
 //!       [`SimParams::global_shape_stiffness`]) and the body collisions
-//!       (spheres, capsules and the [`MeshCollider`]'s field), and in the
+//!       (spheres, capsules and the [`MeshCollider`]'s field, rigid with the
+//!       head or following bones), and in the
 //!       last iteration the stretch limit ([`SimParams::stretch_limit`],
 //!       when set); then friction
 //!       against the mesh collider. Each constraint is one GLSL include
@@ -59,7 +60,9 @@ mod cpu;
 mod driver;
 pub mod lod;
 pub(crate) mod math;
+mod mesh_bones;
 mod mesh_collider;
+pub(crate) mod mesh_skin;
 pub mod motion;
 mod packing;
 mod params;
@@ -84,6 +87,7 @@ pub use cpu::{CpuHairSim, REFERENCE_STEP_TOLERANCE_M};
 pub use driver::{FixedStepDriver, StepPlan};
 pub use lod::FOLLOW_FADE;
 pub use mesh_collider::{MeshCollider, MeshColliderParams, MESH_COLLIDER_BUILD_LABEL};
+pub use mesh_skin::{MeshSkin, MESH_MAX_BONES};
 pub(crate) use packing::{check_set, SET_FIELDS};
 pub use params::{SimParams, SolverMode, MAX_SIM_POINTS, MAX_SUBSTEPS};
 pub use state::SimState;
@@ -282,8 +286,15 @@ impl HairSim {
     /// parameters and mesh collider (the kernel specialised to the switches they
     /// turn on), so that recording a step does not compile it.
     fn prepare_step(&mut self) -> Result<()> {
-        let scalp = if self.planner.scalp.is_some() { crate::codes::sim_flags::SCALP } else { 0 };
-        self.pipeline.prepare_variant(packing::flags(&self.planner.params, self.mesh.is_some()) | scalp)
+        use crate::codes::sim_flags::{MESH, MESH_SKIN, SCALP};
+        let mut flags = packing::flags(&self.planner.params, self.mesh.is_some());
+        if self.planner.scalp.is_some() {
+            flags |= SCALP;
+        }
+        if self.planner.mesh_bones.is_some() && flags & MESH != 0 {
+            flags |= MESH_SKIN;
+        }
+        self.pipeline.prepare_variant(flags)
     }
 
     /// Creates, rebuilds or drops the volume stage for `params`. The grid is fitted
@@ -392,7 +403,9 @@ impl HairSim {
     /// particles are projected out of its field along the gradient and rub against
     /// it with [`SimParams::mesh_friction`], alongside the spheres and capsules,
     /// when [`SimParams::collisions_enabled`]. Its field is in the head frame and
-    /// moves with the head transform. The collider must come from this
+    /// moves with the head transform, or, for a [`MeshCollider::skinned`] one,
+    /// with the bones of [`HairSim::set_mesh_bones`] (needed before the next
+    /// step; the volume stage then marks no solid cells by it). The collider must come from this
     /// simulation's context. This waits for the device to be idle (the solver's
     /// descriptors are rewritten) and returns the previous collider.
     pub fn set_mesh_collider(&mut self, mesh: Option<MeshCollider>) -> Result<Option<MeshCollider>> {
@@ -402,6 +415,7 @@ impl HairSim {
             }
         }
         self.planner.mesh = mesh.as_ref().map(MeshCollider::grid);
+        self.planner.mesh_bones = mesh.as_ref().and_then(MeshCollider::skin).map(|_| Default::default());
         let previous = std::mem::replace(&mut self.mesh, mesh);
         self.rewrite_sets()?;
         self.prepare_step()?;

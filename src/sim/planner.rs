@@ -8,12 +8,13 @@ use glam::Mat4;
 
 use super::body::{validate_collider_total, validate_colliders, Collider, RigidTransform};
 use super::mesh_collider::MeshGrid;
+use super::mesh_skin::BoneTrack;
 use super::packing::{self, ScalpLanes, SimShape, SubstepPose};
 use super::params::SimParams;
 use super::teleport::{root_displacement, Move, PendingMove};
 use super::volume::VolumeParams;
 use crate::codes::sim_flags;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gpu_types::{ColliderShape, SimStep, VolumeStep};
 
 /// Everything one sub-step needs, identical for the GPU stages and the CPU reference.
@@ -23,6 +24,9 @@ pub(crate) struct SubstepInputs {
     pub sets: Vec<SimStep>,
     /// The colliders in the world at the end of the sub-step.
     pub colliders: Vec<ColliderShape>,
+    /// A skinned mesh collider's bones: per bone slot its rows at the end of
+    /// the sub-step, then at its start (empty without one).
+    pub bones: Vec<[glam::Vec4; 6]>,
 }
 
 impl SubstepInputs {
@@ -35,11 +39,9 @@ impl SubstepInputs {
     ) -> VolumeStep {
         let p = &self.params;
         let colliders = if p.flags & sim_flags::COLLISIONS != 0 { colliders } else { 0 };
-        let mesh = (p.flags & sim_flags::MESH != 0).then_some(MeshGrid {
-            origin: p.mesh_origin,
-            cell: p.mesh_cell,
-            dims: p.mesh_dims,
-        });
+        // A skinned field is not where the head places it: the volume marks no solid cells by it.
+        let rigid_mesh = p.flags & sim_flags::MESH != 0 && p.flags & sim_flags::MESH_SKIN == 0;
+        let mesh = rigid_mesh.then_some(MeshGrid { origin: p.mesh_origin, cell: p.mesh_cell, dims: p.mesh_dims });
         grid.step_params(params, &p.previous_head, &p.head, p.dt, colliders, mesh.as_ref())
     }
 }
@@ -62,6 +64,8 @@ pub(crate) struct SubstepPlanner {
     pub body_before: Vec<Collider>,
     /// The mesh collider's grid, when set.
     pub mesh: Option<MeshGrid>,
+    /// A skinned mesh collider's bones, when one is set.
+    pub mesh_bones: Option<BoneTrack>,
     pub head: RigidTransform,
     pub time: f64,
     pub substep: u32,
@@ -110,6 +114,7 @@ impl SubstepPlanner {
             body: Vec::new(),
             body_before: Vec::new(),
             mesh: None,
+            mesh_bones: None,
             head: *head,
             time: 0.0,
             substep: 0,
@@ -143,6 +148,15 @@ impl SubstepPlanner {
         validate_colliders(colliders)?;
         validate_collider_total(self.colliders.len(), colliders.len())?;
         self.body = colliders.to_vec();
+        Ok(())
+    }
+
+    /// A skinned mesh collider's bones (rows per slot) at the end of the next step.
+    pub(crate) fn set_mesh_bones(&mut self, rows: Vec<[glam::Vec4; 3]>) -> Result<()> {
+        let Some(track) = &mut self.mesh_bones else {
+            return Err(Error::incompatible("mesh collider bones", "no skinned mesh collider is set"));
+        };
+        track.now = rows;
         Ok(())
     }
 
@@ -195,10 +209,19 @@ impl SubstepPlanner {
     /// The next step, which ends with the head at `head`.
     pub(crate) fn next(&mut self, head: &RigidTransform) -> Result<PlannedStep> {
         head.validate()?;
+        if self.mesh_bones.as_ref().is_some_and(|b| b.now.is_empty()) && self.params.collisions_enabled {
+            return Err(Error::incompatible(
+                "mesh collider",
+                "a skinned mesh collider needs its bones before a step (HairSim::set_mesh_bones)",
+            ));
+        }
         let start = self.start(head);
         // A new body (another count) or a cut starts where the body is now.
         if start.is_some() || self.body_before.len() != self.body.len() {
             self.body_before.clone_from(&self.body);
+        }
+        if let Some(track) = self.mesh_bones.as_mut().filter(|t| start.is_some() || t.before.len() != t.now.len()) {
+            track.before.clone_from(&track.now);
         }
         let p = &self.params;
         let dt = p.substep_dt();
@@ -228,8 +251,15 @@ impl SubstepPlanner {
                 if let Some(scalp) = &self.scalp {
                     scalp.apply(&mut params, k, p.substeps, restart);
                 }
+                let bones = match &self.mesh_bones {
+                    Some(track) if params.flags & sim_flags::MESH != 0 => {
+                        params.flags |= sim_flags::MESH_SKIN;
+                        track.substep(k, p.substeps)
+                    }
+                    _ => Vec::new(),
+                };
                 let sets = self.sets.iter().map(|s| packing::for_set(&params, s)).collect();
-                SubstepInputs { params, sets, colliders: head_colliders.chain(body).collect() }
+                SubstepInputs { params, sets, colliders: head_colliders.chain(body).collect(), bones }
             })
             .collect();
         if let Some(scalp) = &mut self.scalp {
@@ -237,6 +267,9 @@ impl SubstepPlanner {
         }
         self.head = *head;
         self.body_before.clone_from(&self.body);
+        if let Some(track) = &mut self.mesh_bones {
+            track.before.clone_from(&track.now);
+        }
         self.time += f64::from(p.dt);
         self.substep = self.substep.wrapping_add(p.substeps);
         Ok(PlannedStep { start, substeps: inputs })

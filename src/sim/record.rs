@@ -136,6 +136,11 @@ impl HairSim {
                 let colliders = gpu_colliders(&sub.colliders);
                 d.raw.cmd_update_buffer(cmd, self.gpu.colliders.raw(), offset, bytemuck::cast_slice(&colliders));
             }
+            // At most SIM_MESH_MAX_BONES bones of 96 bytes a sub-step.
+            for (k, sub) in inputs.iter().enumerate().filter(|(_, sub)| !sub.bones.is_empty()) {
+                let offset = state::bone_offset(k);
+                d.raw.cmd_update_buffer(cmd, self.gpu.mesh_bones.raw(), offset, bytemuck::cast_slice(&sub.bones));
+            }
             if self.pending_guides {
                 let guides = bytemuck::cast_slice(&self.lod.guides);
                 update_chunked(d, cmd, self.gpu.guides.raw(), 0, guides);

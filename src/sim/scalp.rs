@@ -110,18 +110,24 @@ impl Scalp {
                 format!("{} vertices have bones, the scalp has {}", self.skin.len(), self.mesh.positions.len()),
             ));
         }
-        for (v, s) in self.skin.iter().enumerate() {
-            let sum: f32 = s.weights.iter().sum();
-            if s.weights.iter().any(|w| !w.is_finite() || *w < 0.0) || (sum - 1.0).abs() > 1e-3 {
-                return Err(Error::param(
-                    "scalp bone weights",
-                    format!("vertex {v}: {:?}", s.weights),
-                    "finite, non-negative, summing to 1",
-                ));
-            }
-        }
-        Ok(())
+        check_weights("scalp bone weights", &self.skin)
     }
+}
+
+/// Refuses, as `what`, a vertex whose weights are not finite, non-negative and
+/// summing to 1 (within 1e-3).
+pub(crate) fn check_weights(what: &'static str, skin: &[VertexSkin]) -> Result<()> {
+    for (v, s) in skin.iter().enumerate() {
+        let sum: f32 = s.weights.iter().sum();
+        if s.weights.iter().any(|w| !w.is_finite() || *w < 0.0) || (sum - 1.0).abs() > 1e-3 {
+            return Err(Error::param(
+                what,
+                format!("vertex {v}: {:?}", s.weights),
+                "finite, non-negative, summing to 1",
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The host's skinned scalp vertices in a GPU buffer of its own (its skinning

@@ -260,7 +260,7 @@ impl HairSim {
     /// Waits for the device to be idle.
     pub(crate) fn rewrite_sets(&self) -> Result<()> {
         self.device.wait_idle()?;
-        let field = self.mesh.as_ref().map(|m| &m.field);
+        let field = self.mesh.as_ref();
         let host = match &self.scalp {
             Some(GpuScalp { source: VertexSource::Host(s), .. }) => Some(s),
             _ => None,

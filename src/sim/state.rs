@@ -19,6 +19,7 @@ use std::sync::Arc;
 use glam::{Vec3, Vec4};
 
 use super::body::{RigidTransform, MAX_COLLIDERS};
+use super::mesh_collider::MeshCollider;
 use super::params::{SimParams, MAX_SIM_POINTS, MAX_SUBSTEPS};
 use crate::error::{Error, Result};
 use crate::gpu_types::{GpuCollider, SimStepParams};
@@ -177,6 +178,11 @@ pub(crate) struct GpuState {
     pub params: Buffer,
     /// Bound as the mesh collider's field while none is set (never read then).
     pub no_mesh: Buffer,
+    /// Bound as the grid points' bones while no skinned mesh collider is set.
+    pub no_mesh_skin: Buffer,
+    /// The bone rows of every sub-step of a step for a skinned mesh collider
+    /// (see [`bone_offset`]).
+    pub mesh_bones: Buffer,
     /// The key hairs in level-of-detail order (`sim::lod`), and each one's guide.
     pub order: Buffer,
     pub guides: Buffer,
@@ -191,6 +197,12 @@ pub(crate) struct GpuState {
 /// Byte offset of sub-step `k`'s colliders in [`GpuState::colliders`].
 pub(crate) fn collider_offset(k: usize) -> u64 {
     (k * MAX_COLLIDERS * std::mem::size_of::<GpuCollider>()) as u64
+}
+
+/// Byte offset of sub-step `k`'s bone rows in [`GpuState::mesh_bones`]
+/// (`mesh_bone_base` of `glsl/include/mesh_sdf.glsl`: six vec4 per bone).
+pub(crate) fn bone_offset(k: usize) -> u64 {
+    (k * crate::limits::SIM_MESH_MAX_BONES as usize * 96) as u64
 }
 
 /// Binding numbers of the step kernel (see `glsl/sim/step.comp`).
@@ -211,6 +223,8 @@ pub(crate) mod binding {
     pub const SCALP_ROOTS: u32 = 14;
     pub const SCALP_PREVIOUS: u32 = 15;
     pub const SCALP_SOURCE: u32 = 16;
+    pub const MESH_SKIN: u32 = 17;
+    pub const MESH_BONES: u32 = 18;
 }
 
 impl GpuState {
@@ -246,6 +260,8 @@ impl GpuState {
                 u64::from(MAX_SUBSTEPS) * std::mem::size_of::<SimStepParams>() as u64,
             )?,
             no_mesh: storage("vkhair sim no mesh collider", 16)?,
+            no_mesh_skin: storage("vkhair sim no mesh collider bones", 16)?,
+            mesh_bones: storage("vkhair sim mesh collider bone rows", bone_offset(MAX_SUBSTEPS as usize))?,
             order: storage("vkhair sim level-of-detail order", 4 * state.strands as u64)?,
             guides: storage("vkhair sim followers' guides", 4 * state.strands as u64)?,
             scalp_roots: storage("vkhair sim no scalp roots", 16)?,
@@ -270,10 +286,12 @@ impl GpuState {
     }
 
     /// Buffers by binding number for half `parity` (reads `parity`, writes the other),
-    /// with `mesh` as the mesh collider's field (none: the placeholder).
-    pub(crate) fn bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 14] {
+    /// with `mesh`'s field and grid points' bones (none: the placeholders).
+    pub(crate) fn bindings<'a>(&'a self, parity: usize, mesh: Option<&'a MeshCollider>) -> [(u32, &'a Buffer); 16] {
         use binding::*;
         [
+            (MESH_SKIN, mesh.and_then(MeshCollider::skin_buffer).unwrap_or(&self.no_mesh_skin)),
+            (MESH_BONES, &self.mesh_bones),
             (SCALP_ROOTS, &self.scalp_roots),
             (SCALP_PREVIOUS, &self.scalp_previous),
             (SCALP_SOURCE, &self.scalp_vertices),
@@ -285,21 +303,27 @@ impl GpuState {
             (COLLIDERS, &self.colliders),
             (POS_OUT, &self.positions[1 - parity]),
             (VEL_OUT, &self.velocities[1 - parity]),
-            (MESH_FIELD, mesh.unwrap_or(&self.no_mesh)),
+            (MESH_FIELD, mesh.map_or(&self.no_mesh, |m| &m.field)),
             (POS_BEFORE, &self.before),
             (ORDER, &self.order),
         ]
     }
 
     /// The follower kernel's buffers for half `parity` (as [`GpuState::bindings`]).
-    pub(crate) fn follow_bindings<'a>(&'a self, parity: usize, mesh: Option<&'a Buffer>) -> [(u32, &'a Buffer); 13] {
+    pub(crate) fn follow_bindings<'a>(
+        &'a self,
+        parity: usize,
+        mesh: Option<&'a MeshCollider>,
+    ) -> [(u32, &'a Buffer); 15] {
         use binding::*;
         [
+            (MESH_SKIN, mesh.and_then(MeshCollider::skin_buffer).unwrap_or(&self.no_mesh_skin)),
+            (MESH_BONES, &self.mesh_bones),
             (SCALP_ROOTS, &self.scalp_roots),
             (SCALP_PREVIOUS, &self.scalp_previous),
             (SCALP_SOURCE, &self.scalp_vertices),
             (COLLIDERS, &self.colliders),
-            (MESH_FIELD, mesh.unwrap_or(&self.no_mesh)),
+            (MESH_FIELD, mesh.map_or(&self.no_mesh, |m| &m.field)),
             (PARAMS, &self.params),
             (POS_IN, &self.positions[parity]),
             (REST, &self.rest),

@@ -13,6 +13,12 @@ bool mesh_friction_on(uint it) {
 }
 
 vec4 mesh_friction_apply(vec4 own) {
+    if ((step_flags() & SIM_MESH_SKIN) != 0u) {
+        own.xyz = mesh_friction_skinned(sim_head(params), sim_mesh_grid(params),
+                                        mesh_bone_base(collider_base / SIM_MAX_COLLIDERS), own.xyz, own_start.xyz,
+                                        own_radius, sim_mesh_friction(params));
+        return own;
+    }
     own.xyz = mesh_friction(sim_head(params), sim_previous_head(params), sim_mesh_grid(params), own.xyz, own_start.xyz,
                             own_radius, sim_mesh_friction(params));
     return own;

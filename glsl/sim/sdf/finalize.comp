@@ -1,7 +1,10 @@
 #version 460
 // Mesh collider build, step 4 — one invocation per grid point: the exact
-// distance to the point's triangle, negative where at least two of the three
-// axis rays vote inside.
+// distance to the point's triangle, negative behind it (by the mesh's
+// overall winding, `sdf_pass_inward`) where the point lies
+// within SDF_FACE_BAND_CELLS cells of the triangle's face (its closest point
+// inside the face), elsewhere where at least two of the three axis rays vote
+// inside.
 #include "sdf.glsl"
 
 layout(local_size_x = ITEM_GROUP) in;
@@ -21,9 +24,18 @@ void main() {
     uint t = ids[k];
     // Unreachable: the seeds cover the mesh and the floods reach every point.
     float d = 3.40282347e38;
+    float side = 0.0;
     if (t != SDF_NONE) {
         vec3 p = sdf_point(sdf_grid_point(k, dims), sdf_pass_origin(pc), sdf_pass_cell(pc));
-        d = sdf_triangle_distance(p, corners[3u * t].xyz, corners[3u * t + 1u].xyz, corners[3u * t + 2u].xyz);
+        vec3 a = corners[3u * t].xyz;
+        vec3 b = corners[3u * t + 1u].xyz;
+        vec3 c = corners[3u * t + 2u].xyz;
+        d = sdf_triangle_distance(p, a, b, c);
+        if (d < float(SDF_FACE_BAND_CELLS) * sdf_pass_cell(pc)) {
+            side = sdf_face_side(p, a, b, c);
+            side = sdf_pass_inward(pc) != 0u ? -side : side;
+        }
     }
-    field[k] = votes[k] >= 2u ? -d : d;
+    bool inside = side != 0.0 ? side < 0.0 : votes[k] >= 2u;
+    field[k] = inside ? -d : d;
 }

@@ -2,7 +2,7 @@
 //! capsules, and friction against them, each as its shader twin computes it
 //! (`glsl/include/mesh_sdf.glsl`, `sim.glsl`, `sim_bodies.glsl`).
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec4};
 
 use super::{dot, transform_point};
 use crate::gpu_types::ColliderShape;
@@ -10,22 +10,37 @@ use crate::groom::sdf::MeshSdf;
 use crate::sim::mesh_collider::MeshGrid;
 
 /// `sim_to_head`: Rᵀ(p − t) for a rigid `m`.
-fn to_head(m: &Mat4, p: Vec3) -> Vec3 {
+pub(super) fn to_head(m: &Mat4, p: Vec3) -> Vec3 {
     let d = p - m.col(3).truncate();
     let row = |i: usize| (m.col(i).x * d.x + m.col(i).y * d.y) + m.col(i).z * d.z;
     Vec3::new(row(0), row(1), row(2))
 }
+
+/// `mesh_bone_base`'s bones of one sub-step: per slot, the rows at its end
+/// then at its start.
+pub(crate) type SubstepBones<'a> = &'a [[Vec4; 6]];
 
 /// The mesh collider's field as the solver sees it.
 #[derive(Clone, Copy)]
 pub(crate) struct MeshField<'a> {
     pub grid: MeshGrid,
     pub values: &'a [f32],
+    /// A skinned field's grid points' bones (`MeshSkin::words`).
+    pub skin: Option<&'a [u32]>,
 }
 
 impl<'a> MeshField<'a> {
     pub(crate) fn new(sdf: &'a MeshSdf) -> Self {
-        MeshField { grid: MeshGrid { origin: sdf.origin, cell: sdf.cell, dims: sdf.dims }, values: &sdf.values }
+        MeshField {
+            grid: MeshGrid { origin: sdf.origin, cell: sdf.cell, dims: sdf.dims },
+            values: &sdf.values,
+            skin: None,
+        }
+    }
+
+    /// The field following bones by `skin` (its grid points' words).
+    pub(crate) fn with_skin(self, skin: Option<&'a [u32]>) -> Self {
+        MeshField { skin, ..self }
     }
 
     /// `mesh_sample`: trilinear value and its gradient (per cell) at q, head frame.
@@ -58,17 +73,39 @@ impl<'a> MeshField<'a> {
         (Vec3::new(gx, gy, gz), value)
     }
 
-    /// `mesh_collide`.
-    fn collide(&self, head: &Mat4, p: Vec3, radius: f32) -> Vec3 {
-        let q = to_head(head, p);
+    /// `mesh_push`: `q` pushed out to a gap of `radius`, `None` where it
+    /// keeps it already (or the gradient vanishes).
+    pub(super) fn push(&self, q: Vec3, radius: f32) -> Option<Vec3> {
         let (gradient, value) = self.sample(q);
         if value < radius {
             let len = dot(gradient, gradient).sqrt();
             if len > 0.0 {
-                return transform_point(head, q + gradient * ((radius - value) / len));
+                return Some(q + gradient * ((radius - value) / len));
             }
         }
-        p
+        None
+    }
+
+    /// `mesh_hold`: `q` held against the surface (its motion along it since
+    /// `from_q` cut by `friction`), `None` where it does not touch.
+    pub(super) fn hold(&self, q: Vec3, from_q: Vec3, radius: f32, friction: f32) -> Option<Vec3> {
+        let (gradient, value) = self.sample(q);
+        let contact = radius + 0.1 * self.grid.cell;
+        let len = dot(gradient, gradient).sqrt();
+        // Written to treat NaN as the shader does: no contact.
+        let held = value < contact && len > 0.0 && friction > 0.0;
+        if !held {
+            return None;
+        }
+        let n = gradient / len;
+        let moved = q - from_q;
+        let along = moved - n * dot(n, moved);
+        Some(q - along * friction)
+    }
+
+    /// `mesh_collide`.
+    fn collide(&self, head: &Mat4, p: Vec3, radius: f32) -> Vec3 {
+        self.push(to_head(head, p), radius).map_or(p, |q| transform_point(head, q))
     }
 
     /// `mesh_friction`.
@@ -82,19 +119,8 @@ impl<'a> MeshField<'a> {
         radius: f32,
         friction: f32,
     ) -> Vec3 {
-        let q = to_head(head, p);
-        let (gradient, value) = self.sample(q);
-        let contact = radius + 0.1 * self.grid.cell;
-        let len = dot(gradient, gradient).sqrt();
-        // Written to treat NaN as the shader does: no contact.
-        let touching = value < contact && len > 0.0;
-        if !touching || friction <= 0.0 {
-            return p;
-        }
-        let n = gradient / len;
-        let moved = q - to_head(previous_head, from);
-        let along = moved - n * dot(n, moved);
-        transform_point(head, q - along * friction)
+        let held = self.hold(to_head(head, p), to_head(previous_head, from), radius, friction);
+        held.map_or(p, |q| transform_point(head, q))
     }
 }
 
@@ -166,6 +192,8 @@ pub(super) struct Bodies<'a> {
     pub colliders: &'a [ColliderShape],
     pub mesh: Option<MeshField<'a>>,
     pub head: &'a Mat4,
+    /// A skinned field's bones of the sub-step (`SIM_MESH_SKIN`; else empty).
+    pub bones: SubstepBones<'a>,
 }
 
 impl Bodies<'_> {
@@ -173,9 +201,23 @@ impl Bodies<'_> {
         for c in self.colliders {
             p = collide(c, p, radius);
         }
-        if let Some(mesh) = &self.mesh {
-            p = mesh.collide(self.head, p, radius);
+        match &self.mesh {
+            Some(mesh @ MeshField { skin: Some(words), .. }) if !self.bones.is_empty() => {
+                mesh.collide_skinned(words, self.head, self.bones, p, radius)
+            }
+            Some(mesh) => mesh.collide(self.head, p, radius),
+            None => p,
         }
-        p
+    }
+
+    /// `mesh_friction` (or `mesh_friction_skinned`) against the mesh collider.
+    pub(super) fn mesh_friction(&self, previous_head: &Mat4, p: Vec3, from: Vec3, radius: f32, friction: f32) -> Vec3 {
+        match &self.mesh {
+            Some(mesh @ MeshField { skin: Some(words), .. }) if !self.bones.is_empty() => {
+                mesh.friction_skinned(words, self.head, self.bones, p, from, radius, friction)
+            }
+            Some(mesh) => mesh.friction(self.head, previous_head, p, from, radius, friction),
+            None => p,
+        }
     }
 }

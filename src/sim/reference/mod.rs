@@ -17,6 +17,7 @@ use crate::gpu_types::{ColliderShape, SimStep};
 
 mod bodies;
 mod constraints;
+mod skin;
 
 pub(crate) use bodies::MeshField;
 use bodies::{collider_friction, Bodies};
@@ -110,7 +111,7 @@ fn predict(p: &SimStep, frames: Option<&[Mat4]>, state: &SimState, active: Optio
 /// the DFTL sweep).
 fn solve(
     (p, frames): (&SimStep, Option<&[Mat4]>),
-    colliders: &[ColliderShape],
+    (colliders, bones): (&[ColliderShape], &[[Vec4; 6]]),
     mesh: Option<MeshField<'_>>,
     state: &SimState,
     active: Option<&[bool]>,
@@ -121,7 +122,8 @@ fn solve(
     let flags = p.flags;
     let collisions = flags & flags::COLLISIONS != 0;
     let mesh = mesh.filter(|_| flags & flags::MESH != 0);
-    let bodies = Bodies { colliders, mesh, head: &p.head };
+    let bones = if flags & flags::MESH_SKIN != 0 { bones } else { &[] };
+    let bodies = Bodies { colliders, mesh, head: &p.head, bones };
     let mut s = vec![Vec4::ZERO; points];
     for strand in (0..p.strands as usize).filter(|&strand| simulated(active, strand)) {
         let base = strand * points;
@@ -214,7 +216,7 @@ pub(crate) fn step(
         let frames = scalp.map(|s| s.frames(p, p.scalp_to, &p.head));
         let frames = frames.as_deref();
         predict(p, frames, state, active, &mut predicted);
-        solve((p, frames), &sub.colliders, mesh, state, active, &mut predicted, &mut correction);
+        solve((p, frames), (&sub.colliders, &sub.bones), mesh, state, active, &mut predicted, &mut correction);
         integrate((&sub.params, &sub.colliders), state, active, &predicted, &correction);
     }
 }
@@ -262,7 +264,8 @@ pub(crate) fn follow(
     let (start, end) = (&first.params, &last.params);
     let collisions = end.flags & flags::COLLISIONS != 0;
     let mesh = mesh.filter(|_| end.flags & flags::MESH != 0);
-    let bodies = Bodies { colliders: &last.colliders, mesh, head: &end.head };
+    let bones: &[[Vec4; 6]] = if end.flags & flags::MESH_SKIN != 0 { &last.bones } else { &[] };
+    let bodies = Bodies { colliders: &last.colliders, mesh, head: &end.head, bones };
     let points = state.points;
     let span = end.dt * substeps.len() as f32;
     let columns = |m: &Mat4| [m.col(0).truncate(), m.col(1).truncate(), m.col(2).truncate()];

@@ -20,11 +20,11 @@ pub(super) fn on(c: &Strand<'_>, _iteration: u32) -> bool {
 }
 
 pub(super) fn apply(_: &Loaded, _set: usize, s: &mut [Vec4], c: &Strand<'_>) {
-    let (Some(mesh), p) = (&c.bodies.mesh, c.p) else { return };
+    let p = c.p;
     for (i, q) in s.iter_mut().enumerate() {
         if q.w > 0.0 {
             let from = c.start[i].truncate();
-            let held = mesh.friction(&p.head, &p.previous_head, q.truncate(), from, c.rest[i].w, p.knobs.mesh_friction);
+            let held = c.bodies.mesh_friction(&p.previous_head, q.truncate(), from, c.rest[i].w, p.knobs.mesh_friction);
             *q = held.extend(q.w);
         }
     }

@@ -119,7 +119,18 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
         say!("simulated: {count} of {} key hairs (the others follow them)", s.groom.strand_count());
     }
     say!("{}", sa.sim.describe(&sim_params, ctx.info().device_type));
-    if sa.input.colliding() || s.character.is_some() {
+    if let Some(ch) = &s.character {
+        // The body near the head as one field that follows the character's bones.
+        let (body, skin) = ch.body_region()?;
+        sim.set_skinned_mesh_collider(&body, &skin, &ch.scalp_bones(0.0), &config.mesh_collider)?;
+        say!(
+            "mesh collider: the body within {} m of the head, {} triangles at {} grid points along the longest axis, \
+             following its bones",
+            vkhair::character::BODY_REACH,
+            body.triangles.len(),
+            config.mesh_collider.resolution
+        );
+    } else if sa.input.colliding() {
         sim.set_mesh_collider(Some(&s.head_mesh), &config.mesh_collider)?;
         say!(
             "mesh collider: {} triangles at {} grid points along the longest axis",
@@ -186,7 +197,9 @@ pub fn render(a: &RenderArgs) -> Result<(), Error> {
             // (the first step's sub-steps move them there from the previous
             // frame's; the scheduler takes them per frame, the head per step).
             sim.set_body_colliders(&ch.colliders_at(time(first_step + steps_per_frame)))?;
-            sim.set_scalp_bones(&ch.scalp_bones(time(first_step + steps_per_frame)))?;
+            let bones = ch.scalp_bones(time(first_step + steps_per_frame));
+            sim.set_scalp_bones(&bones)?;
+            sim.set_mesh_bones(&bones)?;
         }
         let started = host_now_ns();
         let mut shown_time = 0.0;

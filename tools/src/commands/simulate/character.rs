@@ -1,9 +1,9 @@
 //! `simulate --gltf`: key hairs grown on an animated character's head, their
 //! roots bound to the character's mesh and riding it as the tool skins it
 //! every step into a GPU buffer the simulation reads (`HairSim::bind_scalp_source`,
-//! the way a host hands over its skinning pass's output), the head joint
-//! placing the head's colliders and the bones' capsules the body colliders
-//! every step, and two measures of how well the hair stays on and
+//! the way a host hands over its skinning pass's output), the body near the
+//! head one mesh collider following the bones (`HairSim::set_skinned_mesh`),
+//! the bones' capsules the body colliders every step, and two measures of how well the hair stays on and
 //! out of the character: the roots' distance from the scalp points they were
 //! grown on, skinned by the animation (`root_error_max_m`), and the share of
 //! free points inside the skinned body near the head (`inside_fraction_max`),
@@ -39,7 +39,7 @@ const BODY_FIELD_RESOLUTION: u32 = 64;
 pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
     let config = simulate_params(a)?;
     let params = config.sim.clone();
-    let (crate::args::input::Scaled { groom, .. }, _, head_mesh) = crate::scene::character_groom(&ch, &a.input)?;
+    let (crate::args::input::Scaled { groom, .. }, _, _) = crate::scene::character_groom(&ch, &a.input)?;
     let time = |step: usize| step as f32 * params.dt;
     // Roots bound to the character's triangles in the bind pose (world).
     let bound = ch.bind_roots(&groom, ROOT_TOLERANCE)?;
@@ -64,7 +64,9 @@ pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
     // `sim` (declared before it drops); each write completes before the step
     // reading it is submitted.
     unsafe { sim.bind_scalp_source(&scalp, &source)? };
-    sim.set_mesh(Some(&head_mesh), &config.mesh_collider)?;
+    // The body near the head as one field that follows the character's bones.
+    let (body, body_skin) = ch.body_region()?;
+    sim.set_skinned_mesh(&body, &body_skin, &ch.scalp_bones(0.0), &config.mesh_collider)?;
     apply_simulated(&mut sim, a.sim.simulated_count(groom.strand_count())?, groom.strand_count())?;
     let mut profiler = GpuProfiler::new(&ctx, 1, 1024)?;
     let (strands, points) = sim.size();
@@ -75,6 +77,7 @@ pub fn simulate_character(a: &SimulateArgs, ch: CharacterScene) -> CliResult {
     let (mut root_error, mut inside) = (0.0f32, 0.0f64);
     for step in 0..a.steps {
         sim.set_body_colliders(&ch.colliders_at(time(step + 1)))?;
+        sim.set_mesh_bones(&ch.scalp_bones(time(step + 1)))?;
         let skinned = write_skinned(time(step + 1))?;
         let started = host_now_ns();
         if let Some(report) = sim.run(1, |_| ch.head_at(time(step + 1)), Some(&mut profiler))? {
