@@ -119,6 +119,12 @@ fn gpu_matches_cpu_with_a_skinned_mesh_collider() {
     let mut sim = HairSim::new(gpu.ctx(), &curtain(), &params, &RigidTransform::default()).expect("sim");
     let mut cpu = CpuHairSim::new(&curtain(), &params, &RigidTransform::default()).expect("cpu");
     sim.set_mesh_collider(Some(collider)).expect("set");
+    let mut foreign = bones_of_grid.clone();
+    foreign.words[7] |= 5 << 8;
+    let named = cpu.set_skinned_mesh_collider(field.clone(), foreign).expect_err("slot 5 of 2").to_string();
+    assert!(named.contains("grid point 7"), "{named}");
+    let short = vkhair::sim::MeshSkin { words: bones_of_grid.words[1..].to_vec(), ..bones_of_grid.clone() };
+    assert!(cpu.set_skinned_mesh_collider(field.clone(), short).is_err(), "a skin of another grid was taken");
     cpu.set_skinned_mesh_collider(field, bones_of_grid).expect("cpu collider");
     for step in 0..TURN_STEPS + HOLD_STEPS {
         sim.set_mesh_bones(&bones(step)).expect("bones");

@@ -104,14 +104,9 @@ impl CpuHairSim {
     /// [`HairSim::set_mesh_collider`](super::HairSim::set_mesh_collider): the
     /// field `mesh` following bones by `skin` (e.g. a GPU collider's
     /// [`MeshCollider::skin`](super::MeshCollider::skin), or [`MeshSkin::fit`]).
-    /// Refuses a skin of another grid.
+    /// Refuses a skin of another grid, or words naming bones it does not list.
     pub fn set_skinned_mesh_collider(&mut self, mesh: MeshSdf, skin: MeshSkin) -> Result<()> {
-        if skin.words.len() != mesh.values.len() {
-            return Err(Error::incompatible(
-                "mesh collider bones",
-                format!("{} grid points have bones, the field has {}", skin.words.len(), mesh.values.len()),
-            ));
-        }
+        skin.check(mesh.values.len())?;
         self.set_mesh_collider(Some(mesh));
         self.planner.mesh_bones = Some(Default::default());
         self.mesh_skin = Some(skin);

@@ -65,6 +65,29 @@ impl MeshSkin {
         Ok(MeshSkin { joints, words })
     }
 
+    /// Refuses words of another count than `points` grid points, more than
+    /// [`MESH_MAX_BONES`] bones, or a word naming a slot past them.
+    pub(crate) fn check(&self, points: usize) -> Result<()> {
+        if self.words.len() != points {
+            return Err(Error::incompatible(
+                "mesh collider bones",
+                format!("{} grid points have bones, the field has {points}", self.words.len()),
+            ));
+        }
+        if self.joints.len() > MESH_MAX_BONES {
+            return Err(Error::param("mesh collider bones", self.joints.len(), format!("at most {MESH_MAX_BONES}")));
+        }
+        let slots = self.joints.len() as u32;
+        if let Some(k) = self.words.iter().position(|w| (w & 0xFF) >= slots || ((w >> 8) & 0xFF) >= slots) {
+            return Err(Error::param(
+                "mesh collider bones",
+                format!("grid point {k}'s word {:#010x}", self.words[k]),
+                format!("slots below the {slots} bones"),
+            ));
+        }
+        Ok(())
+    }
+
     /// The rows of each slot's bone of `bones` (see [`bone_rows`]).
     pub(crate) fn rows(&self, bones: &[Mat4]) -> Result<Vec<[Vec4; 3]>> {
         bone_rows(&self.joints, bones)
