@@ -368,6 +368,8 @@ fn bad_values_name_their_option() {
         (&["grow", "--scalp", "sphere", "--radius", "1e30", "--out", o], "--radius \"1e30\": each"),
         (&["grow", "--scalp", "sphere", "--center=NaN,0,0", "--out", o], "--center \"NaN,0,0\": each component"),
         (&["grow", "--scalp", "sphere", "--radius", "1e5", "--out", o], "--radius and --center put the hair 1.000e5"),
+        (&["grow", "--scalp", "sphere", "--radius", "1e5", "--out", o], "across, length 0.3, the default)"),
+        (&["grow", "--scalp", "sphere", "--radius", "1e5", "--length", "0.2", "--out", o], "across, --length 0.2)"),
         (&["grow", "--scalp", "sphere", "--face=NaN,0,0", "--out", o], "invalid parameter --face: [NaN, 0, 0]"),
         (&["convert", g, "--points", "1", "--out", o], "invalid parameter --points: 1"),
         (&["convert", g, "--key-hairs", "21", "--out", o], "invalid parameter --key-hairs: 21"),

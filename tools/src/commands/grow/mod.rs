@@ -188,9 +188,14 @@ pub fn grow_groom(a: &GrowArgs) -> CliResult {
                             _ => "--radius and --center",
                         };
                         let most = vkhair::groom::MAX_DISTANCE_IN_STRANDS;
+                        // The strands' length as the user set it, or the default's value.
+                        let given = match a.length {
+                            Some(l) => format!("--length {l}"),
+                            None => format!("length {length}, the default"),
+                        };
                         format!(
                             "{place} put the hair {distance:.3e} from the origin, over {most} times the size of its \
-                         strands ({median:.3e} across, --length {length}): vkhair keeps a groom within that \
+                         strands ({median:.3e} across, {given}): vkhair keeps a groom within that \
                          (grow a smaller scalp nearer the origin, or longer strands)"
                         )
                         .into()
