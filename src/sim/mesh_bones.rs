@@ -21,8 +21,8 @@ impl MeshCollider {
     /// another length, invalid weights, and more than [`super::MESH_MAX_BONES`]
     /// bones among the vertices' two heaviest. This submits and waits.
     pub fn skinned(ctx: &GpuContext, mesh: &TriMesh, skin: &[VertexSkin], params: &MeshColliderParams) -> Result<Self> {
-        skin_joints(mesh, skin)?;
-        Self::build_skinned(&ctx.device, mesh, skin, params)
+        let joints = skin_joints(mesh, skin)?;
+        Self::build_skinned(&ctx.device, mesh, skin, joints, params)
     }
 }
 
@@ -37,8 +37,8 @@ impl HairSim {
         bones: &[Mat4],
         params: &MeshColliderParams,
     ) -> Result<()> {
-        check_skinned(mesh, skin, bones)?;
-        let collider = MeshCollider::build_skinned(self.device(), mesh, skin, params)?;
+        let joints = check_skinned(mesh, skin, bones)?;
+        let collider = MeshCollider::build_skinned(self.device(), mesh, skin, joints, params)?;
         self.set_mesh_collider(Some(collider))?;
         self.set_mesh_bones(bones)
     }

@@ -136,16 +136,18 @@ impl MeshCollider {
         Self::build(device, mesh, params, None, false).map(|(c, _)| c)
     }
 
-    /// As [`MeshCollider::skinned`], on `device` (the skin checked).
+    /// As [`MeshCollider::skinned`], on `device`, the skin checked (`joints`:
+    /// the bones it names, from `mesh_skin::skin_joints`).
     pub(crate) fn build_skinned(
         device: &Arc<Device>,
         mesh: &TriMesh,
         skin: &[VertexSkin],
+        joints: Vec<u32>,
         params: &MeshColliderParams,
     ) -> Result<Self> {
         let (mut collider, closest) = Self::build(device, mesh, params, None, true)?;
         let sdf = MeshSdf { origin: collider.origin, cell: collider.cell, dims: collider.dims, values: Vec::new() };
-        let fitted = MeshSkin::from_closest(&sdf, mesh, skin, &closest)?;
+        let fitted = MeshSkin::from_closest(&sdf, mesh, skin, joints, &closest);
         let buffer = Buffer::storage(device, "vkhair mesh collider grid bones", fitted.words.len() as u64 * 4)?;
         device.upload_pod(&buffer, &fitted.words)?;
         collider.skin = Some((fitted, buffer));

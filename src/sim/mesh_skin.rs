@@ -42,13 +42,19 @@ impl MeshSkin {
     /// built from) skinned by `skin` (one entry per vertex), each grid point's
     /// closest triangle found as the field's build finds it (on the CPU here).
     pub fn fit(sdf: &MeshSdf, mesh: &TriMesh, skin: &[VertexSkin]) -> Result<MeshSkin> {
-        let closest = sdf.closest_triangles(mesh);
-        Self::from_closest(sdf, mesh, skin, &closest)
+        let joints = skin_joints(mesh, skin)?;
+        Ok(Self::from_closest(sdf, mesh, skin, joints, &sdf.closest_triangles(mesh)))
     }
 
-    /// As [`MeshSkin::fit`], with each grid point's closest triangle given.
-    pub(crate) fn from_closest(sdf: &MeshSdf, mesh: &TriMesh, skin: &[VertexSkin], closest: &[u32]) -> Result<Self> {
-        let joints = skin_joints(mesh, skin)?;
+    /// As [`MeshSkin::fit`], with the skin checked (`joints`, from
+    /// [`skin_joints`]) and each grid point's closest triangle given.
+    pub(crate) fn from_closest(
+        sdf: &MeshSdf,
+        mesh: &TriMesh,
+        skin: &[VertexSkin],
+        joints: Vec<u32>,
+        closest: &[u32],
+    ) -> Self {
         let slot = |j: u32| joints.partition_point(|&x| x < j) as u32;
         let words = closest
             .iter()
@@ -62,7 +68,7 @@ impl MeshSkin {
                 slot(a) | (slot(b) << 8) | (((w * 65535.0).round() as u32) << 16)
             })
             .collect();
-        Ok(MeshSkin { joints, words })
+        MeshSkin { joints, words }
     }
 
     /// Refuses words of another count than `points` grid points, more than
