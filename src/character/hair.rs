@@ -177,8 +177,7 @@ impl HairRig {
     pub fn scalp(&self) -> Result<Scalp> {
         let to_head = self.bind_frame().inverse();
         let positions = self.character.positions.iter().map(|p| to_head.transform_point3(*p)).collect();
-        let skin =
-            self.character.weights.iter().map(|(j, w)| VertexSkin { joints: j.map(u32::from), weights: *w }).collect();
+        let skin = self.character.weights.iter().map(vertex_skin).collect();
         Ok(Scalp { skin, ..Scalp::new(TriMesh::new(positions, self.character.triangles.clone())?) })
     }
 
@@ -234,28 +233,12 @@ impl HairRig {
         let to_head = bind.inverse();
         let origin = bind.transform_point3(Vec3::ZERO);
         let c = &self.character;
-        let near: Vec<bool> = c.positions.iter().map(|p| p.distance(origin) <= BODY_REACH).collect();
-        let mut index = vec![u32::MAX; c.positions.len()];
-        let (mut positions, mut skin, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
-        for t in c.triangles.iter().filter(|t| t.iter().all(|&v| near[v as usize])) {
-            triangles.push(t.map(|v| {
-                let v = v as usize;
-                if index[v] == u32::MAX {
-                    index[v] = positions.len() as u32;
-                    positions.push(to_head.transform_point3(c.positions[v]));
-                    let (j, w) = c.weights[v];
-                    skin.push(VertexSkin { joints: j.map(u32::from), weights: w });
-                }
-                index[v]
-            }));
-        }
-        if triangles.is_empty() {
-            return Err(Error::incompatible(
-                "character",
-                format!("no triangle lies within {BODY_REACH} m of the head"),
-            ));
-        }
-        Ok((TriMesh::new(positions, triangles)?, skin))
+        let in_head: Vec<Vec3> = c.positions.iter().map(|p| to_head.transform_point3(*p)).collect();
+        let near = |v: usize| c.positions[v].distance(origin) <= BODY_REACH;
+        let (mesh, vertices) = c.sub_mesh(near, &in_head)?.ok_or_else(|| {
+            Error::incompatible("character", format!("no triangle lies within {BODY_REACH} m of the head"))
+        })?;
+        Ok((mesh, vertices.iter().map(|&v| vertex_skin(&c.weights[v])).collect()))
     }
 
     /// The head's region at rest, in the head's frame: the mesh collider.
@@ -352,6 +335,11 @@ fn face_triangles(local: &TriMesh, (forward, up): (Vec3, Vec3), min_facing: f32)
             n.dot(forward) >= min_facing && centroid.dot(up) <= crown
         })
         .collect()
+}
+
+/// A character vertex's joints and weights as the simulation takes them.
+fn vertex_skin((joints, weights): &([u16; 4], [f32; 4])) -> VertexSkin {
+    VertexSkin { joints: joints.map(u32::from), weights: *weights }
 }
 
 /// Distance from `p` to the segment `a`–`b`.

@@ -235,30 +235,40 @@ impl Character {
     /// The triangles all of whose vertices `joint` dominates (its region:
     /// the head's is the scalp and face), deformed by `pose`, as their own mesh.
     pub fn region_mesh(&self, joint: usize, pose: &Pose) -> Result<TriMesh> {
-        let skinned = self.skin(pose);
+        let (mesh, _) = self.sub_mesh(|v| self.dominant_joint(v) == joint, &self.skin(pose))?.ok_or_else(|| {
+            let name = &self.skeleton.nodes[self.skeleton.joints[joint]].name;
+            Error::incompatible("character", format!("joint {joint} ({name:?}) dominates no whole triangle"))
+        })?;
+        Ok(mesh)
+    }
+
+    /// The triangles all of whose vertices `keep` takes, with their vertices at
+    /// `positions` (one per vertex of the character), as their own mesh, and
+    /// each of its vertices' index in the character; `None` when no triangle
+    /// is kept.
+    pub(crate) fn sub_mesh(
+        &self,
+        keep: impl Fn(usize) -> bool,
+        positions: &[Vec3],
+    ) -> Result<Option<(TriMesh, Vec<usize>)>> {
+        let kept: Vec<bool> = (0..self.positions.len()).map(keep).collect();
         let mut index = vec![u32::MAX; self.positions.len()];
-        let mut positions = Vec::new();
-        let mut triangles = Vec::new();
-        for t in &self.triangles {
-            if t.iter().all(|&v| self.dominant_joint(v as usize) == joint) {
-                triangles.push(t.map(|v| {
-                    let v = v as usize;
-                    if index[v] == u32::MAX {
-                        index[v] = positions.len() as u32;
-                        positions.push(skinned[v]);
-                    }
-                    index[v]
-                }));
-            }
+        let (mut vertices, mut triangles) = (Vec::new(), Vec::new());
+        for t in self.triangles.iter().filter(|t| t.iter().all(|&v| kept[v as usize])) {
+            triangles.push(t.map(|v| {
+                let v = v as usize;
+                if index[v] == u32::MAX {
+                    index[v] = vertices.len() as u32;
+                    vertices.push(v);
+                }
+                index[v]
+            }));
         }
         if triangles.is_empty() {
-            let name = &self.skeleton.nodes[self.skeleton.joints[joint]].name;
-            return Err(Error::incompatible(
-                "character",
-                format!("joint {joint} ({name:?}) dominates no whole triangle"),
-            ));
+            return Ok(None);
         }
-        TriMesh::new(positions, triangles)
+        let mesh = TriMesh::new(vertices.iter().map(|&v| positions[v]).collect(), triangles)?;
+        Ok(Some((mesh, vertices)))
     }
 
     /// Skin joint `joint`'s frame in `pose` as a rigid transform (its scale
