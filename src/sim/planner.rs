@@ -220,7 +220,9 @@ impl SubstepPlanner {
         if start.is_some() || self.body_before.len() != self.body.len() {
             self.body_before.clone_from(&self.body);
         }
-        if let Some(track) = self.mesh_bones.as_mut().filter(|t| start.is_some() || t.before.len() != t.now.len()) {
+        // A cut starts where the bones are now (a first step, with none before,
+        // does too: `BoneTrack::substep`).
+        if let Some(track) = self.mesh_bones.as_mut().filter(|_| start.is_some()) {
             track.before.clone_from(&track.now);
         }
         let p = &self.params;
