@@ -227,7 +227,10 @@ impl HairRig {
     /// (the triangles whose corners all lie within it: head, neck, shoulders,
     /// upper back and chest), in the head's frame, with each vertex's bones:
     /// the skinned mesh collider (`MeshCollider::skinned`), moved by
-    /// [`HairRig::scalp_bones`].
+    /// [`HairRig::scalp_bones`]. Triangles the rest of that region encloses
+    /// (an inner layer under the skin, eyes, a mouth's inside:
+    /// [`crate::groom::enclosed`]) are left out, so the field's zero lies on
+    /// the skin.
     pub fn body_region(&self) -> Result<(TriMesh, Vec<VertexSkin>)> {
         let bind = self.bind_frame();
         let to_head = bind.inverse();
@@ -235,10 +238,10 @@ impl HairRig {
         let c = &self.character;
         let in_head: Vec<Vec3> = c.positions.iter().map(|p| to_head.transform_point3(*p)).collect();
         let near = |v: usize| c.positions[v].distance(origin) <= BODY_REACH;
-        let (mesh, vertices) = c.sub_mesh(near, &in_head)?.ok_or_else(|| {
-            Error::incompatible("character", format!("no triangle lies within {BODY_REACH} m of the head"))
-        })?;
-        Ok((mesh, vertices.iter().map(|&v| vertex_skin(&c.weights[v])).collect()))
+        let none = || Error::incompatible("character", format!("no triangle lies within {BODY_REACH} m of the head"));
+        let (region, vertices) = c.sub_mesh(near, &in_head)?.ok_or_else(none)?;
+        let (mesh, kept) = crate::groom::enclosed::without_enclosed(&region)?.ok_or_else(none)?;
+        Ok((mesh, kept.iter().map(|&k| vertex_skin(&c.weights[vertices[k]])).collect()))
     }
 
     /// The head's region at rest, in the head's frame: the mesh collider.

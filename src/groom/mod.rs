@@ -34,6 +34,7 @@ pub mod authored;
 pub mod binding;
 mod bytes;
 pub mod cyhair;
+pub mod enclosed;
 pub mod grow;
 pub mod guides;
 pub mod mesh;
