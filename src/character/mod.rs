@@ -252,23 +252,8 @@ impl Character {
         positions: &[Vec3],
     ) -> Result<Option<(TriMesh, Vec<usize>)>> {
         let kept: Vec<bool> = (0..self.positions.len()).map(keep).collect();
-        let mut index = vec![u32::MAX; self.positions.len()];
-        let (mut vertices, mut triangles) = (Vec::new(), Vec::new());
-        for t in self.triangles.iter().filter(|t| t.iter().all(|&v| kept[v as usize])) {
-            triangles.push(t.map(|v| {
-                let v = v as usize;
-                if index[v] == u32::MAX {
-                    index[v] = vertices.len() as u32;
-                    vertices.push(v);
-                }
-                index[v]
-            }));
-        }
-        if triangles.is_empty() {
-            return Ok(None);
-        }
-        let mesh = TriMesh::new(vertices.iter().map(|&v| positions[v]).collect(), triangles)?;
-        Ok(Some((mesh, vertices)))
+        let whole = self.triangles.iter().copied().filter(|t| t.iter().all(|&v| kept[v as usize]));
+        crate::groom::mesh::compact(positions, whole)
     }
 
     /// Skin joint `joint`'s frame in `pose` as a rigid transform (its scale

@@ -46,23 +46,8 @@ pub fn enclosed_triangles(mesh: &TriMesh) -> Vec<bool> {
 /// enclosed.
 pub fn without_enclosed(mesh: &TriMesh) -> Result<Option<(TriMesh, Vec<usize>)>> {
     let enclosed = enclosed_triangles(mesh);
-    let mut index = vec![u32::MAX; mesh.positions.len()];
-    let (mut vertices, mut triangles) = (Vec::new(), Vec::new());
-    for (t, _) in mesh.triangles.iter().zip(&enclosed).filter(|(_, e)| !**e) {
-        triangles.push(t.map(|v| {
-            let v = v as usize;
-            if index[v] == u32::MAX {
-                index[v] = vertices.len() as u32;
-                vertices.push(v);
-            }
-            index[v]
-        }));
-    }
-    if triangles.is_empty() {
-        return Ok(None);
-    }
-    let kept = TriMesh::new(vertices.iter().map(|&v| mesh.positions[v]).collect(), triangles)?;
-    Ok(Some((kept, vertices)))
+    let open = mesh.triangles.iter().zip(&enclosed).filter(|(_, e)| !**e).map(|(t, _)| *t);
+    super::mesh::compact(&mesh.positions, open)
 }
 
 /// The signed solid angle of the triangle (a, b, c) seen from the origin (van

@@ -22,6 +22,32 @@ pub struct TriMesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
+/// `triangles` (indices into `positions`) as their own mesh, each used vertex
+/// once in the order first met, and per vertex of the result its index in
+/// `positions`; `None` when there are no triangles.
+pub(crate) fn compact(
+    positions: &[Vec3],
+    triangles: impl Iterator<Item = [u32; 3]>,
+) -> Result<Option<(TriMesh, Vec<usize>)>> {
+    let mut index = vec![u32::MAX; positions.len()];
+    let (mut vertices, mut kept) = (Vec::new(), Vec::new());
+    for t in triangles {
+        kept.push(t.map(|v| {
+            let v = v as usize;
+            if index[v] == u32::MAX {
+                index[v] = vertices.len() as u32;
+                vertices.push(v);
+            }
+            index[v]
+        }));
+    }
+    if kept.is_empty() {
+        return Ok(None);
+    }
+    let mesh = TriMesh::new(vertices.iter().map(|&v| positions[v]).collect(), kept)?;
+    Ok(Some((mesh, vertices)))
+}
+
 impl TriMesh {
     /// A mesh from positions and triangles, validated (finite positions, indices in
     /// range, at least one triangle).
