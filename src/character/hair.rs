@@ -244,11 +244,17 @@ impl HairRig {
         Ok((mesh, kept.iter().map(|&k| vertex_skin(&c.weights[vertices[k]])).collect()))
     }
 
-    /// The head's region at rest, in the head's frame: the mesh collider.
+    /// The head's region at rest, in the head's frame: the scalp hair is grown
+    /// on and the mesh collider. Triangles the rest of the region encloses (an
+    /// inner layer under the skin, eyes: [`crate::groom::enclosed`]) are left
+    /// out, so no root is grown under the skin.
     pub fn head_region(&self) -> Result<TriMesh> {
         let to_head: Mat4 = self.bind_frame().inverse();
         let region = self.character.region_mesh(self.head, &self.character.bind_pose())?;
-        TriMesh::new(region.positions.iter().map(|p| to_head.transform_point3(*p)).collect(), region.triangles)
+        let local =
+            TriMesh::new(region.positions.iter().map(|p| to_head.transform_point3(*p)).collect(), region.triangles)?;
+        let skin = crate::groom::enclosed::without_enclosed(&local)?;
+        skin.map(|(mesh, _)| mesh).ok_or_else(|| Error::incompatible("character", "its head's region is all enclosed"))
     }
 
     /// The head's region at rest, in the head's frame (the mesh collider), and

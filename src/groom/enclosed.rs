@@ -41,6 +41,20 @@ pub fn enclosed_triangles(mesh: &TriMesh) -> Vec<bool> {
         .collect()
 }
 
+/// The generalised winding number of `mesh` at `p`, read by the mesh's overall
+/// winding: 1 inside a closed mesh, 0 outside, 0.5 on its surface, 1.5 on a
+/// closed layer inside it.
+pub fn winding_number(mesh: &TriMesh, p: Vec3) -> f32 {
+    let facing = if winds_inward(mesh) { -1.0 } else { 1.0 };
+    let sum: f32 = (0..mesh.triangles.len())
+        .map(|t| {
+            let [a, b, c] = mesh.corners(t);
+            solid_angle(a - p, b - p, c - p)
+        })
+        .sum();
+    sum * facing / (4.0 * std::f32::consts::PI)
+}
+
 /// `mesh` without its enclosed triangles ([`enclosed_triangles`]) and, per
 /// vertex of the result, its index in `mesh`; `None` when every triangle is
 /// enclosed.
@@ -107,6 +121,15 @@ mod tests {
         let enclosed = enclosed_triangles(&carded);
         assert_eq!(enclosed.iter().filter(|&&e| e).count(), 2, "the card's two triangles");
         assert!(enclosed[enclosed.len() - 2..].iter().all(|&e| e));
+    }
+
+    /// Inside, outside and between two nested spheres.
+    #[test]
+    fn the_winding_number_counts_the_layers_around_a_point() {
+        let (mesh, _) = nested(0.05);
+        for (p, w) in [(Vec3::ZERO, 2.0), (Vec3::new(0.08, 0.0, 0.0), 1.0), (Vec3::new(0.0, 0.2, 0.0), 0.0)] {
+            assert!((winding_number(&mesh, p) - w).abs() < 1e-3, "{p}: {}", winding_number(&mesh, p));
+        }
     }
 
     /// A sphere alone keeps every triangle.

@@ -270,10 +270,12 @@ fn grown_hair_leaves_the_characters_face_visible_through_its_run() {
 /// far the roots got from the skinned scalp points they were grown on (the
 /// roots ride their triangles of the skinned mesh, which the tool writes into a
 /// GPU buffer every step: a few micrometres, the bind pose's rounding at the
-/// character's scale) and the share of points inside the body: at most 1.5 %
+/// character's scale) and the share of points inside the body: at most 0.5 %
 /// with the body near the head one mesh collider that follows the bones, its
-/// enclosed inner layer left out (1.0 % measured; 2.2 % with the inner layer
-/// in the field; 7.5 % with the head's rigid field and the capsules alone).
+/// enclosed inner layer left out of the field and of the scalp the hair is
+/// grown on (0.2 % measured; 1.0 % with roots grown on the inner layer; 2.2 %
+/// with the inner layer in the field too; 7.5 % with the head's rigid field and
+/// the capsules alone).
 #[test]
 fn simulate_measures_roots_and_penetration_on_an_animated_character() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -287,7 +289,7 @@ fn simulate_measures_roots_and_penetration_on_an_animated_character() {
     let inside = v["run"]["inside_fraction_max"].as_f64().expect("inside_fraction_max");
     eprintln!("root error {root:e} m, inside {inside}");
     assert!(root < 2e-5, "roots {root} m from their skinned scalp points");
-    assert!((0.0..=0.015).contains(&inside), "inside fraction {inside}");
+    assert!((0.0..=0.005).contains(&inside), "inside fraction {inside}");
 }
 
 /// `grow --scalp gltf` writes hair grown on the character's head in its bind
