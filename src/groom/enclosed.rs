@@ -8,7 +8,7 @@
 use glam::Vec3;
 
 use super::mesh::TriMesh;
-use super::sdf::winds_inward;
+use super::sdf::facing;
 use crate::error::Result;
 
 /// The rest of a mesh's winding number at a triangle's centroid past which
@@ -23,20 +23,14 @@ pub const ENCLOSED_WINDING: f32 = 0.75;
 /// triangle against every other: a cost in the square of the triangle count
 /// (a few thousand triangles take a fraction of a second).
 pub fn enclosed_triangles(mesh: &TriMesh) -> Vec<bool> {
-    let facing = if winds_inward(mesh) { -1.0 } else { 1.0 };
+    let facing = facing(mesh);
     let corners: Vec<[Vec3; 3]> = (0..mesh.triangles.len()).map(|t| mesh.corners(t)).collect();
     corners
         .iter()
         .enumerate()
         .map(|(t, [a, b, c])| {
-            let centroid = (*a + *b + *c) / 3.0;
-            let rest: f32 = corners
-                .iter()
-                .enumerate()
-                .filter(|&(other, _)| other != t)
-                .map(|(_, [a, b, c])| solid_angle(*a - centroid, *b - centroid, *c - centroid))
-                .sum();
-            rest * facing / (4.0 * std::f32::consts::PI) > ENCLOSED_WINDING
+            let rest = corners.iter().enumerate().filter(|&(other, _)| other != t).map(|(_, corners)| *corners);
+            winding(rest, facing, (*a + *b + *c) / 3.0) > ENCLOSED_WINDING
         })
         .collect()
 }
@@ -45,13 +39,13 @@ pub fn enclosed_triangles(mesh: &TriMesh) -> Vec<bool> {
 /// winding: 1 inside a closed mesh, 0 outside, 0.5 on its surface, 1.5 on a
 /// closed layer inside it.
 pub fn winding_number(mesh: &TriMesh, p: Vec3) -> f32 {
-    let facing = if winds_inward(mesh) { -1.0 } else { 1.0 };
-    let sum: f32 = (0..mesh.triangles.len())
-        .map(|t| {
-            let [a, b, c] = mesh.corners(t);
-            solid_angle(a - p, b - p, c - p)
-        })
-        .sum();
+    winding((0..mesh.triangles.len()).map(|t| mesh.corners(t)), facing(mesh), p)
+}
+
+/// The winding number at `p` of `triangles` (their corners) wound `facing`:
+/// the solid angles they subtend, summed in order, over 4π.
+fn winding(triangles: impl Iterator<Item = [Vec3; 3]>, facing: f32, p: Vec3) -> f32 {
+    let sum: f32 = triangles.map(|[a, b, c]| solid_angle(a - p, b - p, c - p)).sum();
     sum * facing / (4.0 * std::f32::consts::PI)
 }
 
@@ -104,11 +98,9 @@ mod tests {
         for (t, original) in kept.triangles.iter().zip(&mesh.triangles) {
             assert_eq!(t.map(|v| kept.positions[v as usize]), original.map(|v| mesh.positions[v as usize]));
         }
-        let outer_vertices = TriMesh::uv_sphere(Vec3::ZERO, 0.1, 12, 16).expect("outer").positions.len();
-        assert!(vertices.iter().all(|&v| v < outer_vertices), "a kept vertex is an inner one");
+        let TriMesh { mut positions, mut triangles } = TriMesh::uv_sphere(Vec3::ZERO, 0.1, 12, 16).expect("sphere");
+        assert!(vertices.iter().all(|&v| v < positions.len()), "a kept vertex is an inner one");
         // A card (two triangles) across the inside.
-        let mut positions = TriMesh::uv_sphere(Vec3::ZERO, 0.1, 12, 16).expect("sphere").positions;
-        let mut triangles = TriMesh::uv_sphere(Vec3::ZERO, 0.1, 12, 16).expect("sphere").triangles;
         let base = positions.len() as u32;
         positions.extend([
             Vec3::new(-0.05, 0.01, -0.05),

@@ -57,7 +57,7 @@ impl MeshSdf {
         let mut sdf = MeshSdf { origin, cell, dims, values: Vec::new() };
         let closest = sdf.closest_triangles(mesh);
         let inside = sdf.inside(mesh);
-        let facing = if winds_inward(mesh) { -1.0 } else { 1.0 };
+        let facing = facing(mesh);
         let mut values = Vec::with_capacity(closest.len());
         for (k, (&t, &inside)) in closest.iter().zip(&inside).enumerate() {
             // Unreachable: the seeds cover the mesh and the floods reach every point.
@@ -356,6 +356,15 @@ pub(crate) fn winds_inward(mesh: &TriMesh) -> bool {
         })
         .sum();
     volume < 0.0
+}
+
+/// 1 for a mesh wound outward, −1 for one wound inward ([`winds_inward`]).
+pub(crate) fn facing(mesh: &TriMesh) -> f32 {
+    if winds_inward(mesh) {
+        -1.0
+    } else {
+        1.0
+    }
 }
 
 /// Which side of triangle (a, b, c) `p` lies on when its closest point is
