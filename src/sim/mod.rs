@@ -74,6 +74,8 @@ mod scalp_gpu;
 mod state;
 mod step;
 mod teleport;
+#[cfg(test)]
+mod tests;
 mod view;
 pub mod volume;
 
@@ -247,13 +249,15 @@ impl HairSim {
         let planner = SubstepPlanner::new(params, head, state.rest_roots(), state.points, subgroup)?;
         let lod = lod::SimLod::new(state);
         let gpu = GpuState::new(&device, state, &lod.order.order, &lod.guides)?;
-        let follow = ComputePipeline::new(&device, &SIM_FOLLOW_COMP, 2)?;
+        // Compiled when key hairs are first left out (`record_step`); the step
+        // kernel only as the variants the switches ask for (`prepare_step`).
+        let follow = ComputePipeline::deferred(&device, &SIM_FOLLOW_COMP, 2, false)?;
         let follow_sets = [
             follow.declared_buffer_set(0, &gpu.follow_bindings(0, None))?,
             follow.declared_buffer_set(0, &gpu.follow_bindings(1, None))?,
         ];
         let mover = teleport::MoveKernel::new(&device, &gpu)?;
-        let pipeline = ComputePipeline::with_full_subgroups(&device, step::SHADER, 2, device.full_subgroups)?;
+        let pipeline = ComputePipeline::deferred(&device, step::SHADER, 2, device.full_subgroups)?;
         let sets = [
             pipeline.declared_buffer_set(0, &gpu.bindings(0, None))?,
             pipeline.declared_buffer_set(0, &gpu.bindings(1, None))?,

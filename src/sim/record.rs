@@ -55,6 +55,13 @@ impl HairSim {
         // `new`, `set_params` and `set_mesh_collider`, so found here.
         let features = inputs.iter().fold(0, |f, sub| f | sub.params.flags);
         self.pipeline.prepare_variant(features)?;
+        // The followers' and the move's kernels, compiled when first needed.
+        if (self.lod.simulated as u32) < self.planner.strands {
+            self.follow.prepare()?;
+        }
+        if planned.start.is_some() || !self.partial_moves.is_empty() {
+            self.mover.prepare()?;
+        }
         let scalp = self.take_scalp_upload();
         let mut partial = std::mem::take(&mut self.partial_moves);
         if planned.start.as_ref().is_some_and(|start| start.reset) {

@@ -82,10 +82,16 @@ pub(crate) struct MoveKernel {
 
 impl MoveKernel {
     pub(crate) fn new(device: &Arc<Device>, gpu: &GpuState) -> Result<Self> {
-        let pipeline = ComputePipeline::new(device, &SIM_MOVE_COMP, 2)?;
+        // Compiled on the first move (`prepare`): most simulations never teleport.
+        let pipeline = ComputePipeline::deferred(device, &SIM_MOVE_COMP, 2, false)?;
         let set = |parity: usize| pipeline.declared_buffer_set(0, &gpu.move_bindings(parity));
         let sets = [set(0)?, set(1)?];
         Ok(MoveKernel { device: device.clone(), pipeline, sets })
+    }
+
+    /// Compiles the kernel unless it is (before recording a move).
+    pub(crate) fn prepare(&mut self) -> Result<()> {
+        self.pipeline.prepare()
     }
 
     /// Records `mv` over the points `points` of half `parity`, with a barrier

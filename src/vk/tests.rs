@@ -150,6 +150,48 @@ fn a_variant_sets_specialisation_constant_0() {
 }
 
 #[test]
+fn a_deferred_pipeline_compiles_only_what_is_prepared() {
+    let gpu = TestGpu::new();
+    let d = gpu.device();
+    let mut pipeline =
+        ComputePipeline::deferred(d, &shaders::CORE_SCALE_ADD_COMP, 2, false).expect("deferred pipeline");
+    assert!(!pipeline.is_prepared(), "nothing is compiled at creation");
+    pipeline.prepare_variant(3).expect("variant");
+    assert!(!pipeline.is_prepared(), "a variant compiles only itself");
+    let n = 64usize;
+    let src: Vec<f32> = (0..n).map(|i| i as f32).collect();
+    let src_buf = storage(d, "src", 4 * n as u64);
+    d.upload_pod(&src_buf, &src).expect("upload");
+    let push = ScaleAddPush { count: n as u32, scale: 1.0, bias: 0.5, pad0: 0 };
+    let run = |pipeline: &ComputePipeline, variant: Option<u32>| {
+        let dst = storage(d, "dst", 4 * n as u64);
+        let set = pipeline.buffer_set(0, &[(0, &src_buf), (1, &dst)]).expect("set");
+        d.submit_once("deferred scale_add", |cmd| {
+            // SAFETY: recording command buffer of this device; what is bound is compiled.
+            unsafe {
+                match variant {
+                    None => pipeline.bind(cmd, &[set]),
+                    Some(c) => pipeline.bind_variant(cmd, c, &[set]),
+                }
+                pipeline.push(cmd, &push);
+                pipeline.dispatch_threads(cmd, [n as u32, 1, 1]);
+            }
+        })
+        .expect("submit");
+        d.readback_pod::<f32>(&dst, n).expect("readback")
+    };
+    let variant = run(&pipeline, Some(3));
+    pipeline.prepare().expect("prepare");
+    assert!(pipeline.is_prepared());
+    let default = run(&pipeline, None);
+    // Exact: small integers plus multiples of a half.
+    for (i, x) in src.iter().enumerate() {
+        assert_eq!(variant[i], x + 1.5, "variant 3, element {i}");
+        assert_eq!(default[i], x + 0.5, "default, element {i}");
+    }
+}
+
+#[test]
 fn layout_probe_round_trips_every_member() {
     let gpu = TestGpu::new();
     let d = gpu.device();

@@ -20,9 +20,15 @@ pub(crate) const MAX_WORKGROUPS: u32 = 65_535;
 
 /// A compute pipeline, and variants of it with its specialisation constant 0
 /// set (see [`ComputePipeline::prepare_variant`]).
+///
+/// Compiling is the costly part of creating a pipeline (a software device
+/// compiles to machine code then): [`ComputePipeline::deferred`] compiles
+/// nothing until [`ComputePipeline::prepare`] or a variant asks for it, for a
+/// kernel that is only ever bound as variants or only some of the time.
 pub(crate) struct ComputePipeline {
     layout: Layout,
-    /// The pipeline with every specialisation constant at its default.
+    /// The pipeline with every specialisation constant at its default; null
+    /// until compiled.
     raw: vk::Pipeline,
     /// Variants by the value of specialisation constant 0; destroyed with the pipeline.
     variants: HashMap<u32, vk::Pipeline>,
@@ -50,6 +56,21 @@ impl ComputePipeline {
         max_sets: u32,
         full_subgroups: bool,
     ) -> Result<Self> {
+        let mut pipeline = Self::deferred(device, shader, max_sets, full_subgroups)?;
+        pipeline.prepare()?;
+        Ok(pipeline)
+    }
+
+    /// As [`ComputePipeline::with_full_subgroups`], compiling nothing yet: the
+    /// layout and descriptor sets are there, and [`ComputePipeline::prepare`]
+    /// (the pipeline itself) or [`ComputePipeline::prepare_variant`] compile
+    /// what is bound later.
+    pub(crate) fn deferred(
+        device: &Arc<Device>,
+        shader: &ShaderSource,
+        max_sets: u32,
+        full_subgroups: bool,
+    ) -> Result<Self> {
         if full_subgroups && !device.full_subgroups {
             return Err(Error::MissingRequirement("computeFullSubgroups".into()));
         }
@@ -58,10 +79,9 @@ impl ComputePipeline {
             .workgroup_size
             .ok_or_else(|| Error::Shader { shader: shader.name.to_owned(), reason: "not a compute shader".into() })?;
         let layout = Layout::new(device, shader.name, &[reflection], max_sets)?;
-        let raw = create(&layout, shader.words, shader.name, full_subgroups, None)?;
         Ok(ComputePipeline {
             layout,
-            raw,
+            raw: vk::Pipeline::null(),
             variants: HashMap::new(),
             words: shader.words,
             full_subgroups,
@@ -70,6 +90,21 @@ impl ComputePipeline {
             traffic: Mutex::default(),
             bound: Mutex::default(),
         })
+    }
+
+    /// Compiles, unless it is, the pipeline with every specialisation constant
+    /// at its default (what [`ComputePipeline::bind`] binds).
+    pub(crate) fn prepare(&mut self) -> Result<()> {
+        if self.raw == vk::Pipeline::null() {
+            self.raw = create(&self.layout, self.words, &self.name, self.full_subgroups, None)?;
+        }
+        Ok(())
+    }
+
+    /// Whether the pipeline itself (not a variant) is compiled.
+    #[cfg(test)]
+    pub(crate) fn is_prepared(&self) -> bool {
+        self.raw != vk::Pipeline::null()
     }
 
     /// Creates, unless it exists, the variant with specialisation constant 0 set to
@@ -188,7 +223,8 @@ impl ComputePipeline {
     /// Binds the pipeline and the descriptor sets (from set 0).
     ///
     /// # Safety
-    /// `cmd` is a recording command buffer of this device.
+    /// `cmd` is a recording command buffer of this device, and the pipeline is
+    /// compiled (a deferred one prepared: [`ComputePipeline::prepare`]).
     pub(crate) unsafe fn bind(&self, cmd: vk::CommandBuffer, sets: &[vk::DescriptorSet]) {
         // SAFETY: guaranteed by the caller.
         unsafe { self.bind_raw(cmd, self.raw, sets) };
@@ -198,7 +234,7 @@ impl ComputePipeline {
     /// pipeline itself (every constant at its default) when there is none.
     ///
     /// # Safety
-    /// As [`ComputePipeline::bind`].
+    /// As [`ComputePipeline::bind`], with the variant or the pipeline compiled.
     pub(crate) unsafe fn bind_variant(&self, cmd: vk::CommandBuffer, constant: u32, sets: &[vk::DescriptorSet]) {
         let raw = self.variants.get(&constant).copied().unwrap_or(self.raw);
         // SAFETY: guaranteed by the caller.
@@ -210,6 +246,13 @@ impl ComputePipeline {
     /// # Safety
     /// As [`ComputePipeline::bind`].
     unsafe fn bind_raw(&self, cmd: vk::CommandBuffer, raw: vk::Pipeline, sets: &[vk::DescriptorSet]) {
+        if raw == vk::Pipeline::null() {
+            // A broken contract: binding nothing leaves the dispatch to the
+            // validation layers rather than binding a null handle.
+            log::error!("{}: bound before it was compiled; nothing bound", self.name);
+            debug_assert!(false, "{}: bound before it was compiled", self.name);
+            return;
+        }
         if let (Ok(map), Ok(mut bound)) = (self.traffic.lock(), self.bound.lock()) {
             *bound = sets.iter().filter_map(|s| map.get(s)).fold((0, 0), |a, t| (a.0 + t.0, a.1 + t.1));
         }
@@ -325,7 +368,8 @@ fn create(
 
 impl Drop for ComputePipeline {
     fn drop(&mut self) {
-        for raw in std::iter::once(self.raw).chain(self.variants.values().copied()) {
+        let compiled = std::iter::once(self.raw).filter(|raw| *raw != vk::Pipeline::null());
+        for raw in compiled.chain(self.variants.values().copied()) {
             // SAFETY: pipelines of this device, no longer used by pending work.
             unsafe { self.layout.device.raw.destroy_pipeline(raw, None) };
         }

@@ -82,7 +82,8 @@ impl TransparentPass {
 
         // The pool's buffer count specialises the list shaders (oit.glsl).
         let pool_buffers = res.lists.as_ref().map(|lists| lists.pool.buffers);
-        let mut points = ComputePipeline::new(d, &RENDER_SHADE_POINTS_COMP, 1)?;
+        // Kernels bound only as a variant are compiled only as that variant.
+        let mut points = ComputePipeline::deferred(d, &RENDER_SHADE_POINTS_COMP, 1, false)?;
         points.prepare_variant(frame.features)?;
         let points_set = points.declared_resource_set(0, &buffers, &shading_images)?;
         let rect = ComputePipeline::new(d, &RENDER_HAIR_RECT_COMP, 1)?;
@@ -92,7 +93,7 @@ impl TransparentPass {
             Raster::Tiles => Build::Tiles(Box::new(BinPipelines::new(d, &buffers, &shading_images)?)),
             Raster::Compute => {
                 // Constant 0: the pool's buffers (oit.glsl), as the hardware build's.
-                let mut pipeline = ComputePipeline::new(d, &RENDER_STRAND_RASTER_COMP, 1)?;
+                let mut pipeline = ComputePipeline::deferred(d, &RENDER_STRAND_RASTER_COMP, 1, false)?;
                 pipeline.prepare_variant(pool_buffers.unwrap_or(1))?;
                 let set = pipeline.declared_resource_set(0, &buffers, &shading_images)?;
                 Build::Compute(pipeline, set)
@@ -125,7 +126,7 @@ impl TransparentPass {
             }
             (Some(shader), Some(_)) => {
                 // Constant 0: the pool's buffers (oit.glsl).
-                let mut pipeline = ComputePipeline::new(d, shader, 1)?;
+                let mut pipeline = ComputePipeline::deferred(d, shader, 1, false)?;
                 pipeline.prepare_variant(pool_buffers.unwrap_or(1))?;
                 let set = pipeline.declared_resource_set(0, &ours, &[])?;
                 Some((pipeline, set))
