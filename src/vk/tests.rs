@@ -107,6 +107,33 @@ fn scale_add_matches_cpu() {
     assert!(out[n..].iter().all(|&v| v == sentinel), "writes past count");
 }
 
+/// `scale_add` over `src` (already on the device) with `push`, binding the
+/// pipeline itself (`None`) or the variant for a constant; the results.
+fn scale_add_with(
+    d: &Arc<Device>,
+    pipeline: &ComputePipeline,
+    src: &Buffer,
+    push: &ScaleAddPush,
+    constant: Option<u32>,
+) -> Vec<f32> {
+    let n = push.count as usize;
+    let dst = storage(d, "dst", 4 * n as u64);
+    let set = pipeline.buffer_set(0, &[(0, src), (1, &dst)]).expect("set");
+    d.submit_once("scale_add variant", |cmd| {
+        // SAFETY: recording command buffer of this device; what is bound is compiled.
+        unsafe {
+            match constant {
+                None => pipeline.bind(cmd, &[set]),
+                Some(c) => pipeline.bind_variant(cmd, c, &[set]),
+            }
+            pipeline.push(cmd, push);
+            pipeline.dispatch_threads(cmd, [n as u32, 1, 1]);
+        }
+    })
+    .expect("submit");
+    d.readback_pod::<f32>(&dst, n).expect("readback")
+}
+
 #[test]
 fn a_variant_sets_specialisation_constant_0() {
     let gpu = TestGpu::new();
@@ -119,28 +146,11 @@ fn a_variant_sets_specialisation_constant_0() {
     let src: Vec<f32> = (0..n).map(|i| i as f32 * 0.5).collect();
     let src_buf = storage(d, "src", 4 * n as u64);
     d.upload_pod(&src_buf, &src).expect("upload");
-    let set_for = |dst: &Buffer| pipeline.buffer_set(0, &[(0, &src_buf), (1, dst)]).expect("set");
     let push = ScaleAddPush { count: n as u32, scale: 2.0, bias: 0.25, pad0: 0 };
     // Constant 0 (BIAS_TIMES) at its default 1, at 3 (the variant), and at 7,
     // never prepared: that binds the default pipeline.
-    let mut results = Vec::new();
-    for constant in [None, Some(3), Some(7)] {
-        let dst = storage(d, "dst", 4 * n as u64);
-        let set = set_for(&dst);
-        d.submit_once("scale_add variant", |cmd| {
-            // SAFETY: recording command buffer of this device.
-            unsafe {
-                match constant {
-                    None => pipeline.bind(cmd, &[set]),
-                    Some(c) => pipeline.bind_variant(cmd, c, &[set]),
-                }
-                pipeline.push(cmd, &push);
-                pipeline.dispatch_threads(cmd, [n as u32, 1, 1]);
-            }
-        })
-        .expect("submit");
-        results.push(d.readback_pod::<f32>(&dst, n).expect("readback"));
-    }
+    let results: Vec<Vec<f32>> =
+        [None, Some(3), Some(7)].map(|c| scale_add_with(d, &pipeline, &src_buf, &push, c)).into();
     // Exact: the inputs and results are small multiples of powers of two.
     for (i, x) in src.iter().enumerate() {
         assert_eq!(results[0][i], 2.0 * x + 0.25, "default, element {i}");
@@ -163,27 +173,10 @@ fn a_deferred_pipeline_compiles_only_what_is_prepared() {
     let src_buf = storage(d, "src", 4 * n as u64);
     d.upload_pod(&src_buf, &src).expect("upload");
     let push = ScaleAddPush { count: n as u32, scale: 1.0, bias: 0.5, pad0: 0 };
-    let run = |pipeline: &ComputePipeline, variant: Option<u32>| {
-        let dst = storage(d, "dst", 4 * n as u64);
-        let set = pipeline.buffer_set(0, &[(0, &src_buf), (1, &dst)]).expect("set");
-        d.submit_once("deferred scale_add", |cmd| {
-            // SAFETY: recording command buffer of this device; what is bound is compiled.
-            unsafe {
-                match variant {
-                    None => pipeline.bind(cmd, &[set]),
-                    Some(c) => pipeline.bind_variant(cmd, c, &[set]),
-                }
-                pipeline.push(cmd, &push);
-                pipeline.dispatch_threads(cmd, [n as u32, 1, 1]);
-            }
-        })
-        .expect("submit");
-        d.readback_pod::<f32>(&dst, n).expect("readback")
-    };
-    let variant = run(&pipeline, Some(3));
+    let variant = scale_add_with(d, &pipeline, &src_buf, &push, Some(3));
     pipeline.prepare().expect("prepare");
     assert!(pipeline.is_prepared());
-    let default = run(&pipeline, None);
+    let default = scale_add_with(d, &pipeline, &src_buf, &push, None);
     // Exact: small integers plus multiples of a half.
     for (i, x) in src.iter().enumerate() {
         assert_eq!(variant[i], x + 1.5, "variant 3, element {i}");
