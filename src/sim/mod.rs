@@ -313,8 +313,7 @@ impl HairSim {
         let grid = volume::grid::GridLayout::new(params, &self.shape)?;
         if let Some(stage) = &mut self.volume {
             if stage.grid == grid {
-                stage.params = params.clone();
-                return Ok(());
+                return stage.set_params(params);
             }
         }
         // The old stage's buffers may still be in use by submitted work.

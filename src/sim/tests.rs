@@ -2,9 +2,15 @@
 
 use glam::Vec3;
 
-use super::{HairSim, RigidTransform, SimParams};
-use crate::groom::{grow, scenes};
+use super::{HairSim, RigidTransform, SimParams, VolumeMode, VolumeParams};
+use crate::groom::{grow, scenes, Groom};
 use crate::vk::tests::TestGpu;
+
+/// A small grown groom (40 key hairs of 6 points) and a head at the origin.
+fn small_groom() -> (Groom, RigidTransform) {
+    let params = grow::GrowParams { strands: 40, points_per_strand: 6, length: 0.3, ..Default::default() };
+    (grow::grow(&scenes::thesis_scalp(), &params).expect("groom"), RigidTransform::default())
+}
 
 /// The step kernel is compiled only as the variants its switches ask for, the
 /// followers' kernel when key hairs are first left out, the move's on the first
@@ -13,9 +19,7 @@ use crate::vk::tests::TestGpu;
 #[test]
 fn kernels_are_compiled_when_a_step_first_needs_them() {
     let gpu = TestGpu::new();
-    let params = grow::GrowParams { strands: 40, points_per_strand: 6, length: 0.3, ..Default::default() };
-    let groom = grow::grow(&scenes::thesis_scalp(), &params).expect("groom");
-    let head = RigidTransform::default();
+    let (groom, head) = small_groom();
     let mut sim = HairSim::new(gpu.ctx(), &groom, &SimParams::default(), &head).expect("sim");
     let compiled =
         |sim: &HairSim| (sim.pipeline.is_prepared(), sim.follow.is_prepared(), sim.mover.pipeline.is_prepared());
@@ -35,4 +39,33 @@ fn kernels_are_compiled_when_a_step_first_needs_them() {
     let left = before.positions.iter().zip(&state.positions);
     let behind = left.filter(|(a, b)| (b.truncate() - a.truncate() - moved.translation).length() > 0.05).count();
     assert_eq!(behind, 0, "points not moved with the head");
+}
+
+/// New volume parameters on the same grid give the stage a simulation created
+/// with them would have: the same solver for the device (not `Auto` taken
+/// literally) and the kernels the new mode records, so both step to the same
+/// bits.
+#[test]
+fn volume_parameters_set_later_step_as_if_given_at_creation() {
+    let gpu = TestGpu::new();
+    let (groom, head) = small_groom();
+    let flip = VolumeParams { mode: VolumeMode::Flip, resolution: [8; 3], ..VolumeParams::default() };
+    let friction = VolumeParams { mode: VolumeMode::Friction, ..flip.clone() };
+    let given = SimParams { volume: flip, ..SimParams::default() };
+    let mut created = HairSim::new(gpu.ctx(), &groom, &given, &head).expect("sim with FLIP");
+    let mut changed =
+        HairSim::new(gpu.ctx(), &groom, &SimParams { volume: friction, ..given.clone() }, &head).expect("sim");
+    changed.set_params(&given).expect("FLIP set later");
+    // The solver `Auto` stands for on this device, named.
+    let solver = given.volume.solver.on_device(gpu.device().info.device_type);
+    let named = SimParams { volume: VolumeParams { solver, ..given.volume.clone() }, ..given.clone() };
+    let mut explicit = HairSim::new(gpu.ctx(), &groom, &named, &head).expect("sim with the solver named");
+    let mut bits = Vec::new();
+    for sim in [&mut created, &mut changed, &mut explicit] {
+        sim.run(3, |_| head, None).expect("steps");
+        let state = sim.read_state().expect("state");
+        bits.push(state.positions.iter().flat_map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>());
+    }
+    assert!(bits[0] == bits[2], "`Auto` stepped to other bits than the solver it stands for on this device");
+    assert!(bits[0] == bits[1], "FLIP set after creation stepped to other bits than FLIP given at creation");
 }

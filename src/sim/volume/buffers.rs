@@ -256,7 +256,8 @@ pub(crate) struct KernelPipeline {
     pub sets: Vec<vk::DescriptorSet>,
 }
 
-/// Builds every kernel, with one descriptor set per `(positions, velocities)` variant.
+/// Makes every kernel's layout, with one descriptor set per `(positions,
+/// velocities)` variant; none is compiled yet.
 pub(crate) fn kernels(
     device: &Arc<Device>,
     buffers: &VolumeBuffers,
@@ -269,7 +270,9 @@ pub(crate) fn kernels(
         .map(|kernel| {
             let shared = device.shared_reductions.load(std::sync::atomic::Ordering::Relaxed);
             let int64 = device.int64_atomics.load(std::sync::atomic::Ordering::Relaxed);
-            let pipeline = ComputePipeline::new(device, kernel.shader(shared, int64), particles.len() as u32)?;
+            // Compiled for the parameters' mode and solver (`VolumeStage::set_params`).
+            let pipeline =
+                ComputePipeline::deferred(device, kernel.shader(shared, int64), particles.len() as u32, false)?;
             let sets = particles
                 .iter()
                 .map(|(pos, vel)| pipeline.declared_buffer_set(0, &buffers.table(colliders, mesh_field, pos, vel)))

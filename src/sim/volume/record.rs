@@ -115,9 +115,45 @@ impl VolumeStage {
         params.validate()?;
         let buffers = VolumeBuffers::new(device, &grid)?;
         let kernels = buffers::kernels(device, &buffers, colliders, mesh_field, particles)?;
-        // The solver as recorded here: `Auto` resolved by the device's type.
-        let params = VolumeParams { solver: params.solver.on_device(device.info.device_type), ..params.clone() };
-        Ok(VolumeStage { device: device.clone(), grid, buffers, kernels, params })
+        let mut stage = VolumeStage { device: device.clone(), grid, buffers, kernels, params: params.clone() };
+        stage.set_params(params)?;
+        Ok(stage)
+    }
+
+    /// Takes `params` for the grid this stage has, the solver resolved by the
+    /// device's type (`Auto` never recorded), and compiles the kernels a step
+    /// then records.
+    pub(crate) fn set_params(&mut self, params: &VolumeParams) -> Result<()> {
+        self.params = VolumeParams { solver: params.solver.on_device(self.device.info.device_type), ..params.clone() };
+        for kernel in self.kernels_recorded() {
+            self.kernels[kernel as usize].pipeline.prepare()?;
+        }
+        Ok(())
+    }
+
+    /// The kernels [`VolumeStage::record`] binds with the current parameters
+    /// (its branches, in the same terms).
+    fn kernels_recorded(&self) -> Vec<Kernel> {
+        let mut kernels = vec![Kernel::Scatter, Kernel::Cells, Kernel::G2p];
+        if self.params.mode != VolumeMode::Flip {
+            return kernels;
+        }
+        let multigrid = self.params.preconditioner == Preconditioner::Multigrid;
+        kernels.extend([Kernel::Mark, Kernel::MgStencil, Kernel::Gradient]);
+        if multigrid {
+            kernels.push(Kernel::MgCoarsen);
+        }
+        let share = workgroup_share(&self.grid, self.params.preconditioner);
+        if self.params.solver == PressureSolver::Workgroup && share.is_some() {
+            kernels.push(Kernel::PcgWorkgroup);
+            return kernels;
+        }
+        kernels.extend([Kernel::PcgInit, Kernel::PcgReduce, Kernel::PcgDirection, Kernel::PcgApply, Kernel::PcgUpdate]);
+        if multigrid {
+            let coarse = if cycle_start(&self.grid).is_some() { Kernel::MgCycle } else { Kernel::MgCoarsest };
+            kernels.extend([Kernel::MgSmooth, Kernel::MgRestrict, coarse]);
+        }
+        kernels
     }
 
     fn kernel(&self, kernel: Kernel) -> &KernelPipeline {
