@@ -56,7 +56,7 @@ impl HairSim {
         let features = inputs.iter().fold(0, |f, sub| f | sub.params.flags);
         self.pipeline.prepare_variant(features)?;
         // The followers' and the move's kernels, compiled when first needed.
-        if (self.lod.simulated as u32) < self.planner.strands {
+        if self.has_followers() {
             self.follow.prepare()?;
         }
         if planned.start.is_some() || !self.partial_moves.is_empty() {
@@ -191,6 +191,12 @@ impl HairSim {
         }
     }
 
+    /// Whether key hairs are left out of the step, following their guides
+    /// (a level of detail: [`HairSim::set_simulated_hairs`]).
+    fn has_followers(&self) -> bool {
+        (self.lod.simulated as u32) < self.planner.strands
+    }
+
     /// Records the step kernel for sub-steps `range` = [first, count], reading
     /// half `parity` of the double buffer, in a timestamp scope, with the
     /// kernel's variant for the switches `features`.
@@ -216,7 +222,7 @@ impl HairSim {
                 self.pipeline.push(cmd, &push);
                 self.pipeline.dispatch_threads(cmd, [step::threads(simulated, groups), 1, 1]);
             });
-            if simulated < strands {
+            if self.has_followers() {
                 // The followers read the guides the step wrote.
                 let stepped = barrier::memory(&[AccessKind::ComputeWrite], barrier::COMPUTE_READ_WRITE);
                 self.device.cmd_barrier(cmd, &[stepped], &[], &[]);

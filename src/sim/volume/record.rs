@@ -143,8 +143,7 @@ impl VolumeStage {
         if multigrid {
             kernels.push(Kernel::MgCoarsen);
         }
-        let share = workgroup_share(&self.grid, self.params.preconditioner);
-        if self.params.solver == PressureSolver::Workgroup && share.is_some() {
+        if self.workgroup_solve().is_some() {
             kernels.push(Kernel::PcgWorkgroup);
             return kernels;
         }
@@ -154,6 +153,13 @@ impl VolumeStage {
             kernels.extend([Kernel::MgSmooth, Kernel::MgRestrict, coarse]);
         }
         kernels
+    }
+
+    /// The iterations a dispatch of the one-workgroup solve does, when the
+    /// pressure is solved that way (the solver asks for it and the grid fits).
+    fn workgroup_solve(&self) -> Option<u32> {
+        let share = workgroup_share(&self.grid, self.params.preconditioner);
+        share.filter(|_| self.params.solver == PressureSolver::Workgroup)
     }
 
     fn kernel(&self, kernel: Kernel) -> &KernelPipeline {
@@ -308,8 +314,7 @@ impl VolumeStage {
             }
             let words = if multigrid { self.grid.level_cells() } else { self.grid.cells() };
             self.run(cmd, Kernel::MgStencil, variant, none, Launch::Threads(words));
-            let share = workgroup_share(&self.grid, self.params.preconditioner);
-            if let (PressureSolver::Workgroup, Some(share)) = (self.params.solver, share) {
+            if let Some(share) = self.workgroup_solve() {
                 for k in 0..self.params.max_iterations.div_ceil(share) {
                     let push = VolumePush::from(&WorkgroupSolvePass { start: u32::from(k == 0), iterations: share });
                     let trips = share.saturating_mul(workgroup_trips(&self.grid, self.params.preconditioner));
